@@ -1,0 +1,22 @@
+// IR helpers shared by every stage.
+#include "ps11/ir.h"
+
+#include <bit>
+
+namespace ps11 {
+
+float Instruction::defValue(int i) const { return std::bit_cast<float>(defBits[size_t(i)]); }
+
+char componentLetter(int c) { return "rgba"[c & 3]; }
+
+const char* regPrefix(RegType t) {
+    switch (t) {
+        case RegType::Temp: return "r";
+        case RegType::Input: return "v";
+        case RegType::Const: return "c";
+        case RegType::Texture: return "t";
+    }
+    return "?";
+}
+
+}  // namespace ps11
