@@ -1,0 +1,133 @@
+// Command-line plumbing shared by the ps11 subcommands: file I/O with messages that name
+// the file and the reason, preprocessor options, and the built-in data locations.
+#include "tools/cli_util.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+
+namespace ps11::cli {
+
+std::optional<std::string> readFile(const std::string& path) {
+    if (path == "-") {
+        std::ostringstream ss;
+        ss << std::cin.rdbuf();
+        return ss.str();
+    }
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) {
+        std::cerr << "ps11: cannot read " << path << ": is a directory\n";
+        return std::nullopt;
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        std::cerr << "ps11: cannot read " << path << ": " << std::strerror(errno) << "\n";
+        return std::nullopt;
+    }
+    std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) {
+        std::cerr << "ps11: cannot read " << path << ": read error\n";
+        return std::nullopt;
+    }
+    return data;
+}
+
+bool writeFile(const std::string& path, const std::string& bytes) {
+    if (path == "-") {
+        std::cout.write(bytes.data(), std::streamsize(bytes.size()));
+        return bool(std::cout);
+    }
+    // Write to a temporary beside the target and rename, so a failed write never leaves a
+    // half-written output in place of an older good one.
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out) {
+            std::cerr << "ps11: cannot write " << path << ": " << std::strerror(errno) << "\n";
+            return false;
+        }
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+        out.close();
+        if (!out) {
+            std::cerr << "ps11: cannot write " << path << ": write error\n";
+            std::remove(tmp.c_str());
+            return false;
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec) {
+        std::cerr << "ps11: cannot write " << path << ": " << ec.message() << "\n";
+        std::remove(tmp.c_str());
+        return false;
+    }
+    return true;
+}
+
+bool takePreprocessorOption(const std::vector<std::string>& args, size_t& i, PreprocessOptions& pp,
+                            std::string& error) {
+    const std::string& a = args[i];
+    if (a.rfind("-D", 0) != 0 && a.rfind("-I", 0) != 0) return false;
+    std::string value = a.substr(2);
+    if (value.empty()) {
+        if (i + 1 >= args.size()) {
+            error = a + " needs an argument";
+            return true;
+        }
+        value = args[++i];
+    }
+    if (a[1] == 'D') {
+        size_t eq = value.find('=');
+        std::string name = value.substr(0, eq);
+        if (name.empty()) {
+            error = "-D needs a macro name";
+            return true;
+        }
+        pp.defines.emplace_back(name, eq == std::string::npos ? "1" : value.substr(eq + 1));
+    } else {
+        pp.includeDirs.push_back(value);
+    }
+    return true;
+}
+
+std::string projectDir() {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+#ifdef PS11_SOURCE_DIR
+    if (fs::exists(fs::path(PS11_SOURCE_DIR) / "tests" / "shaders", ec)) return PS11_SOURCE_DIR;
+#endif
+    if (fs::exists(fs::path("tests") / "shaders", ec)) return fs::current_path(ec).string();
+    return "";
+}
+
+std::vector<std::string> listFiles(const std::string& dir, const std::string& extension) {
+    namespace fs = std::filesystem;
+    std::vector<std::string> out;
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) return out;
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec)) {
+        if (it->is_regular_file(ec) && it->path().extension() == extension) out.push_back(it->path().string());
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine) {
+    std::string out;
+    char buf[16];
+    for (size_t i = 0; i < tokens.size(); ++i) {
+        std::snprintf(buf, sizeof buf, "0x%08x", tokens[i]);
+        out += buf;
+        out += (i + 1 == tokens.size() || (i + 1) % perLine == 0) ? '\n' : ' ';
+    }
+    return out;
+}
+
+}  // namespace ps11::cli

@@ -1,0 +1,37 @@
+// Shared pieces of the ps11 command line: file reading and writing with clear errors,
+// the -D/-I options, and locating the project's own data (shader corpus, golden files).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ps11/assembler.h"
+#include "ps11/diagnostics.h"
+
+namespace ps11::cli {
+
+// Exit codes (DESIGN.md): 0 success, 1 user error, 2 usage error.
+enum ExitCode : int { kOk = 0, kUserError = 1, kUsage = 2 };
+
+// Reads a whole file ("-" = standard input). On failure prints "ps11: cannot read FILE: why"
+// and returns nullopt.
+std::optional<std::string> readFile(const std::string& path);
+// Writes a whole file; prints an error and returns false on failure.
+bool writeFile(const std::string& path, const std::string& bytes);
+
+// Consumes -D NAME[=VALUE], -DNAME, -I DIR, -IDIR at args[i]; returns true if it did.
+// Sets `error` for a -D/-I without argument.
+bool takePreprocessorOption(const std::vector<std::string>& args, size_t& i, PreprocessOptions& pp,
+                            std::string& error);
+
+// The project's source directory (for the built-in corpus), or "" if not found.
+std::string projectDir();
+
+// Every *.psh under dir, sorted.
+std::vector<std::string> listFiles(const std::string& dir, const std::string& extension);
+
+std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine = 8);
+
+}  // namespace ps11::cli

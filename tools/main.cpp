@@ -1,0 +1,252 @@
+// The ps11 command line: one binary, one subcommand per job (asm, disasm, check, test,
+// golden, demo). Each subcommand parses its own options; user errors print a message that
+// names the file and place and exit 1, usage errors exit 2.
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "ps11/assembler.h"
+#include "ps11/decoder.h"
+#include "ps11/disassembler.h"
+#include "ps11/encoder.h"
+#include "ps11/validator.h"
+#include "tools/cli_util.h"
+#include "tools/cmd_golden.h"
+#include "tools/cmd_test.h"
+
+namespace ps11::cli {
+namespace {
+
+const char* kUsageText =
+    "usage: ps11 <command> [options]\n"
+    "  asm FILE|- [-o OUT.bin] [--hex] [--no-validate] [-D NAME[=VALUE]] [-I DIR]\n"
+    "                         assemble ps_1_1 … ps_1_4 text to D3D9 tokens\n"
+    "  disasm FILE|- [--hex-input]\n"
+    "                         tokens (binary, or hex words with --hex-input) → text\n"
+    "  check FILE... [--json] [-D NAME[=VALUE]] [-I DIR]\n"
+    "                         validate and print statistics (slots, constants, read ports)\n"
+    "  test FILE.ps11test... [--backend emu|gl|both] [--precision P] [-v]\n"
+    "                         run .ps11test files\n"
+    "  golden (--check|--regen) [DIR]\n"
+    "                         golden disassembly and round trips of the shader corpus\n"
+    "  demo                   the main job on the built-in default\n";
+
+int usage(const std::string& message) {
+    if (!message.empty()) std::cerr << "ps11: " << message << "\n";
+    std::cerr << kUsageText;
+    return kUsage;
+}
+
+// Assembles and (optionally) validates one file; prints diagnostics.
+std::optional<Program> assembleFile(const std::string& path, const PreprocessOptions& pp, bool doValidate,
+                                    ShaderStats* stats, Diagnostics& diags) {
+    std::optional<std::string> text = readFile(path);
+    if (!text) return std::nullopt;
+    AssembleOptions options;
+    options.preprocess = pp;
+    std::string name = path == "-" ? "<stdin>" : path;
+    std::optional<Program> prog = parseAssembly(*text, name, options, diags);
+    if (prog && doValidate) validate(*prog, diags, stats);
+    return prog;
+}
+
+int cmdAsm(const std::vector<std::string>& args) {
+    std::string input, output;
+    bool hex = false, doValidate = true;
+    PreprocessOptions pp;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        std::string err;
+        if (a == "--hex") {
+            hex = true;
+        } else if (a == "--no-validate") {
+            doValidate = false;
+        } else if (a == "-o") {
+            if (i + 1 >= args.size()) return usage("-o needs a file name");
+            output = args[++i];
+        } else if (takePreprocessorOption(args, i, pp, err)) {
+            if (!err.empty()) return usage(err);
+        } else if (a.size() > 1 && a[0] == '-') {
+            return usage("asm: unknown option '" + a + "'");
+        } else if (input.empty()) {
+            input = a;
+        } else {
+            return usage("asm takes one input file");
+        }
+    }
+    if (input.empty()) return usage("asm needs an input file (or - for standard input)");
+    Diagnostics diags;
+    std::optional<Program> prog = assembleFile(input, pp, doValidate, nullptr, diags);
+    std::cerr << diags.formatAll();
+    if (!prog || diags.hasErrors()) return kUserError;
+    std::vector<uint32_t> tokens = encode(*prog);
+    if (!output.empty()) {
+        std::string bytes;
+        bytes.reserve(tokens.size() * 4);
+        for (uint32_t t : tokens)
+            for (int b = 0; b < 4; ++b) bytes += char((t >> (8 * b)) & 0xFF);
+        if (!writeFile(output, bytes)) return kUserError;
+    }
+    if (hex || output.empty()) std::cout << hexWords(tokens);
+    return kOk;
+}
+
+std::optional<Program> decodeFile(const std::string& path, bool hexInput, Diagnostics& diags) {
+    std::optional<std::string> data = readFile(path);
+    if (!data) return std::nullopt;
+    uint32_t fileId = diags.addFile(path == "-" ? "<stdin>" : path);
+    std::optional<std::vector<uint32_t>> tokens =
+        hexInput ? tokensFromHex(*data, fileId, diags) : tokensFromBinary(*data, fileId, diags);
+    if (!tokens) return std::nullopt;
+    return decode(*tokens, fileId, diags);
+}
+
+int cmdDisasm(const std::vector<std::string>& args) {
+    std::string input;
+    bool hexInput = false;
+    for (const std::string& a : args) {
+        if (a == "--hex-input") {
+            hexInput = true;
+        } else if (a.size() > 1 && a[0] == '-') {
+            return usage("disasm: unknown option '" + a + "'");
+        } else if (input.empty()) {
+            input = a;
+        } else {
+            return usage("disasm takes one input file");
+        }
+    }
+    if (input.empty()) return usage("disasm needs an input file (or - for standard input)");
+    Diagnostics diags;
+    std::optional<Program> prog = decodeFile(input, hexInput, diags);
+    std::cerr << diags.formatAll();
+    if (!prog || diags.hasErrors()) return kUserError;
+    std::cout << disassemble(*prog);
+    return kOk;
+}
+
+int cmdCheck(const std::vector<std::string>& args) {
+    std::vector<std::string> inputs;
+    bool json = false, hexInput = false;
+    PreprocessOptions pp;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        std::string err;
+        if (a == "--json") {
+            json = true;
+        } else if (a == "--hex-input") {
+            hexInput = true;
+        } else if (takePreprocessorOption(args, i, pp, err)) {
+            if (!err.empty()) return usage(err);
+        } else if (a.size() > 1 && a[0] == '-') {
+            return usage("check: unknown option '" + a + "'");
+        } else {
+            inputs.push_back(a);
+        }
+    }
+    if (inputs.empty()) return usage("check needs at least one shader file");
+    int status = kOk;
+    if (json) std::cout << "[";
+    for (size_t n = 0; n < inputs.size(); ++n) {
+        const std::string& path = inputs[n];
+        Diagnostics diags;
+        ShaderStats stats;
+        std::optional<Program> prog;
+        bool binary = hexInput || path.ends_with(".bin") || path.ends_with(".vso") || path.ends_with(".pso");
+        if (binary) {
+            prog = decodeFile(path, hexInput, diags);
+            if (prog) validate(*prog, diags, &stats);
+        } else {
+            prog = assembleFile(path, pp, true, &stats, diags);
+        }
+        std::cerr << diags.formatAll();
+        bool ok = prog && !diags.hasErrors();
+        if (!ok) status = kUserError;
+        if (json) {
+            std::cout << (n ? ",\n" : "\n") << "{\"file\": \"";
+            for (char c : path) {
+                if (c == '"' || c == '\\') std::cout << '\\';
+                if (static_cast<unsigned char>(c) < 0x20) continue;
+                std::cout << c;
+            }
+            std::cout << "\", \"valid\": " << (ok ? "true" : "false") << ", \"errors\": " << diags.errorCount();
+            if (prog) std::cout << ", \"stats\": " << statsToJson(stats);
+            std::cout << "}";
+        } else {
+            std::cout << path << ": " << (ok ? "valid" : "INVALID") << "\n";
+            if (prog) std::cout << statsToText(stats) << "\n";
+        }
+    }
+    if (json) std::cout << "\n]\n";
+    return status;
+}
+
+// The main job until the glare techniques land: check the project's shader corpus.
+int cmdDemo(const std::vector<std::string>& args) {
+    if (!args.empty()) return usage("demo takes no arguments");
+    std::string dir = projectDir();
+    if (dir.empty()) {
+        std::cerr << "ps11: demo: cannot find the shader corpus (tests/shaders/corpus); run from the project folder\n";
+        return kUserError;
+    }
+    std::vector<std::string> files = listFiles(dir + "/tests/shaders/corpus", ".psh");
+    if (files.empty()) {
+        std::cerr << "ps11: demo: no shaders under " << dir << "/tests/shaders/corpus\n";
+        return kUserError;
+    }
+    std::printf("ps11 demo: assembling, validating and round-tripping %zu corpus shaders\n\n", files.size());
+    std::printf("%-52s %-7s %-9s %-9s %s\n", "shader", "version", "tex", "arith", "round trip");
+    int failures = 0;
+    for (const std::string& path : files) {
+        Diagnostics diags;
+        ShaderStats stats;
+        std::optional<Program> prog = assembleFile(path, {}, true, &stats, diags);
+        std::string rel = path.substr(dir.size() + 1);
+        if (!prog || diags.hasErrors()) {
+            std::cerr << diags.formatAll();
+            std::printf("%-52s INVALID\n", rel.c_str());
+            ++failures;
+            continue;
+        }
+        std::vector<uint32_t> tokens = encode(*prog);
+        Diagnostics d2;
+        std::optional<Program> back = decode(tokens, d2.addFile(rel), d2);
+        bool roundTrip = false;
+        if (back) {
+            Diagnostics d3;
+            std::optional<Program> again = parseAssembly(disassemble(*back), rel, {}, d3);
+            roundTrip = again && encode(*again) == tokens;
+        }
+        if (!roundTrip) ++failures;
+        char tex[32], arith[32];
+        std::snprintf(tex, sizeof tex, "%d/%d", stats.texSlots, stats.texLimit);
+        std::snprintf(arith, sizeof arith, "%d/%d", stats.arithSlots, stats.arithLimit);
+        std::printf("%-52s ps_%d_%d  %-9s %-9s %s\n", rel.c_str(), stats.version.major, stats.version.minor, tex,
+                    arith, roundTrip ? "identical" : "DIFFERS");
+    }
+    std::printf("\n%zu shaders, %d failed\n", files.size(), failures);
+    return failures ? kUserError : kOk;
+}
+
+}  // namespace
+}  // namespace ps11::cli
+
+int main(int argc, char** argv) {
+    using namespace ps11::cli;
+    if (argc < 2) return usage("");
+    std::string cmd = argv[1];
+    std::vector<std::string> args(argv + 2, argv + argc);
+    if (cmd == "asm") return cmdAsm(args);
+    if (cmd == "disasm") return cmdDisasm(args);
+    if (cmd == "check") return cmdCheck(args);
+    if (cmd == "test") return ps11::cmdTest(args);
+    if (cmd == "golden") return cmdGolden(args);
+    if (cmd == "demo") return cmdDemo(args);
+    if (cmd == "-h" || cmd == "--help" || cmd == "help") {
+        std::cout << kUsageText;
+        return kOk;
+    }
+    return usage("unknown command '" + cmd + "'");
+}
