@@ -12,6 +12,7 @@
 #include "ps11/decoder.h"
 #include "ps11/disassembler.h"
 #include "ps11/encoder.h"
+#include "ps11/isa_doc.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
 #include "tools/cmd_golden.h"
@@ -32,6 +33,7 @@ const char* kUsageText =
     "                         run .ps11test files\n"
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
+    "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
     "  demo                   the main job on the built-in default\n";
 
 int usage(const std::string& message) {
@@ -244,6 +246,10 @@ int main(int argc, char** argv) {
     if (cmd == "test") return ps11::cmdTest(args);
     if (cmd == "golden") return cmdGolden(args);
     if (cmd == "demo") return cmdDemo(args);
+    if (cmd == "isa") {
+        std::cout << ps11::isaMarkdownTable();
+        return kOk;
+    }
     if (cmd == "-h" || cmd == "--help" || cmd == "help") {
         std::cout << kUsageText;
         return kOk;
