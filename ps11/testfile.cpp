@@ -1,0 +1,1638 @@
+// The .ps11test reader (stage: test input, before the device and the executor). Line by
+// line: '%' comment and blank lines are skipped outside [pixel shader], a `[...]` line opens a
+// section, every other line is a keyword line of that section (or a texel row, vertex line or
+// eval interpolant following the line that opened it). Every problem is collected as an error
+// with its file line and parsing goes on.
+#include "ps11/testfile.h"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+
+namespace ps11 {
+namespace {
+
+using Tokens = std::vector<std::string_view>;
+
+char lowerChar(char c) { return (c >= 'A' && c <= 'Z') ? char(c - 'A' + 'a') : c; }
+
+bool iequals(std::string_view a, std::string_view b) {
+    if (a.size() != b.size()) return false;
+    for (size_t i = 0; i < a.size(); ++i)
+        if (lowerChar(a[i]) != lowerChar(b[i])) return false;
+    return true;
+}
+
+bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool isDigit(char c) { return c >= '0' && c <= '9'; }
+
+std::string_view trim(std::string_view s) {
+    while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
+    while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
+    return s;
+}
+
+// Quotes a token for a message, cut short and with control bytes escaped.
+std::string quote(std::string_view s) {
+    std::string out = "'";
+    size_t n = 0;
+    for (char c : s) {
+        if (++n > 40) {
+            out += "...";
+            break;
+        }
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) == 0x7f) {
+            static const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[(c >> 4) & 15];
+            out += hex[c & 15];
+        } else {
+            out += c;
+        }
+    }
+    return out + "'";
+}
+
+// Splits a line into tokens at white space; '(' ')' ',' are tokens of their own and '%' starts
+// a comment that runs to the end of the line.
+Tokens tokenize(std::string_view line) {
+    Tokens toks;
+    size_t i = 0;
+    while (i < line.size()) {
+        char c = line[i];
+        if (c == '%') break;
+        if (isSpace(c)) {
+            ++i;
+        } else if (c == '(' || c == ')' || c == ',') {
+            toks.push_back(line.substr(i, 1));
+            ++i;
+        } else {
+            size_t start = i;
+            while (i < line.size() && !isSpace(line[i]) && line[i] != '(' && line[i] != ')' && line[i] != ',' &&
+                   line[i] != '%')
+                ++i;
+            toks.push_back(line.substr(start, i - start));
+        }
+    }
+    return toks;
+}
+
+bool isHexToken(std::string_view s) { return s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X'); }
+
+// True if the token is meant as a number (it may still be a malformed one).
+bool looksNumeric(std::string_view s) {
+    if (s.empty()) return false;
+    size_t i = (s[0] == '-' || s[0] == '+') ? 1 : 0;
+    if (i < s.size() && s[i] == '.') ++i;
+    return i < s.size() && isDigit(s[i]);
+}
+
+std::optional<uint32_t> parseHex(std::string_view s) {
+    if (!isHexToken(s) || s.size() > 10) return std::nullopt;
+    uint32_t v = 0;
+    for (char c : s.substr(2)) {
+        int d;
+        if (isDigit(c)) d = c - '0';
+        else if (c >= 'a' && c <= 'f') d = c - 'a' + 10;
+        else if (c >= 'A' && c <= 'F') d = c - 'A' + 10;
+        else return std::nullopt;
+        v = v * 16 + uint32_t(d);
+    }
+    return v;
+}
+
+// A decimal float (`0.5`, `-1`, `1e-3`) or a hex integer (`0xff`); finite values only.
+std::optional<double> parseNumber(std::string_view s) {
+    if (isHexToken(s)) {
+        std::optional<uint32_t> h = parseHex(s);
+        if (!h) return std::nullopt;
+        return double(*h);
+    }
+    if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+    if (s.empty() || !looksNumeric(s)) return std::nullopt;
+    double v = 0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+    if (ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+// A 32-bit word: hex, or a decimal integer.
+std::optional<uint32_t> parseWord(std::string_view s) {
+    if (isHexToken(s)) return parseHex(s);
+    std::optional<double> v = parseNumber(s);
+    if (!v || *v < 0 || *v > 4294967295.0 || *v != std::floor(*v)) return std::nullopt;
+    return uint32_t(*v);
+}
+
+template <class E>
+struct NameEntry {
+    const char* name;
+    E value;
+};
+
+template <class E, size_t N>
+std::optional<E> lookup(const NameEntry<E> (&table)[N], std::string_view name) {
+    for (const NameEntry<E>& e : table)
+        if (iequals(name, e.name)) return e.value;
+    return std::nullopt;
+}
+
+template <class E, size_t N>
+std::string namesOf(const NameEntry<E> (&table)[N]) {
+    std::string s;
+    for (size_t i = 0; i < N; ++i) s += (i ? (i + 1 == N ? " or " : ", ") : "") + std::string(table[i].name);
+    return s;
+}
+
+const NameEntry<TexFormat> kFormats[] = {
+    {"A8R8G8B8", TexFormat::A8R8G8B8}, {"X8R8G8B8", TexFormat::X8R8G8B8},
+    {"A8", TexFormat::A8},             {"L8", TexFormat::L8},
+    {"A8L8", TexFormat::A8L8},         {"V8U8", TexFormat::V8U8},
+    {"L6V5U5", TexFormat::L6V5U5},     {"X8L8V8U8", TexFormat::X8L8V8U8},
+    {"Q8W8V8U8", TexFormat::Q8W8V8U8}, {"V16U16", TexFormat::V16U16},
+    {"A16B16G16R16F", TexFormat::A16B16G16R16F}, {"A32B32G32R32F", TexFormat::A32B32G32R32F},
+    {"R32F", TexFormat::R32F},
+};
+const NameEntry<TexFormat> kTargetFormats[] = {
+    {"A8R8G8B8", TexFormat::A8R8G8B8},
+    {"X8R8G8B8", TexFormat::X8R8G8B8},
+    {"A16B16G16R16F", TexFormat::A16B16G16R16F},
+    {"A32B32G32R32F", TexFormat::A32B32G32R32F},
+};
+const NameEntry<Filter> kFilters[] = {{"point", Filter::Point}, {"linear", Filter::Linear}};
+const NameEntry<Filter> kMipFilters[] = {{"none", Filter::None}, {"point", Filter::Point}, {"linear", Filter::Linear}};
+const NameEntry<AddressMode> kAddressModes[] = {
+    {"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp},
+    {"mirror", AddressMode::Mirror}, {"border", AddressMode::Border},
+};
+const NameEntry<TextureOp> kTextureOps[] = {
+    {"disable", TextureOp::Disable},
+    {"selectarg1", TextureOp::SelectArg1},
+    {"selectarg2", TextureOp::SelectArg2},
+    {"modulate", TextureOp::Modulate},
+    {"modulate2x", TextureOp::Modulate2x},
+    {"modulate4x", TextureOp::Modulate4x},
+    {"add", TextureOp::Add},
+    {"addsigned", TextureOp::AddSigned},
+    {"addsigned2x", TextureOp::AddSigned2x},
+    {"subtract", TextureOp::Subtract},
+    {"addsmooth", TextureOp::AddSmooth},
+    {"blenddiffusealpha", TextureOp::BlendDiffuseAlpha},
+    {"blendtexturealpha", TextureOp::BlendTextureAlpha},
+    {"blendfactoralpha", TextureOp::BlendFactorAlpha},
+    {"blendtexturealphapm", TextureOp::BlendTextureAlphaPm},
+    {"blendcurrentalpha", TextureOp::BlendCurrentAlpha},
+    {"premodulate", TextureOp::PreModulate},
+    {"modulatealpha_addcolor", TextureOp::ModulateAlphaAddColor},
+    {"modulatecolor_addalpha", TextureOp::ModulateColorAddAlpha},
+    {"modulateinvalpha_addcolor", TextureOp::ModulateInvAlphaAddColor},
+    {"modulateinvcolor_addalpha", TextureOp::ModulateInvColorAddAlpha},
+    {"bumpenvmap", TextureOp::BumpEnvMap},
+    {"bumpenvmapluminance", TextureOp::BumpEnvMapLuminance},
+    {"dotproduct3", TextureOp::DotProduct3},
+    {"multiplyadd", TextureOp::MultiplyAdd},
+    {"lerp", TextureOp::Lerp},
+};
+const NameEntry<ArgSource> kArgSources[] = {
+    {"diffuse", ArgSource::Diffuse}, {"current", ArgSource::Current}, {"texture", ArgSource::Texture},
+    {"tfactor", ArgSource::TFactor}, {"specular", ArgSource::Specular}, {"temp", ArgSource::Temp},
+};
+const NameEntry<Blend> kBlends[] = {
+    {"zero", Blend::Zero},
+    {"one", Blend::One},
+    {"srccolor", Blend::SrcColor},
+    {"invsrccolor", Blend::InvSrcColor},
+    {"srcalpha", Blend::SrcAlpha},
+    {"invsrcalpha", Blend::InvSrcAlpha},
+    {"destalpha", Blend::DestAlpha},
+    {"invdestalpha", Blend::InvDestAlpha},
+    {"destcolor", Blend::DestColor},
+    {"invdestcolor", Blend::InvDestColor},
+    {"srcalphasat", Blend::SrcAlphaSat},
+    {"bothsrcalpha", Blend::BothSrcAlpha},
+    {"bothinvsrcalpha", Blend::BothInvSrcAlpha},
+    {"blendfactor", Blend::BlendFactor},
+    {"invblendfactor", Blend::InvBlendFactor},
+};
+const NameEntry<BlendOp> kBlendOps[] = {
+    {"add", BlendOp::Add}, {"subtract", BlendOp::Subtract}, {"revsubtract", BlendOp::RevSubtract},
+    {"min", BlendOp::Min}, {"max", BlendOp::Max},
+};
+const NameEntry<CompareFunc> kCompareFuncs[] = {
+    {"never", CompareFunc::Never},     {"less", CompareFunc::Less},
+    {"equal", CompareFunc::Equal},     {"lessequal", CompareFunc::LessEqual},
+    {"greater", CompareFunc::Greater}, {"notequal", CompareFunc::NotEqual},
+    {"greaterequal", CompareFunc::GreaterEqual}, {"always", CompareFunc::Always},
+};
+const NameEntry<CullMode> kCullModes[] = {{"none", CullMode::None}, {"cw", CullMode::Cw}, {"ccw", CullMode::Ccw}};
+const NameEntry<Precision> kPrecisions[] = {
+    {"fx8", Precision::Fx8}, {"fx12", Precision::Fx12}, {"float", Precision::Float}, {"ideal", Precision::Ideal},
+};
+const NameEntry<Backend> kBackends[] = {{"emu", Backend::Emu}, {"gl", Backend::Gl}};
+const NameEntry<bool> kOnOff[] = {{"on", true}, {"off", false}};
+
+// Reads the arguments of one line left to right, reporting what is missing or malformed.
+class Args {
+public:
+    Args(const Tokens& toks, size_t pos, uint32_t line, std::vector<TestFileError>& errors)
+        : m_toks(toks), m_pos(pos), m_line(line), m_errors(errors) {}
+
+    bool atEnd() const { return m_pos >= m_toks.size(); }
+    std::string_view peek() const { return atEnd() ? std::string_view() : m_toks[m_pos]; }
+    std::string_view next() { return atEnd() ? std::string_view() : m_toks[m_pos++]; }
+    bool peekIs(std::string_view word) const { return !atEnd() && iequals(m_toks[m_pos], word); }
+    bool peekNumeric() const { return !atEnd() && looksNumeric(m_toks[m_pos]); }
+    size_t pos() const { return m_pos; }
+    uint32_t line() const { return m_line; }
+
+    void error(std::string message) { m_errors.push_back({m_line, std::move(message)}); }
+
+    // Reports "missing WHAT" at the end of the line.
+    bool need(const std::string& what) {
+        if (!atEnd()) return true;
+        error("missing " + what);
+        return false;
+    }
+
+    std::optional<double> number(const std::string& what) {
+        if (!need(what)) return std::nullopt;
+        std::string_view t = next();
+        std::optional<double> v = parseNumber(t);
+        if (!v) error("bad number " + quote(t) + " for " + what);
+        return v;
+    }
+
+    std::optional<float> floatValue(const std::string& what) {
+        std::optional<double> v = number(what);
+        if (!v) return std::nullopt;
+        if (std::fabs(*v) > double(std::numeric_limits<float>::max())) {
+            error(what + " is out of range");
+            return std::nullopt;
+        }
+        return float(*v);
+    }
+
+    std::optional<int64_t> integer(const std::string& what, int64_t lo, int64_t hi) {
+        std::optional<double> v = number(what);
+        if (!v) return std::nullopt;
+        if (*v != std::floor(*v)) {
+            error(what + " must be an integer, not " + quote(m_toks[m_pos - 1]));
+            return std::nullopt;
+        }
+        if (*v < double(lo) || *v > double(hi)) {
+            error(what + " " + quote(m_toks[m_pos - 1]) + " is out of range (" + std::to_string(lo) + " to " +
+                  std::to_string(hi) + ")");
+            return std::nullopt;
+        }
+        return int64_t(*v);
+    }
+
+    std::optional<uint32_t> word(const std::string& what) {
+        if (!need(what)) return std::nullopt;
+        std::string_view t = next();
+        std::optional<uint32_t> v = parseWord(t);
+        if (!v) error("bad " + what + " " + quote(t) + " (expected a 32-bit word, e.g. 0xff808080)");
+        return v;
+    }
+
+    // n floats into out[0..n).
+    bool floats(float* out, int n, const std::string& what) {
+        bool ok = true;
+        for (int i = 0; i < n; ++i) {
+            std::optional<float> v = floatValue(what);
+            if (!v) {
+                ok = false;
+                if (atEnd()) break;
+            } else {
+                out[i] = *v;
+            }
+        }
+        return ok;
+    }
+
+    // A colour: one word 0xAARRGGBB (hex, or a lone decimal integer), or `channels` floats.
+    std::optional<Color> color(const std::string& what, int channels = 4) {
+        if (!need(what)) return std::nullopt;
+        size_t count = 0;
+        while (m_pos + count < m_toks.size() && looksNumeric(m_toks[m_pos + count])) ++count;
+        if (isHexToken(peek()) || count == 1) {
+            std::optional<uint32_t> w = word(what);
+            if (!w) return std::nullopt;
+            return Color::fromArgb(*w);
+        }
+        if (count < size_t(channels)) {
+            if (count == 0) error("bad " + what + " " + quote(next()));
+            else error(what + " needs one 0xAARRGGBB word or " + std::to_string(channels) + " floats");
+            m_pos += count;
+            return std::nullopt;
+        }
+        Vec4 v{0, 0, 0, 1};
+        if (!floats(v.data(), channels, what)) return std::nullopt;
+        return Color::fromFloats(v);
+    }
+
+    template <class E, size_t N>
+    std::optional<E> name(const NameEntry<E> (&table)[N], const std::string& what) {
+        if (!need(what + " (" + namesOf(table) + ")")) return std::nullopt;
+        std::string_view t = next();
+        std::optional<E> v = lookup(table, t);
+        if (!v) error("unknown " + what + " " + quote(t) + " (expected " + namesOf(table) + ")");
+        return v;
+    }
+
+    // Reports anything left on the line.
+    void end() {
+        if (!atEnd()) error("unexpected " + quote(peek()) + " at the end of the line");
+    }
+
+private:
+    const Tokens& m_toks;
+    size_t m_pos;
+    uint32_t m_line;
+    std::vector<TestFileError>& m_errors;
+};
+
+template <class T>
+void assign(Setting<T>& s, const std::optional<T>& v, uint32_t line) {
+    if (v) {
+        s.value = *v;
+        s.line = line;
+    }
+}
+
+// "t3" → 3 (prefix letter checked case-insensitively); nullopt when it is not that shape.
+std::optional<int> registerIndex(std::string_view t, char prefix) {
+    if (t.size() < 2 || t.size() > 3 || lowerChar(t[0]) != prefix) return std::nullopt;
+    int v = 0;
+    for (char c : t.substr(1)) {
+        if (!isDigit(c)) return std::nullopt;
+        v = v * 10 + (c - '0');
+    }
+    return v;
+}
+
+uint32_t levelExtent(uint32_t size, uint32_t level) { return level >= 32 ? 1 : std::max<uint32_t>(1, size >> level); }
+
+uint32_t maxLevels(uint32_t w, uint32_t h, uint32_t d) {
+    uint32_t m = std::max({w, h, d, 1u}), n = 1;
+    while (m > 1) {
+        m >>= 1;
+        ++n;
+    }
+    return n;
+}
+
+enum class Section { None, Require, RenderTarget, Texture, Sampler, Stage, RenderState, Transform, Constants,
+                     PixelShader, Test };
+
+class Parser {
+public:
+    Parser(TestFile& out, std::vector<TestFileError>& errors) : m_file(out), m_errors(errors) {}
+
+    void run(std::string_view text);
+
+private:
+    void error(uint32_t line, std::string message) { m_errors.push_back({line, std::move(message)}); }
+
+    void sectionLine(uint32_t line, std::string_view trimmed);
+    void openSection(uint32_t line, const Tokens& toks);
+    void closeSection();
+    void contentLine(uint32_t line, const Tokens& toks);
+    bool once(Section s, uint32_t line, const char* name);
+
+    void requireLine(Args& a, std::string_view kw);
+    void renderTargetLine(Args& a, std::string_view kw);
+    void textureLine(Args& a, std::string_view kw);
+    void texelRow(Args& a);
+    void startLevel(uint32_t level, uint32_t line);
+    bool checkTexel(Args& a, const Texel& v);
+    void closeLevel();
+    void closeTexture();
+    void samplerLine(Args& a, std::string_view kw);
+    void stageLine(Args& a, std::string_view kw);
+    void renderStateLine(Args& a, std::string_view kw);
+    void transformLine(Args& a, std::string_view kw);
+    void constantsLine(Args& a, std::string_view kw);
+    void testLine(uint32_t line, const Tokens& toks);
+    bool conditionPrefix(Args& a, Condition& cond);
+    bool drawCommand(Args& a, TestCommand& cmd);
+    void vertexLine(Args& a, DrawPrimitives& draw);
+    void evalLine(Args& a, Eval& eval);
+    bool probeCommand(Args& a, TestCommand& cmd);
+    void closePending();
+    void finish();
+
+    std::optional<Texel> texel(Args& a);
+    std::optional<TextureArg> textureArg(Args& a, bool resultArg);
+
+    TestFile& m_file;
+    std::vector<TestFileError>& m_errors;
+    Section m_section = Section::None;
+    size_t m_index = 0;  // current texture/sampler/stage in its vector
+    std::vector<Section> m_seen;
+    // Texture data being read.
+    bool m_inLevel = false;
+    size_t m_levelRows = 0;
+    // [test]: the draw or eval whose following lines are being read.
+    // Skip swallows the lines following a command line that was in error.
+    enum class Pending { None, Draw, Eval, Skip } m_pending = Pending::None;
+    bool m_sawSectionLine = false;
+};
+
+void Parser::run(std::string_view text) {
+    uint32_t line = 0;
+    size_t pos = 0;
+    std::string shaderText;
+    while (pos <= text.size()) {
+        size_t nl = text.find('\n', pos);
+        if (nl == std::string_view::npos) nl = text.size();
+        std::string_view raw = text.substr(pos, nl - pos);
+        bool lastLine = nl == text.size();
+        pos = nl + 1;
+        if (lastLine && raw.empty() && line > 0) break;  // the file ends with a newline
+        ++line;
+        if (!raw.empty() && raw.back() == '\r') raw.remove_suffix(1);
+        std::string_view trimmed = trim(raw);
+        if (m_section == Section::PixelShader && (trimmed.empty() || trimmed[0] != '[')) {
+            PixelShaderBlock& ps = m_file.pixelShader;
+            if (line > ps.firstLine) ps.text += '\n';
+            if (trimmed.empty() || trimmed[0] != '%') ps.text += raw;
+            continue;
+        }
+        if (trimmed.empty() || trimmed[0] == '%') continue;
+        if (trimmed[0] == '[') {
+            sectionLine(line, trimmed);
+            continue;
+        }
+        contentLine(line, tokenize(trimmed));
+    }
+    closeSection();
+    finish();
+}
+
+void Parser::sectionLine(uint32_t line, std::string_view trimmed) {
+    closeSection();
+    m_sawSectionLine = true;
+    size_t close = trimmed.find(']');
+    if (close == std::string_view::npos) {
+        error(line, "section line " + quote(trimmed) + " has no closing ']'");
+        return;
+    }
+    Tokens rest = tokenize(trimmed.substr(close + 1));
+    if (!rest.empty()) error(line, "unexpected " + quote(rest[0]) + " after the section name");
+    Tokens toks = tokenize(trimmed.substr(1, close - 1));
+    if (toks.empty()) {
+        error(line, "empty section name");
+        return;
+    }
+    openSection(line, toks);
+}
+
+bool Parser::once(Section s, uint32_t line, const char* name) {
+    if (std::find(m_seen.begin(), m_seen.end(), s) != m_seen.end()) {
+        error(line, std::string("duplicate section [") + name + "]");
+        return false;
+    }
+    m_seen.push_back(s);
+    return true;
+}
+
+void Parser::openSection(uint32_t line, const Tokens& toks) {
+    auto is = [&](size_t i, std::string_view w) { return i < toks.size() && iequals(toks[i], w); };
+    Args a(toks, 1, line, m_errors);
+    if (is(0, "require") && toks.size() == 1) {
+        if (once(Section::Require, line, "require")) m_section = Section::Require;
+        m_file.require.line = line;
+    } else if (is(0, "render") && is(1, "target") && toks.size() == 2) {
+        if (once(Section::RenderTarget, line, "render target")) m_section = Section::RenderTarget;
+        m_file.renderTarget.line = line;
+    } else if (is(0, "render") && is(1, "state") && toks.size() == 2) {
+        if (once(Section::RenderState, line, "render state")) m_section = Section::RenderState;
+        m_file.renderState.line = line;
+    } else if (is(0, "transform") && toks.size() == 1) {
+        if (once(Section::Transform, line, "transform")) m_section = Section::Transform;
+        m_file.transform.line = line;
+    } else if (is(0, "constants") && toks.size() == 1) {
+        if (once(Section::Constants, line, "constants")) m_section = Section::Constants;
+    } else if (is(0, "test") && toks.size() == 1) {
+        if (once(Section::Test, line, "test")) m_section = Section::Test;
+        m_file.testLine = line;
+    } else if (is(0, "texture") || is(0, "sampler") || is(0, "stage")) {
+        std::string what = std::string(toks[0]) + " stage";
+        std::optional<int64_t> n = a.integer("[" + std::string(toks[0]) + " N] " + what, 0, 7);
+        a.end();
+        if (!n) return;
+        int stage = int(*n);
+        auto duplicate = [&](const auto& vec) {
+            for (const auto& d : vec)
+                if (d.stage == stage) {
+                    error(line, "duplicate section [" + std::string(toks[0]) + " " + std::to_string(stage) +
+                                    "] (first at line " + std::to_string(d.line) + ")");
+                    return true;
+                }
+            return false;
+        };
+        if (is(0, "texture")) {
+            if (duplicate(m_file.textures)) return;
+            TextureDesc t;
+            t.line = line;
+            t.stage = stage;
+            m_file.textures.push_back(std::move(t));
+            m_index = m_file.textures.size() - 1;
+            m_section = Section::Texture;
+            m_inLevel = false;
+        } else if (is(0, "sampler")) {
+            if (duplicate(m_file.samplers)) return;
+            SamplerDesc s;
+            s.line = line;
+            s.stage = stage;
+            m_file.samplers.push_back(s);
+            m_index = m_file.samplers.size() - 1;
+            m_section = Section::Sampler;
+        } else {
+            if (duplicate(m_file.stages)) return;
+            StageDesc s = defaultStage(stage);
+            s.line = line;
+            m_file.stages.push_back(s);
+            m_index = m_file.stages.size() - 1;
+            m_section = Section::Stage;
+        }
+    } else if (is(0, "pixel") && is(1, "shader")) {
+        if (m_file.pixelShader.present()) {
+            error(line, "duplicate [pixel shader] section (first at line " +
+                            std::to_string(m_file.pixelShader.line) + ")");
+            m_section = Section::None;
+            return;
+        }
+        PixelShaderBlock& ps = m_file.pixelShader;
+        ps.line = line;
+        ps.firstLine = line + 1;
+        m_section = Section::PixelShader;
+        Args h(toks, 2, line, m_errors);
+        if (h.atEnd()) return;
+        if (!h.peekIs("fail")) {
+            h.error("unexpected " + quote(h.peek()) + " in [pixel shader] (expected 'fail CODE [at LINE:COL]')");
+            return;
+        }
+        h.next();
+        ps.expectFail = true;
+        if (!h.need("diagnostic code after 'fail' (e.g. P2003)")) return;
+        std::string_view code = h.next();
+        bool ok = code.size() == 5 && std::isalpha(static_cast<unsigned char>(code[0]));
+        for (size_t i = 1; ok && i < 5; ++i) ok = isDigit(code[i]);
+        if (!ok) {
+            h.error("bad diagnostic code " + quote(code) + " (expected a letter and four digits, e.g. P2003)");
+        } else {
+            ps.failCode = std::string(code);
+            ps.failCode[0] = char(std::toupper(static_cast<unsigned char>(ps.failCode[0])));
+        }
+        if (h.atEnd()) return;
+        if (!h.peekIs("at")) {
+            h.error("unexpected " + quote(h.peek()) + " after the code (expected 'at LINE:COL')");
+            return;
+        }
+        h.next();
+        if (!h.need("LINE:COL after 'at'")) return;
+        std::string_view place = h.next();
+        size_t colon = place.find(':');
+        std::optional<uint32_t> l = parseWord(place.substr(0, colon));
+        std::optional<uint32_t> c = colon == std::string_view::npos ? std::optional<uint32_t>(0)
+                                                                    : parseWord(place.substr(colon + 1));
+        if (isHexToken(place) || !l || !c || *l == 0 || (colon != std::string_view::npos && *c == 0)) {
+            h.error("bad place " + quote(place) + " after 'at' (expected LINE:COL, e.g. 3:5)");
+        } else {
+            ps.failLine = *l;
+            ps.failCol = *c;
+        }
+        h.end();
+    } else {
+        std::string name;
+        for (size_t i = 0; i < toks.size(); ++i) name += (i ? " " : "") + std::string(toks[i]);
+        error(line, "unknown section [" + name + "]");
+    }
+}
+
+void Parser::closeSection() {
+    if (m_section == Section::Texture) closeTexture();
+    if (m_section == Section::Test) closePending();
+    m_section = Section::None;
+}
+
+void Parser::contentLine(uint32_t line, const Tokens& toks) {
+    if (toks.empty()) return;
+    if (m_section == Section::Test) {
+        testLine(line, toks);
+        return;
+    }
+    if (m_section == Section::Texture && (looksNumeric(toks[0]) || toks[0] == "(")) {
+        Args a(toks, 0, line, m_errors);
+        texelRow(a);
+        return;
+    }
+    std::string_view kw = toks[0];
+    Args a(toks, 1, line, m_errors);
+    switch (m_section) {
+    case Section::None:
+        if (!m_sawSectionLine)
+            error(line, quote(kw) + " before any section (a section starts with a line like [test])");
+        // Otherwise the section line itself was bad and already reported.
+        return;
+    case Section::Require: requireLine(a, kw); return;
+    case Section::RenderTarget: renderTargetLine(a, kw); return;
+    case Section::Texture: textureLine(a, kw); return;
+    case Section::Sampler: samplerLine(a, kw); return;
+    case Section::Stage: stageLine(a, kw); return;
+    case Section::RenderState: renderStateLine(a, kw); return;
+    case Section::Transform: transformLine(a, kw); return;
+    case Section::Constants: constantsLine(a, kw); return;
+    case Section::PixelShader:
+    case Section::Test: return;
+    }
+}
+
+void Parser::requireLine(Args& a, std::string_view kw) {
+    RequireDesc& r = m_file.require;
+    uint32_t line = a.line();
+    if (iequals(kw, "version")) {
+        if (!a.need("shader version (ps_1_1 ... ps_1_4)")) return;
+        std::string_view v = a.next();
+        if (v.size() == 6 && iequals(v.substr(0, 5), "ps_1_") && v[5] >= '1' && v[5] <= '4') {
+            r.versionMinor = {v[5] - '0', line};
+        } else {
+            a.error("unknown shader version " + quote(v) + " (expected ps_1_1, ps_1_2, ps_1_3 or ps_1_4)");
+        }
+    } else if (iequals(kw, "precision")) {
+        assign(r.precision, a.name(kPrecisions, "precision"), line);
+    } else if (iequals(kw, "backend")) {
+        uint8_t mask = 0;
+        a.need("backend (" + namesOf(kBackends) + ")");
+        while (!a.atEnd()) {
+            if (a.peek() == ",") {
+                a.next();
+                continue;
+            }
+            std::optional<Backend> b = a.name(kBackends, "backend");
+            if (b) mask |= uint8_t(1u << unsigned(*b));
+        }
+        if (mask) r.backends = {mask, line};
+        return;
+    } else if (iequals(kw, "max_value")) {
+        std::optional<float> v = a.floatValue("max_value");
+        if (v && *v <= 0) a.error("max_value must be > 0");
+        else assign(r.maxValue, v, line);
+    } else {
+        a.error("unknown keyword " + quote(kw) + " in [require] (expected version, precision, backend or max_value)");
+        return;
+    }
+    a.end();
+}
+
+void Parser::renderTargetLine(Args& a, std::string_view kw) {
+    RenderTargetDesc& rt = m_file.renderTarget;
+    uint32_t line = a.line();
+    if (iequals(kw, "size")) {
+        std::optional<int64_t> w = a.integer("render target width", 1, kMaxSurfaceSize);
+        std::optional<int64_t> h = a.integer("render target height", 1, kMaxSurfaceSize);
+        if (w && h) rt.size = {{uint32_t(*w), uint32_t(*h)}, line};
+    } else if (iequals(kw, "format")) {
+        assign(rt.format, a.name(kTargetFormats, "render target format"), line);
+    } else if (iequals(kw, "clear")) {
+        assign(rt.clear, a.color("clear colour"), line);
+    } else if (iequals(kw, "depth")) {
+        std::optional<bool> on = a.name(kOnOff, "depth buffer");
+        if (on && *on && !a.atEnd()) {
+            std::optional<float> z = a.floatValue("depth clear value");
+            if (z && (*z < 0 || *z > 1)) a.error("depth clear value must be in [0, 1]");
+            else if (z) rt.depthClear = *z;
+        }
+        assign(rt.depth, on, line);
+    } else {
+        a.error("unknown keyword " + quote(kw) + " in [render target] (expected size, format, clear or depth)");
+        return;
+    }
+    a.end();
+}
+
+std::optional<Texel> Parser::texel(Args& a) {
+    Texel t;
+    if (a.peek() != "(") {
+        std::optional<uint32_t> w = a.word("texel");
+        if (!w) return std::nullopt;
+        t.bits = *w;
+        return t;
+    }
+    a.next();
+    while (!a.atEnd() && a.peek() != ")") {
+        if (t.count == 4) {
+            a.error("a texel has at most 4 floats");
+            while (!a.atEnd() && a.peek() != ")") a.next();
+            break;
+        }
+        std::optional<float> v = a.floatValue("texel component");
+        if (!v) return std::nullopt;
+        t.value[t.count++] = *v;
+    }
+    if (a.atEnd()) {
+        a.error("missing ')' after the texel's floats");
+        return std::nullopt;
+    }
+    a.next();
+    if (t.count == 0) {
+        a.error("empty texel '()'");
+        return std::nullopt;
+    }
+    return t;
+}
+
+void Parser::textureLine(Args& a, std::string_view kw) {
+    TextureDesc& t = m_file.textures[m_index];
+    uint32_t line = a.line();
+    bool hasData = !t.data.empty();
+    auto beforeData = [&](const char* what) {
+        if (hasData) a.error(std::string("'") + what + "' must come before the texel data");
+        return !hasData;
+    };
+    if (iequals(kw, "size")) {
+        if (!beforeData("size")) return;
+        std::optional<int64_t> w = a.integer("texture width", 1, kMaxSurfaceSize);
+        std::optional<int64_t> h = a.integer("texture height", 1, kMaxSurfaceSize);
+        std::optional<int64_t> d = std::optional<int64_t>(0);
+        if (!a.atEnd()) d = a.integer("volume texture depth", 1, kMaxVolumeDepth);
+        if (w && h && d) {
+            uint64_t texels = uint64_t(*w) * uint64_t(*h) * uint64_t(std::max<int64_t>(*d, 1));
+            if (texels > kMaxTexels) {
+                a.error("texture is too large (" + std::to_string(texels) + " texels, at most " +
+                        std::to_string(kMaxTexels) + ")");
+            } else {
+                t.width = uint32_t(*w);
+                t.height = uint32_t(*h);
+                t.depth = uint32_t(*d);
+                t.sizeLine = line;
+            }
+        }
+    } else if (iequals(kw, "format")) {
+        if (!beforeData("format")) return;
+        assign(t.format, a.name(kFormats, "texture format"), line);
+    } else if (iequals(kw, "levels")) {
+        if (!beforeData("levels")) return;
+        std::optional<int64_t> n = a.integer("levels", 0, 15);
+        if (n) t.levels = {uint32_t(*n), line};
+    } else if (iequals(kw, "level")) {
+        if (t.sizeLine == 0) {
+            a.error("'level' needs the texture's 'size' first");
+            return;
+        }
+        uint32_t count = t.levels.value ? t.levels.value : 1;
+        std::optional<int64_t> n = a.integer("level", 0, 15);
+        if (!n) return;
+        if (*n >= int64_t(count)) {
+            a.error("level " + std::to_string(*n) + " is beyond the texture's " + std::to_string(count) +
+                    (t.levels.value ? " levels" : " level (levels 0 builds the chain from level 0)"));
+            return;
+        }
+        closeLevel();
+        for (const TextureLevel& l : t.data)
+            if (l.level == uint32_t(*n)) {
+                a.error("level " + std::to_string(*n) + " given twice (first at line " + std::to_string(l.line) + ")");
+                return;
+            }
+        startLevel(uint32_t(*n), line);
+    } else if (iequals(kw, "fill")) {
+        if (t.sizeLine == 0) {
+            a.error("'fill' needs the texture's 'size' first");
+            return;
+        }
+        if (!m_inLevel && !t.data.empty()) {
+            a.error("'fill' outside a level (write 'level N' before it)");
+            return;
+        }
+        if (m_inLevel && (m_levelRows > 0 || t.data.back().hasFill)) {
+            a.error("'fill' after texel rows or another 'fill' of the same level");
+            return;
+        }
+        if (!m_inLevel) startLevel(0, line);  // a lone `fill` is level 0
+        if (!a.need("fill texel")) return;
+        std::optional<Texel> v = texel(a);
+        if (!v || !checkTexel(a, *v)) return;
+        t.data.back().hasFill = true;
+        t.data.back().fill = *v;
+    } else {
+        a.error("unknown keyword " + quote(kw) + " in [texture] (expected size, format, levels, level or fill)");
+        return;
+    }
+    a.end();
+}
+
+void Parser::startLevel(uint32_t level, uint32_t line) {
+    TextureDesc& t = m_file.textures[m_index];
+    TextureLevel l;
+    l.line = line;
+    l.level = level;
+    l.width = levelExtent(t.width, level);
+    l.height = levelExtent(t.height, level);
+    l.depth = t.isVolume() ? levelExtent(t.depth, level) : 1;
+    t.data.push_back(std::move(l));
+    m_inLevel = true;
+    m_levelRows = 0;
+}
+
+bool Parser::checkTexel(Args& a, const Texel& v) {
+    TexFormat f = m_file.textures[m_index].format.value;
+    int bits = formatBits(f);
+    if (isFloatFormat(f) && v.count == 0) {
+        a.error(std::string("format ") + texFormatName(f) + " takes float texels in parentheses, e.g. (0.5 0.25 0 1)");
+    } else if (!isFloatFormat(f) && v.count > 0) {
+        a.error(std::string("format ") + texFormatName(f) + " takes one hex word per texel, not floats in parentheses");
+    } else if (f == TexFormat::R32F && v.count > 1) {
+        a.error("format R32F takes one float per texel");
+    } else if (v.count == 0 && bits < 32 && (v.bits >> bits) != 0) {
+        char buf[16];
+        std::snprintf(buf, sizeof buf, "0x%x", v.bits);
+        a.error(std::string("texel ") + buf + " does not fit format " + texFormatName(f) + " (" +
+                std::to_string(bits) + " bits)");
+    } else {
+        return true;
+    }
+    return false;
+}
+
+void Parser::texelRow(Args& a) {
+    TextureDesc& t = m_file.textures[m_index];
+    if (!m_inLevel) {
+        a.error("texel row outside a level (write 'level 0' before the rows)");
+        return;
+    }
+    TextureLevel& l = t.data.back();
+    if (l.hasFill) {
+        a.error("texel row after 'fill' (a level is either filled or given row by row)");
+        return;
+    }
+    ++m_levelRows;
+    size_t count = 0;
+    while (!a.atEnd()) {
+        std::optional<Texel> v = texel(a);
+        ++count;
+        if (v && checkTexel(a, *v)) l.texels.push_back(*v);
+    }
+    if (count != l.width) {
+        a.error("texel row has " + std::to_string(count) + " texels, level " + std::to_string(l.level) + " is " +
+                std::to_string(l.width) + " wide");
+    }
+}
+
+void Parser::closeLevel() {
+    if (!m_inLevel) return;
+    m_inLevel = false;
+    TextureDesc& t = m_file.textures[m_index];
+    TextureLevel& l = t.data.back();
+    if (l.hasFill) return;
+    uint64_t rows = uint64_t(l.height) * l.depth;
+    if (m_levelRows != rows) {
+        error(l.line, "level " + std::to_string(l.level) + " has " + std::to_string(m_levelRows) +
+                          " texel rows, expected " + std::to_string(rows) +
+                          (t.isVolume() ? " (height x depth, slice after slice)" : " (its height)") +
+                          (m_levelRows == 0 ? "; or use 'fill'" : ""));
+    }
+    if (l.texels.size() != uint64_t(l.width) * rows) l.texels.clear();  // incomplete: reported above
+}
+
+void Parser::closeTexture() {
+    closeLevel();
+    TextureDesc& t = m_file.textures[m_index];
+    if (t.sizeLine == 0) {
+        error(t.line, "[texture " + std::to_string(t.stage) + "] needs a 'size'");
+        return;
+    }
+    uint32_t possible = maxLevels(t.width, t.height, t.depth);
+    if (t.levels.value > possible) {
+        error(t.levels.line, "levels " + std::to_string(t.levels.value) + " is more than a " +
+                                 std::to_string(t.width) + "x" + std::to_string(t.height) + " texture has (" +
+                                 std::to_string(possible) + ")");
+    }
+    std::sort(t.data.begin(), t.data.end(), [](const TextureLevel& x, const TextureLevel& y) {
+        return x.level < y.level;
+    });
+    uint32_t needed = std::max<uint32_t>(1, t.levels.value);
+    for (uint32_t k = 0; k < needed && k < possible; ++k) {
+        bool found = std::any_of(t.data.begin(), t.data.end(), [k](const TextureLevel& l) { return l.level == k; });
+        if (!found)
+            error(t.line, "[texture " + std::to_string(t.stage) + "] has no data for level " + std::to_string(k) +
+                              " (write 'level " + std::to_string(k) + "' and its rows, or 'fill')");
+    }
+}
+
+void Parser::samplerLine(Args& a, std::string_view kw) {
+    SamplerDesc& s = m_file.samplers[m_index];
+    uint32_t line = a.line();
+    if (iequals(kw, "filter")) {
+        std::optional<Filter> minF = a.name(kFilters, "filter");
+        std::optional<Filter> magF = minF;
+        if (!a.atEnd() && !a.peekIs("mip")) magF = a.name(kFilters, "mag filter");
+        assign(s.minFilter, minF, line);
+        assign(s.magFilter, magF, line);
+        if (a.peekIs("mip")) {
+            a.next();
+            assign(s.mipFilter, a.name(kMipFilters, "mip filter"), line);
+        }
+    } else if (iequals(kw, "address")) {
+        std::optional<AddressMode> u = a.name(kAddressModes, "address mode");
+        std::optional<AddressMode> v = u, w = u;
+        if (!a.atEnd()) v = w = a.name(kAddressModes, "v address mode");
+        if (!a.atEnd()) w = a.name(kAddressModes, "w address mode");
+        assign(s.addressU, u, line);
+        assign(s.addressV, v, line);
+        assign(s.addressW, w, line);
+    } else if (iequals(kw, "border")) {
+        assign(s.border, a.color("border colour"), line);
+    } else {
+        a.error("unknown keyword " + quote(kw) + " in [sampler] (expected filter, address or border)");
+        return;
+    }
+    a.end();
+}
+
+std::optional<TextureArg> Parser::textureArg(Args& a, bool resultArg) {
+    TextureArg arg;
+    if (resultArg) {
+        if (!a.need("result (current or temp)")) return std::nullopt;
+        std::string_view t = a.next();
+        if (iequals(t, "current")) arg.source = ArgSource::Current;
+        else if (iequals(t, "temp")) arg.source = ArgSource::Temp;
+        else {
+            a.error("unknown result argument " + quote(t) + " (expected current or temp)");
+            return std::nullopt;
+        }
+        return arg;
+    }
+    std::optional<ArgSource> src = a.name(kArgSources, "argument");
+    if (!src) return std::nullopt;
+    arg.source = *src;
+    while (!a.atEnd()) {
+        std::string_view m = a.next();
+        bool* flag = iequals(m, "complement") ? &arg.complement
+                     : iequals(m, "alphareplicate") ? &arg.alphaReplicate
+                                                     : nullptr;
+        if (!flag) {
+            a.error("unknown argument modifier " + quote(m) + " (expected complement or alphareplicate)");
+            return std::nullopt;
+        }
+        if (*flag) a.error("modifier " + quote(m) + " given twice");
+        *flag = true;
+    }
+    return arg;
+}
+
+void Parser::stageLine(Args& a, std::string_view kw) {
+    StageDesc& s = m_file.stages[m_index];
+    uint32_t line = a.line();
+    struct ArgKeyword {
+        const char* name;
+        Setting<TextureArg> StageDesc::*member;
+    };
+    static const ArgKeyword kArgs[] = {
+        {"colorarg0", &StageDesc::colorArg0}, {"colorarg1", &StageDesc::colorArg1},
+        {"colorarg2", &StageDesc::colorArg2}, {"alphaarg0", &StageDesc::alphaArg0},
+        {"alphaarg1", &StageDesc::alphaArg1}, {"alphaarg2", &StageDesc::alphaArg2},
+        {"resultarg", &StageDesc::resultArg},
+    };
+    for (const ArgKeyword& k : kArgs) {
+        if (iequals(kw, k.name)) {
+            assign(s.*k.member, textureArg(a, k.member == &StageDesc::resultArg), line);
+            a.end();
+            return;
+        }
+    }
+    if (iequals(kw, "bumpenvmat")) {
+        Vec4 m{};
+        if (a.floats(m.data(), 4, "bumpenvmat (MAT00 MAT01 MAT10 MAT11)")) s.bumpEnvMat = {m, line};
+    } else if (iequals(kw, "lscale")) {
+        assign(s.lScale, a.floatValue("lscale"), line);
+    } else if (iequals(kw, "loffset")) {
+        assign(s.lOffset, a.floatValue("loffset"), line);
+    } else if (iequals(kw, "transform")) {
+        if (!a.need("transform flags (disable, count1 ... count4 [projected])")) return;
+        std::string_view f = a.next();
+        TransformFlags flags;
+        if (iequals(f, "disable")) {
+            flags.count = 0;
+        } else if (f.size() == 6 && iequals(f.substr(0, 5), "count") && f[5] >= '1' && f[5] <= '4') {
+            flags.count = uint8_t(f[5] - '0');
+            if (a.peekIs("projected")) {
+                a.next();
+                flags.projected = true;
+            }
+        } else {
+            a.error("unknown transform flags " + quote(f) + " (expected disable or count1 ... count4 [projected])");
+            return;
+        }
+        s.transformFlags = {flags, line};
+    } else if (iequals(kw, "texcoordindex")) {
+        std::optional<int64_t> n = a.integer("texcoordindex", 0, 7);
+        if (n) s.texCoordIndex = {uint32_t(*n), line};
+    } else if (iequals(kw, "colorop")) {
+        assign(s.colorOp, a.name(kTextureOps, "texture op"), line);
+    } else if (iequals(kw, "alphaop")) {
+        assign(s.alphaOp, a.name(kTextureOps, "texture op"), line);
+    } else {
+        a.error("unknown keyword " + quote(kw) +
+                " in [stage] (expected bumpenvmat, lscale, loffset, transform, texcoordindex, colorop, "
+                "colorarg0-2, alphaop, alphaarg0-2 or resultarg)");
+        return;
+    }
+    a.end();
+}
+
+void Parser::renderStateLine(Args& a, std::string_view kw) {
+    RenderStateDesc& rs = m_file.renderState;
+    uint32_t line = a.line();
+    if (iequals(kw, "alphablend")) {
+        assign(rs.alphaBlend, a.name(kOnOff, "alphablend"), line);
+    } else if (iequals(kw, "srcblend")) {
+        assign(rs.srcBlend, a.name(kBlends, "blend factor"), line);
+    } else if (iequals(kw, "destblend")) {
+        assign(rs.destBlend, a.name(kBlends, "blend factor"), line);
+    } else if (iequals(kw, "blendop")) {
+        assign(rs.blendOp, a.name(kBlendOps, "blend op"), line);
+    } else if (iequals(kw, "blendfactor")) {
+        assign(rs.blendFactor, a.color("blend factor colour"), line);
+    } else if (iequals(kw, "alphatest")) {
+        std::optional<bool> on = a.name(kOnOff, "alphatest");
+        if (on && *on) {
+            std::optional<CompareFunc> f = a.name(kCompareFuncs, "alpha compare function");
+            std::optional<int64_t> ref = a.integer("alpha reference", 0, 255);
+            if (!f || !ref) return;
+            rs.alphaFunc = {*f, line};
+            rs.alphaRef = {uint32_t(*ref), line};
+        }
+        assign(rs.alphaTest, on, line);
+    } else if (iequals(kw, "texturefactor")) {
+        assign(rs.textureFactor, a.color("texture factor"), line);
+    } else if (iequals(kw, "fog")) {
+        std::optional<bool> on = a.name(kOnOff, "fog");
+        if (on && *on && !a.atEnd()) assign(rs.fogColor, a.color("fog colour"), line);
+        assign(rs.fog, on, line);
+    } else if (iequals(kw, "zfunc")) {
+        assign(rs.zFunc, a.name(kCompareFuncs, "depth compare function"), line);
+    } else if (iequals(kw, "zwrite")) {
+        assign(rs.zWrite, a.name(kOnOff, "zwrite"), line);
+    } else if (iequals(kw, "cullmode")) {
+        assign(rs.cullMode, a.name(kCullModes, "cull mode"), line);
+    } else if (iequals(kw, "colorwrite")) {
+        if (!a.need("colour write channels (any of r g b a, or none)")) return;
+        uint8_t mask = 0;
+        bool ok = true;
+        if (a.peekIs("none")) {
+            a.next();
+        } else {
+            while (ok && !a.atEnd()) {
+                std::string_view t = a.next();
+                for (char c : t) {
+                    char l = lowerChar(c);
+                    uint8_t bit = l == 'r' ? kWriteR : l == 'g' ? kWriteG : l == 'b' ? kWriteB : l == 'a' ? kWriteA : 0;
+                    if (!bit || (mask & bit)) {
+                        a.error("bad colour write channels " + quote(t) + " (any of r g b a, each once, or none)");
+                        ok = false;
+                        break;
+                    }
+                    mask |= bit;
+                }
+            }
+        }
+        if (ok) rs.colorWrite = {mask, line};
+    } else {
+        a.error("unknown keyword " + quote(kw) +
+                " in [render state] (expected alphablend, srcblend, destblend, blendop, blendfactor, alphatest, "
+                "texturefactor, fog, zfunc, zwrite, cullmode or colorwrite)");
+        return;
+    }
+    a.end();
+}
+
+void Parser::transformLine(Args& a, std::string_view kw) {
+    TransformDesc& t = m_file.transform;
+    uint32_t line = a.line();
+    Setting<Matrix4>* target = nullptr;
+    if (iequals(kw, "world")) target = &t.world;
+    else if (iequals(kw, "view")) target = &t.view;
+    else if (iequals(kw, "projection")) target = &t.projection;
+    else if (kw.size() == 8 && iequals(kw.substr(0, 7), "texture") && kw[7] >= '0' && kw[7] <= '7')
+        target = &t.texture[size_t(kw[7] - '0')];
+    if (target) {
+        Matrix4 m{};
+        if (a.floats(m.data(), 16, std::string(kw) + " matrix (16 floats)")) *target = {m, line};
+    } else if (iequals(kw, "viewport")) {
+        Viewport vp;
+        std::optional<int64_t> x = a.integer("viewport x", 0, kMaxSurfaceSize);
+        std::optional<int64_t> y = a.integer("viewport y", 0, kMaxSurfaceSize);
+        std::optional<int64_t> w = a.integer("viewport width", 1, kMaxSurfaceSize);
+        std::optional<int64_t> h = a.integer("viewport height", 1, kMaxSurfaceSize);
+        if (!x || !y || !w || !h) return;
+        vp.x = uint32_t(*x);
+        vp.y = uint32_t(*y);
+        vp.width = uint32_t(*w);
+        vp.height = uint32_t(*h);
+        if (!a.atEnd()) {
+            std::optional<float> zn = a.floatValue("viewport minz"), zf = a.floatValue("viewport maxz");
+            if (!zn || !zf) return;
+            if (*zn < 0 || *zf > 1 || *zn > *zf) {
+                a.error("viewport depth range must satisfy 0 <= minz <= maxz <= 1");
+                return;
+            }
+            vp.minZ = *zn;
+            vp.maxZ = *zf;
+        }
+        t.viewport = {vp, line};
+    } else {
+        a.error("unknown keyword " + quote(kw) +
+                " in [transform] (expected world, view, projection, texture0 ... texture7 or viewport)");
+        return;
+    }
+    a.end();
+}
+
+void Parser::constantsLine(Args& a, std::string_view kw) {
+    std::optional<int> n = registerIndex(kw, 'c');
+    if (!n || *n > 7) {
+        a.error("unknown keyword " + quote(kw) + " in [constants] (expected c0 ... c7)");
+        return;
+    }
+    for (const ConstantDesc& c : m_file.constants)
+        if (c.index == *n) {
+            a.error("c" + std::to_string(*n) + " set twice (first at line " + std::to_string(c.line) + ")");
+            return;
+        }
+    ConstantDesc c;
+    c.line = a.line();
+    c.index = *n;
+    if (!a.floats(c.value.data(), 4, "c" + std::to_string(*n) + " (4 floats)")) return;
+    a.end();
+    m_file.constants.push_back(c);
+}
+
+bool Parser::conditionPrefix(Args& a, Condition& cond) {
+    if (a.peek() != "(") {
+        a.error("missing '(' after the prefix (e.g. if(gl) or todo(fx8))");
+        return false;
+    }
+    a.next();
+    bool any = false;
+    while (!a.atEnd() && a.peek() != ")") {
+        std::string_view t = a.next();
+        if (t == ",") continue;
+        if (std::optional<Backend> b = lookup(kBackends, t)) {
+            cond.backends |= uint8_t(1u << unsigned(*b));
+        } else if (std::optional<Precision> p = lookup(kPrecisions, t)) {
+            cond.precisions |= uint8_t(1u << unsigned(*p));
+        } else {
+            a.error("unknown condition " + quote(t) + " (expected a backend: emu, gl, or a precision: fx8, fx12, "
+                    "float, ideal)");
+            return false;
+        }
+        any = true;
+    }
+    if (a.atEnd()) {
+        a.error("missing ')' after the condition");
+        return false;
+    }
+    a.next();
+    if (!any) {
+        a.error("empty condition '()'");
+        return false;
+    }
+    return true;
+}
+
+void Parser::testLine(uint32_t line, const Tokens& toks) {
+    std::string_view first = toks[0];
+    if (looksNumeric(first) || first == "(") {
+        Args a(toks, 0, line, m_errors);
+        if (m_pending == Pending::Draw) {
+            vertexLine(a, std::get<DrawPrimitives>(m_file.commands.back().op));
+        } else if (m_pending != Pending::Skip) {
+            a.error("vertex line without a 'draw triangles|strip|fan' before it");
+        }
+        return;
+    }
+    if ((registerIndex(first, 'v') || registerIndex(first, 't')) &&
+        (m_pending == Pending::Eval || m_pending == Pending::Skip)) {
+        Args a(toks, 0, line, m_errors);
+        if (m_pending == Pending::Eval) evalLine(a, std::get<Eval>(m_file.commands.back().op));
+        return;
+    }
+    closePending();
+    m_pending = Pending::Skip;  // until the command line below parses
+    Args a(toks, 0, line, m_errors);
+    TestCommand cmd;
+    cmd.line = line;
+    bool sawIf = false;
+    while (a.peekIs("if") || a.peekIs("todo")) {
+        bool isIf = a.peekIs("if");
+        a.next();
+        if (isIf ? sawIf : cmd.todo) {
+            a.error(std::string("more than one ") + (isIf ? "if(...)" : "todo") + " prefix");
+            return;
+        }
+        if (isIf) {
+            sawIf = true;
+            if (!conditionPrefix(a, cmd.onlyIf)) return;
+        } else {
+            cmd.todo = true;
+            if (a.peek() == "(" && !conditionPrefix(a, cmd.todoIf)) return;
+        }
+    }
+    if (!a.need("command after the prefix (draw, eval or probe)")) return;
+    std::string_view kw = a.next();
+    if (iequals(kw, "draw")) {
+        if (!drawCommand(a, cmd)) return;
+    } else if (iequals(kw, "eval")) {
+        cmd.op = Eval{};
+        a.end();
+    } else if (iequals(kw, "probe")) {
+        if (!probeCommand(a, cmd)) return;
+    } else if (registerIndex(kw, 'v') || registerIndex(kw, 't')) {
+        a.error("interpolant " + quote(kw) + " outside an eval (write 'eval' on the line before)");
+        return;
+    } else {
+        a.error("unknown command " + quote(kw) + " in [test] (expected draw, eval or probe)");
+        return;
+    }
+    if (cmd.todo && !std::holds_alternative<Probe>(cmd.op)) {
+        a.error("todo applies to probes only");
+        return;
+    }
+    bool isDraw = std::holds_alternative<DrawPrimitives>(cmd.op);
+    bool isEval = std::holds_alternative<Eval>(cmd.op);
+    m_file.commands.push_back(std::move(cmd));
+    m_pending = isDraw ? Pending::Draw : isEval ? Pending::Eval : Pending::None;
+}
+
+bool Parser::drawCommand(Args& a, TestCommand& cmd) {
+    if (!a.need("primitive (quad, triangles, strip or fan)")) return false;
+    std::string_view prim = a.next();
+    if (iequals(prim, "quad")) {
+        DrawQuad q;
+        std::array<bool, 8> seenSet{};
+        bool seenDiffuse = false, seenSpecular = false;
+        while (!a.atEnd()) {
+            std::string_view opt = a.next();
+            std::optional<int> set = registerIndex(opt, 't');
+            if (iequals(opt, "diffuse") || iequals(opt, "specular")) {
+                bool& seen = iequals(opt, "diffuse") ? seenDiffuse : seenSpecular;
+                if (seen) a.error(quote(opt) + " given twice");
+                seen = true;
+                std::optional<Color> c = a.color(std::string(opt) + " colour");
+                if (!c) return false;
+                (iequals(opt, "diffuse") ? q.diffuse : q.specular) = *c;
+            } else if (set && *set <= 7) {
+                if (seenSet[size_t(*set)]) a.error(quote(opt) + " given twice");
+                seenSet[size_t(*set)] = true;
+                Vec4& r = q.texRect[size_t(*set)];
+                if (!a.floats(r.data(), 4, std::string(opt) + " rectangle (u0 v0 u1 v1)")) return false;
+            } else if (iequals(opt, "rect")) {
+                if (q.hasRect) a.error("'rect' given twice");
+                for (int i = 0; i < 4; ++i) {
+                    static const char* names[] = {"rect x0", "rect y0", "rect x1", "rect y1"};
+                    std::optional<int64_t> v = a.integer(names[i], 0, kMaxSurfaceSize);
+                    if (!v) return false;
+                    q.rect[size_t(i)] = uint32_t(*v);
+                }
+                if (q.rect[0] >= q.rect[2] || q.rect[1] >= q.rect[3]) {
+                    a.error("empty draw rect (x0 < x1 and y0 < y1 needed)");
+                    return false;
+                }
+                q.hasRect = true;
+            } else {
+                a.error("unknown draw quad option " + quote(opt) + " (expected diffuse, specular, t0 ... t7 or rect)");
+                return false;
+            }
+        }
+        cmd.op = q;
+        return true;
+    }
+    DrawPrimitives d;
+    if (iequals(prim, "triangles")) d.type = PrimitiveType::TriangleList;
+    else if (iequals(prim, "strip")) d.type = PrimitiveType::TriangleStrip;
+    else if (iequals(prim, "fan")) d.type = PrimitiveType::TriangleFan;
+    else {
+        a.error("unknown primitive " + quote(prim) + " (expected quad, triangles, strip or fan)");
+        return false;
+    }
+    if (!a.need("vertex format (xyzrhw or xyz)")) return false;
+    std::string_view fmt = a.next();
+    if (iequals(fmt, "xyzrhw")) d.pretransformed = true;
+    else if (!iequals(fmt, "xyz")) {
+        a.error("unknown vertex format " + quote(fmt) + " (expected xyzrhw or xyz)");
+        return false;
+    }
+    a.end();
+    cmd.op = std::move(d);
+    return true;
+}
+
+void Parser::vertexLine(Args& a, DrawPrimitives& draw) {
+    Vertex v;
+    v.line = a.line();
+    int n = draw.pretransformed ? 4 : 3;
+    static const char* names[] = {"vertex x", "vertex y", "vertex z", "vertex rhw"};
+    for (int i = 0; i < n; ++i) {
+        std::optional<float> f = a.floatValue(names[i]);
+        if (!f) return;
+        v.position[size_t(i)] = *f;
+    }
+    if (draw.pretransformed && !(v.position[3] > 0)) {
+        a.error("vertex rhw must be > 0");
+        return;
+    }
+    std::optional<uint32_t> diffuse = a.word("vertex diffuse colour");
+    if (!diffuse) return;
+    std::optional<uint32_t> specular = a.word("vertex specular colour");
+    if (!specular) return;
+    v.diffuse = *diffuse;
+    v.specular = *specular;
+    while (!a.atEnd()) {
+        std::string_view t = a.next();
+        std::optional<int> set = registerIndex(t, 't');
+        if (!set || *set > 7) {
+            a.error("unexpected " + quote(t) + " in a vertex (expected t0 ... t7 and 2-4 coordinates)");
+            return;
+        }
+        if (v.texComponents[size_t(*set)]) {
+            a.error(quote(t) + " given twice in one vertex");
+            return;
+        }
+        uint8_t count = 0;
+        while (count < 4 && a.peekNumeric()) {
+            std::optional<float> f = a.floatValue(std::string(t) + " coordinate");
+            if (!f) return;
+            v.tex[size_t(*set)][count++] = *f;
+        }
+        if (count < 2) {
+            a.error(quote(t) + " needs 2 to 4 coordinates");
+            return;
+        }
+        v.texComponents[size_t(*set)] = count;
+    }
+    draw.vertices.push_back(v);
+}
+
+void Parser::evalLine(Args& a, Eval& eval) {
+    std::string_view t = a.next();
+    bool isColor = lowerChar(t[0]) == 'v';
+    int index = *registerIndex(t, isColor ? 'v' : 't');
+    if (index > (isColor ? 1 : 7)) {
+        a.error("no interpolant " + quote(t) + (isColor ? " (v0 or v1)" : " (t0 ... t7)"));
+        return;
+    }
+    Setting<Vec4>& slot = isColor ? eval.color[size_t(index)] : eval.texture[size_t(index)];
+    if (slot.isSet()) {
+        a.error(quote(t) + " given twice (first at line " + std::to_string(slot.line) + ")");
+        return;
+    }
+    Vec4 v{0, 0, 0, 0};
+    if (isColor && isHexToken(a.peek())) {
+        std::optional<uint32_t> w = a.word(std::string(t) + " colour");
+        if (!w) return;
+        v = Color::fromArgb(*w).rgba;
+    } else {
+        if (!a.need(std::string(t) + " value (1-4 floats)")) return;
+        size_t count = 0;
+        while (!a.atEnd() && count < 4) {
+            std::optional<float> f = a.floatValue(std::string(t) + " component");
+            if (!f) return;
+            v[count++] = *f;
+        }
+    }
+    a.end();
+    slot = {v, a.line()};
+}
+
+bool Parser::probeCommand(Args& a, TestCommand& cmd) {
+    Probe p;
+    if (!a.need("probe target (X Y, rect, all or eval)")) return false;
+    if (a.peekIs("eval")) {
+        a.next();
+        p.kind = ProbeKind::Eval;
+        if (a.peekIs("killed")) {
+            a.next();
+            p.kind = ProbeKind::EvalKilled;
+            a.end();
+            cmd.op = p;
+            return true;
+        }
+    } else if (a.peekIs("all")) {
+        a.next();
+        p.kind = ProbeKind::All;
+    } else if (a.peekIs("rect")) {
+        a.next();
+        p.kind = ProbeKind::Rect;
+        static const char* names[] = {"probe rect x0", "probe rect y0", "probe rect x1", "probe rect y1"};
+        for (int i = 0; i < 4; ++i) {
+            std::optional<int64_t> v = a.integer(names[i], 0, kMaxSurfaceSize);
+            if (!v) return false;
+            p.rect[size_t(i)] = uint32_t(*v);
+        }
+        if (p.rect[0] >= p.rect[2] || p.rect[1] >= p.rect[3]) {
+            a.error("empty probe rect (x0 < x1 and y0 < y1 needed)");
+            return false;
+        }
+    } else if (a.peekNumeric()) {
+        std::optional<int64_t> x = a.integer("probe x", 0, kMaxSurfaceSize - 1);
+        std::optional<int64_t> y = a.integer("probe y", 0, kMaxSurfaceSize - 1);
+        if (!x || !y) return false;
+        p.rect = {uint32_t(*x), uint32_t(*y), uint32_t(*x + 1), uint32_t(*y + 1)};
+    } else {
+        a.error("unknown probe target " + quote(a.peek()) + " (expected X Y, rect, all, eval or eval killed)");
+        return false;
+    }
+    if (!a.need("channels (rgba or rgb)")) return false;
+    std::string_view ch = a.next();
+    if (iequals(ch, "rgba")) p.alpha = true;
+    else if (iequals(ch, "rgb")) p.alpha = false;
+    else {
+        a.error("unknown probe channels " + quote(ch) + " (expected rgba or rgb)");
+        return false;
+    }
+    std::optional<Color> c = a.color("expected colour", p.alpha ? 4 : 3);
+    if (!c) return false;
+    p.expected = *c;
+    if (a.peekIs("tol")) {
+        a.next();
+        std::optional<float> t = a.floatValue("tolerance");
+        if (!t) return false;
+        if (*t < 0) {
+            a.error("tolerance must be >= 0");
+            return false;
+        }
+        p.tolerance = *t;
+    }
+    a.end();
+    cmd.op = p;
+    return true;
+}
+
+void Parser::closePending() {
+    if (m_pending == Pending::Draw) {
+        const TestCommand& cmd = m_file.commands.back();
+        const DrawPrimitives& d = std::get<DrawPrimitives>(cmd.op);
+        size_t n = d.vertices.size();
+        if (d.type == PrimitiveType::TriangleList && (n == 0 || n % 3 != 0))
+            error(cmd.line, "draw triangles has " + std::to_string(n) + " vertices (a positive multiple of 3 needed)");
+        else if (d.type != PrimitiveType::TriangleList && n < 3)
+            error(cmd.line, std::string("draw ") + (d.type == PrimitiveType::TriangleStrip ? "strip" : "fan") +
+                                " has " + std::to_string(n) + " vertices (at least 3 needed)");
+    }
+    m_pending = Pending::None;
+}
+
+// Checks that need the whole file: probes inside the target, evals with a shader.
+void Parser::finish() {
+    const PixelShaderBlock& ps = m_file.pixelShader;
+    if (ps.expectFail && !m_file.commands.empty())
+        error(m_file.testLine, "[test] commands cannot run: the [pixel shader fail] block is expected not to assemble");
+    uint32_t w = m_file.renderTarget.size.value[0], h = m_file.renderTarget.size.value[1];
+    bool sawEval = false;
+    for (const TestCommand& cmd : m_file.commands) {
+        if (const DrawQuad* q = std::get_if<DrawQuad>(&cmd.op)) {
+            if (q->hasRect && (q->rect[2] > w || q->rect[3] > h))
+                error(cmd.line, "draw rect reaches outside the " + std::to_string(w) + "x" + std::to_string(h) +
+                                    " render target");
+        } else if (std::holds_alternative<Eval>(cmd.op)) {
+            sawEval = true;
+            if (!ps.present()) error(cmd.line, "eval needs a [pixel shader]");
+        } else if (const Probe* p = std::get_if<Probe>(&cmd.op)) {
+            if (p->kind == ProbeKind::Pixel || p->kind == ProbeKind::Rect) {
+                if (p->rect[2] > w || p->rect[3] > h)
+                    error(cmd.line, "probe reaches outside the " + std::to_string(w) + "x" + std::to_string(h) +
+                                        " render target");
+            } else if ((p->kind == ProbeKind::Eval || p->kind == ProbeKind::EvalKilled) && !sawEval) {
+                error(cmd.line, "probe eval without an eval before it");
+            }
+        }
+    }
+}
+
+}  // namespace
+
+const char* backendName(Backend b) { return b == Backend::Gl ? "gl" : "emu"; }
+
+const char* precisionName(Precision p) {
+    for (const auto& e : kPrecisions)
+        if (e.value == p) return e.name;
+    return "?";
+}
+
+const char* texFormatName(TexFormat f) {
+    for (const auto& e : kFormats)
+        if (e.value == f) return e.name;
+    return "?";
+}
+
+bool isFloatFormat(TexFormat f) {
+    return f == TexFormat::A16B16G16R16F || f == TexFormat::A32B32G32R32F || f == TexFormat::R32F;
+}
+
+int formatBits(TexFormat f) {
+    switch (f) {
+    case TexFormat::A8:
+    case TexFormat::L8: return 8;
+    case TexFormat::A8L8:
+    case TexFormat::V8U8:
+    case TexFormat::L6V5U5: return 16;
+    case TexFormat::A16B16G16R16F:
+    case TexFormat::A32B32G32R32F:
+    case TexFormat::R32F: return 0;
+    default: return 32;
+    }
+}
+
+const char* textureOpName(TextureOp op) {
+    for (const auto& e : kTextureOps)
+        if (e.value == op) return e.name;
+    return "?";
+}
+
+Color Color::fromArgb(uint32_t argb) {
+    Color c;
+    c.packed = true;
+    c.argb = argb;
+    c.rgba = {float((argb >> 16) & 0xff) / 255.0f, float((argb >> 8) & 0xff) / 255.0f, float(argb & 0xff) / 255.0f,
+              float(argb >> 24) / 255.0f};
+    return c;
+}
+
+Color Color::fromFloats(const Vec4& rgba) {
+    Color c;
+    c.packed = false;
+    c.rgba = rgba;
+    auto level = [](float v) { return uint32_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); };
+    c.argb = (level(rgba[3]) << 24) | (level(rgba[0]) << 16) | (level(rgba[1]) << 8) | level(rgba[2]);
+    return c;
+}
+
+StageDesc defaultStage(int stage) {
+    // D3D9 defaults (IDirect3DDevice9::SetTextureStageState): stage 0 modulates texture by
+    // diffuse and selects texture alpha, every other stage is disabled.
+    StageDesc s;
+    s.stage = stage;
+    s.colorOp.value = stage == 0 ? TextureOp::Modulate : TextureOp::Disable;
+    s.alphaOp.value = stage == 0 ? TextureOp::SelectArg1 : TextureOp::Disable;
+    s.colorArg1.value = {ArgSource::Texture, false, false};
+    s.colorArg2.value = {ArgSource::Current, false, false};
+    s.alphaArg1.value = {ArgSource::Texture, false, false};
+    s.alphaArg2.value = {ArgSource::Current, false, false};
+    s.colorArg0.value = s.alphaArg0.value = s.resultArg.value = {ArgSource::Current, false, false};
+    s.texCoordIndex.value = uint32_t(stage);
+    return s;
+}
+
+Matrix4 identityMatrix() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
+
+DrawQuad::DrawQuad() { texRect.fill({0, 0, 1, 1}); }
+
+bool Condition::matches(Backend b, Precision p) const {
+    bool backendOk = backends == 0 || (backends & (1u << unsigned(b)));
+    bool precisionOk = precisions == 0 || (precisions & (1u << unsigned(p)));
+    return backendOk && precisionOk;
+}
+
+std::string PixelShaderBlock::textWithFileLines() const {
+    return std::string(firstLine > 1 ? firstLine - 1 : 0, '\n') + text;
+}
+
+const TextureDesc* TestFile::texture(int stage) const {
+    for (const TextureDesc& t : textures)
+        if (t.stage == stage) return &t;
+    return nullptr;
+}
+
+const SamplerDesc* TestFile::sampler(int stage) const {
+    for (const SamplerDesc& s : samplers)
+        if (s.stage == stage) return &s;
+    return nullptr;
+}
+
+const StageDesc* TestFile::stage(int stage) const {
+    for (const StageDesc& s : stages)
+        if (s.stage == stage) return &s;
+    return nullptr;
+}
+
+bool parseTestFile(std::string_view text, const std::string& fileName, TestFile& out,
+                   std::vector<TestFileError>& errors) {
+    size_t before = errors.size();
+    out = TestFile{};
+    out.fileName = fileName;
+    Parser(out, errors).run(text);
+    return errors.size() == before;
+}
+
+std::string formatTestFileError(const std::string& fileName, const TestFileError& error) {
+    if (error.line == 0) return fileName + ": " + error.message;
+    return fileName + ":" + std::to_string(error.line) + ": " + error.message;
+}
+
+}  // namespace ps11
