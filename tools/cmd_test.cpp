@@ -1,0 +1,203 @@
+// `ps11 test` (stage: command line over the .ps11test reader, the assembler and the
+// validator). Each file is parsed, its [pixel shader] is assembled and validated (or must fail
+// with the expected diagnostic), and its draws, evals and probes are counted as "not yet
+// runnable" until the executor and the device run them; they never make the run fail.
+#include "tools/cmd_test.h"
+
+#include <iostream>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "ps11/assembler.h"
+#include "ps11/diagnostics.h"
+#include "ps11/testfile.h"
+#include "ps11/validator.h"
+#include "tools/cli_util.h"
+
+namespace ps11 {
+namespace {
+
+constexpr const char* kUsage =
+    "usage: ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [-v]\n";
+
+int usageError(const std::string& message) {
+    std::cerr << "ps11 test: " << message << "\n" << kUsage;
+    return cli::kUsage;
+}
+
+struct RunOptions {
+    uint8_t backends = kBackendEmu;
+    std::optional<Precision> precision;  // overrides [require] precision when given
+    bool verbose = false;
+};
+
+enum class Outcome { Passed, Failed, NotRunnable };
+
+struct FileResult {
+    Outcome outcome = Outcome::Passed;
+    size_t pendingCommands = 0;  // commands the run would execute, not runnable yet
+    bool skipped = false;        // [require] backend excludes every backend of this run
+};
+
+std::string where(const std::string& path, uint32_t line) {
+    return line ? path + ":" + std::to_string(line) : path;
+}
+
+// True if d is the expected failure of the block (code, and place when given).
+bool matchesExpectation(const Diagnostics& diags, const Diagnostic& d, const PixelShaderBlock& ps,
+                        const std::string& path) {
+    if (d.severity != Severity::Error || d.code != ps.failCode) return false;
+    if (ps.failLine == 0) return true;
+    if (d.loc.tokenIndex >= 0 || diags.fileName(d.loc.fileId) != path) return false;
+    return d.loc.line == ps.failLine && (ps.failCol == 0 || d.loc.col == ps.failCol);
+}
+
+// Assembles and validates the [pixel shader] block; returns false (after reporting) when the
+// result is not what the block expects.
+bool checkShader(const TestFile& file, const std::string& path, const RunOptions& opts) {
+    const PixelShaderBlock& ps = file.pixelShader;
+    Diagnostics diags;
+    AssembleOptions options;
+    // The block is assembled as if it stood alone in the .ps11test file, so every diagnostic
+    // carries the file's own line numbers.
+    std::optional<Program> program = parseAssembly(ps.textWithFileLines(), path, options, diags);
+    if (program) validate(*program, diags);
+
+    if (!ps.expectFail) {
+        if (!diags.hasErrors()) {
+            if (opts.verbose && !diags.all().empty()) std::cout << diags.formatAll();
+            return true;
+        }
+        std::cout << where(path, ps.line) << ": [pixel shader] does not assemble and validate:\n"
+                  << diags.formatAll();
+        return false;
+    }
+    std::string expected = ps.failCode;
+    if (ps.failLine) {
+        expected += " at " + std::to_string(ps.failLine);
+        if (ps.failCol) expected += ":" + std::to_string(ps.failCol);
+    }
+    if (!diags.hasErrors()) {
+        std::cout << where(path, ps.line) << ": expected the shader to fail with " << expected
+                  << ", but it assembled and validated\n";
+        return false;
+    }
+    for (const Diagnostic& d : diags.all())
+        if (matchesExpectation(diags, d, ps, path)) {
+            if (opts.verbose) std::cout << diags.formatAll();
+            return true;
+        }
+    std::cout << where(path, ps.line) << ": expected " << expected << ", got:\n" << diags.formatAll();
+    return false;
+}
+
+// Counts the commands this run would execute (their if(...) matches a backend and precision of
+// the run).
+size_t countPending(const TestFile& file, uint8_t backends, Precision precision) {
+    size_t n = 0;
+    for (const TestCommand& cmd : file.commands) {
+        bool runs = false;
+        for (Backend b : {Backend::Emu, Backend::Gl})
+            if ((backends & (1u << unsigned(b))) && cmd.onlyIf.matches(b, precision)) runs = true;
+        if (runs) ++n;
+    }
+    return n;
+}
+
+FileResult runFile(const std::string& path, const RunOptions& opts) {
+    FileResult result;
+    std::optional<std::string> text = cli::readFile(path);
+    if (!text) {
+        result.outcome = Outcome::Failed;
+        return result;
+    }
+    TestFile file;
+    std::vector<TestFileError> errors;
+    if (!parseTestFile(*text, path, file, errors)) {
+        for (const TestFileError& e : errors) std::cout << formatTestFileError(path, e) << "\n";
+        result.outcome = Outcome::Failed;
+        return result;
+    }
+    bool ok = true;
+    if (file.pixelShader.present()) ok = checkShader(file, path, opts);
+    if (!ok) {
+        result.outcome = Outcome::Failed;
+        return result;
+    }
+    uint8_t backends = opts.backends & file.require.backends.value;
+    Precision precision = opts.precision.value_or(file.require.precision.value);
+    if (backends == 0) {
+        result.skipped = !file.commands.empty();
+        return result;
+    }
+    result.pendingCommands = countPending(file, backends, precision);
+    if (result.pendingCommands > 0) result.outcome = Outcome::NotRunnable;
+    return result;
+}
+
+}  // namespace
+
+int cmdTest(const std::vector<std::string>& args) {
+    RunOptions opts;
+    std::vector<std::string> files;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--backend" || a == "--precision") {
+            if (i + 1 >= args.size()) return usageError(a + " needs a value");
+            const std::string& v = args[++i];
+            if (a == "--backend") {
+                if (v == "emu") opts.backends = kBackendEmu;
+                else if (v == "gl") opts.backends = kBackendGl;
+                else if (v == "both") opts.backends = kBackendEmu | kBackendGl;
+                else return usageError("unknown backend '" + v + "' (expected emu, gl or both)");
+            } else {
+                if (v == "fx8") opts.precision = Precision::Fx8;
+                else if (v == "fx12") opts.precision = Precision::Fx12;
+                else if (v == "float") opts.precision = Precision::Float;
+                else if (v == "ideal") opts.precision = Precision::Ideal;
+                else return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+            }
+        } else if (a == "-v" || a == "--verbose") {
+            opts.verbose = true;
+        } else if (a == "-h" || a == "--help") {
+            std::cout << kUsage;
+            return cli::kOk;
+        } else if (a.size() > 1 && a[0] == '-') {
+            return usageError("unknown option '" + a + "'");
+        } else {
+            files.push_back(a);
+        }
+    }
+    if (files.empty()) return usageError("no .ps11test files given");
+
+    size_t passed = 0, failed = 0, notRunnable = 0, pending = 0, skipped = 0;
+    for (const std::string& path : files) {
+        FileResult r = runFile(path, opts);
+        pending += r.pendingCommands;
+        if (r.skipped) ++skipped;
+        switch (r.outcome) {
+        case Outcome::Passed: ++passed; break;
+        case Outcome::Failed: ++failed; break;
+        case Outcome::NotRunnable: ++notRunnable; break;
+        }
+        if (opts.verbose) {
+            const char* label = r.outcome == Outcome::Failed ? "FAIL"
+                                : r.outcome == Outcome::Passed ? (r.skipped ? "PASS (commands skipped)" : "PASS")
+                                                               : "NOT YET RUNNABLE";
+            std::cout << label << " " << path;
+            if (r.outcome == Outcome::NotRunnable) std::cout << " (" << r.pendingCommands << " commands)";
+            std::cout << "\n";
+        }
+    }
+    std::cout << files.size() << (files.size() == 1 ? " file: " : " files: ") << passed << " passed, " << failed
+              << " failed, " << notRunnable << " not yet runnable (eval/draw";
+    if (pending) std::cout << ": " << pending << (pending == 1 ? " command" : " commands");
+    std::cout << ")";
+    if (skipped) std::cout << ", " << skipped << " with commands skipped by [require] backend";
+    std::cout << "\n";
+    return failed ? cli::kUserError : cli::kOk;
+}
+
+}  // namespace ps11
