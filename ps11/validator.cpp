@@ -343,15 +343,14 @@ bool Validator::run() {
             checkTexRegisters(i);
             // Data flow: a co-issued pair reads all sources before either member writes (spec §3.5).
             dataflowReads(i);
-            const bool pairFollows = i + 1 < n && inst(i + 1).coissue;
-            if (pairFollows) {
+            const bool pairFollows = isArith(in) && !in.coissue && i + 1 < n && inst(i + 1).coissue;
+            if (m_pendingWrites < n) dataflowWrites(m_pendingWrites);  // the pair's first member writes now
+            m_pendingWrites = SIZE_MAX;
+            if (pairFollows)
                 m_pendingWrites = i;
-            } else {
-                if (m_pendingWrites + 1 == i && in.coissue) dataflowWrites(m_pendingWrites);
+            else
                 dataflowWrites(i);
-                m_pendingWrites = SIZE_MAX;
-            }
-        } else if (m_pendingWrites + 1 == i) {
+        } else if (m_pendingWrites < n) {
             dataflowWrites(m_pendingWrites);
             m_pendingWrites = SIZE_MAX;
         }
