@@ -163,6 +163,7 @@ int cmdCheck(const std::vector<std::string>& args) {
         } else {
             prog = assembleFile(path, pp, true, &stats, diags);
         }
+        std::cout.flush();
         std::cerr << diags.formatAll();
         bool ok = prog && !diags.hasErrors();
         if (!ok) status = kUserError;
