@@ -83,8 +83,10 @@ void Validator::checkMasks(size_t i) {
     const Opcode op = in.opcode();
     const uint8_t mask = in.dst.mask & kMaskAll;
     if (op == Opcode::Def) {
-        if (mask != kMaskAll || in.dst.saturate || in.dst.shift != 0)
-            error(kDefOperand, in.dst.loc, "def writes a whole constant: no write mask and no instruction modifier");
+        if (mask != kMaskAll)
+            error(kDefOperand, in.dst.loc, "def writes a whole constant; found the write mask " + maskName(mask));
+        if (in.dst.saturate || in.dst.shift != 0)
+            error(kDefOperand, in.loc, "def takes no instruction modifier");
         return;
     }
     if (isArith(in)) {
