@@ -827,3 +827,23 @@ TEST_CASE("testfile: the format corpus parses", "[testfile]") {
     }
     CHECK(count >= 5);
 }
+
+TEST_CASE("testfile: the examples in docs/test-format.md parse", "[testfile][docs]") {
+    std::ifstream in(std::filesystem::path(PS11_SOURCE_DIR) / "docs" / "test-format.md", std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string page = ss.str();
+    REQUIRE(!page.empty());
+    int blocks = 0;
+    for (size_t pos = page.find("```ps11test\n"); pos != std::string::npos; pos = page.find("```ps11test\n", pos)) {
+        pos += 12;
+        size_t end = page.find("```", pos);
+        REQUIRE(end != std::string::npos);
+        Parsed p = parse(page.substr(pos, end - pos));
+        INFO(page.substr(pos, end - pos));
+        REQUIRE_OK(p);
+        pos = end + 3;
+        ++blocks;
+    }
+    CHECK(blocks >= 3);
+}
