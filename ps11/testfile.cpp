@@ -96,10 +96,14 @@ std::optional<uint32_t> parseHex(std::string_view s) {
     uint32_t v = 0;
     for (char c : s.substr(2)) {
         int d;
-        if (isDigit(c)) d = c - '0';
-        else if (c >= 'a' && c <= 'f') d = c - 'a' + 10;
-        else if (c >= 'A' && c <= 'F') d = c - 'A' + 10;
-        else return std::nullopt;
+        if (isDigit(c))
+            d = c - '0';
+        else if (c >= 'a' && c <= 'f')
+            d = c - 'a' + 10;
+        else if (c >= 'A' && c <= 'F')
+            d = c - 'A' + 10;
+        else
+            return std::nullopt;
         v = v * 16 + uint32_t(d);
     }
     return v;
@@ -149,12 +153,18 @@ std::string namesOf(const NameEntry<E> (&table)[N]) {
 }
 
 const NameEntry<TexFormat> kFormats[] = {
-    {"A8R8G8B8", TexFormat::A8R8G8B8}, {"X8R8G8B8", TexFormat::X8R8G8B8},
-    {"A8", TexFormat::A8},             {"L8", TexFormat::L8},
-    {"A8L8", TexFormat::A8L8},         {"V8U8", TexFormat::V8U8},
-    {"L6V5U5", TexFormat::L6V5U5},     {"X8L8V8U8", TexFormat::X8L8V8U8},
-    {"Q8W8V8U8", TexFormat::Q8W8V8U8}, {"V16U16", TexFormat::V16U16},
-    {"A16B16G16R16F", TexFormat::A16B16G16R16F}, {"A32B32G32R32F", TexFormat::A32B32G32R32F},
+    {"A8R8G8B8", TexFormat::A8R8G8B8},
+    {"X8R8G8B8", TexFormat::X8R8G8B8},
+    {"A8", TexFormat::A8},
+    {"L8", TexFormat::L8},
+    {"A8L8", TexFormat::A8L8},
+    {"V8U8", TexFormat::V8U8},
+    {"L6V5U5", TexFormat::L6V5U5},
+    {"X8L8V8U8", TexFormat::X8L8V8U8},
+    {"Q8W8V8U8", TexFormat::Q8W8V8U8},
+    {"V16U16", TexFormat::V16U16},
+    {"A16B16G16R16F", TexFormat::A16B16G16R16F},
+    {"A32B32G32R32F", TexFormat::A32B32G32R32F},
     {"R32F", TexFormat::R32F},
 };
 const NameEntry<TexFormat> kTargetFormats[] = {
@@ -166,8 +176,10 @@ const NameEntry<TexFormat> kTargetFormats[] = {
 const NameEntry<Filter> kFilters[] = {{"point", Filter::Point}, {"linear", Filter::Linear}};
 const NameEntry<Filter> kMipFilters[] = {{"none", Filter::None}, {"point", Filter::Point}, {"linear", Filter::Linear}};
 const NameEntry<AddressMode> kAddressModes[] = {
-    {"wrap", AddressMode::Wrap}, {"clamp", AddressMode::Clamp},
-    {"mirror", AddressMode::Mirror}, {"border", AddressMode::Border},
+    {"wrap", AddressMode::Wrap},
+    {"clamp", AddressMode::Clamp},
+    {"mirror", AddressMode::Mirror},
+    {"border", AddressMode::Border},
 };
 const NameEntry<TextureOp> kTextureOps[] = {
     {"disable", TextureOp::Disable},
@@ -198,7 +210,7 @@ const NameEntry<TextureOp> kTextureOps[] = {
     {"lerp", TextureOp::Lerp},
 };
 const NameEntry<ArgSource> kArgSources[] = {
-    {"diffuse", ArgSource::Diffuse}, {"current", ArgSource::Current}, {"texture", ArgSource::Texture},
+    {"diffuse", ArgSource::Diffuse}, {"current", ArgSource::Current},   {"texture", ArgSource::Texture},
     {"tfactor", ArgSource::TFactor}, {"specular", ArgSource::Specular}, {"temp", ArgSource::Temp},
 };
 const NameEntry<Blend> kBlends[] = {
@@ -223,14 +235,21 @@ const NameEntry<BlendOp> kBlendOps[] = {
     {"min", BlendOp::Min}, {"max", BlendOp::Max},
 };
 const NameEntry<CompareFunc> kCompareFuncs[] = {
-    {"never", CompareFunc::Never},     {"less", CompareFunc::Less},
-    {"equal", CompareFunc::Equal},     {"lessequal", CompareFunc::LessEqual},
-    {"greater", CompareFunc::Greater}, {"notequal", CompareFunc::NotEqual},
-    {"greaterequal", CompareFunc::GreaterEqual}, {"always", CompareFunc::Always},
+    {"never", CompareFunc::Never},
+    {"less", CompareFunc::Less},
+    {"equal", CompareFunc::Equal},
+    {"lessequal", CompareFunc::LessEqual},
+    {"greater", CompareFunc::Greater},
+    {"notequal", CompareFunc::NotEqual},
+    {"greaterequal", CompareFunc::GreaterEqual},
+    {"always", CompareFunc::Always},
 };
 const NameEntry<CullMode> kCullModes[] = {{"none", CullMode::None}, {"cw", CullMode::Cw}, {"ccw", CullMode::Ccw}};
 const NameEntry<Precision> kPrecisions[] = {
-    {"fx8", Precision::Fx8}, {"fx12", Precision::Fx12}, {"float", Precision::Float}, {"ideal", Precision::Ideal},
+    {"fx8", Precision::Fx8},
+    {"fx12", Precision::Fx12},
+    {"float", Precision::Float},
+    {"ideal", Precision::Ideal},
 };
 const NameEntry<Backend> kBackends[] = {{"emu", Backend::Emu}, {"gl", Backend::Gl}};
 const NameEntry<bool> kOnOff[] = {{"on", true}, {"off", false}};
@@ -325,8 +344,10 @@ public:
             return Color::fromArgb(*w);
         }
         if (count < size_t(channels)) {
-            if (count == 0) error("bad " + what + " " + quote(next()));
-            else error(what + " needs one 0xAARRGGBB word or " + std::to_string(channels) + " floats");
+            if (count == 0)
+                error("bad " + what + " " + quote(next()));
+            else
+                error(what + " needs one 0xAARRGGBB word or " + std::to_string(channels) + " floats");
             m_pos += count;
             return std::nullopt;
         }
@@ -386,8 +407,19 @@ uint32_t maxLevels(uint32_t w, uint32_t h, uint32_t d) {
     return n;
 }
 
-enum class Section { None, Require, RenderTarget, Texture, Sampler, Stage, RenderState, Transform, Constants,
-                     PixelShader, Test };
+enum class Section {
+    None,
+    Require,
+    RenderTarget,
+    Texture,
+    Sampler,
+    Stage,
+    RenderState,
+    Transform,
+    Constants,
+    PixelShader,
+    Test
+};
 
 class Parser {
 public:
@@ -563,8 +595,8 @@ void Parser::openSection(uint32_t line, const Tokens& toks) {
         }
     } else if (is(0, "pixel") && is(1, "shader")) {
         if (m_file.pixelShader.present()) {
-            error(line, "duplicate [pixel shader] section (first at line " +
-                            std::to_string(m_file.pixelShader.line) + ")");
+            error(line,
+                  "duplicate [pixel shader] section (first at line " + std::to_string(m_file.pixelShader.line) + ")");
             m_section = Section::None;
             return;
         }
@@ -600,8 +632,8 @@ void Parser::openSection(uint32_t line, const Tokens& toks) {
         std::string_view place = h.next();
         size_t colon = place.find(':');
         std::optional<uint32_t> l = parseWord(place.substr(0, colon));
-        std::optional<uint32_t> c = colon == std::string_view::npos ? std::optional<uint32_t>(0)
-                                                                    : parseWord(place.substr(colon + 1));
+        std::optional<uint32_t> c =
+            colon == std::string_view::npos ? std::optional<uint32_t>(0) : parseWord(place.substr(colon + 1));
         if (isHexToken(place) || !l || !c || *l == 0 || (colon != std::string_view::npos && *c == 0)) {
             h.error("bad place " + quote(place) + " after 'at' (expected LINE:COL, e.g. 3:5)");
         } else {
@@ -636,21 +668,38 @@ void Parser::contentLine(uint32_t line, const Tokens& toks) {
     std::string_view kw = toks[0];
     Args a(toks, 1, line, m_errors);
     switch (m_section) {
-    case Section::None:
-        if (!m_sawSectionLine)
-            error(line, quote(kw) + " before any section (a section starts with a line like [test])");
-        // Otherwise the section line itself was bad and already reported.
-        return;
-    case Section::Require: requireLine(a, kw); return;
-    case Section::RenderTarget: renderTargetLine(a, kw); return;
-    case Section::Texture: textureLine(a, kw); return;
-    case Section::Sampler: samplerLine(a, kw); return;
-    case Section::Stage: stageLine(a, kw); return;
-    case Section::RenderState: renderStateLine(a, kw); return;
-    case Section::Transform: transformLine(a, kw); return;
-    case Section::Constants: constantsLine(a, kw); return;
-    case Section::PixelShader:
-    case Section::Test: return;
+        case Section::None:
+            if (!m_sawSectionLine)
+                error(line, quote(kw) + " before any section (a section starts with a line like [test])");
+            // Otherwise the section line itself was bad and already reported.
+            return;
+        case Section::Require:
+            requireLine(a, kw);
+            return;
+        case Section::RenderTarget:
+            renderTargetLine(a, kw);
+            return;
+        case Section::Texture:
+            textureLine(a, kw);
+            return;
+        case Section::Sampler:
+            samplerLine(a, kw);
+            return;
+        case Section::Stage:
+            stageLine(a, kw);
+            return;
+        case Section::RenderState:
+            renderStateLine(a, kw);
+            return;
+        case Section::Transform:
+            transformLine(a, kw);
+            return;
+        case Section::Constants:
+            constantsLine(a, kw);
+            return;
+        case Section::PixelShader:
+        case Section::Test:
+            return;
     }
 }
 
@@ -682,8 +731,10 @@ void Parser::requireLine(Args& a, std::string_view kw) {
         return;
     } else if (iequals(kw, "max_value")) {
         std::optional<float> v = a.floatValue("max_value");
-        if (v && *v <= 0) a.error("max_value must be > 0");
-        else assign(r.maxValue, v, line);
+        if (v && *v <= 0)
+            a.error("max_value must be > 0");
+        else
+            assign(r.maxValue, v, line);
     } else {
         a.error("unknown keyword " + quote(kw) + " in [require] (expected version, precision, backend or max_value)");
         return;
@@ -706,8 +757,10 @@ void Parser::renderTargetLine(Args& a, std::string_view kw) {
         std::optional<bool> on = a.name(kOnOff, "depth buffer");
         if (on && *on && !a.atEnd()) {
             std::optional<float> z = a.floatValue("depth clear value");
-            if (z && (*z < 0 || *z > 1)) a.error("depth clear value must be in [0, 1]");
-            else if (z) rt.depthClear = *z;
+            if (z && (*z < 0 || *z > 1))
+                a.error("depth clear value must be in [0, 1]");
+            else if (z)
+                rt.depthClear = *z;
         }
         assign(rt.depth, on, line);
     } else {
@@ -852,8 +905,8 @@ bool Parser::checkTexel(Args& a, const Texel& v) {
     } else if (v.count == 0 && bits < 32 && (v.bits >> bits) != 0) {
         char buf[16];
         std::snprintf(buf, sizeof buf, "0x%x", v.bits);
-        a.error(std::string("texel ") + buf + " does not fit format " + texFormatName(f) + " (" +
-                std::to_string(bits) + " bits)");
+        a.error(std::string("texel ") + buf + " does not fit format " + texFormatName(f) + " (" + std::to_string(bits) +
+                " bits)");
     } else {
         return true;
     }
@@ -909,13 +962,11 @@ void Parser::closeTexture() {
     }
     uint32_t possible = maxLevels(t.width, t.height, t.depth);
     if (t.levels.value > possible) {
-        error(t.levels.line, "levels " + std::to_string(t.levels.value) + " is more than a " +
-                                 std::to_string(t.width) + "x" + std::to_string(t.height) + " texture has (" +
-                                 std::to_string(possible) + ")");
+        error(t.levels.line, "levels " + std::to_string(t.levels.value) + " is more than a " + std::to_string(t.width) +
+                                 "x" + std::to_string(t.height) + " texture has (" + std::to_string(possible) + ")");
     }
-    std::sort(t.data.begin(), t.data.end(), [](const TextureLevel& x, const TextureLevel& y) {
-        return x.level < y.level;
-    });
+    std::sort(t.data.begin(), t.data.end(),
+              [](const TextureLevel& x, const TextureLevel& y) { return x.level < y.level; });
     uint32_t needed = std::max<uint32_t>(1, t.levels.value);
     for (uint32_t k = 0; k < needed && k < possible; ++k) {
         bool found = std::any_of(t.data.begin(), t.data.end(), [k](const TextureLevel& l) { return l.level == k; });
@@ -960,8 +1011,10 @@ std::optional<TextureArg> Parser::textureArg(Args& a, bool resultArg) {
     if (resultArg) {
         if (!a.need("result (current or temp)")) return std::nullopt;
         std::string_view t = a.next();
-        if (iequals(t, "current")) arg.source = ArgSource::Current;
-        else if (iequals(t, "temp")) arg.source = ArgSource::Temp;
+        if (iequals(t, "current"))
+            arg.source = ArgSource::Current;
+        else if (iequals(t, "temp"))
+            arg.source = ArgSource::Temp;
         else {
             a.error("unknown result argument " + quote(t) + " (expected current or temp)");
             return std::nullopt;
@@ -973,9 +1026,9 @@ std::optional<TextureArg> Parser::textureArg(Args& a, bool resultArg) {
     arg.source = *src;
     while (!a.atEnd()) {
         std::string_view m = a.next();
-        bool* flag = iequals(m, "complement") ? &arg.complement
+        bool* flag = iequals(m, "complement")       ? &arg.complement
                      : iequals(m, "alphareplicate") ? &arg.alphaReplicate
-                                                     : nullptr;
+                                                    : nullptr;
         if (!flag) {
             a.error("unknown argument modifier " + quote(m) + " (expected complement or alphareplicate)");
             return std::nullopt;
@@ -1116,9 +1169,12 @@ void Parser::transformLine(Args& a, std::string_view kw) {
     TransformDesc& t = m_file.transform;
     uint32_t line = a.line();
     Setting<Matrix4>* target = nullptr;
-    if (iequals(kw, "world")) target = &t.world;
-    else if (iequals(kw, "view")) target = &t.view;
-    else if (iequals(kw, "projection")) target = &t.projection;
+    if (iequals(kw, "world"))
+        target = &t.world;
+    else if (iequals(kw, "view"))
+        target = &t.view;
+    else if (iequals(kw, "projection"))
+        target = &t.projection;
     else if (kw.size() == 8 && iequals(kw.substr(0, 7), "texture") && kw[7] >= '0' && kw[7] <= '7')
         target = &t.texture[size_t(kw[7] - '0')];
     if (target) {
@@ -1188,7 +1244,8 @@ bool Parser::conditionPrefix(Args& a, Condition& cond) {
         } else if (std::optional<Precision> p = lookup(kPrecisions, t)) {
             cond.precisions |= uint8_t(1u << unsigned(*p));
         } else {
-            a.error("unknown condition " + quote(t) + " (expected a backend: emu, gl, or a precision: fx8, fx12, "
+            a.error("unknown condition " + quote(t) +
+                    " (expected a backend: emu, gl, or a precision: fx8, fx12, "
                     "float, ideal)");
             return false;
         }
@@ -1314,16 +1371,20 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
         return true;
     }
     DrawPrimitives d;
-    if (iequals(prim, "triangles")) d.type = PrimitiveType::TriangleList;
-    else if (iequals(prim, "strip")) d.type = PrimitiveType::TriangleStrip;
-    else if (iequals(prim, "fan")) d.type = PrimitiveType::TriangleFan;
+    if (iequals(prim, "triangles"))
+        d.type = PrimitiveType::TriangleList;
+    else if (iequals(prim, "strip"))
+        d.type = PrimitiveType::TriangleStrip;
+    else if (iequals(prim, "fan"))
+        d.type = PrimitiveType::TriangleFan;
     else {
         a.error("unknown primitive " + quote(prim) + " (expected quad, triangles, strip or fan)");
         return false;
     }
     if (!a.need("vertex format (xyzrhw or xyz)")) return false;
     std::string_view fmt = a.next();
-    if (iequals(fmt, "xyzrhw")) d.pretransformed = true;
+    if (iequals(fmt, "xyzrhw"))
+        d.pretransformed = true;
     else if (!iequals(fmt, "xyz")) {
         a.error("unknown vertex format " + quote(fmt) + " (expected xyzrhw or xyz)");
         return false;
@@ -1450,8 +1511,10 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
     }
     if (!a.need("channels (rgba or rgb)")) return false;
     std::string_view ch = a.next();
-    if (iequals(ch, "rgba")) p.alpha = true;
-    else if (iequals(ch, "rgb")) p.alpha = false;
+    if (iequals(ch, "rgba"))
+        p.alpha = true;
+    else if (iequals(ch, "rgb"))
+        p.alpha = false;
     else {
         a.error("unknown probe channels " + quote(ch) + " (expected rgba or rgb)");
         return false;
@@ -1537,15 +1600,19 @@ bool isFloatFormat(TexFormat f) {
 
 int formatBits(TexFormat f) {
     switch (f) {
-    case TexFormat::A8:
-    case TexFormat::L8: return 8;
-    case TexFormat::A8L8:
-    case TexFormat::V8U8:
-    case TexFormat::L6V5U5: return 16;
-    case TexFormat::A16B16G16R16F:
-    case TexFormat::A32B32G32R32F:
-    case TexFormat::R32F: return 0;
-    default: return 32;
+        case TexFormat::A8:
+        case TexFormat::L8:
+            return 8;
+        case TexFormat::A8L8:
+        case TexFormat::V8U8:
+        case TexFormat::L6V5U5:
+            return 16;
+        case TexFormat::A16B16G16R16F:
+        case TexFormat::A32B32G32R32F:
+        case TexFormat::R32F:
+            return 0;
+        default:
+            return 32;
     }
 }
 

@@ -37,8 +37,19 @@ const char* precisionName(Precision p);
 
 // Surface formats a test may name (D3DFMT_* without the prefix).
 enum class TexFormat : uint8_t {
-    A8R8G8B8, X8R8G8B8, A8, L8, A8L8, V8U8, L6V5U5, X8L8V8U8, Q8W8V8U8, V16U16,
-    A16B16G16R16F, A32B32G32R32F, R32F,
+    A8R8G8B8,
+    X8R8G8B8,
+    A8,
+    L8,
+    A8L8,
+    V8U8,
+    L6V5U5,
+    X8L8V8U8,
+    Q8W8V8U8,
+    V16U16,
+    A16B16G16R16F,
+    A32B32G32R32F,
+    R32F,
 };
 const char* texFormatName(TexFormat f);
 bool isFloatFormat(TexFormat f);
@@ -63,12 +74,12 @@ struct Texel {
 };
 
 struct TextureLevel {
-    uint32_t line = 0;    // the `level` line
+    uint32_t line = 0;  // the `level` line
     uint32_t level = 0;
     uint32_t width = 0, height = 0, depth = 1;  // this level's extent
     bool hasFill = false;
-    Texel fill;                   // the whole level is this texel (hasFill)
-    std::vector<Texel> texels;    // otherwise width*height*depth: rows top first, slice after slice
+    Texel fill;                 // the whole level is this texel (hasFill)
+    std::vector<Texel> texels;  // otherwise width*height*depth: rows top first, slice after slice
 };
 
 struct TextureDesc {
@@ -77,12 +88,12 @@ struct TextureDesc {
     Setting<TexFormat> format{TexFormat::A8R8G8B8};
     uint32_t width = 0, height = 0, depth = 0;  // depth 0 = a 2D texture, > 0 = a volume texture
     uint32_t sizeLine = 0;
-    Setting<uint32_t> levels{1};                // 0 = build the full chain from level 0
-    std::vector<TextureLevel> data;             // sorted by level
+    Setting<uint32_t> levels{1};     // 0 = build the full chain from level 0
+    std::vector<TextureLevel> data;  // sorted by level
     bool isVolume() const { return depth > 0; }
 };
 
-enum class Filter : uint8_t { None = 0, Point = 1, Linear = 2 };  // D3DTEXF_*
+enum class Filter : uint8_t { None = 0, Point = 1, Linear = 2 };                   // D3DTEXF_*
 enum class AddressMode : uint8_t { Wrap = 1, Mirror = 2, Clamp = 3, Border = 4 };  // D3DTADDRESS_*
 
 struct SamplerDesc {
@@ -95,10 +106,32 @@ struct SamplerDesc {
 
 // D3DTOP_* (values as in d3d9types.h).
 enum class TextureOp : uint8_t {
-    Disable = 1, SelectArg1, SelectArg2, Modulate, Modulate2x, Modulate4x, Add, AddSigned, AddSigned2x,
-    Subtract, AddSmooth, BlendDiffuseAlpha, BlendTextureAlpha, BlendFactorAlpha, BlendTextureAlphaPm,
-    BlendCurrentAlpha, PreModulate, ModulateAlphaAddColor, ModulateColorAddAlpha, ModulateInvAlphaAddColor,
-    ModulateInvColorAddAlpha, BumpEnvMap, BumpEnvMapLuminance, DotProduct3, MultiplyAdd, Lerp,
+    Disable = 1,
+    SelectArg1,
+    SelectArg2,
+    Modulate,
+    Modulate2x,
+    Modulate4x,
+    Add,
+    AddSigned,
+    AddSigned2x,
+    Subtract,
+    AddSmooth,
+    BlendDiffuseAlpha,
+    BlendTextureAlpha,
+    BlendFactorAlpha,
+    BlendTextureAlphaPm,
+    BlendCurrentAlpha,
+    PreModulate,
+    ModulateAlphaAddColor,
+    ModulateColorAddAlpha,
+    ModulateInvAlphaAddColor,
+    ModulateInvColorAddAlpha,
+    BumpEnvMap,
+    BumpEnvMapLuminance,
+    DotProduct3,
+    MultiplyAdd,
+    Lerp,
 };
 const char* textureOpName(TextureOp op);  // lower case, as written in the file
 
@@ -134,8 +167,21 @@ StageDesc defaultStage(int stage);
 
 // D3DBLEND_* / D3DBLENDOP_* / D3DCMP_* / D3DCULL_* (values as in d3d9types.h).
 enum class Blend : uint8_t {
-    Zero = 1, One, SrcColor, InvSrcColor, SrcAlpha, InvSrcAlpha, DestAlpha, InvDestAlpha, DestColor,
-    InvDestColor, SrcAlphaSat, BothSrcAlpha, BothInvSrcAlpha, BlendFactor, InvBlendFactor,
+    Zero = 1,
+    One,
+    SrcColor,
+    InvSrcColor,
+    SrcAlpha,
+    InvSrcAlpha,
+    DestAlpha,
+    InvDestAlpha,
+    DestColor,
+    InvDestColor,
+    SrcAlphaSat,
+    BothSrcAlpha,
+    BothInvSrcAlpha,
+    BlendFactor,
+    InvBlendFactor,
 };
 enum class BlendOp : uint8_t { Add = 1, Subtract, RevSubtract, Min, Max };
 enum class CompareFunc : uint8_t { Never = 1, Less, Equal, LessEqual, Greater, NotEqual, GreaterEqual, Always };
@@ -260,8 +306,8 @@ struct Probe {
 
 struct TestCommand {
     uint32_t line = 0;
-    Condition onlyIf;     // run only where this matches
-    bool todo = false;    // a known failure where todoIf matches (probes only)
+    Condition onlyIf;   // run only where this matches
+    bool todo = false;  // a known failure where todoIf matches (probes only)
     Condition todoIf;
     std::variant<DrawQuad, DrawPrimitives, Eval, Probe> op;
     bool isTodo(Backend b, Precision p) const { return todo && todoIf.matches(b, p); }

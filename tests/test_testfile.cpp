@@ -42,10 +42,10 @@ bool hasError(const Parsed& p, uint32_t line, std::string_view fragment) {
     INFO(dump(p));    \
     REQUIRE((p).ok)
 
-#define CHECK_ERROR(p, line, fragment)  \
-    do {                                \
-        INFO(dump(p));                  \
-        CHECK(!(p).ok);                 \
+#define CHECK_ERROR(p, line, fragment)      \
+    do {                                    \
+        INFO(dump(p));                      \
+        CHECK(!(p).ok);                     \
         CHECK(hasError(p, line, fragment)); \
     } while (0)
 
@@ -202,8 +202,8 @@ TEST_CASE("testfile: texture formats, float texels and volumes", "[testfile]") {
     for (const char* fmt : {"A8R8G8B8", "X8R8G8B8", "A8", "L8", "A8L8", "V8U8", "L6V5U5", "X8L8V8U8", "Q8W8V8U8",
                             "V16U16", "A16B16G16R16F", "A32B32G32R32F", "R32F"}) {
         bool isFloat = std::string(fmt).back() == 'F';
-        std::string text = std::string("[texture 0]\nsize 1 1\nformat ") + fmt + "\nfill " + (isFloat ? "(1)" : "0") +
-                           "\n";
+        std::string text =
+            std::string("[texture 0]\nsize 1 1\nformat ") + fmt + "\nfill " + (isFloat ? "(1)" : "0") + "\n";
         Parsed f = parse(text);
         INFO(fmt);
         REQUIRE_OK(f);
@@ -341,12 +341,32 @@ TEST_CASE("testfile: [stage N]", "[testfile]") {
     CHECK(d.file.stage(5)->transformFlags.value == TransformFlags{0, false});
     CHECK(d.file.stage(5)->transformFlags.isSet());
 
-    const char* ops[] = {"disable", "selectarg1", "selectarg2", "modulate", "modulate2x", "modulate4x", "add",
-                         "addsigned", "addsigned2x", "subtract", "addsmooth", "blenddiffusealpha",
-                         "blendtexturealpha", "blendfactoralpha", "blendtexturealphapm", "blendcurrentalpha",
-                         "premodulate", "modulatealpha_addcolor", "modulatecolor_addalpha",
-                         "modulateinvalpha_addcolor", "modulateinvcolor_addalpha", "bumpenvmap",
-                         "bumpenvmapluminance", "dotproduct3", "multiplyadd", "lerp"};
+    const char* ops[] = {"disable",
+                         "selectarg1",
+                         "selectarg2",
+                         "modulate",
+                         "modulate2x",
+                         "modulate4x",
+                         "add",
+                         "addsigned",
+                         "addsigned2x",
+                         "subtract",
+                         "addsmooth",
+                         "blenddiffusealpha",
+                         "blendtexturealpha",
+                         "blendfactoralpha",
+                         "blendtexturealphapm",
+                         "blendcurrentalpha",
+                         "premodulate",
+                         "modulatealpha_addcolor",
+                         "modulatecolor_addalpha",
+                         "modulateinvalpha_addcolor",
+                         "modulateinvcolor_addalpha",
+                         "bumpenvmap",
+                         "bumpenvmapluminance",
+                         "dotproduct3",
+                         "multiplyadd",
+                         "lerp"};
     int expected = 1;
     for (const char* name : ops) {
         Parsed o = parse(std::string("[stage 0]\ncolorop ") + name + "\nalphaop " + name + "\n");
@@ -417,9 +437,9 @@ TEST_CASE("testfile: [render state]", "[testfile]") {
     CHECK(def.file.renderState.cullMode.value == CullMode::None);
     CHECK(def.file.renderState.zFunc.value == CompareFunc::LessEqual);
 
-    const char* blends[] = {"zero", "one", "srccolor", "invsrccolor", "srcalpha", "invsrcalpha", "destalpha",
-                            "invdestalpha", "destcolor", "invdestcolor", "srcalphasat", "bothsrcalpha",
-                            "bothinvsrcalpha", "blendfactor", "invblendfactor"};
+    const char* blends[] = {"zero",        "one",          "srccolor",        "invsrccolor", "srcalpha",
+                            "invsrcalpha", "destalpha",    "invdestalpha",    "destcolor",   "invdestcolor",
+                            "srcalphasat", "bothsrcalpha", "bothinvsrcalpha", "blendfactor", "invblendfactor"};
     int n = 1;
     for (const char* b : blends) {
         Parsed o = parse(std::string("[render state]\nsrcblend ") + b + "\ndestblend " + b + "\n");
@@ -671,8 +691,7 @@ TEST_CASE("testfile: draw triangles, strip, fan", "[testfile]") {
     CHECK_ERROR(parse("[test]\ndraw fan xyz\n0 0 0 0 0\n0 0 0 0 0\nprobe all rgba 0\n"), 2, "draw fan has 2");
     CHECK_ERROR(parse("[test]\n0 0 0 0 0\n"), 2, "vertex line without a 'draw triangles|strip|fan'");
     CHECK_ERROR(parse("[test]\ndraw quad\n0 0 0 0 0\n"), 3, "vertex line without");
-    CHECK_ERROR(parse("[test]\ndraw triangles xyzrhw\n0 0 0 0 0 0\n0 0 0 1 0 0\n0 0 0 1 0 0\n"), 3,
-                "rhw must be > 0");
+    CHECK_ERROR(parse("[test]\ndraw triangles xyzrhw\n0 0 0 0 0 0\n0 0 0 1 0 0\n0 0 0 1 0 0\n"), 3, "rhw must be > 0");
     CHECK_ERROR(parse("[test]\ndraw triangles xyz\n0 0 0\n"), 3, "missing vertex diffuse colour");
     CHECK_ERROR(parse("[test]\ndraw triangles xyz\n0 0 0 0xff\n"), 3, "missing vertex specular colour");
     CHECK_ERROR(parse("[test]\ndraw triangles xyz\n0 0 0 1.5 0\n"), 3, "bad vertex diffuse colour '1.5'");

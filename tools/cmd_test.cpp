@@ -41,9 +41,7 @@ struct FileResult {
     bool skipped = false;        // [require] backend excludes every backend of this run
 };
 
-std::string where(const std::string& path, uint32_t line) {
-    return line ? path + ":" + std::to_string(line) : path;
-}
+std::string where(const std::string& path, uint32_t line) { return line ? path + ":" + std::to_string(line) : path; }
 
 // True if d is the expected failure of the block (code, and place when given).
 bool matchesExpectation(const Diagnostics& diags, const Diagnostic& d, const PixelShaderBlock& ps,
@@ -70,8 +68,7 @@ bool checkShader(const TestFile& file, const std::string& path, const RunOptions
             if (opts.verbose && !diags.all().empty()) std::cout << diags.formatAll();
             return true;
         }
-        std::cout << where(path, ps.line) << ": [pixel shader] does not assemble and validate:\n"
-                  << diags.formatAll();
+        std::cout << where(path, ps.line) << ": [pixel shader] does not assemble and validate:\n" << diags.formatAll();
         return false;
     }
     std::string expected = ps.failCode;
@@ -148,16 +145,25 @@ int cmdTest(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
             if (a == "--backend") {
-                if (v == "emu") opts.backends = kBackendEmu;
-                else if (v == "gl") opts.backends = kBackendGl;
-                else if (v == "both") opts.backends = kBackendEmu | kBackendGl;
-                else return usageError("unknown backend '" + v + "' (expected emu, gl or both)");
+                if (v == "emu")
+                    opts.backends = kBackendEmu;
+                else if (v == "gl")
+                    opts.backends = kBackendGl;
+                else if (v == "both")
+                    opts.backends = kBackendEmu | kBackendGl;
+                else
+                    return usageError("unknown backend '" + v + "' (expected emu, gl or both)");
             } else {
-                if (v == "fx8") opts.precision = Precision::Fx8;
-                else if (v == "fx12") opts.precision = Precision::Fx12;
-                else if (v == "float") opts.precision = Precision::Float;
-                else if (v == "ideal") opts.precision = Precision::Ideal;
-                else return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+                if (v == "fx8")
+                    opts.precision = Precision::Fx8;
+                else if (v == "fx12")
+                    opts.precision = Precision::Fx12;
+                else if (v == "float")
+                    opts.precision = Precision::Float;
+                else if (v == "ideal")
+                    opts.precision = Precision::Ideal;
+                else
+                    return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
             }
         } else if (a == "-v" || a == "--verbose") {
             opts.verbose = true;
@@ -178,12 +184,18 @@ int cmdTest(const std::vector<std::string>& args) {
         pending += r.pendingCommands;
         if (r.skipped) ++skipped;
         switch (r.outcome) {
-        case Outcome::Passed: ++passed; break;
-        case Outcome::Failed: ++failed; break;
-        case Outcome::NotRunnable: ++notRunnable; break;
+            case Outcome::Passed:
+                ++passed;
+                break;
+            case Outcome::Failed:
+                ++failed;
+                break;
+            case Outcome::NotRunnable:
+                ++notRunnable;
+                break;
         }
         if (opts.verbose) {
-            const char* label = r.outcome == Outcome::Failed ? "FAIL"
+            const char* label = r.outcome == Outcome::Failed   ? "FAIL"
                                 : r.outcome == Outcome::Passed ? (r.skipped ? "PASS (commands skipped)" : "PASS")
                                                                : "NOT YET RUNNABLE";
             std::cout << label << " " << path;
