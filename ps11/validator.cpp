@@ -157,8 +157,8 @@ void Validator::readAccess(const Instruction& in, RegType type, int index, uint8
         }
         if (missing)
             error(kUndefinedRead, loc,
-                  name + "." + compList(missing) + " is read before it is written" +
-                      (why.empty() ? "" : " (" + why + ")"));
+                  name + "." + compList(missing) + " is read before it is written" + " (" +
+                      (why.empty() ? "no earlier instruction writes it" : why) + ")");
     }
     if (type == RegType::Texture && !is14() && !m_bemRead[size_t(index)].empty() && in.opcode() != Opcode::TexBem &&
         in.opcode() != Opcode::TexBemL)

@@ -244,7 +244,9 @@ private:
     bool is14() const { return m_minor == 4; }
     std::string vname() const { return versionName(m_minor); }
     std::string mn(const Instruction& in) const { return std::string(in.info->mnemonic); }
-    bool inRange(RegType t, int index) const { return index >= 0 && index < m_limits.count[size_t(t)]; }
+    bool inRange(RegType t, int index) const {
+        return size_t(t) < 4 && index >= 0 && index < m_limits.count[size_t(t)];
+    }
     int arithCost(const Instruction& in) const { return is14() ? in.info->arithSlots14 : in.info->arithSlots13; }
     // The instruction before i starts a co-issued pair with i.
     bool pairsWithPrevious(size_t i) const {

@@ -85,8 +85,7 @@ void Validator::checkMasks(size_t i) {
     if (op == Opcode::Def) {
         if (mask != kMaskAll)
             error(kDefOperand, in.dst.loc, "def writes a whole constant; found the write mask " + maskName(mask));
-        if (in.dst.saturate || in.dst.shift != 0)
-            error(kDefOperand, in.loc, "def takes no instruction modifier");
+        if (in.dst.saturate || in.dst.shift != 0) error(kDefOperand, in.loc, "def takes no instruction modifier");
         return;
     }
     if (isArith(in)) {
@@ -298,6 +297,7 @@ void Validator::checkReadPorts(size_t i) {
     std::array<std::set<int>, 4> regs;
     for (size_t s = 0; s < in.info->numSrc; ++s) {
         const Src& src = in.src[s];
+        if (size_t(src.type) >= regs.size()) continue;
         auto& set = regs[size_t(src.type)];
         if (!set.insert(src.index).second) continue;
         const int limit = m_limits.ports[size_t(src.type)];
@@ -310,7 +310,8 @@ void Validator::checkReadPorts(size_t i) {
     for (size_t t = 0; t < 4; ++t) m_stats.maxReadPorts[t] = std::max(m_stats.maxReadPorts[t], int(regs[t].size()));
     if (!pairsWithPrevious(i)) return;
     const Instruction& first = inst(i - 1);
-    for (size_t s = 0; s < first.info->numSrc; ++s) regs[size_t(first.src[s].type)].insert(first.src[s].index);
+    for (size_t s = 0; s < first.info->numSrc; ++s)
+        if (size_t(first.src[s].type) < regs.size()) regs[size_t(first.src[s].type)].insert(first.src[s].index);
     for (size_t t = 0; t < 4; ++t) {
         const int n = int(regs[t].size());
         m_stats.maxPairReadPorts[t] = std::max(m_stats.maxPairReadPorts[t], n);

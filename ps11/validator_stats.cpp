@@ -64,10 +64,13 @@ std::string statsToText(const ShaderStats& s) {
            "\n";
     out += "constants defined: " +
            (s.constantsDefined.empty() ? std::string("none") : intList(s.constantsDefined, "c", " ")) + "\n";
-    out += "read ports (max per instruction / limit; per pair / " + std::to_string(s.pairReadPortLimit) + "):";
+    out += "read ports per instruction (most used / limit):";
     for (size_t t = 0; t < 4; ++t)
-        out += std::string(" ") + regPrefix(RegType(t)) + " " + std::to_string(s.maxReadPorts[t]) + "/" +
-               std::to_string(s.readPortLimit[t]) + ";" + std::to_string(s.maxPairReadPorts[t]);
+        out += std::string(t ? ", " : " ") + regPrefix(RegType(t)) + "# " + std::to_string(s.maxReadPorts[t]) + "/" +
+               std::to_string(s.readPortLimit[t]);
+    out += "\nread ports per co-issued pair (most used / limit " + std::to_string(s.pairReadPortLimit) + "):";
+    for (size_t t = 0; t < 4; ++t)
+        out += std::string(t ? ", " : " ") + regPrefix(RegType(t)) + "# " + std::to_string(s.maxPairReadPorts[t]);
     out += "\n";
     if (s.dp4Count || s.cmpCount || s.bemCount)
         out += "dp4: " + std::to_string(s.dp4Count) + ", cmp: " + std::to_string(s.cmpCount) +

@@ -206,7 +206,8 @@ TEST_CASE("validator: slot limits", "[validator]") {
     CHECK(g.stats.phaseTexSlots[0] == 2);
     CHECK(g.stats.phaseTexSlots[1] == 1);
     // Per-shader caps only where the instruction costs 2 slots.
-    expectOnly("ps_1_3\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\n", "P2012", 5, 1);
+    expectOnly("ps_1_3\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\ncmp r0, v0, v1, c0\n", "P2012", 5,
+               1);
     // ps_1_4 per phase: 6 texture instructions per phase, 12 in the shader is fine.
     std::string t14 = "ps_1_4\n";
     for (int i = 0; i < 6; ++i) t14 += "texld r" + std::to_string(i) + ", t" + std::to_string(i) + "\n";
@@ -219,7 +220,8 @@ TEST_CASE("validator: ordering", "[validator]") {
     expectOnly("ps_1_1\ntex t0\ndef c0, 1, 1, 1, 1\nmov r0, t0\n", "P2020", 3, 1);
     expectOnly("ps_1_1\nmov r0, v0\ntex t0\n", "P2021", 3, 1);
     expectValid("ps_1_1\nnop\ntex t0\nmov r0, t0\n");  // nop is neutral
-    expectOnly("ps_1_4\ntexld r0, t0\nmov r1, r0\ntexld r2, t2\nphase\nmov r0.rgb, r1.b\n+mov r0.a, c0\n", "P2022", 4, 1);
+    expectOnly("ps_1_4\ntexld r0, t0\nmov r1, r0\ntexld r2, t2\nphase\nmov r0.rgb, r1.b\n+mov r0.a, c0\n", "P2022", 4,
+               1);
     expectOnly("ps_1_4\ntexld r0, t0\nphase\ntexld r1, t1\nphase\nmov r0, c0\n", "P2023", 5, 1);
     // Phase 2 starts a new texture block.
     expectValid("ps_1_4\ntexld r0, t0\nmov r1, r0\nphase\ntexld r2, t2\nmov r0, r2\n");
@@ -294,9 +296,10 @@ TEST_CASE("validator: selectors", "[validator]") {
     expectOnly("ps_1_4\ntexld r0, t0_dz\n", "P2063", 2, 11);
     expectValid("ps_1_4\ntexld r0, t0_dw.xyw\ntexcrd r1.rg, t1_dw.xyw\nmul r0, r0, r1.r\n");
     expectValid("ps_1_4\ntexcrd r0.rgb, t0\nphase\ntexld r1, r0_dz.xyz\ntexld r2, r0_dz\nmul r0, r1, r2\n");
-    expectOnly("ps_1_4\ntexcrd r0.rgb, t0\ntexcrd r1.rgb, t1\ntexcrd r2.rgb, t2\nphase\ntexld r3, r0_dz\n"
-               "texld r4, r1_dz\ntexld r5, r2_dz\nmul r0, r3, r4\n",
-               "P2064", 8, 11);
+    expectOnly(
+        "ps_1_4\ntexcrd r0.rgb, t0\ntexcrd r1.rgb, t1\ntexcrd r2.rgb, t2\nphase\ntexld r3, r0_dz\n"
+        "texld r4, r1_dz\ntexld r5, r2_dz\nmul r0, r3, r4\n",
+        "P2064", 8, 11);
     expectOnly("ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t0.xyw\nmul r0, r0, r1.r\n", "P2065", 3, 16);
 }
 
@@ -399,8 +402,9 @@ TEST_CASE("validator: all errors are collected", "[validator]") {
 }
 
 TEST_CASE("validator: statistics text and JSON", "[validator]") {
-    Checked c = check("ps_1_4\ndef c1, 1, 0, 0, 1\ntexld r0, t0\nmul r1, r0, c0\nphase\ntexld r2, r1\n"
-                      "mul r0.rgb, r2, v0\n+mov r0.a, c1\n");
+    Checked c = check(
+        "ps_1_4\ndef c1, 1, 0, 0, 1\ntexld r0, t0\nmul r1, r0, c0\nphase\ntexld r2, r1\n"
+        "mul r0.rgb, r2, v0\n+mov r0.a, c1\n");
     REQUIRE(c.valid);
     const ShaderStats& s = c.stats;
     CHECK(s.version == Version{1, 4});
@@ -490,4 +494,42 @@ TEST_CASE("validator: tests/shaders/validate corpus", "[validator][corpus]") {
     }
     CHECK(files >= 100);
     CHECK(fails >= 80);
+}
+
+TEST_CASE("validator: random programs never crash", "[validator]") {
+    // Any well-typed IR (the decoder can produce any row, register number and modifier) must be
+    // validated without crashing; run under the sanitizer build for the real check.
+    uint32_t state = 12345;
+    auto next = [&state](uint32_t n) {
+        state = state * 1664525u + 1013904223u;
+        return (state >> 8) % n;
+    };
+    const auto table = opcodeTable();
+    for (int round = 0; round < 3000; ++round) {
+        Program p;
+        p.version = {1, int(1 + next(4))};
+        const size_t count = next(16);
+        for (size_t i = 0; i < count; ++i) {
+            Instruction in;
+            in.info = &table[next(uint32_t(table.size()))];
+            in.coissue = next(4) == 0;
+            in.dst.type = RegType(next(4));
+            in.dst.index = uint8_t(next(4) == 0 ? next(256) : next(7));
+            in.dst.mask = uint8_t(next(16));
+            in.dst.saturate = next(2);
+            in.dst.shift = int8_t(int(next(9)) - 4);
+            for (Src& s : in.src) {
+                s.type = RegType(next(4));
+                s.index = uint8_t(next(4) == 0 ? next(256) : next(7));
+                s.swizzle = uint8_t(next(4) == 0 ? next(256) : 0xE4);
+                s.mod = SrcMod(next(11));
+            }
+            p.instructions.push_back(in);
+        }
+        Diagnostics d;
+        ShaderStats stats;
+        validate(p, d, &stats);
+        CHECK(stats.table.size() == count);
+        CHECK_FALSE(statsToJson(stats).empty());
+    }
 }
