@@ -478,7 +478,6 @@ private:
 void Parser::run(std::string_view text) {
     uint32_t line = 0;
     size_t pos = 0;
-    std::string shaderText;
     while (pos <= text.size()) {
         size_t nl = text.find('\n', pos);
         if (nl == std::string_view::npos) nl = text.size();
