@@ -1693,6 +1693,9 @@ bool parseTestFile(std::string_view text, const std::string& fileName, TestFile&
     out = TestFile{};
     out.fileName = fileName;
     Parser(out, errors).run(text);
+    // Whole-file checks run last; report everything in file order.
+    std::stable_sort(errors.begin() + std::ptrdiff_t(before), errors.end(),
+                     [](const TestFileError& a, const TestFileError& b) { return a.line < b.line; });
     return errors.size() == before;
 }
 
