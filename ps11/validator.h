@@ -21,28 +21,28 @@ struct InstructionStats {
     size_t instruction = 0;  // index into Program::instructions
     int phase = 0;           // ps_1_4: 1 or 2 (2 when there is no phase instruction); 0 for 1_1-1_3
     int texSlots = 0;
-    int arithSlots = 0;      // a co-issued pair charges its slot to the first member
-    bool coissue = false;    // second member of a pair
-    std::string text;        // canonical text of the instruction
+    int arithSlots = 0;    // a co-issued pair charges its slot to the first member
+    bool coissue = false;  // second member of a pair
+    std::string text;      // canonical text of the instruction
     SourceLoc loc;
 };
 
 struct ShaderStats {
     Version version;
-    bool valid = false;                  // validate() reported no error
-    int texSlots = 0, texLimit = 0;      // 1_4: the limit applies to each phase separately
+    bool valid = false;              // validate() reported no error
+    int texSlots = 0, texLimit = 0;  // 1_4: the limit applies to each phase separately
     int arithSlots = 0, arithLimit = 0;
     bool hasPhase = false;               // 1_4 only: a phase instruction is present
     std::array<int, 2> phaseTexSlots{};  // 1_4 only: phase 1, phase 2
     std::array<int, 2> phaseArithSlots{};
     int dp4Count = 0, cmpCount = 0, bemCount = 0;
-    std::vector<int> constantsRead;      // c# read by instructions (sorted, unique)
-    std::vector<int> constantsDefined;   // c# set by def (sorted, unique)
+    std::vector<int> constantsRead;     // c# read by instructions (sorted, unique)
+    std::vector<int> constantsDefined;  // c# set by def (sorted, unique)
     // Indexed by RegType (r, v, c, t).
-    std::array<int, 4> maxReadPorts{};       // most distinct registers of the type one instruction reads
-    std::array<int, 4> readPortLimit{};      // the per-instruction limit of the version
-    std::array<int, 4> maxPairReadPorts{};   // most distinct registers of the type a co-issued pair reads
-    int pairReadPortLimit = 3;               // per type, over both members of a pair (spec §3.5)
+    std::array<int, 4> maxReadPorts{};      // most distinct registers of the type one instruction reads
+    std::array<int, 4> readPortLimit{};     // the per-instruction limit of the version
+    std::array<int, 4> maxPairReadPorts{};  // most distinct registers of the type a co-issued pair reads
+    int pairReadPortLimit = 3;              // per type, over both members of a pair (spec §3.5)
     std::vector<InstructionStats> table;
 };
 
