@@ -1,7 +1,7 @@
 // The decoder stage: a D3D9 ps_1_1 … ps_1_4 token stream → the IR (ps1x-spec.md §5).
 // ps 1.x instruction tokens carry no length, so operand counts come from the opcode table.
 // Every malformed token gives a P3xxx diagnostic with its index and hex value
-// (codes in docs/diag_decoder.md); nothing is read past the end of the stream.
+// (codes in docs/diagnostics.md); nothing is read past the end of the stream.
 #include "ps11/decoder.h"
 
 #include <algorithm>

@@ -2,7 +2,7 @@
 // backslash-newlines, strips // and /* */ comments (column-preserving), expands object- and
 // function-like macros (Prosser's hide-set algorithm, with # and ##), evaluates conditionals,
 // follows #include and keeps a per-byte map back to the original file, line and column.
-// Diagnostic codes P1001..P1015 are listed in docs/diag_preprocessor.md.
+// Diagnostic codes P1001..P1015 are listed in docs/diagnostics.md.
 #include "ps11/preprocessor.h"
 
 #include <algorithm>

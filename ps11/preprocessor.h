@@ -39,7 +39,7 @@ struct PreprocessedLine {
 // resolved relative to its directory). Directives produce no output lines; every other
 // line of the source appears in order (blank when skipped by #if). Lines joined by a
 // backslash-newline come out as one line numbered by its first physical line. Errors (P10xx,
-// see docs/diag_preprocessor.md) are reported to diags; processing continues where it can.
+// see docs/diagnostics.md) are reported to diags; processing continues where it can.
 std::vector<PreprocessedLine> preprocess(std::string_view source, const std::string& fileName,
                                          const PreprocessOptions& options, Diagnostics& diags);
 

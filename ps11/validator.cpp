@@ -1,7 +1,7 @@
 // The validator stage: checks an IR Program against every ps_1_1 … ps_1_4 rule of
 // ps1x-spec.md §4 and fills ShaderStats. This file holds the driver, version legality,
 // ordering, slot counting and the data-flow rules; operand rules are in validator_rules.cpp.
-// All errors are collected (P2xxx, docs/diag_validator.md); nothing stops at the first one.
+// All errors are collected (P2xxx, docs/diagnostics.md); nothing stops at the first one.
 #include <algorithm>
 
 #include "ps11/disassembler.h"

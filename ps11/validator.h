@@ -1,6 +1,6 @@
 // The validator: every rule and limit of ps1x-spec.md §4 for ps_1_1 … ps_1_4 (P2xxx
 // diagnostics, all collected), plus the statistics `ps11 check` prints. The codes and the
-// decisions taken on the spec's open points are listed in docs/diag_validator.md.
+// decisions taken on the spec's open points are listed in docs/diagnostics.md.
 #pragma once
 
 #include <array>

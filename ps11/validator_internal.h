@@ -14,7 +14,7 @@
 
 namespace ps11::validator_detail {
 
-// Diagnostic codes (docs/diag_validator.md).
+// Diagnostic codes (docs/diagnostics.md).
 inline constexpr const char* kBadVersion = "P2001";
 inline constexpr const char* kNotInVersion = "P2002";
 inline constexpr const char* kReservedOpcode = "P2003";

@@ -37,7 +37,7 @@ TEST_CASE("docs: every diagnostic code in the sources is documented", "[docs]") 
     size_t seen = 0;
     for (const char* dir : {"ps11", "tools"}) {
         for (const auto& entry : fs::directory_iterator(fs::path(PS11_SOURCE_DIR) / dir)) {
-            if (entry.path().extension() != ".cpp") continue;
+            if (entry.path().extension() != ".cpp" && entry.path().extension() != ".h") continue;
             std::string src = slurp(entry.path());
             for (auto it = std::sregex_iterator(src.begin(), src.end(), code); it != std::sregex_iterator(); ++it) {
                 ++seen;
