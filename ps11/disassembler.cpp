@@ -1,6 +1,6 @@
 // The disassembler stage: IR → canonical assembly text (docs/disassembly.md). The output
 // parses back to the same tokens: masks in rgba order, swizzles as one letter (replicate)
-// or four letters, def values as the shortest decimal that reads back to the same bits,
+// or the shortest letter string that repeats to the swizzle (.rgb = .rgbb), def values as the shortest decimal that reads back to the same bits,
 // non-finite def values as bits(0x%08x).
 #include "ps11/disassembler.h"
 
@@ -34,8 +34,12 @@ std::string formatSwizzle(uint8_t sw) {
     if (sw == 0xE4) return {};
     for (int c = 0; c < 4; ++c)
         if (sw == replicateSwizzle(c)) return std::string(".") + componentLetter(c);
+    // The shortest spelling: trailing letters equal to the one before them are implied,
+    // since the assembler repeats a partial selector's last letter (.rgbb prints as .rgb).
+    int len = 4;
+    while (len > 1 && swizzleComponent(sw, len - 1) == swizzleComponent(sw, len - 2)) --len;
     std::string out = ".";
-    for (int c = 0; c < 4; ++c) out += componentLetter(swizzleComponent(sw, c));
+    for (int c = 0; c < len; ++c) out += componentLetter(swizzleComponent(sw, c));
     return out;
 }
 

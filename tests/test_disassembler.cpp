@@ -65,9 +65,9 @@ TEST_CASE("disassembler: spec 5.6 texture opcodes per version", "[disassembler]"
     CHECK(line(3, {0x00000041, 0xB00F0000}) == "texkill t0");
     CHECK(line(4, {0x00000042, 0x800F0000, 0xB0E40000}) == "texld r0, t0");
     CHECK(line(4, {0x00000040, 0x800F0000, 0xB0E40000}) == "texcrd r0, t0");
-    CHECK(line(4, {0x00000040, 0x80070001, 0xB0A40000}) == "texcrd r1.rgb, t0.rgbb");
+    CHECK(line(4, {0x00000040, 0x80070001, 0xB0A40000}) == "texcrd r1.rgb, t0.rgb");
     CHECK(line(4, {0x00000042, 0x800F0005, 0x89E40002}) == "texld r5, r2_dz");
-    CHECK(line(4, {0x00000042, 0x800F0001, 0xBAF40000}) == "texld r1, t0_dw.rgaa");
+    CHECK(line(4, {0x00000042, 0x800F0001, 0xBAF40000}) == "texld r1, t0_dw.rga");
     CHECK(line(4, {0x00000057, 0x800F0005}) == "texdepth r5");
     CHECK(line(4, {0x0000FFFD}) == "phase");
     CHECK(line(1, {0x00000000}) == "nop");
@@ -118,8 +118,10 @@ TEST_CASE("disassembler: swizzles", "[disassembler]") {
     CHECK(fmt(0x55) == ".g");
     CHECK(fmt(0xAA) == ".b");
     CHECK(fmt(0xFF) == ".a");
-    CHECK(fmt(0xA4) == ".rgbb");
-    CHECK(fmt(0xF4) == ".rgaa");
+    CHECK(fmt(0xA4) == ".rgb");
+    CHECK(fmt(0xF4) == ".rga");
+    CHECK(fmt(0x54) == ".rg");
+    CHECK(fmt(0xC0) == ".rrra");
     CHECK(fmt(0x1B) == ".abgr");
     // Every swizzle prints differently, so the text determines the token.
     std::set<std::string> seen;
