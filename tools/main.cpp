@@ -1,6 +1,7 @@
 // The ps11 command line: one binary, one subcommand per job (asm, disasm, check, test,
 // golden, demo). Each subcommand parses its own options; user errors print a message that
 // names the file and place and exit 1, usage errors exit 2.
+#include <cctype>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -43,16 +44,21 @@ int usage(const std::string& message) {
 }
 
 // Assembles and (optionally) validates one file; prints diagnostics.
+std::optional<Program> assembleText(const std::string& text, const std::string& path, const PreprocessOptions& pp,
+                                    bool doValidate, ShaderStats* stats, Diagnostics& diags) {
+    AssembleOptions options;
+    options.preprocess = pp;
+    std::string name = path == "-" ? "<stdin>" : path;
+    std::optional<Program> prog = parseAssembly(text, name, options, diags);
+    if (prog && doValidate) validate(*prog, diags, stats);
+    return prog;
+}
+
 std::optional<Program> assembleFile(const std::string& path, const PreprocessOptions& pp, bool doValidate,
                                     ShaderStats* stats, Diagnostics& diags) {
     std::optional<std::string> text = readFile(path);
     if (!text) return std::nullopt;
-    AssembleOptions options;
-    options.preprocess = pp;
-    std::string name = path == "-" ? "<stdin>" : path;
-    std::optional<Program> prog = parseAssembly(*text, name, options, diags);
-    if (prog && doValidate) validate(*prog, diags, stats);
-    return prog;
+    return assembleText(*text, path, pp, doValidate, stats, diags);
 }
 
 int cmdAsm(const std::vector<std::string>& args) {
@@ -96,14 +102,53 @@ int cmdAsm(const std::vector<std::string>& args) {
     return kOk;
 }
 
-std::optional<Program> decodeFile(const std::string& path, bool hexInput, Diagnostics& diags) {
-    std::optional<std::string> data = readFile(path);
+// What a shader file holds: binary tokens, hex words as text, or assembly text.
+enum class InputKind { Binary, HexText, Assembly };
+
+InputKind classify(const std::string& data) {
+    for (unsigned char c : data)
+        if (c == 0 || (c < 0x20 && c != '\n' && c != '\r' && c != '\t') || c == 0x7f) return InputKind::Binary;
+    // Text: hex words when the first word (after comments) is 0x… or 8 hex digits.
+    size_t i = 0;
+    while (i < data.size()) {
+        while (i < data.size() && std::isspace(static_cast<unsigned char>(data[i]))) ++i;
+        if (i < data.size() && (data[i] == ';' || data[i] == '#' || data.compare(i, 2, "//") == 0)) {
+            while (i < data.size() && data[i] != '\n') ++i;
+            continue;
+        }
+        break;
+    }
+    if (data.compare(i, 2, "0x") == 0 || data.compare(i, 2, "0X") == 0) return InputKind::HexText;
+    size_t n = 0;
+    while (i + n < data.size() && std::isxdigit(static_cast<unsigned char>(data[i + n]))) ++n;
+    if (n == 8 && (i + n == data.size() || !std::isalnum(static_cast<unsigned char>(data[i + n]))))
+        return InputKind::HexText;
+    return InputKind::Assembly;
+}
+
+// Reads tokens from a file: binary, or hex words (forced with --hex-input, else detected).
+std::optional<Program> decodeData(const std::optional<std::string>& data, const std::string& path, bool hexInput,
+                                  Diagnostics& diags) {
     if (!data) return std::nullopt;
     uint32_t fileId = diags.addFile(path == "-" ? "<stdin>" : path);
+    InputKind kind = hexInput ? InputKind::HexText : classify(*data);
+    if (kind == InputKind::Assembly && !data->empty()) {
+        SourceLoc at;
+        at.fileId = fileId;
+        at.line = 1;
+        diags.error("P3019", at,
+                    "this looks like assembly text, not a token stream; use 'ps11 asm' or 'ps11 check' on it "
+                    "(hex words are read with --hex-input)");
+        return std::nullopt;
+    }
     std::optional<std::vector<uint32_t>> tokens =
-        hexInput ? tokensFromHex(*data, fileId, diags) : tokensFromBinary(*data, fileId, diags);
+        kind == InputKind::HexText ? tokensFromHex(*data, fileId, diags) : tokensFromBinary(*data, fileId, diags);
     if (!tokens) return std::nullopt;
     return decode(*tokens, fileId, diags);
+}
+
+std::optional<Program> decodeFile(const std::string& path, bool hexInput, Diagnostics& diags) {
+    return decodeData(readFile(path), path, hexInput, diags);
 }
 
 int cmdDisasm(const std::vector<std::string>& args) {
@@ -156,12 +201,17 @@ int cmdCheck(const std::vector<std::string>& args) {
         Diagnostics diags;
         ShaderStats stats;
         std::optional<Program> prog;
-        bool binary = hexInput || path.ends_with(".bin") || path.ends_with(".vso") || path.ends_with(".pso");
-        if (binary) {
-            prog = decodeFile(path, hexInput, diags);
+        // Token streams (binary or hex words) are decoded, text is assembled.
+        std::optional<std::string> data = readFile(path);
+        if (!data) {
+            status = kUserError;
+            continue;
+        }
+        if (hexInput || classify(*data) != InputKind::Assembly) {
+            prog = decodeData(data, path, hexInput, diags);
             if (prog) validate(*prog, diags, &stats);
         } else {
-            prog = assembleFile(path, pp, true, &stats, diags);
+            prog = assembleText(*data, path, pp, true, &stats, diags);
         }
         std::cout.flush();
         std::cerr << diags.formatAll();
