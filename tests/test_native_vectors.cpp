@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "ps11/assembler.h"
+#include "ps11/decoder.h"
+#include "ps11/disassembler.h"
 #include "ps11/diagnostics.h"
 #include "ps11/encoder.h"
 #include "ps11/validator.h"
@@ -210,4 +212,33 @@ TEST_CASE("shader corpus assembles and validates", "[native][corpus]") {
     INFO(failures.size() << " of " << count << " corpus shaders failed");
     CHECK(count >= 60);
     CHECK(failures.empty());
+}
+
+// The round-trip property on every native vector: text → tokens → text → tokens gives the
+// same tokens, and the native words themselves decode and print back to those words.
+TEST_CASE("native vectors round-trip through the disassembler", "[native][roundtrip]") {
+    const auto records = readRecords(dataPath("tests/golden/native_vectors.txt"));
+    REQUIRE(records.size() >= 70);
+    size_t checked = 0;
+    std::string failures;
+    for (const Record& rec : records) {
+        ps11::Diagnostics d1;
+        ps11::Diagnostics d2;
+        std::optional<ps11::Program> decoded = ps11::decode(rec.words, 0, d1);
+        if (!decoded) {
+            failures += rec.header + ": native words do not decode:\n" + d1.formatAll();
+            continue;
+        }
+        std::string text = ps11::disassemble(*decoded);
+        std::optional<ps11::Program> again = ps11::parseAssembly(text, "roundtrip.psh", {}, d2);
+        if (!again) {
+            failures += rec.header + ": disassembly does not assemble:\n" + text + d2.formatAll();
+            continue;
+        }
+        if (ps11::encode(*again) != rec.words) failures += rec.header + ": round trip changed the tokens\n" + text;
+        ++checked;
+    }
+    INFO(failures);
+    CHECK(failures.empty());
+    CHECK(checked == records.size());
 }
