@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "ps11/assembler.h"
+#include "ps11/decoder.h"
+#include "ps11/disassembler.h"
+#include "ps11/encoder.h"
 #include "ps11/diagnostics.h"
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
@@ -66,6 +69,18 @@ bool checkShader(const TestFile& file, const std::string& path, const RunOptions
     if (!ps.expectFail) {
         if (!diags.hasErrors()) {
             if (opts.verbose && !diags.all().empty()) std::cout << diags.formatAll();
+            // The toolchain's round-trip property on every valid shader of the corpus:
+            // tokens → disassembly → tokens gives the same words.
+            std::vector<uint32_t> tokens = encode(*program);
+            Diagnostics rt;
+            std::optional<Program> decoded = decode(tokens, rt.addFile(path), rt);
+            std::optional<Program> again =
+                decoded ? parseAssembly(disassemble(*decoded), path + " (disassembly)", options, rt) : std::nullopt;
+            if (!again || encode(*again) != tokens) {
+                std::cout << where(path, ps.line) << ": [pixel shader] does not round-trip through the disassembler\n"
+                          << rt.formatAll();
+                return false;
+            }
             return true;
         }
         std::cout << where(path, ps.line) << ": [pixel shader] does not assemble and validate:\n" << diags.formatAll();
