@@ -11,6 +11,8 @@
 #include <variant>
 #include <vector>
 
+#include "ps11/precision.h"
+
 namespace ps11 {
 
 using Vec4 = std::array<float, 4>;
@@ -26,14 +28,12 @@ struct Setting {
 };
 
 enum class Backend : uint8_t { Emu, Gl };
-enum class Precision : uint8_t { Fx8, Fx12, Float, Ideal };
 
 // Bit masks over Backend / Precision (bit = 1 << enum value).
 enum : uint8_t { kBackendEmu = 1, kBackendGl = 2, kAllBackends = 3 };
 enum : uint8_t { kPrecisionFx8 = 1, kPrecisionFx12 = 2, kPrecisionFloat = 4, kPrecisionIdeal = 8 };
 
 const char* backendName(Backend b);
-const char* precisionName(Precision p);
 
 // Surface formats a test may name (D3DFMT_* without the prefix).
 enum class TexFormat : uint8_t {

@@ -1,0 +1,78 @@
+// The executor: runs a validated ps_1_1 … ps_1_4 program (the IR, never raw tokens) over spans
+// of pixels in structure-of-arrays lanes, in one of the precision profiles of
+// docs/precision.md. Texture instructions call a Sampler. Errors are E40xx diagnostics.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include "ps11/diagnostics.h"
+#include "ps11/ir.h"
+#include "ps11/precision.h"
+#include "ps11/sampler.h"
+
+namespace ps11 {
+
+struct ExecutorOptions {
+    Precision precision = Precision::Fx8;
+    float maxValue = 0;  // PixelShader1xMaxValue; 0 = the version's default (1, or 8 for 1_4)
+};
+
+// Texture stage states the pixel shader reads (D3DTSS_*), per stage.
+struct StageState {
+    std::array<float, 4> bumpMat{0, 0, 0, 0};  // BUMPENVMAT00, 01, 10, 11
+    float lumScale = 0;                        // BUMPENVLSCALE
+    float lumOffset = 0;                       // BUMPENVLOFFSET
+    uint32_t transformFlags = 0;               // TEXTURETRANSFORMFLAGS: COUNTn (1-4) | PROJECTED (256)
+};
+constexpr uint32_t kTtffProjected = 256;
+
+// Interpolated inputs of `count` pixels (count <= kMaxSpan), structure of arrays. A null
+// pointer reads as 0 for every lane.
+struct PixelInputs {
+    int count = 0;
+    bool quads = false;  // lanes 4i..4i+3 are 2x2 quads (see SampleRequest::quads)
+    const float* color[2][4] = {};     // v0, v1: r g b a
+    const float* texcoord[8][4] = {};  // TC[0..7]: u v w q
+};
+
+// Results of `count` pixels. color is always filled (r0 as a real value); grid, if given,
+// receives r0's grid integers in fx profiles; killed (if given) is 1 for pixels discarded by
+// texkill; depth is written only where the shader replaces depth (writesDepth()).
+struct PixelOutputs {
+    float* color[4] = {};
+    int32_t* grid[4] = {};
+    uint8_t* killed = nullptr;
+    float* depth = nullptr;
+};
+
+struct ExecutorStats {
+    uint64_t pixels = 0;
+    uint64_t instructions = 0;  // instruction executions (per pixel)
+};
+
+class Executor {
+public:
+    // Prepares the program (decode once). Reports E40xx and returns null for programs it cannot
+    // run (unsupported version, invalid program). The program should have passed validate().
+    static std::unique_ptr<Executor> create(const Program& program, const ExecutorOptions& options,
+                                            Diagnostics& diags);
+    virtual ~Executor() = default;
+
+    // SetPixelShaderConstantF: c0..c7. A def in the shader overrides the API value.
+    virtual void setConstant(int index, const std::array<float, 4>& value) = 0;
+    virtual void setStageState(int stage, const StageState& state) = 0;
+    // True if the program replaces depth (texm3x2depth, texdepth).
+    virtual bool writesDepth() const = 0;
+    // Stages the program samples (bit per stage).
+    virtual uint32_t sampledStages() const = 0;
+    virtual const ExecutorOptions& options() const = 0;
+
+    // Runs the program for inputs.count pixels (<= kMaxSpan). Thread-safe for distinct
+    // outputs when the sampler is (run keeps no per-call state in the object).
+    virtual void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                     ExecutorStats* stats = nullptr) const = 0;
+};
+
+}  // namespace ps11

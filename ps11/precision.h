@@ -1,0 +1,34 @@
+// Precision profiles (docs/precision.md): how register values are represented and rounded.
+// fx8 and fx12 keep integers on a grid of 1/255 or 1/4080; float and ideal keep float32.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string_view>
+
+namespace ps11 {
+
+enum class Precision : uint8_t { Fx8, Fx12, Float, Ideal };
+
+const char* precisionName(Precision p);                     // "fx8", "fx12", "float", "ideal"
+std::optional<Precision> parsePrecision(std::string_view s);  // case-insensitive
+
+constexpr bool isFixedPoint(Precision p) { return p == Precision::Fx8 || p == Precision::Fx12; }
+// Grid scale G: a register value is n / G (fx profiles); 1 for float profiles.
+constexpr int32_t gridScale(Precision p) { return p == Precision::Fx8 ? 255 : p == Precision::Fx12 ? 4080 : 1; }
+// PixelShader1xMaxValue default for a ps_1_x minor version: 1 for 1_1-1_3, 8 for 1_4.
+constexpr float defaultMaxValue(int minor) { return minor >= 4 ? 8.0f : 1.0f; }
+
+// round_half_even(num / den) for den > 0, exact in integers.
+constexpr int64_t roundHalfEven(int64_t num, int64_t den) {
+    int64_t q = num / den, r = num % den;
+    if (r < 0) r += den, q -= 1;  // floor division
+    int64_t twice = 2 * r;
+    if (twice > den || (twice == den && (q & 1))) ++q;
+    return q;
+}
+
+// round_half_even(v * G) for a double v (exact for float inputs: 24 + 13 bits < 53).
+int32_t toGrid(double v, Precision p);
+
+}  // namespace ps11

@@ -1,0 +1,54 @@
+// The sampler interface between the executor and whoever owns textures (the test sampler
+// in ps11/texture_sampler.h today, the emu device later). The executor asks for a span of
+// lookups at once; the sampler answers in the profile's representation (grid integers for
+// fx profiles, floats otherwise), following docs/precision.md "Sampling".
+#pragma once
+
+#include <cstdint>
+
+#include "ps11/precision.h"
+
+namespace ps11 {
+
+// Largest span the executor runs at once.
+constexpr int kMaxSpan = 256;
+
+struct SampleRequest {
+    int stage = 0;          // sampler stage 0..7
+    int count = 0;          // lanes, <= kMaxSpan
+    bool quads = false;     // lanes 4i..4i+3 form a 2x2 pixel quad (top-left, top-right,
+                            // bottom-left, bottom-right): use them for the mip LOD;
+                            // otherwise sample mip level 0
+    int dims = 2;           // coordinates used: 1 (u), 2 (u, v) or 3 (u, v, w)
+    const float* u = nullptr;
+    const float* v = nullptr;
+    const float* w = nullptr;
+    Precision precision = Precision::Fx8;
+};
+
+// Output lanes: fx profiles fill grid[c][lane] (value = grid / G), float profiles fill
+// value[c][lane]. c = 0..3 is r, g, b, a.
+struct SampleResult {
+    int32_t* grid[4] = {nullptr, nullptr, nullptr, nullptr};
+    float* value[4] = {nullptr, nullptr, nullptr, nullptr};
+};
+
+class Sampler {
+public:
+    virtual ~Sampler() = default;
+    // Samples `req.count` lanes. A stage without a texture returns (0, 0, 0, 1).
+    virtual void sample(const SampleRequest& req, SampleResult& out) = 0;
+    // True if a texture is bound to the stage (for diagnostics only).
+    virtual bool hasTexture(int stage) const = 0;
+    // Texels fetched so far (statistics).
+    virtual uint64_t texelsFetched() const { return 0; }
+};
+
+// A sampler with nothing bound: every lookup returns (0, 0, 0, 1).
+class NullSampler final : public Sampler {
+public:
+    void sample(const SampleRequest& req, SampleResult& out) override;
+    bool hasTexture(int) const override { return false; }
+};
+
+}  // namespace ps11
