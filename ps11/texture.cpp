@@ -1,0 +1,367 @@
+// Software textures: decoding .ps11test texel words and float tuples into per-channel storage,
+// mip chain generation (2x2 / 2x2x2 box, rounded half-even in the stored representation) and
+// the per-profile grid values the sampler reads (docs/textures.md, docs/precision.md "Inputs").
+#include "ps11/texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ps11 {
+
+namespace {
+
+// Per format: how channels are stored and, for integer formats stored Decoded, the denominator
+// of each channel (value = raw / den, clamped to [-1, 1]).
+struct FormatInfo {
+    TexelStorage storage = TexelStorage::Unorm8;
+    bool floats = false;  // float32/float16 channels
+    bool half = false;    // A16B16G16R16F: values rounded to half precision
+    std::array<int32_t, 4> den{1, 1, 1, 1};
+};
+
+FormatInfo formatInfo(TexFormat f) {
+    FormatInfo i;
+    switch (f) {
+        case TexFormat::A8R8G8B8:
+        case TexFormat::X8R8G8B8:
+        case TexFormat::A8:
+        case TexFormat::L8:
+        case TexFormat::A8L8:
+            break;
+        case TexFormat::V8U8:
+        case TexFormat::Q8W8V8U8:
+            i.storage = TexelStorage::Decoded;
+            i.den = {127, 127, 127, 127};
+            break;
+        case TexFormat::L6V5U5:
+            i.storage = TexelStorage::Decoded;
+            i.den = {15, 15, 63, 1};
+            break;
+        case TexFormat::X8L8V8U8:
+            i.storage = TexelStorage::Decoded;
+            i.den = {127, 127, 255, 1};
+            break;
+        case TexFormat::V16U16:
+            i.storage = TexelStorage::Decoded;
+            i.den = {32767, 32767, 1, 1};
+            break;
+        case TexFormat::A16B16G16R16F:
+            i.storage = TexelStorage::Decoded;
+            i.floats = true;
+            i.half = true;
+            break;
+        case TexFormat::A32B32G32R32F:
+        case TexFormat::R32F:
+            i.storage = TexelStorage::Decoded;
+            i.floats = true;
+            break;
+    }
+    return i;
+}
+
+int32_t signExtend(uint32_t v, int bits) {
+    uint32_t m = uint32_t(1) << (bits - 1);
+    v &= (uint32_t(1) << bits) - 1;
+    return int32_t(v ^ m) - int32_t(m);
+}
+
+// A packed word of an Unorm8 format -> r g b a bytes (spec §6.4: missing channels read 1,
+// except A8 whose rgb read 0).
+std::array<uint8_t, 4> decodeUnorm8(TexFormat f, uint32_t w) {
+    auto b = [w](int shift) { return uint8_t((w >> shift) & 0xff); };
+    switch (f) {
+        case TexFormat::A8R8G8B8:
+            return {b(16), b(8), b(0), b(24)};
+        case TexFormat::X8R8G8B8:
+            return {b(16), b(8), b(0), 255};
+        case TexFormat::A8:
+            return {0, 0, 0, b(0)};
+        case TexFormat::L8:
+            return {b(0), b(0), b(0), 255};
+        case TexFormat::A8L8:
+            return {b(0), b(0), b(0), b(8)};
+        default:
+            return {0, 0, 0, 255};
+    }
+}
+
+// A packed word of a signed (bump) format -> raw channel integers over FormatInfo::den.
+// Mapping (docs/textures.md): r = U, g = V, b = L or W (else 1), a = Q (else 1).
+std::array<int32_t, 4> decodeSigned(TexFormat f, uint32_t w) {
+    switch (f) {
+        case TexFormat::V8U8:
+            return {signExtend(w, 8), signExtend(w >> 8, 8), 127, 127};
+        case TexFormat::L6V5U5:
+            return {signExtend(w, 5), signExtend(w >> 5, 5), int32_t((w >> 10) & 63), 1};
+        case TexFormat::X8L8V8U8:
+            return {signExtend(w, 8), signExtend(w >> 8, 8), int32_t((w >> 16) & 0xff), 1};
+        case TexFormat::Q8W8V8U8:
+            return {signExtend(w, 8), signExtend(w >> 8, 8), signExtend(w >> 16, 8), signExtend(w >> 24, 8)};
+        case TexFormat::V16U16:
+            return {signExtend(w, 16), signExtend(w >> 16, 16), 1, 1};
+        default:
+            return {0, 0, 0, 1};
+    }
+}
+
+Vec4 decodeFloat(TexFormat f, const Texel& t) {
+    Vec4 v = t.value;  // components not written are 0 0 0 1 (testfile.h)
+    if (f == TexFormat::R32F) return {v[0], 1.0f, 1.0f, 1.0f};
+    if (f == TexFormat::A16B16G16R16F)
+        for (float& c : v) c = roundToHalf(c);
+    return v;
+}
+
+uint32_t extentAt(uint32_t size, uint32_t level) { return level >= 32 ? 1 : std::max<uint32_t>(1, size >> level); }
+
+// Box-filters level `src` into level `dst` (2x2, or 2x2x2 for volumes). Source coordinates
+// 2x and 2x+1 are clamped to the source extent, so a dimension already at 1 averages one texel
+// twice and odd extents drop their last row/column (as D3DX's box filter for power-of-two
+// chains; docs/textures.md).
+template <class T, class Avg>
+void boxDown(std::vector<T>& data, const TextureLevelInfo& src, const TextureLevelInfo& dst, bool volume, Avg avg) {
+    int n = volume ? 8 : 4;
+    for (uint32_t z = 0; z < dst.depth; ++z)
+        for (uint32_t y = 0; y < dst.height; ++y)
+            for (uint32_t x = 0; x < dst.width; ++x) {
+                size_t taps[8];
+                int k = 0;
+                for (uint32_t dz = 0; dz < (volume ? 2u : 1u); ++dz)
+                    for (uint32_t dy = 0; dy < 2; ++dy)
+                        for (uint32_t dx = 0; dx < 2; ++dx) {
+                            uint32_t sx = std::min(2 * x + dx, src.width - 1);
+                            uint32_t sy = std::min(2 * y + dy, src.height - 1);
+                            uint32_t sz = std::min(2 * z + dz, src.depth - 1);
+                            taps[k++] = src.offset + (size_t(sz) * src.height + sy) * src.width + sx;
+                        }
+                size_t out = dst.offset + (size_t(z) * dst.height + y) * dst.width + x;
+                for (int c = 0; c < 4; ++c) data[out * 4 + c] = avg(data, taps, n, c);
+            }
+}
+
+}  // namespace
+
+uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth) {
+    uint32_t m = std::max({width, height, depth, 1u});
+    uint32_t n = 1;
+    while (m > 1) m >>= 1, ++n;
+    return n;
+}
+
+float roundToHalf(float v) {
+    if (!std::isfinite(v) || v == 0.0f) return v;
+    double a = std::fabs(double(v));
+    if (a >= 65520.0) return std::copysign(INFINITY, v);  // beyond the largest half + half a step
+    int e = 0;
+    std::frexp(a, &e);                         // a = m * 2^e, m in [0.5, 1)
+    int quantumExp = std::max(e - 11, -24);    // 11 significant bits; subnormals step 2^-24
+    double q = std::ldexp(1.0, quantumExp);
+    double r = std::nearbyint(a / q) * q;      // ties to even
+    return float(std::copysign(r, double(v)));
+}
+
+const float* Texture::unorm8Values() {
+    static const std::array<float, 256> table = [] {
+        std::array<float, 256> t{};
+        for (int i = 0; i < 256; ++i) t[size_t(i)] = float(double(i) / 255.0);
+        return t;
+    }();
+    return table.data();
+}
+
+size_t Texture::texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const {
+    const TextureLevelInfo& l = m_levels[size_t(level)];
+    x = std::min(x, l.width - 1), y = std::min(y, l.height - 1), z = std::min(z, l.depth - 1);
+    return l.offset + (size_t(z) * l.height + y) * l.width + x;
+}
+
+Vec4 Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
+    size_t i = texelIndex(level, x, y, z) * 4;
+    Vec4 v;
+    for (size_t c = 0; c < 4; ++c) v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[m_u8[i + c]] : m_value[i + c];
+    return v;
+}
+
+std::array<int32_t, 4> Texture::texelGrid(int level, uint32_t x, uint32_t y, uint32_t z, Precision p) const {
+    size_t i = texelIndex(level, x, y, z) * 4;
+    std::array<int32_t, 4> g{};
+    int32_t scale = gridScale(p) / 255;
+    for (size_t c = 0; c < 4; ++c) g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(m_u8[i + c]) * scale : grid(p)[i + c];
+    return g;
+}
+
+std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error) {
+    const TexFormat fmt = desc.format.value;
+    const FormatInfo info = formatInfo(fmt);
+    const bool volume = desc.isVolume();
+    const uint32_t depth = volume ? desc.depth : 1;
+    if (desc.width == 0 || desc.height == 0) {
+        error = "texture has no size";
+        return std::nullopt;
+    }
+    if (desc.width > kMaxSurfaceSize || desc.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+        error = "texture size " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
+                (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
+                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+        return std::nullopt;
+    }
+    const uint32_t possible = fullMipCount(desc.width, desc.height, depth);
+    const uint32_t count = desc.levels.value == 0 ? possible : desc.levels.value;
+    if (count > possible) {
+        error = "levels " + std::to_string(count) + " is more than the texture has (" + std::to_string(possible) + ")";
+        return std::nullopt;
+    }
+
+    Texture t;
+    t.m_format = fmt;
+    t.m_volume = volume;
+    t.m_storage = info.storage;
+    size_t total = 0;
+    for (uint32_t k = 0; k < count; ++k) {
+        TextureLevelInfo l;
+        l.width = extentAt(desc.width, k);
+        l.height = extentAt(desc.height, k);
+        l.depth = extentAt(depth, k);
+        l.offset = total;
+        total += size_t(l.width) * l.height * l.depth;
+        t.m_levels.push_back(l);
+    }
+    t.m_texelCount = total;
+    // Unorm8: 4 bytes; Decoded: 16 (float) + 32 (two grids) + 16 (raw while building).
+    const uint64_t bytesPerTexel = info.storage == TexelStorage::Unorm8 ? 4 : 64;
+    if (uint64_t(total) * bytesPerTexel > kMaxTextureBytes) {
+        error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" + std::to_string(total) +
+                " texels of " + texFormatName(fmt) + "), more than the limit of " + std::to_string(kMaxTextureBytes);
+        return std::nullopt;
+    }
+
+    // Which levels the description gives; the others (levels 0) are generated.
+    std::vector<const TextureLevel*> given(count, nullptr);
+    for (const TextureLevel& l : desc.data) {
+        if (l.level >= count) {
+            error = "data for level " + std::to_string(l.level) + " beyond the texture's " + std::to_string(count) +
+                    " levels";
+            return std::nullopt;
+        }
+        const TextureLevelInfo& li = t.m_levels[l.level];
+        size_t n = size_t(li.width) * li.height * li.depth;
+        if (!l.hasFill && l.texels.size() != n) {
+            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) + " texels, expected " +
+                    std::to_string(n);
+            return std::nullopt;
+        }
+        given[l.level] = &l;
+    }
+    if (!given[0]) {
+        error = "texture has no data for level 0";
+        return std::nullopt;
+    }
+    if (desc.levels.value != 0)
+        for (uint32_t k = 1; k < count; ++k)
+            if (!given[k]) {
+                error = "texture has no data for level " + std::to_string(k);
+                return std::nullopt;
+            }
+
+    const int bits = formatBits(fmt);
+    auto checkTexel = [&](const Texel& x) {
+        if (info.floats != (x.count > 0)) {
+            error = std::string("format ") + texFormatName(fmt) +
+                    (info.floats ? " takes float texels" : " takes packed texel words, not floats");
+            return false;
+        }
+        if (!info.floats && bits < 32 && (x.bits >> bits) != 0) {
+            error = "texel word " + std::to_string(x.bits) + " does not fit format " + texFormatName(fmt);
+            return false;
+        }
+        return true;
+    };
+
+    std::vector<int32_t> raw;  // signed formats while building
+    std::vector<float> rawf;   // float formats while building
+    if (info.storage == TexelStorage::Unorm8) t.m_u8.assign(total * 4, 0);
+    else if (info.floats) rawf.assign(total * 4, 0.0f);
+    else raw.assign(total * 4, 0);
+
+    auto store = [&](size_t index, const Texel& x) {
+        if (info.storage == TexelStorage::Unorm8) {
+            std::array<uint8_t, 4> b = decodeUnorm8(fmt, x.bits);
+            std::copy(b.begin(), b.end(), t.m_u8.begin() + ptrdiff_t(index * 4));
+        } else if (info.floats) {
+            Vec4 v = decodeFloat(fmt, x);
+            std::copy(v.begin(), v.end(), rawf.begin() + ptrdiff_t(index * 4));
+        } else {
+            std::array<int32_t, 4> r = decodeSigned(fmt, x.bits);
+            std::copy(r.begin(), r.end(), raw.begin() + ptrdiff_t(index * 4));
+        }
+    };
+
+    for (uint32_t k = 0; k < count; ++k) {
+        const TextureLevelInfo& li = t.m_levels[k];
+        size_t n = size_t(li.width) * li.height * li.depth;
+        if (given[k]) {
+            const TextureLevel& l = *given[k];
+            if (l.hasFill) {
+                if (!checkTexel(l.fill)) return std::nullopt;
+                for (size_t i = 0; i < n; ++i) store(li.offset + i, l.fill);
+            } else {
+                for (size_t i = 0; i < n; ++i) {
+                    if (!checkTexel(l.texels[i])) return std::nullopt;
+                    store(li.offset + i, l.texels[i]);
+                }
+            }
+            continue;
+        }
+        // Generated level: box filter of the previous one, rounded half-even in the stored form.
+        const TextureLevelInfo& src = t.m_levels[k - 1];
+        if (info.storage == TexelStorage::Unorm8) {
+            boxDown(t.m_u8, src, li, volume, [](const std::vector<uint8_t>& d, const size_t* taps, int m, int c) {
+                int64_t s = 0;
+                for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
+                return uint8_t(roundHalfEven(s, m));
+            });
+        } else if (info.floats) {
+            bool half = info.half;
+            boxDown(rawf, src, li, volume, [half](const std::vector<float>& d, const size_t* taps, int m, int c) {
+                double s = 0;
+                for (int i = 0; i < m; ++i) s += double(d[taps[i] * 4 + size_t(c)]);
+                float v = float(s / m);
+                return half ? roundToHalf(v) : v;
+            });
+        } else {
+            boxDown(raw, src, li, volume, [](const std::vector<int32_t>& d, const size_t* taps, int m, int c) {
+                int64_t s = 0;
+                for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
+                return int32_t(roundHalfEven(s, m));
+            });
+        }
+    }
+
+    if (info.storage == TexelStorage::Decoded) {
+        t.m_value.resize(total * 4);
+        t.m_grid8.resize(total * 4);
+        t.m_grid12.resize(total * 4);
+        for (size_t i = 0; i < total * 4; ++i) {
+            const size_t c = i & 3;
+            if (info.floats) {
+                float v = rawf[i];
+                t.m_value[i] = v;
+                auto g = [v](Precision p) {
+                    return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid);
+                };
+                t.m_grid8[i] = g(Precision::Fx8);
+                t.m_grid12[i] = g(Precision::Fx12);
+            } else {
+                // docs/precision.md "Inputs": b -> b/den clamped to [-1, 1]; fx: round_half_even(b*G/den).
+                const int64_t den = info.den[c];
+                const int64_t r = std::clamp<int64_t>(raw[i], -den, den);
+                t.m_value[i] = float(double(r) / double(den));
+                t.m_grid8[i] = int32_t(roundHalfEven(r * 255, den));
+                t.m_grid12[i] = int32_t(roundHalfEven(r * 4080, den));
+            }
+        }
+    }
+    return t;
+}
+
+}  // namespace ps11

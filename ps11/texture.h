@@ -1,0 +1,88 @@
+// Software textures (docs/textures.md): a format, 2D or volume, a mip chain, and the texels
+// decoded per channel so that every precision profile reads exact values (8-bit channels as
+// bytes, signed and float formats as per-profile grid integers and float32). Built from the
+// .ps11test model by textureFromDesc(); immutable afterwards, shared by samplers.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ps11/precision.h"
+#include "ps11/testfile.h"
+
+namespace ps11 {
+
+// Largest number of bytes one texture may occupy (all levels, all decoded copies). A full
+// 16384 x 16384 A8R8G8B8 level fits; larger requests are refused with an error, never allocated.
+constexpr uint64_t kMaxTextureBytes = uint64_t(1) << 30;
+
+// Grid values of float texels are clamped to +-kMaxTexelGrid (about +-4112 in fx8, far beyond any
+// MaxValue) so that the exact integer sums of the sampler cannot overflow.
+constexpr int32_t kMaxTexelGrid = 1 << 20;
+
+// How a texture keeps its texels.
+enum class TexelStorage : uint8_t {
+    Unorm8,   // 4 bytes r g b a per texel, value = byte / 255 (A8R8G8B8, X8R8G8B8, A8, L8, A8L8)
+    Decoded,  // float32 r g b a plus fx8 and fx12 grid integers per texel (signed and float formats)
+};
+
+struct TextureLevelInfo {
+    uint32_t width = 1, height = 1, depth = 1;
+    size_t offset = 0;  // index of the level's first texel in the texture's arrays
+};
+
+class Texture {
+public:
+    TexFormat format() const { return m_format; }
+    bool isVolume() const { return m_volume; }
+    TexelStorage storage() const { return m_storage; }
+    int levelCount() const { return int(m_levels.size()); }
+    const TextureLevelInfo& level(int i) const { return m_levels[size_t(i)]; }
+    // Total texels over all levels.
+    size_t texelCount() const { return m_texelCount; }
+
+    // The decoded value of one texel (float profiles): r g b a.
+    Vec4 texelValue(int level, uint32_t x, uint32_t y, uint32_t z = 0) const;
+    // The grid value of one texel in a fixed-point profile (value = grid / G).
+    std::array<int32_t, 4> texelGrid(int level, uint32_t x, uint32_t y, uint32_t z, Precision p) const;
+
+    // Raw arrays for the sampler, 4 entries (r g b a) per texel, indexed by level offset + texel.
+    const uint8_t* unorm8() const { return m_u8.data(); }                            // Unorm8
+    const float* values() const { return m_value.data(); }                           // Decoded
+    const int32_t* grid(Precision p) const {                                         // Decoded, fx
+        return p == Precision::Fx12 ? m_grid12.data() : m_grid8.data();
+    }
+    // Float32 of byte b (b / 255), shared by all Unorm8 textures.
+    static const float* unorm8Values();
+
+private:
+    friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error);
+    size_t texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const;
+
+    TexFormat m_format = TexFormat::A8R8G8B8;
+    bool m_volume = false;
+    TexelStorage m_storage = TexelStorage::Unorm8;
+    std::vector<TextureLevelInfo> m_levels;
+    size_t m_texelCount = 0;
+    std::vector<uint8_t> m_u8;
+    std::vector<float> m_value;
+    std::vector<int32_t> m_grid8, m_grid12;
+};
+
+// Builds a texture from a parsed [texture N] section: texel words in the format's natural
+// packing (docs/test-format.md) or float tuples, `fill`, and `levels 0` (generate the whole chain
+// from level 0). On failure returns nullopt and sets `error`; never allocates more than
+// kMaxTextureBytes.
+std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error);
+
+// Number of levels of a full chain (down to 1x1x1).
+uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);
+
+// float32 -> nearest IEEE half (ties to even, overflow to infinity) -> float32.
+float roundToHalf(float v);
+
+}  // namespace ps11

@@ -1,0 +1,491 @@
+// The software sampler stage: level selection from 2x2 quads, per-axis texel addressing
+// (wrap / mirror / clamp / border / mirroronce) and the exact weighted sums of
+// docs/precision.md "Sampling" (8-bit weights, one round-half-even in fx profiles; float32 in
+// float profiles), plus a bilinear fast path for 8-bit 2D textures in fx (docs/textures.md).
+#include "ps11/texture_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace ps11 {
+
+namespace {
+
+constexpr int kSlots = 2;  // mip levels blended per lane (linear mip filter)
+
+// round_half_even(v / 2^s) for s >= 1 (arithmetic shift = floor division).
+inline int64_t roundShift(int64_t v, int s) {
+    int64_t q = v >> s;
+    int64_t r = v - (q << s);
+    int64_t half = int64_t(1) << (s - 1);
+    if (r > half || (r == half && (q & 1))) ++q;
+    return q;
+}
+
+// Per lane: which levels (slot 0, and slot 1 for a linear mip blend) and which filter.
+struct LaneLevels {
+    uint8_t level[kSlots][kMaxSpan];
+    uint8_t slots[kMaxSpan];
+    uint8_t linear[kMaxSpan];  // 1 = bilinear/trilinear taps, 0 = point
+    int32_t mipW[kMaxSpan];    // fx: weight of slot 1 in 0..256 (slot 0 gets 256 - w)
+    float mipF[kMaxSpan];      // float: weight of slot 1
+};
+
+// Per lane and axis: the two texel indices after the address mode (-1 = border) and the weight
+// of i1 (fx: 0..256, float: [0, 1]).
+struct AxisTaps {
+    int32_t i0[kMaxSpan], i1[kMaxSpan];
+    int32_t w[kMaxSpan];
+    float f[kMaxSpan];
+};
+
+int32_t mirrorIndex(int64_t k, int64_t n) { return int32_t(k < n ? k : 2 * n - 1 - k); }
+
+// Maps the integer texel coordinate `fl` (and fl + 1) of an axis with n texels through the
+// address mode (spec §6.3). `fl` may be any double integer (huge values included); indices
+// are always in [0, n) or -1 for a border texel.
+template <TextureAddress Mode>
+inline void addressPair(double fl, int64_t n, int32_t& i0, int32_t& i1) {
+    if constexpr (Mode == TextureAddress::Wrap) {
+        int64_t k = (fl > -1e15 && fl < 1e15) ? int64_t(fl) % n : int64_t(std::fmod(fl, double(n)));
+        if (k < 0) k += n;
+        i0 = int32_t(k);
+        i1 = k + 1 == n ? 0 : int32_t(k + 1);
+    } else if constexpr (Mode == TextureAddress::Mirror) {
+        const int64_t p = 2 * n;  // mirror repeats every two copies
+        int64_t k = (fl > -1e15 && fl < 1e15) ? int64_t(fl) % p : int64_t(std::fmod(fl, double(p)));
+        if (k < 0) k += p;
+        i0 = mirrorIndex(k, n);
+        i1 = mirrorIndex(k + 1 == p ? 0 : k + 1, n);
+    } else if constexpr (Mode == TextureAddress::Clamp) {
+        int64_t k = int64_t(std::clamp(fl, -1.0, double(n)));
+        i0 = int32_t(std::clamp<int64_t>(k, 0, n - 1));
+        i1 = int32_t(std::clamp<int64_t>(k + 1, 0, n - 1));
+    } else if constexpr (Mode == TextureAddress::Border) {
+        int64_t k = int64_t(std::clamp(fl, -2.0, double(n + 1)));
+        i0 = k >= 0 && k < n ? int32_t(k) : -1;
+        i1 = k + 1 >= 0 && k + 1 < n ? int32_t(k + 1) : -1;
+    } else {  // MirrorOnce: mirror once around 0 (texel -1 is texel 0), then clamp
+        int64_t k = int64_t(std::clamp(fl, -double(n) - 2.0, double(n + 1)));
+        auto once = [n](int64_t j) { return int32_t(std::clamp<int64_t>(j < 0 ? -j - 1 : j, 0, n - 1)); };
+        i0 = once(k);
+        i1 = once(k + 1);
+    }
+}
+
+// Texel-space position of one coordinate: x = u*n - 0.5 for linear (texel centres, spec §6.2),
+// u*n for point (floor(u*n), ties go up). Computed in double, exact for float32 u and n <= 2^14.
+// NaN samples as 0, infinities as a huge finite position (never a crash).
+inline void texelPosition(float u, uint32_t n, bool linear, double& fl, double& fr) {
+    double x = double(u) * double(n) - (linear ? 0.5 : 0.0);
+    fl = std::floor(x);
+    fr = x - fl;
+    if (!(fr >= 0.0 && fr < 1.0)) {
+        fl = x > 0 ? 1e18 : x < 0 ? -1e18 : 0.0;
+        fr = 0.0;
+    }
+}
+
+template <TextureAddress Mode>
+void axisPassT(int count, const float* coord, const uint32_t* extent, const uint8_t* level, const uint8_t* linear,
+               AxisTaps& out) {
+    for (int i = 0; i < count; ++i) {
+        const uint32_t n = extent[level[i]];
+        double fl, fr;
+        texelPosition(coord[i], n, linear[i] != 0, fl, fr);
+        addressPair<Mode>(fl, n, out.i0[i], out.i1[i]);
+        out.w[i] = linear[i] ? int32_t(std::nearbyint(fr * 256.0)) : 0;  // 8-bit weight, ties to even
+        out.f[i] = linear[i] ? float(fr) : 0.0f;
+    }
+}
+
+void axisPass(TextureAddress mode, int count, const float* coord, const uint32_t* extent, const uint8_t* level,
+              const uint8_t* linear, AxisTaps& out) {
+    switch (mode) {
+        case TextureAddress::Wrap:
+            return axisPassT<TextureAddress::Wrap>(count, coord, extent, level, linear, out);
+        case TextureAddress::Mirror:
+            return axisPassT<TextureAddress::Mirror>(count, coord, extent, level, linear, out);
+        case TextureAddress::Clamp:
+            return axisPassT<TextureAddress::Clamp>(count, coord, extent, level, linear, out);
+        case TextureAddress::Border:
+            return axisPassT<TextureAddress::Border>(count, coord, extent, level, linear, out);
+        case TextureAddress::MirrorOnce:
+            return axisPassT<TextureAddress::MirrorOnce>(count, coord, extent, level, linear, out);
+    }
+    axisPassT<TextureAddress::Wrap>(count, coord, extent, level, linear, out);  // invalid state: wrap
+}
+
+// Texel sources: 4 channels of texel `i` (level offset included) in the profile's terms.
+struct U8Grid {
+    const uint8_t* p;
+    int64_t scale;  // 1 (fx8) or 16 (fx12)
+    void get(size_t i, int64_t t[4]) const {
+        for (int c = 0; c < 4; ++c) t[c] = int64_t(p[i * 4 + size_t(c)]) * scale;
+    }
+};
+struct IntGrid {
+    const int32_t* p;
+    void get(size_t i, int64_t t[4]) const {
+        for (int c = 0; c < 4; ++c) t[c] = p[i * 4 + size_t(c)];
+    }
+};
+struct U8Float {
+    const uint8_t* p;
+    const float* table;
+    void get(size_t i, float t[4]) const {
+        for (int c = 0; c < 4; ++c) t[c] = table[p[i * 4 + size_t(c)]];
+    }
+};
+struct ValueFloat {
+    const float* p;
+    void get(size_t i, float t[4]) const {
+        for (int c = 0; c < 4; ++c) t[c] = p[i * 4 + size_t(c)];
+    }
+};
+
+struct CombineInput {
+    int count;
+    const TextureLevelInfo* levels;
+    const LaneLevels* lanes;
+    const AxisTaps (*taps)[3];  // [slot][axis]
+};
+
+// One tap: texel (ix, iy, iz) of a level, or the border colour when any index is -1.
+template <class Src, class T>
+inline void tap(const Src& src, const TextureLevelInfo& li, int32_t ix, int32_t iy, int32_t iz, const T* border,
+                T t[4]) {
+    if ((ix | iy | iz) < 0) {
+        for (int c = 0; c < 4; ++c) t[c] = border[c];
+        return;
+    }
+    src.get(li.offset + (size_t(iz) * li.height + size_t(iy)) * li.width + size_t(ix), t);
+}
+
+// fx: every tap weighted exactly (denominator 2^24 per level, 2^8 for the mip blend), one
+// round-half-even at the end (docs/precision.md "Sampling").
+template <class Src, bool Volume>
+void combineFx(const CombineInput& in, const Src& src, const int64_t* border, int32_t* const* dst) {
+    const LaneLevels& L = *in.lanes;
+    for (int i = 0; i < in.count; ++i) {
+        int64_t acc[4] = {0, 0, 0, 0};
+        const int slots = L.slots[i];
+        for (int s = 0; s < slots; ++s) {
+            const TextureLevelInfo& li = in.levels[L.level[s][i]];
+            const AxisTaps& ax = in.taps[s][0];
+            const AxisTaps& ay = in.taps[s][1];
+            const AxisTaps& az = in.taps[s][2];
+            const int64_t mw = slots == 1 ? 256 : s == 0 ? 256 - L.mipW[i] : L.mipW[i];
+            int64_t t[4];
+            if (!L.linear[i]) {
+                tap(src, li, ax.i0[i], ay.i0[i], Volume ? az.i0[i] : 0, border, t);
+                for (int c = 0; c < 4; ++c) acc[c] += t[c] * (mw << 24);
+                continue;
+            }
+            const int64_t wx[2] = {256 - ax.w[i], ax.w[i]}, wy[2] = {256 - ay.w[i], ay.w[i]};
+            const int64_t wz[2] = {Volume ? 256 - az.w[i] : 256, Volume ? az.w[i] : 0};
+            const int32_t ix[2] = {ax.i0[i], ax.i1[i]}, iy[2] = {ay.i0[i], ay.i1[i]};
+            const int32_t iz[2] = {Volume ? az.i0[i] : 0, Volume ? az.i1[i] : 0};
+            for (int z = 0; z < (Volume ? 2 : 1); ++z)
+                for (int y = 0; y < 2; ++y)
+                    for (int x = 0; x < 2; ++x) {
+                        tap(src, li, ix[x], iy[y], iz[z], border, t);
+                        const int64_t w = wx[x] * wy[y] * wz[z] * mw;
+                        for (int c = 0; c < 4; ++c) acc[c] += t[c] * w;
+                    }
+        }
+        for (int c = 0; c < 4; ++c) dst[c][i] = int32_t(roundShift(acc[c], 32));
+    }
+}
+
+inline float lerpf(float a, float b, float f) { return (1.0f - f) * a + f * b; }
+
+// float/ideal: float32 weights, separable lerps u, then v, then w, then the mip blend.
+template <class Src, bool Volume>
+void combineFloat(const CombineInput& in, const Src& src, const float* border, float* const* dst) {
+    const LaneLevels& L = *in.lanes;
+    for (int i = 0; i < in.count; ++i) {
+        float res[kSlots][4];
+        const int slots = L.slots[i];
+        for (int s = 0; s < slots; ++s) {
+            const TextureLevelInfo& li = in.levels[L.level[s][i]];
+            const AxisTaps& ax = in.taps[s][0];
+            const AxisTaps& ay = in.taps[s][1];
+            const AxisTaps& az = in.taps[s][2];
+            if (!L.linear[i]) {
+                tap(src, li, ax.i0[i], ay.i0[i], Volume ? az.i0[i] : 0, border, res[s]);
+                continue;
+            }
+            float plane[2][4];
+            for (int z = 0; z < (Volume ? 2 : 1); ++z) {
+                const int32_t iz = Volume ? (z ? az.i1[i] : az.i0[i]) : 0;
+                float t00[4], t10[4], t01[4], t11[4];
+                tap(src, li, ax.i0[i], ay.i0[i], iz, border, t00);
+                tap(src, li, ax.i1[i], ay.i0[i], iz, border, t10);
+                tap(src, li, ax.i0[i], ay.i1[i], iz, border, t01);
+                tap(src, li, ax.i1[i], ay.i1[i], iz, border, t11);
+                for (int c = 0; c < 4; ++c)
+                    plane[z][c] = lerpf(lerpf(t00[c], t10[c], ax.f[i]), lerpf(t01[c], t11[c], ax.f[i]), ay.f[i]);
+            }
+            for (int c = 0; c < 4; ++c) res[s][c] = Volume ? lerpf(plane[0][c], plane[1][c], az.f[i]) : plane[0][c];
+        }
+        for (int c = 0; c < 4; ++c) dst[c][i] = slots == 1 ? res[0][c] : lerpf(res[0][c], res[1][c], L.mipF[i]);
+    }
+}
+
+// fx bilinear on an 8-bit 2D texture, one level, wrap/clamp: the same exact sum as combineFx
+// (sum * scale / 2^16, one round-half-even) in 32-bit integers.
+template <TextureAddress MU, TextureAddress MV>
+void fastBilinearU8(int count, const float* u, const float* v, const TextureLevelInfo& li, const uint8_t* texels,
+                    int32_t scale, int32_t* const* dst) {
+    const uint8_t* base = texels + li.offset * 4;
+    for (int i = 0; i < count; ++i) {
+        double flx, frx, fly, fry;
+        texelPosition(u[i], li.width, true, flx, frx);
+        texelPosition(v[i], li.height, true, fly, fry);
+        int32_t x0, x1, y0, y1;
+        addressPair<MU>(flx, li.width, x0, x1);
+        addressPair<MV>(fly, li.height, y0, y1);
+        const int32_t wx = int32_t(std::nearbyint(frx * 256.0)), wy = int32_t(std::nearbyint(fry * 256.0));
+        const uint8_t* r0 = base + size_t(y0) * li.width * 4;
+        const uint8_t* r1 = base + size_t(y1) * li.width * 4;
+        uint8_t t00[4], t10[4], t01[4], t11[4];
+        std::memcpy(t00, r0 + size_t(x0) * 4, 4);
+        std::memcpy(t10, r0 + size_t(x1) * 4, 4);
+        std::memcpy(t01, r1 + size_t(x0) * 4, 4);
+        std::memcpy(t11, r1 + size_t(x1) * 4, 4);
+        const int32_t w00 = (256 - wx) * (256 - wy), w10 = wx * (256 - wy), w01 = (256 - wx) * wy, w11 = wx * wy;
+        for (int c = 0; c < 4; ++c) {
+            const int32_t s = (w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c]) * scale;
+            dst[c][i] = int32_t(roundShift(s, 16));
+        }
+    }
+}
+
+template <TextureAddress MU>
+bool fastBilinearV(TextureAddress mv, int count, const float* u, const float* v, const TextureLevelInfo& li,
+                   const uint8_t* texels, int32_t scale, int32_t* const* dst) {
+    if (mv == TextureAddress::Clamp) {
+        fastBilinearU8<MU, TextureAddress::Clamp>(count, u, v, li, texels, scale, dst);
+        return true;
+    }
+    if (mv == TextureAddress::Wrap) {
+        fastBilinearU8<MU, TextureAddress::Wrap>(count, u, v, li, texels, scale, dst);
+        return true;
+    }
+    return false;
+}
+
+Filter effective(Filter f) { return f == Filter::Linear ? Filter::Linear : Filter::Point; }
+
+// Level selection (docs/textures.md "Level of detail"): per 2x2 quad, the screen derivatives of
+// (u*W, v*H, w*D) at level 0 from the top-left lane; rho = the longer of the two derivative
+// vectors, LOD = log2(rho). Mag filter at LOD <= 0, else min filter; mip none: level 0; point:
+// nearest level (ties up); linear: the two levels around LOD with an 8-bit weight (fx).
+void selectLevels(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
+                  const SamplerState& st, bool fixed, LaneLevels& L) {
+    const bool magLinear = effective(st.magFilter) == Filter::Linear;
+    const bool minLinear = effective(st.minFilter) == Filter::Linear;
+    const int levels = tex.levelCount();
+    const int axes = tex.isVolume() ? 3 : 2;
+    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
+    if (!req.quads) {
+        for (int i = 0; i < count; ++i) L.level[0][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0;
+        return;
+    }
+    for (int q = 0; q < count; q += 4) {
+        const int tl = q, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
+        double dx2 = 0, dy2 = 0;
+        for (int a = 0; a < axes; ++a) {
+            const double c0 = double(coord[a][tl]) * size[a];
+            const double ddx = double(coord[a][tr]) * size[a] - c0, ddy = double(coord[a][bl]) * size[a] - c0;
+            dx2 += ddx * ddx;
+            dy2 += ddy * ddy;
+        }
+        const double rho2 = std::max(dx2, dy2);
+        double lod = 0.5 * std::log2(rho2);  // log2(sqrt(rho2)); rho2 = 0 gives -inf (magnified)
+        if (std::isnan(lod)) lod = 0.0;
+        int level0 = 0, level1 = 0, slots = 1;
+        int32_t mipW = 0;
+        float mipF = 0.0f;
+        if (lod > 0.0 && levels > 1) {
+            if (st.mipFilter == Filter::Point) {
+                const double n = std::floor(lod + 0.5);
+                level0 = n >= double(levels - 1) ? levels - 1 : int(n);
+            } else if (st.mipFilter == Filter::Linear) {
+                const double a = std::floor(lod);
+                if (a >= double(levels - 1)) {
+                    level0 = levels - 1;
+                } else {
+                    level0 = int(a);
+                    level1 = level0 + 1;
+                    const double frac = lod - a;
+                    if (fixed) {
+                        mipW = int32_t(std::nearbyint(frac * 256.0));
+                        if (mipW == 256) level0 = level1;  // exactly the upper level
+                        slots = mipW == 0 || mipW == 256 ? 1 : 2;
+                    } else {
+                        mipF = float(frac);
+                        slots = mipF == 0.0f ? 1 : 2;
+                    }
+                }
+            }
+        }
+        const bool linear = lod > 0.0 ? minLinear : magLinear;
+        for (int i = q; i < std::min(q + 4, count); ++i) {
+            L.level[0][i] = uint8_t(level0);
+            L.level[1][i] = uint8_t(level1);
+            L.slots[i] = uint8_t(slots);
+            L.linear[i] = linear;
+            L.mipW[i] = mipW;
+            L.mipF[i] = mipF;
+        }
+    }
+}
+
+alignas(64) const float kZeros[kMaxSpan] = {};
+
+}  // namespace
+
+SamplerState samplerStateFromDesc(const SamplerDesc& desc) {
+    SamplerState s;
+    s.minFilter = desc.minFilter.value;
+    s.magFilter = desc.magFilter.value;
+    s.mipFilter = desc.mipFilter.value;
+    s.addressU = TextureAddress(desc.addressU.value);  // D3DTADDRESS_* values 1..4 coincide
+    s.addressV = TextureAddress(desc.addressV.value);
+    s.addressW = TextureAddress(desc.addressW.value);
+    s.border = desc.border.value.rgba;
+    return s;
+}
+
+TextureSampler::TextureSampler() {
+    for (int i = 0; i < kMaxSamplerStages; ++i) setSamplerState(i, SamplerState{});
+}
+
+bool TextureSampler::bind(int stage, std::shared_ptr<const Texture> texture) {
+    if (stage < 0 || stage >= kMaxSamplerStages) return false;
+    m_stages[size_t(stage)].texture = std::move(texture);
+    return true;
+}
+
+bool TextureSampler::setSamplerState(int stage, const SamplerState& state) {
+    if (stage < 0 || stage >= kMaxSamplerStages) return false;
+    Stage& s = m_stages[size_t(stage)];
+    s.state = state;
+    for (size_t c = 0; c < 4; ++c) {
+        // The border colour on the fx grids, rounded half-even (docs/textures.md).
+        s.borderGrid8[c] = std::clamp(toGrid(double(state.border[c]), Precision::Fx8), -kMaxTexelGrid, kMaxTexelGrid);
+        s.borderGrid12[c] = std::clamp(toGrid(double(state.border[c]), Precision::Fx12), -kMaxTexelGrid, kMaxTexelGrid);
+    }
+    return true;
+}
+
+bool TextureSampler::hasTexture(int stage) const {
+    return stage >= 0 && stage < kMaxSamplerStages && m_stages[size_t(stage)].texture != nullptr;
+}
+
+void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
+    const int count = std::clamp(req.count, 0, kMaxSpan);
+    const bool fixed = isFixedPoint(req.precision);
+    // Outputs the caller did not ask for go to scratch, so the kernels never test pointers.
+    int32_t scratchGrid[4][kMaxSpan];
+    float scratchValue[4][kMaxSpan];
+    int32_t* gridDst[4];
+    float* valueDst[4];
+    for (int c = 0; c < 4; ++c) {
+        gridDst[c] = out.grid[c] ? out.grid[c] : scratchGrid[c];
+        valueDst[c] = out.value[c] ? out.value[c] : scratchValue[c];
+    }
+
+    const Stage* st = req.stage >= 0 && req.stage < kMaxSamplerStages ? &m_stages[size_t(req.stage)] : nullptr;
+    if (!st || !st->texture || st->texture->levelCount() == 0) {
+        // spec §6.4: a stage without a texture samples as (0, 0, 0, 1).
+        const int32_t one = gridScale(req.precision);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < count; ++i) {
+                if (fixed) gridDst[c][i] = c == 3 ? one : 0;
+                else valueDst[c][i] = c == 3 ? 1.0f : 0.0f;
+            }
+        return;
+    }
+    const Texture& tex = *st->texture;
+    const SamplerState& ss = st->state;
+    const bool volume = tex.isVolume();
+    const float* coord[3] = {req.u ? req.u : kZeros, req.dims >= 2 && req.v ? req.v : kZeros,
+                             req.dims >= 3 && req.w ? req.w : kZeros};
+
+    const bool magLinear = effective(ss.magFilter) == Filter::Linear;
+    const bool uniformFilter = effective(ss.magFilter) == effective(ss.minFilter);
+    const bool singleLevel = tex.levelCount() == 1 || ss.mipFilter == Filter::None;
+    const bool uniform = !req.quads || (uniformFilter && singleLevel);
+
+    // Fast path: fx bilinear, 8-bit 2D texture, level 0, wrap/clamp.
+    if (m_fastPath && fixed && uniform && magLinear && !volume && tex.storage() == TexelStorage::Unorm8) {
+        const int32_t scale = gridScale(req.precision) / 255;
+        bool done = false;
+        if (ss.addressU == TextureAddress::Clamp)
+            done = fastBilinearV<TextureAddress::Clamp>(ss.addressV, count, coord[0], coord[1], tex.level(0),
+                                                        tex.unorm8(), scale, gridDst);
+        else if (ss.addressU == TextureAddress::Wrap)
+            done = fastBilinearV<TextureAddress::Wrap>(ss.addressV, count, coord[0], coord[1], tex.level(0),
+                                                       tex.unorm8(), scale, gridDst);
+        if (done) {
+            m_fetched.fetch_add(uint64_t(count) * 4, std::memory_order_relaxed);
+            return;
+        }
+    }
+
+    LaneLevels lanes;
+    selectLevels(req, count, coord, tex, ss, fixed, lanes);
+
+    // Per-level extents per axis, then the addressing passes (mode chosen once per axis).
+    const int levels = tex.levelCount();
+    uint32_t extent[3][16];
+    for (int k = 0; k < levels && k < 16; ++k) {
+        extent[0][k] = tex.level(k).width;
+        extent[1][k] = tex.level(k).height;
+        extent[2][k] = tex.level(k).depth;
+    }
+    const int axes = volume ? 3 : 2;
+    const TextureAddress modes[3] = {ss.addressU, ss.addressV, ss.addressW};
+    bool anyTwo = false;
+    uint64_t fetched = 0;
+    for (int i = 0; i < count; ++i) {
+        anyTwo |= lanes.slots[i] == 2;
+        fetched += uint64_t(lanes.slots[i]) * (lanes.linear[i] ? (volume ? 8 : 4) : 1);
+    }
+    static thread_local AxisTaps taps[kSlots][3];
+    for (int s = 0; s < (anyTwo ? 2 : 1); ++s)
+        for (int a = 0; a < axes; ++a)
+            axisPass(modes[a], count, coord[a], extent[a], lanes.level[s], lanes.linear, taps[s][a]);
+
+    CombineInput in{count, &tex.level(0), &lanes, taps};
+    if (fixed) {
+        const std::array<int32_t, 4>& bg = req.precision == Precision::Fx12 ? st->borderGrid12 : st->borderGrid8;
+        const int64_t border[4] = {bg[0], bg[1], bg[2], bg[3]};
+        if (tex.storage() == TexelStorage::Unorm8) {
+            U8Grid src{tex.unorm8(), gridScale(req.precision) / 255};
+            volume ? combineFx<U8Grid, true>(in, src, border, gridDst) : combineFx<U8Grid, false>(in, src, border, gridDst);
+        } else {
+            IntGrid src{tex.grid(req.precision)};
+            volume ? combineFx<IntGrid, true>(in, src, border, gridDst)
+                   : combineFx<IntGrid, false>(in, src, border, gridDst);
+        }
+    } else {
+        const float* border = ss.border.data();
+        if (tex.storage() == TexelStorage::Unorm8) {
+            U8Float src{tex.unorm8(), Texture::unorm8Values()};
+            volume ? combineFloat<U8Float, true>(in, src, border, valueDst)
+                   : combineFloat<U8Float, false>(in, src, border, valueDst);
+        } else {
+            ValueFloat src{tex.values()};
+            volume ? combineFloat<ValueFloat, true>(in, src, border, valueDst)
+                   : combineFloat<ValueFloat, false>(in, src, border, valueDst);
+        }
+    }
+    m_fetched.fetch_add(fetched, std::memory_order_relaxed);
+}
+
+}  // namespace ps11

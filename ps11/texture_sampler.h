@@ -1,0 +1,66 @@
+// The software sampler: textures bound to stages 0..7 with D3D9 sampler state (filters,
+// address modes, border colour), answering the executor's span requests exactly as
+// docs/precision.md "Sampling" and docs/textures.md say. Used by the executor's test runs now
+// and by the emu device later.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+
+#include "ps11/sampler.h"
+#include "ps11/testfile.h"
+#include "ps11/texture.h"
+
+namespace ps11 {
+
+// Sampler stages the device has (D3D9 ps 1.x: 8).
+constexpr int kMaxSamplerStages = 8;
+
+// D3DTADDRESS_* including MIRRORONCE, which the .ps11test format does not name (yet).
+enum class TextureAddress : uint8_t { Wrap = 1, Mirror = 2, Clamp = 3, Border = 4, MirrorOnce = 5 };
+
+// D3DSAMP_* state of one stage. Filter::None as min/mag filter acts as point.
+struct SamplerState {
+    Filter minFilter = Filter::Point;
+    Filter magFilter = Filter::Point;
+    Filter mipFilter = Filter::None;
+    TextureAddress addressU = TextureAddress::Wrap;
+    TextureAddress addressV = TextureAddress::Wrap;
+    TextureAddress addressW = TextureAddress::Wrap;
+    Vec4 border{0, 0, 0, 0};  // r g b a
+};
+
+// The state a [sampler N] section describes (D3D9 defaults where it is silent).
+SamplerState samplerStateFromDesc(const SamplerDesc& desc);
+
+class TextureSampler final : public Sampler {
+public:
+    TextureSampler();
+    // Binds (or with nullptr unbinds) a texture; false for a stage outside 0..7.
+    bool bind(int stage, std::shared_ptr<const Texture> texture);
+    // Sets a stage's sampler state; false for a stage outside 0..7.
+    bool setSamplerState(int stage, const SamplerState& state);
+    const SamplerState& samplerState(int stage) const { return m_stages[size_t(stage)].state; }
+
+    void sample(const SampleRequest& req, SampleResult& out) override;
+    bool hasTexture(int stage) const override;
+    uint64_t texelsFetched() const override { return m_fetched.load(std::memory_order_relaxed); }
+
+    // The fx bilinear fast path for 8-bit 2D textures (on by default); tests switch it off to
+    // compare it with the general path.
+    void setFastPath(bool enabled) { m_fastPath = enabled; }
+
+private:
+    struct Stage {
+        std::shared_ptr<const Texture> texture;
+        SamplerState state;
+        std::array<int32_t, 4> borderGrid8{}, borderGrid12{};  // border colour on the fx grids
+    };
+    std::array<Stage, kMaxSamplerStages> m_stages;
+    std::atomic<uint64_t> m_fetched{0};
+    bool m_fastPath = true;
+};
+
+}  // namespace ps11
