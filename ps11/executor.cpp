@@ -1,0 +1,397 @@
+// The executor, stage 1 and driver: create() decodes a validated Program once into a compact op
+// list (register slots, modifiers, masks, shifts, co-issue holds, constants converted to the
+// profile), reports E40xx for what it cannot run; run() cuts a span into chunks, loads the
+// inputs, dispatches each op over the chunk's lanes and stores the outputs.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "ps11/executor_internal.h"
+
+namespace ps11 {
+namespace exec {
+
+const float* texcoordLanes(const RunState& st, int set, int comp) {
+    const float* p = (set >= 0 && set < 8) ? st.in->texcoord[set][comp] : nullptr;
+    return p ? p + st.offset : st.zeros;
+}
+
+namespace {
+
+// fx: D3D9 constants are clamped to [-1, 1] on load (Wine, DXVK, nine; spec §7.2), then
+// rounded to the grid exactly (docs/precision.md "Inputs").
+float clampConst(float v) {
+    if (!(v == v)) return 0;
+    return std::min(1.0f, std::max(-1.0f, v));
+}
+
+class ExecutorImpl final : public Executor {
+public:
+    ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
+                 std::array<std::array<float, 4>, 8> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
+                 uint8_t vUsed)
+        : m_options(options), m_p(profile), m_ops(std::move(ops)), m_defs(defs), m_defMask(defMask),
+          m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
+        for (auto& c : m_api) c = {0, 0, 0, 0};
+        for (int i = 0; i < 8; ++i) refreshConstant(i);
+    }
+
+    void setConstant(int index, const std::array<float, 4>& value) override {
+        if (index < 0 || index >= 8) return;
+        m_api[size_t(index)] = value;
+        refreshConstant(index);
+    }
+    void setStageState(int stage, const StageState& state) override {
+        if (stage >= 0 && stage < 8) m_p.stages[size_t(stage)] = state;
+    }
+    bool writesDepth() const override { return m_writesDepth; }
+    uint32_t sampledStages() const override { return m_stagesUsed; }
+    const ExecutorOptions& options() const override { return m_options; }
+
+    void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+             ExecutorStats* stats) const override;
+
+private:
+    void refreshConstant(int i) {
+        // A def in the shader overrides the API value (spec §1.1, def page).
+        const std::array<float, 4>& v = (m_defMask >> i) & 1 ? m_defs[size_t(i)] : m_api[size_t(i)];
+        for (int c = 0; c < 4; ++c) {
+            float f = clampConst(v[size_t(c)]);
+            if (isFixedPoint(m_p.precision)) {
+                int32_t n = toGrid(double(f), m_p.precision);
+                m_p.constGrid[size_t(i)][size_t(c)] = n;
+                m_p.constF[size_t(i)][size_t(c)] = float(n) / float(m_p.g);
+            } else {
+                m_p.constF[size_t(i)][size_t(c)] = f;
+            }
+        }
+    }
+    void loadColors(RunState& st) const;
+    void runChunk(RunState& st) const;
+
+    ExecutorOptions m_options;
+    Profile m_p;
+    std::vector<DOp> m_ops;
+    std::array<std::array<float, 4>, 8> m_defs;
+    std::array<std::array<float, 4>, 8> m_api{};
+    uint8_t m_defMask = 0;
+    uint32_t m_stagesUsed = 0;
+    bool m_writesDepth = false;
+    uint8_t m_vUsed = 0;
+};
+
+void ExecutorImpl::loadColors(RunState& st) const {
+    // v# are saturated to [0, 1] and rounded to the grid once per pixel (docs/precision.md "Inputs").
+    const bool fx = isFixedPoint(m_p.precision);
+    const float g = float(m_p.g);
+    for (int v = 0; v < 2; ++v) {
+        if (!((m_vUsed >> v) & 1)) continue;
+        for (int c = 0; c < 4; ++c) {
+            const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : st.zeros;
+            if (fx) {
+                int32_t* d = st.bi.reg[kSlotV + v][c];
+                for (int i = 0; i < st.n; ++i) {
+                    float s = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;  // NaN -> 0
+                    d[i] = int32_t(std::nearbyint(double(s) * double(g)));
+                }
+            } else {
+                float* d = st.bf.reg[kSlotV + v][c];
+                for (int i = 0; i < st.n; ++i) d[i] = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;
+            }
+        }
+    }
+}
+
+void ExecutorImpl::runChunk(RunState& st) const {
+    const bool fx = isFixedPoint(m_p.precision);
+    std::memset(st.killed, 0, sizeof st.killed);
+    loadColors(st);
+    for (const DOp& op : m_ops) {
+        if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
+        if (op.texture) {
+            execTexture(m_p, op, st);
+        } else if (fx) {
+            execArithFx(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
+        } else {
+            execArithFloat(m_p, op, st, op.hold ? st.bf.hold : st.bf.reg[op.dstSlot]);
+        }
+        if (!op.hold && (&op != m_ops.data()) && (&op - 1)->hold) {
+            // Co-issued pair: the second member has read and written; now the first writes
+            // (both read before either writes, spec §3.5).
+            const DOp& first = *(&op - 1);
+            for (int c = 0; c < 4; ++c) {
+                if (!((first.mask >> c) & 1)) continue;
+                if (fx)
+                    std::memcpy(st.bi.reg[first.dstSlot][c], st.bi.hold[c], sizeof(int32_t) * size_t(st.n));
+                else
+                    std::memcpy(st.bf.reg[first.dstSlot][c], st.bf.hold[c], sizeof(float) * size_t(st.n));
+            }
+        }
+    }
+}
+
+void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                       ExecutorStats* stats) const {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    auto st = std::make_unique<RunState>();
+    st->in = &inputs;
+    st->sampler = &sampler;
+    std::memset(st->zeros, 0, sizeof st->zeros);
+    const bool fx = isFixedPoint(m_p.precision);
+    // r0 is the output; validated programs write it, zero it anyway so nothing is undefined.
+    std::memset(st->bi.reg[kSlotR], 0, sizeof st->bi.reg[kSlotR]);
+    std::memset(st->bf.reg[kSlotR], 0, sizeof st->bf.reg[kSlotR]);
+    const float g = float(m_p.g);
+    for (int off = 0; off < count; off += kChunk) {
+        st->offset = off;
+        st->n = std::min(kChunk, count - off);
+        st->depthWritten = false;
+        runChunk(*st);
+        for (int c = 0; c < 4; ++c) {
+            if (fx) {
+                const int32_t* r = st->bi.reg[kSlotR][c];
+                if (outputs.color[c])
+                    for (int i = 0; i < st->n; ++i) outputs.color[c][off + i] = float(r[i]) / g;
+                if (outputs.grid[c]) std::memcpy(outputs.grid[c] + off, r, sizeof(int32_t) * size_t(st->n));
+            } else if (outputs.color[c]) {
+                std::memcpy(outputs.color[c] + off, st->bf.reg[kSlotR][c], sizeof(float) * size_t(st->n));
+            }
+        }
+        if (outputs.killed) std::memcpy(outputs.killed + off, st->killed, size_t(st->n));
+        if (outputs.depth && m_writesDepth && st->depthWritten)
+            std::memcpy(outputs.depth + off, st->depth, sizeof(float) * size_t(st->n));
+    }
+    if (stats) {
+        stats->pixels += uint64_t(count);
+        uint64_t executed = 0;
+        for (const DOp& op : m_ops)
+            if (op.op != Opcode::Phase) ++executed;
+        stats->instructions += executed * uint64_t(count);
+    }
+}
+
+// Decoding ------------------------------------------------------------------------------------
+
+struct Decoder {
+    const Program& prog;
+    Diagnostics& diags;
+    int minor = 1;
+    bool ok = true;
+
+    void fail(const char* code, SourceLoc loc, std::string msg) {
+        diags.error(code, loc, std::move(msg));
+        ok = false;
+    }
+
+    // Register slot of an r#/t#/v# operand, or -1 after an E4004.
+    int slotOf(RegType type, int index, SourceLoc loc) {
+        switch (type) {
+            case RegType::Temp:
+                if (index < (minor >= 4 ? 6 : 2)) return kSlotR + index;
+                break;
+            case RegType::Texture:
+                if (minor < 4 && index < 4) return kSlotT + index;
+                break;
+            case RegType::Input:
+                if (index < 2) return kSlotV + index;
+                break;
+            case RegType::Const:
+                break;
+        }
+        fail("E4004", loc,
+             std::string("register ") + regPrefix(type) + std::to_string(index) +
+                 " cannot be used here by the executor (the program should have failed validation)");
+        return -1;
+    }
+
+    DSrc src(const Src& s, bool textureOp) {
+        DSrc d;
+        for (int c = 0; c < 4; ++c) d.sw[size_t(c)] = uint8_t(swizzleComponent(s.swizzle, c));
+        d.mod = s.mod;
+        if (s.type == RegType::Const) {
+            d.kind = SrcKind::Const;
+            if (s.index >= 8) fail("E4004", s.loc, "constant c" + std::to_string(s.index) + " out of range");
+            d.slot = uint8_t(s.index & 7);
+        } else if (s.type == RegType::Texture && minor >= 4 && textureOp) {
+            d.kind = SrcKind::TexCoord;
+            if (s.index >= 8) fail("E4004", s.loc, "texture coordinate t" + std::to_string(s.index) + " out of range");
+            d.slot = uint8_t(s.index & 7);
+        } else {
+            int slot = slotOf(s.type, s.index, s.loc);
+            d.slot = uint8_t(slot < 0 ? 0 : slot);
+        }
+        if ((s.mod == SrcMod::Dz || s.mod == SrcMod::Dw) && !textureOp)
+            fail("E4005", s.loc, "modifier _dz/_dw on an arithmetic instruction cannot be executed");
+        return d;
+    }
+};
+
+}  // namespace
+}  // namespace exec
+
+std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
+                                           Diagnostics& diags) {
+    using namespace exec;
+    Decoder dec{program, diags};
+    const Version& ver = program.version;
+    if (ver.major != 1 || ver.minor < 1 || ver.minor > 4) {
+        diags.error("E4001", program.versionLoc,
+                    "unsupported shader version ps_" + std::to_string(ver.major) + "_" + std::to_string(ver.minor) +
+                        ": the executor runs ps_1_1 to ps_1_4");
+        return nullptr;
+    }
+    dec.minor = ver.minor;
+
+    Profile p;
+    p.precision = options.precision;
+    p.minor = ver.minor;
+    p.g = gridScale(options.precision);
+    p.clampRange = options.precision != Precision::Ideal;
+    float m = options.maxValue == 0 ? defaultMaxValue(ver.minor) : options.maxValue;
+    // fx lanes are int32 with sources k = 4n + 2G: round(M*G) <= 2^24 keeps every product of the
+    // general formula (dp4, lrp, _x8) inside int64, and k inside int32.
+    constexpr double kMaxGrid = 16777216.0;
+    if (!(m > 0) || !(m <= 1e6) || (isFixedPoint(p.precision) && std::nearbyint(double(m) * p.g) > kMaxGrid) ||
+        (isFixedPoint(p.precision) && std::nearbyint(double(m) * p.g) < 1)) {
+        diags.error("E4003", program.versionLoc,
+                    "max value " + std::to_string(m) + " out of range for profile " + precisionName(p.precision) +
+                        " (needs 0 < M <= 1e6 and 1 <= round(M*G) <= 2^24)");
+        return nullptr;
+    }
+    p.maxValue = m;
+    p.nMax = isFixedPoint(p.precision) ? int32_t(std::nearbyint(double(m) * p.g)) : 0;
+    if (isFixedPoint(p.precision)) {
+        // Largest |numerator| of a product instruction: 4 terms of k*k (dp4) plus slack, times 2^3.
+        double kmax = 4.0 * p.nMax + 2.0 * p.g;
+        double bound = (4.0 * kmax * kmax + 4.0 * p.g * kmax) * 8.0;
+        p.wide = bound >= 2147483647.0;
+    }
+
+    std::vector<DOp> ops;
+    std::array<std::array<float, 4>, 8> defs{};
+    uint8_t defMask = 0;
+    uint32_t stages = 0;
+    bool depth = false;
+    uint8_t vUsed = 0;
+    int padRun = 0;
+    for (const Instruction& ins : program.instructions) {
+        if (!ins.info) {
+            dec.fail("E4002", ins.loc, "instruction without an opcode row");
+            continue;
+        }
+        const Opcode opc = ins.opcode();
+        if (opc == Opcode::Def) {
+            int i = ins.dst.index;
+            if (i >= 8) {
+                dec.fail("E4004", ins.dst.loc, "def of c" + std::to_string(i) + " out of range");
+                continue;
+            }
+            for (int c = 0; c < 4; ++c) defs[size_t(i)][size_t(c)] = ins.defValue(c);
+            defMask = uint8_t(defMask | (1u << i));
+            continue;
+        }
+        if (opc == Opcode::Nop || opc == Opcode::Comment || opc == Opcode::End) continue;
+        if (!(ins.info->versions & versionBit(ver.minor)) || opc == Opcode::TexM3x3Diff) {
+            dec.fail("E4002", ins.loc,
+                     "instruction '" + std::string(ins.info->mnemonic) + "' cannot be run in ps_1_" +
+                         std::to_string(ver.minor));
+            continue;
+        }
+        DOp d;
+        d.op = opc;
+        if (opc == Opcode::Phase) {
+            ops.push_back(d);
+            continue;
+        }
+        d.texture = ins.info->cls == OpClass::Texture;
+        if (ins.coissue) {
+            if (ops.empty() || ops.back().texture || ops.back().op == Opcode::Phase || d.texture) {
+                dec.fail("E4006", ins.loc, "co-issued instruction without an arithmetic partner");
+                continue;
+            }
+            ops.back().hold = true;
+        }
+        d.numSrc = ins.info->numSrc;
+        for (int s = 0; s < d.numSrc; ++s) {
+            d.src[size_t(s)] = dec.src(ins.src[size_t(s)], d.texture);
+            if (ins.src[size_t(s)].type == RegType::Input && ins.src[size_t(s)].index < 2)
+                vUsed = uint8_t(vUsed | (1u << ins.src[size_t(s)].index));
+        }
+        if (ins.info->hasDst) {
+            d.mask = ins.dst.mask;
+            d.sat = ins.dst.saturate;
+            d.shift = ins.dst.shift;
+            if (d.shift < -3 || d.shift > 3) dec.fail("E4005", ins.dst.loc, "shift out of range");
+            if (ins.dst.type == RegType::Const || ins.dst.type == RegType::Input) {
+                dec.fail("E4004", ins.dst.loc, "destination register file cannot be written");
+            } else {
+                int slot = dec.slotOf(ins.dst.type, ins.dst.index, ins.dst.loc);
+                d.dstSlot = uint8_t(slot < 0 ? 0 : slot);
+            }
+            d.stage = uint8_t(ins.dst.index & 7);
+        }
+        if (!d.texture && opc == Opcode::Cnd && ver.minor < 4) {
+            // 1_1-1_3: the condition is r0.a for every component (spec §3.6); force the
+            // replicate so the per-component kernel implements the version rule.
+            d.src[0].sw = {3, 3, 3, 3};
+        }
+        if (d.texture) {
+            const bool isPad = opc == Opcode::TexM3x2Pad || opc == Opcode::TexM3x3Pad;
+            d.padIndex = uint8_t(isPad ? std::min(padRun, 1) : 0);
+            d.rowBase = uint8_t(std::max(0, int(d.stage) - padRun));
+            padRun = isPad ? padRun + 1 : 0;
+            if (ver.minor < 4 && ins.info->hasDst && ins.dst.type != RegType::Texture && opc != Opcode::TexDepth)
+                dec.fail("E4004", ins.dst.loc, "texture instruction destination must be t#");
+            switch (opc) {
+                case Opcode::Tex:
+                case Opcode::TexBem:
+                case Opcode::TexBemL:
+                case Opcode::TexReg2AR:
+                case Opcode::TexReg2GB:
+                case Opcode::TexReg2RGB:
+                case Opcode::TexM3x2Tex:
+                case Opcode::TexM3x3Tex:
+                case Opcode::TexM3x3Spec:
+                case Opcode::TexM3x3VSpec:
+                case Opcode::TexDp3Tex:
+                    stages |= 1u << d.stage;
+                    break;
+                case Opcode::TexM3x2Depth:
+                case Opcode::TexDepth:
+                    depth = true;
+                    break;
+                default:
+                    break;
+            }
+            if (opc == Opcode::TexKill && ver.minor < 4) {
+                // 1_1-1_3 texkill names t(m) but tests TC[m] (spec §7.9).
+                d.src[0].kind = SrcKind::TexCoord;
+                d.src[0].slot = d.stage;
+            }
+            if (opc == Opcode::TexKill && ver.minor >= 4) {
+                // 1_4: the destination token names the register tested.
+                const Dst& t = ins.dst;
+                if (t.type == RegType::Texture) {
+                    d.src[0].kind = SrcKind::TexCoord;
+                    d.src[0].slot = uint8_t(t.index & 7);
+                } else {
+                    d.src[0].kind = SrcKind::Reg;
+                    int slot = dec.slotOf(t.type, t.index, t.loc);
+                    d.src[0].slot = uint8_t(slot < 0 ? 0 : slot);
+                }
+                d.src[0].sw = {0, 1, 2, 3};
+            }
+        } else {
+            padRun = 0;
+        }
+        ops.push_back(d);
+    }
+    if (!ops.empty() && ops.back().hold) {
+        dec.fail("E4006", program.instructions.back().loc, "co-issued pair without its second member");
+    }
+    if (!dec.ok) return nullptr;
+    return std::make_unique<ExecutorImpl>(options, p, std::move(ops), defs, defMask, stages, depth, vUsed);
+}
+
+}  // namespace ps11

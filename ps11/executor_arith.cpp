@@ -1,0 +1,308 @@
+// The executor, arithmetic stage: fetch (selector, then modifier) → op → write step (shift,
+// round once, _sat, range clamp) for mov add sub mul mad dp3 dp4 lrp cnd cmp bem, over a chunk
+// of lanes, exactly as docs/precision.md says. fx profiles keep int32 grid integers and form
+// each result as an exact integer numerator (int32 or int64 lanes); float profiles use float32.
+#include <cmath>
+#include <cstring>
+
+#include "ps11/executor_internal.h"
+
+namespace ps11::exec {
+namespace {
+
+// Components of each source an op reads, as a mask of output channels.
+uint8_t fetchMask(const DOp& op) {
+    switch (op.op) {
+        case Opcode::Dp3: return kMaskRGB;
+        case Opcode::Dp4: return kMaskAll;
+        case Opcode::Bem: return kMaskR | kMaskG;
+        default: return op.mask;
+    }
+}
+
+// Source modifier as k = a·n + b (k/(2G) is the exact value, docs/precision.md table) and,
+// for float, x' = a·x + b, which rounds exactly like the written formulas (negation is exact).
+struct Affine {
+    int32_t a, b;
+};
+Affine modAffine(SrcMod m, int32_t g) {
+    switch (m) {
+        case SrcMod::None: return {2, 0};
+        case SrcMod::Neg: return {-2, 0};
+        case SrcMod::Bias: return {2, -g};
+        case SrcMod::BiasNeg: return {-2, g};
+        case SrcMod::Sign: return {4, -2 * g};
+        case SrcMod::SignNeg: return {-4, 2 * g};
+        case SrcMod::Comp: return {-2, 2 * g};
+        case SrcMod::X2: return {4, 0};
+        case SrcMod::X2Neg: return {-4, 0};
+        default: return {2, 0};  // _dz/_dw are rejected by create() on arithmetic instructions
+    }
+}
+
+void fetchFx(const Profile& p, const DOp& op, RunState& st) {
+    const uint8_t fm = fetchMask(op);
+    const int n = st.n;
+    for (int s = 0; s < op.numSrc; ++s) {
+        const DSrc& src = op.src[size_t(s)];
+        const Affine af = modAffine(src.mod, p.g);
+        for (int c = 0; c < 4; ++c) {
+            if (!((fm >> c) & 1)) continue;
+            int32_t* k = st.k[s][c];
+            if (src.kind == SrcKind::Const) {
+                const int32_t v = af.a * p.constGrid[src.slot][src.sw[size_t(c)]] + af.b;
+                for (int i = 0; i < n; ++i) k[i] = v;
+            } else {
+                const int32_t* r = st.bi.reg[src.slot][src.sw[size_t(c)]];
+                const int32_t a = af.a, b = af.b;
+                for (int i = 0; i < n; ++i) k[i] = a * r[i] + b;
+            }
+        }
+    }
+}
+
+// round_half_even(num / D) for a constant D > 0 (floor division, then the tie rule), clamped to
+// [lo, hi]; the only rounding of an fx instruction (docs/precision.md step 2).
+template <class W, int64_t D>
+inline int32_t roundClamp(W num, int32_t lo, int32_t hi) {
+    W q = num / W(D);
+    W r = num - q * W(D);
+    const W neg = W(r < 0);
+    q -= neg;
+    r += neg * W(D);
+    const W twice = r * 2;
+    q += W(twice > W(D)) | (W(twice == W(D)) & (q & 1));
+    q = q < W(lo) ? W(lo) : q;
+    q = q > W(hi) ? W(hi) : q;
+    return int32_t(q);
+}
+
+template <class W, int64_t D, int SH, class F>
+void finishLoop(int n, int32_t* __restrict out, const F& f, int32_t lo, int32_t hi) {
+    for (int i = 0; i < n; ++i) out[i] = roundClamp<W, D>(W(f(i)) * W(int64_t(1) << SH), lo, hi);
+}
+
+// Write step for a numerator over D0 (2 for linear ops, 4G for products): the shift multiplies
+// the numerator or the denominator by 2^|s|, so the result stays exact before the one rounding.
+template <class W, int64_t D0, class F>
+void finish(int shift, int n, int32_t* out, const F& f, int32_t lo, int32_t hi) {
+    switch (shift) {
+        case 1: finishLoop<W, D0, 1>(n, out, f, lo, hi); break;
+        case 2: finishLoop<W, D0, 2>(n, out, f, lo, hi); break;
+        case 3: finishLoop<W, D0, 3>(n, out, f, lo, hi); break;
+        case -1: finishLoop<W, D0 * 2, 0>(n, out, f, lo, hi); break;
+        case -2: finishLoop<W, D0 * 4, 0>(n, out, f, lo, hi); break;
+        case -3: finishLoop<W, D0 * 8, 0>(n, out, f, lo, hi); break;
+        default: finishLoop<W, D0, 0>(n, out, f, lo, hi); break;
+    }
+}
+
+template <class W, int32_t G>
+void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]) {
+    fetchFx(p, op, st);
+    const int n = st.n;
+    const int32_t lo = op.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
+    const int32_t hi = op.sat ? (G < p.nMax ? G : p.nMax) : p.nMax;
+    constexpr int64_t kLin = 2;      // value = K / (2G) -> n = K·2^s / 2
+    constexpr int64_t kProd = 4 * int64_t(G);  // value = P / (4G²) -> n = P·2^s / (4G)
+    const int sh = op.shift;
+    auto& k = st.k;
+    if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
+        // One sum, written to every enabled component (replicated).
+        const int32_t *a0 = k[0][0], *a1 = k[0][1], *a2 = k[0][2], *a3 = k[0][3];
+        const int32_t *b0 = k[1][0], *b1 = k[1][1], *b2 = k[1][2], *b3 = k[1][3];
+        int first = -1;
+        for (int c = 0; c < 4; ++c) {
+            if (!((op.mask >> c) & 1)) continue;
+            if (first >= 0) {
+                std::memcpy(out[c], out[first], sizeof(int32_t) * size_t(n));
+                continue;
+            }
+            first = c;
+            if (op.op == Opcode::Dp3)
+                finish<W, kProd>(sh, n, out[c],
+                                 [=](int i) { return W(a0[i]) * b0[i] + W(a1[i]) * b1[i] + W(a2[i]) * b2[i]; }, lo, hi);
+            else
+                finish<W, kProd>(sh, n, out[c], [=](int i) {
+                    return W(a0[i]) * b0[i] + W(a1[i]) * b1[i] + W(a2[i]) * b2[i] + W(a3[i]) * b3[i];
+                }, lo, hi);
+        }
+        return;
+    }
+    if (op.op == Opcode::Bem) {
+        // bem (1_4): d.r = a.r + M00·b.r + M10·b.g, d.g = a.g + M01·b.r + M11·b.g with the bump
+        // matrix of the destination's stage (spec §2.2), evaluated in double and rounded once.
+        const StageState& ss = p.stages[op.stage];
+        const double m00 = ss.bumpMat[0], m01 = ss.bumpMat[1], m10 = ss.bumpMat[2], m11 = ss.bumpMat[3];
+        const double scale = std::ldexp(0.5, sh);  // K/(2G)·2^s·G
+        for (int c = 0; c < 2; ++c) {
+            if (!((op.mask >> c) & 1)) continue;
+            const double mr = c == 0 ? m00 : m01, mg = c == 0 ? m10 : m11;
+            const int32_t *a = k[0][c], *br = k[1][0], *bg = k[1][1];
+            for (int i = 0; i < n; ++i) {
+                double v = std::nearbyint((double(a[i]) + mr * br[i] + mg * bg[i]) * scale);
+                v = v < lo ? lo : (v > hi ? hi : v);  // NaN cannot occur: finite matrix assumed
+                out[c][i] = v == v ? int32_t(v) : 0;
+            }
+        }
+        return;
+    }
+    for (int c = 0; c < 4; ++c) {
+        if (!((op.mask >> c) & 1)) continue;
+        const int32_t *s0 = k[0][c], *s1 = k[1][c], *s2 = k[2][c];
+        int32_t* o = out[c];
+        switch (op.op) {
+            case Opcode::Mov: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]); }, lo, hi); break;
+            case Opcode::Add: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]) + s1[i]; }, lo, hi); break;
+            case Opcode::Sub: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]) - s1[i]; }, lo, hi); break;
+            case Opcode::Mul: finish<W, kProd>(sh, n, o, [=](int i) { return W(s0[i]) * s1[i]; }, lo, hi); break;
+            case Opcode::Mad:
+                finish<W, kProd>(sh, n, o, [=](int i) { return W(s0[i]) * s1[i] + W(2 * G) * s2[i]; }, lo, hi);
+                break;
+            case Opcode::Lrp:
+                // f·a + (1 − f)·b = (kf·(ka − kb) + 2G·kb) / (4G²)
+                finish<W, kProd>(sh, n, o, [=](int i) { return W(s0[i]) * (W(s1[i]) - s2[i]) + W(2 * G) * s2[i]; },
+                                 lo, hi);
+                break;
+            case Opcode::Cnd:
+                // s0 > 0.5 ⟺ k0 > G (1_1-1_3: s0 is r0.a replicated, see create()).
+                finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i] > G ? s1[i] : s2[i]); }, lo, hi);
+                break;
+            case Opcode::Cmp:
+                finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i] >= 0 ? s1[i] : s2[i]); }, lo, hi);
+                break;
+            default: break;
+        }
+    }
+}
+
+// Float profiles ------------------------------------------------------------------------------
+
+void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
+    const uint8_t fm = fetchMask(op);
+    const int n = st.n;
+    for (int s = 0; s < op.numSrc; ++s) {
+        const DSrc& src = op.src[size_t(s)];
+        const Affine af = modAffine(src.mod, 1);
+        // x' = a·x + b with a ∈ {±1, ±2}, b ∈ {0, ±0.5, ±1}: the same roundings as x − 0.5f,
+        // 2x − 1, 1 − x, 2x (multiplying by ±1 or ±2 is exact; negation commutes with rounding).
+        const float a = float(af.a) * 0.5f, b = float(af.b) * 0.5f;
+        for (int c = 0; c < 4; ++c) {
+            if (!((fm >> c) & 1)) continue;
+            float* x = st.x[s][c];
+            if (src.kind == SrcKind::Const) {
+                const float v = a * p.constF[src.slot][src.sw[size_t(c)]] + b;
+                for (int i = 0; i < n; ++i) x[i] = v;
+            } else if (src.mod == SrcMod::None) {
+                std::memcpy(x, st.bf.reg[src.slot][src.sw[size_t(c)]], sizeof(float) * size_t(n));
+            } else {
+                const float* r = st.bf.reg[src.slot][src.sw[size_t(c)]];
+                for (int i = 0; i < n; ++i) x[i] = a * r[i] + b;
+            }
+        }
+    }
+}
+
+template <class F>
+void finishFloat(int n, float* __restrict out, const F& f, float scale, bool sat, float lo, float hi) {
+    if (sat) {
+        for (int i = 0; i < n; ++i) {
+            float v = f(i) * scale;
+            v = v > 0.0f ? v : 0.0f;  // NaN -> 0
+            v = v < 1.0f ? v : 1.0f;
+            v = v < lo ? lo : v;
+            out[i] = v > hi ? hi : v;
+        }
+    } else {
+        for (int i = 0; i < n; ++i) {
+            float v = f(i) * scale;
+            v = v < lo ? lo : v;
+            out[i] = v > hi ? hi : v;
+        }
+    }
+}
+
+}  // namespace
+
+void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]) {
+    if (p.g == 255) {
+        if (p.wide)
+            arithFx<int64_t, 255>(p, op, st, out);
+        else
+            arithFx<int32_t, 255>(p, op, st, out);
+    } else if (p.wide) {
+        arithFx<int64_t, 4080>(p, op, st, out);
+    } else {
+        arithFx<int32_t, 4080>(p, op, st, out);
+    }
+}
+
+void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]) {
+    fetchFloat(p, op, st);
+    const int n = st.n;
+    const float scale = std::ldexp(1.0f, op.shift);  // exact power of two
+    const float inf = INFINITY;
+    const float lo = p.clampRange ? -p.maxValue : -inf;
+    const float hi = p.clampRange ? p.maxValue : inf;
+    const bool sat = op.sat;
+    auto& x = st.x;
+    if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
+        const float *a0 = x[0][0], *a1 = x[0][1], *a2 = x[0][2], *a3 = x[0][3];
+        const float *b0 = x[1][0], *b1 = x[1][1], *b2 = x[1][2], *b3 = x[1][3];
+        int first = -1;
+        for (int c = 0; c < 4; ++c) {
+            if (!((op.mask >> c) & 1)) continue;
+            if (first >= 0) {
+                std::memcpy(out[c], out[first], sizeof(float) * size_t(n));
+                continue;
+            }
+            first = c;
+            // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a), evaluated as written.
+            if (op.op == Opcode::Dp3)
+                finishFloat(n, out[c], [=](int i) { return (a0[i] * b0[i] + a1[i] * b1[i]) + a2[i] * b2[i]; }, scale,
+                            sat, lo, hi);
+            else
+                finishFloat(n, out[c], [=](int i) {
+                    return ((a0[i] * b0[i] + a1[i] * b1[i]) + a2[i] * b2[i]) + a3[i] * b3[i];
+                }, scale, sat, lo, hi);
+        }
+        return;
+    }
+    if (op.op == Opcode::Bem) {
+        const StageState& ss = p.stages[op.stage];
+        for (int c = 0; c < 2; ++c) {
+            if (!((op.mask >> c) & 1)) continue;
+            const float mr = c == 0 ? ss.bumpMat[0] : ss.bumpMat[1], mg = c == 0 ? ss.bumpMat[2] : ss.bumpMat[3];
+            const float *a = x[0][c], *br = x[1][0], *bg = x[1][1];
+            // a + (Mr·b.r + Mg·b.g), as the spec's formula is written.
+            finishFloat(n, out[c], [=](int i) { return a[i] + (mr * br[i] + mg * bg[i]); }, scale, sat, lo, hi);
+        }
+        return;
+    }
+    for (int c = 0; c < 4; ++c) {
+        if (!((op.mask >> c) & 1)) continue;
+        const float *s0 = x[0][c], *s1 = x[1][c], *s2 = x[2][c];
+        float* o = out[c];
+        switch (op.op) {
+            case Opcode::Mov: finishFloat(n, o, [=](int i) { return s0[i]; }, scale, sat, lo, hi); break;
+            case Opcode::Add: finishFloat(n, o, [=](int i) { return s0[i] + s1[i]; }, scale, sat, lo, hi); break;
+            case Opcode::Sub: finishFloat(n, o, [=](int i) { return s0[i] - s1[i]; }, scale, sat, lo, hi); break;
+            case Opcode::Mul: finishFloat(n, o, [=](int i) { return s0[i] * s1[i]; }, scale, sat, lo, hi); break;
+            case Opcode::Mad:
+                finishFloat(n, o, [=](int i) { return s0[i] * s1[i] + s2[i]; }, scale, sat, lo, hi);
+                break;
+            case Opcode::Lrp:
+                finishFloat(n, o, [=](int i) { return s2[i] + s0[i] * (s1[i] - s2[i]); }, scale, sat, lo, hi);
+                break;
+            case Opcode::Cnd:
+                finishFloat(n, o, [=](int i) { return s0[i] > 0.5f ? s1[i] : s2[i]; }, scale, sat, lo, hi);
+                break;
+            case Opcode::Cmp:
+                finishFloat(n, o, [=](int i) { return s0[i] >= 0.0f ? s1[i] : s2[i]; }, scale, sat, lo, hi);
+                break;
+            default: break;
+        }
+    }
+}
+
+}  // namespace ps11::exec
