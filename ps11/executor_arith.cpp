@@ -183,21 +183,39 @@ void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
     const int n = st.n;
     for (int s = 0; s < op.numSrc; ++s) {
         const DSrc& src = op.src[size_t(s)];
-        const Affine af = modAffine(src.mod, 1);
-        // x' = a·x + b with a ∈ {±1, ±2}, b ∈ {0, ±0.5, ±1}: the same roundings as x − 0.5f,
-        // 2x − 1, 1 − x, 2x (multiplying by ±1 or ±2 is exact; negation commutes with rounding).
-        const float a = float(af.a) * 0.5f, b = float(af.b) * 0.5f;
+        // The written formulas (docs/precision.md "float and ideal"), signed zeros included.
+        auto apply = [m = src.mod](float x) {
+            switch (m) {
+                case SrcMod::Neg: return -x;
+                case SrcMod::Bias: return x - 0.5f;
+                case SrcMod::BiasNeg: return -(x - 0.5f);
+                case SrcMod::Sign: return 2.0f * x - 1.0f;
+                case SrcMod::SignNeg: return -(2.0f * x - 1.0f);
+                case SrcMod::Comp: return 1.0f - x;
+                case SrcMod::X2: return 2.0f * x;
+                case SrcMod::X2Neg: return -(2.0f * x);
+                default: return x;
+            }
+        };
         for (int c = 0; c < 4; ++c) {
             if (!((fm >> c) & 1)) continue;
             float* x = st.x[s][c];
             if (src.kind == SrcKind::Const) {
-                const float v = a * p.constF[src.slot][src.sw[size_t(c)]] + b;
+                const float v = apply(p.constF[src.slot][src.sw[size_t(c)]]);
                 for (int i = 0; i < n; ++i) x[i] = v;
-            } else if (src.mod == SrcMod::None) {
-                std::memcpy(x, st.bf.reg[src.slot][src.sw[size_t(c)]], sizeof(float) * size_t(n));
-            } else {
-                const float* r = st.bf.reg[src.slot][src.sw[size_t(c)]];
-                for (int i = 0; i < n; ++i) x[i] = a * r[i] + b;
+                continue;
+            }
+            const float* r = st.bf.reg[src.slot][src.sw[size_t(c)]];
+            switch (src.mod) {
+                case SrcMod::Neg: for (int i = 0; i < n; ++i) x[i] = -r[i]; break;
+                case SrcMod::Bias: for (int i = 0; i < n; ++i) x[i] = r[i] - 0.5f; break;
+                case SrcMod::BiasNeg: for (int i = 0; i < n; ++i) x[i] = -(r[i] - 0.5f); break;
+                case SrcMod::Sign: for (int i = 0; i < n; ++i) x[i] = 2.0f * r[i] - 1.0f; break;
+                case SrcMod::SignNeg: for (int i = 0; i < n; ++i) x[i] = -(2.0f * r[i] - 1.0f); break;
+                case SrcMod::Comp: for (int i = 0; i < n; ++i) x[i] = 1.0f - r[i]; break;
+                case SrcMod::X2: for (int i = 0; i < n; ++i) x[i] = 2.0f * r[i]; break;
+                case SrcMod::X2Neg: for (int i = 0; i < n; ++i) x[i] = -(2.0f * r[i]); break;
+                default: std::memcpy(x, r, sizeof(float) * size_t(n)); break;
             }
         }
     }
