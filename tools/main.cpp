@@ -16,6 +16,7 @@
 #include "ps11/isa_doc.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
+#include "tools/cmd_eval.h"
 #include "tools/cmd_golden.h"
 #include "tools/cmd_test.h"
 
@@ -32,6 +33,8 @@ const char* kUsageText =
     "                         validate and print statistics (slots, constants, read ports)\n"
     "  test FILE.ps11test... [--backend emu|gl|both] [--precision P] [-v]\n"
     "                         run .ps11test files\n"
+    "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--precision P] [--max-value M] [--texN 0xAARRGGBB]\n"
+    "                         run a shader for one pixel and print r0\n"
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
@@ -295,6 +298,7 @@ int main(int argc, char** argv) {
     if (cmd == "disasm") return cmdDisasm(args);
     if (cmd == "check") return cmdCheck(args);
     if (cmd == "test") return ps11::cmdTest(args);
+    if (cmd == "eval") return ps11::cmdEval(args);
     if (cmd == "golden") return cmdGolden(args);
     if (cmd == "demo") return cmdDemo(args);
     if (cmd == "isa") {

@@ -60,6 +60,30 @@ expect_rc 1 "disasm truncated" "$ps11" disasm "$work/trunc.bin"
 expect_in "$work/err" "P3001" "odd-size binary"
 expect_rc 1 "write into a missing folder" "$ps11" asm "$work/a.psh" -o "$work/no/such/dir.bin"
 
+# eval: one pixel on the executor.
+printf 'ps_1_1\nmov r0, v0\n' >"$work/e.psh"
+expect_rc 0 "eval" "$ps11" eval "$work/e.psh" v0=0.5,0.25,1
+expect_in "$work/out" "r0     0.501961 0.25098 1 0" "eval r0 floats (fx8, missing component 0)"
+expect_in "$work/out" "grid   128 64 255 0" "eval grid integers"
+expect_rc 0 "eval --precision float" "$ps11" eval "$work/e.psh" v0=0.5,0.25,1,1 --precision float
+expect_in "$work/out" "r0     0.5 0.25 1 1" "eval float profile"
+printf 'ps_1_1\ntex t0\nmul r0, t0, c0\n' >"$work/et.psh"
+expect_rc 0 "eval --tex0" "$ps11" eval "$work/et.psh" --tex0 0xff808080 c0=1,1,1,1 t0=0.5,0.5
+expect_in "$work/out" "grid   128 128 128 255" "eval samples the 1x1 texture"
+printf 'ps_1_1\ntexkill t0\nmov r0, v0\n' >"$work/ek.psh"
+expect_rc 0 "eval texkill" "$ps11" eval "$work/ek.psh" t0=-1
+expect_in "$work/out" "killed" "eval reports killed"
+expect_rc 1 "eval bad value" "$ps11" eval "$work/e.psh" t0=x
+expect_in "$work/err" "ps11: eval: bad value for t0: 'x'" "eval names the bad argument"
+expect_rc 1 "eval too many components" "$ps11" eval "$work/e.psh" v0=1,2,3,4,5
+expect_rc 1 "eval bad texture colour" "$ps11" eval "$work/e.psh" --tex0 red
+expect_in "$work/err" "--tex0" "eval names the bad texture option"
+expect_rc 1 "eval invalid shader" "$ps11" eval "$work/bad.psh"
+expect_in "$work/err" "bad.psh:3:9: error P2090" "eval shows the shader diagnostics"
+expect_rc 2 "eval without shader" "$ps11" eval
+expect_rc 2 "eval unknown register" "$ps11" eval "$work/e.psh" q0=1
+expect_rc 2 "eval unknown option" "$ps11" eval "$work/e.psh" --bogus
+
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"
 expect_rc 2 "unknown command" "$ps11" frobnicate

@@ -1,0 +1,227 @@
+// `ps11 eval` (stage: command line over the assembler, the validator and the executor): one
+// pixel of a shader with v#, t# and c# given as NAME=x,y,z,w and stages bound to 1×1 A8R8G8B8
+// textures (--texN 0xAARRGGBB); prints r0 as floats (and grid integers in fx profiles), and
+// whether texkill discarded the pixel or the shader replaced depth.
+#include "tools/cmd_eval.h"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "ps11/assembler.h"
+#include "ps11/diagnostics.h"
+#include "ps11/executor.h"
+#include "ps11/testfile.h"
+#include "ps11/texture.h"
+#include "ps11/texture_sampler.h"
+#include "ps11/validator.h"
+#include "tools/cli_util.h"
+#include "tools/test_eval.h"
+
+namespace ps11 {
+namespace {
+
+constexpr const char* kUsage =
+    "usage: ps11 eval SHADER.psh [v0=r,g,b,a] [v1=...] [t0=u,v,w,q] ... [t7=...] [c0=x,y,z,w] ... [c7=...]\n"
+    "                 [--precision fx8|fx12|float|ideal] [--max-value M] [--tex0 0xAARRGGBB] ... [--tex7 ...]\n"
+    "  values take 1-4 comma-separated floats (missing components are 0); v0/v1 also take 0xAARRGGBB;\n"
+    "  --texN binds a 1x1 A8R8G8B8 texture of that colour to stage N (unbound stages sample (0, 0, 0, 1))\n";
+
+int usageError(const std::string& message) {
+    std::cerr << "ps11: eval: " << message << "\n" << kUsage;
+    return cli::kUsage;
+}
+
+int userError(const std::string& message) {
+    std::cerr << "ps11: eval: " << message << "\n";
+    return cli::kUserError;
+}
+
+std::string lower(std::string s) {
+    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::optional<float> parseFloat(const std::string& s) {
+    if (s.empty()) return std::nullopt;
+    const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
+    const char* end = s.data() + s.size();
+    float v = 0;
+    auto [ptr, ec] = std::from_chars(begin, end, v);
+    if (ec != std::errc() || ptr != end || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::optional<uint32_t> parseHexWord(const std::string& s) {
+    if (s.size() < 3 || s.size() > 10 || s[0] != '0' || (s[1] != 'x' && s[1] != 'X')) return std::nullopt;
+    uint32_t v = 0;
+    auto [ptr, ec] = std::from_chars(s.data() + 2, s.data() + s.size(), v, 16);
+    if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
+    return v;
+}
+
+// "x,y,z,w" with 1-4 components (missing ones 0), or for colours one 0xAARRGGBB word.
+std::optional<Vec4> parseVector(const std::string& s, bool allowWord) {
+    if (allowWord)
+        if (std::optional<uint32_t> w = parseHexWord(s)) return Color::fromArgb(*w).rgba;
+    Vec4 v{0, 0, 0, 0};
+    size_t start = 0;
+    for (int c = 0;; ++c) {
+        if (c == 4) return std::nullopt;
+        size_t comma = s.find(',', start);
+        std::optional<float> f = parseFloat(s.substr(start, comma == std::string::npos ? comma : comma - start));
+        if (!f) return std::nullopt;
+        v[c] = *f;
+        if (comma == std::string::npos) return v;
+        start = comma + 1;
+    }
+}
+
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+struct EvalArgs {
+    std::string shader;
+    std::array<std::optional<Vec4>, 2> color;
+    std::array<std::optional<Vec4>, 8> texcoord;
+    std::array<std::optional<Vec4>, 8> constant;
+    std::array<std::optional<uint32_t>, 8> texture;  // 1x1 A8R8G8B8 colour per stage
+    Precision precision = Precision::Fx8;
+    float maxValue = 0;  // 0 = the version's default
+};
+
+// Parses NAME=VALUE; returns an exit code (kOk = consumed).
+int takeRegister(const std::string& arg, EvalArgs& out) {
+    size_t eq = arg.find('=');
+    std::string name = lower(arg.substr(0, eq));
+    std::string value = arg.substr(eq + 1);
+    std::optional<Vec4>* slot = nullptr;
+    if (name.size() == 2 && name[1] >= '0' && name[1] <= '7') {
+        int n = name[1] - '0';
+        if (name[0] == 'v' && n < 2) slot = &out.color[n];
+        if (name[0] == 't') slot = &out.texcoord[n];
+        if (name[0] == 'c') slot = &out.constant[n];
+    }
+    if (!slot) return usageError("unknown input '" + arg.substr(0, eq) + "' (expected v0, v1, t0..t7 or c0..c7)");
+    if (*slot) return userError(name + " given twice");
+    std::optional<Vec4> v = parseVector(value, name[0] == 'v');
+    if (!v) return userError("bad value for " + name + ": '" + value + "'");
+    *slot = v;
+    return cli::kOk;
+}
+
+}  // namespace
+
+int cmdEval(const std::vector<std::string>& args) {
+    EvalArgs ea;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "-h" || a == "--help") {
+            std::cout << kUsage;
+            return cli::kOk;
+        }
+        bool isTex = a.size() == 6 && a.compare(0, 5, "--tex") == 0 && a[5] >= '0' && a[5] <= '7';
+        if (a == "--precision" || a == "--max-value" || isTex) {
+            if (i + 1 >= args.size()) return usageError(a + " needs a value");
+            const std::string& v = args[++i];
+            if (a == "--precision") {
+                std::optional<Precision> p = parsePrecision(v);
+                if (!p) return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+                ea.precision = *p;
+            } else if (a == "--max-value") {
+                std::optional<float> m = parseFloat(v);
+                if (!m || *m <= 0) return userError("bad value for --max-value: '" + v + "' (expected a float > 0)");
+                ea.maxValue = *m;
+            } else {
+                std::optional<uint32_t> w = parseHexWord(v);
+                if (!w) return userError("bad value for " + a + ": '" + v + "' (expected a colour 0xAARRGGBB)");
+                ea.texture[a[5] - '0'] = *w;
+            }
+        } else if (a.size() > 1 && a[0] == '-') {
+            return usageError("unknown option '" + a + "'");
+        } else if (a.find('=') != std::string::npos) {
+            if (int rc = takeRegister(a, ea); rc != cli::kOk) return rc;
+        } else if (ea.shader.empty()) {
+            ea.shader = a;
+        } else {
+            return usageError("eval takes one shader file ('" + a + "' is a second one)");
+        }
+    }
+    if (ea.shader.empty()) return usageError("eval needs a shader file");
+
+    std::optional<std::string> text = cli::readFile(ea.shader);
+    if (!text) return cli::kUserError;
+    Diagnostics diags;
+    std::string name = ea.shader == "-" ? "<stdin>" : ea.shader;
+    std::optional<Program> program = parseAssembly(*text, name, AssembleOptions{}, diags);
+    if (program) validate(*program, diags);
+    std::cerr << diags.formatAll();
+    if (!program || diags.hasErrors()) return cli::kUserError;
+
+    ExecutorOptions eo;
+    eo.precision = ea.precision;
+    eo.maxValue = ea.maxValue;
+    Diagnostics execDiags = diags;  // the same file ids as the program's source places
+    execDiags.clear();
+    std::unique_ptr<Executor> executor = Executor::create(*program, eo, execDiags);
+    std::cerr << execDiags.formatAll();
+    if (!executor) return cli::kUserError;
+    for (int c = 0; c < 8; ++c)
+        if (ea.constant[c]) executor->setConstant(c, *ea.constant[c]);
+
+    TextureSampler sampler;
+    for (int stage = 0; stage < 8; ++stage) {
+        if (!ea.texture[stage]) continue;
+        TextureDesc desc;
+        desc.stage = stage;
+        desc.width = desc.height = 1;
+        TextureLevel level;
+        level.width = level.height = 1;
+        level.hasFill = true;
+        level.fill.bits = *ea.texture[stage];
+        desc.data.push_back(level);
+        std::string why;
+        std::optional<Texture> texture = textureFromDesc(desc, why);
+        if (!texture) return userError("cannot build the texture of --tex" + std::to_string(stage) + ": " + why);
+        sampler.bind(stage, std::make_shared<const Texture>(std::move(*texture)));
+    }
+    uint32_t sampled = executor->sampledStages();
+    for (int stage = 0; stage < 8; ++stage)
+        if ((sampled & (1u << stage)) && !ea.texture[stage])
+            std::cerr << "ps11: eval: note: the shader samples stage " << stage << ", which has no --tex" << stage
+                      << "; D3D returns (0, 0, 0, 1) there\n";
+
+    EvalInputs in;
+    for (int r = 0; r < 2; ++r)
+        if (ea.color[r]) in.color[r] = &*ea.color[r];
+    for (int r = 0; r < 8; ++r)
+        if (ea.texcoord[r]) in.texture[r] = &*ea.texcoord[r];
+    EvalOutcome out = evalOnePixel(*executor, sampler, in);
+
+    const Precision p = ea.precision;
+    float maxValue = ea.maxValue > 0 ? ea.maxValue : defaultMaxValue(program->version.minor);
+    std::cout << "ps_" << program->version.major << "_" << program->version.minor << ", precision "
+              << precisionName(p) << ", max value " << num(maxValue) << "\n";
+    std::cout << "r0     ";
+    for (int c = 0; c < 4; ++c) std::cout << (c ? " " : "") << num(out.color[c]);
+    std::cout << "\n";
+    if (isFixedPoint(p)) {
+        std::cout << "grid   ";
+        for (int c = 0; c < 4; ++c) std::cout << (c ? " " : "") << out.grid[c];
+        std::cout << "   (value = n/" << gridScale(p) << ")\n";
+    }
+    if (out.killed) std::cout << "killed (texkill discarded the pixel)\n";
+    if (out.hasDepth) std::cout << "depth  " << num(out.depth) << "\n";
+    return cli::kOk;
+}
+
+}  // namespace ps11

@@ -1,0 +1,237 @@
+// `ps11 test`, the executor part: a file's `eval` commands run the validated [pixel shader] for
+// one pixel on the executor (emu backend; the GL backend comes with the device) with the file's
+// precision, max value, [constants], [stage N] state and [texture N]/[sampler N] textures, and
+// `probe eval` compares r0 with an absolute tolerance. Draws and pixel probes only get counted.
+#include "tools/test_eval.h"
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+#include <variant>
+
+#include "ps11/diagnostics.h"
+#include "ps11/texture.h"
+#include "ps11/texture_sampler.h"
+
+namespace ps11 {
+namespace {
+
+std::string where(const std::string& path, uint32_t line) { return path + ":" + std::to_string(line); }
+
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+// "0.5 0.5 0.5 1" (n components).
+std::string floats(const Vec4& v, int n) {
+    std::string s;
+    for (int c = 0; c < n; ++c) s += (c ? " " : "") + num(v[c]);
+    return s;
+}
+
+std::string describeOutcome(const EvalOutcome& o, int n, Precision p) {
+    if (o.killed) return "killed";
+    std::string s = floats(o.color, n);
+    if (isFixedPoint(p)) {
+        s += " = [";
+        for (int c = 0; c < n; ++c) s += (c ? " " : "") + std::to_string(o.grid[c]);
+        s += "]/" + std::to_string(gridScale(p));
+    }
+    return s;
+}
+
+// Checks one eval probe against the last eval; returns the failure text ("" = passed).
+std::string checkProbe(const Probe& probe, const EvalOutcome& got, Precision p) {
+    if (probe.kind == ProbeKind::EvalKilled) {
+        if (got.killed) return "";
+        return "expected killed, got " + describeOutcome(got, 4, p) + " (not killed)";
+    }
+    int n = probe.alpha ? 4 : 3;
+    bool ok = !got.killed;
+    for (int c = 0; ok && c < n; ++c) {
+        double diff = std::fabs(double(got.color[c]) - double(probe.expected.rgba[c]));
+        if (!(diff <= double(probe.tolerance))) ok = false;  // NaN never passes
+    }
+    if (ok) return "";
+    return std::string("expected ") + (probe.alpha ? "rgba " : "rgb ") + floats(probe.expected.rgba, n) + " tol " +
+           num(probe.tolerance) + ", got " + describeOutcome(got, n, p);
+}
+
+bool isDeviceCommand(const TestCommand& cmd) {
+    if (std::holds_alternative<DrawQuad>(cmd.op) || std::holds_alternative<DrawPrimitives>(cmd.op)) return true;
+    if (const Probe* probe = std::get_if<Probe>(&cmd.op))
+        return probe->kind != ProbeKind::Eval && probe->kind != ProbeKind::EvalKilled;
+    return false;
+}
+
+bool runsOn(const TestCommand& cmd, uint8_t backends, Precision p) {
+    for (Backend b : {Backend::Emu, Backend::Gl})
+        if ((backends & (1u << unsigned(b))) && cmd.onlyIf.matches(b, p)) return true;
+    return false;
+}
+
+// The executor and sampler of one file, built on the first eval.
+struct EvalState {
+    std::unique_ptr<Executor> executor;
+    std::unique_ptr<Sampler> sampler;
+};
+
+bool prepare(const TestFile& file, const std::string& path, const Program& program, const CommandRunOptions& opts,
+             EvalState& state) {
+    ExecutorOptions eo;
+    eo.precision = opts.precision;
+    eo.maxValue = file.require.maxValue.value;  // 0 = the version's default
+    Diagnostics diags;
+    if (opts.shaderDiags) {
+        diags = *opts.shaderDiags;
+        diags.clear();
+    }
+    state.executor = Executor::create(program, eo, diags);
+    if (!state.executor) {
+        std::cout << where(path, file.pixelShader.line) << ": the executor cannot run this shader (precision "
+                  << precisionName(opts.precision) << "):\n"
+                  << diags.formatAll();
+        return false;
+    }
+    for (const ConstantDesc& c : file.constants) state.executor->setConstant(c.index, c.value);
+    for (const StageDesc& s : file.stages) state.executor->setStageState(s.stage, stageStateOf(s));
+    std::string error;
+    state.sampler = makeTestSampler(file, path, error);
+    if (!state.sampler) {
+        std::cout << error << "\n";
+        return false;
+    }
+    if (opts.verbose) {
+        uint32_t sampled = state.executor->sampledStages();
+        for (int stage = 0; stage < 8; ++stage)
+            if ((sampled & (1u << stage)) && !file.texture(stage))
+                std::cout << where(path, file.pixelShader.line) << ": note: the shader samples stage " << stage
+                          << ", which has no [texture " << stage << "]; D3D returns (0, 0, 0, 1) there\n";
+    }
+    return true;
+}
+
+}  // namespace
+
+EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalInputs& in, ExecutorStats* stats) {
+    PixelInputs inputs;
+    inputs.count = 1;
+    inputs.quads = false;
+    for (int r = 0; r < 2; ++r)
+        for (int c = 0; c < 4; ++c) inputs.color[r][c] = in.color[r] ? &(*in.color[r])[c] : nullptr;
+    for (int r = 0; r < 8; ++r)
+        for (int c = 0; c < 4; ++c) inputs.texcoord[r][c] = in.texture[r] ? &(*in.texture[r])[c] : nullptr;
+    EvalOutcome out;
+    float depth = 0;
+    uint8_t killed = 0;
+    PixelOutputs outputs;
+    for (int c = 0; c < 4; ++c) {
+        outputs.color[c] = &out.color[c];
+        outputs.grid[c] = &out.grid[c];
+    }
+    outputs.killed = &killed;
+    outputs.depth = &depth;
+    executor.run(inputs, sampler, outputs, stats);
+    out.killed = killed != 0;
+    out.hasDepth = executor.writesDepth();
+    out.depth = depth;
+    return out;
+}
+
+StageState stageStateOf(const StageDesc& stage) {
+    StageState s;
+    s.bumpMat = stage.bumpEnvMat.value;
+    s.lumScale = stage.lScale.value;
+    s.lumOffset = stage.lOffset.value;
+    const TransformFlags& t = stage.transformFlags.value;
+    s.transformFlags = t.count | (t.projected ? kTtffProjected : 0u);
+    return s;
+}
+
+std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path, std::string& error) {
+    auto sampler = std::make_unique<TextureSampler>();
+    for (const TextureDesc& t : file.textures) {
+        std::string why;
+        std::optional<Texture> texture = textureFromDesc(t, why);
+        if (!texture) {
+            error = where(path, t.line) + ": cannot build [texture " + std::to_string(t.stage) + "]: " + why;
+            return nullptr;
+        }
+        sampler->bind(t.stage, std::make_shared<const Texture>(std::move(*texture)));
+    }
+    // A missing [sampler N] keeps D3D9's defaults (SamplerState{}).
+    for (const SamplerDesc& sd : file.samplers) sampler->setSamplerState(sd.stage, samplerStateFromDesc(sd));
+    return sampler;
+}
+
+void runCommands(const TestFile& file, const std::string& path, const Program* program,
+                 const CommandRunOptions& opts, CommandTally& tally) {
+    // Draws and pixel probes wait for the device, whatever the backend: count each once.
+    for (const TestCommand& cmd : file.commands)
+        if (isDeviceCommand(cmd) && runsOn(cmd, opts.backends, opts.precision)) ++tally.pendingDevice;
+
+    const Precision p = opts.precision;
+    EvalState state;
+    bool prepared = false;
+    for (Backend backend : {Backend::Emu, Backend::Gl}) {
+        if (!(opts.backends & (1u << unsigned(backend)))) continue;
+        std::optional<EvalOutcome> last;
+        for (const TestCommand& cmd : file.commands) {
+            if (isDeviceCommand(cmd) || !cmd.onlyIf.matches(backend, p)) continue;
+            if (backend == Backend::Gl) {
+                ++tally.pendingGl;  // the GL backend comes with the device
+                continue;
+            }
+            if (const Eval* eval = std::get_if<Eval>(&cmd.op)) {
+                if (!program) continue;  // the reader rejects evals without a [pixel shader]
+                if (!prepared) {
+                    prepared = true;
+                    if (!prepare(file, path, *program, opts, state)) {
+                        tally.error = true;
+                        return;
+                    }
+                }
+                EvalInputs in;
+                for (int r = 0; r < 2; ++r)
+                    if (eval->color[r].isSet()) in.color[r] = &eval->color[r].value;
+                for (int r = 0; r < 8; ++r)
+                    if (eval->texture[r].isSet()) in.texture[r] = &eval->texture[r].value;
+                last = evalOnePixel(*state.executor, *state.sampler, in, &tally.stats);
+                ++tally.evals;
+                continue;
+            }
+            const Probe& probe = std::get<Probe>(cmd.op);
+            const bool todo = cmd.isTodo(backend, p);
+            if (!last) {
+                std::cout << where(path, cmd.line) << ": probe failed: no eval ran before this probe (precision "
+                          << precisionName(p) << ")\n";
+                ++tally.probesFailed;
+                continue;
+            }
+            std::string failure = checkProbe(probe, *last, p);
+            if (failure.empty() && todo) {
+                std::cout << where(path, cmd.line) << ": error: todo probe passed (remove the todo): "
+                          << describeOutcome(*last, probe.alpha ? 4 : 3, p) << " (precision " << precisionName(p)
+                          << ")\n";
+                ++tally.probesFailed;
+            } else if (failure.empty()) {
+                ++tally.probesPassed;
+            } else if (todo) {
+                ++tally.probesTodo;
+                if (opts.verbose)
+                    std::cout << where(path, cmd.line) << ": todo: " << failure << " (precision " << precisionName(p)
+                              << ")\n";
+            } else {
+                std::cout << where(path, cmd.line) << ": probe failed: " << failure << " (precision "
+                          << precisionName(p) << ")\n";
+                ++tally.probesFailed;
+            }
+        }
+    }
+    if (state.sampler) tally.texelsFetched = state.sampler->texelsFetched();
+}
+
+}  // namespace ps11

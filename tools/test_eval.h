@@ -1,0 +1,72 @@
+// Running a .ps11test's `eval` commands and `probe eval` probes on the executor (the part of
+// `ps11 test` that needs no device), and the one-pixel evaluation `ps11 eval` shares with it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "ps11/diagnostics.h"
+#include "ps11/executor.h"
+#include "ps11/ir.h"
+#include "ps11/sampler.h"
+#include "ps11/testfile.h"
+
+namespace ps11 {
+
+// r0 (and friends) of one evaluated pixel.
+struct EvalOutcome {
+    Vec4 color{0, 0, 0, 0};
+    std::array<int32_t, 4> grid{};  // r0's grid integers (fx profiles only)
+    bool killed = false;
+    bool hasDepth = false;  // the program replaces depth
+    float depth = 0;
+};
+
+// Interpolants of one pixel; a null pointer reads as 0.
+struct EvalInputs {
+    std::array<const Vec4*, 2> color{};    // v0, v1
+    std::array<const Vec4*, 8> texture{};  // TC[0..7]
+};
+
+// Runs the program for one pixel (one lane, quads = false).
+EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalInputs& inputs,
+                         ExecutorStats* stats = nullptr);
+
+// The sampler of a test file's [texture N] / [sampler N] sections (missing [sampler N]: D3D9
+// defaults). Returns null with `error` set ("FILE:LINE: ...") if a texture cannot be built.
+std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path, std::string& error);
+
+// The file's [stage N] state as the executor wants it.
+StageState stageStateOf(const StageDesc& stage);
+
+// What running a file's commands produced.
+struct CommandTally {
+    size_t evals = 0;           // evals run on the executor
+    size_t probesPassed = 0;    // eval probes that passed
+    size_t probesFailed = 0;    // eval probes that failed, and todo probes that passed
+    size_t probesTodo = 0;      // todo probes that failed as expected
+    size_t pendingDevice = 0;   // draws and pixel probes: need the device (not yet runnable)
+    size_t pendingGl = 0;       // evals and eval probes asked on gl (not runnable on gl yet)
+    bool error = false;         // the executor refused the program, or a sampler could not be built
+    ExecutorStats stats;        // executor statistics over every eval
+    uint64_t texelsFetched = 0;
+};
+
+struct CommandRunOptions {
+    uint8_t backends = kBackendEmu;  // already intersected with [require] backend
+    Precision precision = Precision::Fx8;
+    bool verbose = false;
+    // The diagnostics the [pixel shader] was assembled with: their file names resolve the source
+    // places of the executor's E40xx reports.
+    const Diagnostics* shaderDiags = nullptr;
+};
+
+// Runs (or counts) every command of `file` whose if(...) matches the run. `program` is the
+// assembled and validated [pixel shader] (null if the file has none). Failures are printed as
+// `FILE:LINE: probe failed: expected ... got ... (precision P)`.
+void runCommands(const TestFile& file, const std::string& path, const Program* program,
+                 const CommandRunOptions& options, CommandTally& tally);
+
+}  // namespace ps11
