@@ -14,14 +14,9 @@ namespace {
 
 constexpr int kSlots = 2;  // mip levels blended per lane (linear mip filter)
 
-// round_half_even(v / 2^s) for s >= 1 (arithmetic shift = floor division).
-inline int64_t roundShift(int64_t v, int s) {
-    int64_t q = v >> s;
-    int64_t r = v - (q << s);
-    int64_t half = int64_t(1) << (s - 1);
-    if (r > half || (r == half && (q & 1))) ++q;
-    return q;
-}
+// round_half_even(v / 2^s) for s >= 1, branch-free: adding half - 1 plus the quotient's low
+// bit carries exactly when the remainder is above half, or equal to it with an odd quotient.
+inline int64_t roundShift(int64_t v, int s) { return (v + ((int64_t(1) << (s - 1)) - 1) + ((v >> s) & 1)) >> s; }
 
 // Per lane: which levels (slot 0, and slot 1 for a linear mip blend) and which filter.
 struct LaneLevels {
@@ -74,11 +69,23 @@ inline void addressPair(double fl, int64_t n, int32_t& i0, int32_t& i1) {
     }
 }
 
+// round_half_even(x) for |x| < 2^51 in the default rounding mode, without a library call
+// (adding and removing 1.5 * 2^52 leaves no fraction bits; the compiler may not fold it).
+constexpr double kRoundMagic = 6755399441055744.0;
+inline double roundEvenSmall(double x) { return (x + kRoundMagic) - kRoundMagic; }
+constexpr double kSmall = 1099511627776.0;  // 2^40: beyond it positions take the slow path
+
 // Texel-space position of one coordinate: x = u*n - 0.5 for linear (texel centres, spec §6.2),
 // u*n for point (floor(u*n), ties go up). Computed in double, exact for float32 u and n <= 2^14.
 // NaN samples as 0, infinities as a huge finite position (never a crash).
 inline void texelPosition(float u, uint32_t n, bool linear, double& fl, double& fr) {
-    double x = double(u) * double(n) - (linear ? 0.5 : 0.0);
+    const double x = double(u) * double(n) - (linear ? 0.5 : 0.0);
+    if (x > -kSmall && x < kSmall) {
+        double r = roundEvenSmall(x);
+        fl = r > x ? r - 1.0 : r;  // floor
+        fr = x - fl;
+        return;
+    }
     fl = std::floor(x);
     fr = x - fl;
     if (!(fr >= 0.0 && fr < 1.0)) {
@@ -86,6 +93,9 @@ inline void texelPosition(float u, uint32_t n, bool linear, double& fl, double& 
         fr = 0.0;
     }
 }
+
+// The 8-bit weight round_half_even(fr * 256) of a fraction fr in [0, 1).
+inline int32_t weight8(double fr) { return int32_t(roundEvenSmall(fr * 256.0)); }
 
 template <TextureAddress Mode>
 void axisPassT(int count, const float* coord, const uint32_t* extent, const uint8_t* level, const uint8_t* linear,
@@ -95,7 +105,7 @@ void axisPassT(int count, const float* coord, const uint32_t* extent, const uint
         double fl, fr;
         texelPosition(coord[i], n, linear[i] != 0, fl, fr);
         addressPair<Mode>(fl, n, out.i0[i], out.i1[i]);
-        out.w[i] = linear[i] ? int32_t(std::nearbyint(fr * 256.0)) : 0;  // 8-bit weight, ties to even
+        out.w[i] = linear[i] ? weight8(fr) : 0;  // 8-bit weight, ties to even
         out.f[i] = linear[i] ? float(fr) : 0.0f;
     }
 }
@@ -234,22 +244,58 @@ void combineFloat(const CombineInput& in, const Src& src, const float* border, f
     }
 }
 
+// One axis of the fast path: R = round_half_even((u*n - 0.5) * 256) gives the first texel
+// R >> 8 and the 8-bit weight R & 255 of the second. This equals the general rule (i0, w = 256)
+// whenever f*256 rounds up to 256: the tap pair moves one texel on and the weights become
+// (256, 0), the same exact sum. False for positions the fast path leaves to the general one.
+template <TextureAddress Mode>
+inline bool fastAxis(float u, uint32_t n, uint32_t mask, int32_t& i0, int32_t& i1, int32_t& w) {
+    const double x = double(u) * double(n * 256u) - 128.0;  // exact: 24 + 22 bits
+    if (!(x > -kSmall && x < kSmall)) return false;       // huge, infinite or NaN
+    const int64_t r = int64_t(roundEvenSmall(x));
+    const int64_t k = r >> 8;
+    w = int32_t(r & 255);
+    if constexpr (Mode == TextureAddress::Clamp) {
+        i0 = int32_t(std::clamp<int64_t>(k, 0, n - 1));
+        i1 = int32_t(std::clamp<int64_t>(k + 1, 0, n - 1));
+    } else if (mask) {  // wrap, power-of-two extent
+        i0 = int32_t(k & mask);
+        i1 = int32_t((k + 1) & mask);
+    } else {
+        int64_t m = k % n;
+        if (m < 0) m += n;
+        i0 = int32_t(m);
+        i1 = m + 1 == n ? 0 : int32_t(m + 1);
+    }
+    return true;
+}
+
 // fx bilinear on an 8-bit 2D texture, one level, wrap/clamp: the same exact sum as combineFx
-// (sum * scale / 2^16, one round-half-even) in 32-bit integers.
+// (sum * scale / 2^16, one round-half-even) in 32-bit integers. Lanes with unusual coordinates
+// go through the general per-axis rule (texelPosition + addressPair).
 template <TextureAddress MU, TextureAddress MV>
 void fastBilinearU8(int count, const float* u, const float* v, const TextureLevelInfo& li, const uint8_t* texels,
                     int32_t scale, int32_t* const* dst) {
     const uint8_t* base = texels + li.offset * 4;
+    const uint32_t maskU = (li.width & (li.width - 1)) == 0 ? li.width - 1 : 0;
+    const uint32_t maskV = (li.height & (li.height - 1)) == 0 ? li.height - 1 : 0;
+    const size_t stride = size_t(li.width) * 4;
     for (int i = 0; i < count; ++i) {
-        double flx, frx, fly, fry;
-        texelPosition(u[i], li.width, true, flx, frx);
-        texelPosition(v[i], li.height, true, fly, fry);
-        int32_t x0, x1, y0, y1;
-        addressPair<MU>(flx, li.width, x0, x1);
-        addressPair<MV>(fly, li.height, y0, y1);
-        const int32_t wx = int32_t(std::nearbyint(frx * 256.0)), wy = int32_t(std::nearbyint(fry * 256.0));
-        const uint8_t* r0 = base + size_t(y0) * li.width * 4;
-        const uint8_t* r1 = base + size_t(y1) * li.width * 4;
+        int32_t x0, x1, y0, y1, wx, wy;
+        if (!fastAxis<MU>(u[i], li.width, maskU, x0, x1, wx)) {
+            double fl, fr;
+            texelPosition(u[i], li.width, true, fl, fr);
+            addressPair<MU>(fl, li.width, x0, x1);
+            wx = weight8(fr);
+        }
+        if (!fastAxis<MV>(v[i], li.height, maskV, y0, y1, wy)) {
+            double fl, fr;
+            texelPosition(v[i], li.height, true, fl, fr);
+            addressPair<MV>(fl, li.height, y0, y1);
+            wy = weight8(fr);
+        }
+        const uint8_t* r0 = base + size_t(y0) * stride;
+        const uint8_t* r1 = base + size_t(y1) * stride;
         uint8_t t00[4], t10[4], t01[4], t11[4];
         std::memcpy(t00, r0 + size_t(x0) * 4, 4);
         std::memcpy(t10, r0 + size_t(x1) * 4, 4);
@@ -322,7 +368,7 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
                     level1 = level0 + 1;
                     const double frac = lod - a;
                     if (fixed) {
-                        mipW = int32_t(std::nearbyint(frac * 256.0));
+                        mipW = weight8(frac);
                         if (mipW == 256) level0 = level1;  // exactly the upper level
                         slots = mipW == 0 || mipW == 256 ? 1 : 2;
                     } else {

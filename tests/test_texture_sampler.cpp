@@ -555,27 +555,37 @@ TEST_CASE("sampler: unbound stages, output spans, fetch counts", "[sampler]") {
 
 TEST_CASE("sampler: the 8-bit fast path equals the general path", "[sampler]") {
     std::mt19937 rng(1234);
-    std::vector<uint32_t> texels(5 * 3);
-    for (uint32_t& t : texels) t = rng();
-    TextureDesc d = makeDesc(TexFormat::A8R8G8B8, 5, 3, 0, {});
-    for (uint32_t t : texels) d.data[0].texels.push_back(word(t));
-    auto tex = build(d);
-    std::uniform_real_distribution<float> coord(-2.0f, 3.0f);
-    std::vector<float> u(kMaxSpan), v(kMaxSpan);
-    for (int i = 0; i < kMaxSpan; ++i) u[size_t(i)] = coord(rng), v[size_t(i)] = coord(rng);
-    u[0] = 0.5f / 5, v[0] = 0.5f / 3;  // exact centres
-    for (TextureAddress mu : {TextureAddress::Clamp, TextureAddress::Wrap})
-        for (TextureAddress mv : {TextureAddress::Clamp, TextureAddress::Wrap})
-            for (Precision p : {Precision::Fx8, Precision::Fx12}) {
-                TextureSampler fast, general;
-                general.setFastPath(false);
-                SamplerState st = state(Filter::Linear, mu);
-                st.addressV = mv;
-                for (TextureSampler* s : {&fast, &general}) {
-                    s->bind(0, tex);
-                    s->setSamplerState(0, st);
-                }
-                Result a = run(fast, p, u, v), b = run(general, p, u, v);
-                for (int c = 0; c < 4; ++c) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
+    // 5x3 takes the modulo wrap, 4x4 the power-of-two mask.
+    for (uint32_t size : {5u, 4u}) {
+        const uint32_t w = size, h = size == 5 ? 3 : 4;
+        TextureDesc d = makeDesc(TexFormat::A8R8G8B8, w, h, 0, {});
+        for (uint32_t i = 0; i < w * h; ++i) d.data[0].texels.push_back(word(rng()));
+        auto tex = build(d);
+        std::uniform_real_distribution<float> coord(-2.0f, 3.0f);
+        std::uniform_int_distribution<int> grid(-2048, 3072);
+        std::vector<float> u(kMaxSpan), v(kMaxSpan);
+        for (int i = 0; i < kMaxSpan; ++i) {
+            if (i % 2) {
+                u[size_t(i)] = coord(rng), v[size_t(i)] = coord(rng);
+            } else {  // multiples of 1/1024: exact half-way weights and f*256 rounding to 256
+                u[size_t(i)] = float(grid(rng)) / 1024, v[size_t(i)] = float(grid(rng)) / 1024;
             }
+        }
+        u[0] = 0.5f / float(w), v[0] = 0.5f / float(h);  // exact centres
+        u[2] = std::nanf(""), v[4] = std::numeric_limits<float>::infinity(), u[6] = -1e30f;  // the slow lane path
+        for (TextureAddress mu : {TextureAddress::Clamp, TextureAddress::Wrap})
+            for (TextureAddress mv : {TextureAddress::Clamp, TextureAddress::Wrap})
+                for (Precision p : {Precision::Fx8, Precision::Fx12}) {
+                    TextureSampler fast, general;
+                    general.setFastPath(false);
+                    SamplerState st = state(Filter::Linear, mu);
+                    st.addressV = mv;
+                    for (TextureSampler* s : {&fast, &general}) {
+                        s->bind(0, tex);
+                        s->setSamplerState(0, st);
+                    }
+                    Result a = run(fast, p, u, v), b = run(general, p, u, v);
+                    for (int c = 0; c < 4; ++c) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
+                }
+    }
 }
