@@ -1,0 +1,158 @@
+// The emulated Direct3D 9-style device (docs/device.md): D3D9 names and return codes at the
+// edge, plain C++ inside. This slice has resources (textures, volume textures, render targets,
+// depth surfaces, offscreen plain surfaces; Lock/Unlock in D3D's memory layout, mip generation,
+// GetRenderTargetData), every state setter, pixel shaders, Clear and StretchRect. Draws arrive
+// with the rasteriser slice.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+
+#include "emu/d3d9types.h"
+#include "emu/resources.h"
+#include "emu/state.h"
+#include "ps11/precision.h"
+#include "ps11/texture.h"
+
+namespace emu {
+
+struct DeviceOptions {
+    ps11::Precision precision = ps11::Precision::Fx8;  // profile of draws, StretchRect weights
+    float maxValue = 0;     // PixelShader1xMaxValue; 0 = the shader version's default
+    int threads = 0;        // worker threads for draws (later slices); 0 = all cores
+    uint64_t maxResourceBytes = kMaxResourceBytes;  // per resource, checked before allocating
+};
+
+// What the last call reported. Every call resets it; a failed call sets hr, an E41xx code and
+// a message naming the call and the argument.
+struct DeviceError {
+    HRESULT hr = D3D_OK;
+    std::string code;     // "E4101" …, empty on success
+    std::string message;  // "E4101 SetTextureStageState: stage 9 out of range 0..7"
+};
+
+class Device {
+public:
+    explicit Device(const DeviceOptions& options = {});
+    ~Device();
+    Device(const Device&) = delete;
+    Device& operator=(const Device&) = delete;
+
+    const DeviceOptions& options() const { return m_options; }
+    const DeviceState& state() const { return m_state; }
+    const DeviceError& lastError() const { return m_error; }
+
+    // ---- resources ----
+    // Levels 0 = the full chain. AUTOGENMIPMAP: Levels 0 or 1, the chain is kept hidden and
+    // GetLevelCount returns 1 (D3D9).
+    HRESULT CreateTexture(UINT width, UINT height, UINT levels, DWORD usage, D3DFORMAT format, D3DPOOL pool,
+                          Handle* texture);
+    HRESULT CreateVolumeTexture(UINT width, UINT height, UINT depth, UINT levels, DWORD usage, D3DFORMAT format,
+                                D3DPOOL pool, Handle* volumeTexture);
+    HRESULT CreateRenderTarget(UINT width, UINT height, D3DFORMAT format, BOOL lockable, Handle* surface);
+    HRESULT CreateDepthStencilSurface(UINT width, UINT height, D3DFORMAT format, Handle* surface);
+    HRESULT CreateOffscreenPlainSurface(UINT width, UINT height, D3DFORMAT format, D3DPOOL pool, Handle* surface);
+    // Frees an object. Bindings to it (SetTexture, render target, depth, pixel shader) are reset
+    // to NULL; its surface handles die with it.
+    HRESULT Release(Handle object);
+
+    // IDirect3DTexture9 / IDirect3DVolumeTexture9: levels, surfaces, locks.
+    DWORD GetLevelCount(Handle texture);  // 0 (and an error) for a bad handle
+    HRESULT GetLevelDesc(Handle texture, UINT level, D3DSURFACE_DESC* desc);
+    HRESULT GetSurfaceLevel(Handle texture, UINT level, Handle* surface);
+    HRESULT LockRect(Handle texture, UINT level, D3DLOCKED_RECT* locked, const RECT* rect, DWORD flags);
+    HRESULT UnlockRect(Handle texture, UINT level);
+    HRESULT LockBox(Handle volumeTexture, UINT level, D3DLOCKED_BOX* locked, const D3DBOX* box, DWORD flags);
+    HRESULT UnlockBox(Handle volumeTexture, UINT level);
+    // D3D9 regenerates AUTOGENMIPMAP sublevels from level 0; no effect on other textures.
+    HRESULT GenerateMipSubLevels(Handle texture);
+
+    // IDirect3DSurface9
+    HRESULT GetDesc(Handle surface, D3DSURFACE_DESC* desc);
+    HRESULT LockRect(Handle surface, D3DLOCKED_RECT* locked, const RECT* rect, DWORD flags);
+    HRESULT UnlockRect(Handle surface);
+
+    // Copies a render target into a SYSTEMMEM surface of the same size and format.
+    HRESULT GetRenderTargetData(Handle renderTarget, Handle destSurface);
+    // Copies a rectangle between DEFAULT-pool colour surfaces, scaling with POINT or LINEAR
+    // filtering (docs/device.md "StretchRect").
+    HRESULT StretchRect(Handle source, const RECT* sourceRect, Handle dest, const RECT* destRect,
+                        D3DTEXTUREFILTERTYPE filter);
+    // Clears the viewport (∩ scissor when enabled ∩ the rects) of the render target, depth and
+    // stencil (docs/device.md "Clear").
+    HRESULT Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR color, float z, DWORD stencil);
+
+    // ---- state ----
+    HRESULT SetTexture(DWORD stage, Handle texture);
+    HRESULT GetTexture(DWORD stage, Handle* texture);
+    HRESULT SetSamplerState(DWORD sampler, D3DSAMPLERSTATETYPE type, DWORD value);
+    HRESULT GetSamplerState(DWORD sampler, D3DSAMPLERSTATETYPE type, DWORD* value);
+    // Float states (BUMPENVMAT*, BUMPENVLSCALE/LOFFSET) are passed as their bit pattern.
+    HRESULT SetTextureStageState(DWORD stage, D3DTEXTURESTAGESTATETYPE type, DWORD value);
+    HRESULT GetTextureStageState(DWORD stage, D3DTEXTURESTAGESTATETYPE type, DWORD* value);
+    HRESULT SetRenderState(D3DRENDERSTATETYPE state, DWORD value);
+    HRESULT GetRenderState(D3DRENDERSTATETYPE state, DWORD* value);
+    // Index 0 only (one render target). Resets the viewport and scissor rect to the whole target.
+    HRESULT SetRenderTarget(DWORD index, Handle surface);
+    HRESULT GetRenderTarget(DWORD index, Handle* surface);
+    HRESULT SetDepthStencilSurface(Handle surface);
+    HRESULT GetDepthStencilSurface(Handle* surface);
+    HRESULT SetTransform(D3DTRANSFORMSTATETYPE state, const D3DMATRIX* matrix);
+    HRESULT GetTransform(D3DTRANSFORMSTATETYPE state, D3DMATRIX* matrix);
+    HRESULT SetViewport(const D3DVIEWPORT9* viewport);
+    HRESULT GetViewport(D3DVIEWPORT9* viewport);
+    HRESULT SetScissorRect(const RECT* rect);
+    HRESULT GetScissorRect(RECT* rect);
+    HRESULT SetFVF(DWORD fvf);
+
+    // ---- pixel shaders ----
+    // Tokens up to and including the end token (D3D9 has no length: the stream is scanned).
+    HRESULT CreatePixelShader(const DWORD* function, Handle* shader);
+    HRESULT CreatePixelShader(std::span<const DWORD> function, Handle* shader);
+    // Convenience: assembles ps_1_x text (preprocessor included) and validates it.
+    HRESULT CreatePixelShaderFromText(std::string_view source, Handle* shader);
+    HRESULT SetPixelShader(Handle shader);
+    HRESULT SetPixelShaderConstantF(UINT startRegister, const float* data, UINT vector4fCount);
+    HRESULT GetPixelShaderConstantF(UINT startRegister, float* data, UINT vector4fCount);
+
+    // ---- drawing ----
+    // Not in this slice: returns D3DERR_NOTAVAILABLE ("draws arrive with the rasteriser slice").
+    HRESULT DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, const void* vertexData, UINT stride);
+
+    // ---- for the draw slices and tests (not D3D9 API) ----
+    // The sampler's view of a texture or volume texture, rebuilt after writes (mips regenerated
+    // first for AUTOGENMIPMAP); nullptr with lastError() set on failure.
+    std::shared_ptr<const ps11::Texture> sampledTexture(Handle texture);
+    // The decoded, validated program of a pixel shader; nullptr for a bad handle.
+    const ps11::Program* pixelShaderProgram(Handle shader) const;
+
+private:
+    HRESULT fail(HRESULT hr, const char* code, std::string message);
+    HRESULT ok();
+    Handle newHandle();
+    Resource* findResource(Handle h);
+    // The surface's image and owner, or null (with lastError set, naming `call` and `what`).
+    Image* surfaceImage(Handle h, const char* call, const char* what, Resource** owner, SurfaceRef* ref);
+    HRESULT checkNewSize(const char* call, UINT width, UINT height, UINT depth, uint32_t maxSide);
+    HRESULT createResource(const char* call, Resource&& r, UINT width, UINT height, UINT depth, UINT levels,
+                           Handle* out);
+    HRESULT lockLevel(const char* call, Handle owner, Resource& r, uint32_t level, const RECT* rect,
+                      const D3DBOX* box, DWORD flags, D3DLOCKED_BOX* out);
+    HRESULT unlockLevel(const char* call, Resource& r, uint32_t level);
+    HRESULT registerShader(const char* call, PixelShaderObject&& shader, Handle* out);
+    void markWritten(Resource& r, uint32_t level);
+
+    DeviceOptions m_options;
+    DeviceState m_state;
+    DeviceError m_error;
+    uint32_t m_nextHandle = 1;
+    std::unordered_map<uint32_t, Resource> m_resources;
+    std::unordered_map<uint32_t, SurfaceRef> m_surfaces;
+    std::unordered_map<uint32_t, PixelShaderObject> m_shaders;
+};
+
+}  // namespace emu

@@ -1,0 +1,192 @@
+// Device stage: resource storage. Level sizes and pitches, allocation, D3DUSAGE_AUTOGENMIPMAP
+// generation (box filter, rounded half-even in the stored representation) and the hand-over of
+// a resource's levels to the sampler's immutable ps11::Texture.
+#include "emu/resources.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ps11/precision.h"
+#include "ps11/testfile.h"
+
+namespace emu {
+
+namespace {
+
+uint32_t extentAt(uint32_t size, uint32_t level) { return level >= 32 ? 1 : std::max<uint32_t>(1, size >> level); }
+
+// A bit field of a signed (bump) format: shift, width, signed.
+struct Field {
+    int shift, bits;
+    bool isSigned;
+};
+
+int fieldsOf(D3DFORMAT f, Field* out) {
+    switch (f) {
+        case D3DFMT_V8U8:
+            out[0] = {0, 8, true}, out[1] = {8, 8, true};
+            return 2;
+        case D3DFMT_L6V5U5:
+            out[0] = {0, 5, true}, out[1] = {5, 5, true}, out[2] = {10, 6, false};
+            return 3;
+        case D3DFMT_X8L8V8U8:
+            out[0] = {0, 8, true}, out[1] = {8, 8, true}, out[2] = {16, 8, false}, out[3] = {24, 8, false};
+            return 4;
+        case D3DFMT_Q8W8V8U8:
+            for (int i = 0; i < 4; ++i) out[i] = {8 * i, 8, true};
+            return 4;
+        case D3DFMT_V16U16:
+            out[0] = {0, 16, true}, out[1] = {16, 16, true};
+            return 2;
+        default:
+            return 0;
+    }
+}
+
+int64_t fieldValue(uint32_t w, const Field& f) {
+    const uint32_t mask = f.bits == 32 ? ~0u : (uint32_t(1) << f.bits) - 1;
+    const uint32_t v = (w >> f.shift) & mask;
+    if (!f.isSigned) return int64_t(v);
+    const uint32_t m = uint32_t(1) << (f.bits - 1);
+    return int64_t(int32_t(v ^ m) - int32_t(m));
+}
+
+uint32_t packField(int64_t v, const Field& f) {
+    const uint32_t mask = (uint32_t(1) << f.bits) - 1;
+    return (uint32_t(v) & mask) << f.shift;
+}
+
+// One level from the previous one: texel (x, y, z) averages source texels 2x+dx, 2y+dy, 2z+dz
+// (dx, dy, dz in {0, 1}) clamped to the source extent, as ps11/texture.cpp's generated chains.
+void boxLevel(const Image& src, Image& dst, bool volume) {
+    const FormatInfo& f = *src.format;
+    const int n = volume ? 8 : 4;
+    Field fields[4];
+    const int nFields = fieldsOf(f.format, fields);
+    for (uint32_t z = 0; z < dst.depth; ++z)
+        for (uint32_t y = 0; y < dst.height; ++y)
+            for (uint32_t x = 0; x < dst.width; ++x) {
+                const uint8_t* taps[8];
+                int k = 0;
+                for (uint32_t dz = 0; dz < (volume ? 2u : 1u); ++dz)
+                    for (uint32_t dy = 0; dy < 2; ++dy)
+                        for (uint32_t dx = 0; dx < 2; ++dx)
+                            taps[k++] = src.texel(std::min(2 * x + dx, src.width - 1),
+                                                  std::min(2 * y + dy, src.height - 1),
+                                                  std::min(2 * z + dz, src.depth - 1));
+                uint8_t* out = dst.texel(x, y, z);
+                switch (f.cls) {
+                    case FormatClass::Unorm8:  // every byte is one channel
+                        for (uint32_t b = 0; b < f.bytes; ++b) {
+                            int64_t s = 0;
+                            for (int i = 0; i < n; ++i) s += taps[i][b];
+                            out[b] = uint8_t(ps11::roundHalfEven(s, n));
+                        }
+                        break;
+                    case FormatClass::Signed: {
+                        uint32_t word = 0;
+                        for (int c = 0; c < nFields; ++c) {
+                            int64_t s = 0;
+                            for (int i = 0; i < n; ++i) s += fieldValue(loadWord(taps[i], f.bytes), fields[c]);
+                            word |= packField(ps11::roundHalfEven(s, n), fields[c]);
+                        }
+                        for (uint32_t b = 0; b < f.bytes; ++b) out[b] = uint8_t(word >> (8 * b));
+                        break;
+                    }
+                    case FormatClass::Float: {
+                        std::array<double, 4> s{};
+                        for (int i = 0; i < n; ++i) {
+                            std::array<float, 4> v = decodeTexel(f, taps[i]);
+                            for (size_t c = 0; c < 4; ++c) s[c] += double(v[c]);
+                        }
+                        std::array<float, 4> avg;
+                        for (size_t c = 0; c < 4; ++c) avg[c] = float(s[c] / n);
+                        encodeFloat(f, avg, out);
+                        break;
+                    }
+                    case FormatClass::Depth:
+                        break;
+                }
+            }
+}
+
+}  // namespace
+
+uint32_t fullChainLength(uint32_t width, uint32_t height, uint32_t depth) {
+    uint32_t m = std::max({width, height, depth, 1u});
+    uint32_t n = 1;
+    while (m > 1) m >>= 1, ++n;
+    return n;
+}
+
+uint32_t rowPitchOf(const FormatInfo& f, uint32_t width) { return (width * f.bytes + 3u) & ~3u; }
+
+uint64_t resourceBytes(const FormatInfo& f, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels) {
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < levels; ++k)
+        total += uint64_t(rowPitchOf(f, extentAt(width, k))) * extentAt(height, k) * extentAt(depth, k);
+    return total;
+}
+
+void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels) {
+    r.levels.resize(levels);
+    for (uint32_t k = 0; k < levels; ++k) {
+        Image& im = r.levels[k];
+        im.format = r.format;
+        im.width = extentAt(width, k);
+        im.height = extentAt(height, k);
+        im.depth = extentAt(depth, k);
+        im.rowPitch = rowPitchOf(*r.format, im.width);
+        im.slicePitch = uint64_t(im.rowPitch) * im.height;
+        im.bytes.assign(size_t(im.slicePitch * im.depth), 0);
+    }
+    r.locked.assign(levels, 0);
+    r.lockedReadOnly.assign(levels, 0);
+}
+
+void generateMips(Resource& r) {
+    const bool volume = r.kind == ResourceKind::VolumeTexture;
+    for (size_t k = 1; k < r.levels.size(); ++k) boxLevel(r.levels[k - 1], r.levels[k], volume);
+    r.mipsDirty = false;
+}
+
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::string& error) {
+    // The sampler's texture is built from the .ps11test model (ps11/texture.h): every level
+    // given explicitly, packed formats as their texel words, float formats as values.
+    ps11::TextureDesc desc;
+    const FormatInfo& f = *r.format;
+    desc.format.value = f.texFormat;
+    desc.format.line = 1;
+    desc.width = r.levels[0].width;
+    desc.height = r.levels[0].height;
+    desc.depth = r.kind == ResourceKind::VolumeTexture ? r.levels[0].depth : 0;
+    desc.levels.value = uint32_t(r.levels.size());
+    desc.levels.line = 1;
+    desc.data.resize(r.levels.size());
+    for (size_t k = 0; k < r.levels.size(); ++k) {
+        const Image& im = r.levels[k];
+        ps11::TextureLevel& l = desc.data[k];
+        l.level = uint32_t(k);
+        l.width = im.width, l.height = im.height, l.depth = im.depth;
+        l.texels.resize(size_t(im.width) * im.height * im.depth);
+        size_t i = 0;
+        for (uint32_t z = 0; z < im.depth; ++z)
+            for (uint32_t y = 0; y < im.height; ++y)
+                for (uint32_t x = 0; x < im.width; ++x, ++i) {
+                    ps11::Texel& t = l.texels[i];
+                    const uint8_t* p = im.texel(x, y, z);
+                    if (f.cls == FormatClass::Float) {
+                        std::array<float, 4> v = decodeTexel(f, p);
+                        t.value = {v[0], v[1], v[2], v[3]};
+                        t.count = 4;
+                    } else {
+                        t.bits = loadWord(p, f.bytes);
+                    }
+                }
+    }
+    std::optional<ps11::Texture> t = ps11::textureFromDesc(desc, error);
+    if (!t) return nullptr;
+    return std::make_shared<const ps11::Texture>(std::move(*t));
+}
+
+}  // namespace emu

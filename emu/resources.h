@@ -1,0 +1,92 @@
+// The device's objects: textures, volume textures and surfaces kept in D3D9's memory layout
+// (what LockRect hands out), and pixel shaders. Internal to the device (emu/device*.cpp).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "emu/d3d9types.h"
+#include "emu/format.h"
+#include "emu/state.h"
+#include "ps11/ir.h"
+#include "ps11/texture.h"
+
+namespace emu {
+
+// One mip level or one standalone surface: texels in the format's D3D layout, rows `rowPitch`
+// bytes apart, slices `slicePitch` bytes apart.
+struct Image {
+    const FormatInfo* format = nullptr;
+    uint32_t width = 0, height = 0, depth = 1;
+    uint32_t rowPitch = 0;
+    uint64_t slicePitch = 0;
+    std::vector<uint8_t> bytes;
+
+    uint8_t* texel(uint32_t x, uint32_t y, uint32_t z = 0) {
+        return bytes.data() + z * slicePitch + size_t(y) * rowPitch + size_t(x) * format->bytes;
+    }
+    const uint8_t* texel(uint32_t x, uint32_t y, uint32_t z = 0) const {
+        return bytes.data() + z * slicePitch + size_t(y) * rowPitch + size_t(x) * format->bytes;
+    }
+};
+
+enum class ResourceKind : uint8_t { Texture, VolumeTexture, Surface };
+
+// A texture, volume texture or standalone surface (render target, depth stencil, offscreen
+// plain surface).
+struct Resource {
+    ResourceKind kind = ResourceKind::Texture;
+    const FormatInfo* format = nullptr;
+    DWORD usage = 0;
+    D3DPOOL pool = D3DPOOL_DEFAULT;
+    bool lockable = false;
+    bool offscreenPlain = false;     // CreateOffscreenPlainSurface
+    std::vector<Image> levels;       // every level, including the hidden ones of AUTOGENMIPMAP
+    uint32_t exposedLevels = 1;      // GetLevelCount: 1 for AUTOGENMIPMAP (D3D9)
+    std::vector<uint8_t> locked;     // per level: LockRect/LockBox outstanding
+    std::vector<uint8_t> lockedReadOnly;
+    std::vector<Handle> surfaces;    // per exposed level: GetSurfaceLevel's handle, Null until asked
+    bool mipsDirty = false;          // AUTOGENMIPMAP: level 0 changed since the last generation
+    uint64_t generation = 0;         // bumped by every write; the sampler's copy follows it
+    uint64_t sampledGeneration = ~uint64_t(0);
+    std::shared_ptr<const ps11::Texture> sampled;  // the sampler's view (see Device::sampledTexture)
+
+    bool autoGenMips() const { return (usage & D3DUSAGE_AUTOGENMIPMAP) != 0; }
+    bool isRenderTarget() const { return (usage & D3DUSAGE_RENDERTARGET) != 0; }
+    bool isDepthStencil() const { return (usage & D3DUSAGE_DEPTHSTENCIL) != 0; }
+};
+
+// A surface handle: a level of a texture (owner = the texture) or a standalone surface (owner =
+// the surface itself, level 0).
+struct SurfaceRef {
+    Handle owner = Handle::Null;
+    uint32_t level = 0;
+};
+
+struct PixelShaderObject {
+    ps11::Program program;
+    std::vector<DWORD> tokens;  // as given (empty for a shader assembled from text)
+};
+
+// Refusals before any allocation (docs/device.md "Limits").
+constexpr uint32_t kMaxTextureSide = 16384;  // D3DCAPS9 MaxTextureWidth/Height
+constexpr uint32_t kMaxVolumeSide = 2048;    // D3DCAPS9 MaxVolumeExtent
+constexpr uint64_t kMaxResourceBytes = uint64_t(1) << 30;
+
+// Number of levels of a full chain down to 1x1x1.
+uint32_t fullChainLength(uint32_t width, uint32_t height, uint32_t depth);
+// Row pitch of a level in bytes: width * texel size rounded up to 4 bytes (D3D9 pitches are
+// DWORD aligned; callers must use the pitch, never width * size).
+uint32_t rowPitchOf(const FormatInfo& f, uint32_t width);
+// Bytes of a whole resource (all levels) without allocating anything.
+uint64_t resourceBytes(const FormatInfo& f, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels);
+// Allocates the levels (zero-filled). May throw std::bad_alloc.
+void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels);
+// Regenerates levels 1.. from level 0 with a 2x2 (2x2x2) box filter rounded half-even in the
+// stored representation, the rule ps11/texture.cpp uses for generated chains.
+void generateMips(Resource& r);
+// Builds the sampler's immutable texture from the stored levels; nullptr and `error` on failure.
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::string& error);
+
+}  // namespace emu

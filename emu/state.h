@@ -1,0 +1,82 @@
+// The device state: one plain struct holding everything Set* calls change (render states,
+// texture stage and sampler states, bindings, transforms, viewport, scissor, pixel shader and
+// its constants, FVF), initialised to Direct3D 9's defaults, hashable and comparable so draws
+// can cache work per state.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include "emu/d3d9types.h"
+
+namespace emu {
+
+// A device object (texture, volume texture, surface, pixel shader), like a COM pointer: 0 is
+// NULL; the device checks the kind at every call.
+enum class Handle : uint32_t { Null = 0 };
+
+// Stages and samplers of a ps 1.x-class device (D3DCAPS9 MaxTextureBlendStages = 8,
+// MaxSimultaneousTextures = 8).
+constexpr int kMaxStages = 8;
+constexpr int kMaxSamplers = 8;
+// ps_1_x constant registers c0..c7.
+constexpr int kMaxPsConstants = 8;
+
+struct DeviceState {
+    // D3DRS_* values indexed by D3DRENDERSTATETYPE; float states hold their bit pattern.
+    std::array<DWORD, kRenderStateLimit> renderStates{};
+    // D3DTSS_* values per stage, indexed by D3DTEXTURESTAGESTATETYPE.
+    std::array<std::array<DWORD, kStageStateLimit>, kMaxStages> stageStates{};
+    // D3DSAMP_* values per sampler, indexed by D3DSAMPLERSTATETYPE.
+    std::array<std::array<DWORD, kSamplerStateLimit>, kMaxSamplers> samplerStates{};
+    std::array<Handle, kMaxSamplers> textures{};  // SetTexture
+    Handle renderTarget = Handle::Null;             // SetRenderTarget(0, …)
+    Handle depthStencil = Handle::Null;             // SetDepthStencilSurface
+    Handle pixelShader = Handle::Null;              // SetPixelShader; Null = fixed function
+    D3DMATRIX world, view, projection;              // identity
+    std::array<D3DMATRIX, 8> texture;               // D3DTS_TEXTURE0..7, identity
+    D3DVIEWPORT9 viewport;                          // the render target's size when it is set
+    RECT scissor;                                   // idem
+    std::array<std::array<float, 4>, kMaxPsConstants> psConstants{};  // c0..c7, 0
+    DWORD fvf = 0;                                                     // SetFVF
+
+    // Direct3D 9's defaults (docs/device.md "Defaults").
+    DeviceState();
+
+    DWORD renderState(D3DRENDERSTATETYPE s) const { return renderStates[s]; }
+    DWORD stageState(int stage, D3DTEXTURESTAGESTATETYPE s) const { return stageStates[size_t(stage)][s]; }
+    DWORD samplerState(int sampler, D3DSAMPLERSTATETYPE s) const { return samplerStates[size_t(sampler)][s]; }
+    // A float state stored as its bit pattern (D3DRS_FOGSTART, D3DTSS_BUMPENVMAT00, …).
+    float renderStateFloat(D3DRENDERSTATETYPE s) const;
+    float stageStateFloat(int stage, D3DTEXTURESTAGESTATETYPE s) const;
+
+    // Hash and equality over every field, floats compared by bit pattern (so -0 != 0 and a NaN
+    // equals itself, consistent with the hash).
+    size_t hash() const;
+    bool operator==(const DeviceState& other) const;
+
+    // Calls f(uint32_t) for every 32-bit word of the state in a fixed order (hash and == use it).
+    void forEachWord(const std::function<void(uint32_t)>& f) const;
+};
+
+// True for a D3DRENDERSTATETYPE value d3d9types.h defines.
+bool isRenderState(DWORD state);
+// True for a D3DTEXTURESTAGESTATETYPE value d3d9types.h defines.
+bool isStageState(DWORD state);
+// True for a D3DSAMPLERSTATETYPE value d3d9types.h defines.
+bool isSamplerState(DWORD state);
+// True for render / stage states whose DWORD holds a float's bits.
+bool isFloatRenderState(DWORD state);
+bool isFloatStageState(DWORD state);
+
+// The float's bit pattern as D3D passes float states: *(DWORD*)&f.
+DWORD floatBits(float f);
+float bitsFloat(DWORD bits);
+
+struct DeviceStateHash {
+    size_t operator()(const DeviceState& s) const { return s.hash(); }
+};
+
+}  // namespace emu
