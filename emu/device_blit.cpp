@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "emu/device.h"
 #include "ps11/precision.h"
@@ -164,16 +165,58 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     };
     const bool linear = filter == D3DTEXF_LINEAR;
     const bool sameFormat = &sf == &df;
+    // Fast path: an unscaled copy in one format is a row copy with either filter (LINEAR has
+    // f = 0 at every pixel, so it reproduces the texels exactly).
+    if (sameFormat && sw == dw && sh == dh) {
+        const size_t row = size_t(sw) * sf.bytes;
+        for (int64_t j = 0; j < dh; ++j)
+            std::memmove(d->texel(uint32_t(dr.left), uint32_t(dr.top + j)),
+                         s->texel(uint32_t(sr.left), uint32_t(sr.top + j)), row);
+        markWritten(*dst, dstRef.level);
+        return D3D_OK;
+    }
+    // Fast path: an exact 2:1 LINEAR reduction of A8R8G8B8/X8R8G8B8 has f = 1/2 on both axes
+    // (weight 128/256 in fx profiles, 1/2 exactly otherwise), so each byte is
+    // round_half_even((a + b + c + d) / 4) of a 2x2 block, the general path's result.
+    if (linear && sameFormat && sf.bytes == 4 && sf.cls == FormatClass::Unorm8 && sw == 2 * dw && sh == 2 * dh) {
+        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+        for (int64_t j = 0; j < dh; ++j) {
+            const uint8_t* r0 = s->texel(uint32_t(sr.left), uint32_t(sr.top + 2 * j));
+            const uint8_t* r1 = r0 + s->rowPitch;
+            uint8_t* out = d->texel(uint32_t(dr.left), uint32_t(dr.top + j));
+            for (int64_t i = 0; i < dw; ++i, r0 += 8, r1 += 8, out += 4)
+                for (int b = 0; b < 4; ++b) {
+                    const int sum = r0[b] + r0[b + 4] + r1[b] + r1[b + 4];
+                    // (sum + 1 + ((sum >> 2) & 1)) >> 2 is round_half_even(sum / 4).
+                    out[b] = uint8_t((sum + 1 + ((sum >> 2) & 1)) >> 2);
+                }
+            if (x8)
+                for (int64_t i = 0; i < dw; ++i) d->texel(uint32_t(dr.left + i), uint32_t(dr.top + j))[3] = 0xFF;
+        }
+        markWritten(*dst, dstRef.level);
+        return D3D_OK;
+    }
+    std::vector<int64_t> pointX, pointY;
+    std::vector<Tap> tapX, tapY;
+    for (int64_t i = 0; i < dw; ++i) {
+        pointX.push_back(axisPoint(i, sr.left, sw, dw));
+        tapX.push_back(axisLinear(i, sr.left, sw, dw));
+    }
+    for (int64_t j = 0; j < dh; ++j) {
+        pointY.push_back(axisPoint(j, sr.top, sh, dh));
+        tapY.push_back(axisLinear(j, sr.top, sh, dh));
+    }
     for (int64_t j = 0; j < dh; ++j) {
         for (int64_t i = 0; i < dw; ++i) {
             const int64_t dx = dr.left + i, dy = dr.top + j;
             if (!linear) {
-                const int64_t sx = axisPoint(i, sr.left, sw, dw), sy = axisPoint(j, sr.top, sh, dh);
+                const int64_t sx = pointX[size_t(i)], sy = pointY[size_t(j)];
                 if (sameFormat) std::copy_n(s->texel(uint32_t(sx), uint32_t(sy)), sf.bytes, d->texel(uint32_t(dx), uint32_t(dy)));
                 else store(dx, dy, fetch(sx, sy));
                 continue;
             }
-            const Tap tx = axisLinear(i, sr.left, sw, dw), ty = axisLinear(j, sr.top, sh, dh);
+            const Tap& tx = tapX[size_t(i)];
+            const Tap& ty = tapY[size_t(j)];
             const std::array<double, 4> a = fetch(tx.i0, ty.i0), b = fetch(tx.i1, ty.i0);
             const std::array<double, 4> c = fetch(tx.i0, ty.i1), e = fetch(tx.i1, ty.i1);
             std::array<double, 4> v;
@@ -251,8 +294,12 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
         }
         for (const Box& b : boxes) {
             const Box c = b.meet(Box{0, 0, target->width, target->height});
-            for (int64_t y = c.y0; y < c.y1; ++y)
-                for (int64_t x = c.x0; x < c.x1; ++x) std::copy_n(texel, f.bytes, target->texel(uint32_t(x), uint32_t(y)));
+            if (c.empty()) continue;
+            // Fill the first row, then copy it to the others.
+            for (int64_t x = c.x0; x < c.x1; ++x) std::copy_n(texel, f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
+            const size_t row = size_t(c.x1 - c.x0) * f.bytes;
+            for (int64_t y = c.y0 + 1; y < c.y1; ++y)
+                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)), row);
         }
         if (!boxes.empty()) markWritten(*rt, rtRef.level);
     }

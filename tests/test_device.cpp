@@ -707,6 +707,39 @@ TEST_CASE("device: StretchRect point and linear", "[device]") {
         }
     }
 
+    SECTION("2:1 reductions of random data: every byte is the 2x2 block's mean, ties to even") {
+        auto colour = [](UINT x, UINT y) { return (x * 2654435761u + 7) ^ (y * 2246822519u) ^ (x * y * 374761393u); };
+        for (D3DFORMAT fmt : {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8}) {
+            Handle src = makeTarget(dev, 10, 6, colour);
+            Handle dst{};
+            REQUIRE(dev.CreateRenderTarget(7, 5, fmt, 1, &dst) == D3D_OK);
+            Handle srcFmt{};
+            REQUIRE(dev.CreateRenderTarget(10, 6, fmt, 1, &srcFmt) == D3D_OK);
+            REQUIRE(dev.StretchRect(src, nullptr, srcFmt, nullptr, D3DTEXF_POINT) == D3D_OK);  // 1:1 copy
+            RECT sr{2, 0, 10, 6}, dr{1, 1, 5, 4};
+            REQUIRE(dev.StretchRect(srcFmt, &sr, dst, &dr, D3DTEXF_LINEAR) == D3D_OK);
+            for (UINT j = 0; j < 3; ++j)
+                for (UINT i = 0; i < 4; ++i) {
+                    uint32_t expect = 0;
+                    for (int b = 0; b < 4; ++b) {
+                        int sum = 0;
+                        for (UINT dy = 0; dy < 2; ++dy)
+                            for (UINT dx = 0; dx < 2; ++dx) {
+                                uint32_t c = colour(2 + 2 * i + dx, 2 * j + dy);
+                                if (fmt == D3DFMT_X8R8G8B8 && b == 3) c |= 0xFF000000u;
+                                sum += int((c >> (8 * b)) & 0xFF);
+                            }
+                        const int q = sum / 4, r = sum % 4;
+                        const int rounded = r < 2 ? q : r > 2 ? q + 1 : q + (q & 1);
+                        expect |= uint32_t(rounded) << (8 * b);
+                    }
+                    INFO("format " << formatName(fmt) << " pixel " << i << ", " << j);
+                    CHECK(readPixel(dev, dst, 1 + i, 1 + j) == expect);
+                }
+            CHECK(readPixel(dev, dst, 0, 0) == 0u);  // outside the rect
+        }
+    }
+
     SECTION("sub-rectangles, upscaling and edge clamping") {
         // Source row [0, 255] (red); 2 -> 4 linear: x = (i + 1/2)/2 - 1/2 = -0.25, 0.25, 0.75,
         // 1.25; taps clamp to the rect, so 0, 0.25 * 255 = 63.75 -> 64, 191.25 -> 191, 255.
