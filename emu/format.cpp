@@ -69,6 +69,12 @@ const FormatInfo* formatInfo(D3DFORMAT format) {
     return nullptr;
 }
 
+D3DFORMAT d3dFormatOf(ps11::TexFormat format) {
+    for (const FormatInfo& f : kFormats)
+        if (f.texture && f.texFormat == format) return f.format;
+    return D3DFMT_UNKNOWN;
+}
+
 const char* formatName(D3DFORMAT format) {
     const FormatInfo* f = formatInfo(format);
     if (f) return f->name;

@@ -32,6 +32,9 @@ struct FormatInfo {
 
 // Facts about a format; nullptr for a format the device does not know.
 const FormatInfo* formatInfo(D3DFORMAT format);
+// The D3DFORMAT of a .ps11test format name (ps11::TexFormat), so the device can express the
+// test model.
+D3DFORMAT d3dFormatOf(ps11::TexFormat format);
 // "A8R8G8B8", or "format 23" for an unknown value.
 const char* formatName(D3DFORMAT format);
 

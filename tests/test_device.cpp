@@ -17,6 +17,8 @@
 #include "emu/device.h"
 #include "ps11/assembler.h"
 #include "ps11/encoder.h"
+#include "ps11/executor.h"
+#include "ps11/texture_sampler.h"
 
 using namespace emu;
 
@@ -100,6 +102,34 @@ TEST_CASE("device: D3D9 constants have their d3d9types.h values", "[device]") {
     CHECK(D3DFVF_TEXCOORDSIZE3(1) == (1u << 18));
     CHECK(D3DPS_VERSION(1, 4) == 0xFFFF0104u);
     CHECK(D3DCOLOR_ARGB(1, 2, 3, 4) == 0x01020304u);
+}
+
+TEST_CASE("device: the .ps11test model's names map onto D3D9 values", "[device]") {
+    // Every texture format of the test model has a D3DFORMAT and maps back.
+    for (int i = 0; i <= int(ps11::TexFormat::R32F); ++i) {
+        const auto f = ps11::TexFormat(i);
+        const D3DFORMAT d = d3dFormatOf(f);
+        INFO(ps11::texFormatName(f));
+        REQUIRE(formatInfo(d));
+        CHECK(formatInfo(d)->texFormat == f);
+        CHECK(std::string(formatInfo(d)->name) == ps11::texFormatName(f));
+    }
+    // The model's enumerations carry D3D9's numbers, so a cast expresses them.
+    CHECK(DWORD(ps11::TextureOp::Disable) == D3DTOP_DISABLE);
+    CHECK(DWORD(ps11::TextureOp::DotProduct3) == D3DTOP_DOTPRODUCT3);
+    CHECK(DWORD(ps11::TextureOp::Lerp) == D3DTOP_LERP);
+    CHECK(DWORD(ps11::ArgSource::Temp) == D3DTA_TEMP);
+    CHECK(DWORD(ps11::ArgSource::TFactor) == D3DTA_TFACTOR);
+    CHECK(DWORD(ps11::Blend::SrcAlphaSat) == D3DBLEND_SRCALPHASAT);
+    CHECK(DWORD(ps11::Blend::InvBlendFactor) == D3DBLEND_INVBLENDFACTOR);
+    CHECK(DWORD(ps11::BlendOp::Max) == D3DBLENDOP_MAX);
+    CHECK(DWORD(ps11::CompareFunc::GreaterEqual) == D3DCMP_GREATEREQUAL);
+    CHECK(DWORD(ps11::CullMode::Ccw) == D3DCULL_CCW);
+    CHECK(DWORD(ps11::Filter::Linear) == D3DTEXF_LINEAR);
+    CHECK(DWORD(ps11::AddressMode::Border) == D3DTADDRESS_BORDER);
+    CHECK(DWORD(ps11::TextureAddress::MirrorOnce) == D3DTADDRESS_MIRRORONCE);
+    CHECK(ps11::kTtffProjected == DWORD(D3DTTFF_PROJECTED));
+    CHECK(DWORD(ps11::kWriteA) == D3DCOLORWRITEENABLE_ALPHA);
 }
 
 TEST_CASE("device: DeviceState starts at D3D9's defaults", "[device]") {
@@ -476,6 +506,36 @@ TEST_CASE("device: LockRect hands out D3D's memory layout for every format", "[d
     auto g = dev.sampledTexture(tex)->texelGrid(0, 0, 0, 0, ps11::Precision::Fx8);
     CHECK(g[0] == -255);
     CHECK(g[1] == 64);
+}
+
+TEST_CASE("device: the TextureSampler reads a device texture as bound", "[device]") {
+    Device dev;
+    Handle tex{};
+    REQUIRE(dev.CreateTexture(4, 2, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < 2; ++y)
+        for (UINT x = 0; x < 4; ++x) {
+            const uint32_t c = 0xFF000000u | (40 * x + 100 * y) << 16 | 7u;
+            std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + x * 4, &c, 4);
+        }
+    REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+    ps11::TextureSampler sampler;
+    REQUIRE(sampler.bind(0, dev.sampledTexture(tex)));
+    // Point sampling at the centre of texel (2, 1): u = 2.5/4, v = 1.5/2 (ps1x-spec §6.2).
+    const float u = 2.5f / 4, v = 1.5f / 2;
+    int32_t r = 0, g = 0, b = 0, a = 0;
+    ps11::SampleRequest req;
+    req.count = 1;
+    req.u = &u;
+    req.v = &v;
+    ps11::SampleResult out;
+    out.grid[0] = &r, out.grid[1] = &g, out.grid[2] = &b, out.grid[3] = &a;
+    sampler.sample(req, out);
+    CHECK(r == 180);  // 40 * 2 + 100
+    CHECK(g == 0);
+    CHECK(b == 7);
+    CHECK(a == 255);
 }
 
 TEST_CASE("device: lock rules", "[device]") {
