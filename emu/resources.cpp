@@ -155,6 +155,15 @@ std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::
     // given explicitly, packed formats as their texel words, float formats as values.
     ps11::TextureDesc desc;
     const FormatInfo& f = *r.format;
+    // The hand-over goes through one ps11::Texel per texel: refuse before allocating when that
+    // transient copy alone would pass the per-resource byte limit.
+    uint64_t texels = 0;
+    for (const Image& im : r.levels) texels += uint64_t(im.width) * im.height * im.depth;
+    if (texels * sizeof(ps11::Texel) > kMaxResourceBytes) {
+        error = std::to_string(texels) + " texels are too many for the sampler's copy (at most " +
+                std::to_string(kMaxResourceBytes / sizeof(ps11::Texel)) + ")";
+        return nullptr;
+    }
     desc.format.value = f.texFormat;
     desc.format.line = 1;
     desc.width = r.levels[0].width;

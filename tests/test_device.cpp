@@ -394,6 +394,14 @@ TEST_CASE("device: resource creation rules and refusals", "[device]") {
     CHECK(tiny.CreateTexture(16, 16, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_OUTOFVIDEOMEMORY);
     CHECK(tiny.CreateTexture(15, 16, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3D_OK);  // 960 bytes
 
+    // A texture the sampler's copy cannot hold is refused when sampled, not allocated.
+    Handle big{};
+    REQUIRE(dev.CreateTexture(8192, 8192, 1, 0, D3DFMT_L8, D3DPOOL_MANAGED, &big) == D3D_OK);  // 64 MiB
+    CHECK(dev.sampledTexture(big) == nullptr);
+    CHECK(dev.lastError().hr == D3DERR_OUTOFVIDEOMEMORY);
+    CHECK(contains(dev.lastError().message, "67108864 texels are too many"));
+    CHECK(dev.Release(big) == D3D_OK);
+
     // Levels: 0 = the full chain; levels and their sizes.
     REQUIRE(dev.CreateTexture(8, 2, 0, 0, D3DFMT_L8, D3DPOOL_MANAGED, &h) == D3D_OK);
     CHECK(dev.GetLevelCount(h) == 4);  // 8x2, 4x1, 2x1, 1x1
