@@ -57,12 +57,16 @@ HRESULT Device::SetTexture(DWORD stage, Handle texture) {
     if (texture != Handle::Null) {
         Resource* r = findResource(texture);
         if (!r)
-            return fail(D3DERR_INVALIDCALL, "E4102", "SetTexture: handle " + num(uint32_t(texture)) + " is not an object of this device");
+            return fail(D3DERR_INVALIDCALL, "E4102",
+                        "SetTexture: handle " + num(uint32_t(texture)) + " is not an object of this device");
         if (r->kind == ResourceKind::Surface)
-            return fail(D3DERR_INVALIDCALL, "E4102", "SetTexture: handle " + num(uint32_t(texture)) + " is a surface, not a texture");
+            return fail(D3DERR_INVALIDCALL, "E4102",
+                        "SetTexture: handle " + num(uint32_t(texture)) + " is a surface, not a texture");
         // D3D9 refuses SCRATCH resources for the pipeline (D3DPOOL reference page).
         if (r->pool == D3DPOOL_SCRATCH)
-            return fail(D3DERR_INVALIDCALL, "E4112", "SetTexture: texture " + num(uint32_t(texture)) + " is in D3DPOOL_SCRATCH, which cannot be bound");
+            return fail(
+                D3DERR_INVALIDCALL, "E4112",
+                "SetTexture: texture " + num(uint32_t(texture)) + " is in D3DPOOL_SCRATCH, which cannot be bound");
     }
     m_state.textures[stage] = texture;
     return D3D_OK;
@@ -104,7 +108,8 @@ HRESULT Device::SetTextureStageState(DWORD stage, D3DTEXTURESTAGESTATETYPE type,
     if (stage >= DWORD(kMaxStages))
         return fail(D3DERR_INVALIDCALL, "E4101", "SetTextureStageState: stage " + num(stage) + " out of range 0..7");
     if (!isStageState(type))
-        return fail(D3DERR_INVALIDCALL, "E4101", "SetTextureStageState: unknown texture stage state " + num(DWORD(type)));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "SetTextureStageState: unknown texture stage state " + num(DWORD(type)));
     m_state.stageStates[stage][type] = value;
     return D3D_OK;
 }
@@ -115,7 +120,8 @@ HRESULT Device::GetTextureStageState(DWORD stage, D3DTEXTURESTAGESTATETYPE type,
     if (stage >= DWORD(kMaxStages))
         return fail(D3DERR_INVALIDCALL, "E4101", "GetTextureStageState: stage " + num(stage) + " out of range 0..7");
     if (!isStageState(type))
-        return fail(D3DERR_INVALIDCALL, "E4101", "GetTextureStageState: unknown texture stage state " + num(DWORD(type)));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "GetTextureStageState: unknown texture stage state " + num(DWORD(type)));
     *value = m_state.stageStates[stage][type];
     return D3D_OK;
 }
@@ -141,7 +147,8 @@ HRESULT Device::SetRenderTarget(DWORD index, Handle surface) {
     ok();
     // ps 1.x-class hardware: D3DCAPS9 NumSimultaneousRTs = 1.
     if (index != 0)
-        return fail(D3DERR_INVALIDCALL, "E4101", "SetRenderTarget: index " + num(index) + " out of range 0..0 (one render target)");
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "SetRenderTarget: index " + num(index) + " out of range 0..0 (one render target)");
     // D3D9: render target 0 cannot be NULL.
     if (surface == Handle::Null)
         return fail(D3DERR_INVALIDCALL, "E4103", "SetRenderTarget: render target 0 cannot be NULL");
@@ -149,7 +156,9 @@ HRESULT Device::SetRenderTarget(DWORD index, Handle surface) {
     Image* im = surfaceImage(surface, "SetRenderTarget", "surface", &owner, nullptr);
     if (!im) return m_error.hr;
     if (!owner->isRenderTarget())
-        return fail(D3DERR_INVALIDCALL, "E4104", "SetRenderTarget: surface " + num(uint32_t(surface)) + " was not created with D3DUSAGE_RENDERTARGET");
+        return fail(
+            D3DERR_INVALIDCALL, "E4104",
+            "SetRenderTarget: surface " + num(uint32_t(surface)) + " was not created with D3DUSAGE_RENDERTARGET");
     m_state.renderTarget = surface;
     // D3D9 SetRenderTarget: the viewport and the scissor rect become the whole new target.
     m_state.viewport = D3DVIEWPORT9{0, 0, im->width, im->height, 0.0f, 1.0f};
@@ -161,7 +170,8 @@ HRESULT Device::GetRenderTarget(DWORD index, Handle* surface) {
     ok();
     if (!surface) return fail(D3DERR_INVALIDCALL, "E4103", "GetRenderTarget: surface pointer is null");
     if (index != 0)
-        return fail(D3DERR_INVALIDCALL, "E4101", "GetRenderTarget: index " + num(index) + " out of range 0..0 (one render target)");
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "GetRenderTarget: index " + num(index) + " out of range 0..0 (one render target)");
     // D3D9 returns D3DERR_NOTFOUND when no render target is set.
     if (m_state.renderTarget == Handle::Null)
         return fail(D3DERR_NOTFOUND, "E4109", "GetRenderTarget: no render target is set");
@@ -175,7 +185,9 @@ HRESULT Device::SetDepthStencilSurface(Handle surface) {
         Resource* owner = nullptr;
         if (!surfaceImage(surface, "SetDepthStencilSurface", "surface", &owner, nullptr)) return m_error.hr;
         if (!owner->isDepthStencil())
-            return fail(D3DERR_INVALIDCALL, "E4104", "SetDepthStencilSurface: surface " + num(uint32_t(surface)) + " is not a depth stencil surface");
+            return fail(
+                D3DERR_INVALIDCALL, "E4104",
+                "SetDepthStencilSurface: surface " + num(uint32_t(surface)) + " is not a depth stencil surface");
     }
     m_state.depthStencil = surface;
     return D3D_OK;
@@ -205,8 +217,9 @@ HRESULT Device::SetTransform(D3DTRANSFORMSTATETYPE state, const D3DMATRIX* matri
     if (!matrix) return fail(D3DERR_INVALIDCALL, "E4103", "SetTransform: matrix pointer is null");
     D3DMATRIX* slot = transformSlot(m_state, state);
     if (!slot)
-        return fail(D3DERR_INVALIDCALL, "E4101", "SetTransform: transform " + num(DWORD(state)) +
-                    " not taken (VIEW 2, PROJECTION 3, TEXTURE0..7 16..23, WORLD 256; no vertex blending)");
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "SetTransform: transform " + num(DWORD(state)) +
+                        " not taken (VIEW 2, PROJECTION 3, TEXTURE0..7 16..23, WORLD 256; no vertex blending)");
     *slot = *matrix;
     return D3D_OK;
 }
@@ -229,13 +242,15 @@ HRESULT Device::SetViewport(const D3DVIEWPORT9* vp) {
     if (!rt) return m_error.hr;
     // D3D9 returns D3DERR_INVALIDCALL for a viewport outside the render target.
     if (uint64_t(vp->X) + vp->Width > rt->width || uint64_t(vp->Y) + vp->Height > rt->height)
-        return fail(D3DERR_INVALIDCALL, "E4105", "SetViewport: viewport (" + num(vp->X) + ", " + num(vp->Y) + ") " +
-                    num(vp->Width) + "x" + num(vp->Height) + " is outside the " + num(rt->width) + "x" +
-                    num(rt->height) + " render target");
+        return fail(D3DERR_INVALIDCALL, "E4105",
+                    "SetViewport: viewport (" + num(vp->X) + ", " + num(vp->Y) + ") " + num(vp->Width) + "x" +
+                        num(vp->Height) + " is outside the " + num(rt->width) + "x" + num(rt->height) +
+                        " render target");
     if (!std::isfinite(vp->MinZ) || !std::isfinite(vp->MaxZ) || vp->MinZ < 0.0f || vp->MaxZ > 1.0f ||
         vp->MinZ > vp->MaxZ)
-        return fail(D3DERR_INVALIDCALL, "E4105", "SetViewport: MinZ " + std::to_string(vp->MinZ) + ", MaxZ " +
-                    std::to_string(vp->MaxZ) + " must satisfy 0 <= MinZ <= MaxZ <= 1");
+        return fail(D3DERR_INVALIDCALL, "E4105",
+                    "SetViewport: MinZ " + std::to_string(vp->MinZ) + ", MaxZ " + std::to_string(vp->MaxZ) +
+                        " must satisfy 0 <= MinZ <= MaxZ <= 1");
     m_state.viewport = *vp;
     return D3D_OK;
 }
@@ -278,8 +293,8 @@ HRESULT Device::CreatePixelShader(const DWORD* function, Handle* shader) {
     size_t n = 1;
     for (;;) {
         if (n >= kMaxShaderTokens)
-            return fail(D3DERR_INVALIDCALL, "E4107", "CreatePixelShader: no end token (0x0000ffff) within " +
-                        num(kMaxShaderTokens) + " tokens");
+            return fail(D3DERR_INVALIDCALL, "E4107",
+                        "CreatePixelShader: no end token (0x0000ffff) within " + num(kMaxShaderTokens) + " tokens");
         const DWORD t = function[n];
         if (t == kEndToken) {
             ++n;
@@ -299,13 +314,16 @@ HRESULT Device::CreatePixelShader(std::span<const DWORD> function, Handle* shade
     if ((version & 0xFFFF0000u) != 0xFFFF0000u) {
         char hex[16];
         std::snprintf(hex, sizeof hex, "0x%08x", unsigned(version));
-        return fail(D3DERR_INVALIDCALL, "E4107", std::string("CreatePixelShader: version token ") + hex +
-                    ((version & 0xFFFF0000u) == 0xFFFE0000u ? " is a vertex shader" : " is not a pixel shader version"));
+        return fail(
+            D3DERR_INVALIDCALL, "E4107",
+            std::string("CreatePixelShader: version token ") + hex +
+                ((version & 0xFFFF0000u) == 0xFFFE0000u ? " is a vertex shader" : " is not a pixel shader version"));
     }
     // The device models ps 1.x hardware: D3DCAPS9 PixelShaderVersion = 1.4.
     if (major != 1 || minor < 1 || minor > 4)
-        return fail(D3DERR_INVALIDCALL, "E4107", "CreatePixelShader: version ps_" + num(major) + "_" + num(minor) +
-                    " not taken (this device takes ps_1_1 ... ps_1_4)");
+        return fail(D3DERR_INVALIDCALL, "E4107",
+                    "CreatePixelShader: version ps_" + num(major) + "_" + num(minor) +
+                        " not taken (this device takes ps_1_1 ... ps_1_4)");
     ps11::Diagnostics diags;
     const uint32_t file = diags.addFile("CreatePixelShader");
     std::optional<ps11::Program> program = ps11::decode(function, file, diags);
@@ -359,7 +377,8 @@ HRESULT Device::registerShader(const char* call, PixelShaderObject&& shader, Han
 HRESULT Device::SetPixelShader(Handle shader) {
     ok();
     if (shader != Handle::Null && !m_shaders.count(uint32_t(shader)))
-        return fail(D3DERR_INVALIDCALL, "E4102", "SetPixelShader: handle " + num(uint32_t(shader)) + " is not a pixel shader of this device");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "SetPixelShader: handle " + num(uint32_t(shader)) + " is not a pixel shader of this device");
     m_state.pixelShader = shader;
     return D3D_OK;
 }
@@ -367,8 +386,9 @@ HRESULT Device::SetPixelShader(Handle shader) {
 HRESULT Device::SetPixelShaderConstantF(UINT start, const float* data, UINT count) {
     ok();
     if (uint64_t(start) + count > uint64_t(kMaxPsConstants))
-        return fail(D3DERR_INVALIDCALL, "E4101", "SetPixelShaderConstantF: registers c" + num(start) + " + " +
-                    num(count) + " beyond c7 (ps 1.x has c0..c7)");
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "SetPixelShaderConstantF: registers c" + num(start) + " + " + num(count) +
+                        " beyond c7 (ps 1.x has c0..c7)");
     if (!data && count > 0) return fail(D3DERR_INVALIDCALL, "E4103", "SetPixelShaderConstantF: data pointer is null");
     // Stored unclamped; the executor clamps to [-1, 1] on load (docs/precision.md "Inputs").
     for (UINT i = 0; i < count; ++i)
@@ -379,8 +399,9 @@ HRESULT Device::SetPixelShaderConstantF(UINT start, const float* data, UINT coun
 HRESULT Device::GetPixelShaderConstantF(UINT start, float* data, UINT count) {
     ok();
     if (uint64_t(start) + count > uint64_t(kMaxPsConstants))
-        return fail(D3DERR_INVALIDCALL, "E4101", "GetPixelShaderConstantF: registers c" + num(start) + " + " +
-                    num(count) + " beyond c7 (ps 1.x has c0..c7)");
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "GetPixelShaderConstantF: registers c" + num(start) + " + " + num(count) +
+                        " beyond c7 (ps 1.x has c0..c7)");
     if (!data && count > 0) return fail(D3DERR_INVALIDCALL, "E4103", "GetPixelShaderConstantF: data pointer is null");
     for (UINT i = 0; i < count; ++i)
         for (size_t c = 0; c < 4; ++c) data[4 * i + c] = m_state.psConstants[start + i][c];

@@ -22,9 +22,9 @@ namespace emu {
 
 struct DeviceOptions {
     ps11::Precision precision = ps11::Precision::Fx8;  // profile of draws, StretchRect weights
-    float maxValue = 0;     // PixelShader1xMaxValue; 0 = the shader version's default
-    int threads = 0;        // worker threads for draws (later slices); 0 = all cores
-    uint64_t maxResourceBytes = kMaxResourceBytes;  // per resource, checked before allocating
+    float maxValue = 0;                                // PixelShader1xMaxValue; 0 = the shader version's default
+    int threads = 0;                                   // worker threads for draws (later slices); 0 = all cores
+    uint64_t maxResourceBytes = kMaxResourceBytes;     // per resource, checked before allocating
 };
 
 // What the last call reported. Every call resets it; a failed call sets hr, an E41xx code and
@@ -140,8 +140,8 @@ private:
     HRESULT checkNewSize(const char* call, UINT width, UINT height, UINT depth, uint32_t maxSide);
     HRESULT createResource(const char* call, Resource&& r, UINT width, UINT height, UINT depth, UINT levels,
                            Handle* out);
-    HRESULT lockLevel(const char* call, Handle owner, Resource& r, uint32_t level, const RECT* rect,
-                      const D3DBOX* box, DWORD flags, D3DLOCKED_BOX* out);
+    HRESULT lockLevel(const char* call, Handle owner, Resource& r, uint32_t level, const RECT* rect, const D3DBOX* box,
+                      DWORD flags, D3DLOCKED_BOX* out);
     HRESULT unlockLevel(const char* call, Resource& r, uint32_t level);
     HRESULT registerShader(const char* call, PixelShaderObject&& shader, Handle* out);
     void markWritten(Resource& r, uint32_t level);

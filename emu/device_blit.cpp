@@ -54,14 +54,17 @@ HRESULT Device::GetRenderTargetData(Handle renderTarget, Handle destSurface) {
     Image* d = surfaceImage(destSurface, "GetRenderTargetData", "destination", &dst, &dstRef);
     if (!d) return m_error.hr;
     if (!src->isRenderTarget())
-        return fail(D3DERR_INVALIDCALL, "E4108", "GetRenderTargetData: surface " + handleText(renderTarget) + " is not a render target");
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    "GetRenderTargetData: surface " + handleText(renderTarget) + " is not a render target");
     // D3D9: the destination is a D3DPOOL_SYSTEMMEM surface of the same size and format.
     if (dst->pool != D3DPOOL_SYSTEMMEM)
-        return fail(D3DERR_INVALIDCALL, "E4108", "GetRenderTargetData: destination " + handleText(destSurface) + " is not in D3DPOOL_SYSTEMMEM");
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    "GetRenderTargetData: destination " + handleText(destSurface) + " is not in D3DPOOL_SYSTEMMEM");
     if (s->format != d->format || s->width != d->width || s->height != d->height)
-        return fail(D3DERR_INVALIDCALL, "E4108", std::string("GetRenderTargetData: destination is ") + num(d->width) + "x" +
-                    num(d->height) + " " + d->format->name + ", the render target " + num(s->width) + "x" +
-                    num(s->height) + " " + s->format->name);
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    std::string("GetRenderTargetData: destination is ") + num(d->width) + "x" + num(d->height) + " " +
+                        d->format->name + ", the render target " + num(s->width) + "x" + num(s->height) + " " +
+                        s->format->name);
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "GetRenderTargetData: a surface is locked");
     const size_t row = size_t(s->width) * s->format->bytes;
@@ -84,17 +87,20 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     if (source == dest)
         return fail(D3DERR_INVALIDCALL, "E4108", "StretchRect: source and destination are the same surface");
     if (filter != D3DTEXF_NONE && filter != D3DTEXF_POINT && filter != D3DTEXF_LINEAR)
-        return fail(D3DERR_INVALIDCALL, "E4112", "StretchRect: filter " + num(filter) + " not taken (NONE, POINT, LINEAR)");
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "StretchRect: filter " + num(filter) + " not taken (NONE, POINT, LINEAR)");
     // D3D9: both surfaces in D3DPOOL_DEFAULT; the destination a render target or an offscreen
     // plain surface; depth surfaces only whole and unscaled (not supported here).
     if (src->pool != D3DPOOL_DEFAULT || dst->pool != D3DPOOL_DEFAULT)
         return fail(D3DERR_INVALIDCALL, "E4108", "StretchRect: both surfaces must be in D3DPOOL_DEFAULT");
     if (!dst->isRenderTarget() && !dst->offscreenPlain)
-        return fail(D3DERR_INVALIDCALL, "E4108", "StretchRect: destination " + handleText(dest) +
-                    " is neither a render target nor an offscreen plain surface");
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    "StretchRect: destination " + handleText(dest) +
+                        " is neither a render target nor an offscreen plain surface");
     if (!s->format->renderTarget || !d->format->renderTarget)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("StretchRect: formats ") + s->format->name + " -> " +
-                    d->format->name + " not taken (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+        return fail(D3DERR_INVALIDCALL, "E4104",
+                    std::string("StretchRect: formats ") + s->format->name + " -> " + d->format->name +
+                        " not taken (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "StretchRect: a surface is locked");
     const RECT sr = sourceRect ? *sourceRect : RECT{0, 0, LONG(s->width), LONG(s->height)};
@@ -104,11 +110,13 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
                uint32_t(r.bottom) <= im.height;
     };
     if (!inside(sr, *s))
-        return fail(D3DERR_INVALIDCALL, "E4108", "StretchRect: source rect " + rectText(sr) + " is empty or outside the " +
-                    num(s->width) + "x" + num(s->height) + " source");
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    "StretchRect: source rect " + rectText(sr) + " is empty or outside the " + num(s->width) + "x" +
+                        num(s->height) + " source");
     if (!inside(dr, *d))
-        return fail(D3DERR_INVALIDCALL, "E4108", "StretchRect: destination rect " + rectText(dr) +
-                    " is empty or outside the " + num(d->width) + "x" + num(d->height) + " destination");
+        return fail(D3DERR_INVALIDCALL, "E4108",
+                    "StretchRect: destination rect " + rectText(dr) + " is empty or outside the " + num(d->width) +
+                        "x" + num(d->height) + " destination");
 
     const FormatInfo& sf = *s->format;
     const FormatInfo& df = *d->format;
@@ -211,8 +219,10 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
             const int64_t dx = dr.left + i, dy = dr.top + j;
             if (!linear) {
                 const int64_t sx = pointX[size_t(i)], sy = pointY[size_t(j)];
-                if (sameFormat) std::copy_n(s->texel(uint32_t(sx), uint32_t(sy)), sf.bytes, d->texel(uint32_t(dx), uint32_t(dy)));
-                else store(dx, dy, fetch(sx, sy));
+                if (sameFormat)
+                    std::copy_n(s->texel(uint32_t(sx), uint32_t(sy)), sf.bytes, d->texel(uint32_t(dx), uint32_t(dy)));
+                else
+                    store(dx, dy, fetch(sx, sy));
                 continue;
             }
             const Tap& tx = tapX[size_t(i)];
@@ -235,7 +245,9 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     ok();
     const DWORD known = D3DCLEAR_TARGET | D3DCLEAR_ZBUFFER | D3DCLEAR_STENCIL;
     if (flags == 0 || (flags & ~known))
-        return fail(D3DERR_INVALIDCALL, "E4112", "Clear: flags " + num(flags) + " must be a non-empty mix of D3DCLEAR_TARGET (1), ZBUFFER (2), STENCIL (4)");
+        return fail(
+            D3DERR_INVALIDCALL, "E4112",
+            "Clear: flags " + num(flags) + " must be a non-empty mix of D3DCLEAR_TARGET (1), ZBUFFER (2), STENCIL (4)");
     Resource* rt = nullptr;
     Resource* ds = nullptr;
     SurfaceRef rtRef, dsRef;
@@ -255,9 +267,10 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
         depth = surfaceImage(m_state.depthStencil, "Clear", "depth stencil surface", &ds, &dsRef);
         if (!depth) return m_error.hr;
         if ((flags & D3DCLEAR_STENCIL) && depth->format->stencilBits == 0)
-            return fail(D3DERR_INVALIDCALL, "E4104", std::string("Clear: D3DCLEAR_STENCIL on ") + depth->format->name +
-                        ", which has no stencil");
-        if (ds->locked[dsRef.level]) return fail(D3DERR_INVALIDCALL, "E4106", "Clear: the depth stencil surface is locked");
+            return fail(D3DERR_INVALIDCALL, "E4104",
+                        std::string("Clear: D3DCLEAR_STENCIL on ") + depth->format->name + ", which has no stencil");
+        if (ds->locked[dsRef.level])
+            return fail(D3DERR_INVALIDCALL, "E4106", "Clear: the depth stencil surface is locked");
         if ((flags & D3DCLEAR_ZBUFFER) && !(z >= 0.0f && z <= 1.0f))
             return fail(D3DERR_INVALIDCALL, "E4105", "Clear: z " + std::to_string(z) + " outside [0, 1]");
     }
@@ -266,6 +279,8 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     // d3d9 visual tests); D3DRS_COLORWRITEENABLE does not mask clears (wined3d's clear path).
     const D3DVIEWPORT9& vp = m_state.viewport;
     Box region{int64_t(vp.X), int64_t(vp.Y), int64_t(vp.X) + vp.Width, int64_t(vp.Y) + vp.Height};
+    // Without a render target (D3D9 always has one) a depth-only clear covers the depth surface.
+    if (m_state.renderTarget == Handle::Null && depth) region = Box{0, 0, depth->width, depth->height};
     if (m_state.renderStates[D3DRS_SCISSORTESTENABLE]) {
         const RECT& sc = m_state.scissor;
         region = region.meet(Box{sc.left, sc.top, sc.right, sc.bottom});
@@ -284,7 +299,8 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     if (target) {
         const FormatInfo& f = *target->format;
         uint8_t texel[16] = {};
-        const std::array<uint8_t, 4> rgba{uint8_t(color >> 16), uint8_t(color >> 8), uint8_t(color), uint8_t(color >> 24)};
+        const std::array<uint8_t, 4> rgba{uint8_t(color >> 16), uint8_t(color >> 8), uint8_t(color),
+                                          uint8_t(color >> 24)};
         if (f.cls == FormatClass::Unorm8) {
             encodeUnorm8(f, rgba, texel);
         } else {
@@ -296,10 +312,12 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             const Box c = b.meet(Box{0, 0, target->width, target->height});
             if (c.empty()) continue;
             // Fill the first row, then copy it to the others.
-            for (int64_t x = c.x0; x < c.x1; ++x) std::copy_n(texel, f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
+            for (int64_t x = c.x0; x < c.x1; ++x)
+                std::copy_n(texel, f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
             const size_t row = size_t(c.x1 - c.x0) * f.bytes;
             for (int64_t y = c.y0 + 1; y < c.y1; ++y)
-                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)), row);
+                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)),
+                            row);
         }
         if (!boxes.empty()) markWritten(*rt, rtRef.level);
     }

@@ -14,18 +14,20 @@ namespace {
 std::string num(uint64_t v) { return std::to_string(v); }
 std::string handleText(Handle h) { return num(uint32_t(h)); }
 
-constexpr DWORD kKnownUsage = D3DUSAGE_RENDERTARGET | D3DUSAGE_DEPTHSTENCIL | D3DUSAGE_WRITEONLY | 0x10 /* SOFTWAREPROCESSING */ |
-                              D3DUSAGE_DYNAMIC | D3DUSAGE_AUTOGENMIPMAP;
+constexpr DWORD kKnownUsage = D3DUSAGE_RENDERTARGET | D3DUSAGE_DEPTHSTENCIL | D3DUSAGE_WRITEONLY |
+                              0x10 /* SOFTWAREPROCESSING */ | D3DUSAGE_DYNAMIC | D3DUSAGE_AUTOGENMIPMAP;
 
 }  // namespace
 
 HRESULT Device::checkNewSize(const char* call, UINT width, UINT height, UINT depth, uint32_t maxSide) {
     if (width == 0 || height == 0 || depth == 0)
-        return fail(D3DERR_INVALIDCALL, "E4105", std::string(call) + ": size " + num(width) + "x" + num(height) +
-                    (depth != 1 ? "x" + num(depth) : "") + " has a zero side");
+        return fail(D3DERR_INVALIDCALL, "E4105",
+                    std::string(call) + ": size " + num(width) + "x" + num(height) +
+                        (depth != 1 ? "x" + num(depth) : "") + " has a zero side");
     if (width > maxSide || height > maxSide || depth > maxSide)
-        return fail(D3DERR_INVALIDCALL, "E4105", std::string(call) + ": size " + num(width) + "x" + num(height) +
-                    (depth != 1 ? "x" + num(depth) : "") + " beyond " + num(maxSide) + " per side");
+        return fail(D3DERR_INVALIDCALL, "E4105",
+                    std::string(call) + ": size " + num(width) + "x" + num(height) +
+                        (depth != 1 ? "x" + num(depth) : "") + " beyond " + num(maxSide) + " per side");
     return D3D_OK;
 }
 
@@ -33,8 +35,9 @@ HRESULT Device::createResource(const char* call, Resource&& r, UINT width, UINT 
                                Handle* out) {
     const uint64_t bytes = resourceBytes(*r.format, width, height, depth, levels);
     if (bytes > m_options.maxResourceBytes)
-        return fail(D3DERR_OUTOFVIDEOMEMORY, "E4105", std::string(call) + ": " + num(bytes) + " bytes of " +
-                    r.format->name + " beyond the limit of " + num(m_options.maxResourceBytes) + " per resource");
+        return fail(D3DERR_OUTOFVIDEOMEMORY, "E4105",
+                    std::string(call) + ": " + num(bytes) + " bytes of " + r.format->name + " beyond the limit of " +
+                        num(m_options.maxResourceBytes) + " per resource");
     try {
         allocateLevels(r, width, height, depth, levels);
         if (r.kind != ResourceKind::Surface) r.surfaces.assign(r.exposedLevels, Handle::Null);
@@ -56,22 +59,24 @@ HRESULT Device::CreateTexture(UINT width, UINT height, UINT levels, DWORD usage,
     if (checkNewSize(call, width, height, 1, kMaxTextureSide) != D3D_OK) return m_error.hr;
     const FormatInfo* f = formatInfo(format);
     if (!f || !f->texture)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateTexture: format ") + formatName(format) +
-                    " not taken for textures");
+        return fail(D3DERR_INVALIDCALL, "E4104",
+                    std::string("CreateTexture: format ") + formatName(format) + " not taken for textures");
     if (usage & ~kKnownUsage)
         return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: unknown usage bits " + num(usage & ~kKnownUsage));
     if (pool > D3DPOOL_SCRATCH) return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: unknown pool " + num(pool));
     if (usage & D3DUSAGE_DEPTHSTENCIL)
         return fail(D3DERR_INVALIDCALL, "E4104", "CreateTexture: depth textures are not supported");
     if ((usage & D3DUSAGE_RENDERTARGET) && !f->renderTarget)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateTexture: format ") + f->name +
-                    " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+        return fail(D3DERR_INVALIDCALL, "E4104",
+                    std::string("CreateTexture: format ") + f->name +
+                        " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
     // D3D9: render targets and DYNAMIC resources live in D3DPOOL_DEFAULT; DYNAMIC and MANAGED
     // exclude each other; AUTOGENMIPMAP is not allowed in SYSTEMMEM (D3DUSAGE reference page).
     if ((usage & D3DUSAGE_RENDERTARGET) && pool != D3DPOOL_DEFAULT)
         return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: D3DUSAGE_RENDERTARGET needs D3DPOOL_DEFAULT");
     if ((usage & D3DUSAGE_DYNAMIC) && (usage & D3DUSAGE_RENDERTARGET))
-        return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: D3DUSAGE_DYNAMIC and D3DUSAGE_RENDERTARGET exclude each other");
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "CreateTexture: D3DUSAGE_DYNAMIC and D3DUSAGE_RENDERTARGET exclude each other");
     if ((usage & D3DUSAGE_DYNAMIC) && pool == D3DPOOL_MANAGED)
         return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: D3DUSAGE_DYNAMIC cannot be used with D3DPOOL_MANAGED");
     const uint32_t full = fullChainLength(width, height, 1);
@@ -85,15 +90,18 @@ HRESULT Device::CreateTexture(UINT width, UINT height, UINT levels, DWORD usage,
     uint32_t count = levels == 0 ? full : levels;
     if (usage & D3DUSAGE_AUTOGENMIPMAP) {
         if (pool == D3DPOOL_SYSTEMMEM || pool == D3DPOOL_SCRATCH)
-            return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: D3DUSAGE_AUTOGENMIPMAP needs D3DPOOL_DEFAULT or MANAGED");
+            return fail(D3DERR_INVALIDCALL, "E4112",
+                        "CreateTexture: D3DUSAGE_AUTOGENMIPMAP needs D3DPOOL_DEFAULT or MANAGED");
         if (levels > 1)
-            return fail(D3DERR_INVALIDCALL, "E4105", "CreateTexture: D3DUSAGE_AUTOGENMIPMAP takes Levels 0 or 1, not " + num(levels));
+            return fail(D3DERR_INVALIDCALL, "E4105",
+                        "CreateTexture: D3DUSAGE_AUTOGENMIPMAP takes Levels 0 or 1, not " + num(levels));
         count = full;
         r.exposedLevels = 1;
     } else {
         if (count > full)
-            return fail(D3DERR_INVALIDCALL, "E4105", "CreateTexture: " + num(levels) + " levels, a " + num(width) + "x" +
-                        num(height) + " texture has at most " + num(full));
+            return fail(D3DERR_INVALIDCALL, "E4105",
+                        "CreateTexture: " + num(levels) + " levels, a " + num(width) + "x" + num(height) +
+                            " texture has at most " + num(full));
         r.exposedLevels = count;
     }
     return createResource(call, std::move(r), width, height, 1, count, texture);
@@ -107,21 +115,27 @@ HRESULT Device::CreateVolumeTexture(UINT width, UINT height, UINT depth, UINT le
     if (checkNewSize(call, width, height, depth, kMaxVolumeSide) != D3D_OK) return m_error.hr;
     const FormatInfo* f = formatInfo(format);
     if (!f || !f->texture)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateVolumeTexture: format ") + formatName(format) +
-                    " not taken for volume textures");
+        return fail(
+            D3DERR_INVALIDCALL, "E4104",
+            std::string("CreateVolumeTexture: format ") + formatName(format) + " not taken for volume textures");
     if (usage & ~kKnownUsage)
-        return fail(D3DERR_INVALIDCALL, "E4112", "CreateVolumeTexture: unknown usage bits " + num(usage & ~kKnownUsage));
-    if (pool > D3DPOOL_SCRATCH) return fail(D3DERR_INVALIDCALL, "E4112", "CreateVolumeTexture: unknown pool " + num(pool));
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "CreateVolumeTexture: unknown usage bits " + num(usage & ~kKnownUsage));
+    if (pool > D3DPOOL_SCRATCH)
+        return fail(D3DERR_INVALIDCALL, "E4112", "CreateVolumeTexture: unknown pool " + num(pool));
     // D3D9 volume textures cannot be render targets or depth buffers, nor generate their mips.
     if (usage & (D3DUSAGE_RENDERTARGET | D3DUSAGE_DEPTHSTENCIL | D3DUSAGE_AUTOGENMIPMAP))
-        return fail(D3DERR_INVALIDCALL, "E4112", "CreateVolumeTexture: usage " + num(usage) +
-                    " not allowed (no RENDERTARGET, DEPTHSTENCIL or AUTOGENMIPMAP for volumes)");
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "CreateVolumeTexture: usage " + num(usage) +
+                        " not allowed (no RENDERTARGET, DEPTHSTENCIL or AUTOGENMIPMAP for volumes)");
     if ((usage & D3DUSAGE_DYNAMIC) && pool == D3DPOOL_MANAGED)
-        return fail(D3DERR_INVALIDCALL, "E4112", "CreateVolumeTexture: D3DUSAGE_DYNAMIC cannot be used with D3DPOOL_MANAGED");
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "CreateVolumeTexture: D3DUSAGE_DYNAMIC cannot be used with D3DPOOL_MANAGED");
     const uint32_t full = fullChainLength(width, height, depth);
     const uint32_t count = levels == 0 ? full : levels;
     if (count > full)
-        return fail(D3DERR_INVALIDCALL, "E4105", "CreateVolumeTexture: " + num(levels) + " levels, the volume has at most " + num(full));
+        return fail(D3DERR_INVALIDCALL, "E4105",
+                    "CreateVolumeTexture: " + num(levels) + " levels, the volume has at most " + num(full));
     Resource r;
     r.kind = ResourceKind::VolumeTexture;
     r.format = f;
@@ -139,8 +153,9 @@ HRESULT Device::CreateRenderTarget(UINT width, UINT height, D3DFORMAT format, BO
     if (checkNewSize(call, width, height, 1, kMaxTextureSide) != D3D_OK) return m_error.hr;
     const FormatInfo* f = formatInfo(format);
     if (!f || !f->renderTarget)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateRenderTarget: format ") + formatName(format) +
-                    " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+        return fail(D3DERR_INVALIDCALL, "E4104",
+                    std::string("CreateRenderTarget: format ") + formatName(format) +
+                        " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;
@@ -157,8 +172,9 @@ HRESULT Device::CreateDepthStencilSurface(UINT width, UINT height, D3DFORMAT for
     if (checkNewSize(call, width, height, 1, kMaxTextureSide) != D3D_OK) return m_error.hr;
     const FormatInfo* f = formatInfo(format);
     if (!f || f->cls != FormatClass::Depth)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateDepthStencilSurface: format ") + formatName(format) +
-                    " is not a depth format (D16, D16_LOCKABLE, D24S8, D24X8, D32, D32F_LOCKABLE)");
+        return fail(D3DERR_INVALIDCALL, "E4104",
+                    std::string("CreateDepthStencilSurface: format ") + formatName(format) +
+                        " is not a depth format (D16, D16_LOCKABLE, D24S8, D24X8, D32, D32F_LOCKABLE)");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;
@@ -175,12 +191,13 @@ HRESULT Device::CreateOffscreenPlainSurface(UINT width, UINT height, D3DFORMAT f
     if (checkNewSize(call, width, height, 1, kMaxTextureSide) != D3D_OK) return m_error.hr;
     const FormatInfo* f = formatInfo(format);
     if (!f || f->cls == FormatClass::Depth)
-        return fail(D3DERR_INVALIDCALL, "E4104", std::string("CreateOffscreenPlainSurface: format ") + formatName(format) +
-                    " not taken for surfaces");
+        return fail(
+            D3DERR_INVALIDCALL, "E4104",
+            std::string("CreateOffscreenPlainSurface: format ") + formatName(format) + " not taken for surfaces");
     // D3D9: offscreen plain surfaces cannot be MANAGED.
     if (pool == D3DPOOL_MANAGED || pool > D3DPOOL_SCRATCH)
-        return fail(D3DERR_INVALIDCALL, "E4112", "CreateOffscreenPlainSurface: pool " + num(pool) +
-                    " not allowed (DEFAULT, SYSTEMMEM or SCRATCH)");
+        return fail(D3DERR_INVALIDCALL, "E4112",
+                    "CreateOffscreenPlainSurface: pool " + num(pool) + " not allowed (DEFAULT, SYSTEMMEM or SCRATCH)");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;
@@ -207,9 +224,10 @@ HRESULT Device::Release(Handle object) {
     Resource* r = findResource(object);
     if (!r) {
         if (m_surfaces.count(id))
-            return fail(D3DERR_INVALIDCALL, "E4102", "Release: surface " + handleText(object) +
-                        " belongs to a texture; release the texture");
-        return fail(D3DERR_INVALIDCALL, "E4102", "Release: handle " + handleText(object) + " is not an object of this device");
+            return fail(D3DERR_INVALIDCALL, "E4102",
+                        "Release: surface " + handleText(object) + " belongs to a texture; release the texture");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "Release: handle " + handleText(object) + " is not an object of this device");
     }
     for (Handle s : r->surfaces)
         if (s != Handle::Null) {
@@ -226,8 +244,10 @@ Image* Device::surfaceImage(Handle h, const char* call, const char* what, Resour
     auto it = m_surfaces.find(uint32_t(h));
     if (it == m_surfaces.end()) {
         const bool other = m_resources.count(uint32_t(h)) || m_shaders.count(uint32_t(h));
-        fail(D3DERR_INVALIDCALL, "E4102", std::string(call) + ": " + what + " " + handleText(h) +
-             (other ? " is not a surface (use GetSurfaceLevel for a texture level)" : " is not an object of this device"));
+        fail(D3DERR_INVALIDCALL, "E4102",
+             std::string(call) + ": " + what + " " + handleText(h) +
+                 (other ? " is not a surface (use GetSurfaceLevel for a texture level)"
+                        : " is not an object of this device"));
         return nullptr;
     }
     Resource* r = findResource(it->second.owner);
@@ -268,7 +288,8 @@ HRESULT Device::GetLevelDesc(Handle texture, UINT level, D3DSURFACE_DESC* desc) 
     if (!r || r->kind != ResourceKind::Texture)
         return fail(D3DERR_INVALIDCALL, "E4102", "GetLevelDesc: handle " + handleText(texture) + " is not a texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "GetLevelDesc: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "GetLevelDesc: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     describe(*r, r->levels[level], desc);
     return D3D_OK;
 }
@@ -288,9 +309,11 @@ HRESULT Device::GetSurfaceLevel(Handle texture, UINT level, Handle* surface) {
     if (!surface) return fail(D3DERR_INVALIDCALL, "E4103", "GetSurfaceLevel: surface pointer is null");
     Resource* r = findResource(texture);
     if (!r || r->kind != ResourceKind::Texture)
-        return fail(D3DERR_INVALIDCALL, "E4102", "GetSurfaceLevel: handle " + handleText(texture) + " is not a texture");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "GetSurfaceLevel: handle " + handleText(texture) + " is not a texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "GetSurfaceLevel: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "GetSurfaceLevel: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     if (r->surfaces[level] == Handle::Null) {
         const Handle h = newHandle();
         m_surfaces.emplace(uint32_t(h), SurfaceRef{texture, level});
@@ -308,28 +331,30 @@ void Device::markWritten(Resource& r, uint32_t level) {
 HRESULT Device::lockLevel(const char* call, Handle owner, Resource& r, uint32_t level, const RECT* rect,
                           const D3DBOX* box, DWORD flags, D3DLOCKED_BOX* out) {
     if (!r.lockable)
-        return fail(D3DERR_INVALIDCALL, "E4106", std::string(call) + ": " + handleText(owner) +
-                    " is not lockable (D3DPOOL_DEFAULT without D3DUSAGE_DYNAMIC, a render target created "
-                    "unlockable, or a non-lockable depth format)");
+        return fail(D3DERR_INVALIDCALL, "E4106",
+                    std::string(call) + ": " + handleText(owner) +
+                        " is not lockable (D3DPOOL_DEFAULT without D3DUSAGE_DYNAMIC, a render target created "
+                        "unlockable, or a non-lockable depth format)");
     if (r.locked[level])
-        return fail(D3DERR_INVALIDCALL, "E4106", std::string(call) + ": level " + num(level) + " of " +
-                    handleText(owner) + " is already locked");
+        return fail(D3DERR_INVALIDCALL, "E4106",
+                    std::string(call) + ": level " + num(level) + " of " + handleText(owner) + " is already locked");
     Image& im = r.levels[level];
     uint32_t x0 = 0, y0 = 0, z0 = 0;
     if (rect) {
         if (rect->left < 0 || rect->top < 0 || rect->left >= rect->right || rect->top >= rect->bottom ||
             uint32_t(rect->right) > im.width || uint32_t(rect->bottom) > im.height)
-            return fail(D3DERR_INVALIDCALL, "E4106", std::string(call) + ": rect (" + std::to_string(rect->left) + ", " +
-                        std::to_string(rect->top) + ")-(" + std::to_string(rect->right) + ", " +
-                        std::to_string(rect->bottom) + ") is empty or outside the " + num(im.width) + "x" +
-                        num(im.height) + " level");
+            return fail(D3DERR_INVALIDCALL, "E4106",
+                        std::string(call) + ": rect (" + std::to_string(rect->left) + ", " + std::to_string(rect->top) +
+                            ")-(" + std::to_string(rect->right) + ", " + std::to_string(rect->bottom) +
+                            ") is empty or outside the " + num(im.width) + "x" + num(im.height) + " level");
         x0 = uint32_t(rect->left), y0 = uint32_t(rect->top);
     }
     if (box) {
         if (box->Left >= box->Right || box->Top >= box->Bottom || box->Front >= box->Back || box->Right > im.width ||
             box->Bottom > im.height || box->Back > im.depth)
-            return fail(D3DERR_INVALIDCALL, "E4106", std::string(call) + ": box is empty or outside the " +
-                        num(im.width) + "x" + num(im.height) + "x" + num(im.depth) + " level");
+            return fail(D3DERR_INVALIDCALL, "E4106",
+                        std::string(call) + ": box is empty or outside the " + num(im.width) + "x" + num(im.height) +
+                            "x" + num(im.depth) + " level");
         x0 = box->Left, y0 = box->Top, z0 = box->Front;
     }
     r.locked[level] = 1;
@@ -355,7 +380,8 @@ HRESULT Device::LockRect(Handle texture, UINT level, D3DLOCKED_RECT* locked, con
     if (!r || r->kind != ResourceKind::Texture)
         return fail(D3DERR_INVALIDCALL, "E4102", "LockRect: handle " + handleText(texture) + " is not a texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "LockRect: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "LockRect: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     D3DLOCKED_BOX b;
     if (lockLevel("LockRect", texture, *r, level, rect, nullptr, flags, &b) != D3D_OK) return m_error.hr;
     locked->Pitch = b.RowPitch;
@@ -369,7 +395,8 @@ HRESULT Device::UnlockRect(Handle texture, UINT level) {
     if (!r || r->kind != ResourceKind::Texture)
         return fail(D3DERR_INVALIDCALL, "E4102", "UnlockRect: handle " + handleText(texture) + " is not a texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "UnlockRect: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "UnlockRect: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     return unlockLevel("UnlockRect", *r, level);
 }
 
@@ -399,9 +426,11 @@ HRESULT Device::LockBox(Handle volumeTexture, UINT level, D3DLOCKED_BOX* locked,
     if (!locked) return fail(D3DERR_INVALIDCALL, "E4103", "LockBox: locked-box pointer is null");
     Resource* r = findResource(volumeTexture);
     if (!r || r->kind != ResourceKind::VolumeTexture)
-        return fail(D3DERR_INVALIDCALL, "E4102", "LockBox: handle " + handleText(volumeTexture) + " is not a volume texture");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "LockBox: handle " + handleText(volumeTexture) + " is not a volume texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "LockBox: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "LockBox: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     return lockLevel("LockBox", volumeTexture, *r, level, nullptr, box, flags, locked);
 }
 
@@ -409,9 +438,11 @@ HRESULT Device::UnlockBox(Handle volumeTexture, UINT level) {
     ok();
     Resource* r = findResource(volumeTexture);
     if (!r || r->kind != ResourceKind::VolumeTexture)
-        return fail(D3DERR_INVALIDCALL, "E4102", "UnlockBox: handle " + handleText(volumeTexture) + " is not a volume texture");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "UnlockBox: handle " + handleText(volumeTexture) + " is not a volume texture");
     if (level >= r->exposedLevels)
-        return fail(D3DERR_INVALIDCALL, "E4101", "UnlockBox: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
+        return fail(D3DERR_INVALIDCALL, "E4101",
+                    "UnlockBox: level " + num(level) + " out of range 0.." + num(r->exposedLevels - 1));
     return unlockLevel("UnlockBox", *r, level);
 }
 
@@ -419,7 +450,8 @@ HRESULT Device::GenerateMipSubLevels(Handle texture) {
     ok();
     Resource* r = findResource(texture);
     if (!r || r->kind == ResourceKind::Surface)
-        return fail(D3DERR_INVALIDCALL, "E4102", "GenerateMipSubLevels: handle " + handleText(texture) + " is not a texture");
+        return fail(D3DERR_INVALIDCALL, "E4102",
+                    "GenerateMipSubLevels: handle " + handleText(texture) + " is not a texture");
     if (r->autoGenMips() && r->mipsDirty) {
         generateMips(*r);
         ++r->generation;

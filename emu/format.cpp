@@ -141,8 +141,8 @@ std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p) {
             return {snorm(signExtend(w, 5), 15), snorm(signExtend(w >> 5, 5), 15), float(((w >> 10) & 63) / 63.0),
                     1.0f};
         case D3DFMT_X8L8V8U8:
-            return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127),
-                    float(((w >> 16) & 0xff) / 255.0), 1.0f};
+            return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127), float(((w >> 16) & 0xff) / 255.0),
+                    1.0f};
         case D3DFMT_Q8W8V8U8:
             return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127), snorm(signExtend(w >> 16, 8), 127),
                     snorm(signExtend(w >> 24, 8), 127)};
@@ -189,8 +189,8 @@ uint16_t floatToHalf(float v) {
     if (a >= 65520.0) return uint16_t(sign | 0x7c00);  // beyond the largest half + half a step
     if (a == 0.0) return sign;
     int e = 0;
-    std::frexp(a, &e);                              // a = m * 2^e, m in [0.5, 1)
-    const int quantumExp = std::max(e - 11, -24);   // 11 significant bits; subnormals step 2^-24
+    std::frexp(a, &e);                                            // a = m * 2^e, m in [0.5, 1)
+    const int quantumExp = std::max(e - 11, -24);                 // 11 significant bits; subnormals step 2^-24
     const double q = std::nearbyint(std::ldexp(a, -quantumExp));  // ties to even
     const double r = std::ldexp(q, quantumExp);
     if (r < std::ldexp(1.0, -14)) return uint16_t(sign | uint16_t(std::ldexp(r, 24)));  // subnormal
@@ -204,9 +204,12 @@ uint16_t floatToHalf(float v) {
 float halfToFloat(uint16_t h) {
     const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
     double v;
-    if (exponent == 0) v = std::ldexp(double(mantissa), -24);
-    else if (exponent == 31) v = mantissa ? std::nan("") : INFINITY;
-    else v = std::ldexp(double(mantissa + 1024), exponent - 25);
+    if (exponent == 0)
+        v = std::ldexp(double(mantissa), -24);
+    else if (exponent == 31)
+        v = mantissa ? std::nan("") : INFINITY;
+    else
+        v = std::ldexp(double(mantissa + 1024), exponent - 25);
     return float(sign ? -v : v);
 }
 

@@ -23,9 +23,9 @@ struct FormatInfo {
     const char* name = "UNKNOWN";
     uint32_t bytes = 0;  // per texel
     FormatClass cls = FormatClass::Unorm8;
-    bool texture = false;       // CreateTexture / CreateVolumeTexture take it
-    bool renderTarget = false;  // D3DUSAGE_RENDERTARGET / CreateRenderTarget / StretchRect
-    bool lockableDepth = false; // a depth format LockRect may lock (the _LOCKABLE ones)
+    bool texture = false;        // CreateTexture / CreateVolumeTexture take it
+    bool renderTarget = false;   // D3DUSAGE_RENDERTARGET / CreateRenderTarget / StretchRect
+    bool lockableDepth = false;  // a depth format LockRect may lock (the _LOCKABLE ones)
     uint32_t depthBits = 0, stencilBits = 0;
     ps11::TexFormat texFormat = ps11::TexFormat::A8R8G8B8;  // the sampler's name for it
 };

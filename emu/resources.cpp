@@ -71,9 +71,9 @@ void boxLevel(const Image& src, Image& dst, bool volume) {
                 for (uint32_t dz = 0; dz < (volume ? 2u : 1u); ++dz)
                     for (uint32_t dy = 0; dy < 2; ++dy)
                         for (uint32_t dx = 0; dx < 2; ++dx)
-                            taps[k++] = src.texel(std::min(2 * x + dx, src.width - 1),
-                                                  std::min(2 * y + dy, src.height - 1),
-                                                  std::min(2 * z + dz, src.depth - 1));
+                            taps[k++] =
+                                src.texel(std::min(2 * x + dx, src.width - 1), std::min(2 * y + dy, src.height - 1),
+                                          std::min(2 * z + dz, src.depth - 1));
                 uint8_t* out = dst.texel(x, y, z);
                 switch (f.cls) {
                     case FormatClass::Unorm8:  // every byte is one channel

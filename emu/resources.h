@@ -41,14 +41,14 @@ struct Resource {
     DWORD usage = 0;
     D3DPOOL pool = D3DPOOL_DEFAULT;
     bool lockable = false;
-    bool offscreenPlain = false;     // CreateOffscreenPlainSurface
-    std::vector<Image> levels;       // every level, including the hidden ones of AUTOGENMIPMAP
-    uint32_t exposedLevels = 1;      // GetLevelCount: 1 for AUTOGENMIPMAP (D3D9)
-    std::vector<uint8_t> locked;     // per level: LockRect/LockBox outstanding
+    bool offscreenPlain = false;  // CreateOffscreenPlainSurface
+    std::vector<Image> levels;    // every level, including the hidden ones of AUTOGENMIPMAP
+    uint32_t exposedLevels = 1;   // GetLevelCount: 1 for AUTOGENMIPMAP (D3D9)
+    std::vector<uint8_t> locked;  // per level: LockRect/LockBox outstanding
     std::vector<uint8_t> lockedReadOnly;
-    std::vector<Handle> surfaces;    // per exposed level: GetSurfaceLevel's handle, Null until asked
-    bool mipsDirty = false;          // AUTOGENMIPMAP: level 0 changed since the last generation
-    uint64_t generation = 0;         // bumped by every write; the sampler's copy follows it
+    std::vector<Handle> surfaces;  // per exposed level: GetSurfaceLevel's handle, Null until asked
+    bool mipsDirty = false;        // AUTOGENMIPMAP: level 0 changed since the last generation
+    uint64_t generation = 0;       // bumped by every write; the sampler's copy follows it
     uint64_t sampledGeneration = ~uint64_t(0);
     std::shared_ptr<const ps11::Texture> sampled;  // the sampler's view (see Device::sampledTexture)
 

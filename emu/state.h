@@ -31,16 +31,16 @@ struct DeviceState {
     std::array<std::array<DWORD, kStageStateLimit>, kMaxStages> stageStates{};
     // D3DSAMP_* values per sampler, indexed by D3DSAMPLERSTATETYPE.
     std::array<std::array<DWORD, kSamplerStateLimit>, kMaxSamplers> samplerStates{};
-    std::array<Handle, kMaxSamplers> textures{};  // SetTexture
-    Handle renderTarget = Handle::Null;             // SetRenderTarget(0, …)
-    Handle depthStencil = Handle::Null;             // SetDepthStencilSurface
-    Handle pixelShader = Handle::Null;              // SetPixelShader; Null = fixed function
-    D3DMATRIX world, view, projection;              // identity
-    std::array<D3DMATRIX, 8> texture;               // D3DTS_TEXTURE0..7, identity
-    D3DVIEWPORT9 viewport;                          // the render target's size when it is set
-    RECT scissor;                                   // idem
+    std::array<Handle, kMaxSamplers> textures{};                      // SetTexture
+    Handle renderTarget = Handle::Null;                               // SetRenderTarget(0, …)
+    Handle depthStencil = Handle::Null;                               // SetDepthStencilSurface
+    Handle pixelShader = Handle::Null;                                // SetPixelShader; Null = fixed function
+    D3DMATRIX world, view, projection;                                // identity
+    std::array<D3DMATRIX, 8> texture;                                 // D3DTS_TEXTURE0..7, identity
+    D3DVIEWPORT9 viewport;                                            // the render target's size when it is set
+    RECT scissor;                                                     // idem
     std::array<std::array<float, 4>, kMaxPsConstants> psConstants{};  // c0..c7, 0
-    DWORD fvf = 0;                                                     // SetFVF
+    DWORD fvf = 0;                                                    // SetFVF
 
     // Direct3D 9's defaults (docs/device.md "Defaults").
     DeviceState();

@@ -364,10 +364,13 @@ TEST_CASE("device: resource creation rules and refusals", "[device]") {
     CHECK(dev.lastError().message == "E4104 CreateTexture: format format 23 not taken for textures");
     CHECK(dev.CreateTexture(4, 4, 1, 0, D3DFMT_D16, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_L8, D3DPOOL_DEFAULT, &h) == D3DERR_INVALIDCALL);
-    CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
+    CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) ==
+          D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_DYNAMIC, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
-    CHECK(dev.CreateTexture(4, 4, 2, D3DUSAGE_AUTOGENMIPMAP, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
-    CHECK(dev.CreateTexture(4, 4, 0, D3DUSAGE_AUTOGENMIPMAP, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &h) == D3DERR_INVALIDCALL);
+    CHECK(dev.CreateTexture(4, 4, 2, D3DUSAGE_AUTOGENMIPMAP, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) ==
+          D3DERR_INVALIDCALL);
+    CHECK(dev.CreateTexture(4, 4, 0, D3DUSAGE_AUTOGENMIPMAP, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &h) ==
+          D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 4, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);  // 4x4 has 3
     CHECK(dev.CreateTexture(4, 4, 1, 0x80000000u, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL(7), &h) == D3DERR_INVALIDCALL);
@@ -458,18 +461,29 @@ TEST_CASE("device: LockRect hands out D3D's memory layout for every format", "[d
     const std::vector<FormatCase> cases = {
         // 0x80FF4000: A 0x80, R 0xFF, G 0x40, B 0x00.
         {D3DFMT_A8R8G8B8, 4, wordBytes(0x80FF4000u, 4), {1.0f, float(64 / 255.0), 0.0f, float(128 / 255.0)}},
-        {D3DFMT_X8R8G8B8, 4, wordBytes(0x00102030u, 4), {float(16 / 255.0), float(32 / 255.0), float(48 / 255.0), 1.0f}},
+        {D3DFMT_X8R8G8B8,
+         4,
+         wordBytes(0x00102030u, 4),
+         {float(16 / 255.0), float(32 / 255.0), float(48 / 255.0), 1.0f}},
         {D3DFMT_A8, 1, {0x7F}, {0, 0, 0, float(127 / 255.0)}},
         {D3DFMT_L8, 1, {0x33}, {float(51 / 255.0), float(51 / 255.0), float(51 / 255.0), 1.0f}},
         // A8L8 0x8040: L low byte 0x40, A high byte 0x80.
-        {D3DFMT_A8L8, 2, wordBytes(0x8040u, 2), {float(64 / 255.0), float(64 / 255.0), float(64 / 255.0), float(128 / 255.0)}},
+        {D3DFMT_A8L8,
+         2,
+         wordBytes(0x8040u, 2),
+         {float(64 / 255.0), float(64 / 255.0), float(64 / 255.0), float(128 / 255.0)}},
         // V8U8 0x7F81: U = 0x81 = -127 -> -1, V = 127 -> 1.
         {D3DFMT_V8U8, 2, wordBytes(0x7F81u, 2), {-1.0f, 1.0f, 1.0f, 1.0f}},
         // L6V5U5: U = 3 (3/15), V = 0b11011 = -5 (-5/15), L = 21 (21/63): 21<<10 | 27<<5 | 3.
-        {D3DFMT_L6V5U5, 2, wordBytes((21u << 10) | (27u << 5) | 3u, 2),
+        {D3DFMT_L6V5U5,
+         2,
+         wordBytes((21u << 10) | (27u << 5) | 3u, 2),
          {float(3.0 / 15), float(-5.0 / 15), float(21.0 / 63), 1.0f}},
         // X8L8V8U8 0xFF8040C0: U = 0xC0 = -64, V = 64, L = 128 (unsigned), X ignored.
-        {D3DFMT_X8L8V8U8, 4, wordBytes(0xFF8040C0u, 4), {float(-64.0 / 127), float(64.0 / 127), float(128.0 / 255), 1.0f}},
+        {D3DFMT_X8L8V8U8,
+         4,
+         wordBytes(0xFF8040C0u, 4),
+         {float(-64.0 / 127), float(64.0 / 127), float(128.0 / 255), 1.0f}},
         // Q8W8V8U8 0x7F8001FF: U = -1, V = 1, W = -128 (clamped to -1), Q = 127.
         {D3DFMT_Q8W8V8U8, 4, wordBytes(0x7F8001FFu, 4), {float(-1.0 / 127), float(1.0 / 127), -1.0f, 1.0f}},
         // V16U16 0x80017FFF: U = 32767 -> 1, V = -32767 -> -1.
@@ -741,6 +755,19 @@ TEST_CASE("device: Clear converts the colour, depth and stencil to the surface f
     REQUIRE(dev.UnlockRect(d16) == D3D_OK);
     REQUIRE(dev.SetDepthStencilSurface(ds) == D3D_OK);
     CHECK(dev.Clear(0, nullptr, D3DCLEAR_ZBUFFER | D3DCLEAR_STENCIL | D3DCLEAR_TARGET, 0, 0.25f, 0x1A5) == D3D_OK);
+}
+
+TEST_CASE("device: a depth-only Clear without a render target covers the depth surface", "[device]") {
+    Device dev;
+    Handle ds{};
+    REQUIRE(dev.CreateDepthStencilSurface(3, 2, D3DFMT_D16_LOCKABLE, &ds) == D3D_OK);
+    REQUIRE(dev.SetDepthStencilSurface(ds) == D3D_OK);
+    REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_ZBUFFER, 0, 1.0f, 0) == D3D_OK);
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(ds, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+    const uint8_t* p = static_cast<const uint8_t*>(lr.pBits);
+    CHECK((p[lr.Pitch + 4] == 0xFF && p[lr.Pitch + 5] == 0xFF));  // z = 1 -> 65535
+    REQUIRE(dev.UnlockRect(ds) == D3D_OK);
 }
 
 TEST_CASE("device: StretchRect point and linear", "[device]") {
@@ -1031,7 +1058,8 @@ TEST_CASE("device: pixel shaders from tokens and text", "[device]") {
 
     const DWORD ps20[] = {D3DPS_VERSION(2, 0), 0x0000FFFF};
     CHECK(dev.CreatePixelShader(ps20, &ps3) == D3DERR_INVALIDCALL);
-    CHECK(dev.lastError().message == "E4107 CreatePixelShader: version ps_2_0 not taken (this device takes ps_1_1 ... ps_1_4)");
+    CHECK(dev.lastError().message ==
+          "E4107 CreatePixelShader: version ps_2_0 not taken (this device takes ps_1_1 ... ps_1_4)");
     const DWORD vs[] = {0xFFFE0101u, 0x0000FFFF};
     CHECK(dev.CreatePixelShader(vs, &ps3) == D3DERR_INVALIDCALL);
     CHECK(contains(dev.lastError().message, "vertex shader"));
