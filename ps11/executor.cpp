@@ -325,6 +325,9 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
             if (d.shift < -3 || d.shift > 3) dec.fail("E4005", ins.dst.loc, "shift out of range");
             if (ins.dst.type == RegType::Const || ins.dst.type == RegType::Input) {
                 dec.fail("E4004", ins.dst.loc, "destination register file cannot be written");
+            } else if (opc == Opcode::TexKill && ins.dst.type == RegType::Texture && ver.minor >= 4) {
+                // ps_1_4 texkill t#: tests the coordinate set, writes nothing (spec §2.4).
+                d.dstSlot = 0;
             } else {
                 int slot = dec.slotOf(ins.dst.type, ins.dst.index, ins.dst.loc);
                 d.dstSlot = uint8_t(slot < 0 ? 0 : slot);

@@ -1,7 +1,8 @@
-// `ps11 test` (stage: command line over the .ps11test reader, the assembler and the
-// validator). Each file is parsed, its [pixel shader] is assembled and validated (or must fail
-// with the expected diagnostic), and its draws, evals and probes are counted as "not yet
-// runnable" until the executor and the device run them; they never make the run fail.
+// `ps11 test` (stage: command line over the .ps11test reader, the assembler, the validator
+// and the executor). Each file is parsed, its [pixel shader] is assembled and validated (or must
+// fail with the expected diagnostic), its evals and eval probes run on the executor
+// (tools/test_eval.cpp), and its draws and pixel probes are counted as "not yet runnable" until
+// the device runs them; they never make the run fail.
 #include "tools/cmd_test.h"
 
 #include <iostream>
@@ -18,12 +19,13 @@
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
+#include "tools/test_eval.h"
 
 namespace ps11 {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [-v]\n";
+    "usage: ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11 test: " << message << "\n" << kUsage;
@@ -34,14 +36,15 @@ struct RunOptions {
     uint8_t backends = kBackendEmu;
     std::optional<Precision> precision;  // overrides [require] precision when given
     bool verbose = false;
+    bool stats = false;  // print executor statistics per file
 };
 
 enum class Outcome { Passed, Failed, NotRunnable };
 
 struct FileResult {
     Outcome outcome = Outcome::Passed;
-    size_t pendingCommands = 0;  // commands the run would execute, not runnable yet
-    bool skipped = false;        // [require] backend excludes every backend of this run
+    CommandTally tally;   // evals run, probes, commands not runnable yet
+    bool skipped = false;  // [require] backend excludes every backend of this run
 };
 
 std::string where(const std::string& path, uint32_t line) { return line ? path + ":" + std::to_string(line) : path; }
@@ -56,10 +59,10 @@ bool matchesExpectation(const Diagnostics& diags, const Diagnostic& d, const Pix
 }
 
 // Assembles and validates the [pixel shader] block; returns false (after reporting) when the
-// result is not what the block expects.
-bool checkShader(const TestFile& file, const std::string& path, const RunOptions& opts) {
+// result is not what the block expects. A valid program is left in `valid`.
+bool checkShader(const TestFile& file, const std::string& path, const RunOptions& opts,
+                 std::optional<Program>& valid, Diagnostics& diags) {
     const PixelShaderBlock& ps = file.pixelShader;
-    Diagnostics diags;
     AssembleOptions options;
     // The block is assembled as if it stood alone in the .ps11test file, so every diagnostic
     // carries the file's own line numbers.
@@ -81,6 +84,7 @@ bool checkShader(const TestFile& file, const std::string& path, const RunOptions
                           << rt.formatAll();
                 return false;
             }
+            valid = std::move(program);
             return true;
         }
         std::cout << where(path, ps.line) << ": [pixel shader] does not assemble and validate:\n" << diags.formatAll();
@@ -105,19 +109,6 @@ bool checkShader(const TestFile& file, const std::string& path, const RunOptions
     return false;
 }
 
-// Counts the commands this run would execute (their if(...) matches a backend and precision of
-// the run).
-size_t countPending(const TestFile& file, uint8_t backends, Precision precision) {
-    size_t n = 0;
-    for (const TestCommand& cmd : file.commands) {
-        bool runs = false;
-        for (Backend b : {Backend::Emu, Backend::Gl})
-            if ((backends & (1u << unsigned(b))) && cmd.onlyIf.matches(b, precision)) runs = true;
-        if (runs) ++n;
-    }
-    return n;
-}
-
 FileResult runFile(const std::string& path, const RunOptions& opts) {
     FileResult result;
     std::optional<std::string> text = cli::readFile(path);
@@ -133,7 +124,9 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         return result;
     }
     bool ok = true;
-    if (file.pixelShader.present()) ok = checkShader(file, path, opts);
+    std::optional<Program> program;
+    Diagnostics shaderDiags;
+    if (file.pixelShader.present()) ok = checkShader(file, path, opts, program, shaderDiags);
     if (!ok) {
         result.outcome = Outcome::Failed;
         return result;
@@ -144,8 +137,24 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         result.skipped = !file.commands.empty();
         return result;
     }
-    result.pendingCommands = countPending(file, backends, precision);
-    if (result.pendingCommands > 0) result.outcome = Outcome::NotRunnable;
+    CommandRunOptions run;
+    run.backends = backends;
+    run.precision = precision;
+    run.verbose = opts.verbose;
+    run.shaderDiags = &shaderDiags;
+    CommandTally& t = result.tally;
+    runCommands(file, path, program ? &*program : nullptr, run, t);
+    if (opts.stats && t.evals) {
+        const ExecutorStats& s = t.stats;
+        std::cout << path << ": stats (" << precisionName(precision) << "): " << t.evals << " evals, " << s.pixels
+                  << " pixels, " << s.instructions << " instructions executed";
+        if (s.pixels) std::cout << " (" << double(s.instructions) / double(s.pixels) << " per pixel)";
+        std::cout << ", " << t.texelsFetched << " texels fetched\n";
+    }
+    if (t.error || t.probesFailed)
+        result.outcome = Outcome::Failed;
+    else if (t.pendingDevice || t.pendingGl)
+        result.outcome = Outcome::NotRunnable;
     return result;
 }
 
@@ -180,6 +189,8 @@ int cmdTest(const std::vector<std::string>& args) {
                 else
                     return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
             }
+        } else if (a == "--stats") {
+            opts.stats = true;
         } else if (a == "-v" || a == "--verbose") {
             opts.verbose = true;
         } else if (a == "-h" || a == "--help") {
@@ -193,10 +204,17 @@ int cmdTest(const std::vector<std::string>& args) {
     }
     if (files.empty()) return usageError("no .ps11test files given");
 
-    size_t passed = 0, failed = 0, notRunnable = 0, pending = 0, skipped = 0;
+    size_t passed = 0, failed = 0, notRunnable = 0, skipped = 0;
+    CommandTally total;
     for (const std::string& path : files) {
         FileResult r = runFile(path, opts);
-        pending += r.pendingCommands;
+        const CommandTally& t = r.tally;
+        total.evals += t.evals;
+        total.probesPassed += t.probesPassed;
+        total.probesFailed += t.probesFailed;
+        total.probesTodo += t.probesTodo;
+        total.pendingDevice += t.pendingDevice;
+        total.pendingGl += t.pendingGl;
         if (r.skipped) ++skipped;
         switch (r.outcome) {
             case Outcome::Passed:
@@ -214,15 +232,27 @@ int cmdTest(const std::vector<std::string>& args) {
                                 : r.outcome == Outcome::Passed ? (r.skipped ? "PASS (commands skipped)" : "PASS")
                                                                : "NOT YET RUNNABLE";
             std::cout << label << " " << path;
-            if (r.outcome == Outcome::NotRunnable) std::cout << " (" << r.pendingCommands << " commands)";
+            if (t.evals) std::cout << " (" << t.evals << (t.evals == 1 ? " eval" : " evals") << ")";
+            if (t.pendingDevice) std::cout << " (draw/pixel probe: " << t.pendingDevice << " commands waiting)";
+            if (t.pendingGl) std::cout << " (eval on gl: " << t.pendingGl << " commands not runnable)";
             std::cout << "\n";
         }
     }
-    std::cout << files.size() << (files.size() == 1 ? " file: " : " files: ") << passed << " passed, " << failed
-              << " failed, " << notRunnable << " not yet runnable (eval/draw";
-    if (pending) std::cout << ": " << pending << (pending == 1 ? " command" : " commands");
-    std::cout << ")";
-    if (skipped) std::cout << ", " << skipped << " with commands skipped by [require] backend";
+    auto plural = [](size_t n, const char* one, const char* many) {
+        return std::to_string(n) + " " + (n == 1 ? one : many);
+    };
+    std::cout << plural(files.size(), "file", "files") << ": " << passed << " passed, " << failed << " failed, "
+              << notRunnable << " not yet runnable";
+    if (total.pendingDevice || total.pendingGl) {
+        std::cout << " (";
+        if (total.pendingDevice) std::cout << "draw/pixel probe: " << plural(total.pendingDevice, "command", "commands");
+        if (total.pendingDevice && total.pendingGl) std::cout << "; ";
+        if (total.pendingGl) std::cout << "not runnable on gl: " << plural(total.pendingGl, "eval command", "eval commands");
+        std::cout << ")";
+    }
+    std::cout << "; probes: " << total.probesPassed << " passed, " << total.probesFailed << " failed, "
+              << total.probesTodo << " todo";
+    if (skipped) std::cout << "; " << skipped << " with commands skipped by [require] backend";
     std::cout << "\n";
     return failed ? cli::kUserError : cli::kOk;
 }

@@ -1,7 +1,7 @@
-// `ps11 test`: runs .ps11test files (docs/test-format.md). Today it parses every file and
-// checks its [pixel shader] block (assembles and validates, or fails with the expected
-// diagnostic); draws, evals and probes are counted as "not yet runnable" until the executor
-// and the device exist.
+// `ps11 test`: runs .ps11test files (docs/test-format.md). It parses every file, checks its
+// [pixel shader] block (assembles and validates, or fails with the expected diagnostic) and
+// runs its evals and eval probes on the executor; draws and pixel probes are counted as "not
+// yet runnable" until the device exists.
 #pragma once
 
 #include <string>
@@ -9,7 +9,7 @@
 
 namespace ps11 {
 
-// `ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision P] [-v]`. Returns 0 when
+// `ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision P] [--stats] [-v]`. Returns 0 when
 // every runnable check passed, 1 on any failure or parse error, 2 on usage errors.
 int cmdTest(const std::vector<std::string>& args);
 

@@ -84,6 +84,20 @@ expect_rc 2 "eval without shader" "$ps11" eval
 expect_rc 2 "eval unknown register" "$ps11" eval "$work/e.psh" q0=1
 expect_rc 2 "eval unknown option" "$ps11" eval "$work/e.psh" --bogus
 
+# test: evals run on the executor; failures name the probe's line.
+printf '[pixel shader]\nps_1_1\nmov r0, v0\n[test]\neval\n  v0 1 0 0 1\nprobe eval rgba 1 0 0 1 tol 0\nprobe eval rgb 0 1 0 tol 0.01\ntodo(fx12) probe eval rgb 1 0 0\ntodo probe eval rgb 0 0 1\n' >"$work/t.ps11test"
+expect_rc 1 "test with a failing eval probe" "$ps11" test "$work/t.ps11test"
+expect_in "$work/out" "t.ps11test:8: probe failed: expected rgb 0 1 0 tol 0.01, got 1 0 0 = [255 0 0]/255 (precision fx8)" "probe failure names file, line, values and precision"
+expect_in "$work/out" "probes: 2 passed, 1 failed, 1 todo" "probe counts"
+expect_rc 1 "a todo probe that passes is an error" "$ps11" test "$work/t.ps11test" --precision fx12
+expect_in "$work/out" "t.ps11test:9: error: todo probe passed" "passing todo reported"
+sed -i '8d' "$work/t.ps11test"
+expect_rc 0 "test with passing eval probes" "$ps11" test "$work/t.ps11test" --stats
+expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "summary"
+expect_in "$work/out" "1 pixels, 1 instructions executed" "--stats"
+expect_rc 0 "evals on gl are not runnable" "$ps11" test "$work/t.ps11test" --backend gl
+expect_in "$work/out" "1 not yet runnable (not runnable on gl: 4 eval commands)" "gl evals counted apart"
+
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"
 expect_rc 2 "unknown command" "$ps11" frobnicate
