@@ -303,9 +303,9 @@ void execTexm3x3spec(const Profile& p, const DOp& op, RunState& st) {
         for (int i = 0; i < st.n; ++i) ex[i] = c[0], ey[i] = c[1], ez[i] = c[2];
     } else {
         // vspec: E = (TC[m].q, TC[m+1].q, TC[m+2].q).
-        std::memcpy(ex, texcoordLanes(st, op.rowBase, 3), sizeof ex);
-        std::memcpy(ey, texcoordLanes(st, op.rowBase + 1, 3), sizeof ey);
-        std::memcpy(ez, texcoordLanes(st, op.rowBase + 2, 3), sizeof ez);
+        std::memcpy(ex, texcoordLanes(st, op.rowBase, 3), sizeof(float) * size_t(st.n));
+        std::memcpy(ey, texcoordLanes(st, op.rowBase + 1, 3), sizeof(float) * size_t(st.n));
+        std::memcpy(ez, texcoordLanes(st, op.rowBase + 2, 3), sizeof(float) * size_t(st.n));
     }
     Lanes ru, rv, rw;
     const float *nx = st.pad[0], *ny = st.pad[1];
