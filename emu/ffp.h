@@ -1,0 +1,35 @@
+// Fixed-function texture stages lowered to a ps11 program (docs/fixed-function.md): the D3D9
+// combiner (COLOROP/ALPHAOP, their arguments, RESULTARG, bump mapping, texture factor, the
+// specular add) becomes ps11 IR that the one executor runs, exactly like a pixel shader.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "emu/state.h"
+#include "ps11/ir.h"
+
+namespace emu {
+
+// Texture stages whose TEXTURE argument the lowering can sample (D3DCAPS9
+// MaxSimultaneousTextures of a ps 1.1-class part; MaxTextureBlendStages is kMaxStages = 8).
+constexpr int kMaxFixedFunctionTextures = 4;
+
+struct LoweredStages {
+    // Runs on ps11::Executor like a pixel shader: executor texture stage i is device stage i
+    // (SetTexture(i), sampler i) reading executor texture-coordinate slot i, which the draw
+    // fills from the vertex set TEXCOORDINDEX(i) selects. v0 = diffuse, v1 = specular.
+    ps11::Program program;
+    uint32_t sampledStages = 0;  // bit i: stage i's texture is read
+    int activeStages = 0;        // stages before the first COLOROP DISABLE
+};
+
+// Lowers the texture stage states and the render states the combiner reads (TEXTUREFACTOR,
+// SPECULARENABLE) of `state`. Deterministic: equal inputs give equal programs, so the draw may
+// cache by state. For a setup the device cannot run (D3DERR_UNSUPPORTEDCOLOROPERATION and
+// friends in D3D9's ValidateDevice) returns nullopt and sets `error` to "E41xx <what is wrong,
+// naming the stage and the state>".
+std::optional<LoweredStages> lowerFixedFunction(const DeviceState& state, std::string& error);
+
+}  // namespace emu

@@ -1,0 +1,71 @@
+// The output merger (docs/device.md "Output merger"): what happens to a shaded pixel after the
+// pixel shader or fixed-function stages — vertex fog, alpha test, depth test and write, alpha
+// blending, colour write mask — and the store into the render target, in the device's
+// precision profile (docs/precision.md "Outputs").
+#pragma once
+
+#include <cstdint>
+
+#include "emu/d3d9types.h"
+#include "emu/resources.h"
+#include "emu/state.h"
+#include "ps11/precision.h"
+
+namespace emu {
+
+// The render states the merger reads, taken once per draw.
+struct MergeState {
+    bool alphaTest = false;
+    D3DCMPFUNC alphaFunc = D3DCMP_ALWAYS;
+    uint32_t alphaRef = 0;  // 0..255
+    bool depthTest = false;  // ZENABLE and a depth surface bound
+    bool depthWrite = false;
+    D3DCMPFUNC depthFunc = D3DCMP_LESSEQUAL;
+    bool fog = false;  // FOGENABLE with FOGTABLEMODE NONE: vertex fog from the specular alpha
+    D3DCOLOR fogColor = 0;
+    bool blend = false;
+    D3DBLEND srcBlend = D3DBLEND_ONE, dstBlend = D3DBLEND_ZERO;
+    D3DBLENDOP blendOp = D3DBLENDOP_ADD;
+    bool separateAlpha = false;
+    D3DBLEND srcBlendAlpha = D3DBLEND_ONE, dstBlendAlpha = D3DBLEND_ZERO;
+    D3DBLENDOP blendOpAlpha = D3DBLENDOP_ADD;
+    D3DCOLOR blendFactor = 0xffffffff;
+    uint32_t colorWrite = 0xf;  // D3DCOLORWRITEENABLE_* bits: 1 r, 2 g, 4 b, 8 a
+    ps11::Precision precision = ps11::Precision::Fx8;
+
+    // From the device's render states; depthTest only when `hasDepth`.
+    static MergeState from(const DeviceState& state, bool hasDepth, ps11::Precision precision);
+    // True when no pixel can change the target (colour writes off and no depth write, …).
+    bool writesNothing() const;
+};
+
+// Up to ps11::kMaxSpan shaded pixels, structure of arrays, in any order (lanes of 2x2 quads
+// included) but each pixel at most once per call.
+struct MergeInputs {
+    int count = 0;
+    const int32_t* x = nullptr;  // pixel coordinates inside the target
+    const int32_t* y = nullptr;
+    const uint8_t* live = nullptr;  // 1 = covered and not discarded by texkill; null = all live
+    // r0 from the executor: color always (real values); grid in fx profiles (value = grid / G),
+    // null otherwise. The merger uses grid when given.
+    const float* color[4] = {};
+    const int32_t* grid[4] = {};
+    const float* fog = nullptr;  // fog factor per lane (1 = no fog), used when MergeState::fog
+    const float* z = nullptr;    // depth per lane in [0, 1], used when depthTest
+};
+
+struct MergeTarget {
+    Image* color = nullptr;  // A8R8G8B8, X8R8G8B8, A16B16G16R16F or A32B32G32R32F; may be null
+    Image* depth = nullptr;  // a depth format, or null
+};
+
+struct MergeStats {
+    uint64_t written = 0;        // pixels that reached the colour or depth store
+    uint64_t alphaRejected = 0;  // failed the alpha test
+    uint64_t depthRejected = 0;  // failed the depth test
+};
+
+// Merges the pixels into the target. Thread-safe for calls that touch disjoint pixels.
+void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats);
+
+}  // namespace emu
