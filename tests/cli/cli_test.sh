@@ -96,7 +96,7 @@ expect_rc 0 "test with passing eval probes" "$ps11" test "$work/t.ps11test" --st
 expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "summary"
 expect_in "$work/out" "1 pixels, 1 instructions executed" "--stats"
 expect_rc 0 "evals on gl are not runnable" "$ps11" test "$work/t.ps11test" --backend gl
-expect_in "$work/out" "1 not yet runnable (not runnable on gl: 4 eval commands)" "gl evals counted apart"
+expect_in "$work/out" "1 not yet runnable (not runnable on gl yet: 4 commands)" "gl commands counted apart"
 
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"
