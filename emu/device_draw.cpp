@@ -155,6 +155,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         return drawFail(D3DERR_INVALIDCALL, "E4115",
                         "primitive count " + num(primitiveCount) + " outside 1.." + num(kMaxPrimitiveCount));
     if (!vertexData) return drawFail(D3DERR_INVALIDCALL, "E4103", "vertex data pointer is null");
+    if (m_state.renderTarget == Handle::Null) return drawFail(D3DERR_INVALIDCALL, "E4109", "no render target");
     if (m_state.fvf == 0) return drawFail(D3DERR_INVALIDCALL, "E4117", "no FVF set (SetFVF)");
     std::string why;
     const std::optional<VertexLayout> layout = parseFvf(m_state.fvf, why);
@@ -169,7 +170,6 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                             " (the FVF's vertex is " + num(layout->size) + " bytes)");
 
     // ---- render target and depth ----
-    if (m_state.renderTarget == Handle::Null) return drawFail(D3DERR_INVALIDCALL, "E4109", "no render target");
     Resource* rt = nullptr;
     SurfaceRef rtRef;
     Image* target = surfaceImage(m_state.renderTarget, "DrawPrimitiveUP", "render target", &rt, &rtRef);
