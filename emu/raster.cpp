@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace emu {
 
@@ -185,9 +186,20 @@ void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool w
                 for (int k = 0; k < kAttrCount; ++k)
                     if ((planes >> k) & 1) fillPlane(s.attr[size_t(k)], s.ox, s.oy, sx, py, n, span.attr[k]);
             }
-            const uint64_t consts = used & s.constMask;
             for (int k = 0; k < kAttrCount; ++k)
-                if ((consts >> k) & 1) std::fill(span.attr[k], span.attr[k] + n, s.constValue[size_t(k)]);
+                if ((planes >> k) & 1) span.constLanes[size_t(k)] = 0;
+            const uint64_t consts = used & s.constMask;
+            for (int k = 0; k < kAttrCount; ++k) {
+                if (!((consts >> k) & 1)) continue;
+                const float value = s.constValue[size_t(k)];
+                int& have = span.constLanes[size_t(k)];
+                if (have > 0 && std::memcmp(&span.constFill[size_t(k)], &value, sizeof value) != 0) have = 0;
+                if (have < n) {
+                    std::fill(span.attr[k] + have, span.attr[k] + n, value);
+                    span.constFill[size_t(k)] = value;
+                    have = n;
+                }
+            }
             emit(span);
         }
     }

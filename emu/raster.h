@@ -59,6 +59,9 @@ struct QuadSpan {
     alignas(32) uint8_t live[ps11::kMaxSpan];
     alignas(32) float z[ps11::kMaxSpan];
     alignas(32) float attr[kAttrCount][ps11::kMaxSpan];
+    // Lanes of attr[k] already holding constFill[k] (constant attributes are not refilled per span).
+    std::array<int, kAttrCount> constLanes{};
+    std::array<float, kAttrCount> constFill{};
 };
 
 // Rasterises rows [y0, y1) of the triangle (y0 even; rows outside the triangle's range are

@@ -580,3 +580,24 @@ TEST_CASE("vertex: XYZRHW beyond the guard band is clipped in screen space, pers
     const R nan[3] = {{NAN, 0, 0, 1, {0, 0}}, {10, 0, 0, 1, {0, 0}}, {0, 10, 0, 1, {0, 0}}};
     CHECK(run(st, D3DPT_TRIANGLELIST, 1, nan, sizeof(R)).empty());
 }
+
+TEST_CASE("raster: constant attributes are exact and follow each triangle through a reused span", "[raster]") {
+    QuadSpan span;
+    for (int round = 0; round < 3; ++round)
+        for (float value : {0.3f, -2.0f, 0.3f}) {
+            // Wider and narrower triangles alternate, so fills of different lengths are reused.
+            const double w = round == 1 ? 7.0 : 40.0;
+            ScreenTriangle t = tri(sv(0, 0, 0.5f), sv(w, 0, 0.25f), sv(0, 9, 1.0f));
+            for (ScreenVertex& v : t.v) v.attr[size_t(attrTex(0, 3))] = value;
+            TriangleSetup s;
+            REQUIRE(setupTriangle(t, uint64_t(1) << attrTex(0, 3), rect(0, 0, 64, 64), s));
+            int n = 0;
+            rasterizeRows(s, 0, 64, uint64_t(1) << attrTex(0, 3), false, span, [&](QuadSpan& sp) {
+                for (int L = 0; L < sp.count; ++L) {
+                    ++n;
+                    CHECK(sp.attr[attrTex(0, 3)][L] == value);  // exact despite the perspective rhw
+                }
+            });
+            CHECK(n > 0);
+        }
+}
