@@ -36,7 +36,8 @@ constexpr int kBandRows = 16;
 constexpr size_t kMaxCachedExecutors = 64;
 
 bool drawableFormat(D3DFORMAT f) {
-    return f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8 || f == D3DFMT_A16B16G16R16F || f == D3DFMT_A32B32G32R32F;
+    return f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8 || f == D3DFMT_R32F || f == D3DFMT_A16B16G16R16F ||
+           f == D3DFMT_A32B32G32R32F;
 }
 
 // The attributes a program reads: v0/v1 as diffuse/specular, t# as texture-coordinate slots.
@@ -119,6 +120,8 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
 struct CachedExecutor {
     std::unique_ptr<ps11::Executor> executor;
     uint64_t attrs = 0;  // attributesRead of its program
+    bool fixedFunction = false;
+    std::array<ps11::StageState, kMaxStages> stages{};  // fixed function: LoweredStages::executorStages
 };
 
 // Per-device draw machinery: the worker pool and the executors, cached by program identity.
@@ -177,7 +180,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     if (!drawableFormat(target->format->format))
         return drawFail(D3DERR_INVALIDCALL, "E4118",
                         std::string("render target format ") + target->format->name +
-                            " is not drawn (A8R8G8B8, X8R8G8B8, A16B16G16R16F, A32B32G32R32F)");
+                            " is not drawn (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
     if (rt->locked[rtRef.level]) return drawFail(D3DERR_INVALIDCALL, "E4106", "the render target is locked");
     Resource* ds = nullptr;
     SurfaceRef dsRef;
@@ -252,6 +255,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             if (!ce.executor)
                 return drawFail(D3DERR_INVALIDCALL, "E4121", "the executor refused the fixed-function program");
             ce.attrs = attributesRead(lowered->program);
+            ce.fixedFunction = true;
+            ce.stages = lowered->executorStages;
             if (dc.ffpCount >= kMaxCachedExecutors) {
                 dc.ffp.clear();
                 dc.ffpCount = 0;
@@ -342,6 +347,11 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     }
     for (int i = 0; i < kMaxPsConstants; ++i) executor.setConstant(i, m_state.psConstants[size_t(i)]);
     for (int s = 0; s < kMaxStages; ++s) {
+        if (exec->fixedFunction) {
+            // The lowering places the bump values on the stage texbem samples (emu/ffp.h).
+            executor.setStageState(s, exec->stages[size_t(s)]);
+            continue;
+        }
         ps11::StageState st;
         st.bumpMat = {m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
                       m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
@@ -352,6 +362,12 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     }
 
     // ---- output merger ----
+    if (std::string e = mergeStateError(m_state, "DrawPrimitiveUP"); !e.empty()) {
+        m_error.hr = D3DERR_INVALIDCALL;
+        m_error.code = e.substr(0, 5);
+        m_error.message = e;
+        return D3DERR_INVALIDCALL;
+    }
     const MergeState merge = MergeState::from(m_state, depth != nullptr, m_options.precision);
     DrawStats stats;
     stats.draws = 1;

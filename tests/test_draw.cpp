@@ -374,13 +374,14 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     CHECK(dev.lastError().code == "E4124");
     REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
 
-    // A render target format the draw does not write.
-    Handle r32{};
-    REQUIRE(dev.CreateRenderTarget(W, H, D3DFMT_R32F, 0, &r32) == D3D_OK);
-    REQUIRE(dev.SetRenderTarget(0, r32) == D3D_OK);
+    // A merger state value that is not an enumerant (emu/output_merger.h).
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, 99) == D3D_OK);
     CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
-    CHECK(dev.lastError().code == "E4118");
-    // And a locked render target.
+    CHECK(dev.lastError().code == "E4160");
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 0) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+    // A locked render target.
     REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
     REQUIRE(dev.LockRect(rt, &lr, nullptr, 0) == D3D_OK);
     CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
