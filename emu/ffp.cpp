@@ -159,15 +159,27 @@ bool Lowering::arg(int stage, D3DTEXTURESTAGESTATETYPE which, Src& out) {
                     "unknown texture argument " + hex(a) +
                         " (D3DTA_DIFFUSE..D3DTA_CONSTANT with D3DTA_COMPLEMENT / D3DTA_ALPHAREPLICATE)");
     switch (sel) {
-        case D3DTA_DIFFUSE: out = reg(RegType::Input, 0); break;
-        case D3DTA_CURRENT: out = current(); break;  // stage 0 (nothing written yet): diffuse
+        case D3DTA_DIFFUSE:
+            out = reg(RegType::Input, 0);
+            break;
+        case D3DTA_CURRENT:
+            out = current();
+            break;  // stage 0 (nothing written yet): diffuse
         case D3DTA_TEXTURE:
             if (!texture(stage, name, out)) return false;
             break;
-        case D3DTA_TFACTOR: out = constSrc(constant(colorFloats(m_state.renderState(D3DRS_TEXTUREFACTOR)))); break;
-        case D3DTA_SPECULAR: out = reg(RegType::Input, 1); break;
-        case D3DTA_TEMP: out = temp(); break;  // unwritten TEMP reads 0 (DXVK, Wine)
-        default: out = constSrc(constant(colorFloats(tss(stage, D3DTSS_CONSTANT)))); break;
+        case D3DTA_TFACTOR:
+            out = constSrc(constant(colorFloats(m_state.renderState(D3DRS_TEXTUREFACTOR))));
+            break;
+        case D3DTA_SPECULAR:
+            out = reg(RegType::Input, 1);
+            break;
+        case D3DTA_TEMP:
+            out = temp();
+            break;  // unwritten TEMP reads 0 (DXVK, Wine)
+        default:
+            out = constSrc(constant(colorFloats(tss(stage, D3DTSS_CONSTANT))));
+            break;
     }
     if (a & D3DTA_COMPLEMENT) out.mod = SrcMod::Comp;
     // The modifier applies after the selector, and 1 - x.a = (1 - x).a, so the order of the two
@@ -203,9 +215,15 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
     const char* opName = alpha ? "D3DTSS_ALPHAOP" : "D3DTSS_COLOROP";
     Dst d = dst;
     switch (op) {
-        case D3DTOP_SELECTARG1: emit("mov", d, {a1}, out); break;
-        case D3DTOP_SELECTARG2: emit("mov", d, {a2}, out); break;
-        case D3DTOP_MODULATE: emit("mul", d, {a1, a2}, out); break;
+        case D3DTOP_SELECTARG1:
+            emit("mov", d, {a1}, out);
+            break;
+        case D3DTOP_SELECTARG2:
+            emit("mov", d, {a2}, out);
+            break;
+        case D3DTOP_MODULATE:
+            emit("mul", d, {a1, a2}, out);
+            break;
         case D3DTOP_MODULATE2X:
             d.shift = 1;
             emit("mul", d, {a1, a2}, out);
@@ -214,17 +232,25 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
             d.shift = 2;
             emit("mul", d, {a1, a2}, out);
             break;
-        case D3DTOP_ADD: emit("add", d, {a1, a2}, out); break;
-        case D3DTOP_ADDSIGNED: emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out); break;
+        case D3DTOP_ADD:
+            emit("add", d, {a1, a2}, out);
+            break;
+        case D3DTOP_ADDSIGNED:
+            emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out);
+            break;
         case D3DTOP_ADDSIGNED2X:
             d.shift = 1;
             emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out);
             break;
-        case D3DTOP_SUBTRACT: emit("sub", d, {a1, a2}, out); break;
+        case D3DTOP_SUBTRACT:
+            emit("sub", d, {a1, a2}, out);
+            break;
         case D3DTOP_ADDSMOOTH:  // a1 + a2 - a1·a2 = (1 - a1)·a2 + a1
             emit("mad", d, {withMod(a1, invert(a1.mod)), a2, a1}, out);
             break;
-        case D3DTOP_BLENDDIFFUSEALPHA: emit("lrp", d, {alphaOf(reg(RegType::Input, 0)), a1, a2}, out); break;
+        case D3DTOP_BLENDDIFFUSEALPHA:
+            emit("lrp", d, {alphaOf(reg(RegType::Input, 0)), a1, a2}, out);
+            break;
         case D3DTOP_BLENDTEXTUREALPHA: {
             Src t;
             if (!texture(stage, opName, t)) return false;
@@ -243,7 +269,9 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
             emit("mad", d, {a2, withMod(alphaOf(t), SrcMod::Comp), a1}, out);
             break;
         }
-        case D3DTOP_BLENDCURRENTALPHA: emit("lrp", d, {alphaOf(current()), a1, a2}, out); break;
+        case D3DTOP_BLENDCURRENTALPHA:
+            emit("lrp", d, {alphaOf(current()), a1, a2}, out);
+            break;
         case D3DTOP_MODULATEALPHA_ADDCOLOR:  // a1.rgb + a1.a·a2.rgb
             emit("mad", d, {alphaOf(a1), a2, a1}, out);
             break;
@@ -259,9 +287,14 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
         case D3DTOP_DOTPRODUCT3:  // Σ (2·a1 - 1)(2·a2 - 1) over rgb
             emit("dp3", d, {withMod(a1, signedMod(a1.mod)), withMod(a2, signedMod(a2.mod))}, out);
             break;
-        case D3DTOP_MULTIPLYADD: emit("mad", d, {a1, a2, a0}, out); break;
-        case D3DTOP_LERP: emit("lrp", d, {a0, a1, a2}, out); break;
-        default: return fail("E4140", stage, opName, "texture operation " + std::to_string(op) + " cannot be lowered");
+        case D3DTOP_MULTIPLYADD:
+            emit("mad", d, {a1, a2, a0}, out);
+            break;
+        case D3DTOP_LERP:
+            emit("lrp", d, {a0, a1, a2}, out);
+            break;
+        default:
+            return fail("E4140", stage, opName, "texture operation " + std::to_string(op) + " cannot be lowered");
     }
     return true;
 }
@@ -391,10 +424,9 @@ std::optional<LoweredStages> Lowering::run() {
         ps11::StageState& es = out.executorStages[size_t(i)];
         es.transformFlags = tss(i, D3DTSS_TEXTURETRANSFORMFLAGS);
         const int from = m_bumpInto[size_t(i)] ? i - 1 : i;
-        es.bumpMat = {m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT00),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT01),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT10),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT11)};
+        es.bumpMat = {
+            m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT01),
+            m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT11)};
         es.lumScale = m_state.stageStateFloat(from, D3DTSS_BUMPENVLSCALE);
         es.lumOffset = m_state.stageStateFloat(from, D3DTSS_BUMPENVLOFFSET);
         if (!((m_sampled >> i) & 1)) continue;
