@@ -86,6 +86,10 @@ private:
     int constant(const std::array<float, 4>& value);
     bool arg(int stage, D3DTEXTURESTAGESTATETYPE which, Src& out);
     bool lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out);
+    bool lowerBump(int stage, int active);
+    bool lowerStage(int stage);
+    void lowerOutput();
+    void assemble(LoweredStages& out) const;
     Src current() const { return reg(m_r0Written ? RegType::Temp : RegType::Input, 0); }
     Src temp() { return m_r1Written ? reg(RegType::Temp, 1) : constSrc(constant({0, 0, 0, 0})); }
     static Src reg(RegType t, int index) {
@@ -310,89 +314,81 @@ bool sameInstruction(const Instruction& a, const Instruction& b) {
     return true;
 }
 
-std::optional<LoweredStages> Lowering::run() {
-    LoweredStages out;
-    int active = 0;
-    for (; active < kMaxStages; ++active) {
-        const DWORD cop = tss(active, D3DTSS_COLOROP);
-        if (cop == D3DTOP_DISABLE) break;  // disables this stage and every later one, alpha included
-        if (!checkOp(active, D3DTSS_COLOROP, false)) return std::nullopt;
+// A BUMPENVMAP(LUMINANCE) stage: it samples its own texture (du, dv[, l]) and perturbs the next
+// stage's lookup; it outputs nothing, so CURRENT after it is still the value before it
+// (D3DTA_CURRENT page), and its ALPHAOP and RESULTARG are not used.
+bool Lowering::lowerBump(int i, int active) {
+    if (i + 1 >= active)
+        return fail("E4143", i, "D3DTSS_COLOROP",
+                    "D3DTOP_BUMPENVMAP needs an enabled next stage whose texture it perturbs");
+    Src t;
+    if (!texture(i, "D3DTSS_COLOROP", t)) return false;
+    if (i + 1 >= kMaxFixedFunctionTextures)
+        return fail("E4142", i + 1, "D3DTSS_COLOROP",
+                    "is the environment map of stage " + std::to_string(i) +
+                        "'s D3DTOP_BUMPENVMAP, but only stages 0.." + std::to_string(kMaxFixedFunctionTextures - 1) +
+                        " can sample");
+    m_sampled |= 1u << (i + 1);
+    m_bumpInto[size_t(i + 1)] = true;
+    return true;
+}
+
+// A blending stage: its colour and alpha halves as a co-issued pair into CURRENT or TEMP.
+bool Lowering::lowerStage(int i) {
+    const DWORD cop = tss(i, D3DTSS_COLOROP);
+    const DWORD result = tss(i, D3DTSS_RESULTARG);
+    if (result != D3DTA_CURRENT && result != D3DTA_TEMP)
+        return fail("E4146", i, "D3DTSS_RESULTARG",
+                    "result argument " + hex(result) + " is neither D3DTA_CURRENT nor D3DTA_TEMP");
+    const bool toTemp = result == D3DTA_TEMP;
+    Dst dst;
+    dst.type = RegType::Temp;
+    dst.index = toTemp ? 1 : 0;
+    dst.saturate = true;
+    bool& written = toTemp ? m_r1Written : m_r0Written;
+
+    if (cop == D3DTOP_DOTPRODUCT3) {
+        // Replicated to all four channels, alpha included: the stage's ALPHAOP is not used.
+        Instruction ins;
+        dst.mask = ps11::kMaskAll;
+        if (!lowerHalf(i, false, dst, ins)) return false;
+        m_arith.push_back(ins);
+        written = true;
+        return true;
     }
-    out.activeStages = active;
-
-    for (int i = 0; i < active; ++i) {
-        const DWORD cop = tss(i, D3DTSS_COLOROP);
-        if (isBump(cop)) {
-            // The stage perturbs the next stage's lookup with its own texture (du, dv[, l]) and
-            // outputs nothing: CURRENT after it is still the result before it (D3DTA_CURRENT page).
-            if (i + 1 >= active)
-                return fail("E4143", i, "D3DTSS_COLOROP",
-                            "D3DTOP_BUMPENVMAP needs an enabled next stage whose texture it perturbs"),
-                       std::nullopt;
-            Src t;
-            if (!texture(i, "D3DTSS_COLOROP", t)) return std::nullopt;
-            if (i + 1 >= kMaxFixedFunctionTextures)
-                return fail("E4142", i + 1, "D3DTSS_COLOROP",
-                            "is the environment map of stage " + std::to_string(i) +
-                                "'s D3DTOP_BUMPENVMAP, but only stages 0.." +
-                                std::to_string(kMaxFixedFunctionTextures - 1) + " can sample"),
-                       std::nullopt;
-            m_sampled |= 1u << (i + 1);
-            m_bumpInto[size_t(i + 1)] = true;
-            continue;
-        }
-        const DWORD result = tss(i, D3DTSS_RESULTARG);
-        if (result != D3DTA_CURRENT && result != D3DTA_TEMP)
-            return fail("E4146", i, "D3DTSS_RESULTARG",
-                        "result argument " + hex(result) + " is neither D3DTA_CURRENT nor D3DTA_TEMP"),
-                   std::nullopt;
-        const bool toTemp = result == D3DTA_TEMP;
-        Dst dst;
-        dst.type = RegType::Temp;
-        dst.index = toTemp ? 1 : 0;
-        dst.saturate = true;
-        const bool dstWritten = toTemp ? m_r1Written : m_r0Written;
-
-        if (cop == D3DTOP_DOTPRODUCT3) {
-            // Replicated to all four channels, alpha included: the stage's ALPHAOP is ignored.
-            Instruction ins;
-            dst.mask = ps11::kMaskAll;
-            if (!lowerHalf(i, false, dst, ins)) return std::nullopt;
-            m_arith.push_back(ins);
-        } else {
-            const DWORD aop = tss(i, D3DTSS_ALPHAOP);
-            if (!checkOp(i, D3DTSS_ALPHAOP, true)) return std::nullopt;
-            Instruction color, alpha;
-            Dst cd = dst, ad = dst;
-            cd.mask = ps11::kMaskRGB;
-            ad.mask = ps11::kMaskA;
-            if (!lowerHalf(i, false, cd, color)) return std::nullopt;
-            if (aop != D3DTOP_DISABLE) {
-                if (!lowerHalf(i, true, ad, alpha)) return std::nullopt;
-            } else if (!dstWritten) {
-                // ALPHAOP DISABLE keeps the destination's alpha (DXVK; the docs call it undefined);
-                // the register still holds its initial value only virtually, so copy it.
-                emit("mov", ad, {toTemp ? temp() : current()}, alpha);
-            }
-            if (alpha.info && sameInstruction(color, alpha)) {
-                color.dst.mask = ps11::kMaskAll;  // identical halves: one instruction
-                m_arith.push_back(color);
-            } else {
-                m_arith.push_back(color);
-                if (alpha.info) {
-                    alpha.coissue = true;
-                    m_arith.push_back(alpha);
-                }
-            }
-        }
-        (toTemp ? m_r1Written : m_r0Written) = true;
+    const DWORD aop = tss(i, D3DTSS_ALPHAOP);
+    if (!checkOp(i, D3DTSS_ALPHAOP, true)) return false;
+    Instruction color, alpha;
+    Dst cd = dst, ad = dst;
+    cd.mask = ps11::kMaskRGB;
+    ad.mask = ps11::kMaskA;
+    if (!lowerHalf(i, false, cd, color)) return false;
+    if (aop != D3DTOP_DISABLE) {
+        if (!lowerHalf(i, true, ad, alpha)) return false;
+    } else if (!written) {
+        // ALPHAOP DISABLE keeps the destination's alpha (DXVK; the docs call it undefined). An
+        // unwritten register holds its initial value (diffuse, or TEMP's 0) only virtually: copy it.
+        emit("mov", ad, {toTemp ? temp() : current()}, alpha);
     }
+    if (alpha.info && sameInstruction(color, alpha)) {
+        color.dst.mask = ps11::kMaskAll;  // identical halves: one instruction
+        m_arith.push_back(color);
+    } else {
+        m_arith.push_back(color);
+        if (alpha.info) {
+            alpha.coissue = true;
+            m_arith.push_back(alpha);
+        }
+    }
+    written = true;
+    return true;
+}
 
-    const bool specular = m_state.renderState(D3DRS_SPECULARENABLE) != 0;
+// The pixel is CURRENT, plus the specular rgb with D3DRS_SPECULARENABLE (alpha unchanged).
+void Lowering::lowerOutput() {
     Dst r0;
     r0.saturate = true;
-    if (specular) {
-        // The specular colour is added after the last stage, rgb only (D3DRS_SPECULARENABLE).
+    if (m_state.renderState(D3DRS_SPECULARENABLE) != 0) {
         Instruction add;
         r0.mask = ps11::kMaskRGB;
         emit("add", r0, {current(), reg(RegType::Input, 1)}, add);
@@ -409,7 +405,11 @@ std::optional<LoweredStages> Lowering::run() {
         emit("mov", r0, {reg(RegType::Input, 0)}, mov);  // no stage wrote CURRENT: the diffuse colour
         m_arith.push_back(mov);
     }
+}
 
+// defs, then the texture instructions in stage order, then the blending; and the executor
+// stage states (the bump data of a BUMPENVMAP stage moves to the stage its texbem samples).
+void Lowering::assemble(LoweredStages& out) const {
     ps11::Program& prog = out.program;
     prog.version = {1, 1};
     for (size_t c = 0; c < m_consts.size(); ++c) {
@@ -444,6 +444,23 @@ std::optional<LoweredStages> Lowering::run() {
     }
     prog.instructions.insert(prog.instructions.end(), m_arith.begin(), m_arith.end());
     out.sampledStages = m_sampled;
+}
+
+std::optional<LoweredStages> Lowering::run() {
+    LoweredStages out;
+    int active = 0;
+    for (; active < kMaxStages; ++active) {
+        const DWORD cop = tss(active, D3DTSS_COLOROP);
+        if (cop == D3DTOP_DISABLE) break;  // disables this stage and every later one, alpha included
+        if (!checkOp(active, D3DTSS_COLOROP, false)) return std::nullopt;
+    }
+    out.activeStages = active;
+    for (int i = 0; i < active; ++i) {
+        const bool ok = isBump(tss(i, D3DTSS_COLOROP)) ? lowerBump(i, active) : lowerStage(i);
+        if (!ok) return std::nullopt;
+    }
+    lowerOutput();
+    assemble(out);
     return out;
 }
 

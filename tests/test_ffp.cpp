@@ -1,7 +1,7 @@
 // The fixed-function lowering (emu/ffp.cpp, docs/fixed-function.md): texture stage states are
 // lowered, the program runs on ps11::Executor, and every result is compared with the D3D9
 // texture-blending formulas evaluated here independently — exact rational arithmetic rounded
-// half-even to the 8-bit grid once per stage (fx8, docs/precision.md), and in double against the
+// half-even to the grid once per stage (fx8 and fx12, docs/precision.md), and in double against the
 // float profile with a tolerance — plus hand-computed values and the E414x errors.
 #include <catch2/catch.hpp>
 
@@ -134,13 +134,13 @@ int64_t roundHalfEven(int64_t p, int64_t q) {
     return fl;
 }
 
-// fx8: a stage result is rounded once to the 8-bit grid (ties to even) and saturated.
-Q stageRound(Q v) {
-    int64_t n = roundHalfEven(v.p * 255, v.q);
-    return Q(n < 0 ? 0 : n > 255 ? 255 : n, 255);
+// fx: a stage result is rounded once to the grid G (ties to even) and saturated.
+Q stageRound(Q v, int64_t g) {
+    int64_t n = roundHalfEven(v.p * g, v.q);
+    return Q(n < 0 ? 0 : n > g ? g : n, g);
 }
 // float: saturated only.
-double stageRound(double v) { return v < 0 ? 0 : v > 1 ? 1 : v; }
+double stageRound(double v, int64_t) { return v < 0 ? 0 : v > 1 ? 1 : v; }
 
 template <class T>
 T fromGrid(int n) {
@@ -233,7 +233,7 @@ T opFormula(DWORD op, int c, const Vec<T>& a0, const Vec<T>& a1, const Vec<T>& a
 // starts as diffuse, TEMP as 0, COLOROP DISABLE ends the cascade, ALPHAOP DISABLE keeps the
 // destination's alpha, DOTPRODUCT3 writes all four channels, the specular rgb is added last.
 template <class T>
-Vec<T> reference(const DeviceState& s, const Pixel& px) {
+Vec<T> reference(const DeviceState& s, const Pixel& px, int64_t g = 255) {
     const Vec<T> diffuse = gridVec<T>(px.diffuse), specular = gridVec<T>(px.specular);
     const Vec<T> tfactor = colorVec<T>(s.renderState(D3DRS_TEXTUREFACTOR));
     Vec<T> cur = diffuse, temp{T(0), T(0), T(0), T(0)};
@@ -279,26 +279,28 @@ Vec<T> reference(const DeviceState& s, const Pixel& px) {
         const Vec<T> al0 = argv(s.stageState(i, D3DTSS_ALPHAARG0)), al1 = argv(s.stageState(i, D3DTSS_ALPHAARG1)),
                      al2 = argv(s.stageState(i, D3DTSS_ALPHAARG2));
         if (cop == D3DTOP_DOTPRODUCT3) {
-            T d = stageRound(opFormula<T>(cop, 0, c0, c1, c2, diffuse[3], tex[3], tfactor[3], cur[3]));
+            T d = stageRound(opFormula<T>(cop, 0, c0, c1, c2, diffuse[3], tex[3], tfactor[3], cur[3]), g);
             res = {d, d, d, d};
         } else {
             for (int c = 0; c < 3; ++c)
-                res[size_t(c)] = stageRound(opFormula<T>(cop, c, c0, c1, c2, diffuse[3], tex[3], tfactor[3], cur[3]));
+                res[size_t(c)] =
+                    stageRound(opFormula<T>(cop, c, c0, c1, c2, diffuse[3], tex[3], tfactor[3], cur[3]), g);
             const DWORD aop = s.stageState(i, D3DTSS_ALPHAOP);
             if (aop != D3DTOP_DISABLE)
-                res[3] = stageRound(opFormula<T>(aop, 3, al0, al1, al2, diffuse[3], tex[3], tfactor[3], cur[3]));
+                res[3] = stageRound(opFormula<T>(aop, 3, al0, al1, al2, diffuse[3], tex[3], tfactor[3], cur[3]), g);
         }
         (toTemp ? temp : cur) = res;
     }
     if (s.renderState(D3DRS_SPECULARENABLE))
-        for (int c = 0; c < 3; ++c) cur[size_t(c)] = stageRound(cur[size_t(c)] + specular[size_t(c)]);
+        for (int c = 0; c < 3; ++c) cur[size_t(c)] = stageRound(cur[size_t(c)] + specular[size_t(c)], g);
     return cur;
 }
 
-Rgba referenceFx8(const DeviceState& s, const Pixel& px) {
-    Vec<Q> v = reference<Q>(s, px);
+// The reference's grid integers in an fx profile of grid scale g (255: fx8, 4080: fx12).
+Rgba referenceGrid(const DeviceState& s, const Pixel& px, int64_t g) {
+    Vec<Q> v = reference<Q>(s, px, g);
     Rgba r;
-    for (int c = 0; c < 4; ++c) r[size_t(c)] = int(roundHalfEven(v[size_t(c)].p * 255, v[size_t(c)].q));
+    for (int c = 0; c < 4; ++c) r[size_t(c)] = int(roundHalfEven(v[size_t(c)].p * g, v[size_t(c)].q));
     return r;
 }
 
@@ -326,15 +328,21 @@ std::string rgbaText(const Rgba& c) {
            std::to_string(c[3]) + ")";
 }
 
-// Runs `s` in fx8 and float and compares every pixel with the reference; returns mismatches.
+// Runs `s` in fx8, fx12 and float and compares every pixel with the reference; returns mismatches.
 int compareWithReference(const DeviceState& s, const std::vector<Pixel>& px) {
     const Outputs fx = run(s, px, Precision::Fx8);
+    const Outputs fx12 = run(s, px, Precision::Fx12);
     const Outputs fl = run(s, px, Precision::Float);
     int bad = 0;
     for (size_t i = 0; i < px.size(); ++i) {
-        const Rgba want = referenceFx8(s, px[i]);
+        const Rgba want = referenceGrid(s, px[i], 255);
+        const Rgba want12 = referenceGrid(s, px[i], 4080);
         const Vec<double> wantF = reference<double>(s, px[i]);
         bool ok = fx.grid[i] == want;
+        if (fx12.grid[i] != want12) {
+            ok = false;
+            UNSCOPED_INFO("pixel " << i << " fx12 " << rgbaText(fx12.grid[i]) << " want " << rgbaText(want12));
+        }
         for (int c = 0; c < 4; ++c) ok = ok && std::fabs(fl.value[i][size_t(c)] - wantF[size_t(c)]) < 2e-5;
         if (!ok) {
             ++bad;
@@ -384,7 +392,7 @@ bool alphaCapable(DWORD op) { return op < D3DTOP_MODULATEALPHA_ADDCOLOR || op > 
 
 }  // namespace
 
-TEST_CASE("ffp: every colour operation equals its D3D formula (fx8 exact, float)", "[ffp]") {
+TEST_CASE("ffp: every colour operation equals its D3D formula (fx8, fx12 exact, float)", "[ffp]") {
     std::mt19937 rng(11);
     const std::vector<Pixel> px = randomPixels(rng, 48);
     for (DWORD op : kBlendOps) {
@@ -399,7 +407,7 @@ TEST_CASE("ffp: every colour operation equals its D3D formula (fx8 exact, float)
     }
 }
 
-TEST_CASE("ffp: every alpha operation equals its D3D formula (fx8 exact, float)", "[ffp]") {
+TEST_CASE("ffp: every alpha operation equals its D3D formula (fx8, fx12 exact, float)", "[ffp]") {
     std::mt19937 rng(12);
     const std::vector<Pixel> px = randomPixels(rng, 48);
     for (DWORD op : kBlendOps) {
