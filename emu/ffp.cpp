@@ -118,8 +118,8 @@ bool Lowering::checkOp(int stage, D3DTEXTURESTAGESTATETYPE which, bool alpha) {
         return fail("E4140", stage, name, "unknown texture operation " + std::to_string(op) + " (D3DTOP_* is 1..26)");
     if (op == D3DTOP_PREMODULATE)
         return fail("E4145", stage, name,
-                    "D3DTOP_PREMODULATE is not supported (no D3DTEXOPCAPS_PREMODULATE; "
-                    "ValidateDevice: D3DERR_UNSUPPORTEDCOLOROPERATION)");
+                    std::string("D3DTOP_PREMODULATE is not supported (no D3DTEXOPCAPS_PREMODULATE; ValidateDevice: ") +
+                        (alpha ? "D3DERR_UNSUPPORTEDALPHAOPERATION)" : "D3DERR_UNSUPPORTEDCOLOROPERATION)"));
     if (alpha && colorOnly(op))
         return fail("E4144", stage, name,
                     "texture operation " + std::to_string(op) + " is a colour-only operation (D3DTSS_COLOROP only)");
@@ -324,10 +324,9 @@ bool Lowering::lowerBump(int i, int active) {
     Src t;
     if (!texture(i, "D3DTSS_COLOROP", t)) return false;
     if (i + 1 >= kMaxFixedFunctionTextures)
-        return fail("E4142", i + 1, "D3DTSS_COLOROP",
-                    "is the environment map of stage " + std::to_string(i) +
-                        "'s D3DTOP_BUMPENVMAP, but only stages 0.." + std::to_string(kMaxFixedFunctionTextures - 1) +
-                        " can sample");
+        return fail("E4142", i, "D3DTSS_COLOROP",
+                    "D3DTOP_BUMPENVMAP looks up stage " + std::to_string(i + 1) + "'s texture, but only stages 0.." +
+                        std::to_string(kMaxFixedFunctionTextures - 1) + " can sample");
     m_sampled |= 1u << (i + 1);
     m_bumpInto[size_t(i + 1)] = true;
     return true;

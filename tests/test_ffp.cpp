@@ -823,7 +823,7 @@ TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
     fails(s, "E4142 stage 4 D3DTSS_ALPHAARG1:");
     setStage(s, 4, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
     setStage(s, 3, D3DTOP_BUMPENVMAP, D3DTA_TEXTURE, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
-    fails(s, "E4142 stage 4 D3DTSS_COLOROP: is the environment map of stage 3");
+    fails(s, "E4142 stage 3 D3DTSS_COLOROP: D3DTOP_BUMPENVMAP looks up stage 4's texture");
 
     // BUMPENVMAP in the last enabled stage.
     s = DeviceState();
