@@ -88,6 +88,7 @@ private:
     bool lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out);
     bool lowerBump(int stage, int active);
     bool lowerStage(int stage);
+    bool lowerPremodulate(int stage);
     void lowerOutput();
     void assemble(LoweredStages& out) const;
     Src current() const { return reg(m_r0Written ? RegType::Temp : RegType::Input, 0); }
@@ -109,6 +110,10 @@ private:
     uint32_t m_sampled = 0;
     std::array<bool, kMaxStages> m_bumpInto{};  // stage i's texture is looked up by texbem(l)
     std::vector<Instruction> m_arith;
+    // PREMODULATE of the previous stage: its destination and the channels to modulate.
+    uint8_t m_premodMask = 0;
+    uint8_t m_premodReg = 0;
+    bool m_premodAlpha = false;  // the alpha half was PREMODULATE (for the error's state name)
 };
 
 bool Lowering::checkOp(int stage, D3DTEXTURESTAGESTATETYPE which, bool alpha) {
@@ -116,10 +121,6 @@ bool Lowering::checkOp(int stage, D3DTEXTURESTAGESTATETYPE which, bool alpha) {
     const DWORD op = tss(stage, which);
     if (op < D3DTOP_DISABLE || op > D3DTOP_LERP)
         return fail("E4140", stage, name, "unknown texture operation " + std::to_string(op) + " (D3DTOP_* is 1..26)");
-    if (op == D3DTOP_PREMODULATE)
-        return fail("E4145", stage, name,
-                    std::string("D3DTOP_PREMODULATE is not supported (no D3DTEXOPCAPS_PREMODULATE; ValidateDevice: ") +
-                        (alpha ? "D3DERR_UNSUPPORTEDALPHAOPERATION)" : "D3DERR_UNSUPPORTEDCOLOROPERATION)"));
     if (alpha && colorOnly(op))
         return fail("E4144", stage, name,
                     "texture operation " + std::to_string(op) + " is a colour-only operation (D3DTSS_COLOROP only)");
@@ -211,7 +212,7 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
     const auto A2 = alpha ? D3DTSS_ALPHAARG2 : D3DTSS_COLORARG2;
     Src a0, a1, a2;
     const bool uses0 = op == D3DTOP_MULTIPLYADD || op == D3DTOP_LERP;
-    const bool uses2 = op != D3DTOP_SELECTARG1;
+    const bool uses2 = op != D3DTOP_SELECTARG1 && op != D3DTOP_PREMODULATE;
     const bool uses1 = op != D3DTOP_SELECTARG2;
     if (uses1 && !arg(stage, A1, a1)) return false;
     if (uses2 && !arg(stage, A2, a2)) return false;
@@ -220,6 +221,7 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
     Dst d = dst;
     switch (op) {
         case D3DTOP_SELECTARG1:
+        case D3DTOP_PREMODULATE:  // ARG1 now; the next stage first multiplies it by its texture
             emit("mov", d, {a1}, out);
             break;
         case D3DTOP_SELECTARG2:
@@ -346,6 +348,9 @@ bool Lowering::lowerStage(int i) {
     dst.saturate = true;
     bool& written = toTemp ? m_r1Written : m_r0Written;
 
+    m_premodReg = dst.index;
+    m_premodMask = cop == D3DTOP_PREMODULATE ? ps11::kMaskRGB : 0;
+    m_premodAlpha = false;
     if (cop == D3DTOP_DOTPRODUCT3) {
         // Replicated to all four channels, alpha included: the stage's ALPHAOP is not used.
         Instruction ins;
@@ -362,6 +367,10 @@ bool Lowering::lowerStage(int i) {
     cd.mask = ps11::kMaskRGB;
     ad.mask = ps11::kMaskA;
     if (!lowerHalf(i, false, cd, color)) return false;
+    if (aop == D3DTOP_PREMODULATE) {
+        m_premodMask = uint8_t(m_premodMask | ps11::kMaskA);
+        m_premodAlpha = true;
+    }
     if (aop != D3DTOP_DISABLE) {
         if (!lowerHalf(i, true, ad, alpha)) return false;
     } else if (!written) {
@@ -380,6 +389,28 @@ bool Lowering::lowerStage(int i) {
         }
     }
     written = true;
+    return true;
+}
+
+// PREMODULATE in stage i - 1 ("modulate with next texture before use", d3d8types.h): before
+// stage i runs, the channels it wrote are multiplied by stage i's texture. The select was exact,
+// so the product rounds once.
+bool Lowering::lowerPremodulate(int i) {
+    const uint8_t mask = m_premodMask;
+    m_premodMask = 0;
+    if (!mask) return true;
+    if (i >= kMaxFixedFunctionTextures)
+        return fail("E4142", i - 1, m_premodAlpha && mask == ps11::kMaskA ? "D3DTSS_ALPHAOP" : "D3DTSS_COLOROP",
+                    "D3DTOP_PREMODULATE modulates with stage " + std::to_string(i) + "'s texture, but only stages 0.." +
+                        std::to_string(kMaxFixedFunctionTextures - 1) + " can sample");
+    m_sampled |= 1u << i;
+    Dst d;
+    d.index = m_premodReg;
+    d.mask = mask;
+    d.saturate = true;
+    Instruction mul;
+    emit("mul", d, {reg(RegType::Temp, m_premodReg), reg(RegType::Texture, i)}, mul);
+    m_arith.push_back(mul);
     return true;
 }
 
@@ -455,6 +486,7 @@ std::optional<LoweredStages> Lowering::run() {
     }
     out.activeStages = active;
     for (int i = 0; i < active; ++i) {
+        if (!lowerPremodulate(i)) return std::nullopt;
         const bool ok = isBump(tss(i, D3DTSS_COLOROP)) ? lowerBump(i, active) : lowerStage(i);
         if (!ok) return std::nullopt;
     }

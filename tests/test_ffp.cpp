@@ -177,6 +177,7 @@ T opFormula(DWORD op, int c, const Vec<T>& a0, const Vec<T>& a1, const Vec<T>& a
     const T x0 = a0[size_t(c)], x1 = a1[size_t(c)], x2 = a2[size_t(c)];
     switch (op) {
         case D3DTOP_SELECTARG1:
+        case D3DTOP_PREMODULATE:  // this stage's part; the next stage modulates
             return x1;
         case D3DTOP_SELECTARG2:
             return x2;
@@ -231,17 +232,25 @@ T opFormula(DWORD op, int c, const Vec<T>& a0, const Vec<T>& a1, const Vec<T>& a
 
 // The whole texture cascade of `s` for one pixel (no bump stages), D3D9 semantics: CURRENT
 // starts as diffuse, TEMP as 0, COLOROP DISABLE ends the cascade, ALPHAOP DISABLE keeps the
-// destination's alpha, DOTPRODUCT3 writes all four channels, the specular rgb is added last.
+// destination's alpha, DOTPRODUCT3 writes all four channels, PREMODULATE selects ARG1 and the next
+// stage first multiplies those channels by its texture, the specular rgb is added last.
 template <class T>
 Vec<T> reference(const DeviceState& s, const Pixel& px, int64_t g = 255) {
     const Vec<T> diffuse = gridVec<T>(px.diffuse), specular = gridVec<T>(px.specular);
     const Vec<T> tfactor = colorVec<T>(s.renderState(D3DRS_TEXTUREFACTOR));
     Vec<T> cur = diffuse, temp{T(0), T(0), T(0), T(0)};
     const T one = fromGrid<T>(255);
+    bool premod[4] = {false, false, false, false};  // channels the previous stage PREMODULATEd
+    bool premodTemp = false;
     for (int i = 0; i < kMaxStages; ++i) {
         const DWORD cop = s.stageState(i, D3DTSS_COLOROP);
         if (cop == D3DTOP_DISABLE) break;
         const Vec<T> tex = i < kMaxFixedFunctionTextures ? gridVec<T>(px.tex[size_t(i)]) : Vec<T>{};
+        for (int c = 0; c < 4; ++c) {
+            Vec<T>& r = premodTemp ? temp : cur;
+            if (premod[c]) r[size_t(c)] = stageRound(r[size_t(c)] * tex[size_t(c)], g);
+            premod[c] = false;
+        }
         auto argv = [&](DWORD a) {
             Vec<T> v;
             switch (a & D3DTA_SELECTMASK) {
@@ -290,6 +299,9 @@ Vec<T> reference(const DeviceState& s, const Pixel& px, int64_t g = 255) {
                 res[3] = stageRound(opFormula<T>(aop, 3, al0, al1, al2, diffuse[3], tex[3], tfactor[3], cur[3]), g);
         }
         (toTemp ? temp : cur) = res;
+        premodTemp = toTemp;
+        for (int c = 0; c < 3; ++c) premod[c] = cop == D3DTOP_PREMODULATE;
+        premod[3] = cop != D3DTOP_DOTPRODUCT3 && s.stageState(i, D3DTSS_ALPHAOP) == D3DTOP_PREMODULATE;
     }
     if (s.renderState(D3DRS_SPECULARENABLE))
         for (int c = 0; c < 3; ++c) cur[size_t(c)] = stageRound(cur[size_t(c)] + specular[size_t(c)], g);
@@ -366,6 +378,7 @@ void setStage(DeviceState& s, int i, DWORD cop, DWORD c1, DWORD c2, DWORD aop, D
 
 const DWORD kBlendOps[] = {
     D3DTOP_SELECTARG1,
+    D3DTOP_PREMODULATE,
     D3DTOP_SELECTARG2,
     D3DTOP_MODULATE,
     D3DTOP_MODULATE2X,
@@ -612,6 +625,37 @@ TEST_CASE("ffp: disable rules", "[ffp]") {
     CHECK(dot[3] != 40);
 }
 
+TEST_CASE("ffp: PREMODULATE selects ARG1 and the next stage multiplies it by its texture", "[ffp]") {
+    std::vector<Pixel> px(1);
+    px[0].diffuse = {200, 100, 50, 255};
+    px[0].tex[0] = {9, 9, 9, 9};
+    px[0].tex[1] = {128, 255, 0, 64};
+    DeviceState s;
+    setStage(s, 0, D3DTOP_PREMODULATE, D3DTA_DIFFUSE, 0, D3DTOP_PREMODULATE, D3DTA_DIFFUSE, 0);
+    setStage(s, 1, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
+    // 200·128/255 = 100.39 -> 100; 100·255/255 = 100; 50·0 = 0; 255·64/255 = 64.
+    CHECK(run(s, px, Precision::Fx8).grid[0] == Rgba{100, 100, 0, 64});
+    CHECK(lower(s).sampledStages == 2u);
+    // Only the colour half premodulated: alpha stays diffuse's.
+    s.stageStates[0][D3DTSS_ALPHAOP] = D3DTOP_SELECTARG1;
+    CHECK(run(s, px, Precision::Fx8).grid[0] == Rgba{100, 100, 0, 255});
+    // In the last stage there is no next texture: the result is ARG1.
+    s.stageStates[1][D3DTSS_COLOROP] = D3DTOP_DISABLE;
+    CHECK(run(s, px, Precision::Fx8).grid[0] == Rgba{200, 100, 50, 255});
+    CHECK(lower(s).sampledStages == 0u);
+
+    // Through TEMP, against the reference in every profile.
+    std::mt19937 rng(16);
+    const std::vector<Pixel> many = randomPixels(rng, 32);
+    s = DeviceState();
+    setStage(s, 0, D3DTOP_PREMODULATE, D3DTA_TEXTURE, 0, D3DTOP_PREMODULATE, D3DTA_SPECULAR, 0);
+    s.stageStates[0][D3DTSS_RESULTARG] = D3DTA_TEMP;
+    setStage(s, 1, D3DTOP_ADD, D3DTA_TEMP, D3DTA_CURRENT, D3DTOP_MODULATE, D3DTA_TEMP, D3DTA_TEXTURE);
+    setStage(s, 2, D3DTOP_PREMODULATE, D3DTA_CURRENT | D3DTA_COMPLEMENT, 0, D3DTOP_ADD, D3DTA_TEMP, D3DTA_CURRENT);
+    setStage(s, 3, D3DTOP_MODULATE2X, D3DTA_CURRENT, D3DTA_DIFFUSE, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
+    CHECK(compareWithReference(s, many) == 0);
+}
+
 TEST_CASE("ffp: RESULTARG TEMP, TFACTOR and CONSTANT by hand", "[ffp]") {
     std::vector<Pixel> px(1);
     px[0].diffuse = {255, 128, 0, 200};
@@ -840,12 +884,15 @@ TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
         fails(s, "E4144 stage 0 D3DTSS_ALPHAOP:");
     }
 
+    // PREMODULATE in stage 3 needs stage 4's texture.
     s = DeviceState();
-    s.stageStates[0][D3DTSS_COLOROP] = D3DTOP_PREMODULATE;
-    fails(s, "E4145 stage 0 D3DTSS_COLOROP: D3DTOP_PREMODULATE");
-    s = DeviceState();
-    s.stageStates[0][D3DTSS_ALPHAOP] = D3DTOP_PREMODULATE;
-    fails(s, "E4145 stage 0 D3DTSS_ALPHAOP:");
+    for (int i = 0; i < 5; ++i)
+        setStage(s, i, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
+    CHECK(lowerFixedFunction(s, error));
+    s.stageStates[3][D3DTSS_ALPHAOP] = D3DTOP_PREMODULATE;
+    fails(s, "E4142 stage 3 D3DTSS_ALPHAOP: D3DTOP_PREMODULATE modulates with stage 4's texture");
+    s.stageStates[3][D3DTSS_COLOROP] = D3DTOP_PREMODULATE;
+    fails(s, "E4142 stage 3 D3DTSS_COLOROP: D3DTOP_PREMODULATE");
 
     s = DeviceState();
     s.stageStates[0][D3DTSS_RESULTARG] = D3DTA_TEXTURE;
