@@ -1,7 +1,8 @@
 // Fixed-function texture stages lowered to a ps_1_1 program (docs/fixed-function.md). Every
 // D3DTOP operation is one arithmetic instruction whose exact result is the D3D formula, so the
-// executor rounds each stage once, like any shader instruction; colour and alpha halves are a
-// co-issued pair (both read before either writes, as the two halves of a stage do).
+// executor rounds each stage once, like any shader instruction (PREMODULATE adds an exact select
+// and one multiply in the next stage; bump mapping is texbem/texbeml); colour and alpha halves are
+// a co-issued pair (both read before either writes, as the two halves of a stage do).
 #include "emu/ffp.h"
 
 #include <array>
