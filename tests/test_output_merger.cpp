@@ -376,6 +376,22 @@ TEST_CASE("merger: fx12 blending is exact on the 4080 grid and rounds once to 8 
         }
 }
 
+TEST_CASE("merger: blending behind a passing alpha or depth test gives the same bytes", "[merger]") {
+    // Fog, alpha test and depth test take the general per-pixel loop; blending there must agree
+    // with the formula too (an ALWAYS test changes nothing).
+    uint32_t seed = 5000;
+    for (Precision p : {Precision::Fx8, Precision::Fx12})
+        for (D3DBLENDOP op : kAllOps)
+            for (D3DBLEND f : kAllBlends) {
+                MergeState st = blendState(f, D3DBLEND_INVSRCCOLOR, op, p);
+                st.alphaTest = true, st.alphaFunc = D3DCMP_ALWAYS;
+                st.separateAlpha = true, st.srcBlendAlpha = D3DBLEND_DESTALPHA, st.dstBlendAlpha = f;
+                st.blendOpAlpha = D3DBLENDOP_REVSUBTRACT;
+                checkBlendFx(st, seed % 2 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8, seed);
+                ++seed;
+            }
+}
+
 TEST_CASE("merger: X8R8G8B8 reads destination alpha as 1 and stores X = 0xff", "[merger]") {
     uint32_t seed = 4000;
     for (D3DBLEND f : {D3DBLEND_DESTALPHA, D3DBLEND_INVDESTALPHA, D3DBLEND_SRCALPHASAT, D3DBLEND_DESTCOLOR}) {
