@@ -453,8 +453,20 @@ struct Fx {
     static int32_t fogGrid(float f) { return int32_t(rintEven(double(f) * G)); }
 };
 
+// Bytewise min(a + b, 255) of two words (SWAR): the sum of the low 7 bits, the top bits added
+// without carries, and every byte whose carry left bit 7 forced to 0xff.
+inline uint32_t addSaturateBytes(uint32_t a, uint32_t b) {
+    const uint32_t low = (a & 0x7f7f7f7fu) + (b & 0x7f7f7f7fu);
+    const uint32_t sum = low ^ ((a ^ b) & 0x80808080u);
+    const uint32_t carry = ((a & b) | ((a | b) & ~sum)) & 0x80808080u;
+    return sum | ((carry >> 7) * 0xffu);
+}
+
 // The common case: no fog, no tests, no blending, an 8-bit target. Two passes: the words of all
-// lanes (a loop the compiler vectorises), then the stores of the live lanes.
+// lanes (a loop the compiler vectorises), then the stores of the live lanes. `additive`: fx8
+// ONE/ONE ADD blending, whose exact result (s·255 + d·255)/255 = s + d clamped to 255 is a
+// bytewise saturating add.
+template <bool Additive>
 void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const g[4], const float* const f[4],
                       Counts& n) {
     const uint32_t mask = wordMask(p);
@@ -483,7 +495,14 @@ void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const
         uint32_t x, y;
         if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
         uint8_t* q = cs.at(x, y);
-        const uint32_t w = mask == 0xffffffffu ? words[i] : (words[i] & mask) | (load32(q) & ~mask);
+        uint32_t w = words[i];
+        if constexpr (Additive) {
+            const uint32_t old = load32(q);
+            w = addSaturateBytes(w, old);
+            if (mask != 0xffffffffu) w = (w & mask) | (old & ~mask);
+        } else if (mask != 0xffffffffu) {
+            w = (w & mask) | (load32(q) & ~mask);
+        }
         store32(q, w);
         ++written;
     }
@@ -925,8 +944,16 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
 
     Counts n;
     const bool unorm = p.color && (p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8);
-    if (unorm && !p.fog && !p.alphaTest && !p.depthTest && !p.blend && p.channels) {
-        storeUnorm8Plain(p, lanes, grid, color, n);
+    // fx8 ONE/ONE ADD on every channel (additive passes).
+    bool additive = p.blend && state.precision == Precision::Fx8;
+    for (const ChannelPlan& cp : p.ch)
+        additive = additive && cp.kind == OpKind::Linear && cp.cs == 1 && cp.cd == 1 && cp.src.slot == kOne &&
+                   !cp.src.inv && cp.dst.slot == kOne && !cp.dst.inv;
+    if (unorm && !p.fog && !p.alphaTest && !p.depthTest && (!p.blend || additive) && p.channels) {
+        if (additive)
+            storeUnorm8Plain<true>(p, lanes, grid, color, n);
+        else
+            storeUnorm8Plain<false>(p, lanes, grid, color, n);
     } else if (unorm && fx && !p.fog && !p.alphaTest && !p.depthTest && p.channels) {
         if (state.precision == Precision::Fx8)
             blendFxUnorm8Simple<255>(p, lanes, grid, n);

@@ -394,6 +394,7 @@ TEST_CASE("merger: blending behind a passing alpha or depth test gives the same 
 
 TEST_CASE("merger: X8R8G8B8 reads destination alpha as 1 and stores X = 0xff", "[merger]") {
     uint32_t seed = 4000;
+    checkBlendFx(blendState(D3DBLEND_ONE, D3DBLEND_ONE, D3DBLENDOP_ADD, Precision::Fx8), D3DFMT_X8R8G8B8, seed++);
     for (D3DBLEND f : {D3DBLEND_DESTALPHA, D3DBLEND_INVDESTALPHA, D3DBLEND_SRCALPHASAT, D3DBLEND_DESTCOLOR}) {
         checkBlendFx(blendState(D3DBLEND_ONE, f, D3DBLENDOP_ADD, Precision::Fx8), D3DFMT_X8R8G8B8, seed++);
         checkBlendFx(blendState(f, D3DBLEND_ONE, D3DBLENDOP_ADD, Precision::Fx12), D3DFMT_X8R8G8B8, seed++);
@@ -449,7 +450,8 @@ TEST_CASE("merger: float and ideal profiles blend into 8-bit targets", "[merger]
                 std::vector<std::array<uint32_t, 4>> dst(64);
                 for (int i = 0; i < 64; ++i) {
                     std::array<float, 4> v;
-                    for (int c = 0; c < 4; ++c) v[size_t(c)] = float((i * 7 + c * 3) % 9) / 8.0f;  // k/8
+                    for (int c = 0; c < 4; ++c)
+                        v[size_t(c)] = float((i * 7 + c * 3) % 13 - 2) / 8.0f;  // k/8, some outside [0, 1]
                     span.setColor(i, v);
                     for (int c = 0; c < 4; ++c) dst[size_t(i)][size_t(c)] = ((i >> c) & 1) * 255;
                     setRgba(img, uint32_t(i % 16), uint32_t(i / 16), dst[size_t(i)]);
@@ -457,8 +459,11 @@ TEST_CASE("merger: float and ideal profiles blend into 8-bit targets", "[merger]
                 run(st, span, &img);
                 for (int i = 0; i < 64; ++i) {
                     Q s[4], d[4];
-                    for (int c = 0; c < 4; ++c)
-                        s[c] = fromFloat(span.color[c][size_t(i)]), d[c] = mk(dst[size_t(i)][size_t(c)], 255);
+                    for (int c = 0; c < 4; ++c) {
+                        // The 8-bit target saturates the source before blending.
+                        s[c] = qmin(qmax(fromFloat(span.color[c][size_t(i)]), kZeroQ), kOneQ);
+                        d[c] = mk(dst[size_t(i)][size_t(c)], 255);
+                    }
                     const std::array<Q, 4> r = blendRef(st, s, d);
                     const std::array<uint32_t, 4> got = rgbaAt(img, uint32_t(i % 16), uint32_t(i / 16));
                     for (int c = 0; c < 4; ++c) {
@@ -591,6 +596,45 @@ TEST_CASE("merger: vertex fog lerps rgb toward FOGCOLOR by the fog factor", "[me
     st.precision = Precision::Fx8;
     run(st, span, &img);
     CHECK(rgbaAt(img, 0, 0)[0] == 150);
+}
+
+TEST_CASE("merger: fog on float targets works on the unclamped value", "[merger]") {
+    MergeState st;
+    st.fog = true;
+    st.fogColor = 0x00ff0000u;  // r 255, g 0, b 0: exact as floats
+    for (Precision p : {Precision::Fx8, Precision::Fx12, Precision::Ideal}) {
+        st.precision = p;
+        const int32_t G = ps11::gridScale(p);
+        Image img = makeImage(D3DFMT_A32B32G32R32F, 16, 1);
+        Span span(3);
+        const float fs[3] = {0.25f, 0.5f, 0.75f};
+        for (int i = 0; i < 3; ++i) {
+            span.fog[size_t(i)] = fs[i];
+            if (p == Precision::Ideal)
+                span.setColor(i, {3.0f, -1.5f, 0.5f, 2.0f});
+            else
+                span.setGrid(i, {2 * G, -G / 2 - 1, G / 3, 2 * G}, p);  // ps_1_4 range
+        }
+        run(st, span, &img);
+        const Q fog[3] = {kOneQ, kZeroQ, kZeroQ};
+        for (int i = 0; i < 3; ++i)
+            for (int c = 0; c < 4; ++c) {
+                Q want;
+                if (c == 3) {
+                    want = p == Precision::Ideal ? Q{2, 1} : mk(span.grid[3][0], G);
+                } else if (p == Precision::Ideal) {
+                    const Q f = fromFloat(fs[i]);  // dyadic: float32 is exact here
+                    want = f * fromFloat(span.color[c][0]) + (kOneQ - f) * fog[c];
+                } else {
+                    const int64_t fg = rhe(fromFloat(fs[i]) * Q{G, 1});
+                    const Q sv = mk(span.grid[c][0], G);
+                    const int64_t n = rhe((mk(fg, G) * sv + mk(G - fg, G) * fog[c]) * Q{G, 1});
+                    want = fromFloat(float(n) / float(G));  // the grid value as float32
+                }
+                INFO(ps11::precisionName(p) << " lane " << i << " c " << c);
+                CHECK(fromFloat(floatAt(img, uint32_t(i), 0, c)) == want);
+            }
+    }
 }
 
 // ---- alpha test -----------------------------------------------------------------------------
@@ -1075,4 +1119,27 @@ TEST_CASE("merger: writesNothing only when no pixel can change the target", "[me
     span.setColor(0, {INFINITY, NAN, -INFINITY, 1.0f});
     run(st, span, &img);
     CHECK(img.bytes == before);
+}
+
+TEST_CASE("merger: null live means every lane; null z reads 0", "[merger]") {
+    Image img = makeImage(D3DFMT_A8R8G8B8, 16, 1);
+    Image depth = makeImage(D3DFMT_D16, 16, 1);
+    for (uint32_t x = 0; x < 16; ++x) {
+        const uint16_t w = 100;
+        std::memcpy(depth.texel(x, 0), &w, 2);
+    }
+    Span span(16);
+    for (int i = 0; i < 16; ++i) span.setGrid(i, {i, 2 * i, 3 * i, 255}, Precision::Fx8);
+    MergeInputs in = span.inputs(true);
+    in.live = nullptr;
+    in.z = nullptr;
+    MergeState st;
+    st.depthTest = true, st.depthWrite = true, st.depthFunc = D3DCMP_LESS;
+    MergeStats stats;
+    mergePixels(st, in, MergeTarget{&img, &depth}, &stats);
+    CHECK(stats.written == 16);
+    for (uint32_t x = 0; x < 16; ++x) {
+        CHECK(rgbaAt(img, x, 0) == std::array<uint32_t, 4>{x, 2 * x, 3 * x, 255});
+        CHECK(depthWord(depth, x) == 0u);
+    }
 }
