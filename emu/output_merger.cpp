@@ -446,8 +446,11 @@ struct Fx {
         num = num < 0 ? 0 : num > G * G ? G * G : num;
         if constexpr (G == 255)
             return uint32_t(num + 127) / 255u;  // 255 is odd: no ties
-        else
-            return uint32_t(divRoundEven<int64_t(G) * G / 255>(num));
+        else {
+            constexpr uint32_t D = uint32_t(G) * G / 255;  // 65280
+            const uint32_t u = uint32_t(num), q = u / D, r = u - q * D;
+            return q + ((2 * r > D || (2 * r == D && (q & 1u))) ? 1u : 0u);
+        }
     }
     // The fog factor on the grid: round_half_even(f * G) (f * G is exact in double).
     static int32_t fogGrid(float f) { return int32_t(rintEven(double(f) * G)); }
@@ -540,29 +543,20 @@ void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* co
     }
     for (int k = 0; k < m; ++k) sat[k] = std::min(src[3][k], G - dst[3][k]);
     // A factor as base + sign * array[k].
+    // A factor as base + (array[k] negated when neg = -1): (v ^ neg) - neg is v or -v, so the
+    // loop multiplies only s * Fs and d * Fd. Constant factors read an array of zeros.
+    static const int32_t kZeros[kN] = {};
     struct Term {
-        int32_t base, sign;
+        int32_t base, neg;
         const int32_t* arr;
     };
-    const auto term = [&](Factor f, int c) -> Term {
-        const int32_t* arr = src[0];  // any array: sign 0 ignores it
-        int32_t value = 0;
-        bool constant = false;
-        if (f.slot == kZero)
-            constant = true, value = 0;
-        else if (f.slot == kOne)
-            constant = true, value = G;
-        else if (f.slot >= kBf)
-            constant = true, value = int32_t(p.bfByte[f.slot - kBf]) * S;
-        else if (f.slot >= kDst && f.slot < kDst + 4)
-            arr = dst[f.slot - kDst];
-        else if (f.slot == kSat)
-            arr = sat;
-        else
-            arr = src[f.slot - kSrc];
-        (void)c;
-        if (constant) return Term{f.inv ? G - value : value, 0, arr};
-        return Term{f.inv ? G : 0, f.inv ? -1 : 1, arr};
+    const auto term = [&](Factor f) -> Term {
+        if (f.slot == kZero || f.slot == kOne || f.slot >= kBf) {
+            const int32_t value = f.slot == kZero ? 0 : f.slot == kOne ? G : int32_t(p.bfByte[f.slot - kBf]) * S;
+            return Term{f.inv ? G - value : value, 0, kZeros};
+        }
+        const int32_t* arr = f.slot == kSat ? sat : f.slot >= kDst ? dst[f.slot - kDst] : src[f.slot - kSrc];
+        return Term{f.inv ? G : 0, f.inv ? -1 : 0, arr};
     };
     alignas(32) uint32_t out[4][kN];
     for (int c = 0; c < 4; ++c) {
@@ -575,12 +569,13 @@ void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* co
         } else if (cp.kind == OpKind::Max) {
             for (int k = 0; k < m; ++k) o[k] = Fx<G>::byteOf(std::max(sc[k], dc[k]));
         } else {
-            const Term ts = term(cp.src, c), td = term(cp.dst, c);
-            const int32_t csg = cp.cs, cdg = cp.cd;
+            const Term ts = term(cp.src), td = term(cp.dst);
+            const int32_t ns = cp.cs < 0 ? -1 : 0, nd = cp.cd < 0 ? -1 : 0;  // SUBTRACT / REVSUBTRACT
             for (int k = 0; k < m; ++k) {
-                const int32_t fs = ts.base + ts.sign * ts.arr[k];
-                const int32_t fd = td.base + td.sign * td.arr[k];
-                int32_t num = csg * sc[k] * fs + cdg * dc[k] * fd;
+                const int32_t fs = ts.base + ((ts.arr[k] ^ ts.neg) - ts.neg);
+                const int32_t fd = td.base + ((td.arr[k] ^ td.neg) - td.neg);
+                const int32_t ps = sc[k] * fs, pd = dc[k] * fd;
+                int32_t num = ((ps ^ ns) - ns) + ((pd ^ nd) - nd);
                 num = num < 0 ? 0 : num > G * G ? G * G : num;
                 if constexpr (G == 255) {
                     const int32_t y = num + 127;               // round(num / 255) = floor((num + 127) / 255), no ties
