@@ -182,6 +182,16 @@ struct ChannelPlan {
 };
 
 enum class TargetKind : uint8_t { Argb8, Xrgb8, Rgba16F, Rgba32F, R32F };
+
+// A surface's addressing, copied into the loops (so stores through byte pointers, which may
+// alias anything, do not force reloads of the Image's fields).
+struct Surf {
+    uint8_t* base = nullptr;
+    size_t pitch = 0;
+    uint32_t bpp = 0;
+    uint8_t* at(uint32_t x, uint32_t y) const { return base + size_t(y) * pitch + size_t(x) * bpp; }
+};
+Surf surfOf(Image* img) { return img ? Surf{img->bytes.data(), img->rowPitch, img->format->bytes} : Surf{}; }
 enum class DepthKind : uint8_t { D16, D24, D32, D32F };
 
 struct Plan {
@@ -195,6 +205,8 @@ struct Plan {
     uint32_t channels = 0;  // enabled and changing channels, bit c = r g b a
     Image* color = nullptr;
     Image* depth = nullptr;
+    Surf colorSurf, depthSurf;
+    uint32_t boundW = 0, boundH = 0;  // pixels outside are skipped (asserted)
     TargetKind target = TargetKind::Argb8;
     DepthKind depthKind = DepthKind::D16;
 };
@@ -231,6 +243,11 @@ bool resolveTarget(const MergeTarget& t, Plan& p) {
     }
     p.color = t.color;
     p.depth = t.depth;
+    p.colorSurf = surfOf(t.color);
+    p.depthSurf = surfOf(t.depth);
+    p.boundW = p.boundH = ~0u;
+    for (const Image* img : {t.color, t.depth})
+        if (img) p.boundW = std::min(p.boundW, img->width), p.boundH = std::min(p.boundH, img->height);
     return true;
 }
 
@@ -306,18 +323,25 @@ inline uint32_t depthCode(DepthKind k, float z) {
     }
 }
 
+struct DepthCtx {
+    Surf surf;
+    DepthKind kind = DepthKind::D16;
+    uint32_t mask = 0;
+    bool write = false;
+};
+
 // Depth test (and write when it passes). True when the pixel passes.
-inline bool depthStage(const Plan& p, uint32_t x, uint32_t y, float zIn) {
+inline bool depthStage(const DepthCtx& p, uint32_t x, uint32_t y, float zIn) {
     const float z = zIn > 0.0f ? (zIn < 1.0f ? zIn : 1.0f) : 0.0f;  // NaN -> 0
-    uint8_t* q = p.depth->texel(x, y);
-    const uint32_t code = depthCode(p.depthKind, z);
+    uint8_t* q = p.surf.at(x, y);
+    const uint32_t code = depthCode(p.kind, z);
     bool pass;
-    switch (p.depthKind) {
+    switch (p.kind) {
         case DepthKind::D16: {
             uint16_t old;
             std::memcpy(&old, q, 2);
-            pass = cmpPass(p.depthMask, code, uint32_t(old));
-            if (pass && p.depthWrite) {
+            pass = cmpPass(p.mask, code, uint32_t(old));
+            if (pass && p.write) {
                 const uint16_t w = uint16_t(code);
                 std::memcpy(q, &w, 2);
             }
@@ -325,20 +349,20 @@ inline bool depthStage(const Plan& p, uint32_t x, uint32_t y, float zIn) {
         }
         case DepthKind::D24: {
             const uint32_t old = load32(q);
-            pass = cmpPass(p.depthMask, code, old >> 8);
-            if (pass && p.depthWrite) store32(q, (old & 0xffu) | (code << 8));  // keeps stencil / X
+            pass = cmpPass(p.mask, code, old >> 8);
+            if (pass && p.write) store32(q, (old & 0xffu) | (code << 8));  // keeps stencil / X
             break;
         }
         case DepthKind::D32: {
-            pass = cmpPass(p.depthMask, code, load32(q));
-            if (pass && p.depthWrite) store32(q, code);
+            pass = cmpPass(p.mask, code, load32(q));
+            if (pass && p.write) store32(q, code);
             break;
         }
         default: {
             float old;
             std::memcpy(&old, q, 4);
-            pass = cmpPass(p.depthMask, z, old);
-            if (pass && p.depthWrite) std::memcpy(q, &z, 4);
+            pass = cmpPass(p.mask, z, old);
+            if (pass && p.write) std::memcpy(q, &z, 4);
             break;
         }
     }
@@ -350,15 +374,12 @@ inline bool depthStage(const Plan& p, uint32_t x, uint32_t y, float zIn) {
 
 struct Lanes {
     const MergeInputs& in;
-    bool inside(int i, uint32_t& x, uint32_t& y, const Plan& p) const {
-        const int32_t xi = in.x[i], yi = in.y[i];
-        const uint32_t w = p.color ? p.color->width : p.depth->width;
-        const uint32_t h = p.color ? p.color->height : p.depth->height;
-        assert(xi >= 0 && yi >= 0 && uint32_t(xi) < w && uint32_t(yi) < h);
-        if (xi < 0 || yi < 0 || uint32_t(xi) >= w || uint32_t(yi) >= h) return false;
-        if (p.color && p.depth && (uint32_t(xi) >= p.depth->width || uint32_t(yi) >= p.depth->height)) return false;
-        x = uint32_t(xi), y = uint32_t(yi);
-        return true;
+    uint32_t w, h;  // the targets' common extent
+    Lanes(const MergeInputs& inputs, const Plan& p) : in(inputs), w(p.boundW), h(p.boundH) {}
+    bool inside(int i, uint32_t& x, uint32_t& y) const {
+        x = uint32_t(in.x[i]), y = uint32_t(in.y[i]);  // negative coordinates become huge
+        assert(x < w && y < h);
+        return x < w && y < h;
     }
     float fog(int i) const {
         if (!in.fog) return 1.0f;
@@ -373,12 +394,12 @@ struct Counts {
 };
 
 // Runs alpha test then depth test; counts. `alphaPass` is the alpha test's outcome.
-inline bool tests(const Plan& p, bool alphaPass, uint32_t x, uint32_t y, float z, Counts& n) {
+inline bool tests(const DepthCtx* depth, bool alphaPass, uint32_t x, uint32_t y, float z, Counts& n) {
     if (!alphaPass) {
         ++n.alphaRejected;
         return false;
     }
-    if (p.depthTest && !depthStage(p, x, y, z)) {
+    if (depth && !depthStage(*depth, x, y, z)) {
         ++n.depthRejected;
         return false;
     }
@@ -390,6 +411,8 @@ inline bool tests(const Plan& p, bool alphaPass, uint32_t x, uint32_t y, float z
 inline uint32_t packArgb(uint32_t r, uint32_t g, uint32_t b, uint32_t a) {
     return b | (g << 8) | (r << 16) | (a << 24);
 }
+
+DepthCtx depthCtxOf(const Plan& p) { return DepthCtx{p.depthSurf, p.depthKind, p.depthMask, p.depthWrite}; }
 
 // The byte mask of the enabled channels in an 8-bit ARGB word. For X8R8G8B8 the X byte is
 // written (as 0xff) whenever any colour channel is.
@@ -410,41 +433,167 @@ template <int32_t G>
 struct Fx {
     static constexpr int32_t S = G / 255;  // grid steps per 8-bit level (1 or 16)
     // The stored byte of a saturated grid value (fx8: n; fx12: round_half_even(n / 16)).
+    // n in [0, G].
     static uint32_t byteOf(int32_t n) {
         if constexpr (G == 255)
             return uint32_t(n);
-        else
-            return uint32_t(divRoundEven<S>(n));
+        else  // n = 16q + r rounds up when r > 8, or r == 8 and q is odd
+            return uint32_t(n + 7 + ((n >> 4) & 1)) >> 4;
     }
-    // round_half_even(num * 255 / G^2) for num in [0, G^2] (fx8: num / 255; fx12: num / 65280).
-    static uint32_t blendByte(int64_t num) {
-        num = num < 0 ? 0 : num > int64_t(G) * G ? int64_t(G) * G : num;
+    // round_half_even(num * 255 / G^2) for num in [-G^2, 2 G^2] clamped to [0, G^2] first
+    // (fx8: num / 255; fx12: num / 65280); 2 G^2 < 2^31.
+    static uint32_t blendByte(int32_t num) {
+        num = num < 0 ? 0 : num > G * G ? G * G : num;
         if constexpr (G == 255)
-            return uint32_t((num + 127) / 255);  // 255 is odd: no ties
-        else
-            return uint32_t(divRoundEven<int64_t(G) * G / 255>(num));
+            return uint32_t(num + 127) / 255u;  // 255 is odd: no ties
+        else {
+            constexpr uint32_t D = uint32_t(G) * G / 255;  // 65280
+            const uint32_t u = uint32_t(num), q = u / D, r = u - q * D;
+            return q + ((2 * r > D || (2 * r == D && (q & 1u))) ? 1u : 0u);
+        }
     }
     // The fog factor on the grid: round_half_even(f * G) (f * G is exact in double).
     static int32_t fogGrid(float f) { return int32_t(rintEven(double(f) * G)); }
 };
 
-// The common case: no fog, no tests, no blending, fx8, every channel written or a mask.
-void storeFx8Plain(const Plan& p, const MergeInputs& in, const int32_t* const g[4], Counts& n) {
+// Bytewise min(a + b, 255) of two words (SWAR): the sum of the low 7 bits, the top bits added
+// without carries, and every byte whose carry left bit 7 forced to 0xff.
+inline uint32_t addSaturateBytes(uint32_t a, uint32_t b) {
+    const uint32_t low = (a & 0x7f7f7f7fu) + (b & 0x7f7f7f7fu);
+    const uint32_t sum = low ^ ((a ^ b) & 0x80808080u);
+    const uint32_t carry = ((a & b) | ((a | b) & ~sum)) & 0x80808080u;
+    return sum | ((carry >> 7) * 0xffu);
+}
+
+// The common case: no fog, no tests, no blending, an 8-bit target. Two passes: the words of all
+// lanes (a loop the compiler vectorises), then the stores of the live lanes. `additive`: fx8
+// ONE/ONE ADD blending, whose exact result (s·255 + d·255)/255 = s + d clamped to 255 is a
+// bytewise saturating add.
+template <bool Additive>
+void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const g[4], const float* const f[4],
+                      Counts& n) {
     const uint32_t mask = wordMask(p);
     const uint32_t alphaFill = p.target == TargetKind::Xrgb8 ? 0xff000000u : 0u;
-    Image& img = *p.color;
-    const Lanes lanes{in};
-    for (int i = 0; i < in.count; ++i) {
-        if (in.live && !in.live[i]) continue;
-        uint32_t x, y;
-        if (!lanes.inside(i, x, y, p)) continue;
+    const int count = in.count;
+    alignas(32) uint32_t words[ps11::kMaxSpan];
+    if (p.precision == Precision::Fx8) {
+        const int32_t *g0 = g[0], *g1 = g[1], *g2 = g[2], *g3 = g[3];
         const auto clamp = [](int32_t v) { return uint32_t(v < 0 ? 0 : v > 255 ? 255 : v); };
-        uint32_t w = packArgb(clamp(g[0][i]), clamp(g[1][i]), clamp(g[2][i]), clamp(g[3][i])) | alphaFill;
-        uint8_t* q = img.texel(x, y);
-        if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
-        store32(q, w);
-        ++n.written;
+        for (int i = 0; i < count; ++i)
+            words[i] = packArgb(clamp(g0[i]), clamp(g1[i]), clamp(g2[i]), clamp(g3[i])) | alphaFill;
+    } else if (p.precision == Precision::Fx12) {
+        const int32_t *g0 = g[0], *g1 = g[1], *g2 = g[2], *g3 = g[3];
+        const auto b = [](int32_t v) { return Fx<4080>::byteOf(v < 0 ? 0 : v > 4080 ? 4080 : v); };
+        for (int i = 0; i < count; ++i) words[i] = packArgb(b(g0[i]), b(g1[i]), b(g2[i]), b(g3[i])) | alphaFill;
+    } else {
+        const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
+        const auto b = [](float v) { return byteOfUnit(sat(v)); };
+        for (int i = 0; i < count; ++i) words[i] = packArgb(b(f0[i]), b(f1[i]), b(f2[i]), b(f3[i])) | alphaFill;
     }
+    const Surf cs = p.colorSurf;
+    const Lanes lanes(in, p);
+    const uint8_t* live = in.live;
+    uint64_t written = 0;
+    for (int i = 0; i < count; ++i) {
+        uint32_t x, y;
+        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        uint8_t* q = cs.at(x, y);
+        uint32_t w = words[i];
+        if constexpr (Additive) {
+            const uint32_t old = load32(q);
+            w = addSaturateBytes(w, old);
+            if (mask != 0xffffffffu) w = (w & mask) | (old & ~mask);
+        } else if (mask != 0xffffffffu) {
+            w = (w & mask) | (load32(q) & ~mask);
+        }
+        store32(q, w);
+        ++written;
+    }
+    n.written += written;
+}
+
+// Blending without fog or tests into an 8-bit target in an fx profile (the post-processing
+// case: additive or alpha-blended passes). Structure of arrays over the live lanes: gather the
+// destination texels, then per channel one loop whose factor is base + sign * array[k], with
+// base, sign and array chosen per call — no per-pixel decision at all.
+template <int32_t G>
+void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* const g[4], Counts& n) {
+    constexpr int kN = ps11::kMaxSpan;
+    constexpr int32_t S = G / 255;
+    const bool x8 = p.target == TargetKind::Xrgb8;
+    const Surf cs = p.colorSurf;
+    const Lanes lanes(in, p);
+    alignas(32) int32_t src[4][kN], dst[4][kN], sat[kN];
+    alignas(32) uint32_t word[kN];
+    uint8_t* addr[kN];
+    int m = 0;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        if ((in.live && !in.live[i]) || !lanes.inside(i, x, y)) continue;
+        uint8_t* q = cs.at(x, y);
+        const uint32_t old = load32(q);
+        addr[m] = q;
+        word[m] = old;
+        for (int c = 0; c < 4; ++c) src[c][m] = std::clamp(g[c][i], 0, G);  // the 8-bit target saturates
+        dst[0][m] = int32_t((old >> 16) & 0xffu) * S;
+        dst[1][m] = int32_t((old >> 8) & 0xffu) * S;
+        dst[2][m] = int32_t(old & 0xffu) * S;
+        dst[3][m] = x8 ? G : int32_t(old >> 24) * S;  // X8R8G8B8's alpha reads 1
+        ++m;
+    }
+    for (int k = 0; k < m; ++k) sat[k] = std::min(src[3][k], G - dst[3][k]);
+    // A factor as base + sign * array[k].
+    // A factor as base + (array[k] negated when neg = -1): (v ^ neg) - neg is v or -v, so the
+    // loop multiplies only s * Fs and d * Fd. Constant factors read an array of zeros.
+    static const int32_t kZeros[kN] = {};
+    struct Term {
+        int32_t base, neg;
+        const int32_t* arr;
+    };
+    const auto term = [&](Factor f) -> Term {
+        if (f.slot == kZero || f.slot == kOne || f.slot >= kBf) {
+            const int32_t value = f.slot == kZero ? 0 : f.slot == kOne ? G : int32_t(p.bfByte[f.slot - kBf]) * S;
+            return Term{f.inv ? G - value : value, 0, kZeros};
+        }
+        const int32_t* arr = f.slot == kSat ? sat : f.slot >= kDst ? dst[f.slot - kDst] : src[f.slot - kSrc];
+        return Term{f.inv ? G : 0, f.inv ? -1 : 0, arr};
+    };
+    alignas(32) uint32_t out[4][kN];
+    for (int c = 0; c < 4; ++c) {
+        const ChannelPlan cp = p.ch[c];
+        const int32_t* sc = src[c];
+        const int32_t* dc = dst[c];
+        uint32_t* o = out[c];
+        if (cp.kind == OpKind::Min) {
+            for (int k = 0; k < m; ++k) o[k] = Fx<G>::byteOf(std::min(sc[k], dc[k]));
+        } else if (cp.kind == OpKind::Max) {
+            for (int k = 0; k < m; ++k) o[k] = Fx<G>::byteOf(std::max(sc[k], dc[k]));
+        } else {
+            const Term ts = term(cp.src), td = term(cp.dst);
+            const int32_t ns = cp.cs < 0 ? -1 : 0, nd = cp.cd < 0 ? -1 : 0;  // SUBTRACT / REVSUBTRACT
+            for (int k = 0; k < m; ++k) {
+                const int32_t fs = ts.base + ((ts.arr[k] ^ ts.neg) - ts.neg);
+                const int32_t fd = td.base + ((td.arr[k] ^ td.neg) - td.neg);
+                const int32_t ps = sc[k] * fs, pd = dc[k] * fd;
+                int32_t num = ((ps ^ ns) - ns) + ((pd ^ nd) - nd);
+                num = num < 0 ? 0 : num > G * G ? G * G : num;
+                if constexpr (G == 255) {
+                    const int32_t y = num + 127;               // round(num / 255) = floor((num + 127) / 255), no ties
+                    o[k] = uint32_t((y + 1 + (y >> 8)) >> 8);  // floor(y / 255) for y < 65535
+                } else {
+                    o[k] = Fx<G>::blendByte(num);
+                }
+            }
+        }
+    }
+    const uint32_t mask = wordMask(p);
+    const uint32_t alphaFill = x8 ? 0xff000000u : 0u;
+    for (int k = 0; k < m; ++k) {
+        uint32_t w = packArgb(out[0][k], out[1][k], out[2][k], out[3][k]) | alphaFill;
+        if (mask != 0xffffffffu) w = (w & mask) | (word[k] & ~mask);
+        store32(addr[k], w);
+    }
+    n.written += uint64_t(m);
 }
 
 template <int32_t G>
@@ -452,7 +601,14 @@ void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[
     using F = Fx<G>;
     const uint32_t mask = wordMask(p);
     const bool x8 = p.target == TargetKind::Xrgb8;
-    const Lanes lanes{in};
+    const Lanes lanes(in, p);
+    const Surf cs = p.colorSurf;
+    const DepthCtx dc = depthCtxOf(p);
+    const DepthCtx* depth = p.depthTest ? &dc : nullptr;
+    const bool fog = p.fog, alphaTest = p.alphaTest, blend = p.blend, hasColor = p.color != nullptr;
+    const uint32_t alphaMask = p.alphaMask, alphaRef = p.alphaRef;
+    ChannelPlan ch[4];
+    std::copy_n(p.ch, 4, ch);
     int32_t v[kSlots];
     v[kZero] = 0, v[kOne] = G;
     for (int c = 0; c < 4; ++c) v[kBf + c] = int32_t(p.bfByte[c]) * F::S;
@@ -461,19 +617,19 @@ void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[
     for (int i = 0; i < in.count; ++i) {
         if (in.live && !in.live[i]) continue;
         uint32_t x, y;
-        if (!lanes.inside(i, x, y, p)) continue;
+        if (!lanes.inside(i, x, y)) continue;
         int32_t s[4];
         for (int c = 0; c < 4; ++c) s[c] = std::clamp(g[c][i], 0, G);  // the 8-bit target saturates
-        if (p.fog) {
+        if (fog) {
             // colour = f * colour + (1 - f) * FOGCOLOR, exact on the grid, rounded once.
             const int32_t fq = F::fogGrid(lanes.fog(i));
             for (int c = 0; c < 3; ++c) s[c] = divRoundEven<G>(int64_t(fq) * s[c] + int64_t(G - fq) * fogG[c]);
         }
-        const bool alphaPass = !p.alphaTest || cmpPass(p.alphaMask, F::byteOf(s[3]), p.alphaRef);
-        if (!tests(p, alphaPass, x, y, lanes.z(i), n) || !p.color) continue;
-        uint8_t* q = p.color->texel(x, y);
+        const bool alphaPass = !alphaTest || cmpPass(alphaMask, F::byteOf(s[3]), alphaRef);
+        if (!tests(depth, alphaPass, x, y, lanes.z(i), n) || !hasColor) continue;
+        uint8_t* q = cs.at(x, y);
         uint32_t out[4];
-        if (!p.blend) {
+        if (!blend) {
             for (int c = 0; c < 4; ++c) out[c] = F::byteOf(s[c]);
         } else {
             const uint32_t old = load32(q);
@@ -484,12 +640,12 @@ void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[
             v[kDst + 3] = x8 ? G : int32_t(old >> 24) * F::S;  // X8R8G8B8's alpha reads 1
             v[kSat] = std::min(s[3], G - v[kDst + 3]);
             for (int c = 0; c < 4; ++c) {
-                const ChannelPlan& cp = p.ch[c];
+                const ChannelPlan& cp = ch[c];
                 const int32_t d = v[kDst + c];
                 if (cp.kind == OpKind::Linear) {
                     const int32_t fs = cp.src.inv ? G - v[cp.src.slot] : v[cp.src.slot];
                     const int32_t fd = cp.dst.inv ? G - v[cp.dst.slot] : v[cp.dst.slot];
-                    out[c] = F::blendByte(int64_t(cp.cs) * s[c] * fs + int64_t(cp.cd) * d * fd);
+                    out[c] = F::blendByte(cp.cs * s[c] * fs + cp.cd * d * fd);
                 } else {
                     out[c] = F::byteOf(cp.kind == OpKind::Min ? std::min(s[c], d) : std::max(s[c], d));
                 }
@@ -531,7 +687,12 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     const bool unorm = !p.color || p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8;
     const bool x8 = p.target == TargetKind::Xrgb8;
     const uint32_t mask = unorm ? wordMask(p) : 0;
-    const Lanes lanes{in};
+    const Lanes lanes(in, p);
+    const Surf cs = p.colorSurf;
+    const DepthCtx dc = depthCtxOf(p);
+    const DepthCtx* depth = p.depthTest ? &dc : nullptr;
+    ChannelPlan ch[4];
+    std::copy_n(p.ch, 4, ch);
     float v[kSlots];
     v[kZero] = 0.0f, v[kOne] = 1.0f;
     for (int c = 0; c < 4; ++c) v[kBf + c] = float(p.bfByte[c]) / 255.0f;
@@ -542,7 +703,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     for (int i = 0; i < in.count; ++i) {
         if (in.live && !in.live[i]) continue;
         uint32_t x, y;
-        if (!lanes.inside(i, x, y, p)) continue;
+        if (!lanes.inside(i, x, y)) continue;
         float s[4];
         bool alphaPass = true;
         if (fx) {
@@ -578,8 +739,8 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
                                   : cmpPass(p.alphaMask, double(s[3]) * 255.0, double(p.alphaRef));
             }
         }
-        if (!tests(p, alphaPass, x, y, lanes.z(i), n) || !p.color) continue;
-        uint8_t* q = p.color->texel(x, y);
+        if (!tests(depth, alphaPass, x, y, lanes.z(i), n) || !p.color) continue;
+        uint8_t* q = cs.at(x, y);
         if (unorm) {
             uint32_t out[4];
             if (!p.blend) {
@@ -592,7 +753,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
                 v[kDst + 3] = x8 ? 1.0f : float(old >> 24) / 255.0f;
                 for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c];
                 v[kSat] = std::min(s[3], 1.0f - v[kDst + 3]);
-                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(blendFloat(p.ch[c], v, s[c], v[kDst + c])));
+                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(blendFloat(ch[c], v, s[c], v[kDst + c])));
             }
             uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
             if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
@@ -616,7 +777,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
             }
             for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
             v[kSat] = std::min(s[3], 1.0f - d[3]);
-            for (int c = 0; c < 4; ++c) s[c] = blendFloat(p.ch[c], v, s[c], d[c]);
+            for (int c = 0; c < 4; ++c) s[c] = blendFloat(ch[c], v, s[c], d[c]);
         }
         for (int c = 0; c < 4; ++c) {
             if (!(p.channels >> c & 1u)) continue;
@@ -628,6 +789,40 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
             }
         }
     }
+}
+
+// Float targets without fog, tests or blending: convert and store the live lanes' channels.
+void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
+    const Surf cs = p.colorSurf;
+    const Lanes lanes(in, p);
+    const uint32_t channels = p.channels;
+    const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
+    const uint8_t* live = in.live;
+    uint64_t written = 0;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        uint8_t* q = cs.at(x, y);
+        ++written;
+        if (p.target == TargetKind::Rgba16F) {
+            const uint16_t h[4] = {halfOf(f0[i]), halfOf(f1[i]), halfOf(f2[i]), halfOf(f3[i])};
+            if (channels == 0xfu) {
+                std::memcpy(q, h, 8);
+            } else {
+                for (int c = 0; c < 4; ++c)
+                    if (channels >> c & 1u) std::memcpy(q + 2 * c, &h[c], 2);
+            }
+        } else {
+            const float v[4] = {f0[i], f1[i], f2[i], f3[i]};
+            if (channels == 0xfu) {
+                std::memcpy(q, v, 16);
+            } else {
+                for (int c = 0; c < 4; ++c)
+                    if (channels >> c & 1u) std::memcpy(q + 4 * c, &v[c], 4);  // R32F: only red is enabled
+            }
+        }
+    }
+    n.written += written;
 }
 
 [[maybe_unused]] bool supportedColor(const Image* img) {
@@ -744,17 +939,31 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
 
     Counts n;
     const bool unorm = p.color && (p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8);
-    if (!p.color || unorm) {
+    // fx8 ONE/ONE ADD on every channel (additive passes).
+    bool additive = p.blend && state.precision == Precision::Fx8;
+    for (const ChannelPlan& cp : p.ch)
+        additive = additive && cp.kind == OpKind::Linear && cp.cs == 1 && cp.cd == 1 && cp.src.slot == kOne &&
+                   !cp.src.inv && cp.dst.slot == kOne && !cp.dst.inv;
+    if (unorm && !p.fog && !p.alphaTest && !p.depthTest && (!p.blend || additive) && p.channels) {
+        if (additive)
+            storeUnorm8Plain<true>(p, lanes, grid, color, n);
+        else
+            storeUnorm8Plain<false>(p, lanes, grid, color, n);
+    } else if (unorm && fx && !p.fog && !p.alphaTest && !p.depthTest && p.channels) {
+        if (state.precision == Precision::Fx8)
+            blendFxUnorm8Simple<255>(p, lanes, grid, n);
+        else
+            blendFxUnorm8Simple<4080>(p, lanes, grid, n);
+    } else if (!p.color || unorm) {
         if (state.precision == Precision::Fx8) {
-            if (p.color && !p.fog && !p.alphaTest && !p.depthTest && !p.blend && p.channels)
-                storeFx8Plain(p, lanes, grid, n);
-            else
-                mergeFxUnorm8<255>(p, lanes, grid, n);
+            mergeFxUnorm8<255>(p, lanes, grid, n);
         } else if (state.precision == Precision::Fx12) {
             mergeFxUnorm8<4080>(p, lanes, grid, n);
         } else {
             mergeFloat(p, lanes, FloatSource{color, grid, G}, n);
         }
+    } else if (!p.fog && !p.alphaTest && !p.depthTest && !p.blend) {
+        storeFloatPlain(p, lanes, color, n);
     } else {
         mergeFloat(p, lanes, FloatSource{color, grid, G}, n);
     }

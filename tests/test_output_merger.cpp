@@ -376,8 +376,25 @@ TEST_CASE("merger: fx12 blending is exact on the 4080 grid and rounds once to 8 
         }
 }
 
+TEST_CASE("merger: blending behind a passing alpha or depth test gives the same bytes", "[merger]") {
+    // Fog, alpha test and depth test take the general per-pixel loop; blending there must agree
+    // with the formula too (an ALWAYS test changes nothing).
+    uint32_t seed = 5000;
+    for (Precision p : {Precision::Fx8, Precision::Fx12})
+        for (D3DBLENDOP op : kAllOps)
+            for (D3DBLEND f : kAllBlends) {
+                MergeState st = blendState(f, D3DBLEND_INVSRCCOLOR, op, p);
+                st.alphaTest = true, st.alphaFunc = D3DCMP_ALWAYS;
+                st.separateAlpha = true, st.srcBlendAlpha = D3DBLEND_DESTALPHA, st.dstBlendAlpha = f;
+                st.blendOpAlpha = D3DBLENDOP_REVSUBTRACT;
+                checkBlendFx(st, seed % 2 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8, seed);
+                ++seed;
+            }
+}
+
 TEST_CASE("merger: X8R8G8B8 reads destination alpha as 1 and stores X = 0xff", "[merger]") {
     uint32_t seed = 4000;
+    checkBlendFx(blendState(D3DBLEND_ONE, D3DBLEND_ONE, D3DBLENDOP_ADD, Precision::Fx8), D3DFMT_X8R8G8B8, seed++);
     for (D3DBLEND f : {D3DBLEND_DESTALPHA, D3DBLEND_INVDESTALPHA, D3DBLEND_SRCALPHASAT, D3DBLEND_DESTCOLOR}) {
         checkBlendFx(blendState(D3DBLEND_ONE, f, D3DBLENDOP_ADD, Precision::Fx8), D3DFMT_X8R8G8B8, seed++);
         checkBlendFx(blendState(f, D3DBLEND_ONE, D3DBLENDOP_ADD, Precision::Fx12), D3DFMT_X8R8G8B8, seed++);
@@ -433,7 +450,8 @@ TEST_CASE("merger: float and ideal profiles blend into 8-bit targets", "[merger]
                 std::vector<std::array<uint32_t, 4>> dst(64);
                 for (int i = 0; i < 64; ++i) {
                     std::array<float, 4> v;
-                    for (int c = 0; c < 4; ++c) v[size_t(c)] = float((i * 7 + c * 3) % 9) / 8.0f;  // k/8
+                    for (int c = 0; c < 4; ++c)
+                        v[size_t(c)] = float((i * 7 + c * 3) % 13 - 2) / 8.0f;  // k/8, some outside [0, 1]
                     span.setColor(i, v);
                     for (int c = 0; c < 4; ++c) dst[size_t(i)][size_t(c)] = ((i >> c) & 1) * 255;
                     setRgba(img, uint32_t(i % 16), uint32_t(i / 16), dst[size_t(i)]);
@@ -441,8 +459,11 @@ TEST_CASE("merger: float and ideal profiles blend into 8-bit targets", "[merger]
                 run(st, span, &img);
                 for (int i = 0; i < 64; ++i) {
                     Q s[4], d[4];
-                    for (int c = 0; c < 4; ++c)
-                        s[c] = fromFloat(span.color[c][size_t(i)]), d[c] = mk(dst[size_t(i)][size_t(c)], 255);
+                    for (int c = 0; c < 4; ++c) {
+                        // The 8-bit target saturates the source before blending.
+                        s[c] = qmin(qmax(fromFloat(span.color[c][size_t(i)]), kZeroQ), kOneQ);
+                        d[c] = mk(dst[size_t(i)][size_t(c)], 255);
+                    }
                     const std::array<Q, 4> r = blendRef(st, s, d);
                     const std::array<uint32_t, 4> got = rgbaAt(img, uint32_t(i % 16), uint32_t(i / 16));
                     for (int c = 0; c < 4; ++c) {
@@ -575,6 +596,45 @@ TEST_CASE("merger: vertex fog lerps rgb toward FOGCOLOR by the fog factor", "[me
     st.precision = Precision::Fx8;
     run(st, span, &img);
     CHECK(rgbaAt(img, 0, 0)[0] == 150);
+}
+
+TEST_CASE("merger: fog on float targets works on the unclamped value", "[merger]") {
+    MergeState st;
+    st.fog = true;
+    st.fogColor = 0x00ff0000u;  // r 255, g 0, b 0: exact as floats
+    for (Precision p : {Precision::Fx8, Precision::Fx12, Precision::Ideal}) {
+        st.precision = p;
+        const int32_t G = ps11::gridScale(p);
+        Image img = makeImage(D3DFMT_A32B32G32R32F, 16, 1);
+        Span span(3);
+        const float fs[3] = {0.25f, 0.5f, 0.75f};
+        for (int i = 0; i < 3; ++i) {
+            span.fog[size_t(i)] = fs[i];
+            if (p == Precision::Ideal)
+                span.setColor(i, {3.0f, -1.5f, 0.5f, 2.0f});
+            else
+                span.setGrid(i, {2 * G, -G / 2 - 1, G / 3, 2 * G}, p);  // ps_1_4 range
+        }
+        run(st, span, &img);
+        const Q fog[3] = {kOneQ, kZeroQ, kZeroQ};
+        for (int i = 0; i < 3; ++i)
+            for (int c = 0; c < 4; ++c) {
+                Q want;
+                if (c == 3) {
+                    want = p == Precision::Ideal ? Q{2, 1} : mk(span.grid[3][0], G);
+                } else if (p == Precision::Ideal) {
+                    const Q f = fromFloat(fs[i]);  // dyadic: float32 is exact here
+                    want = f * fromFloat(span.color[c][0]) + (kOneQ - f) * fog[c];
+                } else {
+                    const int64_t fg = rhe(fromFloat(fs[i]) * Q{G, 1});
+                    const Q sv = mk(span.grid[c][0], G);
+                    const int64_t n = rhe((mk(fg, G) * sv + mk(G - fg, G) * fog[c]) * Q{G, 1});
+                    want = fromFloat(float(n) / float(G));  // the grid value as float32
+                }
+                INFO(ps11::precisionName(p) << " lane " << i << " c " << c);
+                CHECK(fromFloat(floatAt(img, uint32_t(i), 0, c)) == want);
+            }
+    }
 }
 
 // ---- alpha test -----------------------------------------------------------------------------
@@ -1059,4 +1119,137 @@ TEST_CASE("merger: writesNothing only when no pixel can change the target", "[me
     span.setColor(0, {INFINITY, NAN, -INFINITY, 1.0f});
     run(st, span, &img);
     CHECK(img.bytes == before);
+}
+
+TEST_CASE("merger: null live means every lane; null z reads 0", "[merger]") {
+    Image img = makeImage(D3DFMT_A8R8G8B8, 16, 1);
+    Image depth = makeImage(D3DFMT_D16, 16, 1);
+    for (uint32_t x = 0; x < 16; ++x) {
+        const uint16_t w = 100;
+        std::memcpy(depth.texel(x, 0), &w, 2);
+    }
+    Span span(16);
+    for (int i = 0; i < 16; ++i) span.setGrid(i, {i, 2 * i, 3 * i, 255}, Precision::Fx8);
+    MergeInputs in = span.inputs(true);
+    in.live = nullptr;
+    in.z = nullptr;
+    MergeState st;
+    st.depthTest = true, st.depthWrite = true, st.depthFunc = D3DCMP_LESS;
+    MergeStats stats;
+    mergePixels(st, in, MergeTarget{&img, &depth}, &stats);
+    CHECK(stats.written == 16);
+    for (uint32_t x = 0; x < 16; ++x) {
+        CHECK(rgbaAt(img, x, 0) == std::array<uint32_t, 4>{x, 2 * x, 3 * x, 255});
+        CHECK(depthWord(depth, x) == 0u);
+    }
+}
+
+TEST_CASE("merger: random states through the whole pipeline match a per-pixel model", "[merger]") {
+    // Fog, alpha test, depth test/write, blending (separate alpha too) and write masks drawn at
+    // random, in fx8 and fx12 on A8R8G8B8 / X8R8G8B8 with D16 depth; every pixel is predicted by
+    // the formulas above, stage by stage, in D3D9's order.
+    std::mt19937 rng(2024);
+    for (int round = 0; round < 400; ++round) {
+        const Precision p = round % 2 ? Precision::Fx12 : Precision::Fx8;
+        const int32_t G = ps11::gridScale(p);
+        const D3DFORMAT fmt = (round / 2) % 3 == 0 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8;
+        const bool x8 = fmt == D3DFMT_X8R8G8B8;
+        MergeState st;
+        st.precision = p;
+        st.fog = rng() % 2;
+        st.fogColor = rng();
+        st.alphaTest = rng() % 2;
+        st.alphaFunc = kAllCmps[rng() % 8];
+        st.alphaRef = rng() % 256;
+        st.depthTest = rng() % 3 != 0;
+        st.depthWrite = st.depthTest && rng() % 2;
+        st.depthFunc = kAllCmps[rng() % 8];
+        st.blend = rng() % 4 != 0;
+        st.srcBlend = kAllBlends[rng() % 15], st.dstBlend = kAllBlends[rng() % 15];
+        st.blendOp = kAllOps[rng() % 5];
+        st.separateAlpha = rng() % 2;
+        st.srcBlendAlpha = kAllBlends[rng() % 15], st.dstBlendAlpha = kAllBlends[rng() % 15];
+        st.blendOpAlpha = kAllOps[rng() % 5];
+        st.blendFactor = rng();
+        st.colorWrite = rng() % 3 == 0 ? rng() % 16 : 0xf;
+        Image color = makeImage(fmt, 16, 16);
+        Image depth = makeImage(D3DFMT_D16, 16, 16);
+        Span span(256);
+        std::vector<std::array<uint32_t, 4>> dst(256);
+        std::vector<uint16_t> dz(256);
+        for (int i = 0; i < 256; ++i) {
+            std::array<int32_t, 4> n;
+            for (int c = 0; c < 4; ++c) n[size_t(c)] = int32_t(rng() % (G + 41u)) - 20;
+            span.setGrid(i, n, p);
+            span.live[size_t(i)] = rng() % 8 != 0;
+            span.fog[size_t(i)] = float(int(rng() % 1200) - 100) / 1000.0f;
+            span.z[size_t(i)] = float(rng() % 64) / 63.0f;
+            for (int c = 0; c < 4; ++c) dst[size_t(i)][size_t(c)] = rng() % 256;
+            setRgba(color, uint32_t(i % 16), uint32_t(i / 16), dst[size_t(i)]);
+            dz[size_t(i)] = uint16_t(depthCodeRef(float(rng() % 64) / 63.0f, 16));
+            std::memcpy(depth.texel(uint32_t(i % 16), uint32_t(i / 16)), &dz[size_t(i)], 2);
+        }
+        const MergeStats stats = run(st, span, &color, &depth);
+        // The rgb pair the blend leaves as is (ZERO, ONE with ADD or REVSUBTRACT) is not written:
+        // it matters only for X8R8G8B8's X byte.
+        D3DBLEND rs = st.srcBlend, rd = st.dstBlend;
+        pairRef(rs, rd);
+        const bool rgbKept = st.blend && rs == D3DBLEND_ZERO && rd == D3DBLEND_ONE &&
+                             (st.blendOp == D3DBLENDOP_ADD || st.blendOp == D3DBLENDOP_REVSUBTRACT);
+        uint64_t written = 0, aRej = 0, zRej = 0;
+        for (int i = 0; i < 256; ++i) {
+            const uint32_t x = uint32_t(i % 16), y = uint32_t(i / 16);
+            std::array<uint32_t, 4> want = dst[size_t(i)];
+            uint16_t wantZ = dz[size_t(i)];
+            if (span.live[size_t(i)]) {
+                Q s[4];
+                int32_t n[4];
+                for (int c = 0; c < 4; ++c) n[c] = std::clamp(span.grid[c][size_t(i)], 0, G);
+                if (st.fog) {
+                    const float f = std::clamp(span.fog[size_t(i)], 0.0f, 1.0f);
+                    const int64_t fg = rhe(fromFloat(f) * Q{G, 1});
+                    for (int c = 0; c < 3; ++c) {
+                        const Q fogc = mk((st.fogColor >> (16 - 8 * c)) & 255, 255);
+                        n[c] = int32_t(rhe((mk(fg, G) * mk(n[c], G) + mk(G - fg, G) * fogc) * Q{G, 1}));
+                    }
+                }
+                for (int c = 0; c < 4; ++c) s[c] = mk(n[c], G);
+                const uint32_t alpha8 = byteOfQ(s[3]);
+                const uint64_t code = depthCodeRef(span.z[size_t(i)], 16);
+                if (st.alphaTest && !cmpRef(st.alphaFunc, alpha8, st.alphaRef)) {
+                    ++aRej;
+                } else if (st.depthTest && !cmpRef(st.depthFunc, code, uint64_t(dz[size_t(i)]))) {
+                    ++zRej;
+                } else {
+                    ++written;
+                    if (st.depthWrite) wantZ = uint16_t(code);
+                    std::array<uint32_t, 4> v;
+                    if (st.blend) {
+                        Q d[4];
+                        for (int c = 0; c < 4; ++c) d[c] = mk(dst[size_t(i)][size_t(c)], 255);
+                        if (x8) d[3] = kOneQ;
+                        const std::array<Q, 4> r = blendRef(st, s, d);
+                        for (int c = 0; c < 4; ++c) v[size_t(c)] = byteOfQ(r[size_t(c)]);
+                    } else {
+                        for (int c = 0; c < 4; ++c) v[size_t(c)] = byteOfQ(s[c]);
+                    }
+                    for (int c = 0; c < 3; ++c)
+                        if (st.colorWrite >> c & 1u) want[size_t(c)] = v[size_t(c)];
+                    if (x8) {
+                        if ((st.colorWrite & 7u) && !rgbKept) want[3] = 255;
+                    } else if (st.colorWrite & 8u) {
+                        want[3] = v[3];
+                    }
+                }
+            }
+            uint16_t gotZ;
+            std::memcpy(&gotZ, depth.texel(x, y), 2);
+            INFO("round " << round << " lane " << i);
+            REQUIRE(rgbaAt(color, x, y) == want);
+            REQUIRE(gotZ == wantZ);
+        }
+        CHECK(stats.written == written);
+        CHECK(stats.alphaRejected == aRej);
+        CHECK(stats.depthRejected == zRej);
+    }
 }
