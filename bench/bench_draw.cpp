@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "emu/device.h"
+#include "emu/raster.h"
 
 namespace {
 
@@ -127,8 +128,44 @@ void BM_Draw(benchmark::State& state, Pass pass) {
     state.counters["texels/px"] = double(st.texelsFetched) / (double(kW) * kH);
 }
 
+// The rasteriser alone over the 1080p half-pixel quad: spans with the blur's inputs (4 slots:
+// u, v as planes, w = 0 and q = 1 constant), no shading — the draw's own cost per pixel.
+void BM_Raster(benchmark::State& state) {
+    const int slots = int(state.range(0));
+    auto V = [&](double x, double y, float u, float v) {
+        ScreenVertex s;
+        s.x = x;
+        s.y = y;
+        for (int t = 0; t < slots; ++t) {
+            s.attr[size_t(attrTex(t, 0))] = u + 0.5f * float(t) / kW;
+            s.attr[size_t(attrTex(t, 1))] = v;
+            s.attr[size_t(attrTex(t, 3))] = 1.0f;
+        }
+        return s;
+    };
+    const ScreenVertex a = V(-0.5, -0.5, 0, 0), b = V(kW - 0.5, -0.5, 1, 0), c = V(kW - 0.5, kH - 0.5, 1, 1),
+                       d = V(-0.5, kH - 0.5, 0, 1);
+    const ScreenTriangle tris[2] = {ScreenTriangle{{a, b, c}}, ScreenTriangle{{a, c, d}}};
+    uint64_t used = 0;
+    for (int t = 0; t < slots; ++t) used |= uint64_t(0xF) << attrTex(t, 0);
+    auto span = std::make_unique<QuadSpan>();
+    uint64_t lanes = 0;
+    const std::function<void(QuadSpan&)> emit = [&](QuadSpan& sp) { lanes += uint64_t(sp.count); };
+    for (auto _ : state) {
+        for (const ScreenTriangle& t : tris) {
+            TriangleSetup s;
+            if (setupTriangle(t, used, ClipRect{0, 0, int(kW), int(kH)}, s)) rasterizeRows(s, 0, kH, used, false, *span, emit);
+        }
+        benchmark::DoNotOptimize(span->attr[0][0]);
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
+    state.counters["ns/px"] =
+        benchmark::Counter(double(kW) * kH * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 
+BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)
     ->Arg(1)
