@@ -154,13 +154,14 @@ void BM_Raster(benchmark::State& state) {
     for (auto _ : state) {
         for (const ScreenTriangle& t : tris) {
             TriangleSetup s;
-            if (setupTriangle(t, used, ClipRect{0, 0, int(kW), int(kH)}, s)) rasterizeRows(s, 0, kH, used, false, *span, emit);
+            if (setupTriangle(t, used, ClipRect{0, 0, int(kW), int(kH)}, s))
+                rasterizeRows(s, 0, kH, used, false, *span, emit);
         }
         benchmark::DoNotOptimize(span->attr[0][0]);
     }
     state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
-    state.counters["ns/px"] =
-        benchmark::Counter(double(kW) * kH * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    state.counters["ns/px"] = benchmark::Counter(
+        double(kW) * kH * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace

@@ -160,7 +160,7 @@ void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool w
         } else {
             qx0 = l1, qx1 = r1;
         }
-        qx0 &= ~1;                // quads at even coordinates (clip rects start at >= 0)
+        qx0 &= ~1;  // quads at even coordinates (clip rects start at >= 0)
         qx1 = (qx1 + 1) & ~1;
         constexpr int kQuadCols = ps11::kMaxSpan / 2;  // pixels per row of one span
         for (int sx = qx0; sx < qx1; sx += kQuadCols) {

@@ -274,7 +274,8 @@ TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[dra
         DWORD c;
     };
     // A quad far larger than the clip volume (x, y in ±5): clipped to the viewport [10, 30) × [4, 14).
-    const V q[4] = {{-5, 5, 0.5f, 0xff00ff00}, {5, 5, 0.5f, 0xff00ff00}, {-5, -5, 0.5f, 0xff00ff00}, {5, -5, 0.5f, 0xff00ff00}};
+    const V q[4] = {
+        {-5, 5, 0.5f, 0xff00ff00}, {5, 5, 0.5f, 0xff00ff00}, {-5, -5, 0.5f, 0xff00ff00}, {5, -5, 0.5f, 0xff00ff00}};
     REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
     const auto px = readTarget(dev, rt, W, H);
     for (UINT y = 0; y < H; ++y)
@@ -324,9 +325,11 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     expectFail(D3DERR_INVALIDCALL, "E4115", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0, data, stride); });
     expectFail(D3DERR_INVALIDCALL, "E4115",
                [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0x100000, data, stride); });
-    expectFail(D3DERR_INVALIDCALL, "E4103", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, nullptr, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4103",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, nullptr, stride); });
     expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 0); });
-    expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride - 4); });
+    expectFail(D3DERR_INVALIDCALL, "E4116",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride - 4); });
     expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 4096); });
     REQUIRE(dev.SetFVF(0) == D3D_OK);
     expectFail(D3DERR_INVALIDCALL, "E4117", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
@@ -394,4 +397,47 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3D_OK);
     CHECK(dev.lastError().code.empty());
     CHECK(dev.totalDrawStats().draws == 1);
+}
+
+TEST_CASE("draw: thousands of triangles keep primitive order across chunks and threads", "[draw]") {
+    for (int threads : {1, 2}) {
+        DeviceOptions o;
+        o.threads = threads;
+        Device dev(o);
+        const int W = 100, H = 50;
+        Handle rt = target(dev, W, H, 0);
+        shader(dev, "ps_1_1\nmov r0, v0\n");
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
+        struct V {
+            float x, y, z, rhw;
+            DWORD c;
+        };
+        // Every pixel as its own 1×1 quad (two triangles) in colour A, then the even pixels again in
+        // colour B: 5000 + 2500 quads = 15000 triangles, later ones in later chunks.
+        std::vector<V> v;
+        auto cell = [&](int x, int y, DWORD c) {
+            const float x0 = x - 0.5f, y0 = y - 0.5f, x1 = x + 0.5f, y1 = y + 0.5f;
+            for (auto [px, py] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y0}, {x1, y1}, {x0, y1}})
+                v.push_back(V{px, py, 0, 1, c});
+        };
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) cell(x, y, 0xff000000u | DWORD(x << 8) | DWORD(y));
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x)
+                if ((x + y) % 2 == 0) cell(x, y, 0xffff0000u | DWORD(x));
+        const UINT tris = UINT(v.size() / 3);
+        REQUIRE(tris == 15000);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, tris, v.data(), sizeof(V)) == D3D_OK);
+        const auto px = readTarget(dev, rt, W, H);
+        int bad = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const uint32_t want =
+                    (x + y) % 2 == 0 ? (0xffff0000u | uint32_t(x)) : (0xff000000u | uint32_t(x << 8) | uint32_t(y));
+                bad += px[size_t(y * W + x)] != want;
+            }
+        CHECK(bad == 0);
+        CHECK(dev.lastDrawStats().pixelsCovered == uint64_t(W * H + W * H / 2));
+        CHECK(dev.lastDrawStats().trianglesDrawn == 15000);
+    }
 }
