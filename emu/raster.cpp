@@ -20,10 +20,12 @@ int64_t ceilDiv(int64_t n, int64_t d) { return n >= 0 ? (n + d - 1) / d : -((-n)
 // 2·(L/4) + (L & 1) and its row is (L >> 1) & 1.
 struct LaneTable {
     alignas(32) int32_t colInt[ps11::kMaxSpan];
+    alignas(32) float col[ps11::kMaxSpan];
     alignas(32) int32_t row[ps11::kMaxSpan];
     LaneTable() {
         for (int L = 0; L < ps11::kMaxSpan; ++L) {
             colInt[L] = 2 * (L >> 2) + (L & 1);
+            col[L] = float(colInt[L]);
             row[L] = (L >> 1) & 1;
         }
     }
@@ -41,12 +43,12 @@ void fillPlane(const Plane& p, double ox, double oy, int x0, int y0, int n, floa
     const float f0 = float(s0), f1 = float(s0 + p.dy), fdx = float(p.dx);
     const Quad4 base = {f0, f0, f1, f1};
     const Quad4 d = {fdx, fdx, fdx, fdx};
-    const Quad4 two = {2, 2, 2, 2};
-    Quad4 col = {0, 1, 0, 1};
+    // Columns from a table (no loop-carried dependency: a running column would serialise the adds).
     for (int q = 0; q < n / 4; ++q) {
+        Quad4 col;
+        std::memcpy(&col, kLanes.col + 4 * q, sizeof col);
         const Quad4 r = base + d * col;
         std::memcpy(out + 4 * q, &r, sizeof r);
-        col += two;
     }
 }
 
