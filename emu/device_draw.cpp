@@ -64,6 +64,12 @@ uint64_t attributesRead(const ps11::Program& program) {
     return used;
 }
 
+bool hasTexkill(const ps11::Program& program) {
+    for (const ps11::Instruction& ins : program.instructions)
+        if (ins.info && ins.opcode() == ps11::Opcode::TexKill) return true;
+    return false;
+}
+
 std::optional<ps11::Filter> filterOf(DWORD v, bool mip) {
     switch (v) {
         case D3DTEXF_NONE:
@@ -125,6 +131,7 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
 struct CachedExecutor {
     std::unique_ptr<ps11::Executor> executor;
     uint64_t attrs = 0;  // attributesRead of its program
+    bool kills = false;  // the program has texkill
     bool fixedFunction = false;
     std::array<ps11::StageState, kMaxStages> stages{};  // fixed function: LoweredStages::executorStages
 };
@@ -239,6 +246,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                 return drawFail(D3DERR_INVALIDCALL, "E4121",
                                 "the executor refused pixel shader " + num(uint32_t(m_state.pixelShader)));
             ce.attrs = attributesRead(*program);
+            ce.kills = hasTexkill(*program);
             if (dc.shaders.size() >= kMaxCachedExecutors) dc.shaders.clear();
             it = dc.shaders.emplace(key, std::move(ce)).first;
         }
@@ -267,6 +275,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             if (!ce.executor)
                 return drawFail(D3DERR_INVALIDCALL, "E4121", "the executor refused the fixed-function program");
             ce.attrs = attributesRead(lowered->program);
+            ce.kills = hasTexkill(lowered->program);
             ce.fixedFunction = true;
             ce.stages = lowered->executorStages;
             if (dc.ffpCount >= kMaxCachedExecutors) {
@@ -393,6 +402,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         return D3D_OK;
     }
     const bool shaderDepth = executor.writesDepth();
+    const bool kills = exec->kills;
     const bool wantZ = merge.depthTest || (merge.depthWrite && depth);
     uint64_t used = exec->attrs;
     if (merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
@@ -487,12 +497,14 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                 auto emit = [&](QuadSpan& sp) {
                     in.count = sp.count;
                     executor.run(in, sampler, outp, &es);
-                    for (int L = 0; L < sp.count; ++L) lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
+                    if (kills)
+                        for (int L = 0; L < sp.count; ++L)
+                            lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
                     MergeInputs mi;
                     mi.count = sp.count;
                     mi.x = sp.x;
                     mi.y = sp.y;
-                    mi.live = lanes->live;
+                    mi.live = kills ? lanes->live : sp.live;
                     for (int c = 0; c < 4; ++c) {
                         mi.color[c] = lanes->color[c];
                         mi.grid[c] = fx ? lanes->grid[c] : nullptr;

@@ -441,3 +441,20 @@ TEST_CASE("draw: thousands of triangles keep primitive order across chunks and t
         CHECK(dev.lastDrawStats().trianglesDrawn == 15000);
     }
 }
+
+TEST_CASE("draw: texkill discards pixels before the merger", "[draw]") {
+    Device dev;
+    const UINT W = 16, H = 6;
+    Handle rt = target(dev, W, H, 0xff000000);
+    shader(dev, "ps_1_1\ntexkill t0\nmov r0, v0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xff30c050);
+    // t0.u runs from −1 at the left edge to 1 at the right: u = −1 + 2(x + 0.5)/16 < 0 for x <= 7.
+    for (QuadVertex& q : v) q.uv[0][0] = q.uv[0][0] * 2 - 1;
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) CHECK(px[y * W + x] == (x >= 8 ? 0xff30c050u : 0xff000000u));
+    CHECK(dev.lastDrawStats().pixelsCovered == W * H);
+    CHECK(dev.lastDrawStats().pixelsWritten == 8 * H);
+}
