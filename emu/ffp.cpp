@@ -1,7 +1,8 @@
 // Fixed-function texture stages lowered to a ps_1_1 program (docs/fixed-function.md). Every
 // D3DTOP operation is one arithmetic instruction whose exact result is the D3D formula, so the
-// executor rounds each stage once, like any shader instruction; colour and alpha halves are a
-// co-issued pair (both read before either writes, as the two halves of a stage do).
+// executor rounds each stage once, like any shader instruction (PREMODULATE adds an exact select
+// and one multiply in the next stage; bump mapping is texbem/texbeml); colour and alpha halves are
+// a co-issued pair (both read before either writes, as the two halves of a stage do).
 #include "emu/ffp.h"
 
 #include <array>
@@ -86,6 +87,11 @@ private:
     int constant(const std::array<float, 4>& value);
     bool arg(int stage, D3DTEXTURESTAGESTATETYPE which, Src& out);
     bool lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out);
+    bool lowerBump(int stage, int active);
+    bool lowerStage(int stage);
+    bool lowerPremodulate(int stage);
+    void lowerOutput();
+    void assemble(LoweredStages& out) const;
     Src current() const { return reg(m_r0Written ? RegType::Temp : RegType::Input, 0); }
     Src temp() { return m_r1Written ? reg(RegType::Temp, 1) : constSrc(constant({0, 0, 0, 0})); }
     static Src reg(RegType t, int index) {
@@ -105,6 +111,10 @@ private:
     uint32_t m_sampled = 0;
     std::array<bool, kMaxStages> m_bumpInto{};  // stage i's texture is looked up by texbem(l)
     std::vector<Instruction> m_arith;
+    // PREMODULATE of the previous stage: its destination and the channels to modulate.
+    uint8_t m_premodMask = 0;
+    uint8_t m_premodReg = 0;
+    bool m_premodAlpha = false;  // the alpha half was PREMODULATE (for the error's state name)
 };
 
 bool Lowering::checkOp(int stage, D3DTEXTURESTAGESTATETYPE which, bool alpha) {
@@ -112,10 +122,6 @@ bool Lowering::checkOp(int stage, D3DTEXTURESTAGESTATETYPE which, bool alpha) {
     const DWORD op = tss(stage, which);
     if (op < D3DTOP_DISABLE || op > D3DTOP_LERP)
         return fail("E4140", stage, name, "unknown texture operation " + std::to_string(op) + " (D3DTOP_* is 1..26)");
-    if (op == D3DTOP_PREMODULATE)
-        return fail("E4145", stage, name,
-                    "D3DTOP_PREMODULATE is not supported (no D3DTEXOPCAPS_PREMODULATE; "
-                    "ValidateDevice: D3DERR_UNSUPPORTEDCOLOROPERATION)");
     if (alpha && colorOnly(op))
         return fail("E4144", stage, name,
                     "texture operation " + std::to_string(op) + " is a colour-only operation (D3DTSS_COLOROP only)");
@@ -159,15 +165,27 @@ bool Lowering::arg(int stage, D3DTEXTURESTAGESTATETYPE which, Src& out) {
                     "unknown texture argument " + hex(a) +
                         " (D3DTA_DIFFUSE..D3DTA_CONSTANT with D3DTA_COMPLEMENT / D3DTA_ALPHAREPLICATE)");
     switch (sel) {
-        case D3DTA_DIFFUSE: out = reg(RegType::Input, 0); break;
-        case D3DTA_CURRENT: out = current(); break;  // stage 0 (nothing written yet): diffuse
+        case D3DTA_DIFFUSE:
+            out = reg(RegType::Input, 0);
+            break;
+        case D3DTA_CURRENT:
+            out = current();
+            break;  // stage 0 (nothing written yet): diffuse
         case D3DTA_TEXTURE:
             if (!texture(stage, name, out)) return false;
             break;
-        case D3DTA_TFACTOR: out = constSrc(constant(colorFloats(m_state.renderState(D3DRS_TEXTUREFACTOR)))); break;
-        case D3DTA_SPECULAR: out = reg(RegType::Input, 1); break;
-        case D3DTA_TEMP: out = temp(); break;  // unwritten TEMP reads 0 (DXVK, Wine)
-        default: out = constSrc(constant(colorFloats(tss(stage, D3DTSS_CONSTANT)))); break;
+        case D3DTA_TFACTOR:
+            out = constSrc(constant(colorFloats(m_state.renderState(D3DRS_TEXTUREFACTOR))));
+            break;
+        case D3DTA_SPECULAR:
+            out = reg(RegType::Input, 1);
+            break;
+        case D3DTA_TEMP:
+            out = temp();
+            break;  // unwritten TEMP reads 0 (DXVK, Wine)
+        default:
+            out = constSrc(constant(colorFloats(tss(stage, D3DTSS_CONSTANT))));
+            break;
     }
     if (a & D3DTA_COMPLEMENT) out.mod = SrcMod::Comp;
     // The modifier applies after the selector, and 1 - x.a = (1 - x).a, so the order of the two
@@ -195,7 +213,7 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
     const auto A2 = alpha ? D3DTSS_ALPHAARG2 : D3DTSS_COLORARG2;
     Src a0, a1, a2;
     const bool uses0 = op == D3DTOP_MULTIPLYADD || op == D3DTOP_LERP;
-    const bool uses2 = op != D3DTOP_SELECTARG1;
+    const bool uses2 = op != D3DTOP_SELECTARG1 && op != D3DTOP_PREMODULATE;
     const bool uses1 = op != D3DTOP_SELECTARG2;
     if (uses1 && !arg(stage, A1, a1)) return false;
     if (uses2 && !arg(stage, A2, a2)) return false;
@@ -203,9 +221,16 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
     const char* opName = alpha ? "D3DTSS_ALPHAOP" : "D3DTSS_COLOROP";
     Dst d = dst;
     switch (op) {
-        case D3DTOP_SELECTARG1: emit("mov", d, {a1}, out); break;
-        case D3DTOP_SELECTARG2: emit("mov", d, {a2}, out); break;
-        case D3DTOP_MODULATE: emit("mul", d, {a1, a2}, out); break;
+        case D3DTOP_SELECTARG1:
+        case D3DTOP_PREMODULATE:  // ARG1 now; the next stage first multiplies it by its texture
+            emit("mov", d, {a1}, out);
+            break;
+        case D3DTOP_SELECTARG2:
+            emit("mov", d, {a2}, out);
+            break;
+        case D3DTOP_MODULATE:
+            emit("mul", d, {a1, a2}, out);
+            break;
         case D3DTOP_MODULATE2X:
             d.shift = 1;
             emit("mul", d, {a1, a2}, out);
@@ -214,17 +239,25 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
             d.shift = 2;
             emit("mul", d, {a1, a2}, out);
             break;
-        case D3DTOP_ADD: emit("add", d, {a1, a2}, out); break;
-        case D3DTOP_ADDSIGNED: emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out); break;
+        case D3DTOP_ADD:
+            emit("add", d, {a1, a2}, out);
+            break;
+        case D3DTOP_ADDSIGNED:
+            emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out);
+            break;
         case D3DTOP_ADDSIGNED2X:
             d.shift = 1;
             emit("add", d, {a1, withMod(a2, biased(a2.mod))}, out);
             break;
-        case D3DTOP_SUBTRACT: emit("sub", d, {a1, a2}, out); break;
+        case D3DTOP_SUBTRACT:
+            emit("sub", d, {a1, a2}, out);
+            break;
         case D3DTOP_ADDSMOOTH:  // a1 + a2 - a1·a2 = (1 - a1)·a2 + a1
             emit("mad", d, {withMod(a1, invert(a1.mod)), a2, a1}, out);
             break;
-        case D3DTOP_BLENDDIFFUSEALPHA: emit("lrp", d, {alphaOf(reg(RegType::Input, 0)), a1, a2}, out); break;
+        case D3DTOP_BLENDDIFFUSEALPHA:
+            emit("lrp", d, {alphaOf(reg(RegType::Input, 0)), a1, a2}, out);
+            break;
         case D3DTOP_BLENDTEXTUREALPHA: {
             Src t;
             if (!texture(stage, opName, t)) return false;
@@ -243,7 +276,9 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
             emit("mad", d, {a2, withMod(alphaOf(t), SrcMod::Comp), a1}, out);
             break;
         }
-        case D3DTOP_BLENDCURRENTALPHA: emit("lrp", d, {alphaOf(current()), a1, a2}, out); break;
+        case D3DTOP_BLENDCURRENTALPHA:
+            emit("lrp", d, {alphaOf(current()), a1, a2}, out);
+            break;
         case D3DTOP_MODULATEALPHA_ADDCOLOR:  // a1.rgb + a1.a·a2.rgb
             emit("mad", d, {alphaOf(a1), a2, a1}, out);
             break;
@@ -259,9 +294,14 @@ bool Lowering::lowerHalf(int stage, bool alpha, const Dst& dst, Instruction& out
         case D3DTOP_DOTPRODUCT3:  // Σ (2·a1 - 1)(2·a2 - 1) over rgb
             emit("dp3", d, {withMod(a1, signedMod(a1.mod)), withMod(a2, signedMod(a2.mod))}, out);
             break;
-        case D3DTOP_MULTIPLYADD: emit("mad", d, {a1, a2, a0}, out); break;
-        case D3DTOP_LERP: emit("lrp", d, {a0, a1, a2}, out); break;
-        default: return fail("E4140", stage, opName, "texture operation " + std::to_string(op) + " cannot be lowered");
+        case D3DTOP_MULTIPLYADD:
+            emit("mad", d, {a1, a2, a0}, out);
+            break;
+        case D3DTOP_LERP:
+            emit("lrp", d, {a0, a1, a2}, out);
+            break;
+        default:
+            return fail("E4140", stage, opName, "texture operation " + std::to_string(op) + " cannot be lowered");
     }
     return true;
 }
@@ -277,89 +317,109 @@ bool sameInstruction(const Instruction& a, const Instruction& b) {
     return true;
 }
 
-std::optional<LoweredStages> Lowering::run() {
-    LoweredStages out;
-    int active = 0;
-    for (; active < kMaxStages; ++active) {
-        const DWORD cop = tss(active, D3DTSS_COLOROP);
-        if (cop == D3DTOP_DISABLE) break;  // disables this stage and every later one, alpha included
-        if (!checkOp(active, D3DTSS_COLOROP, false)) return std::nullopt;
+// A BUMPENVMAP(LUMINANCE) stage: it samples its own texture (du, dv[, l]) and perturbs the next
+// stage's lookup; it outputs nothing, so CURRENT after it is still the value before it
+// (D3DTA_CURRENT page), and its ALPHAOP and RESULTARG are not used.
+bool Lowering::lowerBump(int i, int active) {
+    if (i + 1 >= active)
+        return fail("E4143", i, "D3DTSS_COLOROP",
+                    "D3DTOP_BUMPENVMAP needs an enabled next stage whose texture it perturbs");
+    Src t;
+    if (!texture(i, "D3DTSS_COLOROP", t)) return false;
+    if (i + 1 >= kMaxFixedFunctionTextures)
+        return fail("E4142", i, "D3DTSS_COLOROP",
+                    "D3DTOP_BUMPENVMAP looks up stage " + std::to_string(i + 1) + "'s texture, but only stages 0.." +
+                        std::to_string(kMaxFixedFunctionTextures - 1) + " can sample");
+    m_sampled |= 1u << (i + 1);
+    m_bumpInto[size_t(i + 1)] = true;
+    return true;
+}
+
+// A blending stage: its colour and alpha halves as a co-issued pair into CURRENT or TEMP.
+bool Lowering::lowerStage(int i) {
+    const DWORD cop = tss(i, D3DTSS_COLOROP);
+    const DWORD result = tss(i, D3DTSS_RESULTARG);
+    if (result != D3DTA_CURRENT && result != D3DTA_TEMP)
+        return fail("E4146", i, "D3DTSS_RESULTARG",
+                    "result argument " + hex(result) + " is neither D3DTA_CURRENT nor D3DTA_TEMP");
+    const bool toTemp = result == D3DTA_TEMP;
+    Dst dst;
+    dst.type = RegType::Temp;
+    dst.index = toTemp ? 1 : 0;
+    dst.saturate = true;
+    bool& written = toTemp ? m_r1Written : m_r0Written;
+
+    m_premodReg = dst.index;
+    m_premodMask = cop == D3DTOP_PREMODULATE ? ps11::kMaskRGB : 0;
+    m_premodAlpha = false;
+    if (cop == D3DTOP_DOTPRODUCT3) {
+        // Replicated to all four channels, alpha included: the stage's ALPHAOP is not used.
+        Instruction ins;
+        dst.mask = ps11::kMaskAll;
+        if (!lowerHalf(i, false, dst, ins)) return false;
+        m_arith.push_back(ins);
+        written = true;
+        return true;
     }
-    out.activeStages = active;
-
-    for (int i = 0; i < active; ++i) {
-        const DWORD cop = tss(i, D3DTSS_COLOROP);
-        if (isBump(cop)) {
-            // The stage perturbs the next stage's lookup with its own texture (du, dv[, l]) and
-            // outputs nothing: CURRENT after it is still the result before it (D3DTA_CURRENT page).
-            if (i + 1 >= active)
-                return fail("E4143", i, "D3DTSS_COLOROP",
-                            "D3DTOP_BUMPENVMAP needs an enabled next stage whose texture it perturbs"),
-                       std::nullopt;
-            Src t;
-            if (!texture(i, "D3DTSS_COLOROP", t)) return std::nullopt;
-            if (i + 1 >= kMaxFixedFunctionTextures)
-                return fail("E4142", i + 1, "D3DTSS_COLOROP",
-                            "is the environment map of stage " + std::to_string(i) +
-                                "'s D3DTOP_BUMPENVMAP, but only stages 0.." +
-                                std::to_string(kMaxFixedFunctionTextures - 1) + " can sample"),
-                       std::nullopt;
-            m_sampled |= 1u << (i + 1);
-            m_bumpInto[size_t(i + 1)] = true;
-            continue;
-        }
-        const DWORD result = tss(i, D3DTSS_RESULTARG);
-        if (result != D3DTA_CURRENT && result != D3DTA_TEMP)
-            return fail("E4146", i, "D3DTSS_RESULTARG",
-                        "result argument " + hex(result) + " is neither D3DTA_CURRENT nor D3DTA_TEMP"),
-                   std::nullopt;
-        const bool toTemp = result == D3DTA_TEMP;
-        Dst dst;
-        dst.type = RegType::Temp;
-        dst.index = toTemp ? 1 : 0;
-        dst.saturate = true;
-        const bool dstWritten = toTemp ? m_r1Written : m_r0Written;
-
-        if (cop == D3DTOP_DOTPRODUCT3) {
-            // Replicated to all four channels, alpha included: the stage's ALPHAOP is ignored.
-            Instruction ins;
-            dst.mask = ps11::kMaskAll;
-            if (!lowerHalf(i, false, dst, ins)) return std::nullopt;
-            m_arith.push_back(ins);
-        } else {
-            const DWORD aop = tss(i, D3DTSS_ALPHAOP);
-            if (!checkOp(i, D3DTSS_ALPHAOP, true)) return std::nullopt;
-            Instruction color, alpha;
-            Dst cd = dst, ad = dst;
-            cd.mask = ps11::kMaskRGB;
-            ad.mask = ps11::kMaskA;
-            if (!lowerHalf(i, false, cd, color)) return std::nullopt;
-            if (aop != D3DTOP_DISABLE) {
-                if (!lowerHalf(i, true, ad, alpha)) return std::nullopt;
-            } else if (!dstWritten) {
-                // ALPHAOP DISABLE keeps the destination's alpha (DXVK; the docs call it undefined);
-                // the register still holds its initial value only virtually, so copy it.
-                emit("mov", ad, {toTemp ? temp() : current()}, alpha);
-            }
-            if (alpha.info && sameInstruction(color, alpha)) {
-                color.dst.mask = ps11::kMaskAll;  // identical halves: one instruction
-                m_arith.push_back(color);
-            } else {
-                m_arith.push_back(color);
-                if (alpha.info) {
-                    alpha.coissue = true;
-                    m_arith.push_back(alpha);
-                }
-            }
-        }
-        (toTemp ? m_r1Written : m_r0Written) = true;
+    const DWORD aop = tss(i, D3DTSS_ALPHAOP);
+    if (!checkOp(i, D3DTSS_ALPHAOP, true)) return false;
+    Instruction color, alpha;
+    Dst cd = dst, ad = dst;
+    cd.mask = ps11::kMaskRGB;
+    ad.mask = ps11::kMaskA;
+    if (!lowerHalf(i, false, cd, color)) return false;
+    if (aop == D3DTOP_PREMODULATE) {
+        m_premodMask = uint8_t(m_premodMask | ps11::kMaskA);
+        m_premodAlpha = true;
     }
+    if (aop != D3DTOP_DISABLE) {
+        if (!lowerHalf(i, true, ad, alpha)) return false;
+    } else if (!written) {
+        // ALPHAOP DISABLE keeps the destination's alpha (DXVK; the docs call it undefined). An
+        // unwritten register holds its initial value (diffuse, or TEMP's 0) only virtually: copy it.
+        emit("mov", ad, {toTemp ? temp() : current()}, alpha);
+    }
+    if (alpha.info && sameInstruction(color, alpha)) {
+        color.dst.mask = ps11::kMaskAll;  // identical halves: one instruction
+        m_arith.push_back(color);
+    } else {
+        m_arith.push_back(color);
+        if (alpha.info) {
+            alpha.coissue = true;
+            m_arith.push_back(alpha);
+        }
+    }
+    written = true;
+    return true;
+}
 
-    const bool specular = m_state.renderState(D3DRS_SPECULARENABLE) != 0;
+// PREMODULATE in stage i - 1 ("modulate with next texture before use", d3d8types.h): before
+// stage i runs, the channels it wrote are multiplied by stage i's texture. The select was exact,
+// so the product rounds once.
+bool Lowering::lowerPremodulate(int i) {
+    const uint8_t mask = m_premodMask;
+    m_premodMask = 0;
+    if (!mask) return true;
+    if (i >= kMaxFixedFunctionTextures)
+        return fail("E4142", i - 1, m_premodAlpha && mask == ps11::kMaskA ? "D3DTSS_ALPHAOP" : "D3DTSS_COLOROP",
+                    "D3DTOP_PREMODULATE modulates with stage " + std::to_string(i) + "'s texture, but only stages 0.." +
+                        std::to_string(kMaxFixedFunctionTextures - 1) + " can sample");
+    m_sampled |= 1u << i;
+    Dst d;
+    d.index = m_premodReg;
+    d.mask = mask;
+    d.saturate = true;
+    Instruction mul;
+    emit("mul", d, {reg(RegType::Temp, m_premodReg), reg(RegType::Texture, i)}, mul);
+    m_arith.push_back(mul);
+    return true;
+}
+
+// The pixel is CURRENT, plus the specular rgb with D3DRS_SPECULARENABLE (alpha unchanged).
+void Lowering::lowerOutput() {
     Dst r0;
     r0.saturate = true;
-    if (specular) {
-        // The specular colour is added after the last stage, rgb only (D3DRS_SPECULARENABLE).
+    if (m_state.renderState(D3DRS_SPECULARENABLE) != 0) {
         Instruction add;
         r0.mask = ps11::kMaskRGB;
         emit("add", r0, {current(), reg(RegType::Input, 1)}, add);
@@ -376,7 +436,11 @@ std::optional<LoweredStages> Lowering::run() {
         emit("mov", r0, {reg(RegType::Input, 0)}, mov);  // no stage wrote CURRENT: the diffuse colour
         m_arith.push_back(mov);
     }
+}
 
+// defs, then the texture instructions in stage order, then the blending; and the executor
+// stage states (the bump data of a BUMPENVMAP stage moves to the stage its texbem samples).
+void Lowering::assemble(LoweredStages& out) const {
     ps11::Program& prog = out.program;
     prog.version = {1, 1};
     for (size_t c = 0; c < m_consts.size(); ++c) {
@@ -391,10 +455,9 @@ std::optional<LoweredStages> Lowering::run() {
         ps11::StageState& es = out.executorStages[size_t(i)];
         es.transformFlags = tss(i, D3DTSS_TEXTURETRANSFORMFLAGS);
         const int from = m_bumpInto[size_t(i)] ? i - 1 : i;
-        es.bumpMat = {m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT00),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT01),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT10),
-                      m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT11)};
+        es.bumpMat = {
+            m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT01),
+            m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT11)};
         es.lumScale = m_state.stageStateFloat(from, D3DTSS_BUMPENVLSCALE);
         es.lumOffset = m_state.stageStateFloat(from, D3DTSS_BUMPENVLOFFSET);
         if (!((m_sampled >> i) & 1)) continue;
@@ -412,6 +475,24 @@ std::optional<LoweredStages> Lowering::run() {
     }
     prog.instructions.insert(prog.instructions.end(), m_arith.begin(), m_arith.end());
     out.sampledStages = m_sampled;
+}
+
+std::optional<LoweredStages> Lowering::run() {
+    LoweredStages out;
+    int active = 0;
+    for (; active < kMaxStages; ++active) {
+        const DWORD cop = tss(active, D3DTSS_COLOROP);
+        if (cop == D3DTOP_DISABLE) break;  // disables this stage and every later one, alpha included
+        if (!checkOp(active, D3DTSS_COLOROP, false)) return std::nullopt;
+    }
+    out.activeStages = active;
+    for (int i = 0; i < active; ++i) {
+        if (!lowerPremodulate(i)) return std::nullopt;
+        const bool ok = isBump(tss(i, D3DTSS_COLOROP)) ? lowerBump(i, active) : lowerStage(i);
+        if (!ok) return std::nullopt;
+    }
+    lowerOutput();
+    assemble(out);
     return out;
 }
 

@@ -393,7 +393,13 @@ bool DrawRunner::draw(const TestCommand& command, std::string& error) {
         return false;
     }
     m_readBackValid = false;
+    const emu::DrawStats& stats = d.lastDrawStats();
     ++m_tally.draws;
+    m_tally.pixelsShaded += stats.pixelsShaded;
+    m_tally.pixelsWritten += stats.pixelsWritten;
+    m_tally.texelsFetched += stats.texelsFetched;
+    m_tally.instructions += stats.instructions;
+    m_tally.milliseconds += stats.milliseconds;
     return true;
 }
 
