@@ -458,3 +458,59 @@ TEST_CASE("draw: texkill discards pixels before the merger", "[draw]") {
     CHECK(dev.lastDrawStats().pixelsCovered == W * H);
     CHECK(dev.lastDrawStats().pixelsWritten == 8 * H);
 }
+
+TEST_CASE("draw: fixed function MODULATE (no pixel shader) multiplies texture and diffuse", "[draw]") {
+    Device dev;
+    const UINT W = 20, H = 12;
+    Handle rt = target(dev, W, H);
+    std::vector<uint32_t> texels;
+    Handle tex = randomTexture(dev, W, H, texels, 11);
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    // D3D9 defaults: stage 0 COLOROP MODULATE (TEXTURE, CURRENT = diffuse), ALPHAOP SELECTARG1 (TEXTURE).
+    auto v = quad(W, H, 0x40806020);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    const int64_t d[3] = {0x80, 0x60, 0x20};
+    int bad = 0;
+    for (UINT i = 0; i < W * H; ++i) {
+        // fx8 product of two grid values: round_half_even(t·d / 255); alpha is the texel's.
+        for (int c = 0; c < 3; ++c)
+            bad += int64_t(channel(px[i], c)) != rhe(int64_t(channel(texels[i], c)) * d[c], 255);
+        bad += channel(px[i], 3) != channel(texels[i], 3);
+    }
+    CHECK(bad == 0);
+    CHECK(dev.lastDrawStats().pixelsWritten == W * H);
+}
+
+TEST_CASE("draw: 2x2 quads give the sampler its mip level", "[draw]") {
+    // A 64×64 texture with a full chain drawn onto 16×16 pixels: the texture coordinates change by
+    // 4 texels per pixel, so the LOD is log2(4) = 2 and point mip filtering reads level 2 only.
+    Device dev;
+    const UINT W = 16, H = 16;
+    Handle rt = target(dev, W, H);
+    Handle tex{};
+    REQUIRE(dev.CreateTexture(64, 64, 0, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    const DWORD levels = dev.GetLevelCount(tex);
+    REQUIRE(levels == 7);
+    for (DWORD l = 0; l < levels; ++l) {
+        D3DSURFACE_DESC desc;
+        REQUIRE(dev.GetLevelDesc(tex, l, &desc) == D3D_OK);
+        D3DLOCKED_RECT lr;
+        REQUIRE(dev.LockRect(tex, l, &lr, nullptr, 0) == D3D_OK);
+        const uint32_t colour = 0xff000000u | (l * 0x30u) << 16 | 0x10u * l;
+        for (UINT y = 0; y < desc.Height; ++y)
+            for (UINT x = 0; x < desc.Width; ++x)
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + 4 * x, &colour, 4);
+        REQUIRE(dev.UnlockRect(tex, l) == D3D_OK);
+    }
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MIPFILTER, D3DTEXF_POINT) == D3D_OK);
+    shader(dev, "ps_1_1\ntex t0\nmov r0, t0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xffffffff);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    const uint32_t level2 = 0xff000000u | (2 * 0x30u) << 16 | 0x20u;
+    for (uint32_t p : px) CHECK(p == level2);
+}
