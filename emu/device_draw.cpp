@@ -137,9 +137,28 @@ struct CachedExecutor {
 };
 
 // Per-device draw machinery: the worker pool and the executors, cached by program identity.
+// Executor outputs and the merged live mask of one span.
+struct Lanes {
+    alignas(32) float color[4][ps11::kMaxSpan];
+    alignas(32) int32_t grid[4][ps11::kMaxSpan];
+    alignas(32) uint8_t killed[ps11::kMaxSpan];
+    alignas(32) uint8_t live[ps11::kMaxSpan];
+    alignas(32) float depth[ps11::kMaxSpan];
+};
+
+// What a worker keeps between draws (no allocation per draw): its span, lanes and sampler.
+struct WorkerScratch {
+    QuadSpan span;
+    Lanes lanes;
+    ps11::TextureSampler sampler;
+};
+
 struct DrawContext {
-    explicit DrawContext(int threads) : pool(threads) {}
+    explicit DrawContext(int threads) : pool(threads) {
+        for (int i = 0; i < pool.size(); ++i) scratch.push_back(std::make_unique<WorkerScratch>());
+    }
     ThreadPool pool;
+    std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
     // Pixel shaders: by handle (handles are never reused) and profile.
     std::unordered_map<uint64_t, CachedExecutor> shaders;
     // Fixed function: by the state words the lowering reads.
@@ -461,21 +480,16 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             MergeTarget mtarget{target, depth};
             const bool fx = ps11::isFixedPoint(m_options.precision);
             dc.pool.run(workers, [&](int w) {
-                ps11::TextureSampler sampler;
-                for (int s = 0; s < kMaxSamplers; ++s)
-                    if ((sampled >> s) & 1) {
-                        sampler.bind(s, textures[size_t(s)]);
-                        sampler.setSamplerState(s, samplers[size_t(s)]);
-                    }
-                auto span = std::make_unique<QuadSpan>();
-                struct Lanes {
-                    alignas(32) float color[4][ps11::kMaxSpan];
-                    alignas(32) int32_t grid[4][ps11::kMaxSpan];
-                    alignas(32) uint8_t killed[ps11::kMaxSpan];
-                    alignas(32) uint8_t live[ps11::kMaxSpan];
-                    alignas(32) float depth[ps11::kMaxSpan];
-                };
-                auto lanes = std::make_unique<Lanes>();
+                WorkerScratch& ws0 = *dc.scratch[size_t(w)];
+                ps11::TextureSampler& sampler = ws0.sampler;
+                for (int s = 0; s < kMaxSamplers; ++s) {
+                    // Stages the program does not sample are unbound (no texture kept alive).
+                    sampler.bind(s, (sampled >> s) & 1 ? textures[size_t(s)] : nullptr);
+                    if ((sampled >> s) & 1) sampler.setSamplerState(s, samplers[size_t(s)]);
+                }
+                const uint64_t fetchedBefore = sampler.texelsFetched();
+                QuadSpan* span = &ws0.span;
+                Lanes* lanes = &ws0.lanes;
                 ps11::PixelInputs in;
                 in.quads = true;
                 for (int c = 0; c < 4; ++c) {
@@ -528,7 +542,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                 ws.pixelsShaded = es.pixels;
                 ws.instructions = es.instructions;
                 ws.pixelsWritten = ms.written;
-                ws.texelsFetched = sampler.texelsFetched();
+                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore;
             });
             for (const DrawStats& ws : workerStats) {
                 stats.pixelsCovered += ws.pixelsCovered;

@@ -141,6 +141,11 @@ TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and 
         // Instructions: tex + mov per shaded lane; one texel per point lookup, four per bilinear.
         CHECK(st.instructions == 2 * st.pixelsShaded);
         CHECK(st.texelsFetched == st.pixelsShaded * (filter == D3DTEXF_LINEAR ? 4 : 1));
+        // A second draw counts its own fetches only (the workers' samplers persist between draws).
+        const uint64_t first = st.texelsFetched;
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        CHECK(dev.lastDrawStats().texelsFetched == first);
+        CHECK(dev.totalDrawStats().texelsFetched == 2 * first);
     }
 }
 
