@@ -42,7 +42,7 @@ struct QuadVertex {
     float uv[4][2];
 };
 
-enum class Pass { Blur4, CopyPoint, CopyLinear };
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall };
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -51,20 +51,23 @@ struct Scene {
     std::vector<QuadVertex> quad;
     bool ok = false;
 
+    UINT w = kW, h = kH;
+
     Scene(Pass pass, int threads) {
+        if (pass == Pass::CopySmall) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         DeviceOptions o;
         o.threads = threads;
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
-        if (dev->CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
+        if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
         if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
-        if (dev->CreateTexture(kW, kH, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
+        if (dev->CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
         D3DLOCKED_RECT lr;
         if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return;
         std::mt19937 rng(42);
-        for (UINT y = 0; y < kH; ++y) {
+        for (UINT y = 0; y < h; ++y) {
             auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
-            for (UINT x = 0; x < kW; ++x) row[x] = rng();
+            for (UINT x = 0; x < w; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
         const int stages = pass == Pass::Blur4 ? 4 : 1;
@@ -84,14 +87,14 @@ struct Scene {
         // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
         // averages a 2×2 block), the copy at the texel centres.
         const float off[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {-0.5f, 0.5f}, {0.5f, 0.5f}};
-        const float xs[4] = {-0.5f, kW - 0.5f, kW - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, kH - 0.5f, kH - 0.5f};
+        const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
         for (int k : {0, 1, 2, 0, 2, 3}) {
             QuadVertex q{xs[k], ys[k], 0.0f, 1.0f, {}};
             for (int s = 0; s < 4; ++s) {
                 const bool blur = pass == Pass::Blur4;
-                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(kW) : 0.0f);
-                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(kH) : 0.0f);
+                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(w) : 0.0f);
+                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(h) : 0.0f);
             }
             quad.push_back(q);
         }
@@ -102,7 +105,7 @@ struct Scene {
 };
 
 Scene& scene(Pass pass, int threads) {
-    static std::unique_ptr<Scene> scenes[3][3];
+    static std::unique_ptr<Scene> scenes[4][3];
     auto& s = scenes[int(pass)][threads];
     if (!s) s = std::make_unique<Scene>(pass, threads);
     return *s;
@@ -122,10 +125,10 @@ void BM_Draw(benchmark::State& state, Pass pass) {
         }
     }
     const DrawStats& st = sc.dev->lastDrawStats();
-    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
-    state.counters["shaded/px"] = double(st.pixelsShaded) / (double(kW) * kH);
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(sc.w) * sc.h);
+    state.counters["shaded/px"] = double(st.pixelsShaded) / (double(sc.w) * sc.h);
     state.counters["instr/px"] = double(st.instructions) / double(st.pixelsShaded ? st.pixelsShaded : 1);
-    state.counters["texels/px"] = double(st.texelsFetched) / (double(kW) * kH);
+    state.counters["texels/px"] = double(st.texelsFetched) / (double(sc.w) * sc.h);
 }
 
 // The rasteriser alone over the 1080p half-pixel quad: spans with the blur's inputs (4 slots:
@@ -177,6 +180,12 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
 BENCHMARK_MAIN();
