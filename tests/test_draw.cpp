@@ -519,3 +519,52 @@ TEST_CASE("draw: 2x2 quads give the sampler its mip level", "[draw]") {
     const uint32_t level2 = 0xff000000u | (2 * 0x30u) << 16 | 0x20u;
     for (uint32_t p : px) CHECK(p == level2);
 }
+
+TEST_CASE("draw: untransformed vertices through a perspective projection interpolate perspective-correctly", "[draw]") {
+    Device dev;
+    const UINT W = 40, H = 30;
+    Handle rt = target(dev, W, H, 0);
+    shader(dev, "ps_1_1\ntexcoord t0\nmov r0, t0\n");
+    REQUIRE(dev.SetFVF(D3DFVF_XYZ | D3DFVF_TEX1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    // Left-handed perspective, near 1, far 10: clip = (x, y, A·z + B, z).
+    D3DMATRIX proj;
+    const float A = 10.0f / 9.0f, B = -10.0f / 9.0f;
+    proj.m[2][2] = A;
+    proj.m[2][3] = 1;
+    proj.m[3][2] = B;
+    proj.m[3][3] = 0;
+    REQUIRE(dev.SetTransform(D3DTS_PROJECTION, &proj) == D3D_OK);
+    struct V {
+        float x, y, z, u, v;
+    };
+    // A rectangle leaning away: x = −1 + 2u, y = −1 + 3v, z = 1 + 3v (near edge z = 1, far z = 4).
+    const V q[4] = {{-1, -1, 1, 0, 0}, {1, -1, 1, 1, 0}, {-1, 2, 4, 0, 1}, {1, 2, 4, 1, 1}};
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    int bad = 0, checked = 0;
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) {
+            // Pixel centre → ndc: x_ndc = 2x/W − 1, y_ndc = 1 − 2y/H. On the plane
+            // y_ndc = (−1 + 3v)/(1 + 3v) → v = (y_ndc + 1)/(3(1 − y_ndc)); then z = 1 + 3v and
+            // u = (x_ndc·z + 1)/2.
+            const double xn = 2.0 * x / W - 1, yn = 1 - 2.0 * y / H;
+            const double v = (yn + 1) / (3 * (1 - yn));
+            const double u = (xn * (1 + 3 * v) + 1) / 2;
+            const uint32_t got = px[y * W + x];
+            if (u > 0.01 && u < 0.99 && v > 0.01 && v < 0.99) {
+                ++checked;
+                const int eu = int(std::lround(u * 255)), ev = int(std::lround(v * 255));
+                const int gu = int(channel(got, 0)), gv = int(channel(got, 1));
+                if (std::abs(gu - eu) > 1 || std::abs(gv - ev) > 1) {
+                    if (bad < 6) WARN(x << "," << y << " got " << gu << "," << gv << " want " << eu << "," << ev);
+                    ++bad;
+                }
+            } else if (u < -0.01 || u > 1.01 || v < -0.01 || v > 1.01) {
+                ++checked;
+                if (got != 0) ++bad;  // outside the rectangle: untouched
+            }
+        }
+    CHECK(checked > int(W * H) * 3 / 4);
+    CHECK(bad == 0);
+}
