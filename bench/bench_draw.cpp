@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "emu/device.h"
+#include "emu/raster.h"
 
 namespace {
 
@@ -41,7 +42,7 @@ struct QuadVertex {
     float uv[4][2];
 };
 
-enum class Pass { Blur4, CopyPoint, CopyLinear };
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall };
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -50,20 +51,23 @@ struct Scene {
     std::vector<QuadVertex> quad;
     bool ok = false;
 
+    UINT w = kW, h = kH;
+
     Scene(Pass pass, int threads) {
+        if (pass == Pass::CopySmall) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         DeviceOptions o;
         o.threads = threads;
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
-        if (dev->CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
+        if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
         if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
-        if (dev->CreateTexture(kW, kH, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
+        if (dev->CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
         D3DLOCKED_RECT lr;
         if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return;
         std::mt19937 rng(42);
-        for (UINT y = 0; y < kH; ++y) {
+        for (UINT y = 0; y < h; ++y) {
             auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
-            for (UINT x = 0; x < kW; ++x) row[x] = rng();
+            for (UINT x = 0; x < w; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
         const int stages = pass == Pass::Blur4 ? 4 : 1;
@@ -83,14 +87,14 @@ struct Scene {
         // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
         // averages a 2×2 block), the copy at the texel centres.
         const float off[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {-0.5f, 0.5f}, {0.5f, 0.5f}};
-        const float xs[4] = {-0.5f, kW - 0.5f, kW - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, kH - 0.5f, kH - 0.5f};
+        const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
         for (int k : {0, 1, 2, 0, 2, 3}) {
             QuadVertex q{xs[k], ys[k], 0.0f, 1.0f, {}};
             for (int s = 0; s < 4; ++s) {
                 const bool blur = pass == Pass::Blur4;
-                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(kW) : 0.0f);
-                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(kH) : 0.0f);
+                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(w) : 0.0f);
+                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(h) : 0.0f);
             }
             quad.push_back(q);
         }
@@ -101,7 +105,7 @@ struct Scene {
 };
 
 Scene& scene(Pass pass, int threads) {
-    static std::unique_ptr<Scene> scenes[3][3];
+    static std::unique_ptr<Scene> scenes[4][3];
     auto& s = scenes[int(pass)][threads];
     if (!s) s = std::make_unique<Scene>(pass, threads);
     return *s;
@@ -121,14 +125,51 @@ void BM_Draw(benchmark::State& state, Pass pass) {
         }
     }
     const DrawStats& st = sc.dev->lastDrawStats();
-    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
-    state.counters["shaded/px"] = double(st.pixelsShaded) / (double(kW) * kH);
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(sc.w) * sc.h);
+    state.counters["shaded/px"] = double(st.pixelsShaded) / (double(sc.w) * sc.h);
     state.counters["instr/px"] = double(st.instructions) / double(st.pixelsShaded ? st.pixelsShaded : 1);
-    state.counters["texels/px"] = double(st.texelsFetched) / (double(kW) * kH);
+    state.counters["texels/px"] = double(st.texelsFetched) / (double(sc.w) * sc.h);
+}
+
+// The rasteriser alone over the 1080p half-pixel quad: spans with the blur's inputs (4 slots:
+// u, v as planes, w = 0 and q = 1 constant), no shading — the draw's own cost per pixel.
+void BM_Raster(benchmark::State& state) {
+    const int slots = int(state.range(0));
+    auto V = [&](double x, double y, float u, float v) {
+        ScreenVertex s;
+        s.x = x;
+        s.y = y;
+        for (int t = 0; t < slots; ++t) {
+            s.attr[size_t(attrTex(t, 0))] = u + 0.5f * float(t) / kW;
+            s.attr[size_t(attrTex(t, 1))] = v;
+            s.attr[size_t(attrTex(t, 3))] = 1.0f;
+        }
+        return s;
+    };
+    const ScreenVertex a = V(-0.5, -0.5, 0, 0), b = V(kW - 0.5, -0.5, 1, 0), c = V(kW - 0.5, kH - 0.5, 1, 1),
+                       d = V(-0.5, kH - 0.5, 0, 1);
+    const ScreenTriangle tris[2] = {ScreenTriangle{{a, b, c}}, ScreenTriangle{{a, c, d}}};
+    uint64_t used = 0;
+    for (int t = 0; t < slots; ++t) used |= uint64_t(0xF) << attrTex(t, 0);
+    auto span = std::make_unique<QuadSpan>();
+    uint64_t lanes = 0;
+    const std::function<void(QuadSpan&)> emit = [&](QuadSpan& sp) { lanes += uint64_t(sp.count); };
+    for (auto _ : state) {
+        for (const ScreenTriangle& t : tris) {
+            TriangleSetup s;
+            if (setupTriangle(t, used, ClipRect{0, 0, int(kW), int(kH)}, s))
+                rasterizeRows(s, 0, kH, used, false, *span, emit);
+        }
+        benchmark::DoNotOptimize(span->attr[0][0]);
+    }
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
+    state.counters["ns/px"] = benchmark::Counter(
+        double(kW) * kH * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace
 
+BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)
     ->Arg(1)
@@ -139,6 +180,12 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -34,6 +34,8 @@ constexpr uint32_t kMaxStride = 2048;
 constexpr int kBandRows = 16;
 // Executors kept per device (cleared when full).
 constexpr size_t kMaxCachedExecutors = 64;
+// Triangles processed per chunk (vertex processing, setup, rasterisation).
+constexpr uint32_t kChunkTriangles = 1024;
 
 bool drawableFormat(D3DFORMAT f) {
     return f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8 || f == D3DFMT_R32F || f == D3DFMT_A16B16G16R16F ||
@@ -62,11 +64,20 @@ uint64_t attributesRead(const ps11::Program& program) {
     return used;
 }
 
+bool hasTexkill(const ps11::Program& program) {
+    for (const ps11::Instruction& ins : program.instructions)
+        if (ins.info && ins.opcode() == ps11::Opcode::TexKill) return true;
+    return false;
+}
+
 std::optional<ps11::Filter> filterOf(DWORD v, bool mip) {
     switch (v) {
-        case D3DTEXF_NONE: return ps11::Filter::None;
-        case D3DTEXF_POINT: return ps11::Filter::Point;
-        case D3DTEXF_LINEAR: return ps11::Filter::Linear;
+        case D3DTEXF_NONE:
+            return ps11::Filter::None;
+        case D3DTEXF_POINT:
+            return ps11::Filter::Point;
+        case D3DTEXF_LINEAR:
+            return ps11::Filter::Linear;
         // Anisotropic and the quad filters act as linear (a ps 1.x part's MaxAnisotropy 1).
         case D3DTEXF_ANISOTROPIC:
         case D3DTEXF_PYRAMIDALQUAD:
@@ -120,14 +131,34 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
 struct CachedExecutor {
     std::unique_ptr<ps11::Executor> executor;
     uint64_t attrs = 0;  // attributesRead of its program
+    bool kills = false;  // the program has texkill
     bool fixedFunction = false;
     std::array<ps11::StageState, kMaxStages> stages{};  // fixed function: LoweredStages::executorStages
 };
 
 // Per-device draw machinery: the worker pool and the executors, cached by program identity.
+// Executor outputs and the merged live mask of one span.
+struct Lanes {
+    alignas(32) float color[4][ps11::kMaxSpan];
+    alignas(32) int32_t grid[4][ps11::kMaxSpan];
+    alignas(32) uint8_t killed[ps11::kMaxSpan];
+    alignas(32) uint8_t live[ps11::kMaxSpan];
+    alignas(32) float depth[ps11::kMaxSpan];
+};
+
+// What a worker keeps between draws (no allocation per draw): its span, lanes and sampler.
+struct WorkerScratch {
+    QuadSpan span;
+    Lanes lanes;
+    ps11::TextureSampler sampler;
+};
+
 struct DrawContext {
-    explicit DrawContext(int threads) : pool(threads) {}
+    explicit DrawContext(int threads) : pool(threads) {
+        for (int i = 0; i < pool.size(); ++i) scratch.push_back(std::make_unique<WorkerScratch>());
+    }
     ThreadPool pool;
+    std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
     // Pixel shaders: by handle (handles are never reused) and profile.
     std::unordered_map<uint64_t, CachedExecutor> shaders;
     // Fixed function: by the state words the lowering reads.
@@ -146,13 +177,16 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     switch (type) {
         case D3DPT_TRIANGLELIST:
         case D3DPT_TRIANGLESTRIP:
-        case D3DPT_TRIANGLEFAN: break;
+        case D3DPT_TRIANGLEFAN:
+            break;
         case D3DPT_POINTLIST:
         case D3DPT_LINELIST:
         case D3DPT_LINESTRIP:
             return drawFail(D3DERR_NOTAVAILABLE, "E4114",
                             "primitive type " + num(DWORD(type)) + " (points and lines) is not drawn by this device");
-        default: return drawFail(D3DERR_INVALIDCALL, "E4113", "primitive type " + num(DWORD(type)) + " is not a D3DPRIMITIVETYPE");
+        default:
+            return drawFail(D3DERR_INVALIDCALL, "E4113",
+                            "primitive type " + num(DWORD(type)) + " is not a D3DPRIMITIVETYPE");
     }
     if (primitiveCount == 0 || primitiveCount > kMaxPrimitiveCount)
         return drawFail(D3DERR_INVALIDCALL, "E4115",
@@ -162,11 +196,13 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     if (m_state.fvf == 0) return drawFail(D3DERR_INVALIDCALL, "E4117", "no FVF set (SetFVF)");
     std::string why;
     const std::optional<VertexLayout> layout = parseFvf(m_state.fvf, why);
-    if (!layout) return drawFail(D3DERR_INVALIDCALL, "E4117", "FVF 0x" + [&] {
-        char b[16];
-        std::snprintf(b, sizeof b, "%x", unsigned(m_state.fvf));
-        return std::string(b);
-    }() + ": " + why);
+    if (!layout)
+        return drawFail(
+            D3DERR_INVALIDCALL, "E4117", "FVF 0x" + [&] {
+                char b[16];
+                std::snprintf(b, sizeof b, "%x", unsigned(m_state.fvf));
+                return std::string(b);
+            }() + ": " + why);
     if (stride < layout->size || stride > kMaxStride)
         return drawFail(D3DERR_INVALIDCALL, "E4116",
                         "stride " + num(stride) + " outside " + num(layout->size) + ".." + num(kMaxStride) +
@@ -188,7 +224,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     if (m_state.depthStencil != Handle::Null) {
         depth = surfaceImage(m_state.depthStencil, "DrawPrimitiveUP", "depth stencil surface", &ds, &dsRef);
         if (!depth) return m_error.hr;
-        if (ds->locked[dsRef.level]) return drawFail(D3DERR_INVALIDCALL, "E4106", "the depth stencil surface is locked");
+        if (ds->locked[dsRef.level])
+            return drawFail(D3DERR_INVALIDCALL, "E4106", "the depth stencil surface is locked");
         if (depth->width < target->width || depth->height < target->height)
             return drawFail(D3DERR_INVALIDCALL, "E4119",
                             "depth stencil surface " + num(depth->width) + "x" + num(depth->height) +
@@ -204,8 +241,9 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         return drawFail(D3DERR_INVALIDCALL, "E4119", "D3DRS_SHADEMODE " + num(shade) + " is not a D3DSHADEMODE value");
     const DWORD fill = m_state.renderState(D3DRS_FILLMODE);
     if (fill != 3 /* D3DFILL_SOLID */)
-        return drawFail(D3DERR_NOTAVAILABLE, "E4120",
-                        "D3DRS_FILLMODE " + num(fill) + ": only D3DFILL_SOLID (3) is drawn (no point or wireframe fill)");
+        return drawFail(
+            D3DERR_NOTAVAILABLE, "E4120",
+            "D3DRS_FILLMODE " + num(fill) + ": only D3DFILL_SOLID (3) is drawn (no point or wireframe fill)");
 
     // ---- the pixel program ----
     if (!m_draw) m_draw = std::make_shared<DrawContext>(m_options.threads);
@@ -227,6 +265,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                 return drawFail(D3DERR_INVALIDCALL, "E4121",
                                 "the executor refused pixel shader " + num(uint32_t(m_state.pixelShader)));
             ce.attrs = attributesRead(*program);
+            ce.kills = hasTexkill(*program);
             if (dc.shaders.size() >= kMaxCachedExecutors) dc.shaders.clear();
             it = dc.shaders.emplace(key, std::move(ce)).first;
         }
@@ -255,6 +294,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             if (!ce.executor)
                 return drawFail(D3DERR_INVALIDCALL, "E4121", "the executor refused the fixed-function program");
             ce.attrs = attributesRead(lowered->program);
+            ce.kills = hasTexkill(lowered->program);
             ce.fixedFunction = true;
             ce.stages = lowered->executorStages;
             if (dc.ffpCount >= kMaxCachedExecutors) {
@@ -295,8 +335,9 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         for (int a = 0; a < 3; ++a) {
             const DWORD v = m_state.samplerState(s, addr[a]);
             if (v < D3DTADDRESS_WRAP || v > D3DTADDRESS_MIRRORONCE)
-                return drawFail(D3DERR_INVALIDCALL, "E4123",
-                                "sampler " + num(uint32_t(s)) + ": address mode " + num(v) + " is not a D3DTEXTUREADDRESS");
+                return drawFail(
+                    D3DERR_INVALIDCALL, "E4123",
+                    "sampler " + num(uint32_t(s)) + ": address mode " + num(v) + " is not a D3DTEXTUREADDRESS");
             *out[a] = ps11::TextureAddress(v);
         }
         const DWORD border = m_state.samplerState(s, D3DSAMP_BORDERCOLOR);
@@ -333,13 +374,13 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         const DWORD flags = m_state.stageState(s, D3DTSS_TEXTURETRANSFORMFLAGS);
         const bool slotRead = (exec->attrs >> attrTex(s, 0)) & 0xF;
         if (slotRead && (tci & 0xFFFF0000u))
-            return drawFail(D3DERR_INVALIDCALL, "E4119",
-                            "stage " + num(uint32_t(s)) + ": D3DTSS_TEXCOORDINDEX generation mode 0x" +
-                                [&] {
-                                    char b[16];
-                                    std::snprintf(b, sizeof b, "%x", unsigned(tci >> 16));
-                                    return std::string(b);
-                                }() + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
+            return drawFail(
+                D3DERR_INVALIDCALL,
+                "E4119", "stage " + num(uint32_t(s)) + ": D3DTSS_TEXCOORDINDEX generation mode 0x" + [&] {
+                    char b[16];
+                    std::snprintf(b, sizeof b, "%x", unsigned(tci >> 16));
+                    return std::string(b);
+                }() + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
         if ((flags & ~DWORD(D3DTTFF_PROJECTED)) > 4)
             return drawFail(D3DERR_INVALIDCALL, "E4119",
                             "stage " + num(uint32_t(s)) + ": D3DTSS_TEXTURETRANSFORMFLAGS " + num(flags) +
@@ -380,17 +421,16 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         return D3D_OK;
     }
     const bool shaderDepth = executor.writesDepth();
+    const bool kills = exec->kills;
     const bool wantZ = merge.depthTest || (merge.depthWrite && depth);
     uint64_t used = exec->attrs;
     if (merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
 
     // ---- vertices → screen triangles → setups ----
-    std::vector<ScreenTriangle> tris;
     VertexSetup vs;
     vs.layout = &*layout;
     vs.usedAttrs = used;
     VertexStats vstats;
-    processTriangles(m_state, vs, type, primitiveCount, static_cast<const uint8_t*>(vertexData), stride, tris, &vstats);
 
     ClipRect clip;
     {
@@ -408,103 +448,113 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         clip.x1 = int(std::clamp<int64_t>(x1, 0, target->width));
         clip.y1 = int(std::clamp<int64_t>(y1, 0, target->height));
     }
+    // Triangles go through in chunks (memory stays bounded for any count); chunks run one after
+    // the other, so primitive order holds across them.
+    std::vector<ScreenTriangle> tris;
     std::vector<TriangleSetup> setups;
-    setups.reserve(tris.size());
-    int yLo = clip.y1, yHi = clip.y0;
-    for (const ScreenTriangle& t : tris) {
-        TriangleSetup s;
-        if (!setupTriangle(t, used, clip, s)) continue;
-        yLo = std::min(yLo, s.yMin);
-        yHi = std::max(yHi, s.yMax);
-        setups.push_back(s);
-    }
-    stats.trianglesDrawn = setups.size();
-
-    // ---- rows in bands over the workers ----
-    if (!setups.empty()) {
-        const int firstBand = (yLo & ~1) / kBandRows;
-        const int lastBand = (yHi + kBandRows - 1) / kBandRows;
-        const int bands = lastBand - firstBand;
-        std::atomic<int> next{0};
-        const int workers = std::min(dc.pool.size(), bands);
-        std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
-        MergeTarget mtarget{target, depth};
-        const bool fx = ps11::isFixedPoint(m_options.precision);
-        dc.pool.run(workers, [&](int w) {
-            ps11::TextureSampler sampler;
-            for (int s = 0; s < kMaxSamplers; ++s)
-                if ((sampled >> s) & 1) {
-                    sampler.bind(s, textures[size_t(s)]);
-                    sampler.setSamplerState(s, samplers[size_t(s)]);
-                }
-            auto span = std::make_unique<QuadSpan>();
-            struct Lanes {
-                alignas(32) float color[4][ps11::kMaxSpan];
-                alignas(32) int32_t grid[4][ps11::kMaxSpan];
-                alignas(32) uint8_t killed[ps11::kMaxSpan];
-                alignas(32) uint8_t live[ps11::kMaxSpan];
-                alignas(32) float depth[ps11::kMaxSpan];
-            };
-            auto lanes = std::make_unique<Lanes>();
-            ps11::PixelInputs in;
-            in.quads = true;
-            for (int c = 0; c < 4; ++c) {
-                if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
-                if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
-                for (int t = 0; t < kMaxTexSets; ++t)
-                    if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
-            }
-            ps11::PixelOutputs outp;
-            for (int c = 0; c < 4; ++c) {
-                outp.color[c] = lanes->color[c];
-                if (fx) outp.grid[c] = lanes->grid[c];
-            }
-            outp.killed = lanes->killed;
-            outp.depth = shaderDepth ? lanes->depth : nullptr;
-            ps11::ExecutorStats es;
-            MergeStats ms;
-            DrawStats& ws = workerStats[size_t(w)];
-            auto emit = [&](QuadSpan& sp) {
-                in.count = sp.count;
-                executor.run(in, sampler, outp, &es);
-                for (int L = 0; L < sp.count; ++L) lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
-                MergeInputs mi;
-                mi.count = sp.count;
-                mi.x = sp.x;
-                mi.y = sp.y;
-                mi.live = lanes->live;
-                for (int c = 0; c < 4; ++c) {
-                    mi.color[c] = lanes->color[c];
-                    mi.grid[c] = fx ? lanes->grid[c] : nullptr;
-                }
-                mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
-                mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
-                mergePixels(merge, mi, mtarget, &ms);
-                ws.pixelsCovered += uint64_t(sp.liveCount);
-            };
-            const std::function<void(QuadSpan&)> emitFn = emit;
-            for (;;) {
-                const int b = next.fetch_add(1, std::memory_order_relaxed);
-                if (b >= bands) break;
-                const int by0 = (firstBand + b) * kBandRows;
-                const int by1 = by0 + kBandRows;
-                for (const TriangleSetup& s : setups) {
-                    if (s.yMax <= by0 || s.yMin >= by1) continue;
-                    rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
-                }
-            }
-            ws.pixelsShaded = es.pixels;
-            ws.instructions = es.instructions;
-            ws.pixelsWritten = ms.written;
-            ws.texelsFetched = sampler.texelsFetched();
-        });
-        for (const DrawStats& ws : workerStats) {
-            stats.pixelsCovered += ws.pixelsCovered;
-            stats.pixelsShaded += ws.pixelsShaded;
-            stats.instructions += ws.instructions;
-            stats.pixelsWritten += ws.pixelsWritten;
-            stats.texelsFetched += ws.texelsFetched;
+    bool wrote = false;
+    for (uint32_t first = 0; first < primitiveCount; first += kChunkTriangles) {
+        const uint32_t chunk = std::min(kChunkTriangles, primitiveCount - first);
+        tris.clear();
+        setups.clear();
+        processTriangles(m_state, vs, type, first, chunk, static_cast<const uint8_t*>(vertexData), stride, tris,
+                         &vstats);
+        int yLo = clip.y1, yHi = clip.y0;
+        for (const ScreenTriangle& t : tris) {
+            TriangleSetup s;
+            if (!setupTriangle(t, used, clip, s)) continue;
+            yLo = std::min(yLo, s.yMin);
+            yHi = std::max(yHi, s.yMax);
+            setups.push_back(s);
         }
+        stats.trianglesDrawn += setups.size();
+
+        // ---- rows in bands over the workers ----
+        if (!setups.empty()) {
+            const int firstBand = (yLo & ~1) / kBandRows;
+            const int lastBand = (yHi + kBandRows - 1) / kBandRows;
+            const int bands = lastBand - firstBand;
+            std::atomic<int> next{0};
+            const int workers = std::min(dc.pool.size(), bands);
+            std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
+            MergeTarget mtarget{target, depth};
+            const bool fx = ps11::isFixedPoint(m_options.precision);
+            dc.pool.run(workers, [&](int w) {
+                WorkerScratch& ws0 = *dc.scratch[size_t(w)];
+                ps11::TextureSampler& sampler = ws0.sampler;
+                for (int s = 0; s < kMaxSamplers; ++s) {
+                    // Stages the program does not sample are unbound (no texture kept alive).
+                    sampler.bind(s, (sampled >> s) & 1 ? textures[size_t(s)] : nullptr);
+                    if ((sampled >> s) & 1) sampler.setSamplerState(s, samplers[size_t(s)]);
+                }
+                const uint64_t fetchedBefore = sampler.texelsFetched();
+                QuadSpan* span = &ws0.span;
+                Lanes* lanes = &ws0.lanes;
+                ps11::PixelInputs in;
+                in.quads = true;
+                for (int c = 0; c < 4; ++c) {
+                    if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
+                    if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
+                    for (int t = 0; t < kMaxTexSets; ++t)
+                        if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
+                }
+                ps11::PixelOutputs outp;
+                for (int c = 0; c < 4; ++c) {
+                    outp.color[c] = lanes->color[c];
+                    if (fx) outp.grid[c] = lanes->grid[c];
+                }
+                outp.killed = lanes->killed;
+                outp.depth = shaderDepth ? lanes->depth : nullptr;
+                ps11::ExecutorStats es;
+                MergeStats ms;
+                DrawStats& ws = workerStats[size_t(w)];
+                auto emit = [&](QuadSpan& sp) {
+                    in.count = sp.count;
+                    executor.run(in, sampler, outp, &es);
+                    if (kills)
+                        for (int L = 0; L < sp.count; ++L)
+                            lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
+                    MergeInputs mi;
+                    mi.count = sp.count;
+                    mi.x = sp.x;
+                    mi.y = sp.y;
+                    mi.live = kills ? lanes->live : sp.live;
+                    for (int c = 0; c < 4; ++c) {
+                        mi.color[c] = lanes->color[c];
+                        mi.grid[c] = fx ? lanes->grid[c] : nullptr;
+                    }
+                    mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
+                    mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
+                    mergePixels(merge, mi, mtarget, &ms);
+                    ws.pixelsCovered += uint64_t(sp.liveCount);
+                };
+                const std::function<void(QuadSpan&)> emitFn = emit;
+                for (;;) {
+                    const int b = next.fetch_add(1, std::memory_order_relaxed);
+                    if (b >= bands) break;
+                    const int by0 = (firstBand + b) * kBandRows;
+                    const int by1 = by0 + kBandRows;
+                    for (const TriangleSetup& s : setups) {
+                        if (s.yMax <= by0 || s.yMin >= by1) continue;
+                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                    }
+                }
+                ws.pixelsShaded = es.pixels;
+                ws.instructions = es.instructions;
+                ws.pixelsWritten = ms.written;
+                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore;
+            });
+            for (const DrawStats& ws : workerStats) {
+                stats.pixelsCovered += ws.pixelsCovered;
+                stats.pixelsShaded += ws.pixelsShaded;
+                stats.instructions += ws.instructions;
+                stats.pixelsWritten += ws.pixelsWritten;
+                stats.texelsFetched += ws.texelsFetched;
+            }
+            wrote = true;
+        }
+    }
+    if (wrote) {
         markWritten(*rt, rtRef.level);
         if (depth && merge.depthWrite) markWritten(*ds, dsRef.level);
     }

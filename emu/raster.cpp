@@ -19,8 +19,8 @@ int64_t ceilDiv(int64_t n, int64_t d) { return n >= 0 ? (n + d - 1) / d : -((-n)
 // Lane layout of a span: lane L belongs to quad L/4; its column offset within the span is
 // 2·(L/4) + (L & 1) and its row is (L >> 1) & 1.
 struct LaneTable {
-    alignas(32) float col[ps11::kMaxSpan];
     alignas(32) int32_t colInt[ps11::kMaxSpan];
+    alignas(32) float col[ps11::kMaxSpan];
     alignas(32) int32_t row[ps11::kMaxSpan];
     LaneTable() {
         for (int L = 0; L < ps11::kMaxSpan; ++L) {
@@ -32,12 +32,24 @@ struct LaneTable {
 };
 const LaneTable kLanes;
 
+// Four float lanes (GCC/Clang vector extension): one 2×2 quad.
+typedef float Quad4 __attribute__((vector_size(16)));
+
 // Fills lanes [0, n) with the plane's values over the span whose top-left lane is pixel
-// (x0, y0): the two row starts are computed in double, each lane adds dx·column in float.
+// (x0, y0): the two row starts are computed in double, each lane adds dx·column in float
+// (column = its offset from x0, exact in float). One quad per step: (f0, f0, f1, f1) + dx·(c, c+1, c, c+1).
 void fillPlane(const Plane& p, double ox, double oy, int x0, int y0, int n, float* out) {
     const double s0 = p.base + p.dx * (x0 - ox) + p.dy * (y0 - oy);
     const float f0 = float(s0), f1 = float(s0 + p.dy), fdx = float(p.dx);
-    for (int L = 0; L < n; ++L) out[L] = (kLanes.row[L] ? f1 : f0) + fdx * kLanes.col[L];
+    const Quad4 base = {f0, f0, f1, f1};
+    const Quad4 d = {fdx, fdx, fdx, fdx};
+    // Columns from a table (no loop-carried dependency: a running column would serialise the adds).
+    for (int q = 0; q < n / 4; ++q) {
+        Quad4 col;
+        std::memcpy(&col, kLanes.col + 4 * q, sizeof col);
+        const Quad4 r = base + d * col;
+        std::memcpy(out + 4 * q, &r, sizeof r);
+    }
 }
 
 }  // namespace
@@ -150,22 +162,29 @@ void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool w
         } else {
             qx0 = l1, qx1 = r1;
         }
-        qx0 &= ~1;                // quads at even coordinates (clip rects start at >= 0)
+        qx0 &= ~1;  // quads at even coordinates (clip rects start at >= 0)
         qx1 = (qx1 + 1) & ~1;
         constexpr int kQuadCols = ps11::kMaxSpan / 2;  // pixels per row of one span
         for (int sx = qx0; sx < qx1; sx += kQuadCols) {
             const int cols = std::min(kQuadCols, qx1 - sx);
             const int n = cols * 2;  // lanes
             span.count = n;
+            for (int L = 0; L < n; ++L) span.x[L] = sx + kLanes.colInt[L];
+            for (int L = 0; L < n; ++L) span.y[L] = py + kLanes.row[L];
             int liveCount = 0;
-            for (int L = 0; L < n; ++L) {
-                const int x = sx + kLanes.colInt[L];
-                const int r = kLanes.row[L];
-                span.x[L] = x;
-                span.y[L] = py + r;
-                const bool in = r ? (c1 && x >= l1 && x < r1) : (c0 && x >= l0 && x < r0);
-                span.live[L] = uint8_t(in);
-                liveCount += in;
+            const int ex = sx + cols;  // one past the span's last column
+            if (c0 && c1 && sx >= std::max(l0, l1) && ex <= std::min(r0, r1)) {
+                std::memset(span.live, 1, size_t(n));  // inside on both rows: no helper lanes
+                liveCount = n;
+            } else {
+                // Row 0 covers [a0, b0), row 1 [a1, b1) (empty when not covered).
+                const int a0 = c0 ? l0 : 0, b0 = c0 ? r0 : 0, a1 = c1 ? l1 : 0, b1 = c1 ? r1 : 0;
+                for (int L = 0; L < n; ++L) {
+                    const int x = span.x[L];
+                    const bool in = kLanes.row[L] ? (x >= a1 && x < b1) : (x >= a0 && x < b0);
+                    span.live[L] = uint8_t(in);
+                    liveCount += in;
+                }
             }
             span.liveCount = liveCount;
             if (liveCount == 0) continue;

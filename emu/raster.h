@@ -33,7 +33,7 @@ struct TriangleSetup {
     std::array<int64_t, 3> a{}, b{}, c{}, t{};
     int yMin = 0, yMax = 0;  // rows that may be covered, inside the clip rect
     ClipRect clip;
-    double ox = 0, oy = 0;  // plane origin (vertex 0, snapped)
+    double ox = 0, oy = 0;     // plane origin (vertex 0, snapped)
     bool perspective = false;  // rhw differs between vertices: attributes are attr·rhw planes
     Plane rhw, z;
     uint64_t constMask = 0;  // attributes equal at the three vertices: constValue, no plane

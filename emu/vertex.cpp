@@ -11,8 +11,8 @@ namespace emu {
 
 namespace {
 
-constexpr DWORD kKnownFvfBits = D3DFVF_POSITION_MASK | D3DFVF_NORMAL | D3DFVF_PSIZE | D3DFVF_DIFFUSE |
-                                D3DFVF_SPECULAR | D3DFVF_TEXCOUNT_MASK | 0xFFFF0000u;
+constexpr DWORD kKnownFvfBits = D3DFVF_POSITION_MASK | D3DFVF_NORMAL | D3DFVF_PSIZE | D3DFVF_DIFFUSE | D3DFVF_SPECULAR |
+                                D3DFVF_TEXCOUNT_MASK | 0xFFFF0000u;
 
 // Clip-space guard band: |x|, |y| <= kClipGuard·w. With viewports of at most 16384 pixels the
 // screen coordinates stay well inside kGuardBand.
@@ -65,7 +65,7 @@ struct Pipeline {
     const VertexLayout* layout = nullptr;
     uint64_t usedAttrs = 0;
     Mat4 wvp{};
-    std::array<int, kMaxTexSets> slotSet{};   // vertex set each slot reads (-1: none, defaults)
+    std::array<int, kMaxTexSets> slotSet{};    // vertex set each slot reads (-1: none, defaults)
     std::array<int, kMaxTexSets> slotCount{};  // texture transform output count (0 = no transform)
     std::array<Mat4, kMaxTexSets> texMat{};
     double vpX = 0, vpY = 0, vpW = 0, vpH = 0, minZ = 0, maxZ = 1;
@@ -79,8 +79,7 @@ void readVertex(const Pipeline& p, const uint8_t* v, ClipVertex& out) {
     if (L.pretransformed) {
         out.pos = {x, y, z, double(readFloat(v + 12))};  // w slot holds rhw here
     } else {
-        for (size_t j = 0; j < 4; ++j)
-            out.pos[j] = x * p.wvp[0][j] + y * p.wvp[1][j] + z * p.wvp[2][j] + p.wvp[3][j];
+        for (size_t j = 0; j < 4; ++j) out.pos[j] = x * p.wvp[0][j] + y * p.wvp[1][j] + z * p.wvp[2][j] + p.wvp[3][j];
     }
     out.attr.fill(0.0f);
     if (L.hasDiffuse) {
@@ -131,16 +130,14 @@ void applyFlat(ClipVertex* tri[3], const ClipVertex& provoking, ClipVertex out[3
     for (int i = 0; i < 3; ++i) {
         out[i] = *tri[i];
         for (int c = 0; c < 4; ++c) out[i].attr[size_t(kAttrDiffuse + c)] = provoking.attr[size_t(kAttrDiffuse + c)];
-        for (int c = 0; c < 3; ++c)
-            out[i].attr[size_t(kAttrSpecular + c)] = provoking.attr[size_t(kAttrSpecular + c)];
+        for (int c = 0; c < 3; ++c) out[i].attr[size_t(kAttrSpecular + c)] = provoking.attr[size_t(kAttrSpecular + c)];
     }
 }
 
 template <class F>
 void lerpVertex(const ClipVertex& a, const ClipVertex& b, double t, uint64_t used, ClipVertex& out, F&& attrLerp) {
     for (size_t j = 0; j < 4; ++j) out.pos[j] = a.pos[j] + (b.pos[j] - a.pos[j]) * t;
-    for (int k = 0; k < kAttrCount; ++k)
-        out.attr[size_t(k)] = ((used >> k) & 1) ? attrLerp(k, t) : 0.0f;
+    for (int k = 0; k < kAttrCount; ++k) out.attr[size_t(k)] = ((used >> k) & 1) ? attrLerp(k, t) : 0.0f;
 }
 
 // Sutherland–Hodgman against dist(v) >= 0, attributes interpolated linearly in the space the
@@ -304,11 +301,13 @@ private:
 std::optional<VertexLayout> parseFvf(DWORD fvf, std::string& error) {
     VertexLayout L;
     if (fvf & ~kKnownFvfBits) {
-        error = "FVF bits 0x" + [](DWORD v) {
-            char b[16];
-            std::snprintf(b, sizeof b, "%x", unsigned(v));
-            return std::string(b);
-        }(fvf & ~kKnownFvfBits) + " are not taken (blend weights, D3DFVF_LASTBETA_*)";
+        error = "FVF bits 0x" +
+                [](DWORD v) {
+                    char b[16];
+                    std::snprintf(b, sizeof b, "%x", unsigned(v));
+                    return std::string(b);
+                }(fvf & ~kKnownFvfBits) +
+                " are not taken (blend weights, D3DFVF_LASTBETA_*)";
         return std::nullopt;
     }
     const DWORD pos = fvf & D3DFVF_POSITION_MASK;
@@ -358,18 +357,23 @@ std::optional<VertexLayout> parseFvf(DWORD fvf, std::string& error) {
 
 uint64_t vertexCountOf(D3DPRIMITIVETYPE type, uint64_t n) {
     switch (type) {
-        case D3DPT_TRIANGLELIST: return 3 * n;
+        case D3DPT_TRIANGLELIST:
+            return 3 * n;
         case D3DPT_TRIANGLESTRIP:
-        case D3DPT_TRIANGLEFAN: return n + 2;
-        case D3DPT_POINTLIST: return n;
-        case D3DPT_LINELIST: return 2 * n;
-        case D3DPT_LINESTRIP: return n + 1;
+        case D3DPT_TRIANGLEFAN:
+            return n + 2;
+        case D3DPT_POINTLIST:
+            return n;
+        case D3DPT_LINELIST:
+            return 2 * n;
+        case D3DPT_LINESTRIP:
+            return n + 1;
     }
     return 0;
 }
 
-void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRIMITIVETYPE type,
-                      uint32_t primitiveCount, const uint8_t* data, uint32_t stride, std::vector<ScreenTriangle>& out,
+void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRIMITIVETYPE type, uint32_t first,
+                      uint32_t count, const uint8_t* data, uint32_t stride, std::vector<ScreenTriangle>& out,
                       VertexStats* statsOut) {
     Pipeline p;
     p.layout = setup.layout;
@@ -381,8 +385,8 @@ void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRI
         p.slotSet[size_t(slot)] = index < DWORD(L.texCount) ? int(index) : -1;
         // Texture transforms apply to untransformed vertices only; COUNT1 is ignored (Wine's
         // tests of native D3D9); PROJECTED is the executor's business (StageState).
-        const DWORD count = state.stageState(slot, D3DTSS_TEXTURETRANSFORMFLAGS) & 0xFF;
-        p.slotCount[size_t(slot)] = (!L.pretransformed && count >= 2 && count <= 4) ? int(count) : 0;
+        const DWORD flags = state.stageState(slot, D3DTSS_TEXTURETRANSFORMFLAGS) & 0xFF;
+        p.slotCount[size_t(slot)] = (!L.pretransformed && flags >= 2 && flags <= 4) ? int(flags) : 0;
         p.texMat[size_t(slot)] = toMat(state.texture[size_t(slot)]);
     }
     p.vpX = state.viewport.X;
@@ -396,37 +400,39 @@ void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRI
 
     VertexStats stats;
     Processor proc(p, out, stats);
-    const uint64_t nv = vertexCountOf(type, primitiveCount);
-    // Vertices are read once each (strips and fans share them).
-    std::vector<ClipVertex> verts(static_cast<size_t>(nv));
-    for (uint64_t i = 0; i < nv; ++i) readVertex(p, data + i * uint64_t(stride), verts[size_t(i)]);
-    for (uint64_t t = 0; t < primitiveCount; ++t) {
+    ClipVertex v[3];
+    auto read = [&](uint64_t index, ClipVertex& o) { readVertex(p, data + index * uint64_t(stride), o); };
+    for (uint64_t t = first; t < uint64_t(first) + count; ++t) {
         switch (type) {
-            case D3DPT_TRIANGLELIST: {
-                const ClipVertex* v = &verts[size_t(3 * t)];
+            case D3DPT_TRIANGLELIST:
+                for (int k = 0; k < 3; ++k) read(3 * t + uint64_t(k), v[k]);
                 proc.triangle(v[0], v[1], v[2], v[0]);
                 break;
-            }
-            case D3DPT_TRIANGLESTRIP: {
+            case D3DPT_TRIANGLESTRIP:
                 // D3D9: odd triangles are (v[i], v[i+2], v[i+1]) so that all keep the winding;
                 // the first vertex (flat shading) is v[i].
-                const ClipVertex* v = &verts[size_t(t)];
+                for (int k = 0; k < 3; ++k) read(t + uint64_t(k), v[k]);
                 if (t & 1)
                     proc.triangle(v[0], v[2], v[1], v[0]);
                 else
                     proc.triangle(v[0], v[1], v[2], v[0]);
                 break;
-            }
-            case D3DPT_TRIANGLEFAN: {
+            case D3DPT_TRIANGLEFAN:
                 // D3D9: (v[i+1], v[i+2], v[0]); its first vertex v[i+1] shades a flat triangle.
-                const ClipVertex& a = verts[size_t(t + 1)];
-                proc.triangle(a, verts[size_t(t + 2)], verts[0], a);
+                read(t + 1, v[0]);
+                read(t + 2, v[1]);
+                read(0, v[2]);
+                proc.triangle(v[0], v[1], v[2], v[0]);
                 break;
-            }
-            default: return;
+            default:
+                return;
         }
     }
-    if (statsOut) *statsOut = stats;
+    if (statsOut) {
+        statsOut->triangles += stats.triangles;
+        statsOut->culled += stats.culled;
+        statsOut->clipped += stats.clipped;
+    }
 }
 
 }  // namespace emu

@@ -62,17 +62,18 @@ struct VertexSetup {
     uint64_t usedAttrs = ~uint64_t(0);
 };
 
-// Processes `primitiveCount` triangles of type `type` (TRIANGLELIST, STRIP or FAN) from the
-// stream: transforms, clips, culls (D3DRS_CULLMODE), applies flat shading (D3DRS_SHADEMODE) and
-// appends the resulting screen triangles to `out`. Triangles with non-finite positions, or
-// XYZRHW vertices with rhw <= 0, are dropped. `stats` (optional) counts culled/clipped input.
+// Processes triangles [first, first + count) of a draw of type `type` (TRIANGLELIST, STRIP or
+// FAN) from the stream: transforms, clips, culls (D3DRS_CULLMODE), applies flat shading
+// (D3DRS_SHADEMODE) and appends the resulting screen triangles to `out`, in order. Triangles with
+// non-finite positions, or XYZRHW vertices with rhw <= 0, are dropped. `stats` (optional) is
+// added to. The draw calls it in chunks so memory stays bounded for any primitive count.
 struct VertexStats {
     uint64_t triangles = 0;  // input triangles
     uint64_t culled = 0;     // removed by culling or as degenerate
     uint64_t clipped = 0;    // wholly outside (or dropped as invalid)
 };
-void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRIMITIVETYPE type,
-                      uint32_t primitiveCount, const uint8_t* data, uint32_t stride, std::vector<ScreenTriangle>& out,
+void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRIMITIVETYPE type, uint32_t first,
+                      uint32_t count, const uint8_t* data, uint32_t stride, std::vector<ScreenTriangle>& out,
                       VertexStats* stats = nullptr);
 
 // Number of vertices a draw of `primitiveCount` triangles reads (0 for other types).

@@ -141,6 +141,11 @@ TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and 
         // Instructions: tex + mov per shaded lane; one texel per point lookup, four per bilinear.
         CHECK(st.instructions == 2 * st.pixelsShaded);
         CHECK(st.texelsFetched == st.pixelsShaded * (filter == D3DTEXF_LINEAR ? 4 : 1));
+        // A second draw counts its own fetches only (the workers' samplers persist between draws).
+        const uint64_t first = st.texelsFetched;
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        CHECK(dev.lastDrawStats().texelsFetched == first);
+        CHECK(dev.totalDrawStats().texelsFetched == 2 * first);
     }
 }
 
@@ -274,7 +279,8 @@ TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[dra
         DWORD c;
     };
     // A quad far larger than the clip volume (x, y in ±5): clipped to the viewport [10, 30) × [4, 14).
-    const V q[4] = {{-5, 5, 0.5f, 0xff00ff00}, {5, 5, 0.5f, 0xff00ff00}, {-5, -5, 0.5f, 0xff00ff00}, {5, -5, 0.5f, 0xff00ff00}};
+    const V q[4] = {
+        {-5, 5, 0.5f, 0xff00ff00}, {5, 5, 0.5f, 0xff00ff00}, {-5, -5, 0.5f, 0xff00ff00}, {5, -5, 0.5f, 0xff00ff00}};
     REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
     const auto px = readTarget(dev, rt, W, H);
     for (UINT y = 0; y < H; ++y)
@@ -324,9 +330,11 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     expectFail(D3DERR_INVALIDCALL, "E4115", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0, data, stride); });
     expectFail(D3DERR_INVALIDCALL, "E4115",
                [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0x100000, data, stride); });
-    expectFail(D3DERR_INVALIDCALL, "E4103", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, nullptr, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4103",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, nullptr, stride); });
     expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 0); });
-    expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride - 4); });
+    expectFail(D3DERR_INVALIDCALL, "E4116",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride - 4); });
     expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 4096); });
     REQUIRE(dev.SetFVF(0) == D3D_OK);
     expectFail(D3DERR_INVALIDCALL, "E4117", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
@@ -394,4 +402,169 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3D_OK);
     CHECK(dev.lastError().code.empty());
     CHECK(dev.totalDrawStats().draws == 1);
+}
+
+TEST_CASE("draw: thousands of triangles keep primitive order across chunks and threads", "[draw]") {
+    for (int threads : {1, 2}) {
+        DeviceOptions o;
+        o.threads = threads;
+        Device dev(o);
+        const int W = 100, H = 50;
+        Handle rt = target(dev, W, H, 0);
+        shader(dev, "ps_1_1\nmov r0, v0\n");
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
+        struct V {
+            float x, y, z, rhw;
+            DWORD c;
+        };
+        // Every pixel as its own 1×1 quad (two triangles) in colour A, then the even pixels again in
+        // colour B: 5000 + 2500 quads = 15000 triangles, later ones in later chunks.
+        std::vector<V> v;
+        auto cell = [&](int x, int y, DWORD c) {
+            const float x0 = x - 0.5f, y0 = y - 0.5f, x1 = x + 0.5f, y1 = y + 0.5f;
+            for (auto [px, py] : {std::pair{x0, y0}, {x1, y0}, {x1, y1}, {x0, y0}, {x1, y1}, {x0, y1}})
+                v.push_back(V{px, py, 0, 1, c});
+        };
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) cell(x, y, 0xff000000u | DWORD(x << 8) | DWORD(y));
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x)
+                if ((x + y) % 2 == 0) cell(x, y, 0xffff0000u | DWORD(x));
+        const UINT tris = UINT(v.size() / 3);
+        REQUIRE(tris == 15000);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, tris, v.data(), sizeof(V)) == D3D_OK);
+        const auto px = readTarget(dev, rt, W, H);
+        int bad = 0;
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                const uint32_t want =
+                    (x + y) % 2 == 0 ? (0xffff0000u | uint32_t(x)) : (0xff000000u | uint32_t(x << 8) | uint32_t(y));
+                bad += px[size_t(y * W + x)] != want;
+            }
+        CHECK(bad == 0);
+        CHECK(dev.lastDrawStats().pixelsCovered == uint64_t(W * H + W * H / 2));
+        CHECK(dev.lastDrawStats().trianglesDrawn == 15000);
+    }
+}
+
+TEST_CASE("draw: texkill discards pixels before the merger", "[draw]") {
+    Device dev;
+    const UINT W = 16, H = 6;
+    Handle rt = target(dev, W, H, 0xff000000);
+    shader(dev, "ps_1_1\ntexkill t0\nmov r0, v0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xff30c050);
+    // t0.u runs from −1 at the left edge to 1 at the right: u = −1 + 2(x + 0.5)/16 < 0 for x <= 7.
+    for (QuadVertex& q : v) q.uv[0][0] = q.uv[0][0] * 2 - 1;
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) CHECK(px[y * W + x] == (x >= 8 ? 0xff30c050u : 0xff000000u));
+    CHECK(dev.lastDrawStats().pixelsCovered == W * H);
+    CHECK(dev.lastDrawStats().pixelsWritten == 8 * H);
+}
+
+TEST_CASE("draw: fixed function MODULATE (no pixel shader) multiplies texture and diffuse", "[draw]") {
+    Device dev;
+    const UINT W = 20, H = 12;
+    Handle rt = target(dev, W, H);
+    std::vector<uint32_t> texels;
+    Handle tex = randomTexture(dev, W, H, texels, 11);
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    // D3D9 defaults: stage 0 COLOROP MODULATE (TEXTURE, CURRENT = diffuse), ALPHAOP SELECTARG1 (TEXTURE).
+    auto v = quad(W, H, 0x40806020);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    const int64_t d[3] = {0x80, 0x60, 0x20};
+    int bad = 0;
+    for (UINT i = 0; i < W * H; ++i) {
+        // fx8 product of two grid values: round_half_even(t·d / 255); alpha is the texel's.
+        for (int c = 0; c < 3; ++c)
+            bad += int64_t(channel(px[i], c)) != rhe(int64_t(channel(texels[i], c)) * d[c], 255);
+        bad += channel(px[i], 3) != channel(texels[i], 3);
+    }
+    CHECK(bad == 0);
+    CHECK(dev.lastDrawStats().pixelsWritten == W * H);
+}
+
+TEST_CASE("draw: 2x2 quads give the sampler its mip level", "[draw]") {
+    // A 64×64 texture with a full chain drawn onto 16×16 pixels: the texture coordinates change by
+    // 4 texels per pixel, so the LOD is log2(4) = 2 and point mip filtering reads level 2 only.
+    Device dev;
+    const UINT W = 16, H = 16;
+    Handle rt = target(dev, W, H);
+    Handle tex{};
+    REQUIRE(dev.CreateTexture(64, 64, 0, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    const DWORD levels = dev.GetLevelCount(tex);
+    REQUIRE(levels == 7);
+    for (DWORD l = 0; l < levels; ++l) {
+        D3DSURFACE_DESC desc;
+        REQUIRE(dev.GetLevelDesc(tex, l, &desc) == D3D_OK);
+        D3DLOCKED_RECT lr;
+        REQUIRE(dev.LockRect(tex, l, &lr, nullptr, 0) == D3D_OK);
+        const uint32_t colour = 0xff000000u | (l * 0x30u) << 16 | 0x10u * l;
+        for (UINT y = 0; y < desc.Height; ++y)
+            for (UINT x = 0; x < desc.Width; ++x)
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + 4 * x, &colour, 4);
+        REQUIRE(dev.UnlockRect(tex, l) == D3D_OK);
+    }
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MIPFILTER, D3DTEXF_POINT) == D3D_OK);
+    shader(dev, "ps_1_1\ntex t0\nmov r0, t0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xffffffff);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    const uint32_t level2 = 0xff000000u | (2 * 0x30u) << 16 | 0x20u;
+    for (uint32_t p : px) CHECK(p == level2);
+}
+
+TEST_CASE("draw: untransformed vertices through a perspective projection interpolate perspective-correctly", "[draw]") {
+    Device dev;
+    const UINT W = 40, H = 30;
+    Handle rt = target(dev, W, H, 0);
+    shader(dev, "ps_1_1\ntexcoord t0\nmov r0, t0\n");
+    REQUIRE(dev.SetFVF(D3DFVF_XYZ | D3DFVF_TEX1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    // Left-handed perspective, near 1, far 10: clip = (x, y, A·z + B, z).
+    D3DMATRIX proj;
+    const float A = 10.0f / 9.0f, B = -10.0f / 9.0f;
+    proj.m[2][2] = A;
+    proj.m[2][3] = 1;
+    proj.m[3][2] = B;
+    proj.m[3][3] = 0;
+    REQUIRE(dev.SetTransform(D3DTS_PROJECTION, &proj) == D3D_OK);
+    struct V {
+        float x, y, z, u, v;
+    };
+    // A rectangle leaning away: x = −1 + 2u, y = −1 + 3v, z = 1 + 3v (near edge z = 1, far z = 4).
+    const V q[4] = {{-1, -1, 1, 0, 0}, {1, -1, 1, 1, 0}, {-1, 2, 4, 0, 1}, {1, 2, 4, 1, 1}};
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    int bad = 0, checked = 0;
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) {
+            // Pixel centre → ndc: x_ndc = 2x/W − 1, y_ndc = 1 − 2y/H. On the plane
+            // y_ndc = (−1 + 3v)/(1 + 3v) → v = (y_ndc + 1)/(3(1 − y_ndc)); then z = 1 + 3v and
+            // u = (x_ndc·z + 1)/2.
+            const double xn = 2.0 * x / W - 1, yn = 1 - 2.0 * y / H;
+            const double v = (yn + 1) / (3 * (1 - yn));
+            const double u = (xn * (1 + 3 * v) + 1) / 2;
+            const uint32_t got = px[y * W + x];
+            if (u > 0.01 && u < 0.99 && v > 0.01 && v < 0.99) {
+                ++checked;
+                const int eu = int(std::lround(u * 255)), ev = int(std::lround(v * 255));
+                const int gu = int(channel(got, 0)), gv = int(channel(got, 1));
+                if (std::abs(gu - eu) > 1 || std::abs(gv - ev) > 1) {
+                    if (bad < 6) WARN(x << "," << y << " got " << gu << "," << gv << " want " << eu << "," << ev);
+                    ++bad;
+                }
+            } else if (u < -0.01 || u > 1.01 || v < -0.01 || v > 1.01) {
+                ++checked;
+                if (got != 0) ++bad;  // outside the rectangle: untouched
+            }
+        }
+    CHECK(checked > int(W * H) * 3 / 4);
+    CHECK(bad == 0);
 }

@@ -347,7 +347,7 @@ std::vector<ScreenTriangle> run(const DeviceState& st, D3DPRIMITIVETYPE type, ui
     setup.layout = &*layout;
     setup.usedAttrs = used;
     std::vector<ScreenTriangle> out;
-    processTriangles(st, setup, type, count, static_cast<const uint8_t*>(data), stride, out, stats);
+    processTriangles(st, setup, type, 0, count, static_cast<const uint8_t*>(data), stride, out, stats);
     return out;
 }
 
@@ -370,18 +370,18 @@ TEST_CASE("vertex: FVF layouts, sizes and refusals", "[raster][vertex]") {
     CHECK(L->texOffset[1] == 32);
     CHECK(L->texOffset[2] == 36);
     CHECK(L->size == 52);
-    auto N = parseFvf(D3DFVF_XYZ | D3DFVF_NORMAL | D3DFVF_PSIZE | D3DFVF_DIFFUSE | D3DFVF_TEX1 | D3DFVF_TEXCOORDSIZE3(0),
-                      err);
+    auto N = parseFvf(
+        D3DFVF_XYZ | D3DFVF_NORMAL | D3DFVF_PSIZE | D3DFVF_DIFFUSE | D3DFVF_TEX1 | D3DFVF_TEXCOORDSIZE3(0), err);
     REQUIRE(N);
     CHECK_FALSE(N->pretransformed);
     CHECK(N->diffuseOffset == 28);  // 12 xyz + 12 normal + 4 psize
     CHECK(N->texSize[0] == 3);
     CHECK(N->size == 44);
-    CHECK_FALSE(parseFvf(D3DFVF_DIFFUSE, err));                    // no position
-    CHECK_FALSE(parseFvf(0x0006 /* XYZB1 */, err));                // blend weights
+    CHECK_FALSE(parseFvf(D3DFVF_DIFFUSE, err));      // no position
+    CHECK_FALSE(parseFvf(0x0006 /* XYZB1 */, err));  // blend weights
     CHECK_FALSE(parseFvf(0x4002 /* XYZW */, err));
     CHECK_FALSE(parseFvf(D3DFVF_XYZRHW | D3DFVF_NORMAL, err));
-    CHECK_FALSE(parseFvf(D3DFVF_XYZ | 0x0900, err));               // 9 texture sets
+    CHECK_FALSE(parseFvf(D3DFVF_XYZ | 0x0900, err));  // 9 texture sets
     CHECK_FALSE(parseFvf(D3DFVF_XYZ | 0x1000 /* LASTBETA_UBYTE4 */, err));
     CHECK(vertexCountOf(D3DPT_TRIANGLELIST, 4) == 12);
     CHECK(vertexCountOf(D3DPT_TRIANGLESTRIP, 4) == 6);
@@ -394,7 +394,8 @@ TEST_CASE("vertex: World·View·Projection with row vectors and the viewport equ
     // World translates by (0.5, 0, 0); projection scales w by 2 (m[3][3] = 2) → x/w halves.
     st.world.m[3][0] = 0.5f;
     st.projection.m[3][3] = 2.0f;
-    const XyzVertex v[3] = {{-1.5f, 1, 0.5f, 0xff000000, 0, 0}, {0.5f, 1, 0.5f, 0xff000000, 1, 0}, {-1.5f, -1, 0.5f, 0xff000000, 0, 1}};
+    const XyzVertex v[3] = {
+        {-1.5f, 1, 0.5f, 0xff000000, 0, 0}, {0.5f, 1, 0.5f, 0xff000000, 1, 0}, {-1.5f, -1, 0.5f, 0xff000000, 0, 1}};
     auto out = run(st, D3DPT_TRIANGLELIST, 1, v, sizeof(XyzVertex));
     REQUIRE(out.size() == 1);
     // Vertex 0: clip (−1, 1, 0.5, 2) → ndc (−0.5, 0.5, 0.25): x = 10 + (1 − 0.5)·50 = 35,
@@ -467,7 +468,7 @@ TEST_CASE("vertex: strips alternate the winding, fans keep it; flat shading uses
         DWORD diffuse, specular;
     };
     // A zig-zag strip over 4 columns, clockwise first triangle: all triangles must survive CCW culling.
-    const V strip[6] = {{0, 0, 0, 1, 0xff000001, 0x10000000}, {0, 10, 0, 1, 0xff000002, 0x20000000},
+    const V strip[6] = {{0, 0, 0, 1, 0xff000001, 0x10000000},  {0, 10, 0, 1, 0xff000002, 0x20000000},
                         {10, 0, 0, 1, 0xff000003, 0x30000000}, {10, 10, 0, 1, 0xff000004, 0x40000000},
                         {20, 0, 0, 1, 0xff000005, 0x50000000}, {20, 10, 0, 1, 0xff000006, 0x60000000}};
     DeviceState st = stateFor(32, 32, D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_SPECULAR);
@@ -485,8 +486,11 @@ TEST_CASE("vertex: strips alternate the winding, fans keep it; flat shading uses
         CHECK(fog.size() == 3);
     }
     // A fan around (10, 10): triangle t is (v[t+1], v[t+2], v[0]) and flat-shaded with v[t+1].
-    const V fan[5] = {{10, 10, 0, 1, 0xff000001, 0}, {0, 0, 0, 1, 0xff000002, 0}, {20, 0, 0, 1, 0xff000003, 0},
-                      {20, 20, 0, 1, 0xff000004, 0}, {0, 20, 0, 1, 0xff000005, 0}};
+    const V fan[5] = {{10, 10, 0, 1, 0xff000001, 0},
+                      {0, 0, 0, 1, 0xff000002, 0},
+                      {20, 0, 0, 1, 0xff000003, 0},
+                      {20, 20, 0, 1, 0xff000004, 0},
+                      {0, 20, 0, 1, 0xff000005, 0}};
     st.renderStates[D3DRS_CULLMODE] = D3DCULL_CCW;  // the fan is clockwise on the screen
     out = run(st, D3DPT_TRIANGLEFAN, 3, fan, sizeof(V));
     REQUIRE(out.size() == 3);
