@@ -1,0 +1,207 @@
+// The body of the fast Unorm8 kernels, included by texture_sampler_fast.cpp (baseline ISA) and
+// texture_sampler_fast_avx2.cpp (AVX2 + FMA) with PS11_FAST_KERNEL naming the exported function.
+// Everything else has internal linkage so the two builds never mix at link time.
+//
+// Exactness (docs/precision.md "Sampling"): per axis R = round_half_even((u*n - 0.5)*256) gives
+// the first texel R >> 8 and the 8-bit weight R & 255 of the second; when f*256 rounds up to 256
+// this moves the tap pair one texel on with weights (256, 0), the same exact sum as the general
+// rule. The blend sum(w_k * byte_k) with w_k = wx'*wy' <= 65536 is an integer below 2^24, so it
+// is exact in float32 whatever the order or FMA; scaling by 2^-16 (fx8) or 2^-12 (fx12, 16
+// grid units per byte) is exact, and adding and removing 1.5 * 2^23 rounds to the nearest
+// integer, ties to even: one rounding, as the reference does in 64-bit integers.
+#include <cstring>
+
+#include "ps11/texture.h"
+#include "ps11/texture_sampler_fast.h"
+#include "ps11/texture_sampler_internal.h"
+
+#ifndef PS11_FAST_KERNEL
+#error "define PS11_FAST_KERNEL before including texture_sampler_fast_impl.h"
+#endif
+
+namespace ps11::fastpath {
+namespace {
+
+// Positions with |x| below this (in the axis's units) take the integer path; others (huge,
+// infinite, NaN) the reference's per-lane rule.
+constexpr double kFastRange = 1073741824.0;  // 2^30
+constexpr float kFloatMagic = 12582912.0f;   // 1.5 * 2^23
+
+// Lane arrays of one span, padded so vector loops may run past the end.
+struct Scratch {
+    alignas(64) int32_t x0[kMaxSpan], x1[kMaxSpan], wx[kMaxSpan];
+    alignas(64) int32_t y0[kMaxSpan], y1[kMaxSpan], wy[kMaxSpan];
+    alignas(64) uint32_t t00[kMaxSpan], t10[kMaxSpan], t01[kMaxSpan], t11[kMaxSpan];
+};
+
+// k mod n for |k| < 2^23, n <= 2^15: a double quotient is within one of the true one.
+inline int32_t modSmall(int32_t k, int32_t n, double inv) {
+    int32_t m = k - int32_t(double(k) * inv) * n;
+    m = m < 0 ? m + n : m;
+    return m >= n ? m - n : m;
+}
+
+// Maps texel index k of an axis with n texels through the address mode (-1 = border). Valid
+// for |k| < 2^23; the same mapping as addressPair.
+template <TextureAddress Mode>
+inline int32_t address1(int32_t k, int32_t n, double inv, double inv2) {
+    if constexpr (Mode == TextureAddress::Wrap) {
+        return modSmall(k, n, inv);
+    } else if constexpr (Mode == TextureAddress::Mirror) {
+        const int32_t m = modSmall(k, 2 * n, inv2);
+        return m < n ? m : 2 * n - 1 - m;
+    } else if constexpr (Mode == TextureAddress::Clamp) {
+        return std::min(std::max(k, 0), n - 1);
+    } else if constexpr (Mode == TextureAddress::Border) {
+        return uint32_t(k) < uint32_t(n) ? k : -1;
+    } else {
+        const int32_t j = k < 0 ? -k - 1 : k;
+        return std::min(j, n - 1);
+    }
+}
+
+// One axis of a run: texel pair and weight (bilinear) or texel (point) per lane.
+template <TextureAddress Mode, bool Linear>
+void axis(int count, const float* c, uint32_t n, int32_t* __restrict i0, int32_t* __restrict i1,
+          int32_t* __restrict w) {
+    const double scale = Linear ? double(n) * 256.0 : double(n);
+    const double bias = Linear ? 128.0 : 0.0;
+    const int32_t ni = int32_t(n);
+    const double inv = 1.0 / double(n), inv2 = 0.5 / double(n);
+    int bad = 0;
+    for (int i = 0; i < count; ++i) {
+        const double x = double(c[i]) * scale - bias;  // exact: 24 + 22 bits
+        const bool ok = x > -kFastRange && x < kFastRange;
+        bad += !ok;
+        const double xs = ok ? x : 0.0;
+        const double r = roundEvenSmall(xs);
+        int32_t k;
+        if constexpr (Linear) {
+            const int32_t R = int32_t(r);
+            k = R >> 8;
+            w[i] = R & 255;
+        } else {
+            k = int32_t(r > xs ? r - 1.0 : r);  // floor(u*n): ties go up
+        }
+        i0[i] = address1<Mode>(k, ni, inv, inv2);
+        if constexpr (Linear) i1[i] = address1<Mode>(k + 1, ni, inv, inv2);
+    }
+    if (!bad) return;
+    for (int i = 0; i < count; ++i) {
+        const double x = double(c[i]) * scale - bias;
+        if (x > -kFastRange && x < kFastRange) continue;
+        double fl, fr;
+        texelPosition(c[i], n, Linear, fl, fr);
+        int32_t a, b;
+        addressPair<Mode>(fl, n, a, b);
+        i0[i] = a;
+        if constexpr (Linear) i1[i] = b, w[i] = weight8(fr);
+    }
+}
+
+template <bool Linear>
+void axisPass(TextureAddress mode, int count, const float* c, uint32_t n, int32_t* i0, int32_t* i1, int32_t* w) {
+    switch (mode) {
+        case TextureAddress::Mirror:
+            return axis<TextureAddress::Mirror, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::Clamp:
+            return axis<TextureAddress::Clamp, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::Border:
+            return axis<TextureAddress::Border, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::MirrorOnce:
+            return axis<TextureAddress::MirrorOnce, Linear>(count, c, n, i0, i1, w);
+        default:  // Wrap (and an invalid value, as the reference)
+            return axis<TextureAddress::Wrap, Linear>(count, c, n, i0, i1, w);
+    }
+}
+
+inline uint32_t load32(const uint8_t* p) {
+    uint32_t w;
+    std::memcpy(&w, p, 4);
+    return w;
+}
+inline uint64_t load64(const uint8_t* p) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    return w;
+}
+
+// The four taps of every lane as b g r a words: one 64-bit load per row when the pair is
+// adjacent (the usual case), else two 32-bit loads or the border word.
+void gatherBilinear(const Unorm8Run& run, int count, Scratch& s) {
+    const uint8_t* base = run.texels;
+    const size_t stride = size_t(run.width) * 4;
+    for (int i = 0; i < count; ++i) {
+        const int32_t x0 = s.x0[i], x1 = s.x1[i], y0 = s.y0[i], y1 = s.y1[i];
+        if ((x0 | x1 | y0 | y1) >= 0) {
+            const uint8_t* r0 = base + size_t(y0) * stride;
+            const uint8_t* r1 = base + size_t(y1) * stride;
+            if (x1 == x0 + 1) {
+                const uint64_t a = load64(r0 + size_t(x0) * 4), b = load64(r1 + size_t(x0) * 4);
+                s.t00[i] = uint32_t(a), s.t10[i] = uint32_t(a >> 32);
+                s.t01[i] = uint32_t(b), s.t11[i] = uint32_t(b >> 32);
+            } else {
+                s.t00[i] = load32(r0 + size_t(x0) * 4), s.t10[i] = load32(r0 + size_t(x1) * 4);
+                s.t01[i] = load32(r1 + size_t(x0) * 4), s.t11[i] = load32(r1 + size_t(x1) * 4);
+            }
+            continue;
+        }
+        auto tap = [&](int32_t x, int32_t y) {
+            return (x | y) < 0 ? run.borderWord : load32(base + size_t(y) * stride + size_t(x) * 4);
+        };
+        s.t00[i] = tap(x0, y0), s.t10[i] = tap(x1, y0), s.t01[i] = tap(x0, y1), s.t11[i] = tap(x1, y1);
+    }
+}
+
+inline float byteOf(uint32_t w, int b) { return float(int32_t((w >> (8 * b)) & 255u)); }
+
+// sum(w_k * byte_k) per channel, scaled and rounded once (see the top of this file).
+void blend(int count, const Scratch& s, float outScale, int32_t* __restrict r, int32_t* __restrict g,
+           int32_t* __restrict b, int32_t* __restrict a) {
+    for (int i = 0; i < count; ++i) {
+        const float fx = float(s.wx[i]), fy = float(s.wy[i]);
+        const float w11 = fx * fy, w10 = fx * 256.0f - w11, w01 = fy * 256.0f - w11;
+        const float w00 = 65536.0f - fx * 256.0f - w01;
+        const uint32_t t00 = s.t00[i], t10 = s.t10[i], t01 = s.t01[i], t11 = s.t11[i];
+        auto ch = [&](int k) {
+            const float sum = w00 * byteOf(t00, k) + w10 * byteOf(t10, k) + w01 * byteOf(t01, k) + w11 * byteOf(t11, k);
+            return int32_t((sum * outScale + kFloatMagic) - kFloatMagic);
+        };
+        b[i] = ch(0), g[i] = ch(1), r[i] = ch(2), a[i] = ch(3);
+    }
+}
+
+void pointOut(int count, const Unorm8Run& run, const Scratch& s, int32_t* __restrict r, int32_t* __restrict g,
+              int32_t* __restrict b, int32_t* __restrict a) {
+    const uint8_t* base = run.texels;
+    const size_t stride = size_t(run.width) * 4;
+    uint32_t* words = const_cast<uint32_t*>(s.t00);
+    for (int i = 0; i < count; ++i) {
+        const int32_t x = s.x0[i], y = s.y0[i];
+        words[i] = (x | y) < 0 ? run.borderWord : load32(base + size_t(y) * stride + size_t(x) * 4);
+    }
+    const int32_t sc = run.scale;
+    for (int i = 0; i < count; ++i) {
+        const uint32_t w = words[i];
+        b[i] = int32_t(w & 255u) * sc, g[i] = int32_t((w >> 8) & 255u) * sc;
+        r[i] = int32_t((w >> 16) & 255u) * sc, a[i] = int32_t(w >> 24) * sc;
+    }
+}
+
+}  // namespace
+
+void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst) {
+    static thread_local Scratch s;
+    if (run.linear) {
+        axisPass<true>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+        axisPass<true>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+        gatherBilinear(run, count, s);
+        blend(count, s, run.scale == 1 ? 1.0f / 65536.0f : 1.0f / 4096.0f, dst[0], dst[1], dst[2], dst[3]);
+    } else {
+        axisPass<false>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+        axisPass<false>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+        pointOut(count, run, s, dst[0], dst[1], dst[2], dst[3]);
+    }
+}
+
+}  // namespace ps11::fastpath
