@@ -398,7 +398,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                              req.dims >= 3 && req.w ? req.w : kZeros};
     const std::array<int32_t, 4>& borderGrid = req.precision == Precision::Fx12 ? st->borderGrid12 : st->borderGrid8;
 
-    uint64_t fetched = 0;
+    uint64_t fetched = 0, fastLanes = 0;
     if (m_fastPath && fixed && !tex.isVolume() && tex.storage() == TexelStorage::Unorm8) {
         fastpath::Unorm8Run run;
         run.addressU = ss.addressU;
@@ -414,6 +414,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 int32_t* dst[4] = {gridDst[0] + first, gridDst[1] + first, gridDst[2] + first, gridDst[3] + first};
                 kernel(run, n, coord[0] + first, coord[1] + first, dst);
                 fetched += uint64_t(n) * (linear ? 4 : 1);
+                fastLanes += uint64_t(n);
             };
             const bool magLinear = effective(ss.magFilter) == Filter::Linear;
             const bool uniformFilter = effective(ss.magFilter) == effective(ss.minFilter);
@@ -446,6 +447,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 }
             }
             m_fetched.fetch_add(fetched, std::memory_order_relaxed);
+            m_fastLanes.fetch_add(fastLanes, std::memory_order_relaxed);
             return;
         }
     }

@@ -53,6 +53,8 @@ public:
     // The fast kernels for 8-bit 2-D textures in fx profiles (point and bilinear, one level per
     // quad, every address mode; on by default). Off: the reference path only.
     void setFastPath(bool enabled) { m_fastPath = enabled; }
+    // Lanes answered by the fast kernels so far (statistics; tests check the fast path ran).
+    uint64_t fastLanes() const { return m_fastLanes.load(std::memory_order_relaxed); }
 
 private:
     struct Stage {
@@ -62,6 +64,7 @@ private:
     };
     std::array<Stage, kMaxSamplerStages> m_stages;
     std::atomic<uint64_t> m_fetched{0};
+    std::atomic<uint64_t> m_fastLanes{0};
     bool m_fastPath = true;
 };
 
