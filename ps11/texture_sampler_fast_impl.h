@@ -10,6 +10,9 @@
 // grid units per byte) is exact, and adding and removing 1.5 * 2^23 rounds to the nearest
 // integer, ties to even: one rounding, as the reference does in 64-bit integers.
 #include <cstring>
+#ifdef __AVX2__
+#include <immintrin.h>
+#endif
 
 #include "ps11/texture.h"
 #include "ps11/texture_sampler_fast.h"
@@ -99,19 +102,94 @@ void axis(int count, const float* c, uint32_t n, int32_t* __restrict i0, int32_t
     }
 }
 
+#ifdef __AVX2__
+// The address mode on 8 int32 lanes (same mapping as address1).
+template <TextureAddress Mode>
+inline __m256i address8(__m256i k, __m256i n, __m256d inv, __m256i twoN, __m256d inv2) {
+    const __m256i zero = _mm256_setzero_si256();
+    auto modN = [&](__m256i kk, __m256i nn, __m256d iv) {
+        const __m256d lo = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(kk)), iv);
+        const __m256d hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(kk, 1)), iv);
+        const __m256i q = _mm256_setr_m128i(_mm256_cvttpd_epi32(lo), _mm256_cvttpd_epi32(hi));
+        __m256i m = _mm256_sub_epi32(kk, _mm256_mullo_epi32(q, nn));
+        m = _mm256_add_epi32(m, _mm256_and_si256(_mm256_cmpgt_epi32(zero, m), nn));             // m < 0: + n
+        m = _mm256_sub_epi32(m, _mm256_andnot_si256(_mm256_cmpgt_epi32(nn, m), nn));            // m >= n: - n
+        return m;
+    };
+    if constexpr (Mode == TextureAddress::Wrap) {
+        return modN(k, n, inv);
+    } else if constexpr (Mode == TextureAddress::Mirror) {
+        const __m256i m = modN(k, twoN, inv2);
+        const __m256i flipped = _mm256_sub_epi32(_mm256_sub_epi32(twoN, _mm256_set1_epi32(1)), m);
+        return _mm256_blendv_epi8(flipped, m, _mm256_cmpgt_epi32(n, m));
+    } else if constexpr (Mode == TextureAddress::Clamp) {
+        return _mm256_min_epi32(_mm256_max_epi32(k, zero), _mm256_sub_epi32(n, _mm256_set1_epi32(1)));
+    } else if constexpr (Mode == TextureAddress::Border) {
+        const __m256i in = _mm256_and_si256(_mm256_cmpgt_epi32(k, _mm256_set1_epi32(-1)), _mm256_cmpgt_epi32(n, k));
+        return _mm256_or_si256(_mm256_and_si256(in, k), _mm256_andnot_si256(in, _mm256_set1_epi32(-1)));
+    } else {
+        const __m256i j = _mm256_xor_si256(k, _mm256_srai_epi32(k, 31));  // k < 0: -k - 1 = ~k
+        return _mm256_min_epi32(j, _mm256_sub_epi32(n, _mm256_set1_epi32(1)));
+    }
+}
+
+// 8 lanes at a time; lanes outside the integer range and the tail go to the scalar axis().
+template <TextureAddress Mode, bool Linear>
+void axisAvx2(int count, const float* c, uint32_t n, int32_t* __restrict i0, int32_t* __restrict i1,
+              int32_t* __restrict w) {
+    const __m256d scale = _mm256_set1_pd(Linear ? double(n) * 256.0 : double(n));
+    const __m256d bias = _mm256_set1_pd(Linear ? 128.0 : 0.0);
+    const __m256d range = _mm256_set1_pd(kFastRange);
+    const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m256i nv = _mm256_set1_epi32(int32_t(n)), twoN = _mm256_set1_epi32(int32_t(2 * n));
+    const __m256d inv = _mm256_set1_pd(1.0 / double(n)), inv2 = _mm256_set1_pd(0.5 / double(n));
+    const __m256i one = _mm256_set1_epi32(1);
+    int i = 0;
+    for (; i + 8 <= count; i += 8) {
+        const __m256 uf = _mm256_loadu_ps(c + i);
+        __m256d xl = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(uf)), scale), bias);
+        __m256d xh = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(uf, 1)), scale), bias);
+        const __m256d okl = _mm256_cmp_pd(_mm256_and_pd(xl, absMask), range, _CMP_LT_OQ);
+        const __m256d okh = _mm256_cmp_pd(_mm256_and_pd(xh, absMask), range, _CMP_LT_OQ);
+        if ((_mm256_movemask_pd(okl) & _mm256_movemask_pd(okh)) != 15) {
+            axis<Mode, Linear>(8, c + i, n, i0 + i, i1 + i, w + i);  // some lane needs the general rule
+            continue;
+        }
+        __m256i k;
+        if constexpr (Linear) {
+            // cvtpd rounds to nearest, ties to even (the default MXCSR mode): R = round(x * 256).
+            const __m256i R = _mm256_setr_m128i(_mm256_cvtpd_epi32(xl), _mm256_cvtpd_epi32(xh));
+            k = _mm256_srai_epi32(R, 8);
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(w + i), _mm256_and_si256(R, _mm256_set1_epi32(255)));
+        } else {
+            xl = _mm256_floor_pd(xl), xh = _mm256_floor_pd(xh);
+            k = _mm256_setr_m128i(_mm256_cvttpd_epi32(xl), _mm256_cvttpd_epi32(xh));
+        }
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(i0 + i), address8<Mode>(k, nv, inv, twoN, inv2));
+        if constexpr (Linear)
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(i1 + i),
+                                address8<Mode>(_mm256_add_epi32(k, one), nv, inv, twoN, inv2));
+    }
+    if (i < count) axis<Mode, Linear>(count - i, c + i, n, i0 + i, i1 + i, w + i);
+}
+#define PS11_AXIS axisAvx2
+#else
+#define PS11_AXIS axis
+#endif
+
 template <bool Linear>
 void axisPass(TextureAddress mode, int count, const float* c, uint32_t n, int32_t* i0, int32_t* i1, int32_t* w) {
     switch (mode) {
         case TextureAddress::Mirror:
-            return axis<TextureAddress::Mirror, Linear>(count, c, n, i0, i1, w);
+            return PS11_AXIS<TextureAddress::Mirror, Linear>(count, c, n, i0, i1, w);
         case TextureAddress::Clamp:
-            return axis<TextureAddress::Clamp, Linear>(count, c, n, i0, i1, w);
+            return PS11_AXIS<TextureAddress::Clamp, Linear>(count, c, n, i0, i1, w);
         case TextureAddress::Border:
-            return axis<TextureAddress::Border, Linear>(count, c, n, i0, i1, w);
+            return PS11_AXIS<TextureAddress::Border, Linear>(count, c, n, i0, i1, w);
         case TextureAddress::MirrorOnce:
-            return axis<TextureAddress::MirrorOnce, Linear>(count, c, n, i0, i1, w);
+            return PS11_AXIS<TextureAddress::MirrorOnce, Linear>(count, c, n, i0, i1, w);
         default:  // Wrap (and an invalid value, as the reference)
-            return axis<TextureAddress::Wrap, Linear>(count, c, n, i0, i1, w);
+            return PS11_AXIS<TextureAddress::Wrap, Linear>(count, c, n, i0, i1, w);
     }
 }
 
