@@ -233,20 +233,41 @@ void gatherBilinear(const Unorm8Run& run, int count, Scratch& s) {
 
 inline float byteOf(uint32_t w, int b) { return float(int32_t((w >> (8 * b)) & 255u)); }
 
-// sum(w_k * byte_k) per channel, scaled and rounded once (see the top of this file).
-void blend(int count, const Scratch& s, float outScale, int32_t* __restrict r, int32_t* __restrict g,
+inline uint32_t word(const uint8_t* p, int i) {
+    uint32_t w;
+    std::memcpy(&w, p + 4 * i, 4);
+    return w;
+}
+
+// sum(w_k * byte_k) per channel, scaled and rounded once (see the top of this file). The taps are
+// b g r a words at t00..t11 (lane i at byte 4i): the gathered scratch arrays, or texel rows
+// read in place for a screen-aligned span.
+void blend(int count, const uint8_t* t00p, const uint8_t* t10p, const uint8_t* t01p, const uint8_t* t11p,
+           const int32_t* wxp, const int32_t* wyp, float outScale, int32_t* __restrict r, int32_t* __restrict g,
            int32_t* __restrict b, int32_t* __restrict a) {
     for (int i = 0; i < count; ++i) {
-        const float fx = float(s.wx[i]), fy = float(s.wy[i]);
+        const float fx = float(wxp[i]), fy = float(wyp[i]);
         const float w11 = fx * fy, w10 = fx * 256.0f - w11, w01 = fy * 256.0f - w11;
         const float w00 = 65536.0f - fx * 256.0f - w01;
-        const uint32_t t00 = s.t00[i], t10 = s.t10[i], t01 = s.t01[i], t11 = s.t11[i];
+        const uint32_t t00 = word(t00p, i), t10 = word(t10p, i), t01 = word(t01p, i), t11 = word(t11p, i);
         auto ch = [&](int k) {
             const float sum = w00 * byteOf(t00, k) + w10 * byteOf(t10, k) + w01 * byteOf(t01, k) + w11 * byteOf(t11, k);
             return int32_t((sum * outScale + kFloatMagic) - kFloatMagic);
         };
         b[i] = ch(0), g[i] = ch(1), r[i] = ch(2), a[i] = ch(3);
     }
+}
+
+// True when the span reads two texel rows in order: one row pair (no border) and column pairs
+// x0 + i, x0 + i + 1 (a screen-aligned pass at the texture's resolution, any fixed fraction).
+// Then the taps are read in place instead of gathered.
+bool rowContiguous(int count, const Scratch& s) {
+    const int32_t x0 = s.x0[0], y0 = s.y0[0], y1 = s.y1[0];
+    if ((x0 | y0 | y1) < 0) return false;
+    int bad = 0;
+    for (int i = 0; i < count; ++i)
+        bad |= (s.x0[i] - i - x0) | (s.x1[i] - i - 1 - x0) | (s.y0[i] - y0) | (s.y1[i] - y1);
+    return bad == 0;
 }
 
 void pointOut(int count, const Unorm8Run& run, const Scratch& s, int32_t* __restrict r, int32_t* __restrict g,
@@ -273,8 +294,18 @@ void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const flo
     if (run.linear) {
         axisPass<true>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
         axisPass<true>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
-        gatherBilinear(run, count, s);
-        blend(count, s, run.scale == 1 ? 1.0f / 65536.0f : 1.0f / 4096.0f, dst[0], dst[1], dst[2], dst[3]);
+        const float outScale = run.scale == 1 ? 1.0f / 65536.0f : 1.0f / 4096.0f;
+        if (rowContiguous(count, s)) {
+            const size_t stride = size_t(run.width) * 4;
+            const uint8_t* r0 = run.texels + size_t(s.y0[0]) * stride + size_t(s.x0[0]) * 4;
+            const uint8_t* r1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
+            blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
+        } else {
+            gatherBilinear(run, count, s);
+            auto bytes = [](const uint32_t* p) { return reinterpret_cast<const uint8_t*>(p); };
+            blend(count, bytes(s.t00), bytes(s.t10), bytes(s.t01), bytes(s.t11), s.wx, s.wy, outScale, dst[0], dst[1],
+                  dst[2], dst[3]);
+        }
     } else {
         axisPass<false>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
         axisPass<false>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
