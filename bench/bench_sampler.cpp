@@ -60,7 +60,7 @@ std::shared_ptr<const Texture> texture1080p() {
     return t;
 }
 
-enum class Pattern { HalfTexelTaps, OneToOne, Random, Downsample2x };
+enum class Pattern { HalfTexelTaps, HalfTexelQuads, OneToOne, Random, Downsample2x };
 
 // Coordinates of `rows` screen rows (spans of kMaxSpan lanes): the screen-aligned patterns of
 // full-screen passes, or uniformly random positions in [0, 1).
@@ -76,6 +76,13 @@ Coords makeCoords(Pattern p, int rows) {
         const int y = int(uint32_t(r) * 67u % kH);  // rows spread over the texture
         for (uint32_t x = 0; x < kW; ++x) {
             float u = 0, v = 0;
+            if (p == Pattern::HalfTexelQuads) {
+                // 2x2 quads as the rasteriser sends them (TL TR BL BR): lane x of the row is pixel
+                // (2 * (x / 4) + x % 2, y + (x / 2) % 2) of a two-row band.
+                const uint32_t px = 2 * (x / 4) % kW + x % 2, py = (uint32_t(y) + (x / 2) % 2) % kH;
+                c.u.push_back((float(px) + 1.0f) / float(kW)), c.v.push_back((float(py) + 1.0f) / float(kH));
+                continue;
+            }
             switch (p) {
                 case Pattern::HalfTexelTaps:  // a blur tap half a texel right and down of the centre
                     u = (float(x) + 1.0f) / float(kW), v = (float(y) + 1.0f) / float(kH);
@@ -97,8 +104,9 @@ Coords makeCoords(Pattern p, int rows) {
 }
 
 // Samples every span of `c` once; returns the elapsed nanoseconds.
-double pass(TextureSampler& s, const Coords& c, std::array<std::vector<int32_t>, 4>& out) {
+double pass(TextureSampler& s, const Coords& c, std::array<std::vector<int32_t>, 4>& out, bool quads) {
     SampleRequest req;
+    req.quads = quads;
     req.precision = Precision::Fx8;
     SampleResult r;
     const auto t0 = Clock::now();
@@ -128,8 +136,8 @@ void BM_Lookup(benchmark::State& state, Pattern pattern, Filter filter, TextureA
     fastpath::setForceGeneric(generic);
     double fastNs = 0, refNs = 0;
     for (auto _ : state) {
-        fastNs += pass(fast, c, out);
-        refNs += pass(ref, c, out);
+        fastNs += pass(fast, c, out, pattern == Pattern::HalfTexelQuads);
+        refNs += pass(ref, c, out, pattern == Pattern::HalfTexelQuads);
     }
     fastpath::setForceGeneric(false);
     const double lookups = double(c.u.size()) * double(state.iterations());
@@ -189,6 +197,9 @@ BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_clamp, Pattern::HalfTexelTaps, F
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_wrap, Pattern::HalfTexelTaps, Filter::Linear, TextureAddress::Wrap,
                   false)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_quads_clamp, Pattern::HalfTexelQuads, Filter::Linear,
+                  TextureAddress::Clamp, false)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_clamp_generic, Pattern::HalfTexelTaps, Filter::Linear,
                   TextureAddress::Clamp, true)

@@ -165,10 +165,18 @@ void axisAvx2(int count, const float* c, uint32_t n, int32_t* __restrict i0, int
             xl = _mm256_floor_pd(xl), xh = _mm256_floor_pd(xh);
             k = _mm256_setr_m128i(_mm256_cvttpd_epi32(xl), _mm256_cvttpd_epi32(xh));
         }
-        _mm256_storeu_si256(reinterpret_cast<__m256i*>(i0 + i), address8<Mode>(k, nv, inv, twoN, inv2));
-        if constexpr (Linear)
-            _mm256_storeu_si256(reinterpret_cast<__m256i*>(i1 + i),
-                                address8<Mode>(_mm256_add_epi32(k, one), nv, inv, twoN, inv2));
+        const __m256i a0 = address8<Mode>(k, nv, inv, twoN, inv2);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(i0 + i), a0);
+        if constexpr (Linear) {
+            __m256i a1;
+            if constexpr (Mode == TextureAddress::Wrap) {  // the next texel of a0, n wrapping to 0
+                const __m256i next = _mm256_add_epi32(a0, one);
+                a1 = _mm256_andnot_si256(_mm256_cmpeq_epi32(next, nv), next);
+            } else {
+                a1 = address8<Mode>(_mm256_add_epi32(k, one), nv, inv, twoN, inv2);
+            }
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(i1 + i), a1);
+        }
     }
     if (i < count) axis<Mode, Linear>(count - i, c + i, n, i0 + i, i1 + i, w + i);
 }
@@ -228,6 +236,39 @@ void gatherBilinear(const Unorm8Run& run, int count, Scratch& s) {
             return (x | y) < 0 ? run.borderWord : load32(base + size_t(y) * stride + size_t(x) * 4);
         };
         s.t00[i] = tap(x0, y0), s.t10[i] = tap(x1, y0), s.t01[i] = tap(x0, y1), s.t11[i] = tap(x1, y1);
+    }
+}
+
+// True when the span is 2x2 quads (lanes TL TR BL BR) of a screen-aligned pass at the texture's
+// resolution: quad q reads columns x0 + 2q + (0 | 1) (and + 1), its top lanes one row pair and its
+// bottom lanes another, none of them border. Then each row's two adjacent lanes are one 64-bit copy.
+bool quadContiguous(int count, const Scratch& s) {
+    if (count % 4 != 0) return false;
+    const int32_t x0 = s.x0[0], ya0 = s.y0[0], ya1 = s.y1[0], yb0 = s.y0[2], yb1 = s.y1[2];
+    if ((x0 | ya0 | ya1 | yb0 | yb1) < 0) return false;
+    int bad = 0;
+    for (int i = 0; i < count; ++i) {
+        const int32_t col = x0 + 2 * (i >> 2) + (i & 1);
+        const bool top = (i & 2) == 0;
+        bad |= (s.x0[i] - col) | (s.x1[i] - col - 1) | (s.y0[i] - (top ? ya0 : yb0)) | (s.y1[i] - (top ? ya1 : yb1));
+    }
+    return bad == 0;
+}
+
+inline void copy8(uint32_t* dst, const uint8_t* src) { std::memcpy(dst, src, 8); }
+
+void gatherQuads(const Unorm8Run& run, int count, Scratch& s) {
+    const size_t stride = size_t(run.width) * 4;
+    const uint8_t* a0 = run.texels + size_t(s.y0[0]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* a1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* b0 = run.texels + size_t(s.y0[2]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* b1 = run.texels + size_t(s.y1[2]) * stride + size_t(s.x0[0]) * 4;
+    for (int i = 0; i < count; i += 4) {
+        const size_t o = size_t(i / 2) * 4;  // column x0 + 2q
+        copy8(s.t00 + i, a0 + o), copy8(s.t00 + i + 2, b0 + o);
+        copy8(s.t10 + i, a0 + o + 4), copy8(s.t10 + i + 2, b0 + o + 4);
+        copy8(s.t01 + i, a1 + o), copy8(s.t01 + i + 2, b1 + o);
+        copy8(s.t11 + i, a1 + o + 4), copy8(s.t11 + i + 2, b1 + o + 4);
     }
 }
 
@@ -301,7 +342,8 @@ void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const flo
             const uint8_t* r1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
             blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
         } else {
-            gatherBilinear(run, count, s);
+            if (quadContiguous(count, s)) gatherQuads(run, count, s);
+            else gatherBilinear(run, count, s);
             auto bytes = [](const uint32_t* p) { return reinterpret_cast<const uint8_t*>(p); };
             blend(count, bytes(s.t00), bytes(s.t10), bytes(s.t01), bytes(s.t11), s.wx, s.wy, outScale, dst[0], dst[1],
                   dst[2], dst[3]);

@@ -438,6 +438,14 @@ TEST_CASE("sampler fast: screen-aligned taps on a 1080p-shaped texture", "[sampl
                         for (int i = 0; i < kMaxSpan; ++i)
                             u[size_t(i)] = (float(x0 + i) * step + 0.5f + offset) / 1920.0f;
                         bad += compareSpan(pr, Precision::Fx8, u.data(), v.data(), kMaxSpan, false);
+                        // The same pass as 2x2 quads (TL TR BL BR), as the rasteriser sends them.
+                        for (int i = 0; i < kMaxSpan; ++i) {
+                            const int px = x0 + 2 * (i / 4) + i % 2, py = row + (i / 2) % 2;
+                            u[size_t(i)] = (float(px) * step + 0.5f + offset) / 1920.0f;
+                            v[size_t(i)] = (float(py) + 0.5f + offset) / 1080.0f;
+                        }
+                        bad += compareSpan(pr, Precision::Fx8, u.data(), v.data(), kMaxSpan, true);
+                        bad += compareSpan(pr, Precision::Fx12, u.data(), v.data(), 4 * int(1 + rng() % 64), true);
                     }
     });
     CHECK(bad == 0);
