@@ -7,9 +7,9 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
-#include <ctime>
 #include <cstdint>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <optional>
 #include <random>
@@ -204,8 +204,8 @@ BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_quads_clamp, Pattern::HalfTexelQ
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_clamp_generic, Pattern::HalfTexelTaps, Filter::Linear,
                   TextureAddress::Clamp, true)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Lookup, bilinear_downsample2x_clamp, Pattern::Downsample2x, Filter::Linear,
-                  TextureAddress::Clamp, false)
+BENCHMARK_CAPTURE(BM_Lookup, bilinear_downsample2x_clamp, Pattern::Downsample2x, Filter::Linear, TextureAddress::Clamp,
+                  false)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_random_wrap, Pattern::Random, Filter::Linear, TextureAddress::Wrap, false)
     ->Unit(benchmark::kMillisecond);

@@ -158,8 +158,8 @@ std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::
         const Image& im = r.levels[k];
         levels[k] = {im.width, im.height, im.depth, im.bytes.data(), im.rowPitch, size_t(im.slicePitch)};
     }
-    std::optional<ps11::Texture> t = ps11::Texture::fromLevels(r.format->texFormat, r.kind == ResourceKind::VolumeTexture,
-                                                              levels.data(), levels.size(), error);
+    std::optional<ps11::Texture> t = ps11::Texture::fromLevels(
+        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), error);
     if (!t) return nullptr;
     return std::make_shared<const ps11::Texture>(std::move(*t));
 }

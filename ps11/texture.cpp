@@ -155,10 +155,10 @@ float roundToHalf(float v) {
     double a = std::fabs(double(v));
     if (a >= 65520.0) return std::copysign(INFINITY, v);  // beyond the largest half + half a step
     int e = 0;
-    std::frexp(a, &e);                         // a = m * 2^e, m in [0.5, 1)
-    int quantumExp = std::max(e - 11, -24);    // 11 significant bits; subnormals step 2^-24
+    std::frexp(a, &e);                       // a = m * 2^e, m in [0.5, 1)
+    int quantumExp = std::max(e - 11, -24);  // 11 significant bits; subnormals step 2^-24
     double q = std::ldexp(1.0, quantumExp);
-    double r = std::nearbyint(a / q) * q;      // ties to even
+    double r = std::nearbyint(a / q) * q;  // ties to even
     return float(std::copysign(r, double(v)));
 }
 
@@ -215,8 +215,9 @@ bool Texture::layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height
     // Unorm8: 4 bytes; Decoded: 16 (float) + 32 (two grids) + 16 (raw while building).
     const uint64_t bytesPerTexel = info.storage == TexelStorage::Unorm8 ? 4 : 64;
     if (uint64_t(total) * bytesPerTexel > kMaxTextureBytes) {
-        error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" + std::to_string(total) +
-                " texels of " + texFormatName(fmt) + "), more than the limit of " + std::to_string(kMaxTextureBytes);
+        error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" +
+                std::to_string(total) + " texels of " + texFormatName(fmt) + "), more than the limit of " +
+                std::to_string(kMaxTextureBytes);
         return false;
     }
     return true;
@@ -284,8 +285,8 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
         const TextureLevelInfo& li = t.m_levels[l.level];
         size_t n = size_t(li.width) * li.height * li.depth;
         if (!l.hasFill && l.texels.size() != n) {
-            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) + " texels, expected " +
-                    std::to_string(n);
+            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) +
+                    " texels, expected " + std::to_string(n);
             return std::nullopt;
         }
         given[l.level] = &l;
@@ -317,9 +318,12 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
 
     std::vector<int32_t> raw;  // signed formats while building
     std::vector<float> rawf;   // float formats while building
-    if (info.storage == TexelStorage::Unorm8) t.m_u8.assign(total * 4, 0);
-    else if (info.floats) rawf.assign(total * 4, 0.0f);
-    else raw.assign(total * 4, 0);
+    if (info.storage == TexelStorage::Unorm8)
+        t.m_u8.assign(total * 4, 0);
+    else if (info.floats)
+        rawf.assign(total * 4, 0.0f);
+    else
+        raw.assign(total * 4, 0);
 
     auto store = [&](size_t index, const Texel& x) {
         if (info.storage == TexelStorage::Unorm8) {
@@ -398,9 +402,12 @@ namespace {
 float halfBitsToFloat(uint16_t h) {
     const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
     double v;
-    if (exponent == 0) v = std::ldexp(double(mantissa), -24);
-    else if (exponent == 31) v = mantissa ? double(NAN) : double(INFINITY);
-    else v = std::ldexp(double(mantissa + 1024), exponent - 25);
+    if (exponent == 0)
+        v = std::ldexp(double(mantissa), -24);
+    else if (exponent == 31)
+        v = mantissa ? double(NAN) : double(INFINITY);
+    else
+        v = std::ldexp(double(mantissa + 1024), exponent - 25);
     return float(sign ? -v : v);
 }
 
@@ -476,8 +483,8 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
     }
     const uint32_t possible = fullMipCount(l0.width, l0.height, depth);
     if (levelCount > possible) {
-        error = "levels " + std::to_string(levelCount) + " is more than the texture has (" + std::to_string(possible) +
-                ")";
+        error =
+            "levels " + std::to_string(levelCount) + " is more than the texture has (" + std::to_string(possible) + ")";
         return std::nullopt;
     }
     Texture t;

@@ -68,9 +68,9 @@ public:
 
     // Raw arrays for the sampler, 4 entries per texel, indexed by level offset + texel: Unorm8 as
     // b g r a bytes (kUnorm8Byte), Decoded as r g b a.
-    const uint8_t* unorm8() const { return m_u8.data(); }                            // Unorm8
-    const float* values() const { return m_value.data(); }                           // Decoded
-    const int32_t* grid(Precision p) const {                                         // Decoded, fx
+    const uint8_t* unorm8() const { return m_u8.data(); }   // Unorm8
+    const float* values() const { return m_value.data(); }  // Decoded
+    const int32_t* grid(Precision p) const {                // Decoded, fx
         return p == Precision::Fx12 ? m_grid12.data() : m_grid8.data();
     }
     // Float32 of byte b (b / 255), shared by all Unorm8 textures.

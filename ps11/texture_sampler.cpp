@@ -1,7 +1,8 @@
 // The software sampler stage: level selection from 2x2 quads, per-axis texel addressing
 // (wrap / mirror / clamp / border / mirroronce) and the exact weighted sums of
 // docs/precision.md "Sampling" (8-bit weights, one round-half-even in fx profiles; float32 in
-// float profiles), plus a bilinear fast path for 8-bit 2D textures in fx (docs/textures.md).
+// float profiles) on the reference path, and the dispatch of 8-bit 2-D fx lookups to the fast
+// kernels of texture_sampler_fast*.cpp (docs/textures.md "Fast path").
 #include "ps11/texture_sampler.h"
 
 #include "ps11/texture_sampler_fast.h"
@@ -333,7 +334,8 @@ uint64_t sampleReference(const SampleRequest& req, int count, const float* const
         const int64_t border[4] = {borderGrid[0], borderGrid[1], borderGrid[2], borderGrid[3]};
         if (tex.storage() == TexelStorage::Unorm8) {
             U8Grid src{tex.unorm8(), gridScale(req.precision) / 255};
-            volume ? combineFx<U8Grid, true>(in, src, border, gridDst) : combineFx<U8Grid, false>(in, src, border, gridDst);
+            volume ? combineFx<U8Grid, true>(in, src, border, gridDst)
+                   : combineFx<U8Grid, false>(in, src, border, gridDst);
         } else {
             IntGrid src{tex.grid(req.precision)};
             volume ? combineFx<IntGrid, true>(in, src, border, gridDst)
@@ -387,8 +389,10 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
         const int32_t one = gridScale(req.precision);
         for (int c = 0; c < 4; ++c)
             for (int i = 0; i < count; ++i) {
-                if (fixed) gridDst[c][i] = c == 3 ? one : 0;
-                else valueDst[c][i] = c == 3 ? 1.0f : 0.0f;
+                if (fixed)
+                    gridDst[c][i] = c == 3 ? one : 0;
+                else
+                    valueDst[c][i] = c == 3 ? 1.0f : 0.0f;
             }
         return;
     }

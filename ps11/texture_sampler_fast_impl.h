@@ -112,8 +112,8 @@ inline __m256i address8(__m256i k, __m256i n, __m256d inv, __m256i twoN, __m256d
         const __m256d hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(kk, 1)), iv);
         const __m256i q = _mm256_setr_m128i(_mm256_cvttpd_epi32(lo), _mm256_cvttpd_epi32(hi));
         __m256i m = _mm256_sub_epi32(kk, _mm256_mullo_epi32(q, nn));
-        m = _mm256_add_epi32(m, _mm256_and_si256(_mm256_cmpgt_epi32(zero, m), nn));             // m < 0: + n
-        m = _mm256_sub_epi32(m, _mm256_andnot_si256(_mm256_cmpgt_epi32(nn, m), nn));            // m >= n: - n
+        m = _mm256_add_epi32(m, _mm256_and_si256(_mm256_cmpgt_epi32(zero, m), nn));   // m < 0: + n
+        m = _mm256_sub_epi32(m, _mm256_andnot_si256(_mm256_cmpgt_epi32(nn, m), nn));  // m >= n: - n
         return m;
     };
     if constexpr (Mode == TextureAddress::Wrap) {
@@ -342,8 +342,10 @@ void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const flo
             const uint8_t* r1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
             blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
         } else {
-            if (quadContiguous(count, s)) gatherQuads(run, count, s);
-            else gatherBilinear(run, count, s);
+            if (quadContiguous(count, s))
+                gatherQuads(run, count, s);
+            else
+                gatherBilinear(run, count, s);
             auto bytes = [](const uint32_t* p) { return reinterpret_cast<const uint8_t*>(p); };
             blend(count, bytes(s.t00), bytes(s.t10), bytes(s.t01), bytes(s.t11), s.wx, s.wy, outScale, dst[0], dst[1],
                   dst[2], dst[3]);

@@ -25,11 +25,10 @@ using namespace ps11;
 
 namespace {
 
-constexpr TexFormat kAllFormats[] = {TexFormat::A8R8G8B8, TexFormat::X8R8G8B8,      TexFormat::A8,
-                                     TexFormat::L8,       TexFormat::A8L8,          TexFormat::V8U8,
-                                     TexFormat::L6V5U5,   TexFormat::X8L8V8U8,      TexFormat::Q8W8V8U8,
-                                     TexFormat::V16U16,   TexFormat::A16B16G16R16F, TexFormat::A32B32G32R32F,
-                                     TexFormat::R32F};
+constexpr TexFormat kAllFormats[] = {
+    TexFormat::A8R8G8B8,      TexFormat::X8R8G8B8,      TexFormat::A8,       TexFormat::L8,       TexFormat::A8L8,
+    TexFormat::V8U8,          TexFormat::L6V5U5,        TexFormat::X8L8V8U8, TexFormat::Q8W8V8U8, TexFormat::V16U16,
+    TexFormat::A16B16G16R16F, TexFormat::A32B32G32R32F, TexFormat::R32F};
 constexpr TexFormat kUnorm8Formats[] = {TexFormat::A8R8G8B8, TexFormat::X8R8G8B8, TexFormat::A8, TexFormat::L8,
                                         TexFormat::A8L8};
 constexpr TextureAddress kModes[] = {TextureAddress::Wrap, TextureAddress::Mirror, TextureAddress::Clamp,
@@ -105,7 +104,8 @@ TextureDesc descOf(TexFormat f, bool volume, const D3DLevels& L) {
                         std::memcpy(t.value.data(), p, 16);
                         t.count = 4;
                     } else if (f == TexFormat::A16B16G16R16F) {
-                        for (int c = 0; c < 4; ++c) t.value[size_t(c)] = emu::halfToFloat(uint16_t(p[2 * c] | p[2 * c + 1] << 8));
+                        for (int c = 0; c < 4; ++c)
+                            t.value[size_t(c)] = emu::halfToFloat(uint16_t(p[2 * c] | p[2 * c + 1] << 8));
                         t.count = 4;
                     } else {
                         for (uint32_t i = 0; i < bpt; ++i) t.bits |= uint32_t(p[i]) << (8 * i);
@@ -117,7 +117,9 @@ TextureDesc descOf(TexFormat f, bool volume, const D3DLevels& L) {
     return desc;
 }
 
-bool sameFloat(float a, float b) { return (std::isnan(a) && std::isnan(b)) || std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+bool sameFloat(float a, float b) {
+    return (std::isnan(a) && std::isnan(b)) || std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b);
+}
 
 void checkSameTexture(const Texture& a, const Texture& b) {
     REQUIRE(a.format() == b.format());
@@ -140,8 +142,7 @@ void checkSameTexture(const Texture& a, const Texture& b) {
                 }
     }
     // The raw arrays the sampler reads must agree too (Unorm8: the b g r a bytes).
-    if (a.storage() == TexelStorage::Unorm8)
-        mismatches += std::memcmp(a.unorm8(), b.unorm8(), a.texelCount() * 4) != 0;
+    if (a.storage() == TexelStorage::Unorm8) mismatches += std::memcmp(a.unorm8(), b.unorm8(), a.texelCount() * 4) != 0;
     CHECK(mismatches == 0);
 }
 
@@ -169,7 +170,7 @@ float nastyCoord(std::mt19937& rng, uint32_t n) {
             return std::uniform_real_distribution<float>(-50.0f, 50.0f)(rng);
         case 4:
             return (float(texel(rng)) + 0.5f) / float(n);  // a texel centre
-        case 5:  // half-way weight: x*256 = m + 1/2 with x = u*n - 1/2
+        case 5:                                            // half-way weight: x*256 = m + 1/2 with x = u*n - 1/2
             return float((double(texel(rng)) * 256.0 + 128.0 + double(rng() % 256) + 0.5) / (256.0 * n));
         case 6:  // weight 255.5..256: f*256 rounds to 256
             return float((double(texel(rng)) + 0.5 + 255.75 / 256.0) / n);
@@ -178,8 +179,15 @@ float nastyCoord(std::mt19937& rng, uint32_t n) {
         case 8:
             return std::uniform_real_distribution<float>(-1e7f, 1e7f)(rng);  // beyond the integer fast range
         case 9: {
-            const float special[] = {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                                     std::nanf(""), 1e30f, -1e30f, 0.0f, -0.0f, 4194304.0f, -8388608.5f};
+            const float special[] = {std::numeric_limits<float>::infinity(),
+                                     -std::numeric_limits<float>::infinity(),
+                                     std::nanf(""),
+                                     1e30f,
+                                     -1e30f,
+                                     0.0f,
+                                     -0.0f,
+                                     4194304.0f,
+                                     -8388608.5f};
             return special[rng() % 9];
         }
         case 10:  // exact multiples of 1/(512 n) around the texture
@@ -290,7 +298,8 @@ TEST_CASE("texture: fromLevels stores A8R8G8B8 as D3D's bytes and X8 alpha as 25
     REQUIRE(t);
     CHECK(std::memcmp(t->unorm8(), bytes, 8) == 0);
     CHECK(t->texelGrid(0, 0, 0, 0, Precision::Fx8) == std::array<int32_t, 4>{0x40, 0x20, 0x10, 0x80});
-    CHECK(t->texelGrid(0, 1, 0, 0, Precision::Fx12) == std::array<int32_t, 4>{0x03 * 16, 0x02 * 16, 0x01 * 16, 0x04 * 16});
+    CHECK(t->texelGrid(0, 1, 0, 0, Precision::Fx12) ==
+          std::array<int32_t, 4>{0x03 * 16, 0x02 * 16, 0x01 * 16, 0x04 * 16});
     std::optional<Texture> x = Texture::fromLevels(TexFormat::X8R8G8B8, false, &l, 1, error);
     REQUIRE(x);
     CHECK(x->texelGrid(0, 0, 0, 0, Precision::Fx8) == std::array<int32_t, 4>{0x40, 0x20, 0x10, 255});
@@ -346,7 +355,9 @@ TEST_CASE("sampler fast: equals the reference, every format, address mode pair a
                                 for (int i = 0; i < count; ++i)
                                     u[size_t(i)] = nastyCoord(rng, sz[0]), v[size_t(i)] = nastyCoord(rng, sz[1]);
                                 const int b = compareSpan(pr, p, u.data(), v.data(), count, false);
-                                if (b) INFO(texFormatName(f) << " " << int(mu) << "/" << int(mv) << " filter " << int(flt));
+                                if (b)
+                                    INFO(texFormatName(f)
+                                         << " " << int(mu) << "/" << int(mv) << " filter " << int(flt));
                                 bad += b;
                                 fastLanes += pr.fast.fastLanes();
                             }
