@@ -96,6 +96,8 @@ Coords makeCoords(Pattern p, int rows) {
                 case Pattern::Random:
                     u = unit(rng), v = unit(rng);
                     break;
+                case Pattern::HalfTexelQuads:  // handled above
+                    break;
             }
             c.u.push_back(u), c.v.push_back(v);
         }

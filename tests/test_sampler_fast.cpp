@@ -15,6 +15,7 @@
 #include <random>
 #include <vector>
 
+#include "emu/device.h"
 #include "emu/format.h"
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
@@ -287,6 +288,65 @@ TEST_CASE("texture: fromLevels equals textureFromDesc for every format", "[sampl
                 REQUIRE(b);
                 checkSameTexture(*a, *b);
             }
+}
+
+TEST_CASE("texture: the device hands every format over as textureFromDesc builds it", "[sampler][fast]") {
+    // Through emu::Device: random bytes written with LockRect/LockBox (D3D pitches, odd widths so
+    // 1- and 2-byte formats have padded rows), then sampledTexture (makeSampledTexture ->
+    // Texture::fromLevels) against textureFromDesc of the same texels.
+    using emu::D3D_OK, emu::D3DFORMAT, emu::D3DLOCKED_BOX, emu::D3DLOCKED_RECT, emu::D3DPOOL_MANAGED;
+    std::mt19937 rng(31);
+    for (TexFormat f : kAllFormats)
+        for (bool volume : {false, true}) {
+            INFO(texFormatName(f) << (volume ? " volume" : ""));
+            emu::Device dev;
+            const D3DFORMAT d3d = emu::d3dFormatOf(f);
+            const uint32_t w = 7, h = 5, d = volume ? 3 : 1;
+            emu::Handle tex{};
+            if (volume)
+                REQUIRE(dev.CreateVolumeTexture(w, h, d, 0, 0, d3d, D3DPOOL_MANAGED, &tex) == D3D_OK);
+            else
+                REQUIRE(dev.CreateTexture(w, h, 0, 0, d3d, D3DPOOL_MANAGED, &tex) == D3D_OK);
+            const uint32_t levels = dev.GetLevelCount(tex);
+            REQUIRE(levels == fullMipCount(w, h, d));
+            D3DLevels L;  // the bytes as the device holds them, for the description
+            L.bytes.resize(levels);
+            for (uint32_t k = 0; k < levels; ++k) {
+                TextureLevelBytes l;
+                l.width = extent(w, k), l.height = extent(h, k), l.depth = extent(d, k);
+                void* bits = nullptr;
+                if (volume) {
+                    D3DLOCKED_BOX box;
+                    REQUIRE(dev.LockBox(tex, k, &box, nullptr, 0) == D3D_OK);
+                    l.rowPitch = size_t(box.RowPitch), l.slicePitch = size_t(box.SlicePitch), bits = box.pBits;
+                } else {
+                    D3DLOCKED_RECT rect;
+                    REQUIRE(dev.LockRect(tex, k, &rect, nullptr, 0) == D3D_OK);
+                    l.rowPitch = size_t(rect.Pitch), l.slicePitch = l.rowPitch * l.height, bits = rect.pBits;
+                }
+                D3DLevels one = randomLevels(rng, f, l.width, l.height, l.depth, 1, true);
+                std::vector<uint8_t>& b = L.bytes[k];
+                b.assign(l.slicePitch * l.depth, 0);
+                const uint32_t row = l.width * bytesPerTexel(f);
+                for (uint32_t z = 0; z < l.depth; ++z)
+                    for (uint32_t y = 0; y < l.height; ++y) {
+                        const uint8_t* src =
+                            one.levels[0].data + z * one.levels[0].slicePitch + y * one.levels[0].rowPitch;
+                        std::memcpy(b.data() + z * l.slicePitch + y * l.rowPitch, src, row);
+                        std::memcpy(static_cast<uint8_t*>(bits) + z * l.slicePitch + y * l.rowPitch, src, row);
+                    }
+                REQUIRE((volume ? dev.UnlockBox(tex, k) : dev.UnlockRect(tex, k)) == D3D_OK);
+                l.data = b.data();
+                L.levels.push_back(l);
+            }
+            std::shared_ptr<const Texture> got = dev.sampledTexture(tex);
+            REQUIRE(got);
+            std::string error;
+            std::optional<Texture> want = textureFromDesc(descOf(f, volume, L), error);
+            INFO(error);
+            REQUIRE(want);
+            checkSameTexture(*got, *want);
+        }
 }
 
 TEST_CASE("texture: fromLevels stores A8R8G8B8 as D3D's bytes and X8 alpha as 255", "[sampler][fast]") {
