@@ -413,11 +413,4 @@ const ps11::Program* Device::pixelShaderProgram(Handle shader) const {
     return it == m_shaders.end() ? nullptr : &it->second.program;
 }
 
-// ---- drawing ----
-
-HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE, UINT, const void*, UINT) {
-    ok();
-    return fail(D3DERR_NOTAVAILABLE, "E4110", "DrawPrimitiveUP: draws arrive with the rasteriser slice");
-}
-
 }  // namespace emu

@@ -1,8 +1,8 @@
 // The emulated Direct3D 9-style device (docs/device.md): D3D9 names and return codes at the
 // edge, plain C++ inside. This slice has resources (textures, volume textures, render targets,
 // depth surfaces, offscreen plain surfaces; Lock/Unlock in D3D's memory layout, mip generation,
-// GetRenderTargetData), every state setter, pixel shaders, Clear and StretchRect. Draws arrive
-// with the rasteriser slice.
+// GetRenderTargetData), every state setter, pixel shaders, Clear, StretchRect and DrawPrimitiveUP
+// (vertex processing, rasteriser, executor, output merger; docs/device.md "Drawing").
 #pragma once
 
 #include <cstdint>
@@ -23,7 +23,7 @@ namespace emu {
 struct DeviceOptions {
     ps11::Precision precision = ps11::Precision::Fx8;  // profile of draws, StretchRect weights
     float maxValue = 0;                                // PixelShader1xMaxValue; 0 = the shader version's default
-    int threads = 0;                                   // worker threads for draws (later slices); 0 = all cores
+    int threads = 0;                                   // worker threads of draws; 0 = all cores
     uint64_t maxResourceBytes = kMaxResourceBytes;     // per resource, checked before allocating
 };
 
@@ -34,6 +34,22 @@ struct DeviceError {
     std::string code;     // "E4101" …, empty on success
     std::string message;  // "E4101 SetTextureStageState: stage 9 out of range 0..7"
 };
+
+// Counts of one draw (Device::lastDrawStats) or of all draws so far (Device::totalDrawStats).
+struct DrawStats {
+    uint64_t draws = 0;           // DrawPrimitiveUP calls that succeeded
+    uint64_t triangles = 0;       // input triangles
+    uint64_t trianglesDrawn = 0;  // triangles rasterised (after clipping, culling; a clipped polygon is a fan)
+    uint64_t pixelsCovered = 0;   // pixels inside a triangle and the clip rect
+    uint64_t pixelsShaded = 0;    // lanes the executor ran: covered pixels plus quad helper lanes
+    uint64_t pixelsWritten = 0;   // pixels that reached the colour or depth store (output merger)
+    uint64_t texelsFetched = 0;   // texels read by the sampler
+    uint64_t instructions = 0;    // instruction executions (per lane)
+    double milliseconds = 0;      // wall time of the call
+    DrawStats& operator+=(const DrawStats& o);
+};
+
+struct DrawContext;  // emu/device_draw.cpp: worker pool, executor cache
 
 class Device {
 public:
@@ -120,8 +136,12 @@ public:
     HRESULT GetPixelShaderConstantF(UINT startRegister, float* data, UINT vector4fCount);
 
     // ---- drawing ----
-    // Not in this slice: returns D3DERR_NOTAVAILABLE ("draws arrive with the rasteriser slice").
+    // Draws triangle lists, strips and fans from a user pointer with the FVF of SetFVF
+    // (docs/device.md "Drawing"). Points and lines: D3DERR_NOTAVAILABLE.
     HRESULT DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, const void* vertexData, UINT stride);
+    // Statistics of the last successful draw and the running total of all draws.
+    const DrawStats& lastDrawStats() const { return m_lastDraw; }
+    const DrawStats& totalDrawStats() const { return m_totalDraw; }
 
     // ---- for the draw slices and tests (not D3D9 API) ----
     // The sampler's view of a texture or volume texture, rebuilt after writes (mips regenerated
@@ -145,6 +165,10 @@ private:
     HRESULT unlockLevel(const char* call, Resource& r, uint32_t level);
     HRESULT registerShader(const char* call, PixelShaderObject&& shader, Handle* out);
     void markWritten(Resource& r, uint32_t level);
+    HRESULT drawFail(HRESULT hr, const char* code, std::string message);
+
+    DrawStats m_lastDraw, m_totalDraw;
+    std::shared_ptr<DrawContext> m_draw;  // created by the first draw
 
     DeviceOptions m_options;
     DeviceState m_state;

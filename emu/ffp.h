@@ -3,11 +3,13 @@
 // specular add) becomes ps11 IR that the one executor runs, exactly like a pixel shader.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
 
 #include "emu/state.h"
+#include "ps11/executor.h"
 #include "ps11/ir.h"
 
 namespace emu {
@@ -23,6 +25,11 @@ struct LoweredStages {
     ps11::Program program;
     uint32_t sampledStages = 0;  // bit i: stage i's texture is read
     int activeStages = 0;        // stages before the first COLOROP DISABLE
+    // What the draw passes to Executor::setStageState(i, …) for executor stage i. D3D9 puts the
+    // bump matrix and luminance scale/offset on the BUMPENVMAP stage i, while texbem/texbeml
+    // read them from the stage they sample (i + 1): the lowering moves them there. The
+    // projection flags are each stage's own TEXTURETRANSFORMFLAGS.
+    std::array<ps11::StageState, kMaxStages> executorStages{};
 };
 
 // Lowers the texture stage states and the render states the combiner reads (TEXTUREFACTOR,

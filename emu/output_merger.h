@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "emu/d3d9types.h"
 #include "emu/resources.h"
@@ -17,7 +18,7 @@ namespace emu {
 struct MergeState {
     bool alphaTest = false;
     D3DCMPFUNC alphaFunc = D3DCMP_ALWAYS;
-    uint32_t alphaRef = 0;  // 0..255
+    uint32_t alphaRef = 0;   // 0..255
     bool depthTest = false;  // ZENABLE and a depth surface bound
     bool depthWrite = false;
     D3DCMPFUNC depthFunc = D3DCMP_LESSEQUAL;
@@ -55,7 +56,7 @@ struct MergeInputs {
 };
 
 struct MergeTarget {
-    Image* color = nullptr;  // A8R8G8B8, X8R8G8B8, A16B16G16R16F or A32B32G32R32F; may be null
+    Image* color = nullptr;  // A8R8G8B8, X8R8G8B8, A16B16G16R16F, A32B32G32R32F or R32F; may be null
     Image* depth = nullptr;  // a depth format, or null
 };
 
@@ -66,6 +67,14 @@ struct MergeStats {
 };
 
 // Merges the pixels into the target. Thread-safe for calls that touch disjoint pixels.
+// Another colour format, a non-depth format as `depth`, or pixels outside the target are the
+// caller's programming errors: asserted (debug), and skipped in release builds.
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats);
+
+// Draw-time check of the states the merger reads (ValidateDevice-style): "" when they are
+// usable, else "E4160 <call>: D3DRS_SRCBLEND 99 is not a D3DBLEND value" for an unknown
+// D3DBLEND / D3DBLENDOP / D3DCMPFUNC value in a state that is in use. (MergeState::from never
+// fails: unknown values act as the state's D3D9 default.)
+std::string mergeStateError(const DeviceState& state, const char* call);
 
 }  // namespace emu

@@ -1104,10 +1104,10 @@ TEST_CASE("device: Release, handles and draws", "[device]") {
     CHECK(dev.state().depthStencil == Handle::Null);
     CHECK(dev.sampledTexture(rt) == nullptr);  // a surface is not a texture
 
-    // Draws are not in this slice and say so.
+    // A draw after the render target was released has no target (tests/test_draw.cpp has the rest).
     const float v[12] = {};
-    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 1, v, 16) == D3DERR_NOTAVAILABLE);
-    CHECK(dev.lastError().message == "E4110 DrawPrimitiveUP: draws arrive with the rasteriser slice");
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 1, v, 16) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().message == "E4109 DrawPrimitiveUP: no render target");
 }
 
 TEST_CASE("device: every E41xx code in emu/ is documented", "[device][docs]") {

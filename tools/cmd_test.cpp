@@ -1,8 +1,8 @@
 // `ps11 test` (stage: command line over the .ps11test reader, the assembler, the validator
 // and the executor). Each file is parsed, its [pixel shader] is assembled and validated (or must
 // fail with the expected diagnostic), its evals and eval probes run on the executor
-// (tools/test_eval.cpp), and its draws and pixel probes are counted as "not yet runnable" until
-// the device runs them; they never make the run fail.
+// (tools/test_eval.cpp), and its draws and pixel probes run on the emu device
+// (tools/test_draw.cpp). Commands asked of the gl backend are counted as "not yet runnable".
 #include "tools/cmd_test.h"
 
 #include <iostream>
@@ -151,9 +151,16 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         if (s.pixels) std::cout << " (" << double(s.instructions) / double(s.pixels) << " per pixel)";
         std::cout << ", " << t.texelsFetched << " texels fetched\n";
     }
+    if (opts.stats && t.draws.draws) {
+        const DrawTally& d = t.draws;
+        std::cout << path << ": draw stats (" << precisionName(precision) << "): " << d.draws << " draws, "
+                  << d.pixelsShaded << " pixels shaded, " << d.pixelsWritten << " written, " << d.instructions
+                  << " instructions executed, " << d.texelsFetched << " texels fetched, " << d.milliseconds
+                  << " ms\n";
+    }
     if (t.error || t.probesFailed)
         result.outcome = Outcome::Failed;
-    else if (t.pendingDevice || t.pendingGl)
+    else if (t.pendingGl)
         result.outcome = Outcome::NotRunnable;
     return result;
 }
@@ -213,7 +220,6 @@ int cmdTest(const std::vector<std::string>& args) {
         total.probesPassed += t.probesPassed;
         total.probesFailed += t.probesFailed;
         total.probesTodo += t.probesTodo;
-        total.pendingDevice += t.pendingDevice;
         total.pendingGl += t.pendingGl;
         if (r.skipped) ++skipped;
         switch (r.outcome) {
@@ -233,8 +239,8 @@ int cmdTest(const std::vector<std::string>& args) {
                                                                : "NOT YET RUNNABLE";
             std::cout << label << " " << path;
             if (t.evals) std::cout << " (" << t.evals << (t.evals == 1 ? " eval" : " evals") << ")";
-            if (t.pendingDevice) std::cout << " (draw/pixel probe: " << t.pendingDevice << " commands waiting)";
-            if (t.pendingGl) std::cout << " (eval on gl: " << t.pendingGl << " commands not runnable)";
+            if (t.draws.draws) std::cout << " (" << t.draws.draws << (t.draws.draws == 1 ? " draw" : " draws") << ")";
+            if (t.pendingGl) std::cout << " (gl: " << t.pendingGl << " commands not runnable yet)";
             std::cout << "\n";
         }
     }
@@ -243,13 +249,7 @@ int cmdTest(const std::vector<std::string>& args) {
     };
     std::cout << plural(files.size(), "file", "files") << ": " << passed << " passed, " << failed << " failed, "
               << notRunnable << " not yet runnable";
-    if (total.pendingDevice || total.pendingGl) {
-        std::cout << " (";
-        if (total.pendingDevice) std::cout << "draw/pixel probe: " << plural(total.pendingDevice, "command", "commands");
-        if (total.pendingDevice && total.pendingGl) std::cout << "; ";
-        if (total.pendingGl) std::cout << "not runnable on gl: " << plural(total.pendingGl, "eval command", "eval commands");
-        std::cout << ")";
-    }
+    if (total.pendingGl) std::cout << " (not runnable on gl yet: " << plural(total.pendingGl, "command", "commands") << ")";
     std::cout << "; probes: " << total.probesPassed << " passed, " << total.probesFailed << " failed, "
               << total.probesTodo << " todo";
     if (skipped) std::cout << "; " << skipped << " with commands skipped by [require] backend";

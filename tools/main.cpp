@@ -17,6 +17,7 @@
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
 #include "tools/cmd_eval.h"
+#include "tools/cmd_demo.h"
 #include "tools/cmd_golden.h"
 #include "tools/cmd_test.h"
 
@@ -38,7 +39,9 @@ const char* kUsageText =
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
-    "  demo                   the main job on the built-in default\n";
+    "  demo [--size WxH] [--threads N] [--repeats N] [--out PREFIX]\n"
+    "                         the main job: the corpus checked, then a bloom chain rendered on\n"
+    "                         the device in every profile (time per pass, error vs ideal)\n";
 
 int usage(const std::string& message) {
     if (!message.empty()) std::cerr << "ps11: " << message << "\n";
@@ -239,9 +242,43 @@ int cmdCheck(const std::vector<std::string>& args) {
     return status;
 }
 
-// The main job until the glare techniques land: check the project's shader corpus.
+// Parses "WxH" into two sizes in 1..16384.
+bool parseSize(const std::string& s, uint32_t& w, uint32_t& h) {
+    unsigned long a = 0, b = 0;
+    char x = 0, tail = 0;
+    if (std::sscanf(s.c_str(), "%lu%c%lu%c", &a, &x, &b, &tail) != 3 || (x != 'x' && x != 'X')) return false;
+    if (a < 1 || b < 1 || a > 16384 || b > 16384) return false;
+    w = uint32_t(a);
+    h = uint32_t(b);
+    return true;
+}
+
+// The main job until the glare techniques land: check the project's shader corpus, then render
+// the corpus's bloom chain on the device in every profile (tools/cmd_demo.cpp).
 int cmdDemo(const std::vector<std::string>& args) {
-    if (!args.empty()) return usage("demo takes no arguments");
+    BloomDemoOptions bloom;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--size" || a == "--threads" || a == "--repeats" || a == "--out") {
+            if (i + 1 >= args.size()) return usage("demo: " + a + " needs a value");
+            const std::string& v = args[++i];
+            char* end = nullptr;
+            if (a == "--size") {
+                if (!parseSize(v, bloom.width, bloom.height))
+                    return usage("demo: --size takes WIDTHxHEIGHT with sides 1..16384, not '" + v + "'");
+            } else if (a == "--out") {
+                bloom.outPrefix = v;
+            } else {
+                long n = std::strtol(v.c_str(), &end, 10);
+                if (*end || n < (a == "--threads" ? 0 : 1) || n > 256)
+                    return usage("demo: " + a + " takes a number" + (a == "--threads" ? " 0..256" : " 1..256") +
+                                 ", not '" + v + "'");
+                (a == "--threads" ? bloom.threads : bloom.repeats) = int(n);
+            }
+        } else {
+            return usage("demo: unknown argument '" + a + "'");
+        }
+    }
     std::string dir = projectDir();
     if (dir.empty()) {
         std::cerr << "ps11: demo: cannot find the shader corpus (tests/shaders/corpus); run from the project folder\n";
@@ -282,8 +319,9 @@ int cmdDemo(const std::vector<std::string>& args) {
         std::printf("%-52s ps_%d_%d  %-9s %-9s %s\n", rel.c_str(), stats.version.major, stats.version.minor, tex,
                     arith, roundTrip ? "identical" : "DIFFERS");
     }
-    std::printf("\n%zu shaders, %d failed\n", files.size(), failures);
-    return failures ? kUserError : kOk;
+    std::printf("\n%zu shaders, %d failed\n\n", files.size(), failures);
+    if (failures) return kUserError;
+    return runBloomDemo(dir, bloom);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // `ps11 test`, the executor part: a file's `eval` commands run the validated [pixel shader] for
 // one pixel on the executor (emu backend; the GL backend comes with the device) with the file's
 // precision, max value, [constants], [stage N] state and [texture N]/[sampler N] textures, and
-// `probe eval` compares r0 with an absolute tolerance. Draws and pixel probes only get counted.
+// `probe eval` compares r0 with an absolute tolerance. Draws and pixel probes run on the emu device
+// (tools/test_draw.cpp); on the gl backend every command is counted as not runnable yet.
 #include "tools/test_eval.h"
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "ps11/diagnostics.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
+#include "tools/test_draw.h"
 
 namespace ps11 {
 namespace {
@@ -67,12 +69,6 @@ bool isDeviceCommand(const TestCommand& cmd) {
     return false;
 }
 
-bool runsOn(const TestCommand& cmd, uint8_t backends, Precision p) {
-    for (Backend b : {Backend::Emu, Backend::Gl})
-        if ((backends & (1u << unsigned(b))) && cmd.onlyIf.matches(b, p)) return true;
-    return false;
-}
-
 // The executor and sampler of one file, built on the first eval.
 struct EvalState {
     std::unique_ptr<Executor> executor;
@@ -112,6 +108,26 @@ bool prepare(const TestFile& file, const std::string& path, const Program& progr
                           << ", which has no [texture " << stage << "]; D3D returns (0, 0, 0, 1) there\n";
     }
     return true;
+}
+
+// Counts a checked probe: passed, failed, todo, or a todo that passes (an error).
+void countProbe(const std::string& path, const TestCommand& cmd, const std::string& failure, bool todo, Precision p,
+                bool verbose, CommandTally& tally, const std::string& got = "") {
+    if (failure.empty() && todo) {
+        std::cout << where(path, cmd.line) << ": error: todo probe passed (remove the todo)"
+                  << (got.empty() ? "" : ": " + got) << " (precision " << precisionName(p) << ")\n";
+        ++tally.probesFailed;
+    } else if (failure.empty()) {
+        ++tally.probesPassed;
+    } else if (todo) {
+        ++tally.probesTodo;
+        if (verbose)
+            std::cout << where(path, cmd.line) << ": todo: " << failure << " (precision " << precisionName(p) << ")\n";
+    } else {
+        std::cout << where(path, cmd.line) << ": probe failed: " << failure << " (precision " << precisionName(p)
+                  << ")\n";
+        ++tally.probesFailed;
+    }
 }
 
 }  // namespace
@@ -169,20 +185,46 @@ std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string
 
 void runCommands(const TestFile& file, const std::string& path, const Program* program,
                  const CommandRunOptions& opts, CommandTally& tally) {
-    // Draws and pixel probes wait for the device, whatever the backend: count each once.
-    for (const TestCommand& cmd : file.commands)
-        if (isDeviceCommand(cmd) && runsOn(cmd, opts.backends, opts.precision)) ++tally.pendingDevice;
-
     const Precision p = opts.precision;
     EvalState state;
     bool prepared = false;
     for (Backend backend : {Backend::Emu, Backend::Gl}) {
         if (!(opts.backends & (1u << unsigned(backend)))) continue;
+        // The last thing a probe looks at: an eval's r0 or the device's render target.
         std::optional<EvalOutcome> last;
+        std::unique_ptr<DrawRunner> device;
+        bool deviceFailed = false;
         for (const TestCommand& cmd : file.commands) {
-            if (isDeviceCommand(cmd) || !cmd.onlyIf.matches(backend, p)) continue;
+            if (!cmd.onlyIf.matches(backend, p)) continue;
             if (backend == Backend::Gl) {
-                ++tally.pendingGl;  // the GL backend comes with the device
+                ++tally.pendingGl;  // the GL backend is not built yet
+                continue;
+            }
+            if (isDeviceCommand(cmd)) {
+                if (deviceFailed) continue;
+                std::string error;
+                if (!device) {
+                    device = DrawRunner::create(file, path, program, p, error);
+                    if (!device) {
+                        std::cout << error << "\n";
+                        deviceFailed = tally.error = true;
+                        continue;
+                    }
+                }
+                if (!std::holds_alternative<Probe>(cmd.op)) {
+                    if (!device->draw(cmd, error)) {
+                        std::cout << error << "\n";
+                        deviceFailed = tally.error = true;
+                    }
+                    continue;
+                }
+                std::string failure = device->probe(std::get<Probe>(cmd.op), error);
+                if (!error.empty()) {
+                    std::cout << error << "\n";
+                    deviceFailed = tally.error = true;
+                    continue;
+                }
+                countProbe(path, cmd, failure, cmd.isTodo(backend, p), p, opts.verbose, tally);
                 continue;
             }
             if (const Eval* eval = std::get_if<Eval>(&cmd.op)) {
@@ -204,7 +246,6 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 continue;
             }
             const Probe& probe = std::get<Probe>(cmd.op);
-            const bool todo = cmd.isTodo(backend, p);
             if (!last) {
                 std::cout << where(path, cmd.line) << ": probe failed: no eval ran before this probe (precision "
                           << precisionName(p) << ")\n";
@@ -212,23 +253,17 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 continue;
             }
             std::string failure = checkProbe(probe, *last, p);
-            if (failure.empty() && todo) {
-                std::cout << where(path, cmd.line) << ": error: todo probe passed (remove the todo): "
-                          << describeOutcome(*last, probe.alpha ? 4 : 3, p) << " (precision " << precisionName(p)
-                          << ")\n";
-                ++tally.probesFailed;
-            } else if (failure.empty()) {
-                ++tally.probesPassed;
-            } else if (todo) {
-                ++tally.probesTodo;
-                if (opts.verbose)
-                    std::cout << where(path, cmd.line) << ": todo: " << failure << " (precision " << precisionName(p)
-                              << ")\n";
-            } else {
-                std::cout << where(path, cmd.line) << ": probe failed: " << failure << " (precision "
-                          << precisionName(p) << ")\n";
-                ++tally.probesFailed;
-            }
+            countProbe(path, cmd, failure, cmd.isTodo(backend, p), p, opts.verbose, tally,
+                       describeOutcome(*last, probe.alpha ? 4 : 3, p));
+        }
+        if (device) {
+            const DrawTally& d = device->tally();
+            tally.draws.draws += d.draws;
+            tally.draws.pixelsShaded += d.pixelsShaded;
+            tally.draws.pixelsWritten += d.pixelsWritten;
+            tally.draws.texelsFetched += d.texelsFetched;
+            tally.draws.instructions += d.instructions;
+            tally.draws.milliseconds += d.milliseconds;
         }
     }
     if (state.sampler) tally.texelsFetched = state.sampler->texelsFetched();

@@ -12,6 +12,7 @@
 #include "ps11/ir.h"
 #include "ps11/sampler.h"
 #include "ps11/testfile.h"
+#include "tools/test_draw.h"
 
 namespace ps11 {
 
@@ -47,11 +48,11 @@ struct CommandTally {
     size_t probesPassed = 0;    // eval probes that passed
     size_t probesFailed = 0;    // eval probes that failed, and todo probes that passed
     size_t probesTodo = 0;      // todo probes that failed as expected
-    size_t pendingDevice = 0;   // draws and pixel probes: need the device (not yet runnable)
-    size_t pendingGl = 0;       // evals and eval probes asked on gl (not runnable on gl yet)
-    bool error = false;         // the executor refused the program, or a sampler could not be built
+    size_t pendingGl = 0;       // commands asked on gl (not runnable on gl yet)
+    bool error = false;         // the executor or the device refused the file's setup or a draw
     ExecutorStats stats;        // executor statistics over every eval
     uint64_t texelsFetched = 0;
+    DrawTally draws;            // the device's statistics over every draw
 };
 
 struct CommandRunOptions {

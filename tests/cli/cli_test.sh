@@ -96,7 +96,31 @@ expect_rc 0 "test with passing eval probes" "$ps11" test "$work/t.ps11test" --st
 expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "summary"
 expect_in "$work/out" "1 pixels, 1 instructions executed" "--stats"
 expect_rc 0 "evals on gl are not runnable" "$ps11" test "$work/t.ps11test" --backend gl
-expect_in "$work/out" "1 not yet runnable (not runnable on gl: 4 eval commands)" "gl evals counted apart"
+expect_in "$work/out" "1 not yet runnable (not runnable on gl yet: 4 commands)" "gl commands counted apart"
+
+# test: draws run on the device; a pixel probe failure names the line, the expected colour and
+# the first pixel that differs; a draw the device refuses fails with the device's message.
+printf '[render target]\nsize 4 2\nclear 0xff000000\n[pixel shader]\nps_1_1\nmov r0, v0\n[test]\ndraw quad diffuse 0xff0000ff rect 0 0 2 2\nprobe rect 0 0 2 2 rgba 0xff0000ff\nprobe 3 1 rgba 0xff000000\nprobe all rgb 0x0000ff\n' >"$work/d.ps11test"
+expect_rc 1 "draw with a failing pixel probe" "$ps11" test "$work/d.ps11test" --stats
+expect_in "$work/out" "d.ps11test:11: probe failed: expected rgb 0x000000ff tol 0, pixel (2, 0) is 0xff000000 (4 pixels differ) (precision fx8)" "pixel probe failure"
+expect_in "$work/out" "probes: 2 passed, 1 failed, 0 todo" "pixel probe counts"
+expect_in "$work/out" "1 draws, " "draw --stats"
+{
+    printf '[texture 4]\nsize 1 1\nfill 0xffffffff\n'
+    for i in 0 1 2 3; do printf '[stage %d]\ncolorop selectarg1\ncolorarg1 diffuse\n' "$i"; done
+    printf '[stage 4]\ncolorop selectarg1\ncolorarg1 texture\n[test]\ndraw quad\nprobe 0 0 rgba 0xffffffff\n'
+} >"$work/ff.ps11test"
+expect_rc 1 "a draw the device refuses" "$ps11" test "$work/ff.ps11test"
+expect_in "$work/out" "ff.ps11test:20: E4142 DrawPrimitiveUP" "device error names the draw's line"
+
+# demo: options and their usage errors.
+expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
+expect_in "$work/out" "bloom on the emu device: 64x36 scene" "demo header"
+expect_in "$work/out" "fx8 " "demo fx8 row"
+[ -s "$work/demo-fx8.ppm" ] || fail "demo --out wrote no demo-fx8.ppm"
+expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
+expect_rc 2 "demo bad threads" "$ps11" demo --threads many
+expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
 
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"

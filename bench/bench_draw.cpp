@@ -1,0 +1,144 @@
+// Benchmarks of whole draws through emu::Device::DrawPrimitiveUP (Google Benchmark; never run by
+// ctest): the 1080p passes of PERF.md — the 4-tap bilinear blur (ps_1_1 tex t0..t3 + mul/mad
+// with c0 weights) and 1:1 copies — on 1 and 2 worker threads, fx8. Each iteration is one draw of
+// the half-pixel 1:1 quad over a 1920×1080 A8R8G8B8 target from a 1920×1080 A8R8G8B8 texture.
+// How to run and what the numbers mean: bench/README.md "bench_draw".
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/device.h"
+
+namespace {
+
+using namespace emu;
+
+constexpr UINT kW = 1920, kH = 1080;
+
+constexpr const char* kBlur4 =
+    "ps_1_1\n"
+    "tex t0\n"
+    "tex t1\n"
+    "tex t2\n"
+    "tex t3\n"
+    "mul r0, t0, c0\n"
+    "mad r0, t1, c0, r0\n"
+    "mad r0, t2, c0, r0\n"
+    "mad r0, t3, c0, r0\n";
+
+constexpr const char* kCopy =
+    "ps_1_1\n"
+    "tex t0\n"
+    "mov r0, t0\n";
+
+struct QuadVertex {
+    float x, y, z, rhw;
+    float uv[4][2];
+};
+
+enum class Pass { Blur4, CopyPoint, CopyLinear };
+
+// One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
+// draw, so iterations time the draw alone.
+struct Scene {
+    std::unique_ptr<Device> dev;
+    std::vector<QuadVertex> quad;
+    bool ok = false;
+
+    Scene(Pass pass, int threads) {
+        DeviceOptions o;
+        o.threads = threads;
+        dev = std::make_unique<Device>(o);
+        Handle rt{}, tex{}, ps{};
+        if (dev->CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
+        if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
+        if (dev->CreateTexture(kW, kH, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
+        D3DLOCKED_RECT lr;
+        if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return;
+        std::mt19937 rng(42);
+        for (UINT y = 0; y < kH; ++y) {
+            auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
+            for (UINT x = 0; x < kW; ++x) row[x] = rng();
+        }
+        dev->UnlockRect(tex, 0);
+        const int stages = pass == Pass::Blur4 ? 4 : 1;
+        const DWORD filter = pass == Pass::CopyPoint ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+        for (int s = 0; s < stages; ++s) {
+            dev->SetTexture(DWORD(s), tex);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_MINFILTER, filter);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
+        }
+        if (dev->CreatePixelShaderFromText(pass == Pass::Blur4 ? kBlur4 : kCopy, &ps) != D3D_OK) return;
+        dev->SetPixelShader(ps);
+        const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
+        dev->SetPixelShaderConstantF(0, c0, 1);
+        dev->SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4);
+        // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
+        // averages a 2×2 block), the copy at the texel centres.
+        const float off[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {-0.5f, 0.5f}, {0.5f, 0.5f}};
+        const float xs[4] = {-0.5f, kW - 0.5f, kW - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, kH - 0.5f, kH - 0.5f};
+        const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            QuadVertex q{xs[k], ys[k], 0.0f, 1.0f, {}};
+            for (int s = 0; s < 4; ++s) {
+                const bool blur = pass == Pass::Blur4;
+                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(kW) : 0.0f);
+                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(kH) : 0.0f);
+            }
+            quad.push_back(q);
+        }
+        ok = draw();  // warm-up: builds the sampler's copy of the texture and the executor
+    }
+
+    bool draw() { return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(QuadVertex)) == D3D_OK; }
+};
+
+Scene& scene(Pass pass, int threads) {
+    static std::unique_ptr<Scene> scenes[3][3];
+    auto& s = scenes[int(pass)][threads];
+    if (!s) s = std::make_unique<Scene>(pass, threads);
+    return *s;
+}
+
+void BM_Draw(benchmark::State& state, Pass pass) {
+    const int threads = int(state.range(0));
+    Scene& sc = scene(pass, threads);
+    if (!sc.ok) {
+        state.SkipWithError(("device refused the setup: " + sc.dev->lastError().message).c_str());
+        return;
+    }
+    for (auto _ : state) {
+        if (!sc.draw()) {
+            state.SkipWithError(sc.dev->lastError().message.c_str());
+            return;
+        }
+    }
+    const DrawStats& st = sc.dev->lastDrawStats();
+    state.SetItemsProcessed(int64_t(state.iterations()) * int64_t(kW) * kH);
+    state.counters["shaded/px"] = double(st.pixelsShaded) / (double(kW) * kH);
+    state.counters["instr/px"] = double(st.instructions) / double(st.pixelsShaded ? st.pixelsShaded : 1);
+    state.counters["texels/px"] = double(st.texelsFetched) / (double(kW) * kH);
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, copy_linear_1080p_fx8, Pass::CopyLinear)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+BENCHMARK_MAIN();

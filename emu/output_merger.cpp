@@ -1,0 +1,768 @@
+// The output merger (docs/output-merger.md): vertex fog, alpha test, depth test and write, alpha
+// blending, colour write mask and the store into the render target, per pixel in D3D9's order.
+// Per call, the render states are resolved into a plan (factor selectors, compare masks, write
+// masks) so the per-pixel loops never switch on a D3DBLEND or D3DCMPFUNC value.
+#include "emu/output_merger.h"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cstring>
+#include <string>
+
+#include "ps11/sampler.h"
+
+namespace emu {
+
+namespace {
+
+using ps11::Precision;
+
+// ---------------------------------------------------------------------------------------------
+// Small exact helpers.
+
+// round_half_even(x) for 0 <= x < 2^51 under the default rounding mode: adding 1.5 * 2^52 leaves
+// no fraction bits, so the addition itself rounds to the nearest integer, ties to even. This is
+// the rounding std::nearbyint does (Clear uses it), without a libm call per pixel.
+inline double rintEven(double x) {
+    constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
+    return (x + kMagic) - kMagic;                  // not folded: without -ffast-math the compiler keeps IEEE rounding
+}
+
+// round_half_even(num / den) for num >= 0, den > 0 a compile-time constant.
+template <int64_t Den>
+inline int32_t divRoundEven(int64_t num) {
+    const int64_t q = num / Den, r = num % Den;
+    return int32_t(q + ((2 * r > Den || (2 * r == Den && (q & 1))) ? 1 : 0));
+}
+
+// Saturate to [0, 1]; NaN becomes 0.
+inline float sat(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+// The 8-bit value of a saturated float (precision.md "Outputs": round_half_even(x * 255); x * 255
+// is exact in double).
+inline uint32_t byteOfUnit(float v) { return uint32_t(rintEven(double(v) * 255.0)); }
+
+// Compare: D3DCMPFUNC - 1 is a 3-bit mask of the outcomes that pass (bit 0 less, bit 1 equal,
+// bit 2 greater): NEVER 0, LESS 1, EQUAL 2, LESSEQUAL 3, GREATER 4, NOTEQUAL 5, GREATEREQUAL 6,
+// ALWAYS 7. Bit 3 is the unordered outcome of a NaN (passes NOTEQUAL and ALWAYS, as IEEE).
+inline uint32_t cmpMask(D3DCMPFUNC f) {
+    uint32_t m = uint32_t(f) - 1;
+    return m | ((m == 5 || m == 7) ? 8u : 0u);
+}
+template <typename T>
+inline bool cmpPass(uint32_t mask, T a, T b) {
+    const uint32_t outcome = a < b ? 0u : a == b ? 1u : a > b ? 2u : 3u;
+    return (mask >> outcome) & 1u;
+}
+
+inline uint32_t load32(const uint8_t* p) {
+    uint32_t w;
+    std::memcpy(&w, p, 4);
+    return w;
+}
+inline void store32(uint8_t* p, uint32_t w) { std::memcpy(p, &w, 4); }
+
+// IEEE half <-> float by bits, round to nearest even; the same results as emu::floatToHalf /
+// halfToFloat (tests check every half and a sweep of floats) at a fraction of the cost.
+inline uint16_t halfOf(float f) {
+    const uint32_t bits = std::bit_cast<uint32_t>(f);
+    const uint16_t sign = uint16_t((bits >> 16) & 0x8000u);
+    const uint32_t x = bits & 0x7fffffffu;
+    if (x > 0x7f800000u) return uint16_t(sign | 0x7e00u);       // NaN
+    if (x >= 0x477ff000u) return uint16_t(sign | 0x7c00u);      // >= 65520 (and infinity): infinity
+    if (x < 0x38800000u) {                                      // below 2^-14: subnormal half
+        const float v = std::bit_cast<float>(x) * 16777216.0f;  // exact: value in units of 2^-24
+        const float r = (v + 8388608.0f) - 8388608.0f;          // round to an integer, ties to even
+        return uint16_t(sign | uint16_t(r));
+    }
+    uint32_t h = (x - 0x38000000u) >> 13;  // rebias 127 -> 15, keep 10 mantissa bits
+    const uint32_t rest = x & 0x1fffu;
+    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;  // a carry into the exponent is right
+    return uint16_t(sign | h);
+}
+inline float floatOfHalf(uint16_t h) {
+    const uint32_t sign = uint32_t(h & 0x8000u) << 16;
+    const uint32_t e = (h >> 10) & 31u, m = h & 1023u;
+    if (e == 0) {
+        const float v = float(m) * 5.9604644775390625e-8f;  // m * 2^-24, exact
+        return sign ? -v : v;
+    }
+    if (e == 31) return std::bit_cast<float>(sign | 0x7f800000u | (m ? 0x400000u | (m << 13) : 0u));
+    return std::bit_cast<float>(sign | ((e + 112u) << 23) | (m << 13));
+}
+
+// ---------------------------------------------------------------------------------------------
+// State sanitising (MergeState::from never fails; unknown values act as the state's default).
+
+bool knownBlend(DWORD b) { return b >= D3DBLEND_ZERO && b <= D3DBLEND_INVBLENDFACTOR; }
+bool knownOp(DWORD o) { return o >= D3DBLENDOP_ADD && o <= D3DBLENDOP_MAX; }
+bool knownCmp(DWORD c) { return c >= D3DCMP_NEVER && c <= D3DCMP_ALWAYS; }
+
+D3DBLEND blendOr(DWORD b, D3DBLEND dflt) { return knownBlend(b) ? D3DBLEND(b) : dflt; }
+D3DBLENDOP opOr(DWORD o, D3DBLENDOP dflt) { return knownOp(o) ? D3DBLENDOP(o) : dflt; }
+D3DCMPFUNC cmpOr(DWORD c, D3DCMPFUNC dflt) { return knownCmp(c) ? D3DCMPFUNC(c) : dflt; }
+
+// Resolves the legacy pair factors: SRCBLEND BOTHSRCALPHA means (SRCALPHA, INVSRCALPHA) and
+// BOTHINVSRCALPHA (INVSRCALPHA, SRCALPHA), overriding the destination factor (D3D9 docs, Wine).
+// As a destination factor (which D3D9 does not define) each acts as the destination half of
+// its pair.
+void resolvePair(D3DBLEND& src, D3DBLEND& dst) {
+    if (src == D3DBLEND_BOTHSRCALPHA) {
+        src = D3DBLEND_SRCALPHA, dst = D3DBLEND_INVSRCALPHA;
+    } else if (src == D3DBLEND_BOTHINVSRCALPHA) {
+        src = D3DBLEND_INVSRCALPHA, dst = D3DBLEND_SRCALPHA;
+    } else if (dst == D3DBLEND_BOTHSRCALPHA) {
+        dst = D3DBLEND_INVSRCALPHA;
+    } else if (dst == D3DBLEND_BOTHINVSRCALPHA) {
+        dst = D3DBLEND_SRCALPHA;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The per-call plan.
+
+// Per-pixel value slots a factor selects from (all on the same scale: the grid G in fx
+// profiles, 1.0 in float arithmetic).
+enum Slot : uint8_t {
+    kZero = 0,
+    kOne = 1,
+    kSrc = 2,   // 2..5: source r g b a
+    kDst = 6,   // 6..9: destination r g b a
+    kSat = 10,  // min(As, 1 - Ad)
+    kBf = 11,   // 11..14: BLENDFACTOR r g b a
+    kSlots = 15
+};
+
+// A factor is base + sign * slot: inverse factors are 1 - slot.
+struct Factor {
+    uint8_t slot = kZero;
+    bool inv = false;
+};
+
+Factor factorOf(D3DBLEND b, int c) {
+    switch (b) {
+        case D3DBLEND_ZERO:
+            return {kZero, false};
+        case D3DBLEND_ONE:
+            return {kOne, false};
+        case D3DBLEND_SRCCOLOR:
+            return {uint8_t(kSrc + c), false};
+        case D3DBLEND_INVSRCCOLOR:
+            return {uint8_t(kSrc + c), true};
+        case D3DBLEND_SRCALPHA:
+            return {uint8_t(kSrc + 3), false};
+        case D3DBLEND_INVSRCALPHA:
+            return {uint8_t(kSrc + 3), true};
+        case D3DBLEND_DESTALPHA:
+            return {uint8_t(kDst + 3), false};
+        case D3DBLEND_INVDESTALPHA:
+            return {uint8_t(kDst + 3), true};
+        case D3DBLEND_DESTCOLOR:
+            return {uint8_t(kDst + c), false};
+        case D3DBLEND_INVDESTCOLOR:
+            return {uint8_t(kDst + c), true};
+        case D3DBLEND_SRCALPHASAT:
+            return c < 3 ? Factor{kSat, false} : Factor{kOne, false};  // (f, f, f, 1)
+        case D3DBLEND_BLENDFACTOR:
+            return {uint8_t(kBf + c), false};
+        case D3DBLEND_INVBLENDFACTOR:
+            return {uint8_t(kBf + c), true};
+        default:
+            return {kZero, false};  // BOTH* are resolved before; unknown values sanitised
+    }
+}
+
+enum class OpKind : uint8_t { Linear, Min, Max };
+
+struct ChannelPlan {
+    Factor src, dst;
+    OpKind kind = OpKind::Linear;
+    int32_t cs = 1, cd = 1;  // Linear: cs * src * Fs + cd * dst * Fd
+};
+
+enum class TargetKind : uint8_t { Argb8, Xrgb8, Rgba16F, Rgba32F, R32F };
+enum class DepthKind : uint8_t { D16, D24, D32, D32F };
+
+struct Plan {
+    Precision precision = Precision::Fx8;
+    bool alphaTest = false, depthTest = false, depthWrite = false, fog = false, blend = false;
+    uint32_t alphaMask = 7, depthMask = 3;
+    uint32_t alphaRef = 0;
+    uint8_t fogByte[3] = {};  // FOGCOLOR r g b
+    uint8_t bfByte[4] = {};   // BLENDFACTOR r g b a
+    ChannelPlan ch[4];
+    uint32_t channels = 0;  // enabled and changing channels, bit c = r g b a
+    Image* color = nullptr;
+    Image* depth = nullptr;
+    TargetKind target = TargetKind::Argb8;
+    DepthKind depthKind = DepthKind::D16;
+};
+
+bool resolveTarget(const MergeTarget& t, Plan& p) {
+    if (t.color) {
+        switch (t.color->format ? t.color->format->format : D3DFMT_UNKNOWN) {
+            case D3DFMT_A8R8G8B8:
+                p.target = TargetKind::Argb8;
+                break;
+            case D3DFMT_X8R8G8B8:
+                p.target = TargetKind::Xrgb8;
+                break;
+            case D3DFMT_A16B16G16R16F:
+                p.target = TargetKind::Rgba16F;
+                break;
+            case D3DFMT_A32B32G32R32F:
+                p.target = TargetKind::Rgba32F;
+                break;
+            case D3DFMT_R32F:
+                p.target = TargetKind::R32F;
+                break;
+            default:
+                return false;
+        }
+    }
+    if (t.depth) {
+        const FormatInfo* f = t.depth->format;
+        if (!f || f->cls != FormatClass::Depth) return false;
+        p.depthKind = f->format == D3DFMT_D32F_LOCKABLE ? DepthKind::D32F
+                      : f->depthBits == 16              ? DepthKind::D16
+                      : f->depthBits == 24              ? DepthKind::D24
+                                                        : DepthKind::D32;
+    }
+    p.color = t.color;
+    p.depth = t.depth;
+    return true;
+}
+
+Plan makePlan(const MergeState& s, const MergeTarget& t, bool& ok) {
+    Plan p;
+    ok = resolveTarget(t, p);
+    p.precision = s.precision;
+    p.alphaTest = s.alphaTest;
+    p.alphaMask = cmpMask(cmpOr(s.alphaFunc, D3DCMP_ALWAYS));
+    p.alphaRef = s.alphaRef & 0xffu;
+    p.depthTest = s.depthTest && t.depth;
+    p.depthWrite = p.depthTest && s.depthWrite;
+    p.depthMask = cmpMask(cmpOr(s.depthFunc, D3DCMP_LESSEQUAL));
+    p.fog = s.fog;
+    for (int c = 0; c < 3; ++c) p.fogByte[c] = uint8_t(s.fogColor >> (16 - 8 * c));
+    p.blend = s.blend;
+    const uint8_t bf[4] = {uint8_t(s.blendFactor >> 16), uint8_t(s.blendFactor >> 8), uint8_t(s.blendFactor),
+                           uint8_t(s.blendFactor >> 24)};
+    std::copy_n(bf, 4, p.bfByte);
+
+    // Which channels the target has and the mask enables.
+    uint32_t channels = s.colorWrite & 0xfu;
+    if (!t.color)
+        channels = 0;
+    else if (p.target == TargetKind::Xrgb8)
+        channels &= 7u;  // no alpha channel (the X byte: see the store)
+    else if (p.target == TargetKind::R32F)
+        channels &= 1u;
+
+    D3DBLEND src = blendOr(s.srcBlend, D3DBLEND_ONE), dst = blendOr(s.dstBlend, D3DBLEND_ZERO);
+    resolvePair(src, dst);
+    const D3DBLENDOP op = opOr(s.blendOp, D3DBLENDOP_ADD);
+    D3DBLEND srcA = src, dstA = dst;
+    D3DBLENDOP opA = op;
+    if (s.separateAlpha) {
+        srcA = blendOr(s.srcBlendAlpha, D3DBLEND_ONE), dstA = blendOr(s.dstBlendAlpha, D3DBLEND_ZERO);
+        resolvePair(srcA, dstA);
+        opA = opOr(s.blendOpAlpha, D3DBLENDOP_ADD);
+    }
+    for (int c = 0; c < 4; ++c) {
+        const D3DBLEND fs = c < 3 ? src : srcA, fd = c < 3 ? dst : dstA;
+        const D3DBLENDOP o = c < 3 ? op : opA;
+        ChannelPlan& cp = p.ch[c];
+        cp.src = factorOf(fs, c);
+        cp.dst = factorOf(fd, c);
+        cp.kind = o == D3DBLENDOP_MIN ? OpKind::Min : o == D3DBLENDOP_MAX ? OpKind::Max : OpKind::Linear;
+        cp.cs = o == D3DBLENDOP_REVSUBTRACT ? -1 : 1;
+        cp.cd = o == D3DBLENDOP_SUBTRACT ? -1 : 1;
+        // A channel blended as 0 * src + 1 * dst (ADD or REVSUBTRACT) keeps the target: leave it
+        // unwritten, so skipping such a draw (writesNothing) changes nothing either.
+        if (p.blend && cp.kind == OpKind::Linear && fs == D3DBLEND_ZERO && fd == D3DBLEND_ONE && cp.cd == 1)
+            channels &= ~(1u << c);
+    }
+    p.channels = channels;
+    return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Depth.
+
+// The depth surface's stored value for z in [0, 1]: the nearest of 2^bits - 1 steps, ties to
+// even, exactly as Clear stores it (emu/device_blit.cpp, docs/device.md "Clear").
+inline uint32_t depthCode(DepthKind k, float z) {
+    switch (k) {
+        case DepthKind::D16:
+            return uint32_t(rintEven(double(z) * 65535.0));
+        case DepthKind::D24:
+            return uint32_t(rintEven(double(z) * 16777215.0));
+        case DepthKind::D32:
+            return uint32_t(rintEven(double(z) * 4294967295.0));
+        default:
+            return std::bit_cast<uint32_t>(z);
+    }
+}
+
+// Depth test (and write when it passes). True when the pixel passes.
+inline bool depthStage(const Plan& p, uint32_t x, uint32_t y, float zIn) {
+    const float z = zIn > 0.0f ? (zIn < 1.0f ? zIn : 1.0f) : 0.0f;  // NaN -> 0
+    uint8_t* q = p.depth->texel(x, y);
+    const uint32_t code = depthCode(p.depthKind, z);
+    bool pass;
+    switch (p.depthKind) {
+        case DepthKind::D16: {
+            uint16_t old;
+            std::memcpy(&old, q, 2);
+            pass = cmpPass(p.depthMask, code, uint32_t(old));
+            if (pass && p.depthWrite) {
+                const uint16_t w = uint16_t(code);
+                std::memcpy(q, &w, 2);
+            }
+            break;
+        }
+        case DepthKind::D24: {
+            const uint32_t old = load32(q);
+            pass = cmpPass(p.depthMask, code, old >> 8);
+            if (pass && p.depthWrite) store32(q, (old & 0xffu) | (code << 8));  // keeps stencil / X
+            break;
+        }
+        case DepthKind::D32: {
+            pass = cmpPass(p.depthMask, code, load32(q));
+            if (pass && p.depthWrite) store32(q, code);
+            break;
+        }
+        default: {
+            float old;
+            std::memcpy(&old, q, 4);
+            pass = cmpPass(p.depthMask, z, old);
+            if (pass && p.depthWrite) std::memcpy(q, &z, 4);
+            break;
+        }
+    }
+    return pass;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Lane access.
+
+struct Lanes {
+    const MergeInputs& in;
+    bool inside(int i, uint32_t& x, uint32_t& y, const Plan& p) const {
+        const int32_t xi = in.x[i], yi = in.y[i];
+        const uint32_t w = p.color ? p.color->width : p.depth->width;
+        const uint32_t h = p.color ? p.color->height : p.depth->height;
+        assert(xi >= 0 && yi >= 0 && uint32_t(xi) < w && uint32_t(yi) < h);
+        if (xi < 0 || yi < 0 || uint32_t(xi) >= w || uint32_t(yi) >= h) return false;
+        if (p.color && p.depth && (uint32_t(xi) >= p.depth->width || uint32_t(yi) >= p.depth->height)) return false;
+        x = uint32_t(xi), y = uint32_t(yi);
+        return true;
+    }
+    float fog(int i) const {
+        if (!in.fog) return 1.0f;
+        return sat(in.fog[i]);
+    }
+    float z(int i) const { return in.z ? in.z[i] : 0.0f; }
+};
+
+// The stats of one call, added to the caller's at the end.
+struct Counts {
+    uint64_t written = 0, alphaRejected = 0, depthRejected = 0;
+};
+
+// Runs alpha test then depth test; counts. `alphaPass` is the alpha test's outcome.
+inline bool tests(const Plan& p, bool alphaPass, uint32_t x, uint32_t y, float z, Counts& n) {
+    if (!alphaPass) {
+        ++n.alphaRejected;
+        return false;
+    }
+    if (p.depthTest && !depthStage(p, x, y, z)) {
+        ++n.depthRejected;
+        return false;
+    }
+    ++n.written;
+    return true;
+}
+
+// Packs r g b a bytes into the target's word (bytes B G R A; X8R8G8B8 stores X = 0xff).
+inline uint32_t packArgb(uint32_t r, uint32_t g, uint32_t b, uint32_t a) {
+    return b | (g << 8) | (r << 16) | (a << 24);
+}
+
+// The byte mask of the enabled channels in an 8-bit ARGB word. For X8R8G8B8 the X byte is
+// written (as 0xff) whenever any colour channel is.
+uint32_t wordMask(const Plan& p) {
+    uint32_t m = 0;
+    if (p.channels & 1u) m |= 0x00ff0000u;
+    if (p.channels & 2u) m |= 0x0000ff00u;
+    if (p.channels & 4u) m |= 0x000000ffu;
+    if (p.channels & 8u) m |= 0xff000000u;
+    if (p.target == TargetKind::Xrgb8 && (p.channels & 7u)) m |= 0xff000000u;
+    return m;
+}
+
+// ---------------------------------------------------------------------------------------------
+// 8-bit targets in fx profiles: integer arithmetic on the grid G (255 or 4080).
+
+template <int32_t G>
+struct Fx {
+    static constexpr int32_t S = G / 255;  // grid steps per 8-bit level (1 or 16)
+    // The stored byte of a saturated grid value (fx8: n; fx12: round_half_even(n / 16)).
+    static uint32_t byteOf(int32_t n) {
+        if constexpr (G == 255)
+            return uint32_t(n);
+        else
+            return uint32_t(divRoundEven<S>(n));
+    }
+    // round_half_even(num * 255 / G^2) for num in [0, G^2] (fx8: num / 255; fx12: num / 65280).
+    static uint32_t blendByte(int64_t num) {
+        num = num < 0 ? 0 : num > int64_t(G) * G ? int64_t(G) * G : num;
+        if constexpr (G == 255)
+            return uint32_t((num + 127) / 255);  // 255 is odd: no ties
+        else
+            return uint32_t(divRoundEven<int64_t(G) * G / 255>(num));
+    }
+    // The fog factor on the grid: round_half_even(f * G) (f * G is exact in double).
+    static int32_t fogGrid(float f) { return int32_t(rintEven(double(f) * G)); }
+};
+
+// The common case: no fog, no tests, no blending, fx8, every channel written or a mask.
+void storeFx8Plain(const Plan& p, const MergeInputs& in, const int32_t* const g[4], Counts& n) {
+    const uint32_t mask = wordMask(p);
+    const uint32_t alphaFill = p.target == TargetKind::Xrgb8 ? 0xff000000u : 0u;
+    Image& img = *p.color;
+    const Lanes lanes{in};
+    for (int i = 0; i < in.count; ++i) {
+        if (in.live && !in.live[i]) continue;
+        uint32_t x, y;
+        if (!lanes.inside(i, x, y, p)) continue;
+        const auto clamp = [](int32_t v) { return uint32_t(v < 0 ? 0 : v > 255 ? 255 : v); };
+        uint32_t w = packArgb(clamp(g[0][i]), clamp(g[1][i]), clamp(g[2][i]), clamp(g[3][i])) | alphaFill;
+        uint8_t* q = img.texel(x, y);
+        if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
+        store32(q, w);
+        ++n.written;
+    }
+}
+
+template <int32_t G>
+void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[4], Counts& n) {
+    using F = Fx<G>;
+    const uint32_t mask = wordMask(p);
+    const bool x8 = p.target == TargetKind::Xrgb8;
+    const Lanes lanes{in};
+    int32_t v[kSlots];
+    v[kZero] = 0, v[kOne] = G;
+    for (int c = 0; c < 4; ++c) v[kBf + c] = int32_t(p.bfByte[c]) * F::S;
+    int32_t fogG[3];
+    for (int c = 0; c < 3; ++c) fogG[c] = int32_t(p.fogByte[c]) * F::S;
+    for (int i = 0; i < in.count; ++i) {
+        if (in.live && !in.live[i]) continue;
+        uint32_t x, y;
+        if (!lanes.inside(i, x, y, p)) continue;
+        int32_t s[4];
+        for (int c = 0; c < 4; ++c) s[c] = std::clamp(g[c][i], 0, G);  // the 8-bit target saturates
+        if (p.fog) {
+            // colour = f * colour + (1 - f) * FOGCOLOR, exact on the grid, rounded once.
+            const int32_t fq = F::fogGrid(lanes.fog(i));
+            for (int c = 0; c < 3; ++c) s[c] = divRoundEven<G>(int64_t(fq) * s[c] + int64_t(G - fq) * fogG[c]);
+        }
+        const bool alphaPass = !p.alphaTest || cmpPass(p.alphaMask, F::byteOf(s[3]), p.alphaRef);
+        if (!tests(p, alphaPass, x, y, lanes.z(i), n) || !p.color) continue;
+        uint8_t* q = p.color->texel(x, y);
+        uint32_t out[4];
+        if (!p.blend) {
+            for (int c = 0; c < 4; ++c) out[c] = F::byteOf(s[c]);
+        } else {
+            const uint32_t old = load32(q);
+            for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c];
+            v[kDst + 0] = int32_t((old >> 16) & 0xffu) * F::S;
+            v[kDst + 1] = int32_t((old >> 8) & 0xffu) * F::S;
+            v[kDst + 2] = int32_t(old & 0xffu) * F::S;
+            v[kDst + 3] = x8 ? G : int32_t(old >> 24) * F::S;  // X8R8G8B8's alpha reads 1
+            v[kSat] = std::min(s[3], G - v[kDst + 3]);
+            for (int c = 0; c < 4; ++c) {
+                const ChannelPlan& cp = p.ch[c];
+                const int32_t d = v[kDst + c];
+                if (cp.kind == OpKind::Linear) {
+                    const int32_t fs = cp.src.inv ? G - v[cp.src.slot] : v[cp.src.slot];
+                    const int32_t fd = cp.dst.inv ? G - v[cp.dst.slot] : v[cp.dst.slot];
+                    out[c] = F::blendByte(int64_t(cp.cs) * s[c] * fs + int64_t(cp.cd) * d * fd);
+                } else {
+                    out[c] = F::byteOf(cp.kind == OpKind::Min ? std::min(s[c], d) : std::max(s[c], d));
+                }
+            }
+        }
+        uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
+        if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
+        store32(q, w);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Float arithmetic: float/ideal profiles on 8-bit targets, every profile on float targets.
+
+// s * Fs (op) d * Fd in float32, evaluated as written (two products, one sum; a ZERO factor
+// contributes nothing, so 0 * inf does not make a NaN). v holds the slots.
+inline float blendFloat(const ChannelPlan& cp, const float* v, float s, float d) {
+    if (cp.kind == OpKind::Min) return s < d ? s : d;
+    if (cp.kind == OpKind::Max) return s > d ? s : d;
+    const bool zs = cp.src.slot == kZero && !cp.src.inv, zd = cp.dst.slot == kZero && !cp.dst.inv;
+    const float fs = cp.src.inv ? 1.0f - v[cp.src.slot] : v[cp.src.slot];
+    const float fd = cp.dst.inv ? 1.0f - v[cp.dst.slot] : v[cp.dst.slot];
+    const float ts = float(cp.cs) * (s * fs), td = float(cp.cd) * (d * fd);
+    if (zs) return zd ? 0.0f : td;
+    if (zd) return ts;
+    return ts + td;
+}
+
+// Real source values: color[] (fx profiles: n / G rounded to float, as the executor gives them).
+struct FloatSource {
+    const float* const* color;
+    const int32_t* const* grid;  // fx profiles, for exact fog and alpha test
+    int32_t G;
+};
+
+void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Counts& n) {
+    const bool fx = ps11::isFixedPoint(p.precision);
+    // Without a colour target (depth only) the alpha test uses the 8-bit rule.
+    const bool unorm = !p.color || p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8;
+    const bool x8 = p.target == TargetKind::Xrgb8;
+    const uint32_t mask = unorm ? wordMask(p) : 0;
+    const Lanes lanes{in};
+    float v[kSlots];
+    v[kZero] = 0.0f, v[kOne] = 1.0f;
+    for (int c = 0; c < 4; ++c) v[kBf + c] = float(p.bfByte[c]) / 255.0f;
+    float fogF[3];
+    int32_t fogG[3];
+    for (int c = 0; c < 3; ++c) fogF[c] = float(p.fogByte[c]) / 255.0f, fogG[c] = int32_t(p.fogByte[c]) * (src.G / 255);
+    const int32_t G = src.G;
+    for (int i = 0; i < in.count; ++i) {
+        if (in.live && !in.live[i]) continue;
+        uint32_t x, y;
+        if (!lanes.inside(i, x, y, p)) continue;
+        float s[4];
+        bool alphaPass = true;
+        if (fx) {
+            // Grid values: saturated for an 8-bit target, as the executor left them (within
+            // +-M) for a float target; fog exact on the grid.
+            int32_t gn[4];
+            for (int c = 0; c < 4; ++c) gn[c] = unorm ? std::clamp(src.grid[c][i], 0, G) : src.grid[c][i];
+            if (p.fog) {
+                const int32_t fq = int32_t(rintEven(double(lanes.fog(i)) * G));
+                for (int c = 0; c < 3; ++c) {
+                    const int64_t num = int64_t(fq) * gn[c] + int64_t(G - fq) * fogG[c];
+                    gn[c] = int32_t(ps11::roundHalfEven(num, G));
+                }
+            }
+            for (int c = 0; c < 4; ++c) s[c] = (unorm || p.fog) ? float(gn[c]) / float(G) : src.color[c][i];
+            // Alpha n / G against ALPHAREF / 255, exactly.
+            if (p.alphaTest) {
+                if (unorm) {
+                    const uint32_t a8 = G == 255 ? uint32_t(gn[3]) : uint32_t(divRoundEven<16>(gn[3]));
+                    alphaPass = cmpPass(p.alphaMask, a8, p.alphaRef);
+                } else {
+                    alphaPass = cmpPass(p.alphaMask, int64_t(gn[3]) * 255, int64_t(p.alphaRef) * G);
+                }
+            }
+        } else {
+            for (int c = 0; c < 4; ++c) s[c] = unorm ? sat(src.color[c][i]) : src.color[c][i];
+            if (p.fog) {
+                const float f = lanes.fog(i);
+                for (int c = 0; c < 3; ++c) s[c] = f * s[c] + (1.0f - f) * fogF[c];
+            }
+            if (p.alphaTest) {
+                alphaPass = unorm ? cmpPass(p.alphaMask, byteOfUnit(s[3]), p.alphaRef)
+                                  : cmpPass(p.alphaMask, double(s[3]) * 255.0, double(p.alphaRef));
+            }
+        }
+        if (!tests(p, alphaPass, x, y, lanes.z(i), n) || !p.color) continue;
+        uint8_t* q = p.color->texel(x, y);
+        if (unorm) {
+            uint32_t out[4];
+            if (!p.blend) {
+                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(s[c]));
+            } else {
+                const uint32_t old = load32(q);
+                v[kDst + 0] = float((old >> 16) & 0xffu) / 255.0f;
+                v[kDst + 1] = float((old >> 8) & 0xffu) / 255.0f;
+                v[kDst + 2] = float(old & 0xffu) / 255.0f;
+                v[kDst + 3] = x8 ? 1.0f : float(old >> 24) / 255.0f;
+                for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c];
+                v[kSat] = std::min(s[3], 1.0f - v[kDst + 3]);
+                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(blendFloat(p.ch[c], v, s[c], v[kDst + c])));
+            }
+            uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
+            if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
+            store32(q, w);
+            continue;
+        }
+        // Float targets.
+        float d[4] = {0, 0, 0, 1};
+        if (p.blend) {
+            if (p.target == TargetKind::Rgba16F) {
+                for (int c = 0; c < 4; ++c) {
+                    uint16_t h;
+                    std::memcpy(&h, q + 2 * c, 2);
+                    d[c] = floatOfHalf(h);
+                }
+            } else if (p.target == TargetKind::Rgba32F) {
+                std::memcpy(d, q, 16);
+            } else {
+                std::memcpy(d, q, 4);  // R32F: g b a read 1
+                d[1] = d[2] = d[3] = 1.0f;
+            }
+            for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
+            v[kSat] = std::min(s[3], 1.0f - d[3]);
+            for (int c = 0; c < 4; ++c) s[c] = blendFloat(p.ch[c], v, s[c], d[c]);
+        }
+        for (int c = 0; c < 4; ++c) {
+            if (!(p.channels >> c & 1u)) continue;
+            if (p.target == TargetKind::Rgba16F) {
+                const uint16_t h = halfOf(s[c]);
+                std::memcpy(q + 2 * c, &h, 2);
+            } else {
+                std::memcpy(q + 4 * c, &s[c], 4);  // R32F: only c = 0 is enabled
+            }
+        }
+    }
+}
+
+[[maybe_unused]] bool supportedColor(const Image* img) {
+    if (!img || !img->format) return false;
+    switch (img->format->format) {
+        case D3DFMT_A8R8G8B8:
+        case D3DFMT_X8R8G8B8:
+        case D3DFMT_A16B16G16R16F:
+        case D3DFMT_A32B32G32R32F:
+        case D3DFMT_R32F:
+            return true;
+        default:
+            return false;
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+MergeState MergeState::from(const DeviceState& st, bool hasDepth, ps11::Precision precision) {
+    MergeState m;
+    const auto rs = [&](D3DRENDERSTATETYPE s) { return st.renderState(s); };
+    m.alphaTest = rs(D3DRS_ALPHATESTENABLE) != 0;
+    m.alphaFunc = cmpOr(rs(D3DRS_ALPHAFUNC), D3DCMP_ALWAYS);
+    m.alphaRef = rs(D3DRS_ALPHAREF) & 0xffu;                     // D3D9 takes 0x00..0xff; the low byte
+    m.depthTest = hasDepth && rs(D3DRS_ZENABLE) != D3DZB_FALSE;  // USEW acts as TRUE
+    m.depthWrite = m.depthTest && rs(D3DRS_ZWRITEENABLE) != 0;   // ZENABLE FALSE: no depth writes either
+    m.depthFunc = cmpOr(rs(D3DRS_ZFUNC), D3DCMP_LESSEQUAL);
+    m.fog = rs(D3DRS_FOGENABLE) != 0 && rs(D3DRS_FOGTABLEMODE) == D3DFOG_NONE;
+    m.fogColor = rs(D3DRS_FOGCOLOR);
+    m.blend = rs(D3DRS_ALPHABLENDENABLE) != 0;
+    m.srcBlend = blendOr(rs(D3DRS_SRCBLEND), D3DBLEND_ONE);
+    m.dstBlend = blendOr(rs(D3DRS_DESTBLEND), D3DBLEND_ZERO);
+    m.blendOp = opOr(rs(D3DRS_BLENDOP), D3DBLENDOP_ADD);
+    m.separateAlpha = rs(D3DRS_SEPARATEALPHABLENDENABLE) != 0;
+    m.srcBlendAlpha = blendOr(rs(D3DRS_SRCBLENDALPHA), D3DBLEND_ONE);
+    m.dstBlendAlpha = blendOr(rs(D3DRS_DESTBLENDALPHA), D3DBLEND_ZERO);
+    m.blendOpAlpha = opOr(rs(D3DRS_BLENDOPALPHA), D3DBLENDOP_ADD);
+    m.blendFactor = rs(D3DRS_BLENDFACTOR);
+    m.colorWrite = rs(D3DRS_COLORWRITEENABLE) & 0xfu;
+    m.precision = precision;
+    return m;
+}
+
+bool MergeState::writesNothing() const {
+    if (alphaTest && cmpOr(alphaFunc, D3DCMP_ALWAYS) == D3DCMP_NEVER) return true;
+    if (depthTest && cmpOr(depthFunc, D3DCMP_LESSEQUAL) == D3DCMP_NEVER) return true;
+    if (depthWrite) return false;
+    // The colour channels that change: makePlan drops disabled ones and those blended as
+    // 0 * src + 1 * dst. An A8R8G8B8 target stands for "every channel present".
+    Image probe;
+    static const FormatInfo* argb = formatInfo(D3DFMT_A8R8G8B8);
+    probe.format = argb;
+    bool ok = false;
+    const Plan p = makePlan(*this, MergeTarget{&probe, nullptr}, ok);
+    return p.channels == 0;
+}
+
+std::string mergeStateError(const DeviceState& st, const char* call) {
+    const auto rs = [&](D3DRENDERSTATETYPE s) { return st.renderState(s); };
+    const auto bad = [&](const char* state, DWORD value, const char* what) {
+        return std::string("E4160 ") + call + ": " + state + " " + std::to_string(value) + " is not a " + what +
+               " value";
+    };
+    if (rs(D3DRS_ALPHATESTENABLE) && !knownCmp(rs(D3DRS_ALPHAFUNC)))
+        return bad("D3DRS_ALPHAFUNC", rs(D3DRS_ALPHAFUNC), "D3DCMPFUNC");
+    if (rs(D3DRS_ZENABLE) != D3DZB_FALSE && !knownCmp(rs(D3DRS_ZFUNC)))
+        return bad("D3DRS_ZFUNC", rs(D3DRS_ZFUNC), "D3DCMPFUNC");
+    if (rs(D3DRS_ALPHABLENDENABLE)) {
+        if (!knownBlend(rs(D3DRS_SRCBLEND))) return bad("D3DRS_SRCBLEND", rs(D3DRS_SRCBLEND), "D3DBLEND");
+        if (!knownBlend(rs(D3DRS_DESTBLEND))) return bad("D3DRS_DESTBLEND", rs(D3DRS_DESTBLEND), "D3DBLEND");
+        if (!knownOp(rs(D3DRS_BLENDOP))) return bad("D3DRS_BLENDOP", rs(D3DRS_BLENDOP), "D3DBLENDOP");
+        if (rs(D3DRS_SEPARATEALPHABLENDENABLE)) {
+            if (!knownBlend(rs(D3DRS_SRCBLENDALPHA)))
+                return bad("D3DRS_SRCBLENDALPHA", rs(D3DRS_SRCBLENDALPHA), "D3DBLEND");
+            if (!knownBlend(rs(D3DRS_DESTBLENDALPHA)))
+                return bad("D3DRS_DESTBLENDALPHA", rs(D3DRS_DESTBLENDALPHA), "D3DBLEND");
+            if (!knownOp(rs(D3DRS_BLENDOPALPHA)))
+                return bad("D3DRS_BLENDOPALPHA", rs(D3DRS_BLENDOPALPHA), "D3DBLENDOP");
+        }
+    }
+    return {};
+}
+
+void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats) {
+    // A colour target of another format, or a depth target of a non-depth format, is the
+    // caller's programming error: asserted, and in release builds nothing is written.
+    assert(!target.color || supportedColor(target.color));
+    bool ok = false;
+    const Plan p = makePlan(state, target, ok);
+    assert(ok);
+    if (!ok || in.count <= 0 || (!p.color && !p.depth)) return;
+    assert(in.count <= ps11::kMaxSpan && in.x && in.y);
+    const int count = std::min(in.count, int(ps11::kMaxSpan));
+    MergeInputs lanes = in;
+    lanes.count = count;
+
+    // Missing channels read as 0; fx profiles without grid values take them from color.
+    static const float zeros[ps11::kMaxSpan] = {};
+    const bool fx = ps11::isFixedPoint(state.precision);
+    const int32_t G = ps11::gridScale(state.precision);
+    int32_t gridBuf[4][ps11::kMaxSpan];
+    const int32_t* grid[4];
+    const float* color[4];
+    for (int c = 0; c < 4; ++c) {
+        color[c] = in.color[c] ? in.color[c] : zeros;
+        grid[c] = in.grid[c];
+        if (fx && !grid[c]) {
+            for (int i = 0; i < count; ++i) gridBuf[c][i] = ps11::toGrid(double(color[c][i]), state.precision);
+            grid[c] = gridBuf[c];
+        }
+    }
+
+    Counts n;
+    const bool unorm = p.color && (p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8);
+    if (!p.color || unorm) {
+        if (state.precision == Precision::Fx8) {
+            if (p.color && !p.fog && !p.alphaTest && !p.depthTest && !p.blend && p.channels)
+                storeFx8Plain(p, lanes, grid, n);
+            else
+                mergeFxUnorm8<255>(p, lanes, grid, n);
+        } else if (state.precision == Precision::Fx12) {
+            mergeFxUnorm8<4080>(p, lanes, grid, n);
+        } else {
+            mergeFloat(p, lanes, FloatSource{color, grid, G}, n);
+        }
+    } else {
+        mergeFloat(p, lanes, FloatSource{color, grid, G}, n);
+    }
+    if (stats) {
+        stats->written += n.written;
+        stats->alphaRejected += n.alphaRejected;
+        stats->depthRejected += n.depthRejected;
+    }
+}
+
+}  // namespace emu

@@ -1,0 +1,208 @@
+// The rasteriser: exact fixed-point coverage with the top-left rule, attribute planes, and
+// spans of 2×2 quads for the executor.
+#include "emu/raster.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace emu {
+
+namespace {
+
+constexpr int64_t kOne = int64_t(1) << kSubPixelBits;
+
+// floor(n / d) and ceil(n / d) for d > 0.
+int64_t floorDiv(int64_t n, int64_t d) { return n >= 0 ? n / d : -((-n + d - 1) / d); }
+int64_t ceilDiv(int64_t n, int64_t d) { return n >= 0 ? (n + d - 1) / d : -((-n) / d); }
+
+// Lane layout of a span: lane L belongs to quad L/4; its column offset within the span is
+// 2·(L/4) + (L & 1) and its row is (L >> 1) & 1.
+struct LaneTable {
+    alignas(32) float col[ps11::kMaxSpan];
+    alignas(32) int32_t colInt[ps11::kMaxSpan];
+    alignas(32) int32_t row[ps11::kMaxSpan];
+    LaneTable() {
+        for (int L = 0; L < ps11::kMaxSpan; ++L) {
+            colInt[L] = 2 * (L >> 2) + (L & 1);
+            col[L] = float(colInt[L]);
+            row[L] = (L >> 1) & 1;
+        }
+    }
+};
+const LaneTable kLanes;
+
+// Fills lanes [0, n) with the plane's values over the span whose top-left lane is pixel
+// (x0, y0): the two row starts are computed in double, each lane adds dx·column in float.
+void fillPlane(const Plane& p, double ox, double oy, int x0, int y0, int n, float* out) {
+    const double s0 = p.base + p.dx * (x0 - ox) + p.dy * (y0 - oy);
+    const float f0 = float(s0), f1 = float(s0 + p.dy), fdx = float(p.dx);
+    for (int L = 0; L < n; ++L) out[L] = (kLanes.row[L] ? f1 : f0) + fdx * kLanes.col[L];
+}
+
+}  // namespace
+
+bool setupTriangle(const ScreenTriangle& tri, uint64_t used, const ClipRect& clip, TriangleSetup& s) {
+    if (clip.x0 >= clip.x1 || clip.y0 >= clip.y1) return false;
+    std::array<int64_t, 3> X, Y;
+    for (size_t i = 0; i < 3; ++i) {
+        // Snap to 1/256 pixel (round half away from zero; positions are within the guard band).
+        X[i] = std::llround(tri.v[i].x * double(kOne));
+        Y[i] = std::llround(tri.v[i].y * double(kOne));
+    }
+    for (size_t i = 0; i < 3; ++i) {
+        const size_t j = (i + 1) % 3;
+        s.a[i] = -(Y[j] - Y[i]);
+        s.b[i] = X[j] - X[i];
+        s.c[i] = -s.a[i] * X[i] - s.b[i] * Y[i];
+    }
+    const int64_t area = s.a[0] * X[2] + s.b[0] * Y[2] + s.c[0];
+    if (area == 0) return false;
+    if (area < 0)
+        for (size_t i = 0; i < 3; ++i) {
+            s.a[i] = -s.a[i];
+            s.b[i] = -s.b[i];
+            s.c[i] = -s.c[i];
+        }
+    // Inside is E > 0. Top-left rule: a left edge has the inside to its right (a > 0), a top edge
+    // is horizontal with the inside below (a == 0, b > 0); pixel centres on them are covered.
+    for (size_t i = 0; i < 3; ++i) s.t[i] = (s.a[i] > 0 || (s.a[i] == 0 && s.b[i] > 0)) ? 0 : 1;
+
+    const int64_t yLo = std::min({Y[0], Y[1], Y[2]}), yHi = std::max({Y[0], Y[1], Y[2]});
+    s.clip = clip;
+    s.yMin = int(std::max<int64_t>(clip.y0, ceilDiv(yLo, kOne)));
+    s.yMax = int(std::min<int64_t>(clip.y1, floorDiv(yHi, kOne) + 1));
+    const int64_t xLo = std::min({X[0], X[1], X[2]}), xHi = std::max({X[0], X[1], X[2]});
+    if (s.yMin >= s.yMax || ceilDiv(xLo, kOne) >= clip.x1 || floorDiv(xHi, kOne) < clip.x0) return false;
+
+    // Attribute planes from the snapped positions.
+    const double x0 = double(X[0]) / kOne, y0 = double(Y[0]) / kOne;
+    const double x1 = double(X[1]) / kOne - x0, y1 = double(Y[1]) / kOne - y0;
+    const double x2 = double(X[2]) / kOne - x0, y2 = double(Y[2]) / kOne - y0;
+    const double det = x1 * y2 - x2 * y1;
+    s.ox = x0;
+    s.oy = y0;
+    auto plane = [&](double a0, double a1, double a2) {
+        const double d1 = a1 - a0, d2 = a2 - a0;
+        return Plane{a0, (d1 * y2 - d2 * y1) / det, (d2 * x1 - d1 * x2) / det};
+    };
+    const ScreenVertex& v0 = tri.v[0];
+    const ScreenVertex& v1 = tri.v[1];
+    const ScreenVertex& v2 = tri.v[2];
+    s.perspective = !(v0.rhw == v1.rhw && v1.rhw == v2.rhw);
+    s.rhw = plane(v0.rhw, v1.rhw, v2.rhw);
+    s.z = plane(v0.z, v1.z, v2.z);
+    s.constMask = 0;
+    for (int k = 0; k < kAttrCount; ++k) {
+        if (!((used >> k) & 1)) continue;
+        const float a0 = v0.attr[size_t(k)], a1 = v1.attr[size_t(k)], a2 = v2.attr[size_t(k)];
+        if (a0 == a1 && a1 == a2) {
+            // Equal at the vertices: exactly that value everywhere (no rounding of a plane).
+            s.constMask |= uint64_t(1) << k;
+            s.constValue[size_t(k)] = a0;
+        } else if (s.perspective) {
+            s.attr[size_t(k)] = plane(double(a0) * v0.rhw, double(a1) * v1.rhw, double(a2) * v2.rhw);
+        } else {
+            s.attr[size_t(k)] = plane(a0, a1, a2);
+        }
+    }
+    return true;
+}
+
+bool rowCoverage(const TriangleSetup& s, int y, int& xl, int& xr) {
+    if (y < s.yMin || y >= s.yMax) return false;
+    int64_t lo = s.clip.x0, hi = s.clip.x1;  // [lo, hi)
+    const int64_t Y = int64_t(y) * kOne;
+    for (size_t i = 0; i < 3; ++i) {
+        // Covered: a·256·x + k >= t with k = b·Y + c, solved exactly for the integer x.
+        const int64_t k = s.b[i] * Y + s.c[i];
+        const int64_t A = s.a[i] * kOne;
+        if (A > 0) {
+            lo = std::max(lo, ceilDiv(s.t[i] - k, A));
+        } else if (A < 0) {
+            hi = std::min(hi, floorDiv(k - s.t[i], -A) + 1);
+        } else if (k < s.t[i]) {
+            return false;
+        }
+        if (lo >= hi) return false;
+    }
+    xl = int(lo);
+    xr = int(hi);
+    return true;
+}
+
+void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool wantZ, QuadSpan& span,
+                   const std::function<void(QuadSpan&)>& emit) {
+    const int yStart = std::max(y0, s.yMin & ~1);
+    const int yEnd = std::min(y1, s.yMax);
+    const uint64_t planes = used & ~s.constMask;
+    for (int py = yStart; py < yEnd; py += 2) {
+        int l0 = 0, r0 = 0, l1 = 0, r1 = 0;
+        const bool c0 = py >= y0 && rowCoverage(s, py, l0, r0);
+        const bool c1 = py + 1 < y1 && rowCoverage(s, py + 1, l1, r1);
+        if (!c0 && !c1) continue;
+        int qx0, qx1;
+        if (c0 && c1) {
+            qx0 = std::min(l0, l1);
+            qx1 = std::max(r0, r1);
+        } else if (c0) {
+            qx0 = l0, qx1 = r0;
+        } else {
+            qx0 = l1, qx1 = r1;
+        }
+        qx0 &= ~1;                // quads at even coordinates (clip rects start at >= 0)
+        qx1 = (qx1 + 1) & ~1;
+        constexpr int kQuadCols = ps11::kMaxSpan / 2;  // pixels per row of one span
+        for (int sx = qx0; sx < qx1; sx += kQuadCols) {
+            const int cols = std::min(kQuadCols, qx1 - sx);
+            const int n = cols * 2;  // lanes
+            span.count = n;
+            int liveCount = 0;
+            for (int L = 0; L < n; ++L) {
+                const int x = sx + kLanes.colInt[L];
+                const int r = kLanes.row[L];
+                span.x[L] = x;
+                span.y[L] = py + r;
+                const bool in = r ? (c1 && x >= l1 && x < r1) : (c0 && x >= l0 && x < r0);
+                span.live[L] = uint8_t(in);
+                liveCount += in;
+            }
+            span.liveCount = liveCount;
+            if (liveCount == 0) continue;
+            if (wantZ) fillPlane(s.z, s.ox, s.oy, sx, py, n, span.z);
+            if (s.perspective) {
+                // attr = (attr·rhw)/rhw per lane; helper lanes far outside may extrapolate rhw
+                // to <= 0, kept positive so no lane divides by zero.
+                alignas(32) float inv[ps11::kMaxSpan];
+                fillPlane(s.rhw, s.ox, s.oy, sx, py, n, inv);
+                for (int L = 0; L < n; ++L) inv[L] = 1.0f / std::max(inv[L], 1e-30f);
+                for (int k = 0; k < kAttrCount; ++k) {
+                    if (!((planes >> k) & 1)) continue;
+                    float* out = span.attr[k];
+                    fillPlane(s.attr[size_t(k)], s.ox, s.oy, sx, py, n, out);
+                    for (int L = 0; L < n; ++L) out[L] *= inv[L];
+                }
+            } else {
+                for (int k = 0; k < kAttrCount; ++k)
+                    if ((planes >> k) & 1) fillPlane(s.attr[size_t(k)], s.ox, s.oy, sx, py, n, span.attr[k]);
+            }
+            for (int k = 0; k < kAttrCount; ++k)
+                if ((planes >> k) & 1) span.constLanes[size_t(k)] = 0;
+            const uint64_t consts = used & s.constMask;
+            for (int k = 0; k < kAttrCount; ++k) {
+                if (!((consts >> k) & 1)) continue;
+                const float value = s.constValue[size_t(k)];
+                int& have = span.constLanes[size_t(k)];
+                if (have > 0 && std::memcmp(&span.constFill[size_t(k)], &value, sizeof value) != 0) have = 0;
+                if (have < n) {
+                    std::fill(span.attr[k] + have, span.attr[k] + n, value);
+                    span.constFill[size_t(k)] = value;
+                    have = n;
+                }
+            }
+            emit(span);
+        }
+    }
+}
+
+}  // namespace emu

@@ -1,0 +1,75 @@
+// libFuzzer target for the device through the .ps11test runner: arbitrary bytes as a test file;
+// files the reader accepts are set up on emu::Device and their draws and pixel probes run. The
+// device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
+// format can express; a refused call must carry a message. Sizes are capped so each input
+// stays fast (the limits themselves are tested elsewhere).
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "ps11/assembler.h"
+#include "ps11/diagnostics.h"
+#include "ps11/testfile.h"
+#include "ps11/validator.h"
+#include "tools/test_draw.h"
+
+namespace {
+
+void check(bool condition) {
+    if (!condition) std::abort();
+}
+
+bool small(const ps11::TestFile& file) {
+    const auto& size = file.renderTarget.size.value;
+    if (uint64_t(size[0]) * size[1] > 64 * 64) return false;
+    uint64_t texels = 0;
+    for (const ps11::TextureDesc& t : file.textures) texels += uint64_t(t.width) * t.height * std::max(t.depth, 1u);
+    if (texels > 64 * 64 * 4) return false;
+    size_t vertices = 0;
+    for (const ps11::TestCommand& cmd : file.commands)
+        if (const auto* d = std::get_if<ps11::DrawPrimitives>(&cmd.op)) vertices += d->vertices.size();
+    return vertices <= 96 && file.commands.size() <= 32;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+    std::string_view text(reinterpret_cast<const char*>(data), size);
+    ps11::TestFile file;
+    std::vector<ps11::TestFileError> errors;
+    if (!ps11::parseTestFile(text, "fuzz.ps11test", file, errors) || !small(file)) return 0;
+
+    std::optional<ps11::Program> program;
+    if (file.pixelShader.present()) {
+        if (file.pixelShader.expectFail) return 0;
+        ps11::Diagnostics diags;
+        ps11::AssembleOptions options;
+        program = ps11::parseAssembly(file.pixelShader.textWithFileLines(), "fuzz.ps11test", options, diags);
+        if (program) ps11::validate(*program, diags);
+        if (!program || diags.hasErrors()) return 0;
+    }
+    for (ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Float}) {
+        std::string error;
+        auto runner = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, p, error);
+        if (!runner) {
+            check(!error.empty());
+            continue;
+        }
+        for (const ps11::TestCommand& cmd : file.commands) {
+            if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;
+            error.clear();
+            if (const auto* probe = std::get_if<ps11::Probe>(&cmd.op)) {
+                if (probe->kind == ps11::ProbeKind::Eval || probe->kind == ps11::ProbeKind::EvalKilled) continue;
+                (void)runner->probe(*probe, error);
+            } else if (!runner->draw(cmd, error)) {
+                check(!error.empty());
+            }
+        }
+    }
+    return 0;
+}

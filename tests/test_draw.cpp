@@ -1,0 +1,397 @@
+// End-to-end draws through emu::Device::DrawPrimitiveUP: pixel shaders over the half-pixel 1:1
+// quad (colour, an exact texture copy, a 4-tap bilinear blur checked against the fx8 arithmetic
+// of docs/precision.md computed here with integers), 1 vs 2 threads, statistics, and every error
+// path (its code, and nothing changed).
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "emu/device.h"
+
+using namespace emu;
+
+namespace {
+
+struct QuadVertex {
+    float x, y, z, rhw;
+    DWORD diffuse;
+    float uv[4][2];
+};
+constexpr DWORD kQuadFvf = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_TEX4;
+
+// The 1:1 quad of D3D9 post-processing over pixels [0, w) × [0, h): corners at −0.5, texture
+// coordinates 0..1 on every set, plus a per-set offset in texels of a w × h texture.
+std::vector<QuadVertex> quad(int w, int h, DWORD diffuse, const float (*offsets)[2] = nullptr) {
+    const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
+    const float us[4] = {0, 1, 1, 0};
+    const float vs[4] = {0, 0, 1, 1};
+    std::vector<QuadVertex> v;
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        QuadVertex q{xs[k], ys[k], 0.0f, 1.0f, diffuse, {}};
+        for (int s = 0; s < 4; ++s) {
+            q.uv[s][0] = us[k] + (offsets ? offsets[s][0] / float(w) : 0.0f);
+            q.uv[s][1] = vs[k] + (offsets ? offsets[s][1] / float(h) : 0.0f);
+        }
+        v.push_back(q);
+    }
+    return v;
+}
+
+Handle target(Device& dev, UINT w, UINT h, DWORD fill = 0x11223344) {
+    Handle rt{};
+    REQUIRE(dev.CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 1, &rt) == D3D_OK);
+    REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+    REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, fill, 1.0f, 0) == D3D_OK);
+    return rt;
+}
+
+std::vector<uint32_t> readTarget(Device& dev, Handle rt, UINT w, UINT h) {
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(rt, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+    std::vector<uint32_t> px(size_t(w) * h);
+    for (UINT y = 0; y < h; ++y) std::memcpy(&px[y * w], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, 4 * w);
+    REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+    return px;
+}
+
+Handle randomTexture(Device& dev, UINT w, UINT h, std::vector<uint32_t>& texels, uint32_t seed) {
+    Handle tex{};
+    REQUIRE(dev.CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    std::mt19937 rng(seed);
+    texels.resize(size_t(w) * h);
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < h; ++y)
+        for (UINT x = 0; x < w; ++x) {
+            texels[y * w + x] = rng();
+            std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + 4 * x, &texels[y * w + x], 4);
+        }
+    REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+    return tex;
+}
+
+uint32_t channel(uint32_t argb, int c) {  // c: 0 r, 1 g, 2 b, 3 a
+    static const int shift[4] = {16, 8, 0, 24};
+    return (argb >> shift[c]) & 0xff;
+}
+
+// round_half_even(p / q) for p >= 0, q > 0.
+int64_t rhe(int64_t p, int64_t q) {
+    const int64_t n = p / q, r = p % q;
+    if (2 * r > q || (2 * r == q && (n & 1))) return n + 1;
+    return n;
+}
+
+Handle shader(Device& dev, const char* text) {
+    Handle ps{};
+    REQUIRE(dev.CreatePixelShaderFromText(text, &ps) == D3D_OK);
+    REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
+    return ps;
+}
+
+}  // namespace
+
+TEST_CASE("draw: mov r0, v0 fills exactly the quad's pixels with the diffuse colour", "[draw]") {
+    Device dev;
+    const UINT W = 37, H = 23;
+    Handle rt = target(dev, W, H);
+    shader(dev, "ps_1_1\nmov r0, v0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    // A rect [5, 30) × [3, 20) through the half-pixel corners.
+    std::vector<QuadVertex> v = quad(W, H, 0x80c0ff10);
+    for (QuadVertex& q : v) {
+        q.x = q.x < 0 ? 4.5f : 29.5f;
+        q.y = q.y < 0 ? 2.5f : 19.5f;
+    }
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) {
+            const bool in = x >= 5 && x < 30 && y >= 3 && y < 20;
+            INFO(x << "," << y);
+            CHECK(px[y * W + x] == (in ? 0x80c0ff10u : 0x11223344u));
+        }
+    const DrawStats& st = dev.lastDrawStats();
+    CHECK(st.pixelsCovered == 25 * 17);
+    CHECK(st.pixelsWritten == 25 * 17);
+    CHECK(st.triangles == 2);
+    CHECK(st.trianglesDrawn == 2);
+}
+
+TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
+    for (DWORD filter : {DWORD(D3DTEXF_POINT), DWORD(D3DTEXF_LINEAR)}) {
+        Device dev;
+        const UINT W = 67, H = 41;
+        Handle rt = target(dev, W, H);
+        std::vector<uint32_t> texels;
+        Handle tex = randomTexture(dev, W, H, texels, 7);
+        REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(0, D3DSAMP_MINFILTER, filter) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, filter) == D3D_OK);
+        shader(dev, "ps_1_1\ntex t0\nmov r0, t0\n");
+        REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+        auto v = quad(W, H, 0xffffffff);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        CHECK(readTarget(dev, rt, W, H) == texels);
+        const DrawStats& st = dev.lastDrawStats();
+        CHECK(st.pixelsCovered == W * H);
+        // Instructions: tex + mov per shaded lane; one texel per point lookup, four per bilinear.
+        CHECK(st.instructions == 2 * st.pixelsShaded);
+        CHECK(st.texelsFetched == st.pixelsShaded * (filter == D3DTEXF_LINEAR ? 4 : 1));
+    }
+}
+
+TEST_CASE("draw: the 4-tap bilinear blur equals the fx8 arithmetic of docs/precision.md", "[draw]") {
+    Device dev;
+    const UINT W = 48, H = 30;
+    Handle rt = target(dev, W, H);
+    std::vector<uint32_t> texels;
+    Handle tex = randomTexture(dev, W, H, texels, 99);
+    for (DWORD s = 0; s < 4; ++s) {
+        REQUIRE(dev.SetTexture(s, tex) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP) == D3D_OK);
+    }
+    shader(dev,
+           "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\n"
+           "mul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n");
+    const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
+    REQUIRE(dev.SetPixelShaderConstantF(0, c0, 1) == D3D_OK);
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    const float off[4][2] = {{0.25f, 0.25f}, {-0.25f, 0.25f}, {0.25f, -0.25f}, {-0.25f, -0.25f}};
+    auto v = quad(W, H, 0xffffffff, off);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+
+    // Expected: the constant 0.25 on the grid is round(0.25·255) = 64 (63.75 rounds up).
+    const int64_t cn = 64;
+    auto texel = [&](int x, int y, int c) {
+        x = std::clamp(x, 0, int(W) - 1);
+        y = std::clamp(y, 0, int(H) - 1);
+        return int64_t(channel(texels[size_t(y) * W + size_t(x)], c));
+    };
+    // Tap at texel offset (dx, dy) = ±0.25: texel space x + dx; i0 = floor, weight round(f·256):
+    // +0.25 → i0 = x, w = 64; −0.25 → i0 = x − 1, w = 192. Sum exact, rounded once to the grid.
+    auto tap = [&](int x, int y, int s, int c) {
+        const bool px_ = off[s][0] > 0, py_ = off[s][1] > 0;
+        const int i0 = px_ ? x : x - 1, j0 = py_ ? y : y - 1;
+        const int64_t wx = px_ ? 64 : 192, wy = py_ ? 64 : 192;
+        const int64_t sum = (256 - wx) * (256 - wy) * texel(i0, j0, c) + wx * (256 - wy) * texel(i0 + 1, j0, c) +
+                            (256 - wx) * wy * texel(i0, j0 + 1, c) + wx * wy * texel(i0 + 1, j0 + 1, c);
+        return rhe(sum, 65536);
+    };
+    int mismatches = 0;
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x)
+            for (int c = 0; c < 4; ++c) {
+                // mul: (2n)(2c)/(4G²) → n·c/G rounded; mad: (n·c + G·r)/G rounded (all non-negative).
+                int64_t r = rhe(tap(int(x), int(y), 0, c) * cn, 255);
+                for (int s = 1; s < 4; ++s) r = rhe(tap(int(x), int(y), s, c) * cn + 255 * r, 255);
+                if (int64_t(channel(px[y * W + x], c)) != r) ++mismatches;
+            }
+    CHECK(mismatches == 0);
+    const DrawStats& st = dev.lastDrawStats();
+    CHECK(st.texelsFetched == 16 * st.pixelsShaded);
+    CHECK(st.instructions == 8 * st.pixelsShaded);
+}
+
+TEST_CASE("draw: one and two threads give identical images", "[draw]") {
+    std::vector<std::vector<uint32_t>> images;
+    for (int threads : {1, 2, 3}) {
+        DeviceOptions o;
+        o.threads = threads;
+        Device dev(o);
+        const UINT W = 150, H = 97;
+        Handle rt = target(dev, W, H);
+        std::vector<uint32_t> texels;
+        Handle tex = randomTexture(dev, 32, 32, texels, 5);
+        REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(0, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(0, D3DSAMP_MIPFILTER, D3DTEXF_POINT) == D3D_OK);
+        shader(dev, "ps_1_1\ntex t0\nmul r0, t0, v0\n");
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_TEX1) == D3D_OK);
+        struct V {
+            float x, y, z, rhw;
+            DWORD c;
+            float u, v;
+        };
+        // Overlapping perspective triangles (later ones win where they overlap).
+        const V tris[6] = {{3.3f, 1.2f, 0, 1.0f, 0xffff0000, 0, 0},    {148.1f, 20.7f, 0, 0.2f, 0xff00ff00, 4, 0},
+                           {20.4f, 95.9f, 0, 0.5f, 0xff0000ff, 0, 3},  {140.0f, 90.0f, 0, 1.0f, 0x80ffffff, 2, 2},
+                           {10.0f, 60.0f, 0, 0.3f, 0xffffff00, -1, 1}, {100.0f, 2.0f, 0, 0.7f, 0xff00ffff, 1, -1}};
+        REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, tris, sizeof(V)) == D3D_OK);
+        images.push_back(readTarget(dev, rt, W, H));
+    }
+    CHECK(images[0] == images[1]);
+    CHECK(images[0] == images[2]);
+    CHECK(images[0] != std::vector<uint32_t>(images[0].size(), 0x11223344u));
+}
+
+TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]") {
+    Device dev;
+    const UINT W = 8, H = 8;
+    target(dev, W, H);
+    shader(dev, "ps_1_1\nmov r0, v0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xffffffff);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    // The diagonal (−0.5, −0.5)–(7.5, 7.5) splits the 4×4 quads: each triangle touches the 6 quads
+    // on its side and the 4 on the diagonal (pixel (2i+1, 2i) is above it, (2i, 2i+1) below), so
+    // 20 quads = 80 lanes are shaded for 64 covered pixels.
+    const DrawStats a = dev.lastDrawStats();
+    CHECK(a.pixelsCovered == 64);
+    CHECK(a.pixelsShaded == 80);
+    CHECK(a.instructions == 80);
+    CHECK(a.pixelsWritten == 64);
+    CHECK(a.texelsFetched == 0);
+    CHECK(a.draws == 1);
+    CHECK(a.milliseconds >= 0);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 1, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    const DrawStats& t = dev.totalDrawStats();
+    CHECK(t.draws == 2);
+    CHECK(t.triangles == 3);
+    CHECK(t.pixelsCovered == 64 + dev.lastDrawStats().pixelsCovered);
+}
+
+TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[draw]") {
+    Device dev;
+    const UINT W = 40, H = 20;
+    Handle rt = target(dev, W, H, 0);
+    shader(dev, "ps_1_1\nmov r0, v0\n");
+    REQUIRE(dev.SetFVF(D3DFVF_XYZ | D3DFVF_DIFFUSE) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    D3DVIEWPORT9 vp{10, 4, 20, 10, 0, 1};
+    REQUIRE(dev.SetViewport(&vp) == D3D_OK);
+    struct V {
+        float x, y, z;
+        DWORD c;
+    };
+    // A quad far larger than the clip volume (x, y in ±5): clipped to the viewport [10, 30) × [4, 14).
+    const V q[4] = {{-5, 5, 0.5f, 0xff00ff00}, {5, 5, 0.5f, 0xff00ff00}, {-5, -5, 0.5f, 0xff00ff00}, {5, -5, 0.5f, 0xff00ff00}};
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
+    const auto px = readTarget(dev, rt, W, H);
+    for (UINT y = 0; y < H; ++y)
+        for (UINT x = 0; x < W; ++x) {
+            const bool in = x >= 10 && x < 30 && y >= 4 && y < 14;
+            INFO(x << "," << y);
+            CHECK(px[y * W + x] == (in ? 0xff00ff00u : 0u));
+        }
+    // Scissor test: only [12, 15) × [5, 7) of a second draw.
+    REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0, 1.0f, 0) == D3D_OK);
+    RECT sc{12, 5, 15, 7};
+    REQUIRE(dev.SetScissorRect(&sc) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SCISSORTESTENABLE, 1) == D3D_OK);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q, sizeof(V)) == D3D_OK);
+    CHECK(dev.lastDrawStats().pixelsCovered == 3 * 2);
+}
+
+TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]") {
+    DeviceOptions o;
+    o.threads = 1;
+    Device dev(o);
+    const UINT W = 8, H = 8;
+    auto v = quad(W, H, 0xffffffff);
+    const void* data = v.data();
+    const UINT stride = sizeof(QuadVertex);
+
+    // No render target.
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4109");
+
+    Handle rt = target(dev, W, H);
+    shader(dev, "ps_1_1\nmov r0, v0\n");
+    const auto before = readTarget(dev, rt, W, H);
+    auto expectFail = [&](HRESULT hr, const char* code, auto&& call) {
+        INFO(code);
+        const DeviceState s0 = dev.state();
+        CHECK(call() == hr);
+        CHECK(dev.state() == s0);
+        CHECK(dev.lastError().code == code);
+        CHECK(dev.lastError().message.find("DrawPrimitiveUP") != std::string::npos);
+        CHECK(readTarget(dev, rt, W, H) == before);
+    };
+    expectFail(D3DERR_INVALIDCALL, "E4113", [&] { return dev.DrawPrimitiveUP(D3DPRIMITIVETYPE(9), 2, data, stride); });
+    expectFail(D3DERR_NOTAVAILABLE, "E4114", [&] { return dev.DrawPrimitiveUP(D3DPT_POINTLIST, 2, data, stride); });
+    expectFail(D3DERR_NOTAVAILABLE, "E4114", [&] { return dev.DrawPrimitiveUP(D3DPT_LINELIST, 2, data, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4115", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0, data, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4115",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 0x100000, data, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4103", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, nullptr, stride); });
+    expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 0); });
+    expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride - 4); });
+    expectFail(D3DERR_INVALIDCALL, "E4116", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, 4096); });
+    REQUIRE(dev.SetFVF(0) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4117", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetFVF(0x4002 | D3DFVF_DIFFUSE) == D3D_OK);  // XYZW
+    expectFail(D3DERR_INVALIDCALL, "E4117", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, 7) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4119", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_CCW) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_FILLMODE, 2 /* WIREFRAME */) == D3D_OK);
+    expectFail(D3DERR_NOTAVAILABLE, "E4120", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetRenderState(D3DRS_FILLMODE, 3) == D3D_OK);
+
+    // Sampler and stage states of a sampled stage.
+    std::vector<uint32_t> texels;
+    Handle tex = randomTexture(dev, 8, 8, texels, 3);
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    shader(dev, "ps_1_1\ntex t0\nmov r0, t0\n");
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, 9) == D3D_OK);
+    expectFail(D3DERR_UNSUPPORTEDTEXTUREFILTER, "E4123",
+               [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, D3DTEXF_POINT) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_ADDRESSU, 0) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4123", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_ADDRESSU, D3DTADDRESS_WRAP) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXTURETRANSFORMFLAGS, 5) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4119", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXTURETRANSFORMFLAGS, 0) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXCOORDINDEX, D3DTSS_TCI_SPHEREMAP) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4119", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXCOORDINDEX, 0) == D3D_OK);
+    // A locked texture.
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+    expectFail(D3DERR_INVALIDCALL, "E4106", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
+    REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+
+    // The render target as a texture level that is also bound for sampling.
+    Handle rtTex{}, level{};
+    REQUIRE(dev.CreateTexture(W, H, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &rtTex) == D3D_OK);
+    REQUIRE(dev.GetSurfaceLevel(rtTex, 0, &level) == D3D_OK);
+    REQUIRE(dev.SetRenderTarget(0, level) == D3D_OK);
+    REQUIRE(dev.SetTexture(0, rtTex) == D3D_OK);
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4124");
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+
+    // A merger state value that is not an enumerant (emu/output_merger.h).
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, 99) == D3D_OK);
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4160");
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 0) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+    // A locked render target.
+    REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+    REQUIRE(dev.LockRect(rt, &lr, nullptr, 0) == D3D_OK);
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4106");
+    REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+
+    // After all the failures a valid draw works and the statistics count only it.
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_CCW) == D3D_OK);
+    CHECK(dev.totalDrawStats().draws == 0);
+    CHECK(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride) == D3D_OK);
+    CHECK(dev.lastError().code.empty());
+    CHECK(dev.totalDrawStats().draws == 1);
+}

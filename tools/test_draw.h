@@ -1,0 +1,66 @@
+// Running a .ps11test's `draw` commands and pixel probes on the emu device (the part of
+// `ps11 test` that needs a render target): the file's sections become the D3D9 calls a user
+// would make (CreateTexture + LockRect, SetSamplerState, SetTextureStageState, SetRenderState,
+// SetTransform, SetPixelShader, SetPixelShaderConstantF), each draw becomes DrawPrimitiveUP and
+// each probe reads the target back through GetRenderTargetData.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "ps11/ir.h"
+#include "ps11/precision.h"
+#include "ps11/testfile.h"
+
+namespace emu {
+class Device;
+}
+
+namespace ps11 {
+
+// Statistics over a file's draws (Device::lastDrawStats summed).
+struct DrawTally {
+    size_t draws = 0;
+    uint64_t pixelsShaded = 0;
+    uint64_t pixelsWritten = 0;
+    uint64_t texelsFetched = 0;
+    uint64_t instructions = 0;
+    double milliseconds = 0;
+};
+
+class DrawRunner {
+public:
+    // Sets up the device for `file`: render target (and depth buffer), textures, sampler, stage
+    // and render states, transforms, constants and the pixel shader (`program`, null = fixed
+    // function). Returns null with `error` set ("FILE:LINE: …") when the device refuses a call.
+    static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
+                                              Precision precision, std::string& error);
+    ~DrawRunner();
+
+    // Runs a `draw quad` / `draw triangles|strip|fan` command; false with `error` set when the
+    // device refuses it.
+    bool draw(const TestCommand& command, std::string& error);
+    // Checks a pixel, rect or all probe against the render target: "" when it passes, else
+    // what was expected and what the first failing pixel holds.
+    std::string probe(const Probe& probe, std::string& error);
+
+    const DrawTally& tally() const { return m_tally; }
+
+private:
+    DrawRunner() = default;
+    bool readBack(std::string& error);
+
+    std::unique_ptr<emu::Device> m_device;
+    std::string m_path;
+    uint32_t m_width = 0, m_height = 0;
+    TexFormat m_format = TexFormat::A8R8G8B8;
+    uint32_t m_target = 0;  // emu::Handle of the render target
+    bool m_readBackValid = false;
+    std::vector<Vec4> m_pixels;          // read-back values: 8-bit levels, or floats on float targets
+    std::vector<uint32_t> m_pixelWords;  // read-back 0xAARRGGBB (8-bit targets)
+    DrawTally m_tally;
+};
+
+}  // namespace ps11
