@@ -151,49 +151,15 @@ void generateMips(Resource& r) {
 }
 
 std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::string& error) {
-    // The sampler's texture is built from the .ps11test model (ps11/texture.h): every level
-    // given explicitly, packed formats as their texel words, float formats as values.
-    ps11::TextureDesc desc;
-    const FormatInfo& f = *r.format;
-    // The hand-over goes through one ps11::Texel per texel: refuse before allocating when that
-    // transient copy alone would pass the per-resource byte limit.
-    uint64_t texels = 0;
-    for (const Image& im : r.levels) texels += uint64_t(im.width) * im.height * im.depth;
-    if (texels * sizeof(ps11::Texel) > kMaxResourceBytes) {
-        error = std::to_string(texels) + " texels are too many for the sampler's copy (at most " +
-                std::to_string(kMaxResourceBytes / sizeof(ps11::Texel)) + ")";
-        return nullptr;
-    }
-    desc.format.value = f.texFormat;
-    desc.format.line = 1;
-    desc.width = r.levels[0].width;
-    desc.height = r.levels[0].height;
-    desc.depth = r.kind == ResourceKind::VolumeTexture ? r.levels[0].depth : 0;
-    desc.levels.value = uint32_t(r.levels.size());
-    desc.levels.line = 1;
-    desc.data.resize(r.levels.size());
+    // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): a row copy
+    // for A8R8G8B8, a per-texel expansion for the other formats. No transient per-texel model.
+    std::vector<ps11::TextureLevelBytes> levels(r.levels.size());
     for (size_t k = 0; k < r.levels.size(); ++k) {
         const Image& im = r.levels[k];
-        ps11::TextureLevel& l = desc.data[k];
-        l.level = uint32_t(k);
-        l.width = im.width, l.height = im.height, l.depth = im.depth;
-        l.texels.resize(size_t(im.width) * im.height * im.depth);
-        size_t i = 0;
-        for (uint32_t z = 0; z < im.depth; ++z)
-            for (uint32_t y = 0; y < im.height; ++y)
-                for (uint32_t x = 0; x < im.width; ++x, ++i) {
-                    ps11::Texel& t = l.texels[i];
-                    const uint8_t* p = im.texel(x, y, z);
-                    if (f.cls == FormatClass::Float) {
-                        std::array<float, 4> v = decodeTexel(f, p);
-                        t.value = {v[0], v[1], v[2], v[3]};
-                        t.count = 4;
-                    } else {
-                        t.bits = loadWord(p, f.bytes);
-                    }
-                }
+        levels[k] = {im.width, im.height, im.depth, im.bytes.data(), im.rowPitch, size_t(im.slicePitch)};
     }
-    std::optional<ps11::Texture> t = ps11::textureFromDesc(desc, error);
+    std::optional<ps11::Texture> t = ps11::Texture::fromLevels(
+        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), error);
     if (!t) return nullptr;
     return std::make_shared<const ps11::Texture>(std::move(*t));
 }

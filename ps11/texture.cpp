@@ -4,7 +4,9 @@
 #include "ps11/texture.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstring>
 
 namespace ps11 {
 
@@ -65,15 +67,15 @@ int32_t signExtend(uint32_t v, int bits) {
     return int32_t(v ^ m) - int32_t(m);
 }
 
-// A packed word of an Unorm8 format -> r g b a bytes (spec §6.4: missing channels read 1,
-// except A8 whose rgb read 0).
+// A packed word of an Unorm8 format -> the stored bytes b g r a (spec §6.4: missing channels
+// read 1, except A8 whose rgb read 0). A8R8G8B8 keeps D3D's byte order, so its hand-over is a copy.
 std::array<uint8_t, 4> decodeUnorm8(TexFormat f, uint32_t w) {
     auto b = [w](int shift) { return uint8_t((w >> shift) & 0xff); };
     switch (f) {
         case TexFormat::A8R8G8B8:
-            return {b(16), b(8), b(0), b(24)};
+            return {b(0), b(8), b(16), b(24)};
         case TexFormat::X8R8G8B8:
-            return {b(16), b(8), b(0), 255};
+            return {b(0), b(8), b(16), 255};
         case TexFormat::A8:
             return {0, 0, 0, b(0)};
         case TexFormat::L8:
@@ -153,10 +155,10 @@ float roundToHalf(float v) {
     double a = std::fabs(double(v));
     if (a >= 65520.0) return std::copysign(INFINITY, v);  // beyond the largest half + half a step
     int e = 0;
-    std::frexp(a, &e);                         // a = m * 2^e, m in [0.5, 1)
-    int quantumExp = std::max(e - 11, -24);    // 11 significant bits; subnormals step 2^-24
+    std::frexp(a, &e);                       // a = m * 2^e, m in [0.5, 1)
+    int quantumExp = std::max(e - 11, -24);  // 11 significant bits; subnormals step 2^-24
     double q = std::ldexp(1.0, quantumExp);
-    double r = std::nearbyint(a / q) * q;      // ties to even
+    double r = std::nearbyint(a / q) * q;  // ties to even
     return float(std::copysign(r, double(v)));
 }
 
@@ -178,7 +180,8 @@ size_t Texture::texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const 
 Vec4 Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
     size_t i = texelIndex(level, x, y, z) * 4;
     Vec4 v;
-    for (size_t c = 0; c < 4; ++c) v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[m_u8[i + c]] : m_value[i + c];
+    for (size_t c = 0; c < 4; ++c)
+        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[m_u8[i + size_t(kUnorm8Byte[c])]] : m_value[i + c];
     return v;
 }
 
@@ -186,8 +189,63 @@ std::array<int32_t, 4> Texture::texelGrid(int level, uint32_t x, uint32_t y, uin
     size_t i = texelIndex(level, x, y, z) * 4;
     std::array<int32_t, 4> g{};
     int32_t scale = gridScale(p) / 255;
-    for (size_t c = 0; c < 4; ++c) g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(m_u8[i + c]) * scale : grid(p)[i + c];
+    for (size_t c = 0; c < 4; ++c)
+        g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(m_u8[i + size_t(kUnorm8Byte[c])]) * scale : grid(p)[i + c];
     return g;
+}
+
+bool Texture::layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
+                     std::string& error) {
+    const FormatInfo info = formatInfo(fmt);
+    m_format = fmt;
+    m_volume = volume;
+    m_storage = info.storage;
+    m_levels.clear();
+    size_t total = 0;
+    for (uint32_t k = 0; k < count; ++k) {
+        TextureLevelInfo l;
+        l.width = extentAt(width, k);
+        l.height = extentAt(height, k);
+        l.depth = extentAt(depth, k);
+        l.offset = total;
+        total += size_t(l.width) * l.height * l.depth;
+        m_levels.push_back(l);
+    }
+    m_texelCount = total;
+    // Unorm8: 4 bytes; Decoded: 16 (float) + 32 (two grids) + 16 (raw while building).
+    const uint64_t bytesPerTexel = info.storage == TexelStorage::Unorm8 ? 4 : 64;
+    if (uint64_t(total) * bytesPerTexel > kMaxTextureBytes) {
+        error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" +
+                std::to_string(total) + " texels of " + texFormatName(fmt) + "), more than the limit of " +
+                std::to_string(kMaxTextureBytes);
+        return false;
+    }
+    return true;
+}
+
+void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf) {
+    const FormatInfo info = formatInfo(m_format);
+    const size_t n = m_texelCount * 4;
+    m_value.resize(n);
+    m_grid8.resize(n);
+    m_grid12.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        const size_t c = i & 3;
+        if (info.floats) {
+            float v = rawf[i];
+            m_value[i] = v;
+            auto g = [v](Precision p) { return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid); };
+            m_grid8[i] = g(Precision::Fx8);
+            m_grid12[i] = g(Precision::Fx12);
+        } else {
+            // docs/precision.md "Inputs": b -> b/den clamped to [-1, 1]; fx: round_half_even(b*G/den).
+            const int64_t den = info.den[c];
+            const int64_t r = std::clamp<int64_t>(raw[i], -den, den);
+            m_value[i] = float(double(r) / double(den));
+            m_grid8[i] = int32_t(roundHalfEven(r * 255, den));
+            m_grid12[i] = int32_t(roundHalfEven(r * 4080, den));
+        }
+    }
 }
 
 std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error) {
@@ -213,27 +271,8 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
     }
 
     Texture t;
-    t.m_format = fmt;
-    t.m_volume = volume;
-    t.m_storage = info.storage;
-    size_t total = 0;
-    for (uint32_t k = 0; k < count; ++k) {
-        TextureLevelInfo l;
-        l.width = extentAt(desc.width, k);
-        l.height = extentAt(desc.height, k);
-        l.depth = extentAt(depth, k);
-        l.offset = total;
-        total += size_t(l.width) * l.height * l.depth;
-        t.m_levels.push_back(l);
-    }
-    t.m_texelCount = total;
-    // Unorm8: 4 bytes; Decoded: 16 (float) + 32 (two grids) + 16 (raw while building).
-    const uint64_t bytesPerTexel = info.storage == TexelStorage::Unorm8 ? 4 : 64;
-    if (uint64_t(total) * bytesPerTexel > kMaxTextureBytes) {
-        error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" + std::to_string(total) +
-                " texels of " + texFormatName(fmt) + "), more than the limit of " + std::to_string(kMaxTextureBytes);
-        return std::nullopt;
-    }
+    if (!t.layout(fmt, volume, desc.width, desc.height, depth, count, error)) return std::nullopt;
+    const size_t total = t.m_texelCount;
 
     // Which levels the description gives; the others (levels 0) are generated.
     std::vector<const TextureLevel*> given(count, nullptr);
@@ -246,8 +285,8 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
         const TextureLevelInfo& li = t.m_levels[l.level];
         size_t n = size_t(li.width) * li.height * li.depth;
         if (!l.hasFill && l.texels.size() != n) {
-            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) + " texels, expected " +
-                    std::to_string(n);
+            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) +
+                    " texels, expected " + std::to_string(n);
             return std::nullopt;
         }
         given[l.level] = &l;
@@ -279,9 +318,12 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
 
     std::vector<int32_t> raw;  // signed formats while building
     std::vector<float> rawf;   // float formats while building
-    if (info.storage == TexelStorage::Unorm8) t.m_u8.assign(total * 4, 0);
-    else if (info.floats) rawf.assign(total * 4, 0.0f);
-    else raw.assign(total * 4, 0);
+    if (info.storage == TexelStorage::Unorm8)
+        t.m_u8.assign(total * 4, 0);
+    else if (info.floats)
+        rawf.assign(total * 4, 0.0f);
+    else
+        raw.assign(total * 4, 0);
 
     auto store = [&](size_t index, const Texel& x) {
         if (info.storage == TexelStorage::Unorm8) {
@@ -337,30 +379,180 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
         }
     }
 
-    if (info.storage == TexelStorage::Decoded) {
-        t.m_value.resize(total * 4);
-        t.m_grid8.resize(total * 4);
-        t.m_grid12.resize(total * 4);
-        for (size_t i = 0; i < total * 4; ++i) {
-            const size_t c = i & 3;
-            if (info.floats) {
-                float v = rawf[i];
-                t.m_value[i] = v;
-                auto g = [v](Precision p) {
-                    return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid);
-                };
-                t.m_grid8[i] = g(Precision::Fx8);
-                t.m_grid12[i] = g(Precision::Fx12);
-            } else {
-                // docs/precision.md "Inputs": b -> b/den clamped to [-1, 1]; fx: round_half_even(b*G/den).
-                const int64_t den = info.den[c];
-                const int64_t r = std::clamp<int64_t>(raw[i], -den, den);
-                t.m_value[i] = float(double(r) / double(den));
-                t.m_grid8[i] = int32_t(roundHalfEven(r * 255, den));
-                t.m_grid12[i] = int32_t(roundHalfEven(r * 4080, den));
+    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, rawf);
+    return t;
+}
+
+uint32_t bytesPerTexel(TexFormat f) {
+    switch (f) {
+        case TexFormat::A16B16G16R16F:
+            return 8;
+        case TexFormat::A32B32G32R32F:
+            return 16;
+        case TexFormat::R32F:
+            return 4;
+        default:
+            return uint32_t(formatBits(f) / 8);
+    }
+}
+
+namespace {
+
+// IEEE half -> float32 (exact).
+float halfBitsToFloat(uint16_t h) {
+    const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
+    double v;
+    if (exponent == 0)
+        v = std::ldexp(double(mantissa), -24);
+    else if (exponent == 31)
+        v = mantissa ? double(NAN) : double(INFINITY);
+    else
+        v = std::ldexp(double(mantissa + 1024), exponent - 25);
+    return float(sign ? -v : v);
+}
+
+inline uint32_t loadLE(const uint8_t* p, uint32_t bytes) {
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < bytes; ++i) w |= uint32_t(p[i]) << (8 * i);
+    return w;
+}
+
+inline float loadF32(const uint8_t* p) {
+    float f;
+    std::memcpy(&f, p, 4);
+    return f;
+}
+
+// One row of an Unorm8 format into b g r a words (little-endian host: word = 0xAARRGGBB).
+void unorm8Row(TexFormat f, const uint8_t* src, uint32_t width, uint8_t* dst) {
+    switch (f) {
+        case TexFormat::A8R8G8B8:
+            std::memcpy(dst, src, size_t(width) * 4);  // D3D's byte order is the stored order
+            return;
+        case TexFormat::X8R8G8B8:
+            for (uint32_t x = 0; x < width; ++x) {
+                uint32_t w;
+                std::memcpy(&w, src + 4 * x, 4);
+                w |= 0xff000000u;  // X reads 1
+                std::memcpy(dst + 4 * x, &w, 4);
             }
+            return;
+        case TexFormat::A8:
+            for (uint32_t x = 0; x < width; ++x) {
+                const uint32_t w = uint32_t(src[x]) << 24;
+                std::memcpy(dst + 4 * x, &w, 4);
+            }
+            return;
+        case TexFormat::L8:
+            for (uint32_t x = 0; x < width; ++x) {
+                const uint32_t w = uint32_t(src[x]) * 0x010101u | 0xff000000u;
+                std::memcpy(dst + 4 * x, &w, 4);
+            }
+            return;
+        case TexFormat::A8L8:
+            for (uint32_t x = 0; x < width; ++x) {
+                const uint32_t w = uint32_t(src[2 * x]) * 0x010101u | uint32_t(src[2 * x + 1]) << 24;
+                std::memcpy(dst + 4 * x, &w, 4);
+            }
+            return;
+        default:
+            return;
+    }
+}
+
+}  // namespace
+
+std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const TextureLevelBytes* levels,
+                                           size_t levelCount, std::string& error) {
+    static_assert(std::endian::native == std::endian::little, "Unorm8 words are stored little endian");
+    if (levelCount == 0 || !levels) {
+        error = "texture has no levels";
+        return std::nullopt;
+    }
+    const TextureLevelBytes& l0 = levels[0];
+    const uint32_t depth = volume ? l0.depth : 1;
+    if (l0.width == 0 || l0.height == 0 || depth == 0) {
+        error = "texture has no size";
+        return std::nullopt;
+    }
+    if (l0.width > kMaxSurfaceSize || l0.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+        error = "texture size " + std::to_string(l0.width) + "x" + std::to_string(l0.height) +
+                (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
+                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+        return std::nullopt;
+    }
+    const uint32_t possible = fullMipCount(l0.width, l0.height, depth);
+    if (levelCount > possible) {
+        error =
+            "levels " + std::to_string(levelCount) + " is more than the texture has (" + std::to_string(possible) + ")";
+        return std::nullopt;
+    }
+    Texture t;
+    if (!t.layout(fmt, volume, l0.width, l0.height, depth, uint32_t(levelCount), error)) return std::nullopt;
+    const uint32_t bpt = bytesPerTexel(fmt);
+    for (size_t k = 0; k < levelCount; ++k) {
+        const TextureLevelInfo& li = t.m_levels[k];
+        const TextureLevelBytes& lb = levels[k];
+        if (lb.width != li.width || lb.height != li.height || (volume ? lb.depth : 1) != li.depth) {
+            error = "level " + std::to_string(k) + " is " + std::to_string(lb.width) + "x" + std::to_string(lb.height) +
+                    (volume ? "x" + std::to_string(lb.depth) : "") + ", expected " + std::to_string(li.width) + "x" +
+                    std::to_string(li.height) + (volume ? "x" + std::to_string(li.depth) : "");
+            return std::nullopt;
+        }
+        if (!lb.data || lb.rowPitch < size_t(li.width) * bpt ||
+            (li.depth > 1 && lb.slicePitch < lb.rowPitch * li.height)) {
+            error = "level " + std::to_string(k) + " has no data or a pitch smaller than its rows";
+            return std::nullopt;
         }
     }
+
+    const FormatInfo info = formatInfo(fmt);
+    const size_t total = t.m_texelCount;
+    auto forEachRow = [&](auto&& row) {
+        for (size_t k = 0; k < levelCount; ++k) {
+            const TextureLevelInfo& li = t.m_levels[k];
+            const TextureLevelBytes& lb = levels[k];
+            for (uint32_t z = 0; z < li.depth; ++z)
+                for (uint32_t y = 0; y < li.height; ++y)
+                    row(lb.data + z * lb.slicePitch + y * lb.rowPitch, li.width,
+                        li.offset + (size_t(z) * li.height + y) * li.width);
+        }
+    };
+    if (info.storage == TexelStorage::Unorm8) {
+        t.m_u8.resize(total * 4);
+        forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
+            unorm8Row(fmt, src, width, t.m_u8.data() + first * 4);
+        });
+        return t;
+    }
+    std::vector<int32_t> raw;
+    std::vector<float> rawf;
+    if (info.floats) {
+        rawf.resize(total * 4);
+        forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
+            float* d = rawf.data() + first * 4;
+            for (uint32_t x = 0; x < width; ++x, d += 4) {
+                const uint8_t* p = src + size_t(x) * bpt;
+                if (fmt == TexFormat::R32F) {
+                    d[0] = loadF32(p), d[1] = d[2] = d[3] = 1.0f;
+                } else if (fmt == TexFormat::A16B16G16R16F) {
+                    for (int c = 0; c < 4; ++c) d[c] = halfBitsToFloat(uint16_t(loadLE(p + 2 * c, 2)));
+                } else {
+                    for (int c = 0; c < 4; ++c) d[c] = loadF32(p + 4 * c);
+                }
+            }
+        });
+    } else {
+        raw.resize(total * 4);
+        forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
+            int32_t* d = raw.data() + first * 4;
+            for (uint32_t x = 0; x < width; ++x, d += 4) {
+                const std::array<int32_t, 4> r = decodeSigned(fmt, loadLE(src + size_t(x) * bpt, bpt));
+                std::copy(r.begin(), r.end(), d);
+            }
+        });
+    }
+    t.finishDecoded(raw, rawf);
     return t;
 }
 

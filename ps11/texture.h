@@ -1,7 +1,8 @@
 // Software textures (docs/textures.md): a format, 2D or volume, a mip chain, and the texels
 // decoded per channel so that every precision profile reads exact values (8-bit channels as
 // bytes, signed and float formats as per-profile grid integers and float32). Built from the
-// .ps11test model by textureFromDesc(); immutable afterwards, shared by samplers.
+// .ps11test model by textureFromDesc() or from levels in D3D's memory layout by
+// Texture::fromLevels() (the device's hand-over); immutable afterwards, shared by samplers.
 #pragma once
 
 #include <array>
@@ -26,8 +27,23 @@ constexpr int32_t kMaxTexelGrid = 1 << 20;
 
 // How a texture keeps its texels.
 enum class TexelStorage : uint8_t {
-    Unorm8,   // 4 bytes r g b a per texel, value = byte / 255 (A8R8G8B8, X8R8G8B8, A8, L8, A8L8)
+    Unorm8,   // 4 bytes b g r a per texel (D3D's A8R8G8B8 order), value = byte / 255
+              // (A8R8G8B8, X8R8G8B8, A8, L8, A8L8)
     Decoded,  // float32 r g b a plus fx8 and fx12 grid integers per texel (signed and float formats)
+};
+
+// Byte index of channel c (0..3 = r g b a) inside a Unorm8 texel (stored b g r a).
+constexpr int kUnorm8Byte[4] = {2, 1, 0, 3};
+
+// One level in D3D9's memory layout (what LockRect/LockBox hand out): texel (x, y, z) at
+// data + z * slicePitch + y * rowPitch + x * bytesPerTexel(format). Packed formats store their
+// texel word little endian (A8R8G8B8 = bytes B G R A, V8U8 = U V, ...), A16B16G16R16F four halves
+// r g b a, A32B32G32R32F four floats r g b a, R32F one float.
+struct TextureLevelBytes {
+    uint32_t width = 1, height = 1, depth = 1;
+    const uint8_t* data = nullptr;
+    size_t rowPitch = 0;
+    size_t slicePitch = 0;
 };
 
 struct TextureLevelInfo {
@@ -50,18 +66,32 @@ public:
     // The grid value of one texel in a fixed-point profile (value = grid / G).
     std::array<int32_t, 4> texelGrid(int level, uint32_t x, uint32_t y, uint32_t z, Precision p) const;
 
-    // Raw arrays for the sampler, 4 entries (r g b a) per texel, indexed by level offset + texel.
-    const uint8_t* unorm8() const { return m_u8.data(); }                            // Unorm8
-    const float* values() const { return m_value.data(); }                           // Decoded
-    const int32_t* grid(Precision p) const {                                         // Decoded, fx
+    // Raw arrays for the sampler, 4 entries per texel, indexed by level offset + texel: Unorm8 as
+    // b g r a bytes (kUnorm8Byte), Decoded as r g b a.
+    const uint8_t* unorm8() const { return m_u8.data(); }   // Unorm8
+    const float* values() const { return m_value.data(); }  // Decoded
+    const int32_t* grid(Precision p) const {                // Decoded, fx
         return p == Precision::Fx12 ? m_grid12.data() : m_grid8.data();
     }
     // Float32 of byte b (b / 255), shared by all Unorm8 textures.
     static const float* unorm8Values();
 
+    // Builds a texture from every level of a mip chain in D3D's memory layout (the device's
+    // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
+    // (level k has the extents of level 0 halved k times). The result is the one
+    // textureFromDesc gives for the same texels; A8R8G8B8 levels are copied row by row.
+    // On failure returns nullopt and sets `error`; never allocates more than kMaxTextureBytes.
+    static std::optional<Texture> fromLevels(TexFormat format, bool volume, const TextureLevelBytes* levels,
+                                             size_t levelCount, std::string& error);
+
 private:
     friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error);
     size_t texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const;
+    // Sets format and level extents; false (with `error`) beyond kMaxTextureBytes.
+    bool layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
+                std::string& error);
+    // Signed formats: raw channel integers -> values and grids; float formats: the floats -> grids.
+    void finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf);
 
     TexFormat m_format = TexFormat::A8R8G8B8;
     bool m_volume = false;
@@ -81,6 +111,9 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
 
 // Number of levels of a full chain (down to 1x1x1).
 uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);
+
+// Bytes per texel of a format in D3D's memory layout.
+uint32_t bytesPerTexel(TexFormat f);
 
 // float32 -> nearest IEEE half (ties to even, overflow to infinity) -> float32.
 float roundToHalf(float v);

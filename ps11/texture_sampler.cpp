@@ -1,8 +1,12 @@
 // The software sampler stage: level selection from 2x2 quads, per-axis texel addressing
 // (wrap / mirror / clamp / border / mirroronce) and the exact weighted sums of
 // docs/precision.md "Sampling" (8-bit weights, one round-half-even in fx profiles; float32 in
-// float profiles), plus a bilinear fast path for 8-bit 2D textures in fx (docs/textures.md).
+// float profiles) on the reference path, and the dispatch of 8-bit 2-D fx lookups to the fast
+// kernels of texture_sampler_fast*.cpp (docs/textures.md "Fast path").
 #include "ps11/texture_sampler.h"
+
+#include "ps11/texture_sampler_fast.h"
+#include "ps11/texture_sampler_internal.h"
 
 #include <algorithm>
 #include <cmath>
@@ -34,68 +38,6 @@ struct AxisTaps {
     int32_t w[kMaxSpan];
     float f[kMaxSpan];
 };
-
-int32_t mirrorIndex(int64_t k, int64_t n) { return int32_t(k < n ? k : 2 * n - 1 - k); }
-
-// Maps the integer texel coordinate `fl` (and fl + 1) of an axis with n texels through the
-// address mode (spec §6.3). `fl` may be any double integer (huge values included); indices
-// are always in [0, n) or -1 for a border texel.
-template <TextureAddress Mode>
-inline void addressPair(double fl, int64_t n, int32_t& i0, int32_t& i1) {
-    if constexpr (Mode == TextureAddress::Wrap) {
-        int64_t k = (fl > -1e15 && fl < 1e15) ? int64_t(fl) % n : int64_t(std::fmod(fl, double(n)));
-        if (k < 0) k += n;
-        i0 = int32_t(k);
-        i1 = k + 1 == n ? 0 : int32_t(k + 1);
-    } else if constexpr (Mode == TextureAddress::Mirror) {
-        const int64_t p = 2 * n;  // mirror repeats every two copies
-        int64_t k = (fl > -1e15 && fl < 1e15) ? int64_t(fl) % p : int64_t(std::fmod(fl, double(p)));
-        if (k < 0) k += p;
-        i0 = mirrorIndex(k, n);
-        i1 = mirrorIndex(k + 1 == p ? 0 : k + 1, n);
-    } else if constexpr (Mode == TextureAddress::Clamp) {
-        int64_t k = int64_t(std::clamp(fl, -1.0, double(n)));
-        i0 = int32_t(std::clamp<int64_t>(k, 0, n - 1));
-        i1 = int32_t(std::clamp<int64_t>(k + 1, 0, n - 1));
-    } else if constexpr (Mode == TextureAddress::Border) {
-        int64_t k = int64_t(std::clamp(fl, -2.0, double(n + 1)));
-        i0 = k >= 0 && k < n ? int32_t(k) : -1;
-        i1 = k + 1 >= 0 && k + 1 < n ? int32_t(k + 1) : -1;
-    } else {  // MirrorOnce: mirror once around 0 (texel -1 is texel 0), then clamp
-        int64_t k = int64_t(std::clamp(fl, -double(n) - 2.0, double(n + 1)));
-        auto once = [n](int64_t j) { return int32_t(std::clamp<int64_t>(j < 0 ? -j - 1 : j, 0, n - 1)); };
-        i0 = once(k);
-        i1 = once(k + 1);
-    }
-}
-
-// round_half_even(x) for |x| < 2^51 in the default rounding mode, without a library call
-// (adding and removing 1.5 * 2^52 leaves no fraction bits; the compiler may not fold it).
-constexpr double kRoundMagic = 6755399441055744.0;
-inline double roundEvenSmall(double x) { return (x + kRoundMagic) - kRoundMagic; }
-constexpr double kSmall = 1099511627776.0;  // 2^40: beyond it positions take the slow path
-
-// Texel-space position of one coordinate: x = u*n - 0.5 for linear (texel centres, spec §6.2),
-// u*n for point (floor(u*n), ties go up). Computed in double, exact for float32 u and n <= 2^14.
-// NaN samples as 0, infinities as a huge finite position (never a crash).
-inline void texelPosition(float u, uint32_t n, bool linear, double& fl, double& fr) {
-    const double x = double(u) * double(n) - (linear ? 0.5 : 0.0);
-    if (x > -kSmall && x < kSmall) {
-        double r = roundEvenSmall(x);
-        fl = r > x ? r - 1.0 : r;  // floor
-        fr = x - fl;
-        return;
-    }
-    fl = std::floor(x);
-    fr = x - fl;
-    if (!(fr >= 0.0 && fr < 1.0)) {
-        fl = x > 0 ? 1e18 : x < 0 ? -1e18 : 0.0;
-        fr = 0.0;
-    }
-}
-
-// The 8-bit weight round_half_even(fr * 256) of a fraction fr in [0, 1).
-inline int32_t weight8(double fr) { return int32_t(roundEvenSmall(fr * 256.0)); }
 
 template <TextureAddress Mode>
 void axisPassT(int count, const float* coord, const uint32_t* extent, const uint8_t* level, const uint8_t* linear,
@@ -132,7 +74,7 @@ struct U8Grid {
     const uint8_t* p;
     int64_t scale;  // 1 (fx8) or 16 (fx12)
     void get(size_t i, int64_t t[4]) const {
-        for (int c = 0; c < 4; ++c) t[c] = int64_t(p[i * 4 + size_t(c)]) * scale;
+        for (int c = 0; c < 4; ++c) t[c] = int64_t(p[i * 4 + size_t(kUnorm8Byte[c])]) * scale;
     }
 };
 struct IntGrid {
@@ -145,7 +87,7 @@ struct U8Float {
     const uint8_t* p;
     const float* table;
     void get(size_t i, float t[4]) const {
-        for (int c = 0; c < 4; ++c) t[c] = table[p[i * 4 + size_t(c)]];
+        for (int c = 0; c < 4; ++c) t[c] = table[p[i * 4 + size_t(kUnorm8Byte[c])]];
     }
 };
 struct ValueFloat {
@@ -244,85 +186,6 @@ void combineFloat(const CombineInput& in, const Src& src, const float* border, f
     }
 }
 
-// One axis of the fast path: R = round_half_even((u*n - 0.5) * 256) gives the first texel
-// R >> 8 and the 8-bit weight R & 255 of the second. This equals the general rule (i0, w = 256)
-// whenever f*256 rounds up to 256: the tap pair moves one texel on and the weights become
-// (256, 0), the same exact sum. False for positions the fast path leaves to the general one.
-template <TextureAddress Mode>
-inline bool fastAxis(float u, uint32_t n, uint32_t mask, int32_t& i0, int32_t& i1, int32_t& w) {
-    const double x = double(u) * double(n * 256u) - 128.0;  // exact: 24 + 22 bits
-    if (!(x > -kSmall && x < kSmall)) return false;       // huge, infinite or NaN
-    const int64_t r = int64_t(roundEvenSmall(x));
-    const int64_t k = r >> 8;
-    w = int32_t(r & 255);
-    if constexpr (Mode == TextureAddress::Clamp) {
-        i0 = int32_t(std::clamp<int64_t>(k, 0, n - 1));
-        i1 = int32_t(std::clamp<int64_t>(k + 1, 0, n - 1));
-    } else if (mask) {  // wrap, power-of-two extent
-        i0 = int32_t(k & mask);
-        i1 = int32_t((k + 1) & mask);
-    } else {
-        int64_t m = k % n;
-        if (m < 0) m += n;
-        i0 = int32_t(m);
-        i1 = m + 1 == n ? 0 : int32_t(m + 1);
-    }
-    return true;
-}
-
-// fx bilinear on an 8-bit 2D texture, one level, wrap/clamp: the same exact sum as combineFx
-// (sum * scale / 2^16, one round-half-even) in 32-bit integers. Lanes with unusual coordinates
-// go through the general per-axis rule (texelPosition + addressPair).
-template <TextureAddress MU, TextureAddress MV>
-void fastBilinearU8(int count, const float* u, const float* v, const TextureLevelInfo& li, const uint8_t* texels,
-                    int32_t scale, int32_t* const* dst) {
-    const uint8_t* base = texels + li.offset * 4;
-    const uint32_t maskU = (li.width & (li.width - 1)) == 0 ? li.width - 1 : 0;
-    const uint32_t maskV = (li.height & (li.height - 1)) == 0 ? li.height - 1 : 0;
-    const size_t stride = size_t(li.width) * 4;
-    for (int i = 0; i < count; ++i) {
-        int32_t x0, x1, y0, y1, wx, wy;
-        if (!fastAxis<MU>(u[i], li.width, maskU, x0, x1, wx)) {
-            double fl, fr;
-            texelPosition(u[i], li.width, true, fl, fr);
-            addressPair<MU>(fl, li.width, x0, x1);
-            wx = weight8(fr);
-        }
-        if (!fastAxis<MV>(v[i], li.height, maskV, y0, y1, wy)) {
-            double fl, fr;
-            texelPosition(v[i], li.height, true, fl, fr);
-            addressPair<MV>(fl, li.height, y0, y1);
-            wy = weight8(fr);
-        }
-        const uint8_t* r0 = base + size_t(y0) * stride;
-        const uint8_t* r1 = base + size_t(y1) * stride;
-        uint8_t t00[4], t10[4], t01[4], t11[4];
-        std::memcpy(t00, r0 + size_t(x0) * 4, 4);
-        std::memcpy(t10, r0 + size_t(x1) * 4, 4);
-        std::memcpy(t01, r1 + size_t(x0) * 4, 4);
-        std::memcpy(t11, r1 + size_t(x1) * 4, 4);
-        const int32_t w00 = (256 - wx) * (256 - wy), w10 = wx * (256 - wy), w01 = (256 - wx) * wy, w11 = wx * wy;
-        for (int c = 0; c < 4; ++c) {
-            const int32_t s = (w00 * t00[c] + w10 * t10[c] + w01 * t01[c] + w11 * t11[c]) * scale;
-            dst[c][i] = int32_t(roundShift(s, 16));
-        }
-    }
-}
-
-template <TextureAddress MU>
-bool fastBilinearV(TextureAddress mv, int count, const float* u, const float* v, const TextureLevelInfo& li,
-                   const uint8_t* texels, int32_t scale, int32_t* const* dst) {
-    if (mv == TextureAddress::Clamp) {
-        fastBilinearU8<MU, TextureAddress::Clamp>(count, u, v, li, texels, scale, dst);
-        return true;
-    }
-    if (mv == TextureAddress::Wrap) {
-        fastBilinearU8<MU, TextureAddress::Wrap>(count, u, v, li, texels, scale, dst);
-        return true;
-    }
-    return false;
-}
-
 Filter effective(Filter f) { return f == Filter::Linear ? Filter::Linear : Filter::Point; }
 
 // Level selection (docs/textures.md "Level of detail"): per 2x2 quad, the screen derivatives of
@@ -406,7 +269,7 @@ SamplerState samplerStateFromDesc(const SamplerDesc& desc) {
     return s;
 }
 
-TextureSampler::TextureSampler() {
+TextureSampler::TextureSampler(bool fastPath) : m_fastPath(fastPath) {
     for (int i = 0; i < kMaxSamplerStages; ++i) setSamplerState(i, SamplerState{});
 }
 
@@ -432,57 +295,16 @@ bool TextureSampler::hasTexture(int stage) const {
     return stage >= 0 && stage < kMaxSamplerStages && m_stages[size_t(stage)].texture != nullptr;
 }
 
-void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
-    const int count = std::clamp(req.count, 0, kMaxSpan);
+namespace {
+
+// The reference path (docs/textures.md "Sampling"): level selection, per-axis addressing with the
+// mode as a template argument, one combine loop per (profile kind, storage, 2-D/volume). Returns
+// the texels fetched.
+uint64_t sampleReference(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
+                         const SamplerState& ss, const std::array<int32_t, 4>& borderGrid, int32_t* const* gridDst,
+                         float* const* valueDst) {
     const bool fixed = isFixedPoint(req.precision);
-    // Outputs the caller did not ask for go to scratch, so the kernels never test pointers.
-    int32_t scratchGrid[4][kMaxSpan];
-    float scratchValue[4][kMaxSpan];
-    int32_t* gridDst[4];
-    float* valueDst[4];
-    for (int c = 0; c < 4; ++c) {
-        gridDst[c] = out.grid[c] ? out.grid[c] : scratchGrid[c];
-        valueDst[c] = out.value[c] ? out.value[c] : scratchValue[c];
-    }
-
-    const Stage* st = req.stage >= 0 && req.stage < kMaxSamplerStages ? &m_stages[size_t(req.stage)] : nullptr;
-    if (!st || !st->texture || st->texture->levelCount() == 0) {
-        // spec §6.4: a stage without a texture samples as (0, 0, 0, 1).
-        const int32_t one = gridScale(req.precision);
-        for (int c = 0; c < 4; ++c)
-            for (int i = 0; i < count; ++i) {
-                if (fixed) gridDst[c][i] = c == 3 ? one : 0;
-                else valueDst[c][i] = c == 3 ? 1.0f : 0.0f;
-            }
-        return;
-    }
-    const Texture& tex = *st->texture;
-    const SamplerState& ss = st->state;
     const bool volume = tex.isVolume();
-    const float* coord[3] = {req.u ? req.u : kZeros, req.dims >= 2 && req.v ? req.v : kZeros,
-                             req.dims >= 3 && req.w ? req.w : kZeros};
-
-    const bool magLinear = effective(ss.magFilter) == Filter::Linear;
-    const bool uniformFilter = effective(ss.magFilter) == effective(ss.minFilter);
-    const bool singleLevel = tex.levelCount() == 1 || ss.mipFilter == Filter::None;
-    const bool uniform = !req.quads || (uniformFilter && singleLevel);
-
-    // Fast path: fx bilinear, 8-bit 2D texture, level 0, wrap/clamp.
-    if (m_fastPath && fixed && uniform && magLinear && !volume && tex.storage() == TexelStorage::Unorm8) {
-        const int32_t scale = gridScale(req.precision) / 255;
-        bool done = false;
-        if (ss.addressU == TextureAddress::Clamp)
-            done = fastBilinearV<TextureAddress::Clamp>(ss.addressV, count, coord[0], coord[1], tex.level(0),
-                                                        tex.unorm8(), scale, gridDst);
-        else if (ss.addressU == TextureAddress::Wrap)
-            done = fastBilinearV<TextureAddress::Wrap>(ss.addressV, count, coord[0], coord[1], tex.level(0),
-                                                       tex.unorm8(), scale, gridDst);
-        if (done) {
-            m_fetched.fetch_add(uint64_t(count) * 4, std::memory_order_relaxed);
-            return;
-        }
-    }
-
     LaneLevels lanes;
     selectLevels(req, count, coord, tex, ss, fixed, lanes);
 
@@ -509,11 +331,11 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
 
     CombineInput in{count, &tex.level(0), &lanes, taps};
     if (fixed) {
-        const std::array<int32_t, 4>& bg = req.precision == Precision::Fx12 ? st->borderGrid12 : st->borderGrid8;
-        const int64_t border[4] = {bg[0], bg[1], bg[2], bg[3]};
+        const int64_t border[4] = {borderGrid[0], borderGrid[1], borderGrid[2], borderGrid[3]};
         if (tex.storage() == TexelStorage::Unorm8) {
             U8Grid src{tex.unorm8(), gridScale(req.precision) / 255};
-            volume ? combineFx<U8Grid, true>(in, src, border, gridDst) : combineFx<U8Grid, false>(in, src, border, gridDst);
+            volume ? combineFx<U8Grid, true>(in, src, border, gridDst)
+                   : combineFx<U8Grid, false>(in, src, border, gridDst);
         } else {
             IntGrid src{tex.grid(req.precision)};
             volume ? combineFx<IntGrid, true>(in, src, border, gridDst)
@@ -531,6 +353,109 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                    : combineFloat<ValueFloat, false>(in, src, border, valueDst);
         }
     }
+    return fetched;
+}
+
+// The border colour as a b g r a byte word when its grid value is byte * scale for bytes in
+// 0..255 (so the fast kernels can treat it as a texel); false otherwise.
+bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& word) {
+    word = 0;
+    for (int c = 0; c < 4; ++c) {
+        const int32_t g = grid[size_t(c)];
+        if (g < 0 || g > 255 * scale || g % scale != 0) return false;
+        word |= uint32_t(g / scale) << (8 * kUnorm8Byte[c]);
+    }
+    return true;
+}
+
+}  // namespace
+
+void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
+    const int count = std::clamp(req.count, 0, kMaxSpan);
+    const bool fixed = isFixedPoint(req.precision);
+    // Outputs the caller did not ask for go to scratch, so the kernels never test pointers.
+    int32_t scratchGrid[4][kMaxSpan];
+    float scratchValue[4][kMaxSpan];
+    int32_t* gridDst[4];
+    float* valueDst[4];
+    for (int c = 0; c < 4; ++c) {
+        gridDst[c] = out.grid[c] ? out.grid[c] : scratchGrid[c];
+        valueDst[c] = out.value[c] ? out.value[c] : scratchValue[c];
+    }
+
+    const Stage* st = req.stage >= 0 && req.stage < kMaxSamplerStages ? &m_stages[size_t(req.stage)] : nullptr;
+    if (!st || !st->texture || st->texture->levelCount() == 0) {
+        // spec §6.4: a stage without a texture samples as (0, 0, 0, 1).
+        const int32_t one = gridScale(req.precision);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < count; ++i) {
+                if (fixed)
+                    gridDst[c][i] = c == 3 ? one : 0;
+                else
+                    valueDst[c][i] = c == 3 ? 1.0f : 0.0f;
+            }
+        return;
+    }
+    const Texture& tex = *st->texture;
+    const SamplerState& ss = st->state;
+    const float* coord[3] = {req.u ? req.u : kZeros, req.dims >= 2 && req.v ? req.v : kZeros,
+                             req.dims >= 3 && req.w ? req.w : kZeros};
+    const std::array<int32_t, 4>& borderGrid = req.precision == Precision::Fx12 ? st->borderGrid12 : st->borderGrid8;
+
+    uint64_t fetched = 0, fastLanes = 0;
+    if (m_fastPath && fixed && !tex.isVolume() && tex.storage() == TexelStorage::Unorm8) {
+        fastpath::Unorm8Run run;
+        run.addressU = ss.addressU;
+        run.addressV = ss.addressV;
+        run.scale = gridScale(req.precision) / 255;
+        const bool border = ss.addressU == TextureAddress::Border || ss.addressV == TextureAddress::Border;
+        if (!border || borderAsWord(borderGrid, run.scale, run.borderWord)) {
+            const fastpath::Unorm8Kernel kernel = fastpath::unorm8Kernel();
+            auto fastRun = [&](int first, int n, int level, bool linear) {
+                const TextureLevelInfo& li = tex.level(level);
+                run.texels = tex.unorm8() + li.offset * 4;
+                run.width = li.width, run.height = li.height, run.linear = linear;
+                int32_t* dst[4] = {gridDst[0] + first, gridDst[1] + first, gridDst[2] + first, gridDst[3] + first};
+                kernel(run, n, coord[0] + first, coord[1] + first, dst);
+                fetched += uint64_t(n) * (linear ? 4 : 1);
+                fastLanes += uint64_t(n);
+            };
+            const bool magLinear = effective(ss.magFilter) == Filter::Linear;
+            const bool uniformFilter = effective(ss.magFilter) == effective(ss.minFilter);
+            const bool singleLevel = tex.levelCount() == 1 || ss.mipFilter == Filter::None;
+            if (!req.quads || (uniformFilter && singleLevel)) {
+                fastRun(0, count, 0, magLinear);  // level 0, one filter (docs/textures.md "Level of detail")
+            } else {
+                // Per quad level and filter, then runs of whole quads: one level -> fast kernel,
+                // a linear mip blend of two levels -> the reference path (quad-aligned, so its LOD
+                // is the same).
+                static thread_local LaneLevels lanes;
+                selectLevels(req, count, coord, tex, ss, true, lanes);
+                for (int q = 0; q < count;) {
+                    const bool two = lanes.slots[q] == 2;
+                    int e = q + 4;
+                    while (e < count && (lanes.slots[e] == 2) == two &&
+                           (two || (lanes.level[0][e] == lanes.level[0][q] && lanes.linear[e] == lanes.linear[q])))
+                        e += 4;
+                    e = std::min(e, count);
+                    if (!two) {
+                        fastRun(q, e - q, lanes.level[0][q], lanes.linear[q] != 0);
+                    } else {
+                        SampleRequest sub = req;
+                        sub.count = e - q;
+                        const float* c3[3] = {coord[0] + q, coord[1] + q, coord[2] + q};
+                        int32_t* g[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
+                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst);
+                    }
+                    q = e;
+                }
+            }
+            m_fetched.fetch_add(fetched, std::memory_order_relaxed);
+            m_fastLanes.fetch_add(fastLanes, std::memory_order_relaxed);
+            return;
+        }
+    }
+    fetched = sampleReference(req, count, coord, tex, ss, borderGrid, gridDst, valueDst);
     m_fetched.fetch_add(fetched, std::memory_order_relaxed);
 }
 

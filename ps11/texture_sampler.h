@@ -37,7 +37,9 @@ SamplerState samplerStateFromDesc(const SamplerDesc& desc);
 
 class TextureSampler final : public Sampler {
 public:
-    TextureSampler();
+    // `fastPath` false forces the reference path for every lookup (tests and benchmarks compare
+    // the two; the results are bit-identical).
+    explicit TextureSampler(bool fastPath = true);
     // Binds (or with nullptr unbinds) a texture; false for a stage outside 0..7.
     bool bind(int stage, std::shared_ptr<const Texture> texture);
     // Sets a stage's sampler state; false for a stage outside 0..7.
@@ -48,9 +50,11 @@ public:
     bool hasTexture(int stage) const override;
     uint64_t texelsFetched() const override { return m_fetched.load(std::memory_order_relaxed); }
 
-    // The fx bilinear fast path for 8-bit 2D textures (on by default); tests switch it off to
-    // compare it with the general path.
+    // The fast kernels for 8-bit 2-D textures in fx profiles (point and bilinear, one level per
+    // quad, every address mode; on by default). Off: the reference path only.
     void setFastPath(bool enabled) { m_fastPath = enabled; }
+    // Lanes answered by the fast kernels so far (statistics; tests check the fast path ran).
+    uint64_t fastLanes() const { return m_fastLanes.load(std::memory_order_relaxed); }
 
 private:
     struct Stage {
@@ -60,6 +64,7 @@ private:
     };
     std::array<Stage, kMaxSamplerStages> m_stages;
     std::atomic<uint64_t> m_fetched{0};
+    std::atomic<uint64_t> m_fastLanes{0};
     bool m_fastPath = true;
 };
 

@@ -1,0 +1,36 @@
+// The fast sampling kernels for 8-bit (Unorm8) 2-D textures in fx profiles: point and bilinear
+// on one mip level, every address mode. They compute exactly what the reference path of
+// TextureSampler computes (docs/textures.md "Fast path"); TextureSampler decides when a span
+// (or a run of its quads) qualifies. Internal to ps11/texture_sampler*.cpp.
+#pragma once
+
+#include <cstdint>
+
+#include "ps11/texture_sampler.h"
+
+namespace ps11::fastpath {
+
+// One run of lanes that all read the same level with the same filter.
+struct Unorm8Run {
+    const uint8_t* texels = nullptr;  // the level's first texel: b g r a bytes, rows width * 4 apart
+    uint32_t width = 1, height = 1;
+    bool linear = false;  // bilinear (4 taps) or point
+    TextureAddress addressU = TextureAddress::Wrap, addressV = TextureAddress::Wrap;
+    uint32_t borderWord = 0;  // the border colour as a b g r a word (its grid value is byte * scale)
+    int32_t scale = 1;        // grid units per byte: 1 (fx8) or 16 (fx12)
+};
+
+using Unorm8Kernel = void (*)(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
+
+// Portable build (baseline x86-64 / any CPU).
+void sampleUnorm8Generic(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
+// Built with AVX2 + FMA; call only when the CPU has both.
+void sampleUnorm8Avx2(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
+// The best kernel this CPU runs (chosen once, by __builtin_cpu_supports), or the generic one
+// while setForceGeneric(true) (tests compare both builds on a CPU that has AVX2).
+Unorm8Kernel unorm8Kernel();
+void setForceGeneric(bool generic);
+// True when this process would pick the AVX2 build.
+bool hasAvx2Kernel();
+
+}  // namespace ps11::fastpath

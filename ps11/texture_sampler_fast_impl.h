@@ -1,0 +1,360 @@
+// The body of the fast Unorm8 kernels, included by texture_sampler_fast.cpp (baseline ISA) and
+// texture_sampler_fast_avx2.cpp (AVX2 + FMA) with PS11_FAST_KERNEL naming the exported function.
+// Everything else has internal linkage so the two builds never mix at link time.
+//
+// Exactness (docs/precision.md "Sampling"): per axis R = round_half_even((u*n - 0.5)*256) gives
+// the first texel R >> 8 and the 8-bit weight R & 255 of the second; when f*256 rounds up to 256
+// this moves the tap pair one texel on with weights (256, 0), the same exact sum as the general
+// rule. The blend sum(w_k * byte_k) with w_k = wx'*wy' <= 65536 is an integer below 2^24, so it
+// is exact in float32 whatever the order or FMA; scaling by 2^-16 (fx8) or 2^-12 (fx12, 16
+// grid units per byte) is exact, and adding and removing 1.5 * 2^23 rounds to the nearest
+// integer, ties to even: one rounding, as the reference does in 64-bit integers.
+#include <cstring>
+#ifdef __AVX2__
+#include <immintrin.h>
+#endif
+
+#include "ps11/texture.h"
+#include "ps11/texture_sampler_fast.h"
+#include "ps11/texture_sampler_internal.h"
+
+#ifndef PS11_FAST_KERNEL
+#error "define PS11_FAST_KERNEL before including texture_sampler_fast_impl.h"
+#endif
+
+namespace ps11::fastpath {
+namespace {
+
+// Positions with |x| below this (in the axis's units) take the integer path; others (huge,
+// infinite, NaN) the reference's per-lane rule.
+constexpr double kFastRange = 1073741824.0;  // 2^30
+constexpr float kFloatMagic = 12582912.0f;   // 1.5 * 2^23
+
+// Lane arrays of one span, padded so vector loops may run past the end.
+struct Scratch {
+    alignas(64) int32_t x0[kMaxSpan], x1[kMaxSpan], wx[kMaxSpan];
+    alignas(64) int32_t y0[kMaxSpan], y1[kMaxSpan], wy[kMaxSpan];
+    alignas(64) uint32_t t00[kMaxSpan], t10[kMaxSpan], t01[kMaxSpan], t11[kMaxSpan];
+};
+
+// k mod n for |k| < 2^23, n <= 2^15: a double quotient is within one of the true one.
+inline int32_t modSmall(int32_t k, int32_t n, double inv) {
+    int32_t m = k - int32_t(double(k) * inv) * n;
+    m = m < 0 ? m + n : m;
+    return m >= n ? m - n : m;
+}
+
+// Maps texel index k of an axis with n texels through the address mode (-1 = border). Valid
+// for |k| < 2^23; the same mapping as addressPair.
+template <TextureAddress Mode>
+inline int32_t address1(int32_t k, int32_t n, double inv, double inv2) {
+    if constexpr (Mode == TextureAddress::Wrap) {
+        return modSmall(k, n, inv);
+    } else if constexpr (Mode == TextureAddress::Mirror) {
+        const int32_t m = modSmall(k, 2 * n, inv2);
+        return m < n ? m : 2 * n - 1 - m;
+    } else if constexpr (Mode == TextureAddress::Clamp) {
+        return std::min(std::max(k, 0), n - 1);
+    } else if constexpr (Mode == TextureAddress::Border) {
+        return uint32_t(k) < uint32_t(n) ? k : -1;
+    } else {
+        const int32_t j = k < 0 ? -k - 1 : k;
+        return std::min(j, n - 1);
+    }
+}
+
+// One axis of a run: texel pair and weight (bilinear) or texel (point) per lane.
+template <TextureAddress Mode, bool Linear>
+void axis(int count, const float* c, uint32_t n, int32_t* __restrict i0, int32_t* __restrict i1,
+          int32_t* __restrict w) {
+    const double scale = Linear ? double(n) * 256.0 : double(n);
+    const double bias = Linear ? 128.0 : 0.0;
+    const int32_t ni = int32_t(n);
+    const double inv = 1.0 / double(n), inv2 = 0.5 / double(n);
+    int bad = 0;
+    for (int i = 0; i < count; ++i) {
+        const double x = double(c[i]) * scale - bias;  // exact: 24 + 22 bits
+        const bool ok = x > -kFastRange && x < kFastRange;
+        bad += !ok;
+        const double xs = ok ? x : 0.0;
+        const double r = roundEvenSmall(xs);
+        int32_t k;
+        if constexpr (Linear) {
+            const int32_t R = int32_t(r);
+            k = R >> 8;
+            w[i] = R & 255;
+        } else {
+            k = int32_t(r > xs ? r - 1.0 : r);  // floor(u*n): ties go up
+        }
+        i0[i] = address1<Mode>(k, ni, inv, inv2);
+        if constexpr (Linear) i1[i] = address1<Mode>(k + 1, ni, inv, inv2);
+    }
+    if (!bad) return;
+    for (int i = 0; i < count; ++i) {
+        const double x = double(c[i]) * scale - bias;
+        if (x > -kFastRange && x < kFastRange) continue;
+        double fl, fr;
+        texelPosition(c[i], n, Linear, fl, fr);
+        int32_t a, b;
+        addressPair<Mode>(fl, n, a, b);
+        i0[i] = a;
+        if constexpr (Linear) i1[i] = b, w[i] = weight8(fr);
+    }
+}
+
+#ifdef __AVX2__
+// The address mode on 8 int32 lanes (same mapping as address1).
+template <TextureAddress Mode>
+inline __m256i address8(__m256i k, __m256i n, __m256d inv, __m256i twoN, __m256d inv2) {
+    const __m256i zero = _mm256_setzero_si256();
+    auto modN = [&](__m256i kk, __m256i nn, __m256d iv) {
+        const __m256d lo = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_castsi256_si128(kk)), iv);
+        const __m256d hi = _mm256_mul_pd(_mm256_cvtepi32_pd(_mm256_extracti128_si256(kk, 1)), iv);
+        const __m256i q = _mm256_setr_m128i(_mm256_cvttpd_epi32(lo), _mm256_cvttpd_epi32(hi));
+        __m256i m = _mm256_sub_epi32(kk, _mm256_mullo_epi32(q, nn));
+        m = _mm256_add_epi32(m, _mm256_and_si256(_mm256_cmpgt_epi32(zero, m), nn));   // m < 0: + n
+        m = _mm256_sub_epi32(m, _mm256_andnot_si256(_mm256_cmpgt_epi32(nn, m), nn));  // m >= n: - n
+        return m;
+    };
+    if constexpr (Mode == TextureAddress::Wrap) {
+        return modN(k, n, inv);
+    } else if constexpr (Mode == TextureAddress::Mirror) {
+        const __m256i m = modN(k, twoN, inv2);
+        const __m256i flipped = _mm256_sub_epi32(_mm256_sub_epi32(twoN, _mm256_set1_epi32(1)), m);
+        return _mm256_blendv_epi8(flipped, m, _mm256_cmpgt_epi32(n, m));
+    } else if constexpr (Mode == TextureAddress::Clamp) {
+        return _mm256_min_epi32(_mm256_max_epi32(k, zero), _mm256_sub_epi32(n, _mm256_set1_epi32(1)));
+    } else if constexpr (Mode == TextureAddress::Border) {
+        const __m256i in = _mm256_and_si256(_mm256_cmpgt_epi32(k, _mm256_set1_epi32(-1)), _mm256_cmpgt_epi32(n, k));
+        return _mm256_or_si256(_mm256_and_si256(in, k), _mm256_andnot_si256(in, _mm256_set1_epi32(-1)));
+    } else {
+        const __m256i j = _mm256_xor_si256(k, _mm256_srai_epi32(k, 31));  // k < 0: -k - 1 = ~k
+        return _mm256_min_epi32(j, _mm256_sub_epi32(n, _mm256_set1_epi32(1)));
+    }
+}
+
+// 8 lanes at a time; lanes outside the integer range and the tail go to the scalar axis().
+template <TextureAddress Mode, bool Linear>
+void axisAvx2(int count, const float* c, uint32_t n, int32_t* __restrict i0, int32_t* __restrict i1,
+              int32_t* __restrict w) {
+    const __m256d scale = _mm256_set1_pd(Linear ? double(n) * 256.0 : double(n));
+    const __m256d bias = _mm256_set1_pd(Linear ? 128.0 : 0.0);
+    const __m256d range = _mm256_set1_pd(kFastRange);
+    const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m256i nv = _mm256_set1_epi32(int32_t(n)), twoN = _mm256_set1_epi32(int32_t(2 * n));
+    const __m256d inv = _mm256_set1_pd(1.0 / double(n)), inv2 = _mm256_set1_pd(0.5 / double(n));
+    const __m256i one = _mm256_set1_epi32(1);
+    int i = 0;
+    for (; i + 8 <= count; i += 8) {
+        const __m256 uf = _mm256_loadu_ps(c + i);
+        __m256d xl = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_castps256_ps128(uf)), scale), bias);
+        __m256d xh = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(_mm256_extractf128_ps(uf, 1)), scale), bias);
+        const __m256d okl = _mm256_cmp_pd(_mm256_and_pd(xl, absMask), range, _CMP_LT_OQ);
+        const __m256d okh = _mm256_cmp_pd(_mm256_and_pd(xh, absMask), range, _CMP_LT_OQ);
+        if ((_mm256_movemask_pd(okl) & _mm256_movemask_pd(okh)) != 15) {
+            axis<Mode, Linear>(8, c + i, n, i0 + i, i1 + i, w + i);  // some lane needs the general rule
+            continue;
+        }
+        __m256i k;
+        if constexpr (Linear) {
+            // cvtpd rounds to nearest, ties to even (the default MXCSR mode): R = round(x * 256).
+            const __m256i R = _mm256_setr_m128i(_mm256_cvtpd_epi32(xl), _mm256_cvtpd_epi32(xh));
+            k = _mm256_srai_epi32(R, 8);
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(w + i), _mm256_and_si256(R, _mm256_set1_epi32(255)));
+        } else {
+            xl = _mm256_floor_pd(xl), xh = _mm256_floor_pd(xh);
+            k = _mm256_setr_m128i(_mm256_cvttpd_epi32(xl), _mm256_cvttpd_epi32(xh));
+        }
+        const __m256i a0 = address8<Mode>(k, nv, inv, twoN, inv2);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(i0 + i), a0);
+        if constexpr (Linear) {
+            __m256i a1;
+            if constexpr (Mode == TextureAddress::Wrap) {  // the next texel of a0, n wrapping to 0
+                const __m256i next = _mm256_add_epi32(a0, one);
+                a1 = _mm256_andnot_si256(_mm256_cmpeq_epi32(next, nv), next);
+            } else {
+                a1 = address8<Mode>(_mm256_add_epi32(k, one), nv, inv, twoN, inv2);
+            }
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(i1 + i), a1);
+        }
+    }
+    if (i < count) axis<Mode, Linear>(count - i, c + i, n, i0 + i, i1 + i, w + i);
+}
+#define PS11_AXIS axisAvx2
+#else
+#define PS11_AXIS axis
+#endif
+
+template <bool Linear>
+void axisPass(TextureAddress mode, int count, const float* c, uint32_t n, int32_t* i0, int32_t* i1, int32_t* w) {
+    switch (mode) {
+        case TextureAddress::Mirror:
+            return PS11_AXIS<TextureAddress::Mirror, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::Clamp:
+            return PS11_AXIS<TextureAddress::Clamp, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::Border:
+            return PS11_AXIS<TextureAddress::Border, Linear>(count, c, n, i0, i1, w);
+        case TextureAddress::MirrorOnce:
+            return PS11_AXIS<TextureAddress::MirrorOnce, Linear>(count, c, n, i0, i1, w);
+        default:  // Wrap (and an invalid value, as the reference)
+            return PS11_AXIS<TextureAddress::Wrap, Linear>(count, c, n, i0, i1, w);
+    }
+}
+
+inline uint32_t load32(const uint8_t* p) {
+    uint32_t w;
+    std::memcpy(&w, p, 4);
+    return w;
+}
+inline uint64_t load64(const uint8_t* p) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    return w;
+}
+
+// The four taps of every lane as b g r a words: one 64-bit load per row when the pair is
+// adjacent (the usual case), else two 32-bit loads or the border word.
+void gatherBilinear(const Unorm8Run& run, int count, Scratch& s) {
+    const uint8_t* base = run.texels;
+    const size_t stride = size_t(run.width) * 4;
+    for (int i = 0; i < count; ++i) {
+        const int32_t x0 = s.x0[i], x1 = s.x1[i], y0 = s.y0[i], y1 = s.y1[i];
+        if ((x0 | x1 | y0 | y1) >= 0) {
+            const uint8_t* r0 = base + size_t(y0) * stride;
+            const uint8_t* r1 = base + size_t(y1) * stride;
+            if (x1 == x0 + 1) {
+                const uint64_t a = load64(r0 + size_t(x0) * 4), b = load64(r1 + size_t(x0) * 4);
+                s.t00[i] = uint32_t(a), s.t10[i] = uint32_t(a >> 32);
+                s.t01[i] = uint32_t(b), s.t11[i] = uint32_t(b >> 32);
+            } else {
+                s.t00[i] = load32(r0 + size_t(x0) * 4), s.t10[i] = load32(r0 + size_t(x1) * 4);
+                s.t01[i] = load32(r1 + size_t(x0) * 4), s.t11[i] = load32(r1 + size_t(x1) * 4);
+            }
+            continue;
+        }
+        auto tap = [&](int32_t x, int32_t y) {
+            return (x | y) < 0 ? run.borderWord : load32(base + size_t(y) * stride + size_t(x) * 4);
+        };
+        s.t00[i] = tap(x0, y0), s.t10[i] = tap(x1, y0), s.t01[i] = tap(x0, y1), s.t11[i] = tap(x1, y1);
+    }
+}
+
+// True when the span is 2x2 quads (lanes TL TR BL BR) of a screen-aligned pass at the texture's
+// resolution: quad q reads columns x0 + 2q + (0 | 1) (and + 1), its top lanes one row pair and its
+// bottom lanes another, none of them border. Then each row's two adjacent lanes are one 64-bit copy.
+bool quadContiguous(int count, const Scratch& s) {
+    if (count % 4 != 0) return false;
+    const int32_t x0 = s.x0[0], ya0 = s.y0[0], ya1 = s.y1[0], yb0 = s.y0[2], yb1 = s.y1[2];
+    if ((x0 | ya0 | ya1 | yb0 | yb1) < 0) return false;
+    int bad = 0;
+    for (int i = 0; i < count; ++i) {
+        const int32_t col = x0 + 2 * (i >> 2) + (i & 1);
+        const bool top = (i & 2) == 0;
+        bad |= (s.x0[i] - col) | (s.x1[i] - col - 1) | (s.y0[i] - (top ? ya0 : yb0)) | (s.y1[i] - (top ? ya1 : yb1));
+    }
+    return bad == 0;
+}
+
+inline void copy8(uint32_t* dst, const uint8_t* src) { std::memcpy(dst, src, 8); }
+
+void gatherQuads(const Unorm8Run& run, int count, Scratch& s) {
+    const size_t stride = size_t(run.width) * 4;
+    const uint8_t* a0 = run.texels + size_t(s.y0[0]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* a1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* b0 = run.texels + size_t(s.y0[2]) * stride + size_t(s.x0[0]) * 4;
+    const uint8_t* b1 = run.texels + size_t(s.y1[2]) * stride + size_t(s.x0[0]) * 4;
+    for (int i = 0; i < count; i += 4) {
+        const size_t o = size_t(i / 2) * 4;  // column x0 + 2q
+        copy8(s.t00 + i, a0 + o), copy8(s.t00 + i + 2, b0 + o);
+        copy8(s.t10 + i, a0 + o + 4), copy8(s.t10 + i + 2, b0 + o + 4);
+        copy8(s.t01 + i, a1 + o), copy8(s.t01 + i + 2, b1 + o);
+        copy8(s.t11 + i, a1 + o + 4), copy8(s.t11 + i + 2, b1 + o + 4);
+    }
+}
+
+inline float byteOf(uint32_t w, int b) { return float(int32_t((w >> (8 * b)) & 255u)); }
+
+inline uint32_t word(const uint8_t* p, int i) {
+    uint32_t w;
+    std::memcpy(&w, p + 4 * i, 4);
+    return w;
+}
+
+// sum(w_k * byte_k) per channel, scaled and rounded once (see the top of this file). The taps are
+// b g r a words at t00..t11 (lane i at byte 4i): the gathered scratch arrays, or texel rows
+// read in place for a screen-aligned span.
+void blend(int count, const uint8_t* t00p, const uint8_t* t10p, const uint8_t* t01p, const uint8_t* t11p,
+           const int32_t* wxp, const int32_t* wyp, float outScale, int32_t* __restrict r, int32_t* __restrict g,
+           int32_t* __restrict b, int32_t* __restrict a) {
+    for (int i = 0; i < count; ++i) {
+        const float fx = float(wxp[i]), fy = float(wyp[i]);
+        const float w11 = fx * fy, w10 = fx * 256.0f - w11, w01 = fy * 256.0f - w11;
+        const float w00 = 65536.0f - fx * 256.0f - w01;
+        const uint32_t t00 = word(t00p, i), t10 = word(t10p, i), t01 = word(t01p, i), t11 = word(t11p, i);
+        auto ch = [&](int k) {
+            const float sum = w00 * byteOf(t00, k) + w10 * byteOf(t10, k) + w01 * byteOf(t01, k) + w11 * byteOf(t11, k);
+            return int32_t((sum * outScale + kFloatMagic) - kFloatMagic);
+        };
+        b[i] = ch(0), g[i] = ch(1), r[i] = ch(2), a[i] = ch(3);
+    }
+}
+
+// True when the span reads two texel rows in order: one row pair (no border) and column pairs
+// x0 + i, x0 + i + 1 (a screen-aligned pass at the texture's resolution, any fixed fraction).
+// Then the taps are read in place instead of gathered.
+bool rowContiguous(int count, const Scratch& s) {
+    const int32_t x0 = s.x0[0], y0 = s.y0[0], y1 = s.y1[0];
+    if ((x0 | y0 | y1) < 0) return false;
+    int bad = 0;
+    for (int i = 0; i < count; ++i)
+        bad |= (s.x0[i] - i - x0) | (s.x1[i] - i - 1 - x0) | (s.y0[i] - y0) | (s.y1[i] - y1);
+    return bad == 0;
+}
+
+void pointOut(int count, const Unorm8Run& run, const Scratch& s, int32_t* __restrict r, int32_t* __restrict g,
+              int32_t* __restrict b, int32_t* __restrict a) {
+    const uint8_t* base = run.texels;
+    const size_t stride = size_t(run.width) * 4;
+    uint32_t* words = const_cast<uint32_t*>(s.t00);
+    for (int i = 0; i < count; ++i) {
+        const int32_t x = s.x0[i], y = s.y0[i];
+        words[i] = (x | y) < 0 ? run.borderWord : load32(base + size_t(y) * stride + size_t(x) * 4);
+    }
+    const int32_t sc = run.scale;
+    for (int i = 0; i < count; ++i) {
+        const uint32_t w = words[i];
+        b[i] = int32_t(w & 255u) * sc, g[i] = int32_t((w >> 8) & 255u) * sc;
+        r[i] = int32_t((w >> 16) & 255u) * sc, a[i] = int32_t(w >> 24) * sc;
+    }
+}
+
+}  // namespace
+
+void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst) {
+    static thread_local Scratch s;
+    if (run.linear) {
+        axisPass<true>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+        axisPass<true>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+        const float outScale = run.scale == 1 ? 1.0f / 65536.0f : 1.0f / 4096.0f;
+        if (rowContiguous(count, s)) {
+            const size_t stride = size_t(run.width) * 4;
+            const uint8_t* r0 = run.texels + size_t(s.y0[0]) * stride + size_t(s.x0[0]) * 4;
+            const uint8_t* r1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
+            blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
+        } else {
+            if (quadContiguous(count, s))
+                gatherQuads(run, count, s);
+            else
+                gatherBilinear(run, count, s);
+            auto bytes = [](const uint32_t* p) { return reinterpret_cast<const uint8_t*>(p); };
+            blend(count, bytes(s.t00), bytes(s.t10), bytes(s.t01), bytes(s.t11), s.wx, s.wy, outScale, dst[0], dst[1],
+                  dst[2], dst[3]);
+        }
+    } else {
+        axisPass<false>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+        axisPass<false>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+        pointOut(count, run, s, dst[0], dst[1], dst[2], dst[3]);
+    }
+}
+
+}  // namespace ps11::fastpath
