@@ -83,9 +83,7 @@ void BM_store_fx8(benchmark::State& s) { run(s, base(Precision::Fx8), D3DFMT_A8R
 void BM_store_fx12(benchmark::State& s) { run(s, base(Precision::Fx12), D3DFMT_A8R8G8B8, D3DFMT_UNKNOWN); }
 void BM_store_float(benchmark::State& s) { run(s, base(Precision::Float), D3DFMT_A8R8G8B8, D3DFMT_UNKNOWN); }
 void BM_store_fx8_half(benchmark::State& s) { run(s, base(Precision::Fx8), D3DFMT_A16B16G16R16F, D3DFMT_UNKNOWN); }
-void BM_store_float_f32(benchmark::State& s) {
-    run(s, base(Precision::Float), D3DFMT_A32B32G32R32F, D3DFMT_UNKNOWN);
-}
+void BM_store_float_f32(benchmark::State& s) { run(s, base(Precision::Float), D3DFMT_A32B32G32R32F, D3DFMT_UNKNOWN); }
 void BM_add_fx8(benchmark::State& s) {
     run(s, blended(Precision::Fx8, D3DBLEND_ONE, D3DBLEND_ONE), D3DFMT_A8R8G8B8, D3DFMT_UNKNOWN);
 }

@@ -12,6 +12,11 @@
 
 #include "ps11/sampler.h"
 
+#if defined(__x86_64__)
+#include <cpuid.h>
+#include <immintrin.h>
+#endif
+
 namespace emu {
 
 namespace {
@@ -78,7 +83,8 @@ inline uint16_t halfOf(float f) {
     }
     uint32_t h = (x - 0x38000000u) >> 13;  // rebias 127 -> 15, keep 10 mantissa bits
     const uint32_t rest = x & 0x1fffu;
-    if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;  // a carry into the exponent is right
+    // Round up above half, or at half when odd (a carry into the exponent is right).
+    h += uint32_t(rest + (h & 1u) > 0x1000u);
     return uint16_t(sign | h);
 }
 inline float floatOfHalf(uint16_t h) {
@@ -791,11 +797,24 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     }
 }
 
-// Float targets without fog, tests or blending: convert and store the live lanes' channels.
-void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
-    const Surf cs = p.colorSurf;
-    const Lanes lanes(in, p);
-    const uint32_t channels = p.channels;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// A16B16G16R16F stores with the F16C conversion (VCVTPS2PH, round to nearest even: the same
+// halves as halfOf for every non-NaN value; a NaN stays a NaN), chosen at run time.
+// CPUID: F16C, AVX and OSXSAVE, and XCR0 saying the OS keeps the AVX state (VCVTPS2PH is
+// VEX-encoded). cpuid.h rather than __builtin_cpu_supports, which clang 14 lacks "f16c" for.
+bool hasF16c() {
+    static const bool ok = [] {
+        unsigned a = 0, b = 0, c = 0, d = 0;
+        if (!__get_cpuid(1, &a, &b, &c, &d)) return false;
+        if (((c >> 27) & 7u) != 7u) return false;  // OSXSAVE (27), AVX (28), F16C (29)
+        uint32_t lo = 0, hi = 0;
+        __asm__("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
+        return (lo & 6u) == 6u;  // SSE and AVX state enabled
+    }();
+    return ok;
+}
+__attribute__((target("f16c"))) uint64_t storeHalfF16c(const Surf& cs, const Lanes& lanes, const MergeInputs& in,
+                                                       const float* const f[4], uint32_t channels) {
     const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
     const uint8_t* live = in.live;
     uint64_t written = 0;
@@ -804,7 +823,41 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
         if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
         uint8_t* q = cs.at(x, y);
         ++written;
-        if (p.target == TargetKind::Rgba16F) {
+        const __m128i h = _mm_cvtps_ph(_mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), _MM_FROUND_TO_NEAREST_INT);
+        uint16_t v[8];
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(v), h);
+        if (channels == 0xfu) {
+            std::memcpy(q, v, 8);
+        } else {
+            for (int c = 0; c < 4; ++c)
+                if (channels >> c & 1u) std::memcpy(q + 2 * c, &v[c], 2);
+        }
+    }
+    return written;
+}
+#endif
+
+// Float targets without fog, tests or blending: convert and store the live lanes' channels.
+void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
+    const Surf cs = p.colorSurf;
+    const Lanes lanes(in, p);
+    const uint32_t channels = p.channels;
+    const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
+    const uint8_t* live = in.live;
+    const bool half = p.target == TargetKind::Rgba16F;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    if (half && hasF16c()) {
+        n.written += storeHalfF16c(cs, lanes, in, f, channels);
+        return;
+    }
+#endif
+    uint64_t written = 0;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        uint8_t* q = cs.at(x, y);
+        ++written;
+        if (half) {
             const uint16_t h[4] = {halfOf(f0[i]), halfOf(f1[i]), halfOf(f2[i]), halfOf(f3[i])};
             if (channels == 0xfu) {
                 std::memcpy(q, h, 8);

@@ -51,8 +51,8 @@ struct MergeInputs {
     // null otherwise. The merger uses grid when given.
     const float* color[4] = {};
     const int32_t* grid[4] = {};
-    const float* fog = nullptr;  // fog factor per lane (1 = no fog), used when MergeState::fog
-    const float* z = nullptr;    // depth per lane in [0, 1], used when depthTest
+    const float* fog = nullptr;  // fog factor per lane (1 = no fog; clamped to [0, 1]; null = 1), when MergeState::fog
+    const float* z = nullptr;    // depth per lane (clamped to [0, 1]; null = 0), used when depthTest
 };
 
 struct MergeTarget {
@@ -60,8 +60,9 @@ struct MergeTarget {
     Image* depth = nullptr;  // a depth format, or null
 };
 
+// Counts of live pixels; written + alphaRejected + depthRejected = the live lanes.
 struct MergeStats {
-    uint64_t written = 0;        // pixels that reached the colour or depth store
+    uint64_t written = 0;        // pixels that passed every test and reached the store (whatever the mask)
     uint64_t alphaRejected = 0;  // failed the alpha test
     uint64_t depthRejected = 0;  // failed the depth test
 };
