@@ -64,7 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;
             error.clear();
             if (const auto* probe = std::get_if<ps11::Probe>(&cmd.op)) {
-                if (probe->kind == ps11::ProbeKind::Eval || probe->kind == ps11::ProbeKind::EvalKilled) continue;
+                if (ps11::isEvalProbe(probe->kind)) continue;
                 (void)runner->probe(*probe, error);
             } else if (!runner->draw(cmd, error)) {
                 check(!error.empty());

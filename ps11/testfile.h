@@ -294,7 +294,9 @@ struct Eval {
     std::array<Setting<Vec4>, 8> texture;  // t0 ... (missing ones are 0)
 };
 
-enum class ProbeKind : uint8_t { Pixel, Rect, All, Eval, EvalKilled };
+enum class ProbeKind : uint8_t { Pixel, Rect, All, Eval, EvalKilled, EvalDepth };
+// True for the probes that look at the last eval (not at the render target).
+constexpr bool isEvalProbe(ProbeKind k) { return k == ProbeKind::Eval || k == ProbeKind::EvalKilled || k == ProbeKind::EvalDepth; }
 
 struct Probe {
     ProbeKind kind = ProbeKind::Pixel;
@@ -302,6 +304,7 @@ struct Probe {
     bool alpha = true;               // rgba (true) or rgb
     Color expected;
     float tolerance = 0;  // 8-bit levels on 8-bit targets, absolute otherwise
+    float depth = 0;      // EvalDepth: the expected depth the shader wrote
 };
 
 struct TestCommand {

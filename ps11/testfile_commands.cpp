@@ -263,6 +263,17 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
             cmd.op = p;
             return true;
         }
+        if (a.peekIs("depth")) {  // probe eval depth Z [tol T]: the depth texdepth/texm3x2depth wrote
+            a.next();
+            p.kind = ProbeKind::EvalDepth;
+            std::optional<float> z = a.floatValue("expected depth");
+            if (!z) return false;
+            p.depth = *z;
+            if (!probeTolerance(a, p)) return false;
+            a.end();
+            cmd.op = p;
+            return true;
+        }
     } else if (a.peekIs("all")) {
         a.next();
         p.kind = ProbeKind::All;
@@ -301,18 +312,22 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
     std::optional<Color> c = a.color("expected colour", p.alpha ? 4 : 3);
     if (!c) return false;
     p.expected = *c;
-    if (a.peekIs("tol")) {
-        a.next();
-        std::optional<float> t = a.floatValue("tolerance");
-        if (!t) return false;
-        if (*t < 0) {
-            a.error("tolerance must be >= 0");
-            return false;
-        }
-        p.tolerance = *t;
-    }
+    if (!probeTolerance(a, p)) return false;
     a.end();
     cmd.op = p;
+    return true;
+}
+
+bool Parser::probeTolerance(Args& a, Probe& p) {
+    if (!a.peekIs("tol")) return true;
+    a.next();
+    std::optional<float> t = a.floatValue("tolerance");
+    if (!t) return false;
+    if (*t < 0) {
+        a.error("tolerance must be >= 0");
+        return false;
+    }
+    p.tolerance = *t;
     return true;
 }
 
@@ -350,7 +365,7 @@ void Parser::finish() {
                 if (p->rect[2] > w || p->rect[3] > h)
                     error(cmd.line, "probe reaches outside the " + std::to_string(w) + "x" + std::to_string(h) +
                                         " render target");
-            } else if ((p->kind == ProbeKind::Eval || p->kind == ProbeKind::EvalKilled) && !sawEval) {
+            } else if (isEvalProbe(p->kind) && !sawEval) {
                 error(cmd.line, "probe eval without an eval before it");
             }
         }

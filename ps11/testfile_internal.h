@@ -350,6 +350,7 @@ private:
     void vertexLine(Args& a, DrawPrimitives& draw);
     void evalLine(Args& a, Eval& eval);
     bool probeCommand(Args& a, TestCommand& cmd);
+    bool probeTolerance(Args& a, Probe& p);
     void closePending();
     void finish();
 

@@ -785,6 +785,20 @@ TEST_CASE("testfile: eval and probes", "[testfile]") {
     CHECK_ERROR(withShader("probe 1.5 0 rgba 0\n"), 5, "probe x must be an integer");
     CHECK_ERROR(withShader("probe -1 0 rgba 0\n"), 5, "probe x '-1' is out of range");
     CHECK_ERROR(withShader("explode\n"), 5, "unknown command 'explode' in [test]");
+
+    Parsed depth = withShader("eval\nt0 1\nprobe eval depth 0.25 tol 1e-6\nprobe eval depth 1\n");
+    REQUIRE_OK(depth);
+    const Probe& d0 = op<Probe>(depth.file, 1);
+    CHECK(d0.kind == ProbeKind::EvalDepth);
+    CHECK(d0.depth == 0.25f);
+    CHECK(d0.tolerance == 1e-6f);
+    CHECK(op<Probe>(depth.file, 2).tolerance == 0.0f);
+    CHECK(isEvalProbe(ProbeKind::EvalDepth));
+    CHECK(!isEvalProbe(ProbeKind::All));
+    CHECK_ERROR(withShader("probe eval depth 0.5\n"), 5, "probe eval without an eval before it");
+    CHECK_ERROR(withShader("eval\nprobe eval depth\n"), 6, "missing expected depth");
+    CHECK_ERROR(withShader("eval\nprobe eval depth 0.5 tol\n"), 6, "missing tolerance");
+    CHECK_ERROR(withShader("eval\nprobe eval depth 0.5 0.5\n"), 6, "unexpected '0.5'");
 }
 
 TEST_CASE("testfile: if() and todo() prefixes", "[testfile]") {

@@ -47,6 +47,13 @@ std::string describeOutcome(const EvalOutcome& o, int n, Precision p) {
 
 // Checks one eval probe against the last eval; returns the failure text ("" = passed).
 std::string checkProbe(const Probe& probe, const EvalOutcome& got, Precision p) {
+    if (probe.kind == ProbeKind::EvalDepth) {
+        if (got.killed) return "expected depth " + num(probe.depth) + ", got a killed pixel";
+        if (!got.hasDepth) return "expected depth " + num(probe.depth) + ", but the shader does not write depth";
+        const double diff = std::fabs(double(got.depth) - double(probe.depth));
+        if (diff <= double(probe.tolerance)) return "";
+        return "expected depth " + num(probe.depth) + " tol " + num(probe.tolerance) + ", got " + num(got.depth);
+    }
     if (probe.kind == ProbeKind::EvalKilled) {
         if (got.killed) return "";
         return "expected killed, got " + describeOutcome(got, 4, p) + " (not killed)";
@@ -65,7 +72,7 @@ std::string checkProbe(const Probe& probe, const EvalOutcome& got, Precision p) 
 bool isDeviceCommand(const TestCommand& cmd) {
     if (std::holds_alternative<DrawQuad>(cmd.op) || std::holds_alternative<DrawPrimitives>(cmd.op)) return true;
     if (const Probe* probe = std::get_if<Probe>(&cmd.op))
-        return probe->kind != ProbeKind::Eval && probe->kind != ProbeKind::EvalKilled;
+        return !isEvalProbe(probe->kind);
     return false;
 }
 
