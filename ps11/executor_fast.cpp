@@ -63,6 +63,28 @@ bool textureWritesDst(const DOp& op) {
     }
 }
 
+// Texture ops that write all four components of their destination for every lane, so the
+// int32 copy of the destination need not be brought up to date first.
+bool textureWritesAll(const DOp& op, int minor) {
+    switch (op.op) {
+        case Opcode::TexCoord: return minor < 4;  // 1_4 texcrd writes its mask only
+        case Opcode::Tex:
+        case Opcode::TexBem:
+        case Opcode::TexBemL:
+        case Opcode::TexReg2AR:
+        case Opcode::TexReg2GB:
+        case Opcode::TexReg2RGB:
+        case Opcode::TexM3x2Tex:
+        case Opcode::TexM3x3Tex:
+        case Opcode::TexM3x3:
+        case Opcode::TexM3x3Spec:
+        case Opcode::TexM3x3VSpec:
+        case Opcode::TexDp3Tex:
+        case Opcode::TexDp3: return true;
+        default: return false;
+    }
+}
+
 struct FastRunState {
     RunState st;
     FastBank bank;
@@ -71,15 +93,13 @@ struct FastRunState {
 void toInt32(const int16_t* s, int32_t* d, int n) {
     for (int i = 0; i < n; ++i) d[i] = s[i];
 }
-void toInt16(const int32_t* s, int16_t* d, int n) {
-    for (int i = 0; i < n; ++i) d[i] = int16_t(s[i]);  // in ±round(M·G): the texture stage clamps
-}
 
 void syncTo32(FastRunState& fs, int slot) {
     for (int c = 0; c < 4; ++c) toInt32(fs.bank.reg[slot][c], fs.st.bi.reg[slot][c], fs.st.n);
 }
-void syncTo16(FastRunState& fs, int slot) {
-    for (int c = 0; c < 4; ++c) toInt16(fs.st.bi.reg[slot][c], fs.bank.reg[slot][c], fs.st.n);
+// Texture results to int16, clamped to ±round(M·G) (tex/texld defer that clamp to here).
+void syncTo16(FastRunState& fs, int slot, const FastKernels& k, int32_t nMax) {
+    for (int c = 0; c < 4; ++c) k.narrow(fs.st.bi.reg[slot][c], fs.bank.reg[slot][c], fs.st.n, int16_t(nMax));
 }
 
 }  // namespace
@@ -88,8 +108,10 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
     fp = FastProgram{};
     if (!kernels || p.precision != Precision::Fx8 || p.g != 255 || p.nMax > kFastMaxGrid || p.nMax < 1) return false;
     fp.ops.resize(ops.size());
+    fp.syncDstBefore.assign(ops.size(), 0);
     for (size_t i = 0; i < ops.size(); ++i) {
         const DOp& d = ops[i];
+        if (d.texture) fp.syncDstBefore[i] = !textureWritesAll(d, p.minor);
         if (d.texture || d.op == Opcode::Phase) continue;
         FastOp& f = fp.ops[i];
         if (!fastKind(d.op, f.kind)) return false;
@@ -112,6 +134,7 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
             const DSrc& ds = d.src[size_t(s)];
             if (ds.kind == SrcKind::TexCoord) return false;
             fs.slot = uint8_t(ds.kind == SrcKind::Const ? kFastConstSlot + (ds.slot & 7) : ds.slot);
+            if (ds.kind == SrcKind::Const) fp.constsUsed = uint8_t(fp.constsUsed | (1u << (ds.slot & 7)));
             fs.sw = ds.sw;
             if (!fastAffine(ds.mod, fs.a, fs.b)) return false;
         }
@@ -140,13 +163,15 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
     st.in = &inputs;
     st.sampler = &sampler;
     std::memset(st.zeros, 0, sizeof st.zeros);
-    // Every lane of the int16 bank holds a valid grid value from the start (lanes past a chunk's
-    // count are computed too, up to the next multiple of 16, and never stored).
-    std::memset(bank.reg, 0, sizeof bank.reg);
+    // r0 is the output: zero it as the generic path does. Lanes past a chunk's count (up to the
+    // next multiple of 16) are computed too and never stored; the kernels use only wrapping
+    // SIMD arithmetic, so whatever those lanes hold is harmless.
+    std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
     for (int i = 0; i < 8; ++i)
-        for (int c = 0; c < 4; ++c) std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
-    const FastArithFn arith = fp.kernels->arith;
-    const float g = float(p.g);
+        if ((fp.constsUsed >> i) & 1)
+            for (int c = 0; c < 4; ++c)
+                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    const FastKernels& kern = *fp.kernels;
     for (int off = 0; off < count; off += kChunk) {
         st.offset = off;
         st.n = std::min(kChunk, count - off);
@@ -159,11 +184,7 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c) {
                 const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : st.zeros;
-                int16_t* d = bank.reg[kSlotV + v][c];
-                for (int i = 0; i < n; ++i) {
-                    float s = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;  // NaN -> 0
-                    d[i] = int16_t(std::nearbyint(double(s) * double(g)));
-                }
+                kern.loadColor(src, bank.reg[kSlotV + v][c], n);
             }
         }
         for (size_t idx = 0; idx < ops.size(); ++idx) {
@@ -172,12 +193,14 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
             if (op.texture) {
                 for (int s = 0; s < op.numSrc; ++s)
                     if (op.src[size_t(s)].kind == SrcKind::Reg) syncTo32(*fs, op.src[size_t(s)].slot);
-                syncTo32(*fs, op.dstSlot);  // texdepth reads it; partial writers (texcrd) keep the rest
+                if (fp.syncDstBefore[idx]) syncTo32(*fs, op.dstSlot);  // texdepth reads it; texcrd keeps the rest
+                st.deferTexelClamp = op.op == Opcode::Tex;
                 execTexture(p, op, st);
-                if (textureWritesDst(op)) syncTo16(*fs, op.dstSlot);
+                st.deferTexelClamp = false;
+                if (textureWritesDst(op)) syncTo16(*fs, op.dstSlot, kern, p.nMax);
             } else {
                 const FastOp& f = fp.ops[idx];
-                arith(f, bank, nv);
+                kern.arith(f, bank, nv);
                 if (f.viaTemp)
                     for (int c = 0; c < 4; ++c)
                         if ((f.mask >> c) & 1) std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
@@ -190,17 +213,9 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
                         std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
             }
         }
-        for (int c = 0; c < 4; ++c) {
-            const int16_t* r = bank.reg[kSlotR][c];
-            if (outputs.color[c]) {
-                float* o = outputs.color[c] + off;
-                for (int i = 0; i < n; ++i) o[i] = float(r[i]) / g;
-            }
-            if (outputs.grid[c]) {
-                int32_t* o = outputs.grid[c] + off;
-                for (int i = 0; i < n; ++i) o[i] = r[i];
-            }
-        }
+        for (int c = 0; c < 4; ++c)
+            kern.store(bank.reg[kSlotR][c], outputs.color[c] ? outputs.color[c] + off : nullptr,
+                       outputs.grid[c] ? outputs.grid[c] + off : nullptr, n);
         if (outputs.killed) std::memcpy(outputs.killed + off, st.killed, size_t(n));
         if (outputs.depth && writesDepth && st.depthWritten)
             std::memcpy(outputs.depth + off, st.depth, sizeof(float) * size_t(n));

@@ -59,9 +59,19 @@ using FastArithFn = void (*)(const FastOp& op, FastBank& bank, int nv);
 using FastRoundProductFn = void (*)(const int32_t* p, int16_t* out, int count, int shift, int16_t lo, int16_t hi);
 using FastRoundLinearFn = void (*)(const int16_t* k, int16_t* out, int count, int shift, int16_t lo, int16_t hi);
 
+// v# input: saturate to [0, 1] (NaN -> 0) and round_half_even(s·255) computed in double, n lanes.
+using FastLoadColorFn = void (*)(const float* src, int16_t* dst, int n);
+// int32 register lanes (texture stage results) to int16, clamped to [-m, m].
+using FastNarrowFn = void (*)(const int32_t* src, int16_t* dst, int n, int16_t m);
+// r0 output: color = float(n) / 255 (correctly rounded division), grid = n; either may be null.
+using FastStoreFn = void (*)(const int16_t* r, float* color, int32_t* grid, int n);
+
 struct FastKernels {
     const char* name;  // "avx2" or "sse2"
     FastArithFn arith;
+    FastLoadColorFn loadColor;
+    FastStoreFn store;
+    FastNarrowFn narrow;
     FastRoundProductFn roundProduct;
     FastRoundLinearFn roundLinear;
 };
@@ -88,6 +98,8 @@ namespace ps11::exec {
 struct FastProgram {
     const FastKernels* kernels = nullptr;
     std::vector<FastOp> ops;
+    uint8_t constsUsed = 0;  // constants the arithmetic ops read (bit per c#)
+    std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
 };
 
 // Fills fp for ops if the fast path applies (fx8, round(M·G) <= kFastMaxGrid, no bem) and
