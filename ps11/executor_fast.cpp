@@ -138,6 +138,10 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
             fs.sw = ds.sw;
             if (!fastAffine(ds.mod, fs.a, fs.b)) return false;
         }
+        // Sources with even a and b (every modifier but _bias) let products run on k/2.
+        f.half = true;
+        for (int s = 0; s < f.numSrc; ++s)
+            if ((f.src[size_t(s)].a & 1) || (f.src[size_t(s)].b & 1)) f.half = false;
         // Component c of the destination is written before component c' > c is read: a source
         // that is the destination itself and reads other components must see the old values.
         if (!f.hold && f.kind != FastKind::Dp3 && f.kind != FastKind::Dp4) {

@@ -36,6 +36,7 @@ struct FastOp {
     FastKind kind = FastKind::Mov;
     bool hold = false;  // write into the hold buffer (first member of a co-issued pair)
     bool viaTemp = false;  // write into tmp, then copy (the destination is also a swizzled source)
+    bool half = false;     // products: every source k is even, formed halved (see the kernels)
     uint8_t dst = 0;
     uint8_t mask = kMaskAll;
     int8_t shift = 0;
@@ -54,9 +55,10 @@ struct FastBank {
 using FastArithFn = void (*)(const FastOp& op, FastBank& bank, int nv);
 
 // Test hooks: the rounding steps of the kernels on their own, count lanes (a multiple of 16).
-// Products: n = round_half_even(P·2^s / (4G)), clamped to [lo, hi]. Linear: n =
-// round_half_even(K·2^s / 2), clamped.
-using FastRoundProductFn = void (*)(const int32_t* p, int16_t* out, int count, int shift, int16_t lo, int16_t hi);
+// Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
+// [lo, hi]. Linear: n = round_half_even(K·2^s / 2), clamped.
+using FastRoundProductFn = void (*)(const int32_t* p, int16_t* out, int count, int shift, bool half, int16_t lo,
+                                    int16_t hi);
 using FastRoundLinearFn = void (*)(const int16_t* k, int16_t* out, int count, int shift, int16_t lo, int16_t hi);
 
 // v# input: saturate to [0, 1] (NaN -> 0) and round_half_even(s·255) computed in double, n lanes.

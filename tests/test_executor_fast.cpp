@@ -49,17 +49,19 @@ struct Bounds {
 const Bounds kBounds[] = {{0, 255}, {-255, 255}, {-2040, 2040}, {-1020, 1020}};
 
 // Checks roundProduct over p[0..n) (n a multiple of 16) against the exact definition.
-int64_t checkProducts(const ps11::exec::FastKernels& k, const std::vector<int32_t>& p, int shift, Bounds b) {
+int64_t checkProducts(const ps11::exec::FastKernels& k, const std::vector<int32_t>& p, int shift, bool half, Bounds b) {
     std::vector<int16_t> out(p.size());
-    k.roundProduct(p.data(), out.data(), int(p.size()), shift, b.lo, b.hi);
+    k.roundProduct(p.data(), out.data(), int(p.size()), shift, half, b.lo, b.hi);
     int64_t bad = 0;
+    const int64_t den0 = half ? 255 : 1020;
     for (size_t i = 0; i < p.size(); ++i) {
-        // n = round_half_even(P·2^s / (4G)), G = 255, then clamped.
+        // n = round_half_even(P·2^s / (4G)), G = 255 (half: P'·2^s / G), then clamped.
         const int64_t num = shift > 0 ? int64_t(p[i]) << shift : int64_t(p[i]);
-        const int64_t den = shift < 0 ? int64_t(1020) << -shift : 1020;
+        const int64_t den = shift < 0 ? den0 << -shift : den0;
         const int64_t want = std::clamp<int64_t>(rhe(num, den), b.lo, b.hi);
         if (out[i] != want && bad++ < 5)
-            FAIL_CHECK(k.name << " product P=" << p[i] << " shift " << shift << ": " << out[i] << " want " << want);
+            FAIL_CHECK(k.name << (half ? " half" : "") << " product P=" << p[i] << " shift " << shift << ": " << out[i]
+                              << " want " << want);
     }
     return bad;
 }
@@ -67,36 +69,42 @@ int64_t checkProducts(const ps11::exec::FastKernels& k, const std::vector<int32_
 }  // namespace
 
 TEST_CASE("fast: product rounding is exact over every non-saturating numerator", "[fast]") {
-    // Largest |P| the fast path forms: dp4 of four k·k with |k| <= 4·2040 + 510.
-    const int64_t kMaxP = 4 * int64_t(8670) * 8670;
     for (const auto* k : kernelSets()) {
-        for (int shift = -3; shift <= 3; ++shift) {
-            // Every P whose result is within ±2043 (beyond it every bound saturates), in blocks.
-            const int64_t den = shift < 0 ? int64_t(1020) << -shift : 1020;
-            const int64_t lim = (2043 * den) >> std::max(shift, 0);
-            std::vector<int32_t> p;
-            int64_t bad = 0, checked = 0;
-            for (const Bounds& b : {kBounds[2], kBounds[0]}) {
-                for (int64_t v = -lim; v <= lim;) {
-                    p.clear();
-                    for (; v <= lim && p.size() < (1u << 20); ++v) p.push_back(int32_t(v));
-                    while (p.size() % 16) p.push_back(0);
-                    bad += checkProducts(*k, p, shift, b);
-                    checked += int64_t(p.size());
+        for (bool half : {false, true}) {
+            // Largest |P| the fast path forms: dp4 of four k·k with |k| <= 4·2040 + 510 (half: k/2).
+            const int64_t kMax = half ? 4335 : 8670;
+            const int64_t kMaxP = 4 * kMax * kMax;
+            for (int shift = -3; shift <= 3; ++shift) {
+                // Every P whose result is within ±2043 (beyond it every bound saturates), in blocks.
+                const int64_t den0 = half ? 255 : 1020;
+                const int64_t den = shift < 0 ? den0 << -shift : den0;
+                const int64_t lim = (2043 * den) >> std::max(shift, 0);
+                std::vector<int32_t> p;
+                int64_t bad = 0, checked = 0;
+                for (const Bounds& b : {kBounds[2], kBounds[0]}) {
+                    for (int64_t v = -lim; v <= lim;) {
+                        p.clear();
+                        for (; v <= lim && p.size() < (1u << 20); ++v) p.push_back(int32_t(v));
+                        while (p.size() % 16) p.push_back(0);
+                        bad += checkProducts(*k, p, shift, half, b);
+                        checked += int64_t(p.size());
+                    }
                 }
+                // Beyond: a dense stride and random numerators up to the largest |P|, all bounds.
+                p.clear();
+                std::mt19937 rng(uint32_t(77 + shift));
+                for (int64_t v = -kMaxP; v <= kMaxP; v += 9973) p.push_back(int32_t(v));
+                for (int i = 0; i < 200000; ++i)
+                    p.push_back(int32_t(std::uniform_int_distribution<int64_t>(-kMaxP, kMaxP)(rng)));
+                p.push_back(int32_t(kMaxP));
+                p.push_back(int32_t(-kMaxP));
+                while (p.size() % 16) p.push_back(int32_t(kMaxP));
+                for (const Bounds& b : kBounds) bad += checkProducts(*k, p, shift, half, b);
+                INFO(k->name << (half ? " half" : "") << " shift " << shift << ": " << checked
+                             << " numerators exhaustively");
+                CHECK(bad == 0);
+                CHECK(checked >= 2 * lim);
             }
-            // Beyond: a dense stride and random numerators up to the largest |P|, all bounds.
-            p.clear();
-            std::mt19937 rng(uint32_t(77 + shift));
-            for (int64_t v = -kMaxP; v <= kMaxP; v += 9973) p.push_back(int32_t(v));
-            for (int i = 0; i < 200000; ++i) p.push_back(int32_t(std::uniform_int_distribution<int64_t>(-kMaxP, kMaxP)(rng)));
-            p.push_back(int32_t(kMaxP));
-            p.push_back(int32_t(-kMaxP));
-            while (p.size() % 16) p.push_back(int32_t(kMaxP));
-            for (const Bounds& b : kBounds) bad += checkProducts(*k, p, shift, b);
-            INFO(k->name << " shift " << shift << ": " << checked << " numerators exhaustively");
-            CHECK(bad == 0);
-            CHECK(checked >= 2 * lim);
         }
     }
 }
@@ -131,17 +139,29 @@ TEST_CASE("fast: hand-computed ties and known values", "[fast]") {
         // mul 255·1 _d2 (k = 510, 2): P = 1020, 1020/2040 = ½ → 0 (even); 3·255·1 → 1.5 → 2.
         alignas(32) int32_t p[16] = {1020, 3060, 5100, -1020, -3060, 512, 508, 510, 1530, 0, 0, 0, 0, 0, 0, 0};
         alignas(32) int16_t out[16];
-        k->roundProduct(p, out, 16, -1, -255, 255);
+        k->roundProduct(p, out, 16, -1, false, -255, 255);
         CHECK(out[0] == 0);
         CHECK(out[1] == 2);
         CHECK(out[2] == 2);   // 2.5 → 2
         CHECK(out[3] == 0);   // −0.5 → 0
         CHECK(out[4] == -2);  // −1.5 → −2
-        k->roundProduct(p, out, 16, 0, -255, 255);
+        k->roundProduct(p, out, 16, 0, false, -255, 255);
         CHECK(out[5] == 1);  // 512/1020 > ½
         CHECK(out[6] == 0);  // 508/1020 < ½
         CHECK(out[7] == 0);  // 510/1020 = ½ → 0
         CHECK(out[8] == 2);  // 1530/1020 = 1.5 → 2
+        // half: P'/255 — 127/255 < ½, 128/255 > ½; _d2: 255/510 = ½ → 0, 765/510 = 1.5 → 2.
+        alignas(32) int32_t ph[16] = {127, 128, -127, -128, 255, 765, 1275, -255, 0, 0, 0, 0, 0, 0, 0, 0};
+        k->roundProduct(ph, out, 16, 0, true, -255, 255);
+        CHECK(out[0] == 0);
+        CHECK(out[1] == 1);
+        CHECK(out[2] == 0);
+        CHECK(out[3] == -1);
+        k->roundProduct(ph, out, 16, -1, true, -255, 255);
+        CHECK(out[4] == 0);
+        CHECK(out[5] == 2);
+        CHECK(out[6] == 2);  // 2.5 → 2
+        CHECK(out[7] == 0);  // −0.5 → 0
         alignas(32) int16_t kk[16] = {3, 5, -1, -3, 1, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
         k->roundLinear(kk, out, 16, 0, -255, 255);  // K/2
         CHECK(out[0] == 2);
