@@ -22,7 +22,9 @@ namespace ps11::exec::avx2 {
 namespace ps11::exec {
 const FastKernels* fastKernelsAvx2() {
 #ifdef PS11_HAVE_AVX2_KERNELS
-    static const bool ok = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    // __builtin_cpu_supports also checks that the OS saves the AVX state; cpu_init makes the
+    // check valid even if an executor is created during static initialisation.
+    static const bool ok = (__builtin_cpu_init(), __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
     return ok ? &avx2::kKernels : nullptr;
 #else
     return nullptr;
