@@ -232,16 +232,20 @@ double timeRows(const Executor& executor, Sampler& sampler, const SpanInputs& sp
 
 // One benchmark per program × profile × sampler. Each iteration runs the 16 rows with the default
 // path (Auto: the fast path where it applies) and, where the fast path applies, the same rows with
-// the generic path, alternating the order (A B, B A, …) so drift of the shared VM hits both alike.
+// the generic path and with the fast path's SSE2 kernels, alternating the order (A B C, C B A, …)
+// so drift of the shared VM hits all alike.
 // Thread CPU time, like the CPU column: on a shared VM wall time also counts other tenants.
 void runProgram(benchmark::State& state, const BenchProgram& prog, Precision precision, bool textured) {
     std::unique_ptr<Executor> fast = makeExecutor(prog.text, precision, ExecPath::Auto);
     std::unique_ptr<Executor> generic = makeExecutor(prog.text, precision, ExecPath::Generic);
-    if (!fast || !generic) {
+    std::unique_ptr<Executor> sse2 = makeExecutor(prog.text, precision, ExecPath::FastBaseline);
+    if (!fast || !generic || !sse2) {
         state.SkipWithError("cannot prepare the program");
         return;
     }
     const bool compare = std::string(fast->pathName()) != "generic";
+    // The SSE2 kernels too, when the default path runs the AVX2 ones.
+    const bool compareSse2 = compare && std::string(fast->pathName()) != sse2->pathName();
     std::unique_ptr<Sampler> sampler = makeSampler(textured);
     static const SpanInputs spans;
     SpanOutputs out(precision);
@@ -251,11 +255,13 @@ void runProgram(benchmark::State& state, const BenchProgram& prog, Precision pre
     fast->run(spans.inputs[0], *sampler, out.outputs, &stats);
     const double perPixel = stats.pixels ? double(stats.instructions) / double(stats.pixels) : 0.0;
 
-    double tFast = 0, tGeneric = 0;
+    double tFast = 0, tGeneric = 0, tSse2 = 0;
     bool fastFirst = true;
     for (auto _ : state) {
         if (compare && !fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
+        if (compareSse2 && !fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
         tFast += timeRows(*fast, *sampler, spans, out);
+        if (compareSse2 && fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
         if (compare && fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
         fastFirst = !fastFirst;
     }
@@ -268,6 +274,7 @@ void runProgram(benchmark::State& state, const BenchProgram& prog, Precision pre
         if (perPixel > 0) state.counters["generic_ns/pixel/instr"] = tGeneric / (pixels * perPixel);
         state.counters["speedup"] = tFast > 0 ? tGeneric / tFast : 0.0;
     }
+    if (compareSse2) state.counters["sse2_ns/pixel"] = tSse2 / pixels;
     state.SetItemsProcessed(int64_t(pixels));
     state.SetLabel(fast->pathName());
 }

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <memory>
@@ -462,6 +463,10 @@ TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem
         for (int t = 0; t < 8; ++t)
             for (int c = 0; c < 4; ++c) l.tc[t][c][size_t(i)] = c == 3 ? 1.0f : u(rng);
     }
+    // Colours the device should never send but the executor must treat alike: NaN, ±inf, −0.
+    const float odd[] = {std::nanf(""), INFINITY, -INFINITY, -0.0f, 0.5f / 255.0f, 1.5f / 255.0f, 254.5f / 255.0f};
+    for (int i = 0; i < count; i += 3)
+        for (int v = 0; v < 2; ++v) l.col[v][(i / 3) % 4][size_t(i)] = odd[size_t((i / 3 + v) % 7)];
     std::array<std::array<float, 4>, 8> consts;
     for (auto& c : consts)
         for (float& f : c) f = u(rng) * 1.6f - 0.8f;
