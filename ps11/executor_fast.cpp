@@ -15,32 +15,72 @@ namespace {
 // Source modifier as k = a·n + b for G = 255 (docs/precision.md table; as executor_arith.cpp).
 bool fastAffine(SrcMod m, int16_t& a, int16_t& b) {
     switch (m) {
-        case SrcMod::None: a = 2, b = 0; return true;
-        case SrcMod::Neg: a = -2, b = 0; return true;
-        case SrcMod::Bias: a = 2, b = -255; return true;
-        case SrcMod::BiasNeg: a = -2, b = 255; return true;
-        case SrcMod::Sign: a = 4, b = -510; return true;
-        case SrcMod::SignNeg: a = -4, b = 510; return true;
-        case SrcMod::Comp: a = -2, b = 510; return true;
-        case SrcMod::X2: a = 4, b = 0; return true;
-        case SrcMod::X2Neg: a = -4, b = 0; return true;
-        default: return false;
+        case SrcMod::None:
+            a = 2, b = 0;
+            return true;
+        case SrcMod::Neg:
+            a = -2, b = 0;
+            return true;
+        case SrcMod::Bias:
+            a = 2, b = -255;
+            return true;
+        case SrcMod::BiasNeg:
+            a = -2, b = 255;
+            return true;
+        case SrcMod::Sign:
+            a = 4, b = -510;
+            return true;
+        case SrcMod::SignNeg:
+            a = -4, b = 510;
+            return true;
+        case SrcMod::Comp:
+            a = -2, b = 510;
+            return true;
+        case SrcMod::X2:
+            a = 4, b = 0;
+            return true;
+        case SrcMod::X2Neg:
+            a = -4, b = 0;
+            return true;
+        default:
+            return false;
     }
 }
 
 bool fastKind(Opcode op, FastKind& k) {
     switch (op) {
-        case Opcode::Mov: k = FastKind::Mov; return true;
-        case Opcode::Add: k = FastKind::Add; return true;
-        case Opcode::Sub: k = FastKind::Sub; return true;
-        case Opcode::Mul: k = FastKind::Mul; return true;
-        case Opcode::Mad: k = FastKind::Mad; return true;
-        case Opcode::Dp3: k = FastKind::Dp3; return true;
-        case Opcode::Dp4: k = FastKind::Dp4; return true;
-        case Opcode::Lrp: k = FastKind::Lrp; return true;
-        case Opcode::Cnd: k = FastKind::Cnd; return true;
-        case Opcode::Cmp: k = FastKind::Cmp; return true;
-        default: return false;  // bem (and anything new) stays on the generic path
+        case Opcode::Mov:
+            k = FastKind::Mov;
+            return true;
+        case Opcode::Add:
+            k = FastKind::Add;
+            return true;
+        case Opcode::Sub:
+            k = FastKind::Sub;
+            return true;
+        case Opcode::Mul:
+            k = FastKind::Mul;
+            return true;
+        case Opcode::Mad:
+            k = FastKind::Mad;
+            return true;
+        case Opcode::Dp3:
+            k = FastKind::Dp3;
+            return true;
+        case Opcode::Dp4:
+            k = FastKind::Dp4;
+            return true;
+        case Opcode::Lrp:
+            k = FastKind::Lrp;
+            return true;
+        case Opcode::Cnd:
+            k = FastKind::Cnd;
+            return true;
+        case Opcode::Cmp:
+            k = FastKind::Cmp;
+            return true;
+        default:
+            return false;  // bem (and anything new) stays on the generic path
     }
 }
 
@@ -58,8 +98,10 @@ bool textureWritesDst(const DOp& op) {
         case Opcode::TexM3x2Pad:
         case Opcode::TexM3x3Pad:
         case Opcode::TexM3x2Depth:
-        case Opcode::TexDepth: return false;
-        default: return true;
+        case Opcode::TexDepth:
+            return false;
+        default:
+            return true;
     }
 }
 
@@ -67,7 +109,8 @@ bool textureWritesDst(const DOp& op) {
 // int32 copy of the destination need not be brought up to date first.
 bool textureWritesAll(const DOp& op, int minor) {
     switch (op.op) {
-        case Opcode::TexCoord: return minor < 4;  // 1_4 texcrd writes its mask only
+        case Opcode::TexCoord:
+            return minor < 4;  // 1_4 texcrd writes its mask only
         case Opcode::Tex:
         case Opcode::TexBem:
         case Opcode::TexBemL:
@@ -80,8 +123,10 @@ bool textureWritesAll(const DOp& op, int minor) {
         case Opcode::TexM3x3Spec:
         case Opcode::TexM3x3VSpec:
         case Opcode::TexDp3Tex:
-        case Opcode::TexDp3: return true;
-        default: return false;
+        case Opcode::TexDp3:
+            return true;
+        default:
+            return false;
     }
 }
 
@@ -215,7 +260,8 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
                 kern.arith(f, bank, nv);
                 if (f.viaTemp)
                     for (int c = 0; c < 4; ++c)
-                        if ((f.mask >> c) & 1) std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+                        if ((f.mask >> c) & 1)
+                            std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
             }
             if (!op.hold && idx > 0 && ops[idx - 1].hold) {
                 // Co-issued pair: both members have read; now the first writes (spec §3.5).

@@ -34,7 +34,7 @@ struct FastSrc {
 
 struct FastOp {
     FastKind kind = FastKind::Mov;
-    bool hold = false;  // write into the hold buffer (first member of a co-issued pair)
+    bool hold = false;     // write into the hold buffer (first member of a co-issued pair)
     bool viaTemp = false;  // write into tmp, then copy (the destination is also a swizzled source)
     bool half = false;     // products: every source k is even, formed halved (see the kernels)
     uint8_t dst = 0;
@@ -100,7 +100,7 @@ namespace ps11::exec {
 struct FastProgram {
     const FastKernels* kernels = nullptr;
     std::vector<FastOp> ops;
-    uint8_t constsUsed = 0;  // constants the arithmetic ops read (bit per c#)
+    uint8_t constsUsed = 0;              // constants the arithmetic ops read (bit per c#)
     std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
 };
 

@@ -19,8 +19,8 @@
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
 #include "ps11/executor_fast.h"
-#include "ps11/texture_sampler.h"
 #include "ps11/testfile.h"
+#include "ps11/texture_sampler.h"
 #include "ps11/validator.h"
 
 namespace {
@@ -288,8 +288,8 @@ int64_t diffPaths(const std::string& text, float maxValue, const Lanes& l, int s
     return bad;
 }
 
-const char* kModSuffix[9][2] = {{"", ""},     {"-", ""},      {"", "_bias"}, {"-", "_bias"}, {"", "_bx2"},
-                                {"-", "_bx2"}, {"1-", ""},     {"", "_x2"},   {"-", "_x2"}};
+const char* kModSuffix[9][2] = {{"", ""},      {"-", ""},  {"", "_bias"}, {"-", "_bias"}, {"", "_bx2"},
+                                {"-", "_bx2"}, {"1-", ""}, {"", "_x2"},   {"-", "_x2"}};
 const char* kShiftName[7] = {"_d8", "_d4", "_d2", "", "_x2", "_x4", "_x8"};
 
 }  // namespace
@@ -450,7 +450,8 @@ TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem
         "ps_1_1\ntex t0\ntexkill t1\nmul r0.rgb, t0, v0\n+add r0.a, t0.a, -v1.a\n",
         "ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, c0, v0_bias\n",
         "ps_1_3\ntex t0\ntexreg2ar t1, t0\ndp3_sat r0, t0_bx2, t1_bx2\n",
-        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, -r2\n+mov r0.a, r3.a\n",
+        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
+        "-r2\n+mov r0.a, r3.a\n",
         "ps_1_4\ntexld r1, t0\ntexkill r1\ncmp r0, r1_bias, c0, c1\n",
     };
     std::mt19937 rng(99);
@@ -484,6 +485,7 @@ TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
     CHECK(std::string(make(text, Precision::Fx12, 0, ExecPath::Auto)->pathName()) == "generic");
     CHECK(std::string(make(text, Precision::Float, 0, ExecPath::Auto)->pathName()) == "generic");
     CHECK(std::string(make(text, Precision::Fx8, 0, ExecPath::Generic)->pathName()) == "generic");
-    CHECK(std::string(make("ps_1_4\ntexld r1, t0\nbem r2.rg, c0, r1\nphase\nmov r0, r2.r\n", Precision::Fx8, 0, ExecPath::Auto)->pathName()) ==
-          "generic");
+    CHECK(std::string(
+              make("ps_1_4\ntexld r1, t0\nbem r2.rg, c0, r1\nphase\nmov r0, r2.r\n", Precision::Fx8, 0, ExecPath::Auto)
+                  ->pathName()) == "generic");
 }
