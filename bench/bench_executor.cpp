@@ -179,7 +179,7 @@ double threadCpuNs() {
     return double(ts.tv_sec) * 1e9 + double(ts.tv_nsec);
 }
 
-std::unique_ptr<Executor> makeExecutor(const char* text, Precision precision) {
+std::unique_ptr<Executor> makeExecutor(const char* text, Precision precision, ExecPath path) {
     Diagnostics diags;
     std::optional<Program> program = parseAssembly(text, "<bench>", AssembleOptions{}, diags);
     if (program) validate(*program, diags);
@@ -187,6 +187,7 @@ std::unique_ptr<Executor> makeExecutor(const char* text, Precision precision) {
     if (program && !diags.hasErrors()) {
         ExecutorOptions options;
         options.precision = precision;
+        options.path = path;
         executor = Executor::create(*program, options, diags);
     }
     if (!executor) {
@@ -200,46 +201,82 @@ std::unique_ptr<Executor> makeExecutor(const char* text, Precision precision) {
     return executor;
 }
 
+// Outputs of one span.
+struct SpanOutputs {
+    std::array<std::vector<float>, 4> color;
+    std::array<std::vector<int32_t>, 4> grid;
+    std::vector<uint8_t> killed;
+    PixelOutputs outputs;
+    explicit SpanOutputs(Precision precision) {
+        for (int c = 0; c < 4; ++c) {
+            color[c].assign(kMaxSpan, 0.0f);
+            grid[c].assign(kMaxSpan, 0);
+            outputs.color[c] = color[c].data();
+            if (isFixedPoint(precision)) outputs.grid[c] = grid[c].data();
+        }
+        killed.assign(kMaxSpan, 0);
+        outputs.killed = killed.data();
+    }
+};
+
+// Runs every row once through the executor and returns the thread CPU time in ns.
+double timeRows(const Executor& executor, Sampler& sampler, const SpanInputs& spans, SpanOutputs& out) {
+    const double start = threadCpuNs();
+    for (const PixelInputs& in : spans.inputs) {
+        executor.run(in, sampler, out.outputs);
+        benchmark::DoNotOptimize(out.color[0].data());
+        benchmark::ClobberMemory();
+    }
+    return threadCpuNs() - start;
+}
+
+// One benchmark per program × profile × sampler. Each iteration runs the 16 rows with the default
+// path (Auto: the fast path where it applies) and, where the fast path applies, the same rows with
+// the generic path and with the fast path's SSE2 kernels, alternating the order (A B C, C B A, …)
+// so drift of the shared VM hits all alike.
+// Thread CPU time, like the CPU column: on a shared VM wall time also counts other tenants.
 void runProgram(benchmark::State& state, const BenchProgram& prog, Precision precision, bool textured) {
-    std::unique_ptr<Executor> executor = makeExecutor(prog.text, precision);
-    if (!executor) {
+    std::unique_ptr<Executor> fast = makeExecutor(prog.text, precision, ExecPath::Auto);
+    std::unique_ptr<Executor> generic = makeExecutor(prog.text, precision, ExecPath::Generic);
+    std::unique_ptr<Executor> sse2 = makeExecutor(prog.text, precision, ExecPath::FastBaseline);
+    if (!fast || !generic || !sse2) {
         state.SkipWithError("cannot prepare the program");
         return;
     }
+    const bool compare = std::string(fast->pathName()) != "generic";
+    // The SSE2 kernels too, when the default path runs the AVX2 ones.
+    const bool compareSse2 = compare && std::string(fast->pathName()) != sse2->pathName();
     std::unique_ptr<Sampler> sampler = makeSampler(textured);
     static const SpanInputs spans;
-    std::array<std::vector<float>, 4> color;
-    std::array<std::vector<int32_t>, 4> grid;
-    PixelOutputs outputs;
-    for (int c = 0; c < 4; ++c) {
-        color[c].assign(kMaxSpan, 0.0f);
-        grid[c].assign(kMaxSpan, 0);
-        outputs.color[c] = color[c].data();
-        if (isFixedPoint(precision)) outputs.grid[c] = grid[c].data();
-    }
-    std::vector<uint8_t> killed(kMaxSpan, 0);
-    outputs.killed = killed.data();
+    SpanOutputs out(precision);
 
     // Instructions per pixel, as the executor counts them.
     ExecutorStats stats;
-    executor->run(spans.inputs[0], *sampler, outputs, &stats);
+    fast->run(spans.inputs[0], *sampler, out.outputs, &stats);
     const double perPixel = stats.pixels ? double(stats.instructions) / double(stats.pixels) : 0.0;
 
-    size_t row = 0;
-    const double start = threadCpuNs();
+    double tFast = 0, tGeneric = 0, tSse2 = 0;
+    bool fastFirst = true;
     for (auto _ : state) {
-        executor->run(spans.inputs[row], *sampler, outputs);
-        benchmark::DoNotOptimize(color[0].data());
-        benchmark::ClobberMemory();
-        row = (row + 1) % SpanInputs::kRows;
+        if (compare && !fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
+        if (compareSse2 && !fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
+        tFast += timeRows(*fast, *sampler, spans, out);
+        if (compareSse2 && fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
+        if (compare && fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
+        fastFirst = !fastFirst;
     }
-    // Thread CPU time, like the CPU column: on a shared VM wall time also counts other tenants.
-    const double elapsed = threadCpuNs() - start;
-    const double pixels = double(state.iterations()) * kMaxSpan;
-    state.counters["ns/pixel"] = elapsed / pixels;
-    if (perPixel > 0) state.counters["ns/pixel/instr"] = elapsed / (pixels * perPixel);
+    const double pixels = double(state.iterations()) * SpanInputs::kRows * kMaxSpan;
+    state.counters["ns/pixel"] = tFast / pixels;
+    if (perPixel > 0) state.counters["ns/pixel/instr"] = tFast / (pixels * perPixel);
     state.counters["instr/pixel"] = perPixel;
+    if (compare) {
+        state.counters["generic_ns/pixel"] = tGeneric / pixels;
+        if (perPixel > 0) state.counters["generic_ns/pixel/instr"] = tGeneric / (pixels * perPixel);
+        state.counters["speedup"] = tFast > 0 ? tGeneric / tFast : 0.0;
+    }
+    if (compareSse2) state.counters["sse2_ns/pixel"] = tSse2 / pixels;
     state.SetItemsProcessed(int64_t(pixels));
+    state.SetLabel(fast->pathName());
 }
 
 // Registers program × profile (× sampler for textured programs).

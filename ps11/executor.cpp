@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 
+#include "ps11/executor_fast.h"
 #include "ps11/executor_internal.h"
 
 namespace ps11 {
@@ -35,6 +36,10 @@ public:
           m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < 8; ++i) refreshConstant(i);
+        if (options.path != ExecPath::Generic) {
+            const FastKernels* k = options.path == ExecPath::FastBaseline ? fastKernelsBaseline() : fastKernelsBest();
+            buildFastProgram(m_p, m_ops, k, m_fast);
+        }
     }
 
     void setConstant(int index, const std::array<float, 4>& value) override {
@@ -48,6 +53,10 @@ public:
     bool writesDepth() const override { return m_writesDepth; }
     uint32_t sampledStages() const override { return m_stagesUsed; }
     const ExecutorOptions& options() const override { return m_options; }
+    const char* pathName() const override {
+        if (!m_fast.kernels) return "generic";
+        return m_fast.kernels == fastKernelsAvx2() ? "fast-avx2" : "fast-sse2";
+    }
 
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
              ExecutorStats* stats) const override;
@@ -67,6 +76,7 @@ private:
             }
         }
     }
+    void runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const;
     void loadColors(RunState& st) const;
     void runChunk(RunState& st) const;
 
@@ -79,6 +89,7 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
+    FastProgram m_fast;  // kernels == null: the generic path runs
 };
 
 void ExecutorImpl::loadColors(RunState& st) const {
@@ -134,6 +145,22 @@ void ExecutorImpl::runChunk(RunState& st) const {
 void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
                        ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    if (m_fast.kernels) {
+        runFast(m_fast, m_p, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
+    } else {
+        runGeneric(inputs, sampler, outputs);
+    }
+    if (stats) {
+        stats->pixels += uint64_t(count);
+        uint64_t executed = 0;
+        for (const DOp& op : m_ops)
+            if (op.op != Opcode::Phase) ++executed;
+        stats->instructions += executed * uint64_t(count);
+    }
+}
+
+void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
     std::unique_ptr<RunState> st(new RunState);  // default-init: no 60 KB zero fill per call
     st->in = &inputs;
     st->sampler = &sampler;
@@ -161,13 +188,6 @@ void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs
         if (outputs.killed) std::memcpy(outputs.killed + off, st->killed, size_t(st->n));
         if (outputs.depth && m_writesDepth && st->depthWritten)
             std::memcpy(outputs.depth + off, st->depth, sizeof(float) * size_t(st->n));
-    }
-    if (stats) {
-        stats->pixels += uint64_t(count);
-        uint64_t executed = 0;
-        for (const DOp& op : m_ops)
-            if (op.op != Opcode::Phase) ++executed;
-        stats->instructions += executed * uint64_t(count);
     }
 }
 

@@ -14,9 +14,16 @@
 
 namespace ps11 {
 
+// Which implementation runs a program. Results are bit-identical; tests and benchmarks compare
+// them in one process. Auto: the fx8 fast path (int16 lanes, AVX2 when the CPU has it) where it
+// applies (fx8, round(M·G) <= 2040, no bem), the generic path otherwise. Generic: always the
+// generic path (the reference). FastBaseline: as Auto but with the fast path's SSE2 kernels.
+enum class ExecPath : uint8_t { Auto, Generic, FastBaseline };
+
 struct ExecutorOptions {
     Precision precision = Precision::Fx8;
     float maxValue = 0;  // PixelShader1xMaxValue; 0 = the version's default (1, or 8 for 1_4)
+    ExecPath path = ExecPath::Auto;
 };
 
 // Texture stage states the pixel shader reads (D3DTSS_*), per stage.
@@ -68,6 +75,8 @@ public:
     // Stages the program samples (bit per stage).
     virtual uint32_t sampledStages() const = 0;
     virtual const ExecutorOptions& options() const = 0;
+    // The implementation run() uses: "generic", "fast-avx2" or "fast-sse2".
+    virtual const char* pathName() const = 0;
 
     // Runs the program for inputs.count pixels (<= kMaxSpan). Thread-safe for distinct
     // outputs when the sampler is (run keeps no per-call state in the object).

@@ -7,6 +7,12 @@
 
 #include "ps11/executor_internal.h"
 
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define PS11_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define PS11_AVX2_CLONES
+#endif
+
 namespace ps11::exec {
 namespace {
 
@@ -178,7 +184,7 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
 
 // Float profiles ------------------------------------------------------------------------------
 
-void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
+[[gnu::always_inline]] inline void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
     const uint8_t fm = fetchMask(op);
     const int n = st.n;
     for (int s = 0; s < op.numSrc; ++s) {
@@ -222,7 +228,7 @@ void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
 }
 
 template <class F>
-void finishFloat(int n, float* __restrict out, const F& f, float scale, bool sat, float lo, float hi) {
+[[gnu::always_inline]] inline void finishFloat(int n, float* __restrict out, const F& f, float scale, bool sat, float lo, float hi) {
     if (sat) {
         for (int i = 0; i < n; ++i) {
             float v = f(i) * scale;
@@ -255,7 +261,9 @@ void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[k
     }
 }
 
-void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]) {
+// Compiled for AVX2 and for the baseline, picked at load time (ifunc); the float formulas are
+// the same in both (-ffp-contract=off for this file: no FMA contraction).
+PS11_AVX2_CLONES void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]) {
     fetchFloat(p, op, st);
     const int n = st.n;
     const float scale = std::ldexp(1.0f, op.shift);  // exact power of two

@@ -68,6 +68,9 @@ struct RunState {
     alignas(64) uint8_t killed[kChunk];
     alignas(64) float depth[kChunk];
     bool depthWritten = false;
+    // Set by the fx8 fast path around tex/texld: sampleInto then leaves the ±M clamp of the
+    // texels to the caller, which clamps while converting to its int16 registers.
+    bool deferTexelClamp = false;
 };
 
 // What the kernels need from the executor (read-only during run()).

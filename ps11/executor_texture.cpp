@@ -88,6 +88,7 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
     if (isFixedPoint(p.precision)) {
         for (int c = 0; c < 4; ++c) res.grid[c] = st.bi.reg[slot][c];
         st.sampler->sample(req, res);
+        if (st.deferTexelClamp) return;
         const int32_t m = p.nMax;
         for (int c = 0; c < 4; ++c) {
             int32_t* d = st.bi.reg[slot][c];
@@ -190,6 +191,12 @@ void execTexkill(const Profile& p, const DOp& op, RunState& st) {
 }
 
 void execTex(const Profile& p, const DOp& op, RunState& st) {
+    if (!(p.stages[size_t(op.stage)].transformFlags & kTtffProjected)) {
+        // Not projected: the coordinates are TC[m] as they are, no copy needed.
+        sampleInto(p, st, op.stage, 3, texcoordLanes(st, op.stage, 0), texcoordLanes(st, op.stage, 1),
+                   texcoordLanes(st, op.stage, 2), op.dstSlot);
+        return;
+    }
     Lanes u, v, w;
     staticCoords(p, st, op.stage, u, v, w);
     sampleInto(p, st, op.stage, 3, u, v, w, op.dstSlot);

@@ -1,0 +1,283 @@
+// The fx8 fast path, driver: decides whether a program can run on int16 lanes, translates its
+// arithmetic ops (modifier affine k = a·n + b, write-step clamps), and runs spans chunk by chunk.
+// Texture instructions keep using the generic texture stage (executor_texture.cpp) on the int32
+// bank: the registers they read and write are converted around them.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "ps11/executor_fast.h"
+
+namespace ps11::exec {
+namespace {
+
+// Source modifier as k = a·n + b for G = 255 (docs/precision.md table; as executor_arith.cpp).
+bool fastAffine(SrcMod m, int16_t& a, int16_t& b) {
+    switch (m) {
+        case SrcMod::None:
+            a = 2, b = 0;
+            return true;
+        case SrcMod::Neg:
+            a = -2, b = 0;
+            return true;
+        case SrcMod::Bias:
+            a = 2, b = -255;
+            return true;
+        case SrcMod::BiasNeg:
+            a = -2, b = 255;
+            return true;
+        case SrcMod::Sign:
+            a = 4, b = -510;
+            return true;
+        case SrcMod::SignNeg:
+            a = -4, b = 510;
+            return true;
+        case SrcMod::Comp:
+            a = -2, b = 510;
+            return true;
+        case SrcMod::X2:
+            a = 4, b = 0;
+            return true;
+        case SrcMod::X2Neg:
+            a = -4, b = 0;
+            return true;
+        default:
+            return false;
+    }
+}
+
+bool fastKind(Opcode op, FastKind& k) {
+    switch (op) {
+        case Opcode::Mov:
+            k = FastKind::Mov;
+            return true;
+        case Opcode::Add:
+            k = FastKind::Add;
+            return true;
+        case Opcode::Sub:
+            k = FastKind::Sub;
+            return true;
+        case Opcode::Mul:
+            k = FastKind::Mul;
+            return true;
+        case Opcode::Mad:
+            k = FastKind::Mad;
+            return true;
+        case Opcode::Dp3:
+            k = FastKind::Dp3;
+            return true;
+        case Opcode::Dp4:
+            k = FastKind::Dp4;
+            return true;
+        case Opcode::Lrp:
+            k = FastKind::Lrp;
+            return true;
+        case Opcode::Cnd:
+            k = FastKind::Cnd;
+            return true;
+        case Opcode::Cmp:
+            k = FastKind::Cmp;
+            return true;
+        default:
+            return false;  // bem (and anything new) stays on the generic path
+    }
+}
+
+// Source components an op reads, as a mask of output channels (as executor_arith.cpp).
+uint8_t readMask(const FastOp& op) {
+    if (op.kind == FastKind::Dp3) return kMaskRGB;
+    if (op.kind == FastKind::Dp4) return kMaskAll;
+    return op.mask;
+}
+
+// Texture ops that write their destination register (the others write pad/depth/killed only).
+bool textureWritesDst(const DOp& op) {
+    switch (op.op) {
+        case Opcode::TexKill:
+        case Opcode::TexM3x2Pad:
+        case Opcode::TexM3x3Pad:
+        case Opcode::TexM3x2Depth:
+        case Opcode::TexDepth:
+            return false;
+        default:
+            return true;
+    }
+}
+
+// Texture ops that write all four components of their destination for every lane, so the
+// int32 copy of the destination need not be brought up to date first.
+bool textureWritesAll(const DOp& op, int minor) {
+    switch (op.op) {
+        case Opcode::TexCoord:
+            return minor < 4;  // 1_4 texcrd writes its mask only
+        case Opcode::Tex:
+        case Opcode::TexBem:
+        case Opcode::TexBemL:
+        case Opcode::TexReg2AR:
+        case Opcode::TexReg2GB:
+        case Opcode::TexReg2RGB:
+        case Opcode::TexM3x2Tex:
+        case Opcode::TexM3x3Tex:
+        case Opcode::TexM3x3:
+        case Opcode::TexM3x3Spec:
+        case Opcode::TexM3x3VSpec:
+        case Opcode::TexDp3Tex:
+        case Opcode::TexDp3:
+            return true;
+        default:
+            return false;
+    }
+}
+
+struct FastRunState {
+    RunState st;
+    FastBank bank;
+};
+
+void toInt32(const int16_t* s, int32_t* d, int n) {
+    for (int i = 0; i < n; ++i) d[i] = s[i];
+}
+
+void syncTo32(FastRunState& fs, int slot) {
+    for (int c = 0; c < 4; ++c) toInt32(fs.bank.reg[slot][c], fs.st.bi.reg[slot][c], fs.st.n);
+}
+// Texture results to int16, clamped to ±round(M·G) (tex/texld defer that clamp to here).
+void syncTo16(FastRunState& fs, int slot, const FastKernels& k, int32_t nMax) {
+    for (int c = 0; c < 4; ++c) k.narrow(fs.st.bi.reg[slot][c], fs.bank.reg[slot][c], fs.st.n, int16_t(nMax));
+}
+
+}  // namespace
+
+bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp) {
+    fp = FastProgram{};
+    if (!kernels || p.precision != Precision::Fx8 || p.g != 255 || p.nMax > kFastMaxGrid || p.nMax < 1) return false;
+    fp.ops.resize(ops.size());
+    fp.syncDstBefore.assign(ops.size(), 0);
+    for (size_t i = 0; i < ops.size(); ++i) {
+        const DOp& d = ops[i];
+        if (d.texture) fp.syncDstBefore[i] = !textureWritesAll(d, p.minor);
+        if (d.texture || d.op == Opcode::Phase) continue;
+        FastOp& f = fp.ops[i];
+        if (!fastKind(d.op, f.kind)) return false;
+        f.hold = d.hold;
+        f.dst = d.dstSlot;
+        f.mask = d.mask;
+        f.shift = d.shift;
+        if (d.shift < -3 || d.shift > 3) return false;
+        // The write-step bounds exactly as executor_arith.cpp forms them.
+        f.lo = int16_t(d.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax);
+        f.hi = int16_t(d.sat ? (255 < p.nMax ? 255 : p.nMax) : p.nMax);
+        f.numSrc = d.numSrc;
+        for (int s = 0; s < 3; ++s) {
+            FastSrc& fs = f.src[size_t(s)];
+            if (s >= d.numSrc) {
+                fs = FastSrc{};
+                fs.slot = uint8_t(kFastConstSlot);  // never read by the op's formula; any valid lanes
+                continue;
+            }
+            const DSrc& ds = d.src[size_t(s)];
+            if (ds.kind == SrcKind::TexCoord) return false;
+            fs.slot = uint8_t(ds.kind == SrcKind::Const ? kFastConstSlot + (ds.slot & 7) : ds.slot);
+            if (ds.kind == SrcKind::Const) fp.constsUsed = uint8_t(fp.constsUsed | (1u << (ds.slot & 7)));
+            fs.sw = ds.sw;
+            if (!fastAffine(ds.mod, fs.a, fs.b)) return false;
+        }
+        // Sources with even a and b (every modifier but _bias) let products run on k/2.
+        f.half = true;
+        for (int s = 0; s < f.numSrc; ++s)
+            if ((f.src[size_t(s)].a & 1) || (f.src[size_t(s)].b & 1)) f.half = false;
+        // Component c of the destination is written before component c' > c is read: a source
+        // that is the destination itself and reads other components must see the old values.
+        if (!f.hold && f.kind != FastKind::Dp3 && f.kind != FastKind::Dp4) {
+            const uint8_t rm = readMask(f);
+            for (int s = 0; s < f.numSrc; ++s) {
+                const FastSrc& fs = f.src[size_t(s)];
+                if (fs.slot != f.dst) continue;
+                for (int c = 0; c < 4; ++c)
+                    if (((rm >> c) & 1) && fs.sw[size_t(c)] != c) f.viaTemp = true;
+            }
+        }
+    }
+    fp.kernels = kernels;
+    return true;
+}
+
+void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed, bool writesDepth,
+             const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    // One state per thread, kept between calls (no 60 KB allocation per span); taken out of the
+    // cache while in use, so a nested or concurrent call on the same thread allocates its own.
+    thread_local std::unique_ptr<FastRunState> cache;
+    std::unique_ptr<FastRunState> fs = std::move(cache);
+    if (!fs) fs.reset(new FastRunState);  // default-init: no zero fill of the banks
+    struct GiveBack {
+        std::unique_ptr<FastRunState>& fs;
+        ~GiveBack() { cache = std::move(fs); }
+    } giveBack{fs};
+    RunState& st = fs->st;
+    FastBank& bank = fs->bank;
+    st.in = &inputs;
+    st.sampler = &sampler;
+    std::memset(st.zeros, 0, sizeof st.zeros);
+    // r0 is the output: zero it as the generic path does. Lanes past a chunk's count (up to the
+    // next multiple of 16) are computed too and never stored; the kernels use only wrapping
+    // SIMD arithmetic, so whatever those lanes hold is harmless.
+    std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
+    for (int i = 0; i < 8; ++i)
+        if ((fp.constsUsed >> i) & 1)
+            for (int c = 0; c < 4; ++c)
+                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    const FastKernels& kern = *fp.kernels;
+    for (int off = 0; off < count; off += kChunk) {
+        st.offset = off;
+        st.n = std::min(kChunk, count - off);
+        st.depthWritten = false;
+        const int n = st.n;
+        const int nv = (n + 15) & ~15;
+        std::memset(st.killed, 0, sizeof st.killed);
+        // v# saturated and rounded once per pixel (docs/precision.md "Inputs"), as the generic path.
+        for (int v = 0; v < 2; ++v) {
+            if (!((vUsed >> v) & 1)) continue;
+            for (int c = 0; c < 4; ++c) {
+                const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : st.zeros;
+                kern.loadColor(src, bank.reg[kSlotV + v][c], n);
+            }
+        }
+        for (size_t idx = 0; idx < ops.size(); ++idx) {
+            const DOp& op = ops[idx];
+            if (op.op == Opcode::Phase) continue;
+            if (op.texture) {
+                for (int s = 0; s < op.numSrc; ++s)
+                    if (op.src[size_t(s)].kind == SrcKind::Reg) syncTo32(*fs, op.src[size_t(s)].slot);
+                if (fp.syncDstBefore[idx]) syncTo32(*fs, op.dstSlot);  // texdepth reads it; texcrd keeps the rest
+                st.deferTexelClamp = op.op == Opcode::Tex;
+                execTexture(p, op, st);
+                st.deferTexelClamp = false;
+                if (textureWritesDst(op)) syncTo16(*fs, op.dstSlot, kern, p.nMax);
+            } else {
+                const FastOp& f = fp.ops[idx];
+                kern.arith(f, bank, nv);
+                if (f.viaTemp)
+                    for (int c = 0; c < 4; ++c)
+                        if ((f.mask >> c) & 1)
+                            std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+            }
+            if (!op.hold && idx > 0 && ops[idx - 1].hold) {
+                // Co-issued pair: both members have read; now the first writes (spec §3.5).
+                const DOp& first = ops[idx - 1];
+                for (int c = 0; c < 4; ++c)
+                    if ((first.mask >> c) & 1)
+                        std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
+            }
+        }
+        for (int c = 0; c < 4; ++c)
+            kern.store(bank.reg[kSlotR][c], outputs.color[c] ? outputs.color[c] + off : nullptr,
+                       outputs.grid[c] ? outputs.grid[c] + off : nullptr, n);
+        if (outputs.killed) std::memcpy(outputs.killed + off, st.killed, size_t(n));
+        if (outputs.depth && writesDepth && st.depthWritten)
+            std::memcpy(outputs.depth + off, st.depth, sizeof(float) * size_t(n));
+    }
+}
+
+}  // namespace ps11::exec

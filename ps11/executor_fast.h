@@ -1,0 +1,115 @@
+// The fx8 fast path of the executor: registers as int16 lanes (16 per AVX2 register), sources
+// fetched as k = a·n + b in int16, products and sums of products formed exactly in int32 by
+// pmaddwd, then the one round-half-even of docs/precision.md done with integer and float
+// operations whose exactness is proven over the whole input range (tests/test_executor_fast.cpp).
+// It gives results bit-identical to the generic int32/int64 path (executor_arith.cpp), which
+// stays the reference and runs whatever the fast path does not cover. The kernels are compiled
+// twice (executor_fast_avx2.cpp with -mavx2 -mfma, executor_fast_sse2.cpp for any x86-64) and
+// picked once at run time. Not part of the public API.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "ps11/executor_internal.h"
+
+namespace ps11::exec {
+
+// Applies when: fx8 (G = 255) and round(M·G) <= kFastMaxGrid. Then every grid value n and every
+// source k = a·n + b fits int16 (|k| <= 4·2040 + 510 = 8670, lrp's ka − kb <= 17340) and every
+// product numerator (dp4: 4·8670² ≈ 3.0e8, doubled for _x8) fits int32.
+constexpr int32_t kFastMaxGrid = 2040;
+
+enum class FastKind : uint8_t { Mov, Add, Sub, Mul, Mad, Dp3, Dp4, Lrp, Cnd, Cmp };
+
+// Slots of the int16 bank: the register slots of executor_internal.h, then c0..c7 as lanes.
+constexpr int kFastConstSlot = kNumSlots;
+constexpr int kFastSlots = kNumSlots + 8;
+
+struct FastSrc {
+    uint8_t slot = 0;
+    std::array<uint8_t, 4> sw{0, 1, 2, 3};
+    int16_t a = 2, b = 0;  // k = a·n + b (docs/precision.md modifier table, G = 255)
+};
+
+struct FastOp {
+    FastKind kind = FastKind::Mov;
+    bool hold = false;     // write into the hold buffer (first member of a co-issued pair)
+    bool viaTemp = false;  // write into tmp, then copy (the destination is also a swizzled source)
+    bool half = false;     // products: every source k is even, formed halved (see the kernels)
+    uint8_t dst = 0;
+    uint8_t mask = kMaskAll;
+    int8_t shift = 0;
+    int16_t lo = -255, hi = 255;  // _sat and range clamp, as the generic path computes them
+    uint8_t numSrc = 0;
+    std::array<FastSrc, 3> src{};
+};
+
+struct FastBank {
+    alignas(64) int16_t reg[kFastSlots][4][kChunk];
+    alignas(64) int16_t hold[4][kChunk];
+    alignas(64) int16_t tmp[4][kChunk];
+};
+
+// Runs one arithmetic op over lanes [0, nv) (nv a multiple of 16, <= kChunk).
+using FastArithFn = void (*)(const FastOp& op, FastBank& bank, int nv);
+
+// Test hooks: the rounding steps of the kernels on their own, count lanes (a multiple of 16).
+// Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
+// [lo, hi]. Linear: n = round_half_even(K·2^s / 2), clamped.
+using FastRoundProductFn = void (*)(const int32_t* p, int16_t* out, int count, int shift, bool half, int16_t lo,
+                                    int16_t hi);
+using FastRoundLinearFn = void (*)(const int16_t* k, int16_t* out, int count, int shift, int16_t lo, int16_t hi);
+
+// v# input: saturate to [0, 1] (NaN -> 0) and round_half_even(s·255) computed in double, n lanes.
+using FastLoadColorFn = void (*)(const float* src, int16_t* dst, int n);
+// int32 register lanes (texture stage results) to int16, clamped to [-m, m].
+using FastNarrowFn = void (*)(const int32_t* src, int16_t* dst, int n, int16_t m);
+// r0 output: color = float(n) / 255 (correctly rounded division), grid = n; either may be null.
+using FastStoreFn = void (*)(const int16_t* r, float* color, int32_t* grid, int n);
+
+struct FastKernels {
+    const char* name;  // "avx2" or "sse2"
+    FastArithFn arith;
+    FastLoadColorFn loadColor;
+    FastStoreFn store;
+    FastNarrowFn narrow;
+    FastRoundProductFn roundProduct;
+    FastRoundLinearFn roundLinear;
+};
+
+// Kernel sets: the baseline (SSE2, every x86-64) and AVX2 (null if the CPU lacks AVX2 or the
+// build has no x86 kernels). fastKernelsBaseline() is null on non-x86 builds.
+const FastKernels* fastKernelsBaseline();
+const FastKernels* fastKernelsAvx2();
+// The best set for this CPU (AVX2 when available), chosen once.
+const FastKernels* fastKernelsBest();
+
+namespace sse2 {
+extern const FastKernels kKernels;
+}
+namespace avx2 {
+extern const FastKernels kKernels;
+}
+
+}  // namespace ps11::exec
+
+namespace ps11::exec {
+
+// A program prepared for the fast path: one FastOp per DOp (unused for texture ops and phase).
+struct FastProgram {
+    const FastKernels* kernels = nullptr;
+    std::vector<FastOp> ops;
+    uint8_t constsUsed = 0;              // constants the arithmetic ops read (bit per c#)
+    std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
+};
+
+// Fills fp for ops if the fast path applies (fx8, round(M·G) <= kFastMaxGrid, no bem) and
+// kernels is not null; returns false otherwise (the generic path then runs the program).
+bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp);
+
+// run() of the fast path: same inputs, outputs and semantics as the generic run.
+void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed, bool writesDepth,
+             const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
+
+}  // namespace ps11::exec

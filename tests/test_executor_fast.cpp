@@ -1,0 +1,494 @@
+// The fx8 fast path (ps11/executor_fast.h) against the generic path, which is the reference
+// (test_executor_reference.cpp checks it against docs/precision.md). The rounding steps of both
+// kernel sets (SSE2, AVX2) are checked exhaustively over every input that does not saturate, and
+// sampled beyond; then whole programs are compared pixel by pixel: every arithmetic op over all
+// operand pairs with each modifier, shift and _sat, random valid programs (co-issue, masks,
+// selectors, 1_4 ranges) over spans of 1..256 pixels, and textured programs.
+#include <algorithm>
+#include <array>
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "executor_random_programs.h"
+#include "ps11/assembler.h"
+#include "ps11/executor.h"
+#include "ps11/executor_fast.h"
+#include "ps11/testfile.h"
+#include "ps11/texture_sampler.h"
+#include "ps11/validator.h"
+
+namespace {
+
+using ps11::ExecPath;
+using ps11::Precision;
+
+// round_half_even(num / den), den > 0, written here from the definition.
+int64_t rhe(int64_t num, int64_t den) {
+    int64_t q = num / den, r = num % den;
+    if (r < 0) r += den, q -= 1;
+    if (2 * r > den || (2 * r == den && (q & 1))) ++q;
+    return q;
+}
+
+std::vector<const ps11::exec::FastKernels*> kernelSets() {
+    std::vector<const ps11::exec::FastKernels*> k;
+    if (ps11::exec::fastKernelsBaseline()) k.push_back(ps11::exec::fastKernelsBaseline());
+    if (ps11::exec::fastKernelsAvx2()) k.push_back(ps11::exec::fastKernelsAvx2());
+    return k;
+}
+
+struct Bounds {
+    int16_t lo, hi;
+};
+// The write-step bounds the fast path meets: _sat, ±1 (1_1-1_3), ±8 (1_4), something between.
+const Bounds kBounds[] = {{0, 255}, {-255, 255}, {-2040, 2040}, {-1020, 1020}};
+
+// Checks roundProduct over p[0..n) (n a multiple of 16) against the exact definition.
+int64_t checkProducts(const ps11::exec::FastKernels& k, const std::vector<int32_t>& p, int shift, bool half, Bounds b) {
+    std::vector<int16_t> out(p.size());
+    k.roundProduct(p.data(), out.data(), int(p.size()), shift, half, b.lo, b.hi);
+    int64_t bad = 0;
+    const int64_t den0 = half ? 255 : 1020;
+    for (size_t i = 0; i < p.size(); ++i) {
+        // n = round_half_even(P·2^s / (4G)), G = 255 (half: P'·2^s / G), then clamped.
+        const int64_t num = shift > 0 ? int64_t(p[i]) << shift : int64_t(p[i]);
+        const int64_t den = shift < 0 ? den0 << -shift : den0;
+        const int64_t want = std::clamp<int64_t>(rhe(num, den), b.lo, b.hi);
+        if (out[i] != want && bad++ < 5)
+            FAIL_CHECK(k.name << (half ? " half" : "") << " product P=" << p[i] << " shift " << shift << ": " << out[i]
+                              << " want " << want);
+    }
+    return bad;
+}
+
+}  // namespace
+
+TEST_CASE("fast: product rounding is exact over every non-saturating numerator", "[fast]") {
+    for (const auto* k : kernelSets()) {
+        for (bool half : {false, true}) {
+            // Largest |P| the fast path forms: dp4 of four k·k with |k| <= 4·2040 + 510 (half: k/2).
+            const int64_t kMax = half ? 4335 : 8670;
+            const int64_t kMaxP = 4 * kMax * kMax;
+            for (int shift = -3; shift <= 3; ++shift) {
+                // Every P whose result is within ±2043 (beyond it every bound saturates), in blocks.
+                const int64_t den0 = half ? 255 : 1020;
+                const int64_t den = shift < 0 ? den0 << -shift : den0;
+                const int64_t lim = (2043 * den) >> std::max(shift, 0);
+                std::vector<int32_t> p;
+                int64_t bad = 0, checked = 0;
+                for (const Bounds& b : {kBounds[2], kBounds[0]}) {
+                    for (int64_t v = -lim; v <= lim;) {
+                        p.clear();
+                        for (; v <= lim && p.size() < (1u << 20); ++v) p.push_back(int32_t(v));
+                        while (p.size() % 16) p.push_back(0);
+                        bad += checkProducts(*k, p, shift, half, b);
+                        checked += int64_t(p.size());
+                    }
+                }
+                // Beyond: a dense stride and random numerators up to the largest |P|, all bounds.
+                p.clear();
+                std::mt19937 rng(uint32_t(77 + shift));
+                for (int64_t v = -kMaxP; v <= kMaxP; v += 9973) p.push_back(int32_t(v));
+                for (int i = 0; i < 200000; ++i)
+                    p.push_back(int32_t(std::uniform_int_distribution<int64_t>(-kMaxP, kMaxP)(rng)));
+                p.push_back(int32_t(kMaxP));
+                p.push_back(int32_t(-kMaxP));
+                while (p.size() % 16) p.push_back(int32_t(kMaxP));
+                for (const Bounds& b : kBounds) bad += checkProducts(*k, p, shift, half, b);
+                INFO(k->name << (half ? " half" : "") << " shift " << shift << ": " << checked
+                             << " numerators exhaustively");
+                CHECK(bad == 0);
+                CHECK(checked >= 2 * lim);
+            }
+        }
+    }
+}
+
+TEST_CASE("fast: linear rounding is exact over every reachable numerator", "[fast]") {
+    // K = k0 ± k1 with |k| <= 8670: |K| <= 17340.
+    std::vector<int16_t> kv;
+    for (int v = -17344; v <= 17344; ++v) kv.push_back(int16_t(v));
+    while (kv.size() % 16) kv.push_back(0);
+    std::vector<int16_t> out(kv.size());
+    for (const auto* k : kernelSets())
+        for (int shift = -3; shift <= 3; ++shift)
+            for (const Bounds& b : kBounds) {
+                k->roundLinear(kv.data(), out.data(), int(kv.size()), shift, b.lo, b.hi);
+                int bad = 0;
+                for (size_t i = 0; i < kv.size(); ++i) {
+                    // n = round_half_even(K·2^s / 2)
+                    const int64_t num = shift > 0 ? int64_t(kv[i]) << shift : kv[i];
+                    const int64_t den = shift < 0 ? int64_t(2) << -shift : 2;
+                    const int64_t want = std::clamp<int64_t>(rhe(num, den), b.lo, b.hi);
+                    if (out[i] != want && bad++ < 5)
+                        FAIL_CHECK(k->name << " linear K=" << kv[i] << " shift " << shift << ": " << out[i] << " want "
+                                           << want);
+                }
+                CHECK(bad == 0);
+            }
+}
+
+TEST_CASE("fast: hand-computed ties and known values", "[fast]") {
+    for (const auto* k : kernelSets()) {
+        INFO(k->name);
+        // mul 255·1 _d2 (k = 510, 2): P = 1020, 1020/2040 = ½ → 0 (even); 3·255·1 → 1.5 → 2.
+        alignas(32) int32_t p[16] = {1020, 3060, 5100, -1020, -3060, 512, 508, 510, 1530, 0, 0, 0, 0, 0, 0, 0};
+        alignas(32) int16_t out[16];
+        k->roundProduct(p, out, 16, -1, false, -255, 255);
+        CHECK(out[0] == 0);
+        CHECK(out[1] == 2);
+        CHECK(out[2] == 2);   // 2.5 → 2
+        CHECK(out[3] == 0);   // −0.5 → 0
+        CHECK(out[4] == -2);  // −1.5 → −2
+        k->roundProduct(p, out, 16, 0, false, -255, 255);
+        CHECK(out[5] == 1);  // 512/1020 > ½
+        CHECK(out[6] == 0);  // 508/1020 < ½
+        CHECK(out[7] == 0);  // 510/1020 = ½ → 0
+        CHECK(out[8] == 2);  // 1530/1020 = 1.5 → 2
+        // half: P'/255 — 127/255 < ½, 128/255 > ½; _d2: 255/510 = ½ → 0, 765/510 = 1.5 → 2.
+        alignas(32) int32_t ph[16] = {127, 128, -127, -128, 255, 765, 1275, -255, 0, 0, 0, 0, 0, 0, 0, 0};
+        k->roundProduct(ph, out, 16, 0, true, -255, 255);
+        CHECK(out[0] == 0);
+        CHECK(out[1] == 1);
+        CHECK(out[2] == 0);
+        CHECK(out[3] == -1);
+        k->roundProduct(ph, out, 16, -1, true, -255, 255);
+        CHECK(out[4] == 0);
+        CHECK(out[5] == 2);
+        CHECK(out[6] == 2);  // 2.5 → 2
+        CHECK(out[7] == 0);  // −0.5 → 0
+        alignas(32) int16_t kk[16] = {3, 5, -1, -3, 1, 7, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+        k->roundLinear(kk, out, 16, 0, -255, 255);  // K/2
+        CHECK(out[0] == 2);
+        CHECK(out[1] == 2);
+        CHECK(out[2] == 0);
+        CHECK(out[3] == -2);
+        CHECK(out[4] == 0);
+        CHECK(out[5] == 4);
+    }
+}
+
+namespace {
+
+std::unique_ptr<ps11::Executor> make(const std::string& text, Precision prec, float maxValue, ExecPath path) {
+    ps11::Diagnostics diags;
+    auto prog = ps11::parseAssembly(text, "fast.psh", {}, diags);
+    REQUIRE(prog);
+    if (!ps11::validate(*prog, diags)) FAIL(text << diags.formatAll());
+    ps11::ExecutorOptions opt;
+    opt.precision = prec;
+    opt.maxValue = maxValue;
+    opt.path = path;
+    auto e = ps11::Executor::create(*prog, opt, diags);
+    REQUIRE(e);
+    return e;
+}
+
+// Per-pixel input arrays for up to count pixels.
+struct Lanes {
+    int count;
+    std::vector<float> col[2][4], tc[8][4];
+    explicit Lanes(int n) : count(n) {
+        for (auto& v : col)
+            for (auto& c : v) c.assign(size_t(n), 0.0f);
+        for (auto& v : tc)
+            for (auto& c : v) c.assign(size_t(n), 0.0f);
+    }
+    ps11::PixelInputs inputs(int off, int n) const {
+        ps11::PixelInputs in;
+        in.count = n;
+        for (int i = 0; i < 2; ++i)
+            for (int c = 0; c < 4; ++c) in.color[i][c] = col[i][c].data() + off;
+        for (int i = 0; i < 8; ++i)
+            for (int c = 0; c < 4; ++c) in.texcoord[i][c] = tc[i][c].data() + off;
+        return in;
+    }
+};
+
+struct Out {
+    std::vector<float> color[4];
+    std::vector<int32_t> grid[4];
+    std::vector<uint8_t> killed;
+    explicit Out(int n) {
+        for (int c = 0; c < 4; ++c) color[c].assign(size_t(n), -7.0f), grid[c].assign(size_t(n), -77777);
+        killed.assign(size_t(n), 9);
+    }
+    ps11::PixelOutputs outputs(int off) {
+        ps11::PixelOutputs o;
+        for (int c = 0; c < 4; ++c) o.color[c] = color[c].data() + off, o.grid[c] = grid[c].data() + off;
+        o.killed = killed.data() + off;
+        return o;
+    }
+};
+
+// Runs exec over all lanes in spans of `span` pixels.
+void runAll(const ps11::Executor& e, const Lanes& l, Out& out, ps11::Sampler& s, int span) {
+    for (int off = 0; off < l.count; off += span) {
+        const int n = std::min(span, l.count - off);
+        ps11::PixelInputs in = l.inputs(off, n);
+        ps11::PixelOutputs o = out.outputs(off);
+        e.run(in, s, o);
+    }
+}
+
+// Compares two outputs bit for bit (grid, colour bits, killed); returns the mismatch count.
+int64_t compare(const Out& a, const Out& b, int count, const std::string& what) {
+    int64_t bad = 0;
+    for (int i = 0; i < count; ++i) {
+        bool ok = a.killed[size_t(i)] == b.killed[size_t(i)];
+        for (int c = 0; c < 4; ++c) {
+            ok = ok && a.grid[c][size_t(i)] == b.grid[c][size_t(i)];
+            ok = ok && std::memcmp(&a.color[c][size_t(i)], &b.color[c][size_t(i)], sizeof(float)) == 0;
+        }
+        if (!ok && bad++ < 3) {
+            FAIL_CHECK(what << "\npixel " << i << ": fast (" << a.grid[0][size_t(i)] << ", " << a.grid[1][size_t(i)]
+                            << ", " << a.grid[2][size_t(i)] << ", " << a.grid[3][size_t(i)] << ") generic ("
+                            << b.grid[0][size_t(i)] << ", " << b.grid[1][size_t(i)] << ", " << b.grid[2][size_t(i)]
+                            << ", " << b.grid[3][size_t(i)] << ")");
+        }
+    }
+    return bad;
+}
+
+// Runs text with the generic path and both fast kernel sets over the lanes; checks the fast
+// executors really take the fast path; returns mismatches.
+int64_t diffPaths(const std::string& text, float maxValue, const Lanes& l, int span, ps11::Sampler& s,
+                  const std::array<std::array<float, 4>, 8>* consts = nullptr, bool expectFast = true) {
+    auto gen = make(text, Precision::Fx8, maxValue, ExecPath::Generic);
+    CHECK(std::string(gen->pathName()) == "generic");
+    auto set = [&](ps11::Executor& e) {
+        if (consts)
+            for (int i = 0; i < 8; ++i) e.setConstant(i, (*consts)[size_t(i)]);
+    };
+    set(*gen);
+    Out want(l.count);
+    runAll(*gen, l, want, s, span);
+    int64_t bad = 0;
+    for (ExecPath path : {ExecPath::Auto, ExecPath::FastBaseline}) {
+        auto fast = make(text, Precision::Fx8, maxValue, path);
+        const std::string name = fast->pathName();
+        if (!ps11::exec::fastKernelsBaseline()) {
+            CHECK(name == "generic");  // a build without x86 kernels: the generic path everywhere
+        } else if (expectFast) {
+            CHECK(name != "generic");
+            if (path == ExecPath::FastBaseline) CHECK(name == "fast-sse2");
+            if (path == ExecPath::Auto && ps11::exec::fastKernelsAvx2()) CHECK(name == "fast-avx2");
+        } else {
+            CHECK(name == "generic");
+        }
+        set(*fast);
+        Out got(l.count);
+        runAll(*fast, l, got, s, span);
+        bad += compare(got, want, l.count, name + " span " + std::to_string(span) + "\n" + text);
+    }
+    return bad;
+}
+
+const char* kModSuffix[9][2] = {{"", ""},      {"-", ""},  {"", "_bias"}, {"-", "_bias"}, {"", "_bx2"},
+                                {"-", "_bx2"}, {"1-", ""}, {"", "_x2"},   {"-", "_x2"}};
+const char* kShiftName[7] = {"_d8", "_d4", "_d2", "", "_x2", "_x4", "_x8"};
+
+}  // namespace
+
+TEST_CASE("fast: every op over all operand pairs, each modifier, shift and _sat (ps_1_4, M = 1 and 8)", "[fast]") {
+    // r0, r1, r2 loaded by texcrd from TC0..2 (exact grid values n/255 in ±M); pixel i carries
+    // the pair (n0, n1) in each of r, g, b, so 3 pairs per pixel; n2 is pseudo-random.
+    ps11::NullSampler sampler;
+    struct OpDesc {
+        const char* name;
+        int srcs;
+    };
+    const OpDesc ops[] = {{"mov", 1}, {"add", 2}, {"sub", 2}, {"mul", 2}, {"mad", 3},
+                          {"lrp", 3}, {"cnd", 3}, {"cmp", 3}, {"dp3", 2}};
+    int64_t bad = 0, pixels = 0;
+    for (float M : {1.0f, 8.0f}) {
+        const int nMax = int(M) * 255;
+        // M = 1: all 511² pairs; M = 8: n0 over all 4081 values, n1 with a stride of 127 plus its ends.
+        std::vector<int> v1;
+        for (int n = -nMax; n <= nMax; n += (M == 1.0f ? 1 : 127)) v1.push_back(n);
+        v1.push_back(nMax);
+        const int pairs = (2 * nMax + 1) * int(v1.size());
+        const int count = (pairs + 2) / 3;
+        Lanes l(count);
+        std::mt19937 rng(1234);
+        for (int p = 0; p < 3 * count; ++p) {
+            const int pi = p % pairs;
+            const int n0 = -nMax + pi / int(v1.size()), n1 = v1[size_t(pi % int(v1.size()))];
+            const int n2 = std::uniform_int_distribution<int>(-nMax, nMax)(rng);
+            const int lane = p / 3, comp = p % 3;
+            l.tc[0][comp][size_t(lane)] = float(n0) / 255.0f;
+            l.tc[1][comp][size_t(lane)] = float(n1) / 255.0f;
+            l.tc[2][comp][size_t(lane)] = float(n2) / 255.0f;
+        }
+        struct Cfg {
+            int mods[3];
+            int shift;
+            bool sat;
+        };
+        std::vector<Cfg> cfgs;
+        for (int m = 0; m < 9; ++m)
+            for (int s = 0; s < 3; ++s) {
+                Cfg c{{0, 0, 0}, 0, false};
+                c.mods[s] = m;
+                cfgs.push_back(c);
+            }
+        for (int sh = -3; sh <= 3; ++sh)
+            for (bool sat : {false, true}) cfgs.push_back(Cfg{{0, 0, 0}, sh, sat});
+        cfgs.push_back(Cfg{{4, 6, 2}, 1, true});
+        cfgs.push_back(Cfg{{5, 8, 3}, -2, false});
+        for (const OpDesc& op : ops) {
+            for (const Cfg& cfg : cfgs) {
+                if (cfg.mods[1] && op.srcs < 2) continue;
+                if (cfg.mods[2] && op.srcs < 3) continue;
+                std::string text = "ps_1_4\ntexcrd r0.rgb, t0\ntexcrd r1.rgb, t1\ntexcrd r2.rgb, t2\n";
+                text += std::string(op.name) + kShiftName[cfg.shift + 3] + (cfg.sat ? "_sat" : "") + " r0.rgb";
+                for (int s = 0; s < op.srcs; ++s)
+                    text += std::string(", ") + kModSuffix[cfg.mods[s]][0] + "r" + std::to_string(s) +
+                            kModSuffix[cfg.mods[s]][1];
+                text += "\n";
+                bad += diffPaths(text, M, l, 256, sampler);
+                pixels += count;
+            }
+        }
+    }
+    INFO(pixels << " pixels compared per path");
+    CHECK(bad == 0);
+}
+
+TEST_CASE("fast: random valid programs over spans of 1..256 pixels equal the generic path", "[fast]") {
+    using namespace ps11test;
+    ps11::NullSampler sampler;
+    struct Run {
+        uint32_t seed;
+        int minor;
+        int programs;
+    };
+    const Run runs[] = {{0xfa570101u, 1, 300}, {0xfa570102u, 2, 150}, {0xfa570103u, 3, 150}, {0xfa570104u, 4, 400}};
+    int64_t bad = 0;
+    int fastRuns = 0, genericRuns = 0;
+    for (const Run& r : runs) {
+        Gen g(r.seed);
+        int valid = 0, generated = 0;
+        while (valid < r.programs && generated < r.programs * 40) {
+            ++generated;
+            Prog p = g.program(r.minor);
+            const std::string text = progText(p);
+            std::string err;
+            if (!assemble(text, err)) continue;
+            ++valid;
+            // Maximum value: the default mostly; 1_4 also 1, 2, 4; now and then 16 (beyond int16:
+            // the generic path must run).
+            float M = 0;
+            if (g.coin(0.2)) M = r.minor == 4 ? std::array<float, 4>{1, 2, 4, 16}[size_t(g.uni(0, 3))] : 2.0f;
+            const bool fastExpected = M != 16.0f;
+            const int count = g.coin(0.3) ? g.uni(1, 40) : g.uni(41, 700);
+            const int span = g.coin(0.5) ? 256 : g.uni(1, 256);
+            Lanes l(count);
+            for (int i = 0; i < count; ++i) {
+                Inputs in = g.inputs();
+                for (int v = 0; v < 2; ++v)
+                    for (int c = 0; c < 4; ++c) l.col[v][c][size_t(i)] = in.color[v][c];
+                for (int t = 0; t < 8; ++t)
+                    for (int c = 0; c < 4; ++c) l.tc[t][c][size_t(i)] = in.tc[t][c];
+            }
+            std::array<std::array<float, 4>, 8> consts;
+            Inputs ci = g.inputs();
+            for (int i = 0; i < 8; ++i) consts[size_t(i)] = ci.consts[i];
+            bad += diffPaths(text, M, l, span, sampler, &consts, fastExpected);
+            (fastExpected ? fastRuns : genericRuns)++;
+            if (bad > 10) break;
+        }
+        CHECK(valid >= r.programs / 2);
+    }
+    INFO(fastRuns << " programs on the fast path, " << genericRuns << " beyond it");
+    CHECK(bad == 0);
+    CHECK(fastRuns >= 700);
+    CHECK(genericRuns >= 5);
+}
+
+namespace {
+
+std::shared_ptr<const ps11::Texture> smallTexture() {
+    using namespace ps11;
+    TextureDesc desc;
+    desc.width = desc.height = 16;
+    TextureLevel level;
+    level.width = level.height = 16;
+    level.texels.resize(256);
+    for (uint32_t i = 0; i < 256; ++i) {
+        const uint32_t h = (i * 2654435761u) >> 8;
+        level.texels[i].bits = (h & 0xffffffu) | ((i * 37u & 0xffu) << 24);
+    }
+    desc.data.push_back(std::move(level));
+    std::string error;
+    auto t = textureFromDesc(desc, error);
+    REQUIRE(t);
+    return std::make_shared<const Texture>(std::move(*t));
+}
+
+}  // namespace
+
+TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem) equal the generic path", "[fast]") {
+    using namespace ps11;
+    TextureSampler sampler;
+    auto tex = smallTexture();
+    SamplerDesc sd;
+    sd.minFilter.value = sd.magFilter.value = Filter::Linear;
+    for (int s = 0; s < 4; ++s) {
+        sampler.bind(s, tex);
+        sampler.setSamplerState(s, samplerStateFromDesc(sd));
+    }
+    const char* programs[] = {
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\n"
+        "mad r0, t3, c0, r0\n",
+        "ps_1_1\ntex t0\nsub_sat r0, t0, c0\nmul_x4 r0, r0, r0\nmul r0, r0, c1\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r1, t1, c1\nmad r1, 1-t0, r1, t0\nlrp r0, c0.a, r1, t0\n",
+        "ps_1_1\ntex t0\ntexkill t1\nmul r0.rgb, t0, v0\n+add r0.a, t0.a, -v1.a\n",
+        "ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, c0, v0_bias\n",
+        "ps_1_3\ntex t0\ntexreg2ar t1, t0\ndp3_sat r0, t0_bx2, t1_bx2\n",
+        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
+        "-r2\n+mov r0.a, r3.a\n",
+        "ps_1_4\ntexld r1, t0\ntexkill r1\ncmp r0, r1_bias, c0, c1\n",
+    };
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<float> u(-0.2f, 1.2f);
+    const int count = 300;
+    Lanes l(count);
+    for (int i = 0; i < count; ++i) {
+        for (int v = 0; v < 2; ++v)
+            for (int c = 0; c < 4; ++c) l.col[v][c][size_t(i)] = u(rng);
+        for (int t = 0; t < 8; ++t)
+            for (int c = 0; c < 4; ++c) l.tc[t][c][size_t(i)] = c == 3 ? 1.0f : u(rng);
+    }
+    // Colours the device should never send but the executor must treat alike: NaN, ±inf, −0.
+    const float odd[] = {std::nanf(""), INFINITY, -INFINITY, -0.0f, 0.5f / 255.0f, 1.5f / 255.0f, 254.5f / 255.0f};
+    for (int i = 0; i < count; i += 3)
+        for (int v = 0; v < 2; ++v) l.col[v][(i / 3) % 4][size_t(i)] = odd[size_t((i / 3 + v) % 7)];
+    std::array<std::array<float, 4>, 8> consts;
+    for (auto& c : consts)
+        for (float& f : c) f = u(rng) * 1.6f - 0.8f;
+    int64_t bad = 0;
+    for (const char* text : programs)
+        for (int span : {256, 64, 37, 1}) bad += diffPaths(text, 0, l, span, sampler, &consts);
+    CHECK(bad == 0);
+}
+
+TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
+    if (!ps11::exec::fastKernelsBaseline()) return;  // no x86 kernels in this build
+    const std::string text = "ps_1_4\ntexcrd r0.rgb, t0\nmul r0.rgb, r0, r0\n";
+    CHECK(std::string(make(text, Precision::Fx8, 0, ExecPath::Auto)->pathName()) != "generic");
+    CHECK(std::string(make(text, Precision::Fx8, 8, ExecPath::Auto)->pathName()) != "generic");
+    CHECK(std::string(make(text, Precision::Fx8, 9, ExecPath::Auto)->pathName()) == "generic");
+    CHECK(std::string(make(text, Precision::Fx12, 0, ExecPath::Auto)->pathName()) == "generic");
+    CHECK(std::string(make(text, Precision::Float, 0, ExecPath::Auto)->pathName()) == "generic");
+    CHECK(std::string(make(text, Precision::Fx8, 0, ExecPath::Generic)->pathName()) == "generic");
+    CHECK(std::string(
+              make("ps_1_4\ntexld r1, t0\nbem r2.rg, c0, r1\nphase\nmov r0, r2.r\n", Precision::Fx8, 0, ExecPath::Auto)
+                  ->pathName()) == "generic");
+}
