@@ -5,6 +5,7 @@
 // (tools/test_draw.cpp). Commands asked of the gl backend are counted as "not yet runnable".
 #include "tools/cmd_test.h"
 
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <string>
@@ -25,7 +26,7 @@ namespace ps11 {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n";
+    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11 test: " << message << "\n" << kUsage;
@@ -206,7 +207,18 @@ int cmdTest(const std::vector<std::string>& args) {
         } else if (a.size() > 1 && a[0] == '-') {
             return usageError("unknown option '" + a + "'");
         } else {
-            files.push_back(a);
+            std::error_code ec;
+            if (std::filesystem::is_directory(a, ec)) {
+                // A folder stands for every .ps11test below it, sorted.
+                std::vector<std::string> found = cli::listFiles(a, ".ps11test");
+                if (found.empty()) {
+                    std::cerr << "ps11 test: no .ps11test files under " << a << "\n";
+                    return cli::kUserError;
+                }
+                files.insert(files.end(), found.begin(), found.end());
+            } else {
+                files.push_back(a);
+            }
         }
     }
     if (files.empty()) return usageError("no .ps11test files given");

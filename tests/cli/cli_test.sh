@@ -113,6 +113,15 @@ expect_in "$work/out" "1 draws, " "draw --stats"
 expect_rc 1 "a draw the device refuses" "$ps11" test "$work/ff.ps11test"
 expect_in "$work/out" "ff.ps11test:20: E4142 DrawPrimitiveUP" "device error names the draw's line"
 
+# test: a folder stands for every .ps11test below it.
+mkdir -p "$work/suite/sub" "$work/empty"
+cp "$work/d.ps11test" "$work/suite/sub/"
+printf '[pixel shader]\nps_1_1\nmov r0, v0\n[test]\neval\n  v0 1 0 0 1\nprobe eval rgba 1 0 0 1\n' >"$work/suite/e.ps11test"
+expect_rc 1 "test on a folder" "$ps11" test "$work/suite"
+expect_in "$work/out" "2 files: 1 passed, 1 failed" "a folder's files all run"
+expect_rc 1 "test on a folder without test files" "$ps11" test "$work/empty"
+expect_in "$work/err" "no .ps11test files under" "empty folder named"
+
 # demo: options and their usage errors.
 expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
 expect_in "$work/out" "bloom on the emu device: 64x36 scene" "demo header"
