@@ -36,23 +36,33 @@ const LaneTable kLanes;
 typedef float Quad4 __attribute__((vector_size(16)));
 
 // Fills lanes [0, n) with the plane's values over the span whose top-left lane is pixel
-// (x0, y0): the two row starts are computed in double, each lane adds dx·column in float
-// (column = its offset from x0, exact in float). One quad per step: (f0, f0, f1, f1) + dx·(c, c+1, c, c+1).
+// (x0, y0). A lane's value depends on its pixel alone, never on where the span starts:
+// value(x, y) = float(rowBase(y)) + float(dx) · float(x), rowBase(y) = base + dx·(0 − ox) +
+// dy·(y − oy) in double (planeRowBase), then one float multiply and one float add
+// (planeValue). The aligned-pass path (emu/aligned_pass.h) relies on that to build its
+// per-column and per-row tables from the same formula. One quad per step.
 void fillPlane(const Plane& p, double ox, double oy, int x0, int y0, int n, float* out) {
-    const double s0 = p.base + p.dx * (x0 - ox) + p.dy * (y0 - oy);
-    const float f0 = float(s0), f1 = float(s0 + p.dy), fdx = float(p.dx);
+    const float f0 = float(planeRowBase(p, ox, oy, y0)), f1 = float(planeRowBase(p, ox, oy, y0 + 1));
+    const float fdx = float(p.dx), fx0 = float(x0);
     const Quad4 base = {f0, f0, f1, f1};
     const Quad4 d = {fdx, fdx, fdx, fdx};
+    const Quad4 start = {fx0, fx0, fx0, fx0};
     // Columns from a table (no loop-carried dependency: a running column would serialise the adds).
     for (int q = 0; q < n / 4; ++q) {
         Quad4 col;
         std::memcpy(&col, kLanes.col + 4 * q, sizeof col);
-        const Quad4 r = base + d * col;
+        const Quad4 r = base + d * (start + col);  // start + col = x exactly (x < 2^24)
         std::memcpy(out + 4 * q, &r, sizeof r);
     }
 }
 
 }  // namespace
+
+float planeValue(const Plane& p, double ox, double oy, int x, int y) {
+    const float base = float(planeRowBase(p, ox, oy, y));
+    const float prod = float(p.dx) * float(x);
+    return base + prod;
+}
 
 bool setupTriangle(const ScreenTriangle& tri, uint64_t used, const ClipRect& clip, TriangleSetup& s) {
     if (clip.x0 >= clip.x1 || clip.y0 >= clip.y1) return false;

@@ -27,6 +27,14 @@ struct Plane {
     double base = 0, dx = 0, dy = 0;
 };
 
+// The rasteriser's value of a plane at pixel (x, y) (not perspective-divided): the float sum
+// float(planeRowBase(p, ox, oy, y)) + float(p.dx) · float(x), with no contraction into an FMA.
+// Spans compute exactly this per lane, so a value depends on the pixel only.
+inline double planeRowBase(const Plane& p, double ox, double oy, int y) {
+    return p.base + p.dx * (0.0 - ox) + p.dy * (double(y) - oy);
+}
+float planeValue(const Plane& p, double ox, double oy, int x, int y);
+
 struct TriangleSetup {
     // Edge i: E(X, Y) = a·X + b·Y + c with X, Y in 1/256 pixel; a pixel centre is covered when
     // E >= t for all three edges (t = 0 on top and left edges, 1 on the others).
