@@ -25,6 +25,9 @@ struct DeviceOptions {
     float maxValue = 0;                                // PixelShader1xMaxValue; 0 = the shader version's default
     int threads = 0;                                   // worker threads of draws; 0 = all cores
     uint64_t maxResourceBytes = kMaxResourceBytes;     // per resource, checked before allocating
+    // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
+    // no helper lanes, so fewer pixels shaded). Off: every draw goes through 2x2 quads.
+    bool alignedPasses = true;
 };
 
 // What the last call reported. Every call resets it; a failed call sets hr, an E41xx code and

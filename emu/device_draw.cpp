@@ -10,6 +10,7 @@
 #include <list>
 #include <unordered_map>
 
+#include "emu/aligned_pass.h"
 #include "emu/device.h"
 #include "emu/ffp.h"
 #include "emu/output_merger.h"
@@ -151,6 +152,7 @@ struct WorkerScratch {
     QuadSpan span;
     Lanes lanes;
     ps11::TextureSampler sampler;
+    AlignedScratch aligned;
 };
 
 struct DrawContext {
@@ -453,6 +455,14 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     std::vector<ScreenTriangle> tris;
     std::vector<TriangleSetup> setups;
     bool wrote = false;
+    // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
+    MergeTarget mtarget{target, depth};
+    AlignedDraw aligned;
+    const bool alignedDraw = m_options.alignedPasses && prepareAlignedDraw(executor, m_options.precision, textures,
+                                                                           samplers, merge, mtarget, wantZ, used,
+                                                                           aligned);
+    std::vector<AlignedTriangle> alignedTris;
+    std::vector<uint8_t> isAligned;
     for (uint32_t first = 0; first < primitiveCount; first += kChunkTriangles) {
         const uint32_t chunk = std::min(kChunkTriangles, primitiveCount - first);
         tris.clear();
@@ -468,6 +478,12 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             setups.push_back(s);
         }
         stats.trianglesDrawn += setups.size();
+        isAligned.assign(setups.size(), 0);
+        if (alignedDraw && setups.size() <= kMaxAlignedTriangles) {
+            alignedTris.resize(setups.size());
+            for (size_t i = 0; i < setups.size(); ++i)
+                isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
+        }
 
         // ---- rows in bands over the workers ----
         if (!setups.empty()) {
@@ -477,7 +493,6 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             std::atomic<int> next{0};
             const int workers = std::min(dc.pool.size(), bands);
             std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
-            MergeTarget mtarget{target, depth};
             const bool fx = ps11::isFixedPoint(m_options.precision);
             dc.pool.run(workers, [&](int w) {
                 WorkerScratch& ws0 = *dc.scratch[size_t(w)];
@@ -529,20 +544,26 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                     ws.pixelsCovered += uint64_t(sp.liveCount);
                 };
                 const std::function<void(QuadSpan&)> emitFn = emit;
+                AlignedStats as;
                 for (;;) {
                     const int b = next.fetch_add(1, std::memory_order_relaxed);
                     if (b >= bands) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
-                    for (const TriangleSetup& s : setups) {
+                    for (size_t i = 0; i < setups.size(); ++i) {
+                        const TriangleSetup& s = setups[i];
                         if (s.yMax <= by0 || s.yMin >= by1) continue;
-                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                        if (isAligned[i])
+                            drawAlignedRows(aligned, alignedTris[i], s, by0, by1, ws0.aligned, as);
+                        else
+                            rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                     }
                 }
-                ws.pixelsShaded = es.pixels;
-                ws.instructions = es.instructions;
-                ws.pixelsWritten = ms.written;
-                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore;
+                ws.pixelsCovered += as.pixels;
+                ws.pixelsShaded = es.pixels + as.exec.pixels;
+                ws.instructions = es.instructions + as.exec.instructions;
+                ws.pixelsWritten = ms.written + as.written;
+                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore + as.texels;
             });
             for (const DrawStats& ws : workerStats) {
                 stats.pixelsCovered += ws.pixelsCovered;

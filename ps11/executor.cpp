@@ -60,6 +60,9 @@ public:
 
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
              ExecutorStats* stats) const override;
+    bool tapPlan(TapPlan& plan) const override;
+    void runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+                       ExecutorStats* stats) const override;
 
 private:
     void refreshConstant(int i) {
@@ -139,6 +142,40 @@ void ExecutorImpl::runChunk(RunState& st) const {
                     std::memcpy(st.bf.reg[first.dstSlot][c], st.bf.hold[c], sizeof(float) * size_t(st.n));
             }
         }
+    }
+}
+
+bool ExecutorImpl::tapPlan(TapPlan& plan) const {
+    plan = TapPlan{};
+    if (!m_fast.kernels) return false;
+    for (const DOp& op : m_ops) {
+        if (!op.texture) continue;
+        if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
+        uint8_t set = op.stage;
+        if (m_p.minor < 4) {
+            if (m_p.stages[op.stage].transformFlags & kTtffProjected) return false;
+        } else {
+            const DSrc& s = op.src[0];
+            if (s.kind != SrcKind::TexCoord || s.mod != SrcMod::None || s.sw[0] != 0 || s.sw[1] != 1) return false;
+            set = s.slot;
+        }
+        plan.stage[size_t(plan.count)] = op.stage;
+        plan.coordSet[size_t(plan.count)] = set;
+        ++plan.count;
+    }
+    return true;
+}
+
+void ExecutorImpl::runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+                                 ExecutorStats* stats) const {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    runFastPresampled(m_fast, m_p, m_ops, m_vUsed, inputs, taps, r0);
+    if (stats) {
+        stats->pixels += uint64_t(count);
+        uint64_t executed = 0;
+        for (const DOp& op : m_ops)
+            if (op.op != Opcode::Phase) ++executed;
+        stats->instructions += executed * uint64_t(count);
     }
 }
 

@@ -59,6 +59,15 @@ struct ExecutorStats {
     uint64_t instructions = 0;  // instruction executions (per pixel)
 };
 
+// The texture reads of a program that can take its texels pre-sampled (Executor::tapPlan): tap
+// i is the i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy with
+// no projection and no dependency on other registers.
+struct TapPlan {
+    int count = 0;
+    std::array<uint8_t, 8> stage{};
+    std::array<uint8_t, 8> coordSet{};
+};
+
 class Executor {
 public:
     // Prepares the program (decode once). Reports E40xx and returns null for programs it cannot
@@ -82,6 +91,19 @@ public:
     // outputs when the sampler is (run keeps no per-call state in the object).
     virtual void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
                      ExecutorStats* stats = nullptr) const = 0;
+
+    // Pre-sampled runs, for callers that sample screen-aligned rows themselves (the device's
+    // aligned-pass path, emu/aligned_pass.h). Available when the program runs on the fx8 fast
+    // path and its only texture instructions are plain reads: `tex t#` in ps_1_1–1_3 on a stage
+    // without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw,
+    // .xy as written). Fills `plan` and returns true, else false.
+    virtual bool tapPlan(TapPlan& plan) const = 0;
+    // Runs `count` (<= kMaxSpan) pixels whose texture instructions read taps[i][c][lane] (fx8 grid
+    // integers of tap i, channel c = r g b a) instead of a sampler; v0/v1 come from inputs.color.
+    // r0[c][lane] receives r0's grid integers. Same results as run() with a sampler returning
+    // those texels. Only valid after tapPlan() returned true.
+    virtual void runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+                               ExecutorStats* stats = nullptr) const = 0;
 };
 
 }  // namespace ps11

@@ -280,4 +280,62 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
     }
 }
 
+void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
+                       const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4]) {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    thread_local std::unique_ptr<FastRunState> cache;
+    std::unique_ptr<FastRunState> fs = std::move(cache);
+    if (!fs) fs.reset(new FastRunState);
+    struct GiveBack {
+        std::unique_ptr<FastRunState>& fs;
+        ~GiveBack() { cache = std::move(fs); }
+    } giveBack{fs};
+    FastBank& bank = fs->bank;
+    alignas(64) float zeros[kChunk] = {};
+    std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
+    for (int i = 0; i < 8; ++i)
+        if ((fp.constsUsed >> i) & 1)
+            for (int c = 0; c < 4; ++c)
+                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    const FastKernels& kern = *fp.kernels;
+    const int16_t m = int16_t(p.nMax);
+    for (int off = 0; off < count; off += kChunk) {
+        const int n = std::min(kChunk, count - off);
+        const int nv = (n + 15) & ~15;
+        for (int v = 0; v < 2; ++v) {
+            if (!((vUsed >> v) & 1)) continue;
+            for (int c = 0; c < 4; ++c)
+                kern.loadColor(inputs.color[v][c] ? inputs.color[v][c] + off : zeros, bank.reg[kSlotV + v][c], n);
+        }
+        int tap = 0;
+        for (size_t idx = 0; idx < ops.size(); ++idx) {
+            const DOp& op = ops[idx];
+            if (op.op == Opcode::Phase) continue;
+            if (op.texture) {
+                // A plain read (Executor::tapPlan): the tap's texels, clamped to ±M as sampleInto does.
+                for (int c = 0; c < 4; ++c) {
+                    const int16_t* src = taps[tap][c] + off;
+                    int16_t* dst = bank.reg[op.dstSlot][c];
+                    for (int i = 0; i < n; ++i) dst[i] = src[i] < -m ? int16_t(-m) : (src[i] > m ? m : src[i]);
+                }
+                ++tap;
+            } else {
+                const FastOp& f = fp.ops[idx];
+                kern.arith(f, bank, nv);
+                if (f.viaTemp)
+                    for (int c = 0; c < 4; ++c)
+                        if ((f.mask >> c) & 1)
+                            std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+            }
+            if (!op.hold && idx > 0 && ops[idx - 1].hold) {
+                const DOp& first = ops[idx - 1];
+                for (int c = 0; c < 4; ++c)
+                    if ((first.mask >> c) & 1)
+                        std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
+            }
+        }
+        for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * size_t(n));
+    }
+}
+
 }  // namespace ps11::exec

@@ -33,4 +33,11 @@ void setForceGeneric(bool generic);
 // True when this process would pick the AVX2 build.
 bool hasAvx2Kernel();
 
+// One axis of the kernels above on its own, for callers that tabulate it (the device's
+// aligned-pass path): per coordinate c[i] of an axis with n texels, the texel pair i0/i1 (-1 =
+// border) and the 8-bit weight w of i1 (bilinear), or the texel i0 = i1 with w = 0 (point).
+// Exactly the values the kernels use for the same coordinate.
+void axisTable(TextureAddress mode, bool linear, int count, const float* c, uint32_t n, int32_t* i0, int32_t* i1,
+               int32_t* w);
+
 }  // namespace ps11::fastpath

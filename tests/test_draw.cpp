@@ -240,7 +240,10 @@ TEST_CASE("draw: one and two threads give identical images", "[draw]") {
 }
 
 TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]") {
-    Device dev;
+    // The quad path (the aligned-pass path shades no helper lanes: see the last section).
+    DeviceOptions opt;
+    opt.alignedPasses = false;
+    Device dev(opt);
     const UINT W = 8, H = 8;
     target(dev, W, H);
     shader(dev, "ps_1_1\nmov r0, v0\n");
@@ -263,6 +266,17 @@ TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]
     CHECK(t.draws == 2);
     CHECK(t.triangles == 3);
     CHECK(t.pixelsCovered == 64 + dev.lastDrawStats().pixelsCovered);
+
+    // The same draw on the aligned-pass path: rows, no helper lanes.
+    Device fast;
+    target(fast, W, H);
+    shader(fast, "ps_1_1\nmov r0, v0\n");
+    REQUIRE(fast.SetFVF(kQuadFvf) == D3D_OK);
+    REQUIRE(fast.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    CHECK(fast.lastDrawStats().pixelsCovered == 64);
+    CHECK(fast.lastDrawStats().pixelsShaded == 64);
+    CHECK(fast.lastDrawStats().instructions == 64);
+    CHECK(fast.lastDrawStats().pixelsWritten == 64);
 }
 
 TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[draw]") {

@@ -1,0 +1,314 @@
+// Device stage: the aligned-pass path of DrawPrimitiveUP (emu/aligned_pass.h). Eligibility,
+// per-triangle column tables, per-row filtering of each tap into int16 lanes (scalar for any
+// footprint, AVX2 for runs of columns that step one texel with a fixed weight), the pre-sampled
+// executor run, and the stores. Exactness: the tables hold the very texel pairs and weights the
+// TextureSampler's kernels compute for the same coordinates (ps11::fastpath::axisTable), and the
+// coordinates are the rasteriser's own formula (emu/raster.h planeValue); the blend is the
+// exact sum Σ w·byte rounded once, half to even (docs/precision.md "Sampling").
+#include "emu/aligned_pass.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "emu/aligned_pass_kernels.h"
+#include "ps11/texture_sampler_fast.h"
+
+namespace emu {
+
+namespace {
+
+bool effectiveLinear(ps11::Filter f) { return f == ps11::Filter::Linear; }
+
+// round_half_even(t / 65536) for 0 <= t < 2^24.
+inline int32_t roundBlend(uint32_t t) { return int32_t((t + 0x7fffu + ((t >> 16) & 1u)) >> 16); }
+
+// Channel c (r g b a) of a b g r a word.
+inline uint32_t channel(uint32_t word, int c) { return (word >> (8 * ps11::kUnorm8Byte[c])) & 0xffu; }
+
+inline uint32_t load32(const uint8_t* p) {
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return v;
+}
+
+// One row of one tap: the two texel rows (null = border) and the vertical weight.
+struct TapRow {
+    const uint8_t* row0 = nullptr;
+    const uint8_t* row1 = nullptr;
+    int32_t wy = 0;
+};
+
+// Any footprint, one pixel at a time: the exact four-texel sum of the reference.
+void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase,
+                  int first, int count, int lane, int16_t* const out[4]) {
+    const int32_t wy = row.wy;
+    for (int i = 0; i < count; ++i) {
+        const int x = first + i - colBase;
+        const int32_t o0 = cols.off0[size_t(x)], o1 = cols.off1[size_t(x)], wx = cols.w[size_t(x)];
+        const uint32_t a = row.row0 && o0 >= 0 ? load32(row.row0 + o0) : tap.borderWord;
+        const uint32_t b = row.row0 && o1 >= 0 ? load32(row.row0 + o1) : tap.borderWord;
+        const uint32_t c = row.row1 && o0 >= 0 ? load32(row.row1 + o0) : tap.borderWord;
+        const uint32_t d = row.row1 && o1 >= 0 ? load32(row.row1 + o1) : tap.borderWord;
+        for (int ch = 0; ch < 4; ++ch) {
+            const uint32_t h0 = channel(a, ch) * uint32_t(256 - wx) + channel(b, ch) * uint32_t(wx);
+            const uint32_t h1 = channel(c, ch) * uint32_t(256 - wx) + channel(d, ch) * uint32_t(wx);
+            out[ch][lane + i] = int16_t(roundBlend(h0 * uint32_t(256 - wy) + h1 * uint32_t(wy)));
+        }
+    }
+}
+
+#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+bool hasAvx2() {
+    static const bool has = __builtin_cpu_supports("avx2");
+    return has;
+}
+#else
+bool hasAvx2() { return false; }
+#endif
+
+template <bool Additive>
+void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    for (int i = 0; i < count; ++i) {
+        auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
+        uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
+        if constexpr (Additive) {
+            const uint32_t old = load32(dst + 4 * i);
+            uint32_t s = 0;
+            for (int k = 0; k < 4; ++k)
+                s |= std::min<uint32_t>(((w >> (8 * k)) & 0xff) + ((old >> (8 * k)) & 0xff), 255u) << (8 * k);
+            w = s;
+        }
+        std::memcpy(dst + 4 * i, &w, 4);
+    }
+}
+
+// The texel rows and vertical weight of a tap on pixel row y.
+TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
+    TapRow r;
+    const int k = attrTex(tap.coordSet, 1);
+    const float v = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+    int32_t j0 = 0, j1 = 0, w = 0;
+    ps11::fastpath::axisTable(tap.addressV, tap.linear, 1, &v, tap.height, &j0, &j1, &w);
+    const size_t pitch = size_t(tap.width) * 4;
+    r.row0 = j0 >= 0 ? tap.texels + size_t(j0) * pitch : nullptr;
+    r.row1 = j1 >= 0 ? tap.texels + size_t(j1) * pitch : nullptr;
+    r.wy = w;
+    return r;
+}
+
+// Filters pixels [first, first + count) of a row of one tap into out[c] + lane.
+void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase, int first,
+               int count, int lane, int16_t* const out[4]) {
+    if (!tap.bound) {
+        for (int c = 0; c < 4; ++c) std::fill_n(out[c] + lane, count, int16_t(c == 3 ? 255 : 0));
+        return;
+    }
+    const bool rowsOk = row.row0 && (row.row1 || row.wy == 0);
+    int x = first;
+    const int end = first + count;
+    while (x < end) {
+        const int t = x - colBase;
+        int runEnd = std::min(end, cols.runEnd[size_t(t)]);
+        if (hasAvx2() && rowsOk && runEnd - x >= 16) {
+            const int n = (runEnd - x) & ~15;
+#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+            const uint8_t* r1 = row.row1 ? row.row1 + cols.off0[size_t(t)] : nullptr;
+            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, lane + (x - first), out);
+#endif
+            x += n;
+            continue;
+        }
+        // A short run, a border texel or no AVX2: one pixel at a time up to the next long run.
+        int e = x + 1;
+        while (e < end && !(hasAvx2() && rowsOk && std::min(end, cols.runEnd[size_t(e - colBase)]) - e >= 16)) ++e;
+        filterScalar(tap, cols, row, colBase, x, e - x, lane + (x - first), out);
+        x = e;
+    }
+}
+
+}  // namespace
+
+bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
+                        const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
+                        const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
+                        const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
+    if (precision != ps11::Precision::Fx8 || wantZ || merge.fog || !target.color) return false;
+    AlignedDraw d;
+    if (!executor.tapPlan(d.plan)) return false;
+    d.executor = &executor;
+    for (int i = 0; i < d.plan.count; ++i) {
+        const int stage = d.plan.stage[size_t(i)];
+        AlignedTap& tap = d.taps[size_t(i)];
+        tap.coordSet = d.plan.coordSet[size_t(i)];
+        const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
+        if (!tex) continue;  // (0, 0, 0, 1)
+        const ps11::SamplerState& ss = samplers[size_t(stage)];
+        // One level and one filter for every pixel, as the sampler decides (docs/textures.md).
+        if (tex->isVolume() || tex->storage() != ps11::TexelStorage::Unorm8) return false;
+        if (effectiveLinear(ss.minFilter) != effectiveLinear(ss.magFilter)) return false;
+        if (tex->levelCount() != 1 && ss.mipFilter != ps11::Filter::None) return false;
+        const ps11::TextureLevelInfo& li = tex->level(0);
+        tap.bound = true;
+        tap.texels = tex->unorm8() + li.offset * 4;
+        tap.width = li.width;
+        tap.height = li.height;
+        tap.linear = effectiveLinear(ss.magFilter);
+        tap.addressU = ss.addressU;
+        tap.addressV = ss.addressV;
+        // The border colour's bytes (the device sets it from a D3DCOLOR: byte / 255 per channel).
+        uint32_t word = 0;
+        for (int c = 0; c < 4; ++c) {
+            const float f = ss.border[size_t(c)] * 255.0f;
+            const uint32_t b = uint32_t(std::clamp(f, 0.0f, 255.0f) + 0.5f);
+            if (float(b) / 255.0f != ss.border[size_t(c)]) return false;
+            word |= b << (8 * ps11::kUnorm8Byte[c]);
+        }
+        tap.borderWord = word;
+    }
+    d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
+    d.merge = merge;
+    d.target = target;
+    const D3DFORMAT f = target.color->format->format;
+    const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
+    const bool plain = unorm && !merge.alphaTest && !merge.depthTest && !merge.depthWrite && merge.colorWrite == 0xf;
+    d.directStore = plain && !merge.blend;
+    const bool oneOne = merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE &&
+                        merge.blendOp == D3DBLENDOP_ADD &&
+                        (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE &&
+                                                  merge.dstBlendAlpha == D3DBLEND_ONE &&
+                                                  merge.blendOpAlpha == D3DBLENDOP_ADD));
+    d.directAdd = plain && merge.blend && oneOne;
+    out = d;
+    return true;
+}
+
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+    if (s.perspective) return false;
+    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const int ku = attrTex(draw.taps[size_t(i)].coordSet, 0), kv = ku + 1;
+        if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
+        if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
+    }
+    out.x0 = s.clip.x0;
+    out.x1 = s.clip.x1;
+    const int n = out.x1 - out.x0;
+    std::vector<float> u(size_t(std::max(n, 0)));
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const AlignedTap& tap = draw.taps[size_t(i)];
+        AlignedTriangle::Columns& cols = out.taps[size_t(i)];
+        if (!tap.bound) continue;
+        const int k = attrTex(tap.coordSet, 0);
+        for (int x = 0; x < n; ++x)
+            u[size_t(x)] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
+                                                  : planeValue(s.attr[size_t(k)], s.ox, s.oy, out.x0 + x, s.yMin);
+        cols.off0.resize(size_t(n));
+        cols.off1.resize(size_t(n));
+        cols.w.resize(size_t(n));
+        cols.runEnd.resize(size_t(n));
+        ps11::fastpath::axisTable(tap.addressU, tap.linear, n, u.data(), tap.width, cols.off0.data(), cols.off1.data(),
+                                  cols.w.data());
+        // Runs (runEnd in absolute columns; runEnd == column: not in a run): columns stepping
+        // one texel with one weight, not on the border. The vector kernels read texels i0 and,
+        // when the weight is not 0, i0 + 1 of both rows, so i0 + 1 must then be the pair's second.
+        for (int x = n - 1; x >= 0; --x) {
+            const int32_t i0 = cols.off0[size_t(x)], i1 = cols.off1[size_t(x)], w = cols.w[size_t(x)];
+            const bool ok = i0 >= 0 && (w == 0 || i1 == i0 + 1);
+            const bool joins = ok && x + 1 < n && cols.off0[size_t(x + 1)] == i0 + 1 && cols.w[size_t(x + 1)] == w &&
+                               cols.runEnd[size_t(x + 1)] > out.x0 + x + 1;
+            cols.runEnd[size_t(x)] = ok ? (joins ? cols.runEnd[size_t(x + 1)] : out.x0 + x + 1) : out.x0 + x;
+        }
+        // Texel indices to byte offsets within a row (−1 stays the border).
+        for (int x = 0; x < n; ++x) {
+            if (cols.off0[size_t(x)] >= 0) cols.off0[size_t(x)] *= 4;
+            if (cols.off1[size_t(x)] >= 0) cols.off1[size_t(x)] *= 4;
+        }
+    }
+    return true;
+}
+
+void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const TriangleSetup& s, int y0, int y1,
+                     AlignedScratch& sc, AlignedStats& stats) {
+    const int yStart = std::max(y0, s.yMin), yEnd = std::min(y1, s.yMax);
+    const ps11::Executor& exec = *draw.executor;
+    Image& target = *draw.target.color;
+    const bool x8 = target.format->format == D3DFMT_X8R8G8B8;
+    const uint32_t orMask = x8 ? 0xff000000u : 0u;
+    const int taps = draw.plan.count;
+    int16_t* tapOut[8][4];
+    for (int t = 0; t < 8; ++t)
+        for (int c = 0; c < 4; ++c) tapOut[t][c] = sc.taps[t][c];
+    int16_t* const r0[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
+    const int16_t* const r0c[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
+    ps11::PixelInputs in;
+    for (int c = 0; c < 4; ++c) {
+        if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
+        if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
+    }
+    std::array<TapRow, 8> rows{};
+    for (int y = yStart; y < yEnd; ++y) {
+        int xl = 0, xr = 0;
+        if (!rowCoverage(s, y, xl, xr)) continue;
+        for (int t = 0; t < taps; ++t)
+            if (draw.taps[size_t(t)].bound) rows[size_t(t)] = tapRow(draw.taps[size_t(t)], s, y);
+        for (int x = xl; x < xr; x += ps11::kMaxSpan) {
+            const int n = std::min(ps11::kMaxSpan, xr - x);
+            for (int t = 0; t < taps; ++t) {
+                filterTap(draw.taps[size_t(t)], tri.taps[size_t(t)], rows[size_t(t)], tri.x0, x, n, 0, tapOut[t]);
+                stats.texels += uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
+            }
+            for (int k = 0; k < 8; ++k) {
+                const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
+                if (!((draw.colorAttrs >> attr) & 1)) continue;
+                float* dst = sc.color[k];
+                if ((s.constMask >> attr) & 1) {
+                    std::fill_n(dst, n, s.constValue[size_t(attr)]);
+                } else {
+                    const Plane& p = s.attr[size_t(attr)];
+                    const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
+                    for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+                }
+            }
+            in.count = n;
+            exec.runPresampled(in, tapOut, r0, &stats.exec);
+            stats.pixels += uint64_t(n);
+            uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
+            if (draw.directStore || draw.directAdd) {
+#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+                if (hasAvx2()) {
+                    if (draw.directAdd)
+                        alignedStoreRowAvx2(true, r0c, n, orMask, row);
+                    else
+                        alignedStoreRowAvx2(false, r0c, n, orMask, row);
+                } else
+#endif
+                    if (draw.directAdd) {
+                    storeRowScalar<true>(r0c, n, orMask, row);
+                } else {
+                    storeRowScalar<false>(r0c, n, orMask, row);
+                }
+                stats.written += uint64_t(n);
+                continue;
+            }
+            // Anything else: the output merger over the row.
+            MergeInputs mi;
+            mi.count = n;
+            for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+            mi.x = sc.x;
+            mi.y = sc.y;
+            for (int c = 0; c < 4; ++c) {
+                for (int i = 0; i < n; ++i) {
+                    sc.grid[c][i] = sc.r0[c][i];
+                    sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
+                }
+                mi.color[c] = sc.colorOut[c];
+                mi.grid[c] = sc.grid[c];
+            }
+            MergeStats ms;
+            mergePixels(draw.merge, mi, draw.target, &ms);
+            stats.written += ms.written;
+        }
+    }
+}
+
+}  // namespace emu

@@ -1,0 +1,91 @@
+// The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): triangles whose
+// texture coordinates are screen-aligned (u depends on x only, v on y only, no perspective) in
+// fx8, with a program whose texture reads are plain (ps11::Executor::tapPlan), are drawn row by
+// row without quads or per-lane coordinates: each tap's texel columns and weights are tabulated
+// once per triangle and its rows once per pixel row, texels are filtered straight from the level
+// into int16 lanes (fixed-fraction runs vectorised), the executor runs pre-sampled, and 8-bit
+// targets take plain and additive stores directly. Results are bit-identical to the quad path.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "emu/output_merger.h"
+#include "emu/raster.h"
+#include "ps11/executor.h"
+#include "ps11/texture.h"
+#include "ps11/texture_sampler.h"
+
+namespace emu {
+
+// One texture read of the program, resolved against the draw's textures and sampler states.
+struct AlignedTap {
+    bool bound = false;                // no texture: every lookup is (0, 0, 0, 1)
+    const uint8_t* texels = nullptr;   // level 0, b g r a bytes, rows width * 4 apart
+    uint32_t width = 1, height = 1;
+    bool linear = false;
+    ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;
+    uint32_t borderWord = 0;  // D3DCOLOR (bytes b g r a)
+    int coordSet = 0;
+};
+
+// What one draw needs, shared read-only by the workers.
+struct AlignedDraw {
+    const ps11::Executor* executor = nullptr;
+    ps11::TapPlan plan;
+    std::array<AlignedTap, 8> taps{};
+    uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
+    MergeState merge;
+    MergeTarget target;
+    bool directStore = false;  // 8-bit target, no tests, fog or blending, all channels: stored here
+    bool directAdd = false;    // fx8 ONE/ONE ADD on every channel into an 8-bit target
+};
+
+// Decides whether a draw can take the aligned path (per-triangle checks come later) and fills
+// `out`. `textures`/`samplers` are indexed by stage.
+bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
+                        const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
+                        const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
+                        const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out);
+
+// Per-triangle column tables of every tap: texel byte offsets of the pair (−1 = border) and the
+// 8-bit weight per column, and for each column the end of the run of columns that step one texel
+// with the same weight (filtered with vector loads).
+struct AlignedTriangle {
+    int x0 = 0, x1 = 0;  // columns tabulated: [x0, x1)
+    struct Columns {
+        std::vector<int32_t> off0, off1, w, runEnd;
+    };
+    std::array<Columns, 8> taps;
+};
+
+// True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
+// colours constant or affine) and then fills its tables.
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out);
+
+// Largest number of triangles (after setup) a draw may have for the aligned path: tables cost
+// about the clip width per tap per triangle, so meshes stay on the quad path.
+constexpr size_t kMaxAlignedTriangles = 16;
+
+// Per-worker buffers, allocated once.
+struct AlignedScratch {
+    alignas(32) int16_t taps[8][4][ps11::kMaxSpan];
+    alignas(32) int16_t r0[4][ps11::kMaxSpan];
+    alignas(32) float color[8][ps11::kMaxSpan];  // diffuse r g b a, specular r g b a
+    alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
+    alignas(32) int32_t grid[4][ps11::kMaxSpan];
+    alignas(32) float colorOut[4][ps11::kMaxSpan];
+};
+
+struct AlignedStats {
+    uint64_t pixels = 0, written = 0, texels = 0;
+    ps11::ExecutorStats exec;
+};
+
+// Draws rows [y0, y1) of a prepared triangle.
+void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const TriangleSetup& s, int y0, int y1,
+                     AlignedScratch& scratch, AlignedStats& stats);
+
+}  // namespace emu

@@ -1,0 +1,286 @@
+// The aligned-pass path of DrawPrimitiveUP (emu/aligned_pass.h) against the quad path: random
+// screen-aligned draws (target and texture sizes, texel formats, filters, every address mode,
+// border colours, 1:1 / offset / scaled / downsampling coordinates, colour gradients, programs of
+// ps_1_1–1_4, blending, alpha test, write masks, scissor) drawn by two devices, one with
+// DeviceOptions::alignedPasses off; the render targets must be identical byte for byte, and the
+// aligned device must really have taken the row path (no helper lanes shaded).
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/device.h"
+
+using namespace emu;
+
+namespace {
+
+struct Vtx {
+    float x, y, z, rhw;
+    DWORD diffuse;
+    float uv[4][2];
+};
+constexpr DWORD kFvf = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_TEX4;
+
+const char* const kPrograms[] = {
+    "ps_1_1\ntex t0\nmov r0, t0\n",
+    "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+    "ps_1_1\ntex t0\nsub_sat r0, t0, c1\nmul_x4 r0, r0, c2\nmul r0, r0, v0\n",
+    "ps_1_1\ntex t0\ntex t1\nmul r1, t1, c0\nmad r0, 1-t0, r1, t0\nlrp r0, c3, r0, v0\n",
+    "ps_1_1\ntex t0\ntex t1\ndp3_sat r0.rgb, t0_bx2, t1_bx2\n+mov r0.a, t0.a\n",
+    "ps_1_2\ntex t0\ntex t2\nmov r0, t0\ncnd r1, r0.a, t0, t2\nadd_d2 r0.rgb, r1, v0\n",
+    "ps_1_3\ntex t1\ntex t3\nmad_x2 r1, t1, v0, -t3\ncmp r0, r1, r1, c1\n",
+    "ps_1_4\ntexld r0, t0\ntexld r1, t2\nmul r0, r0, r1\nphase\ntexld r2, t1\nadd_sat r0.rgb, r0, r2\n+mov r0.a, r2.a\n",
+    "ps_1_4\ntexld r3, t3\nmov_x4 r0, r3\nmad r0, r0, c0, -r3\n",
+    "ps_1_1\nmov r0, v0\n",
+};
+
+const D3DFORMAT kTexFormats[] = {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8, D3DFMT_L8, D3DFMT_A8, D3DFMT_A8L8};
+
+uint32_t texelBytes(D3DFORMAT f) {
+    switch (f) {
+        case D3DFMT_L8:
+        case D3DFMT_A8:
+            return 1;
+        case D3DFMT_A8L8:
+            return 2;
+        default:
+            return 4;
+    }
+}
+
+// Everything one random case sets, applied identically to both devices.
+struct Case {
+    UINT w = 1, h = 1;
+    D3DFORMAT rtFormat = D3DFMT_A8R8G8B8;
+    std::vector<uint8_t> rtInit;
+    struct Tex {
+        UINT w = 1, h = 1;
+        D3DFORMAT format = D3DFMT_A8R8G8B8;
+        std::vector<uint8_t> bytes;
+        DWORD filter = D3DTEXF_POINT, addressU = D3DTADDRESS_CLAMP, addressV = D3DTADDRESS_CLAMP, border = 0;
+        bool bound = true;
+    };
+    std::vector<Tex> tex;  // 4 stages
+    std::string program;
+    float consts[4][4] = {};
+    std::vector<Vtx> verts;
+    DWORD blend = 0;  // 0 off, 1 ONE/ONE, 2 SRCALPHA/INVSRCALPHA
+    bool alphaTest = false;
+    DWORD alphaRef = 0;
+    DWORD writeMask = 0xf;
+    bool scissor = false;
+    RECT scissorRect{};
+};
+
+Case randomCase(std::mt19937& rng) {
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    Case c;
+    c.w = UINT(uni(1, 300));
+    c.h = UINT(uni(1, 24));
+    c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+    c.rtInit.resize(size_t(c.w) * c.h * 4);
+    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    c.tex.resize(4);
+    for (Case::Tex& t : c.tex) {
+        t.w = UINT(uni(0, 2) ? uni(1, 320) : c.w);
+        t.h = UINT(uni(0, 2) ? uni(1, 40) : c.h);
+        t.format = kTexFormats[uni(0, 4)];
+        t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
+        for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : (uni(0, 1) ? 0 : 255));
+        t.filter = uni(0, 2) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        t.addressU = DWORD(uni(1, 5));
+        t.addressV = DWORD(uni(1, 5));
+        t.border = DWORD(rng());
+        t.bound = uni(0, 9) != 0;
+    }
+    c.program = kPrograms[uni(0, int(std::size(kPrograms)) - 1)];
+    for (auto& k : c.consts)
+        for (float& v : k) v = uni(0, 3) ? real(-1.2f, 1.2f) : float(uni(0, 4)) * 0.25f;
+    // A rectangle in pixels (corners anywhere, often on the half-pixel grid) and per set a
+    // texture-coordinate rectangle: 1:1 with a texel offset, a 2:1 reduction, or anything.
+    auto corner = [&](int n) { return uni(0, 1) ? float(uni(-3, n + 3)) - 0.5f : real(-3.0f, float(n) + 3.0f); };
+    float x0 = corner(int(c.w)), x1 = corner(int(c.w)), y0 = corner(int(c.h)), y1 = corner(int(c.h));
+    // Half the cases are post-processing passes: the whole target through the half-pixel corners,
+    // textures of the target's size (1:1) or twice it (2:1 reduction).
+    const bool post = uni(0, 1);
+    if (post) {
+        x0 = -0.5f, x1 = float(c.w) - 0.5f, y0 = -0.5f, y1 = float(c.h) - 0.5f;
+        const UINT scale = UINT(uni(1, 2));
+        for (Case::Tex& t : c.tex) {
+            t.w = c.w * scale, t.h = c.h * scale;
+            t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : (uni(0, 1) ? 0 : 255));
+        }
+    }
+    float u[4][2], v[4][2];
+    for (int s = 0; s < 4; ++s) {
+        const Case::Tex& t = c.tex[size_t(s)];
+        const int kind = post ? 0 : uni(0, 3);
+        if (kind == 0) {
+            // Offsets in eighths of a texel: fixed 8-bit weights 0, 32, ..., 224 along whole rows.
+            const float ox = float(uni(-16, 16)) * 0.125f / float(t.w), oy = float(uni(-16, 16)) * 0.125f / float(t.h);
+            u[s][0] = ox, u[s][1] = 1 + ox, v[s][0] = oy, v[s][1] = 1 + oy;
+        } else if (kind == 1) {
+            u[s][0] = 0, u[s][1] = 2, v[s][0] = 0, v[s][1] = 2;
+        } else {
+            u[s][0] = real(-1.5f, 1.5f), u[s][1] = real(-1.5f, 2.5f), v[s][0] = real(-1.5f, 1.5f),
+            v[s][1] = real(-1.5f, 2.5f);
+        }
+    }
+    DWORD dif[4];
+    const bool gradient = uni(0, 1);
+    for (DWORD& d : dif) d = gradient ? DWORD(rng()) : 0;
+    if (!gradient) {
+        const DWORD one = DWORD(rng());
+        for (DWORD& d : dif) d = one;
+    }
+    const float xs[4] = {x0, x1, x1, x0}, ys[4] = {y0, y0, y1, y1};
+    const int order[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
+    const int split = uni(0, 1);
+    for (int k : order[split]) {
+        Vtx q{xs[k], ys[k], real(0, 1), 1.0f, dif[k], {}};
+        for (int s = 0; s < 4; ++s) {
+            q.uv[s][0] = (k == 1 || k == 2) ? u[s][1] : u[s][0];
+            q.uv[s][1] = (k >= 2) ? v[s][1] : v[s][0];
+        }
+        c.verts.push_back(q);
+    }
+    c.blend = DWORD(uni(0, 4) < 3 ? 0 : uni(1, 2));
+    c.alphaTest = uni(0, 5) == 0;
+    c.alphaRef = DWORD(uni(0, 255));
+    c.writeMask = uni(0, 5) == 0 ? DWORD(uni(0, 15)) : 0xf;
+    c.scissor = uni(0, 5) == 0;
+    c.scissorRect = RECT{uni(0, int(c.w)), uni(0, int(c.h)), uni(0, int(c.w)), uni(0, int(c.h))};
+    return c;
+}
+
+std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
+    Handle rt{};
+    REQUIRE(dev.CreateRenderTarget(c.w, c.h, c.rtFormat, 1, &rt) == D3D_OK);
+    REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+    D3DLOCKED_RECT lr;
+    REQUIRE(dev.LockRect(rt, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < c.h; ++y)
+        std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &c.rtInit[size_t(y) * c.w * 4], 4 * c.w);
+    REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+    for (DWORD s = 0; s < 4; ++s) {
+        const Case::Tex& t = c.tex[s];
+        Handle tex{};
+        REQUIRE(dev.CreateTexture(t.w, t.h, 1, 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
+        REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
+        const size_t row = size_t(t.w) * texelBytes(t.format);
+        for (UINT y = 0; y < t.h; ++y)
+            std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &t.bytes[y * row], row);
+        REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+        REQUIRE(dev.SetTexture(s, t.bound ? tex : Handle::Null) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, t.filter) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, t.filter) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, t.addressU) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, t.addressV) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_BORDERCOLOR, t.border) == D3D_OK);
+    }
+    Handle ps{};
+    REQUIRE(dev.CreatePixelShaderFromText(c.program.c_str(), &ps) == D3D_OK);
+    REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
+    REQUIRE(dev.SetPixelShaderConstantF(0, &c.consts[0][0], 4) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    if (c.blend) {
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, c.blend == 1 ? D3DBLEND_ONE : D3DBLEND_SRCALPHA) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, c.blend == 1 ? D3DBLEND_ONE : D3DBLEND_INVSRCALPHA) == D3D_OK);
+    }
+    if (c.alphaTest) {
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHATESTENABLE, 1) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHAFUNC, D3DCMP_GREATEREQUAL) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHAREF, c.alphaRef) == D3D_OK);
+    }
+    REQUIRE(dev.SetRenderState(D3DRS_COLORWRITEENABLE, c.writeMask) == D3D_OK);
+    if (c.scissor) {
+        REQUIRE(dev.SetScissorRect(&c.scissorRect) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_SCISSORTESTENABLE, 1) == D3D_OK);
+    }
+    REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, c.verts.data(), sizeof(Vtx)) == D3D_OK);
+    stats = dev.lastDrawStats();
+    std::vector<uint8_t> out(size_t(c.w) * c.h * 4);
+    REQUIRE(dev.LockRect(rt, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+    for (UINT y = 0; y < c.h; ++y)
+        std::memcpy(&out[size_t(y) * c.w * 4], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, 4 * c.w);
+    REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte for byte", "[draw][aligned]") {
+    std::mt19937 rng(20261125);
+    int aligned = 0, cases = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Case c = randomCase(rng);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.alignedPasses = false;
+        quadOpt.threads = rowOpt.threads = 1 + (i & 1);
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << " program:\n" << c.program);
+        REQUIRE(got == expected);
+        CHECK(rs.pixelsCovered == qs.pixelsCovered);
+        CHECK(rs.pixelsWritten == qs.pixelsWritten);
+        if (qs.pixelsCovered == 0) continue;
+        ++cases;
+        // The row path shades exactly the covered pixels; the quad path adds helper lanes.
+        if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
+        CHECK(rs.instructions * qs.pixelsShaded == qs.instructions * rs.pixelsShaded);
+    }
+    // Every case qualifies (fx8, plain texture reads, screen-aligned): all must take the row path,
+    // save those whose quads happened to be all covered.
+    INFO(aligned << " of " << cases << " cases took the row path");
+    CHECK(aligned * 10 >= cases * 9);
+}
+
+TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path", "[draw][aligned]") {
+    std::mt19937 rng(7);
+    Case c = randomCase(rng);
+    c.program = kPrograms[1];
+    c.w = 40, c.h = 20;
+    c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+    c.scissor = false;
+    // Full-target quad with its texture coordinates rotated by 90 degrees: u follows y.
+    c.verts.clear();
+    const float xs[4] = {-0.5f, 39.5f, 39.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, 19.5f, 19.5f};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+        for (auto& uv : q.uv) uv[0] = k >= 2 ? 1.0f : 0.0f, uv[1] = (k == 1 || k == 2) ? 1.0f : 0.0f;
+        c.verts.push_back(q);
+    }
+    DrawStats a, b;
+    Device rowDev;
+    DeviceOptions quadOpt;
+    quadOpt.alignedPasses = false;
+    Device quadDev(quadOpt);
+    CHECK(drawCase(rowDev, c, a) == drawCase(quadDev, c, b));
+    CHECK(a.pixelsShaded == b.pixelsShaded);  // both through quads
+    CHECK(a.pixelsShaded > a.pixelsCovered);
+
+    // Perspective (rhw differs): quads.
+    for (size_t k = 0; k < c.verts.size(); ++k) c.verts[k].rhw = c.verts[k].x > 0 ? 0.5f : 1.0f;
+    Device rowDev2;
+    DrawStats p;
+    drawCase(rowDev2, c, p);
+    CHECK(p.pixelsShaded > p.pixelsCovered);
+
+    // fx12: the row path is fx8 only.
+    DeviceOptions fx12;
+    fx12.precision = ps11::Precision::Fx12;
+    Device rowDev3(fx12);
+    c.program = kPrograms[0];
+    for (auto& q : c.verts) q.rhw = 1.0f;
+    drawCase(rowDev3, c, p);
+    CHECK(p.pixelsShaded > p.pixelsCovered);
+}
