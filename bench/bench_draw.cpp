@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <chrono>
 #include <memory>
 #include <random>
 #include <string>
@@ -53,10 +54,11 @@ struct Scene {
 
     UINT w = kW, h = kH;
 
-    Scene(Pass pass, int threads) {
+    Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         DeviceOptions o;
         o.threads = threads;
+        o.alignedPasses = aligned;
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
@@ -104,11 +106,51 @@ struct Scene {
     bool draw() { return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(QuadVertex)) == D3D_OK; }
 };
 
-Scene& scene(Pass pass, int threads) {
-    static std::unique_ptr<Scene> scenes[4][3];
-    auto& s = scenes[int(pass)][threads];
-    if (!s) s = std::make_unique<Scene>(pass, threads);
+Scene& scene(Pass pass, int threads, bool aligned = true) {
+    static std::unique_ptr<Scene> scenes[4][3][2];
+    auto& s = scenes[int(pass)][threads][aligned];
+    if (!s) s = std::make_unique<Scene>(pass, threads, aligned);
     return *s;
+}
+
+// The aligned-pass path against the quad path (DeviceOptions::alignedPasses off) on the same
+// pass: each iteration draws once with each, alternating which goes first, each timed on its own
+// (wall time); the reported time is the aligned draw's, `quad_ms` and `speedup` (quad / aligned,
+// ratio of the sums over the same iterations) compare them.
+void BM_AlignedVsQuads(benchmark::State& state, Pass pass) {
+    const int threads = int(state.range(0));
+    Scene& a = scene(pass, threads, true);
+    Scene& q = scene(pass, threads, false);
+    if (!a.ok || !q.ok) {
+        state.SkipWithError("device refused the setup");
+        return;
+    }
+    double aSum = 0, qSum = 0;
+    bool flip = false;
+    for (auto _ : state) {
+        auto time = [](Scene& sc) {
+            const auto t0 = std::chrono::steady_clock::now();
+            sc.draw();
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        };
+        double ta, tq;
+        if (flip) {
+            tq = time(q);
+            ta = time(a);
+        } else {
+            ta = time(a);
+            tq = time(q);
+        }
+        flip = !flip;
+        aSum += ta;
+        qSum += tq;
+        state.SetIterationTime(ta);
+    }
+    const double n = double(std::max<int64_t>(state.iterations(), 1));
+    state.counters["quad_ms"] = qSum / n * 1e3;
+    state.counters["aligned_ms"] = aSum / n * 1e3;
+    state.counters["speedup"] = aSum > 0 ? qSum / aSum : 0;
+    state.counters["aligned_shaded/px"] = double(a.dev->lastDrawStats().pixelsShaded) / (double(a.w) * a.h);
 }
 
 void BM_Draw(benchmark::State& state, Pass pass) {
@@ -187,5 +229,21 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
+
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_1080p_fx8, Pass::Blur4)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_1080p_fx8, Pass::CopyLinear)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
 
 BENCHMARK_MAIN();

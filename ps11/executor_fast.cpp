@@ -316,7 +316,8 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                 for (int c = 0; c < 4; ++c) {
                     const int16_t* src = taps[tap][c] + off;
                     int16_t* dst = bank.reg[op.dstSlot][c];
-                    for (int i = 0; i < n; ++i) dst[i] = src[i] < -m ? int16_t(-m) : (src[i] > m ? m : src[i]);
+                    const int16_t lo = int16_t(-m);
+                    for (int i = 0; i < n; ++i) dst[i] = std::min<int16_t>(std::max<int16_t>(src[i], lo), m);
                 }
                 ++tap;
             } else {
