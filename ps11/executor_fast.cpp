@@ -187,6 +187,13 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
         f.half = true;
         for (int s = 0; s < f.numSrc; ++s)
             if ((f.src[size_t(s)].a & 1) || (f.src[size_t(s)].b & 1)) f.half = false;
+        // Every value within ±255 (MaxValue 1), sources unmodified or negated, no shift: the
+        // products fit 16 bits (productSmall).
+        if ((f.kind == FastKind::Mul || f.kind == FastKind::Mad) && f.shift == 0 && p.nMax <= 255) {
+            f.small = true;
+            for (int s = 0; s < f.numSrc; ++s)
+                if ((f.src[size_t(s)].a != 2 && f.src[size_t(s)].a != -2) || f.src[size_t(s)].b != 0) f.small = false;
+        }
         // Component c of the destination is written before component c' > c is read: a source
         // that is the destination itself and reads other components must see the old values.
         if (!f.hold && f.kind != FastKind::Dp3 && f.kind != FastKind::Dp4) {
