@@ -110,12 +110,20 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
         const int t = x - colBase;
         int runEnd = std::min(end, cols.runEnd[size_t(t)]);
         if (hasAvx2() && rowsOk && runEnd - x >= 16) {
-            const int n = (runEnd - x) & ~15;
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+            // Whole groups of 16, then the last 16 of the run again (overlapping lanes get the
+            // same values), so no pixel of a run takes the scalar loop.
+            const int n = (runEnd - x) & ~15;
             const uint8_t* r1 = row.row1 ? row.row1 + cols.off0[size_t(t)] : nullptr;
             alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, lane + (x - first), out);
+            if (n < runEnd - x) {
+                const int tx = runEnd - 16 - colBase;
+                const uint8_t* t1 = row.row1 ? row.row1 + cols.off0[size_t(tx)] : nullptr;
+                alignedFilterRunAvx2(row.row0 + cols.off0[size_t(tx)], t1, cols.w[size_t(tx)], row.wy, 16,
+                                     lane + (runEnd - 16 - first), out);
+            }
 #endif
-            x += n;
+            x = runEnd;
             continue;
         }
         // A short run, a border texel or no AVX2: one pixel at a time up to the next long run.
@@ -235,9 +243,6 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
     const bool x8 = target.format->format == D3DFMT_X8R8G8B8;
     const uint32_t orMask = x8 ? 0xff000000u : 0u;
     const int taps = draw.plan.count;
-    int16_t* tapOut[8][4];
-    for (int t = 0; t < 8; ++t)
-        for (int c = 0; c < 4; ++c) tapOut[t][c] = sc.taps[t][c];
     int16_t* const r0[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
     const int16_t* const r0c[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
     ps11::PixelInputs in;
@@ -246,6 +251,19 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
         if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
     }
     std::array<TapRow, 8> rows{};
+    // The executor asks for each tap's lanes chunk by chunk and they are filtered straight into
+    // its registers.
+    struct FillCtx {
+        const AlignedDraw* draw;
+        const AlignedTriangle* tri;
+        const std::array<TapRow, 8>* rows;
+        int x;
+    } ctx{&draw, &tri, &rows, 0};
+    const ps11::Executor::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
+        const FillCtx& f = *static_cast<const FillCtx*>(p);
+        filterTap(f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
+                  count, 0, dst);
+    };
     for (int y = yStart; y < yEnd; ++y) {
         int xl = 0, xr = 0;
         if (!rowCoverage(s, y, xl, xr)) continue;
@@ -253,10 +271,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
             if (draw.taps[size_t(t)].bound) rows[size_t(t)] = tapRow(draw.taps[size_t(t)], s, y);
         for (int x = xl; x < xr; x += ps11::kMaxSpan) {
             const int n = std::min(ps11::kMaxSpan, xr - x);
-            for (int t = 0; t < taps; ++t) {
-                filterTap(draw.taps[size_t(t)], tri.taps[size_t(t)], rows[size_t(t)], tri.x0, x, n, 0, tapOut[t]);
+            for (int t = 0; t < taps; ++t)
                 stats.texels += uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
-            }
+            ctx.x = x;
             for (int k = 0; k < 8; ++k) {
                 const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
                 if (!((draw.colorAttrs >> attr) & 1)) continue;
@@ -270,7 +287,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
                 }
             }
             in.count = n;
-            exec.runPresampled(in, tapOut, r0, &stats.exec);
+            exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
             stats.pixels += uint64_t(n);
             uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
             if (draw.directStore || draw.directAdd) {

@@ -71,7 +71,6 @@ constexpr size_t kMaxAlignedTriangles = 16;
 
 // Per-worker buffers, allocated once.
 struct AlignedScratch {
-    alignas(32) int16_t taps[8][4][ps11::kMaxSpan];
     alignas(32) int16_t r0[4][ps11::kMaxSpan];
     alignas(32) float color[8][ps11::kMaxSpan];  // diffuse r g b a, specular r g b a
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];

@@ -61,7 +61,7 @@ public:
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
              ExecutorStats* stats) const override;
     bool tapPlan(TapPlan& plan) const override;
-    void runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+    void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                        ExecutorStats* stats) const override;
 
 private:
@@ -166,10 +166,10 @@ bool ExecutorImpl::tapPlan(TapPlan& plan) const {
     return true;
 }
 
-void ExecutorImpl::runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    runFastPresampled(m_fast, m_p, m_ops, m_vUsed, inputs, taps, r0);
+    runFastPresampled(m_fast, m_p, m_ops, m_vUsed, inputs, fill, ctx, r0);
     if (stats) {
         stats->pixels += uint64_t(count);
         uint64_t executed = 0;

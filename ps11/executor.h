@@ -98,11 +98,15 @@ public:
     // without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw,
     // .xy as written). Fills `plan` and returns true, else false.
     virtual bool tapPlan(TapPlan& plan) const = 0;
-    // Runs `count` (<= kMaxSpan) pixels whose texture instructions read taps[i][c][lane] (fx8 grid
-    // integers of tap i, channel c = r g b a) instead of a sampler; v0/v1 come from inputs.color.
-    // r0[c][lane] receives r0's grid integers. Same results as run() with a sampler returning
-    // those texels. Only valid after tapPlan() returned true.
-    virtual void runPresampled(const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4],
+    // Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from
+    // `fill` instead of a sampler: fill(ctx, i, first, n, dst) writes the fx8 grid integers of
+    // tap i for lanes [first, first + n) into dst[c][0 .. n) (c = r g b a), values within ±255
+    // (8-bit texels; the executor clamps them to ±round(M·G) when that is smaller, as it does
+    // sampled texels). v0/v1 come from inputs.color. r0[c][lane]
+    // receives r0's grid integers. Same results as run() with a sampler returning those texels.
+    // Only valid after tapPlan() returned true.
+    using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);
+    virtual void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                                ExecutorStats* stats = nullptr) const = 0;
 };
 

@@ -288,7 +288,7 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
 }
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
-                       const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4]) {
+                       const PixelInputs& inputs, Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     thread_local std::unique_ptr<FastRunState> cache;
     std::unique_ptr<FastRunState> fs = std::move(cache);
@@ -298,7 +298,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
         ~GiveBack() { cache = std::move(fs); }
     } giveBack{fs};
     FastBank& bank = fs->bank;
-    alignas(64) float zeros[kChunk] = {};
+    alignas(64) static const float zeros[kChunk] = {};
     std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
     for (int i = 0; i < 8; ++i)
         if ((fp.constsUsed >> i) & 1)
@@ -319,12 +319,15 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase) continue;
             if (op.texture) {
-                // A plain read (Executor::tapPlan): the tap's texels, clamped to ±M as sampleInto does.
-                for (int c = 0; c < 4; ++c) {
-                    const int16_t* src = taps[tap][c] + off;
-                    int16_t* dst = bank.reg[op.dstSlot][c];
+                // A plain read (Executor::tapPlan): the caller's texels, clamped to ±M as sampleInto does
+                // (a no-op for 8-bit texels when M >= 1).
+                int16_t* const dst[4] = {bank.reg[op.dstSlot][0], bank.reg[op.dstSlot][1], bank.reg[op.dstSlot][2],
+                                         bank.reg[op.dstSlot][3]};
+                fill(ctx, tap, off, n, dst);
+                if (m < 255) {
                     const int16_t lo = int16_t(-m);
-                    for (int i = 0; i < n; ++i) dst[i] = std::min<int16_t>(std::max<int16_t>(src[i], lo), m);
+                    for (int c = 0; c < 4; ++c)
+                        for (int i = 0; i < n; ++i) dst[c][i] = std::min<int16_t>(std::max<int16_t>(dst[c][i], lo), m);
                 }
                 ++tap;
             } else {
@@ -342,7 +345,11 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                         std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
             }
         }
-        for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * size_t(n));
+        // A whole chunk is a fixed-size copy (vector moves, not a variable-length rep movs).
+        if (n == kChunk)
+            for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * kChunk);
+        else
+            for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * size_t(n));
     }
 }
 

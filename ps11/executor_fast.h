@@ -114,9 +114,9 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
              const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
 // Executor::runPresampled on the fast path: texture instructions (plain reads, Executor::tapPlan)
-// copy tap i's lanes (clamped to ±nMax as sampled texels are) instead of sampling; r0's int16
-// lanes are the output.
+// have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
+// sampled texels are) instead of sampling; r0's int16 lanes are the output.
 void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
-                       const PixelInputs& inputs, const int16_t* const (*taps)[4], int16_t* const r0[4]);
+                       const PixelInputs& inputs, Executor::TapFill fill, void* ctx, int16_t* const r0[4]);
 
 }  // namespace ps11::exec
