@@ -157,6 +157,8 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
     for (size_t i = 0; i < ops.size(); ++i) {
         const DOp& d = ops[i];
         if (d.texture) fp.syncDstBefore[i] = !textureWritesAll(d, p.minor);
+        if (d.dstSlot == kSlotR && d.op != Opcode::Phase && (!d.texture || textureWritesDst(d)))
+            fp.r0Written = uint8_t(fp.r0Written | d.mask);
         if (d.texture || d.op == Opcode::Phase) continue;
         FastOp& f = fp.ops[i];
         if (!fastKind(d.op, f.kind)) return false;
@@ -299,7 +301,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
     } giveBack{fs};
     FastBank& bank = fs->bank;
     alignas(64) static const float zeros[kChunk] = {};
-    std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
+    // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
+    for (int c = 0; c < 4; ++c)
+        if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
     for (int i = 0; i < 8; ++i)
         if ((fp.constsUsed >> i) & 1)
             for (int c = 0; c < 4; ++c)

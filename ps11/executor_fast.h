@@ -102,6 +102,7 @@ struct FastProgram {
     const FastKernels* kernels = nullptr;
     std::vector<FastOp> ops;
     uint8_t constsUsed = 0;              // constants the arithmetic ops read (bit per c#)
+    uint8_t r0Written = 0;               // r0 channels some op writes (the others stay 0)
     std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
 };
 

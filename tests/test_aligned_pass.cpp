@@ -35,6 +35,7 @@ const char* const kPrograms[] = {
     "ps_1_4\ntexld r0, t0\ntexld r1, t2\nmul r0, r0, r1\nphase\ntexld r2, t1\nadd_sat r0.rgb, r0, r2\n+mov r0.a, r2.a\n",
     "ps_1_4\ntexld r3, t3\nmov_x4 r0, r3\nmad r0, r0, c0, -r3\n",
     "ps_1_1\nmov r0, v0\n",
+    "ps_1_1\ntex t0\nmul r0.rgb, t0, v0\n",  // r0.a never written: reads 0
 };
 
 const D3DFORMAT kTexFormats[] = {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8, D3DFMT_L8, D3DFMT_A8, D3DFMT_A8L8};
