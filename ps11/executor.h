@@ -100,9 +100,9 @@ public:
     virtual bool tapPlan(TapPlan& plan) const = 0;
     // Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from
     // `fill` instead of a sampler: fill(ctx, i, first, n, dst) writes the fx8 grid integers of
-    // tap i for lanes [first, first + n) into dst[c][0 .. n) (c = r g b a), values within ±255
-    // (8-bit texels; the executor clamps them to ±round(M·G) when that is smaller, as it does
-    // sampled texels). v0/v1 come from inputs.color. r0[c][lane]
+    // tap i for lanes [first, first + n) into dst[c][0 .. n) (c = r g b a): 8-bit texels, values
+    // in [0, 255] (the executor relies on that, and clamps them to ±round(M·G) when that is
+    // smaller, as it does sampled texels). v0/v1 come from inputs.color. r0[c][lane]
     // receives r0's grid integers. Same results as run() with a sampler returning those texels.
     // Only valid after tapPlan() returned true.
     using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);

@@ -310,6 +310,47 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                 std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
     const FastKernels& kern = *fp.kernels;
     const int16_t m = int16_t(p.nMax);
+    // Sign analysis for productSmall: channels known >= 0 per slot (bit c). Taps are 8-bit texels
+    // (>= 0), v# are in [0, 1], constants as they are; a mov or small mul/mad of known
+    // non-negative sources with positive modifiers, or a _sat result, is >= 0. Programs with
+    // co-issued pairs (results written late) skip the analysis.
+    thread_local std::vector<FastOp> ops2;
+    ops2 = fp.ops;
+    bool paired = false;
+    for (const DOp& op : ops) paired = paired || op.hold;
+    if (!paired) {
+        std::array<uint8_t, kFastSlots> pos{};
+        pos[kSlotV] = pos[kSlotV + 1] = kMaskAll;
+        for (int i = 0; i < 8; ++i)
+            for (int c = 0; c < 4; ++c)
+                if (p.constGrid[size_t(i)][size_t(c)] >= 0) pos[size_t(kFastConstSlot + i)] |= uint8_t(1u << c);
+        auto known = [&](const FastSrc& s, int c) { return (pos[s.slot] >> s.sw[size_t(c)]) & 1; };
+        for (size_t idx = 0; idx < ops.size(); ++idx) {
+            const DOp& op = ops[idx];
+            if (op.op == Opcode::Phase) continue;
+            if (op.texture) {
+                pos[op.dstSlot] = kMaskAll;
+                continue;
+            }
+            FastOp& f = ops2[idx];
+            uint8_t result = 0;
+            if (f.small && f.src[0].a > 0 && f.src[1].a > 0) {
+                bool all = true;
+                for (int c = 0; c < 4; ++c)
+                    if ((f.mask >> c) & 1) all = all && known(f.src[0], c) && known(f.src[1], c);
+                f.nonNegative = all;
+                if (all)
+                    for (int c = 0; c < 4; ++c)
+                        if ((f.mask >> c) & 1 && (f.kind == FastKind::Mul || (f.src[2].a > 0 && known(f.src[2], c))))
+                            result |= uint8_t(1u << c);
+            } else if (f.kind == FastKind::Mov && f.src[0].a > 0 && f.src[0].b == 0) {
+                for (int c = 0; c < 4; ++c)
+                    if (known(f.src[0], c)) result |= uint8_t(1u << c);
+            }
+            if (f.lo >= 0) result = kMaskAll;
+            pos[f.dst] = uint8_t((pos[f.dst] & ~f.mask) | (result & f.mask));
+        }
+    }
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
         const int nv = (n + 15) & ~15;
@@ -335,7 +376,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                 }
                 ++tap;
             } else {
-                const FastOp& f = fp.ops[idx];
+                const FastOp& f = ops2[idx];
                 kern.arith(f, bank, nv);
                 if (f.viaTemp)
                     for (int c = 0; c < 4; ++c)
