@@ -115,7 +115,8 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
             // same values), so no pixel of a run takes the scalar loop.
             const int n = (runEnd - x) & ~15;
             const uint8_t* r1 = row.row1 ? row.row1 + cols.off0[size_t(t)] : nullptr;
-            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, lane + (x - first), out);
+            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, lane + (x - first),
+                                 out);
             if (n < runEnd - x) {
                 const int tx = runEnd - 16 - colBase;
                 const uint8_t* t1 = row.row1 ? row.row1 + cols.off0[size_t(tx)] : nullptr;
@@ -180,11 +181,10 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
     const bool plain = unorm && !merge.alphaTest && !merge.depthTest && !merge.depthWrite && merge.colorWrite == 0xf;
     d.directStore = plain && !merge.blend;
-    const bool oneOne = merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE &&
-                        merge.blendOp == D3DBLENDOP_ADD &&
-                        (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE &&
-                                                  merge.dstBlendAlpha == D3DBLEND_ONE &&
-                                                  merge.blendOpAlpha == D3DBLENDOP_ADD));
+    const bool oneOne =
+        merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
+        (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE && merge.dstBlendAlpha == D3DBLEND_ONE &&
+                                  merge.blendOpAlpha == D3DBLENDOP_ADD));
     d.directAdd = plain && merge.blend && oneOne;
     out = d;
     return true;
@@ -291,19 +291,15 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
             stats.pixels += uint64_t(n);
             uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
             if (draw.directStore || draw.directAdd) {
+                int done = 0;
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-                if (hasAvx2()) {
-                    if (draw.directAdd)
-                        alignedStoreRowAvx2(true, r0c, n, orMask, row);
-                    else
-                        alignedStoreRowAvx2(false, r0c, n, orMask, row);
-                } else
+                if (hasAvx2()) done = alignedStoreRowAvx2(draw.directAdd, r0c, n, orMask, row);
 #endif
-                    if (draw.directAdd) {
-                    storeRowScalar<true>(r0c, n, orMask, row);
-                } else {
-                    storeRowScalar<false>(r0c, n, orMask, row);
-                }
+                const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
+                if (draw.directAdd)
+                    storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
+                else
+                    storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
                 stats.written += uint64_t(n);
                 continue;
             }

@@ -22,8 +22,8 @@ namespace emu {
 
 // One texture read of the program, resolved against the draw's textures and sampler states.
 struct AlignedTap {
-    bool bound = false;                // no texture: every lookup is (0, 0, 0, 1)
-    const uint8_t* texels = nullptr;   // level 0, b g r a bytes, rows width * 4 apart
+    bool bound = false;               // no texture: every lookup is (0, 0, 0, 1)
+    const uint8_t* texels = nullptr;  // level 0, b g r a bytes, rows width * 4 apart
     uint32_t width = 1, height = 1;
     bool linear = false;
     ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;

@@ -11,13 +11,6 @@ namespace emu {
 
 namespace {
 
-inline uint32_t load32(const uint8_t* p) {
-    uint32_t v;
-    std::memcpy(&v, p, 4);
-    return v;
-}
-
-
 // 16 b g r a words as int16 (4 registers: pixels 0-3, 4-7, 8-11, 12-15, channels in b g r a
 // order within each pixel) transposed into r g b a planes of 16 lanes, stored at out[c] + lane.
 inline void storePlanes(__m256i p0, __m256i p1, __m256i p2, __m256i p3, int16_t* const out[4], int lane) {
@@ -68,7 +61,7 @@ inline __m256i roundBlend8(__m256i t) {
 // Pixels [0, count) (count a multiple of 16) whose texels are a0 + 4i, a0 + 4i + 4 on both rows
 // with the fixed weights wx, wy. Four kernels by weight: copy, horizontal or vertical only, both.
 void alignedFilterRunAvx2(const uint8_t* r0, const uint8_t* r1, int32_t wx, int32_t wy, int count, int lane,
-                             int16_t* const out[4]) {
+                          int16_t* const out[4]) {
     if (wx == 0 && wy == 0) {
         for (int i = 0; i < count; i += 16) {
             const uint8_t* p = r0 + 4 * i;
@@ -117,8 +110,10 @@ void alignedFilterRunAvx2(const uint8_t* r0, const uint8_t* r1, int32_t wx, int3
     const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
     const __m256i flip = _mm256_set1_epi16(int16_t(0x8000)), bias = _mm256_set1_epi32(32768 * 256);
     auto px = [&](int o) {
-        const __m256i h0 = _mm256_add_epi16(_mm256_mullo_epi16(load4(r0 + o), wa), _mm256_mullo_epi16(load4(r0 + o + 4), wb));
-        const __m256i h1 = _mm256_add_epi16(_mm256_mullo_epi16(load4(r1 + o), wa), _mm256_mullo_epi16(load4(r1 + o + 4), wb));
+        const __m256i h0 =
+            _mm256_add_epi16(_mm256_mullo_epi16(load4(r0 + o), wa), _mm256_mullo_epi16(load4(r0 + o + 4), wb));
+        const __m256i h1 =
+            _mm256_add_epi16(_mm256_mullo_epi16(load4(r1 + o), wa), _mm256_mullo_epi16(load4(r1 + o + 4), wb));
         const __m256i s0 = _mm256_xor_si256(h0, flip), s1 = _mm256_xor_si256(h1, flip);
         const __m256i lo = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(s0, s1), wv), bias));
         const __m256i hi = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(s0, s1), wv), bias));
@@ -135,7 +130,7 @@ namespace {
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
-void storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     int i = 0;
     const __m256i om = _mm256_set1_epi32(int32_t(orMask));
     for (; i + 16 <= count; i += 16) {
@@ -158,27 +153,13 @@ void storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* ds
         _mm256_storeu_si256(d0, first);
         _mm256_storeu_si256(d1, second);
     }
-    for (; i < count; ++i) {
-        auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
-        uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
-        if constexpr (Additive) {
-            const uint32_t old = load32(dst + 4 * i);
-            uint32_t s = 0;
-            for (int k = 0; k < 4; ++k)
-                s |= std::min<uint32_t>(((w >> (8 * k)) & 0xff) + ((old >> (8 * k)) & 0xff), 255u) << (8 * k);
-            w = s;
-        }
-        std::memcpy(dst + 4 * i, &w, 4);
-    }
+    return i;
 }
 
 }  // namespace
 
-void alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
-    if (additive)
-        storeRow<true>(r, count, orMask, dst);
-    else
-        storeRow<false>(r, count, orMask, dst);
+int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
 }
 
 }  // namespace emu

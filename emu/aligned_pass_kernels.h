@@ -13,8 +13,9 @@ namespace emu {
 void alignedFilterRunAvx2(const uint8_t* r0, const uint8_t* r1, int32_t wx, int32_t wy, int count, int lane,
                           int16_t* const out[4]);
 
-// Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
-// dst, or-ing orMask; additive: a saturating byte add onto what dst holds.
-void alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+// Stores the first pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
+// dst, or-ing orMask (additive: a saturating byte add onto what dst holds), in whole groups of
+// 16; returns how many it stored (the caller stores the rest).
+int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
 
 }  // namespace emu

@@ -80,6 +80,15 @@ private:
         }
     }
     void runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const;
+    // Adds count pixels and their executed instructions (phase excluded) to stats, if given.
+    void countRun(ExecutorStats* stats, int count) const {
+        if (!stats) return;
+        uint64_t executed = 0;
+        for (const DOp& op : m_ops)
+            if (op.op != Opcode::Phase) ++executed;
+        stats->pixels += uint64_t(count);
+        stats->instructions += executed * uint64_t(count);
+    }
     void loadColors(RunState& st) const;
     void runChunk(RunState& st) const;
 
@@ -170,13 +179,7 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* 
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     runFastPresampled(m_fast, m_p, m_ops, m_vUsed, inputs, fill, ctx, r0);
-    if (stats) {
-        stats->pixels += uint64_t(count);
-        uint64_t executed = 0;
-        for (const DOp& op : m_ops)
-            if (op.op != Opcode::Phase) ++executed;
-        stats->instructions += executed * uint64_t(count);
-    }
+    countRun(stats, count);
 }
 
 void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
@@ -187,13 +190,7 @@ void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs
     } else {
         runGeneric(inputs, sampler, outputs);
     }
-    if (stats) {
-        stats->pixels += uint64_t(count);
-        uint64_t executed = 0;
-        for (const DOp& op : m_ops)
-            if (op.op != Opcode::Phase) ++executed;
-        stats->instructions += executed * uint64_t(count);
-    }
+    countRun(stats, count);
 }
 
 void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const {

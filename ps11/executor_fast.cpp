@@ -147,6 +147,37 @@ void syncTo16(FastRunState& fs, int slot, const FastKernels& k, int32_t nMax) {
     for (int c = 0; c < 4; ++c) k.narrow(fs.st.bi.reg[slot][c], fs.bank.reg[slot][c], fs.st.n, int16_t(nMax));
 }
 
+// One arithmetic op, and its copy out of tmp when it was computed there.
+void arithStep(const FastKernels& kern, const FastOp& f, FastBank& bank, int nv) {
+    kern.arith(f, bank, nv);
+    if (f.viaTemp)
+        for (int c = 0; c < 4; ++c)
+            if ((f.mask >> c) & 1) std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+}
+
+// After op idx: if it ends a co-issued pair, both members have read; now the first writes (spec §3.5).
+void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv) {
+    if (ops[idx].hold || idx == 0 || !ops[idx - 1].hold) return;
+    const DOp& first = ops[idx - 1];
+    for (int c = 0; c < 4; ++c)
+        if ((first.mask >> c) & 1)
+            std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
+}
+
+// The calling thread's run state, kept between calls (no 60 KB allocation per span); taken out
+// of the cache while in use, so a nested or concurrent call on the same thread allocates its own.
+struct ThreadState {
+    static std::unique_ptr<FastRunState>& cache() {
+        thread_local std::unique_ptr<FastRunState> c;
+        return c;
+    }
+    std::unique_ptr<FastRunState> fs;
+    ThreadState() : fs(std::move(cache())) {
+        if (!fs) fs.reset(new FastRunState);  // default-init: no zero fill of the banks
+    }
+    ~ThreadState() { cache() = std::move(fs); }
+};
+
 }  // namespace
 
 bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp) {
@@ -215,15 +246,8 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
 void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed, bool writesDepth,
              const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    // One state per thread, kept between calls (no 60 KB allocation per span); taken out of the
-    // cache while in use, so a nested or concurrent call on the same thread allocates its own.
-    thread_local std::unique_ptr<FastRunState> cache;
-    std::unique_ptr<FastRunState> fs = std::move(cache);
-    if (!fs) fs.reset(new FastRunState);  // default-init: no zero fill of the banks
-    struct GiveBack {
-        std::unique_ptr<FastRunState>& fs;
-        ~GiveBack() { cache = std::move(fs); }
-    } giveBack{fs};
+    ThreadState ts;
+    std::unique_ptr<FastRunState>& fs = ts.fs;
     RunState& st = fs->st;
     FastBank& bank = fs->bank;
     st.in = &inputs;
@@ -265,20 +289,9 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
                 st.deferTexelClamp = false;
                 if (textureWritesDst(op)) syncTo16(*fs, op.dstSlot, kern, p.nMax);
             } else {
-                const FastOp& f = fp.ops[idx];
-                kern.arith(f, bank, nv);
-                if (f.viaTemp)
-                    for (int c = 0; c < 4; ++c)
-                        if ((f.mask >> c) & 1)
-                            std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+                arithStep(kern, fp.ops[idx], bank, nv);
             }
-            if (!op.hold && idx > 0 && ops[idx - 1].hold) {
-                // Co-issued pair: both members have read; now the first writes (spec §3.5).
-                const DOp& first = ops[idx - 1];
-                for (int c = 0; c < 4; ++c)
-                    if ((first.mask >> c) & 1)
-                        std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
-            }
+            commitPair(ops, idx, bank, nv);
         }
         for (int c = 0; c < 4; ++c)
             kern.store(bank.reg[kSlotR][c], outputs.color[c] ? outputs.color[c] + off : nullptr,
@@ -292,13 +305,8 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
 void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
                        const PixelInputs& inputs, Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    thread_local std::unique_ptr<FastRunState> cache;
-    std::unique_ptr<FastRunState> fs = std::move(cache);
-    if (!fs) fs.reset(new FastRunState);
-    struct GiveBack {
-        std::unique_ptr<FastRunState>& fs;
-        ~GiveBack() { cache = std::move(fs); }
-    } giveBack{fs};
+    ThreadState ts;
+    std::unique_ptr<FastRunState>& fs = ts.fs;
     FastBank& bank = fs->bank;
     alignas(64) static const float zeros[kChunk] = {};
     // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
@@ -376,19 +384,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                 }
                 ++tap;
             } else {
-                const FastOp& f = ops2[idx];
-                kern.arith(f, bank, nv);
-                if (f.viaTemp)
-                    for (int c = 0; c < 4; ++c)
-                        if ((f.mask >> c) & 1)
-                            std::memcpy(bank.reg[f.dst][c], bank.tmp[c], sizeof(int16_t) * size_t(nv));
+                arithStep(kern, ops2[idx], bank, nv);
             }
-            if (!op.hold && idx > 0 && ops[idx - 1].hold) {
-                const DOp& first = ops[idx - 1];
-                for (int c = 0; c < 4; ++c)
-                    if ((first.mask >> c) & 1)
-                        std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
-            }
+            commitPair(ops, idx, bank, nv);
         }
         // A whole chunk is a fixed-size copy (vector moves, not a variable-length rep movs).
         if (n == kChunk)

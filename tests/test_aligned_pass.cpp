@@ -26,13 +26,15 @@ constexpr DWORD kFvf = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_TEX4;
 
 const char* const kPrograms[] = {
     "ps_1_1\ntex t0\nmov r0, t0\n",
-    "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+    "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, "
+    "r0\n",
     "ps_1_1\ntex t0\nsub_sat r0, t0, c1\nmul_x4 r0, r0, c2\nmul r0, r0, v0\n",
     "ps_1_1\ntex t0\ntex t1\nmul r1, t1, c0\nmad r0, 1-t0, r1, t0\nlrp r0, c3, r0, v0\n",
     "ps_1_1\ntex t0\ntex t1\ndp3_sat r0.rgb, t0_bx2, t1_bx2\n+mov r0.a, t0.a\n",
     "ps_1_2\ntex t0\ntex t2\nmov r0, t0\ncnd r1, r0.a, t0, t2\nadd_d2 r0.rgb, r1, v0\n",
     "ps_1_3\ntex t1\ntex t3\nmad_x2 r1, t1, v0, -t3\ncmp r0, r1, r1, c1\n",
-    "ps_1_4\ntexld r0, t0\ntexld r1, t2\nmul r0, r0, r1\nphase\ntexld r2, t1\nadd_sat r0.rgb, r0, r2\n+mov r0.a, r2.a\n",
+    "ps_1_4\ntexld r0, t0\ntexld r1, t2\nmul r0, r0, r1\nphase\ntexld r2, t1\nadd_sat r0.rgb, r0, r2\n+mov r0.a, "
+    "r2.a\n",
     "ps_1_4\ntexld r3, t3\nmov_x4 r0, r3\nmad r0, r0, c0, -r3\n",
     "ps_1_1\nmov r0, v0\n",
     "ps_1_1\ntex t0\nmul r0.rgb, t0, v0\n",  // r0.a never written: reads 0
