@@ -96,11 +96,11 @@ TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
     return r;
 }
 
-// Filters pixels [first, first + count) of a row of one tap into out[c] + lane.
+// Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count).
 void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase, int first,
-               int count, int lane, int16_t* const out[4]) {
+               int count, int16_t* const out[4]) {
     if (!tap.bound) {
-        for (int c = 0; c < 4; ++c) std::fill_n(out[c] + lane, count, int16_t(c == 3 ? 255 : 0));
+        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? 255 : 0));
         return;
     }
     const bool rowsOk = row.row0 && (row.row1 || row.wy == 0);
@@ -115,13 +115,12 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
             // same values), so no pixel of a run takes the scalar loop.
             const int n = (runEnd - x) & ~15;
             const uint8_t* r1 = row.row1 ? row.row1 + cols.off0[size_t(t)] : nullptr;
-            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, lane + (x - first),
-                                 out);
+            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, x - first, out);
             if (n < runEnd - x) {
                 const int tx = runEnd - 16 - colBase;
                 const uint8_t* t1 = row.row1 ? row.row1 + cols.off0[size_t(tx)] : nullptr;
                 alignedFilterRunAvx2(row.row0 + cols.off0[size_t(tx)], t1, cols.w[size_t(tx)], row.wy, 16,
-                                     lane + (runEnd - 16 - first), out);
+                                     runEnd - 16 - first, out);
             }
 #endif
             x = runEnd;
@@ -130,7 +129,7 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
         // A short run, a border texel or no AVX2: one pixel at a time up to the next long run.
         int e = x + 1;
         while (e < end && !(hasAvx2() && rowsOk && std::min(end, cols.runEnd[size_t(e - colBase)]) - e >= 16)) ++e;
-        filterScalar(tap, cols, row, colBase, x, e - x, lane + (x - first), out);
+        filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
         x = e;
     }
 }
@@ -262,7 +261,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
     const ps11::Executor::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         filterTap(f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
-                  count, 0, dst);
+                  count, dst);
     };
     for (int y = yStart; y < yEnd; ++y) {
         int xl = 0, xr = 0;
