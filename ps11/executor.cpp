@@ -32,13 +32,20 @@ public:
     ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
                  std::array<std::array<float, 4>, 8> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
                  uint8_t vUsed)
-        : m_options(options), m_p(profile), m_ops(std::move(ops)), m_defs(defs), m_defMask(defMask),
-          m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
+        : m_options(options),
+          m_p(profile),
+          m_ops(std::move(ops)),
+          m_defs(defs),
+          m_defMask(defMask),
+          m_stagesUsed(stagesUsed),
+          m_writesDepth(depth),
+          m_vUsed(vUsed) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < 8; ++i) refreshConstant(i);
         if (options.path != ExecPath::Generic) {
             const FastKernels* k = options.path == ExecPath::FastBaseline ? fastKernelsBaseline() : fastKernelsBest();
             buildFastProgram(m_p, m_ops, k, m_fast);
+            presampledOps(m_fast, m_p, m_ops, m_presampled);
         }
     }
 
@@ -46,6 +53,7 @@ public:
         if (index < 0 || index >= 8) return;
         m_api[size_t(index)] = value;
         refreshConstant(index);
+        if (m_fast.kernels) presampledOps(m_fast, m_p, m_ops, m_presampled);
     }
     void setStageState(int stage, const StageState& state) override {
         if (stage >= 0 && stage < 8) m_p.stages[size_t(stage)] = state;
@@ -58,8 +66,7 @@ public:
         return m_fast.kernels == fastKernelsAvx2() ? "fast-avx2" : "fast-sse2";
     }
 
-    void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
-             ExecutorStats* stats) const override;
+    void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs, ExecutorStats* stats) const override;
     bool tapPlan(TapPlan& plan) const override;
     void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                        ExecutorStats* stats) const override;
@@ -101,7 +108,8 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
-    FastProgram m_fast;  // kernels == null: the generic path runs
+    FastProgram m_fast;                // kernels == null: the generic path runs
+    std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
 };
 
 void ExecutorImpl::loadColors(RunState& st) const {
@@ -178,12 +186,11 @@ bool ExecutorImpl::tapPlan(TapPlan& plan) const {
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    runFastPresampled(m_fast, m_p, m_ops, m_vUsed, inputs, fill, ctx, r0);
+    runFastPresampled(m_fast, m_p, m_ops, m_presampled, m_vUsed, inputs, fill, ctx, r0);
     countRun(stats, count);
 }
 
-void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
-                       ExecutorStats* stats) const {
+void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs, ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.kernels) {
         runFast(m_fast, m_p, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
@@ -284,8 +291,7 @@ struct Decoder {
 }  // namespace
 }  // namespace exec
 
-std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
-                                           Diagnostics& diags) {
+std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options, Diagnostics& diags) {
     using namespace exec;
     Decoder dec{program, diags};
     const Version& ver = program.version;

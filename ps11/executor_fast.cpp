@@ -160,8 +160,7 @@ void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv)
     if (ops[idx].hold || idx == 0 || !ops[idx - 1].hold) return;
     const DOp& first = ops[idx - 1];
     for (int c = 0; c < 4; ++c)
-        if ((first.mask >> c) & 1)
-            std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
+        if ((first.mask >> c) & 1) std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
 }
 
 // The calling thread's run state, kept between calls (no 60 KB allocation per span); taken out
@@ -302,28 +301,13 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
     }
 }
 
-void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
-                       const PixelInputs& inputs, Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
-    const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    ThreadState ts;
-    std::unique_ptr<FastRunState>& fs = ts.fs;
-    FastBank& bank = fs->bank;
-    alignas(64) static const float zeros[kChunk] = {};
-    // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
-    for (int c = 0; c < 4; ++c)
-        if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
-    for (int i = 0; i < 8; ++i)
-        if ((fp.constsUsed >> i) & 1)
-            for (int c = 0; c < 4; ++c)
-                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
-    const FastKernels& kern = *fp.kernels;
-    const int16_t m = int16_t(p.nMax);
+void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out) {
+    out = fp.ops;
+    if (!fp.kernels) return;
     // Sign analysis for productSmall: channels known >= 0 per slot (bit c). Taps are 8-bit texels
     // (>= 0), v# are in [0, 1], constants as they are; a mov or small mul/mad of known
     // non-negative sources with positive modifiers, or a _sat result, is >= 0. Programs with
     // co-issued pairs (results written late) skip the analysis.
-    thread_local std::vector<FastOp> ops2;
-    ops2 = fp.ops;
     bool paired = false;
     for (const DOp& op : ops) paired = paired || op.hold;
     if (!paired) {
@@ -340,7 +324,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
                 pos[op.dstSlot] = kMaskAll;
                 continue;
             }
-            FastOp& f = ops2[idx];
+            FastOp& f = out[idx];
             uint8_t result = 0;
             if (f.small && f.src[0].a > 0 && f.src[1].a > 0) {
                 bool all = true;
@@ -359,6 +343,25 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
             pos[f.dst] = uint8_t((pos[f.dst] & ~f.mask) | (result & f.mask));
         }
     }
+}
+
+void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+                       const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
+                       Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
+    const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    ThreadState ts;
+    std::unique_ptr<FastRunState>& fs = ts.fs;
+    FastBank& bank = fs->bank;
+    alignas(64) static const float zeros[kChunk] = {};
+    // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
+    for (int c = 0; c < 4; ++c)
+        if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
+    for (int i = 0; i < 8; ++i)
+        if ((fp.constsUsed >> i) & 1)
+            for (int c = 0; c < 4; ++c)
+                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    const FastKernels& kern = *fp.kernels;
+    const int16_t m = int16_t(p.nMax);
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
         const int nv = (n + 15) & ~15;

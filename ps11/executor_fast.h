@@ -34,10 +34,10 @@ struct FastSrc {
 
 struct FastOp {
     FastKind kind = FastKind::Mov;
-    bool hold = false;     // write into the hold buffer (first member of a co-issued pair)
-    bool viaTemp = false;  // write into tmp, then copy (the destination is also a swizzled source)
-    bool half = false;     // products: every source k is even, formed halved (see the kernels)
-    bool small = false;    // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
+    bool hold = false;         // write into the hold buffer (first member of a co-issued pair)
+    bool viaTemp = false;      // write into tmp, then copy (the destination is also a swizzled source)
+    bool half = false;         // products: every source k is even, formed halved (see the kernels)
+    bool small = false;        // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
     bool nonNegative = false;  // small, and both factors unnegated and >= 0 in every lane (set per run)
     uint8_t dst = 0;
     uint8_t mask = kMaskAll;
@@ -118,7 +118,14 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
 // Executor::runPresampled on the fast path: texture instructions (plain reads, Executor::tapPlan)
 // have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
 // sampled texels are) instead of sampling; r0's int16 lanes are the output.
-void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed,
-                       const PixelInputs& inputs, Executor::TapFill fill, void* ctx, int16_t* const r0[4]);
+// `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.
+void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+                       const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
+                       Executor::TapFill fill, void* ctx, int16_t* const r0[4]);
+
+// fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
+// 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.
+// Depends on the constants: recomputed when one changes, not per run.
+void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out);
 
 }  // namespace ps11::exec
