@@ -287,3 +287,93 @@ TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path"
     drawCase(rowDev3, c, p);
     CHECK(p.pixelsShaded > p.pixelsCovered);
 }
+
+TEST_CASE("aligned pass: one device across draws (constants change sign, textures rewritten, ping-pong)",
+          "[draw][aligned]") {
+    // What the row path may keep between spans or draws (the sign analysis of the constants,
+    // filtered texel rows) must follow every change: the same calls on both devices, compared
+    // after every draw.
+    std::mt19937 rng(4242);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const UINT w = 203, h = 19;
+    DeviceOptions quadOpt, rowOpt;
+    quadOpt.alignedPasses = false;
+    quadOpt.threads = rowOpt.threads = 2;
+    Device quadDev(quadOpt), rowDev(rowOpt);
+    Device* devs[2] = {&quadDev, &rowDev};
+    Handle src[2], ping[2][2], surf[2][2], ps[2];
+    for (int d = 0; d < 2; ++d) {
+        Device& dev = *devs[d];
+        REQUIRE(dev.CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &src[d]) == D3D_OK);
+        for (int k = 0; k < 2; ++k) {
+            REQUIRE(dev.CreateTexture(w, h, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &ping[d][k]) ==
+                    D3D_OK);
+            REQUIRE(dev.GetSurfaceLevel(ping[d][k], 0, &surf[d][k]) == D3D_OK);
+        }
+        REQUIRE(dev.CreatePixelShaderFromText(
+                    "ps_1_1\ntex t0\ntex t1\ntex t2\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad_sat r0, t2, c2, r0\n",
+                    &ps[d]) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(ps[d]) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+        REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
+        for (DWORD s = 0; s < 3; ++s) {
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP) == D3D_OK);
+        }
+    }
+    // Taps half a texel apart in both directions (the blur footprint) and one at an eighth.
+    std::vector<Vtx> quad;
+    const float xs[4] = {-0.5f, float(w) - 0.5f, float(w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(h) - 0.5f, float(h) - 0.5f};
+    const float off[3][2] = {{-0.5f, -0.5f}, {0.5f, 0.5f}, {0.125f, -0.375f}};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+        for (int s = 0; s < 3; ++s) {
+            q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(w);
+            q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(h);
+        }
+        quad.push_back(q);
+    }
+    std::vector<uint8_t> bytes(size_t(w) * h * 4);
+    for (int iter = 0; iter < 12; ++iter) {
+        // Every third draw rewrites the source texture, every draw flips constant signs.
+        if (iter % 3 == 0)
+            for (uint8_t& b : bytes) b = uint8_t(rng());
+        float consts[3][4];
+        for (auto& c : consts)
+            for (float& v : c) v = float(uni(-4, 4)) * 0.25f;
+        std::vector<uint8_t> result[2];
+        for (int d = 0; d < 2; ++d) {
+            Device& dev = *devs[d];
+            if (iter % 3 == 0) {
+                D3DLOCKED_RECT lr;
+                REQUIRE(dev.LockRect(src[d], 0, &lr, nullptr, 0) == D3D_OK);
+                for (UINT y = 0; y < h; ++y)
+                    std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &bytes[size_t(y) * w * 4], 4 * w);
+                REQUIRE(dev.UnlockRect(src[d], 0) == D3D_OK);
+            }
+            REQUIRE(dev.SetPixelShaderConstantF(0, &consts[0][0], 3) == D3D_OK);
+            // Draw 0 of each group reads the source, the others the previous target (ping-pong).
+            const int to = iter & 1;
+            const Handle from = iter % 3 == 0 ? src[d] : ping[d][to ^ 1];
+            for (DWORD s = 0; s < 3; ++s) REQUIRE(dev.SetTexture(s, from) == D3D_OK);
+            REQUIRE(dev.SetRenderTarget(0, surf[d][to]) == D3D_OK);
+            REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(Vtx)) == D3D_OK);
+            if (d == 1) CHECK(dev.lastDrawStats().pixelsShaded == dev.lastDrawStats().pixelsCovered);
+            Handle sys{};
+            REQUIRE(dev.CreateOffscreenPlainSurface(w, h, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &sys) == D3D_OK);
+            REQUIRE(dev.GetRenderTargetData(surf[d][to], sys) == D3D_OK);
+            D3DLOCKED_RECT lr;
+            REQUIRE(dev.LockRect(sys, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+            result[d].resize(size_t(w) * h * 4);
+            for (UINT y = 0; y < h; ++y)
+                std::memcpy(&result[d][size_t(y) * w * 4], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, 4 * w);
+            REQUIRE(dev.UnlockRect(sys) == D3D_OK);
+            REQUIRE(dev.Release(sys) == D3D_OK);
+        }
+        INFO("draw " << iter);
+        REQUIRE(result[1] == result[0]);
+    }
+}
