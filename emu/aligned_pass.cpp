@@ -1,6 +1,7 @@
 // Device stage: the aligned-pass path of DrawPrimitiveUP (emu/aligned_pass.h). Eligibility,
-// per-triangle column tables, per-row filtering of each tap into int16 lanes (scalar for any
-// footprint, AVX2 for runs of columns that step one texel with a fixed weight), the pre-sampled
+// per-triangle column tables and runs, the per-worker H-row cache, per-row filtering of each tap
+// into int16 lanes (scalar for any footprint, AVX2 for runs of columns that step a fixed number
+// of texels with a fixed weight), the pre-sampled
 // executor run, and the stores. Exactness: the tables hold the very texel pairs and weights the
 // TextureSampler's kernels compute for the same coordinates (ps11::fastpath::axisTable), and the
 // coordinates are the rasteriser's own formula (emu/raster.h planeValue); the blend is the
@@ -8,6 +9,7 @@
 #include "emu/aligned_pass.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 #include "emu/aligned_pass_kernels.h"
@@ -31,11 +33,18 @@ inline uint32_t load32(const uint8_t* p) {
     return v;
 }
 
-// One row of one tap: the two texel rows (null = border) and the vertical weight.
+// One row of one tap: the two texel rows (null = border), the vertical weight, and per config of
+// the tap the H-row planes of both texel rows (null: the tap's runs are filtered per pixel on
+// this row: a border row, or no AVX2).
 struct TapRow {
     const uint8_t* row0 = nullptr;
     const uint8_t* row1 = nullptr;
     int32_t wy = 0;
+    struct Planes {
+        const uint16_t* p[4];
+    };
+    std::array<Planes, kMaxTapConfigs> h0{}, h1{};
+    std::array<bool, kMaxTapConfigs> ready{};
 };
 
 // Any footprint, one pixel at a time: the exact four-texel sum of the reference.
@@ -103,35 +112,91 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
         for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? 255 : 0));
         return;
     }
-    const bool rowsOk = row.row0 && (row.row1 || row.wy == 0);
+    auto vectorRun = [&](int x) {
+        const int32_t r = cols.run[size_t(x - colBase)];
+        return r >= 0 && row.ready[size_t(cols.runs[size_t(r)].config)] ? r : -1;
+    };
     int x = first;
     const int end = first + count;
     while (x < end) {
-        const int t = x - colBase;
-        int runEnd = std::min(end, cols.runEnd[size_t(t)]);
-        if (hasAvx2() && rowsOk && runEnd - x >= 16) {
+        const int r = vectorRun(x);
+        if (r >= 0) {
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-            // Whole groups of 16, then the last 16 of the run again (overlapping lanes get the
-            // same values), so no pixel of a run takes the scalar loop.
-            const int n = (runEnd - x) & ~15;
-            const uint8_t* r1 = row.row1 ? row.row1 + cols.off0[size_t(t)] : nullptr;
-            alignedFilterRunAvx2(row.row0 + cols.off0[size_t(t)], r1, cols.w[size_t(t)], row.wy, n, x - first, out);
-            if (n < runEnd - x) {
-                const int tx = runEnd - 16 - colBase;
-                const uint8_t* t1 = row.row1 ? row.row1 + cols.off0[size_t(tx)] : nullptr;
-                alignedFilterRunAvx2(row.row0 + cols.off0[size_t(tx)], t1, cols.w[size_t(tx)], row.wy, 16,
-                                     runEnd - 16 - first, out);
-            }
-#endif
-            x = runEnd;
+            const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+            const int e = std::min(end, int(run.x1));
+            const int j = run.j0 + (x - run.x0);
+            const TapRow::Planes& p0 = row.h0[size_t(run.config)];
+            const TapRow::Planes& p1 = row.h1[size_t(run.config)];
+            const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
+            const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
+                                           row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
+            alignedVerticalAvx2(hKindOf(cols.w[size_t(x - colBase)]), h0, h1, row.wy, e - x, x - first, out);
+            x = e;
             continue;
+#endif
         }
-        // A short run, a border texel or no AVX2: one pixel at a time up to the next long run.
+        // Border texels, short runs, or no AVX2: one pixel at a time up to the next vector run.
         int e = x + 1;
-        while (e < end && !(hasAvx2() && rowsOk && std::min(end, cols.runEnd[size_t(e - colBase)]) - e >= 16)) ++e;
+        while (e < end && vectorRun(e) < 0) ++e;
         filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
         x = e;
     }
+}
+
+// The H row of texel row `row` for `config` from the worker's cache, built on a miss. Slots used
+// on the current pixel row (stamp) are never evicted, so every pointer handed out for a row stays
+// valid until the next row.
+const uint16_t* const* hRow(HRowCache& cache, const uint8_t* row, const HConfig& config,
+                            std::array<const uint16_t*, 4>& planes) {
+    HRowCache::Slot* hit = nullptr;
+    HRowCache::Slot* victim = nullptr;
+    for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
+        HRowCache::Slot& sl = *sp;
+        if (sl.row == row && sl.config.texels == config.texels && sl.config.wx == config.wx &&
+            sl.config.step == config.step && sl.config.phase == config.phase && sl.config.jlo == config.jlo &&
+            sl.config.jhi == config.jhi) {
+            hit = &sl;
+            break;
+        }
+        if (sl.stamp != cache.stamp && (!victim || sl.stamp < victim->stamp)) victim = &sl;
+    }
+    if (hit) {
+        ++cache.hits;
+    } else {
+        if (!victim) {
+            cache.slots.push_back(std::make_unique<HRowCache::Slot>());
+            victim = cache.slots.back().get();
+        }
+        hit = victim;
+        hit->row = row;
+        hit->config = config;
+        const int n = config.jhi - config.jlo;
+        hit->stride = (n + kHRowPad + 15) & ~15;
+        if (hit->data.size() < size_t(hit->stride) * 4) hit->data.resize(size_t(hit->stride) * 4);
+        uint16_t* const out[4] = {hit->data.data(), hit->data.data() + hit->stride, hit->data.data() + 2 * hit->stride,
+                                  hit->data.data() + 3 * hit->stride};
+#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+        const int first = config.step * config.jlo + config.phase;
+        const uint8_t* src = row + size_t(first) * 4;
+        if (config.step == 1 && config.wx == 0) {
+            alignedDeinterleaveAvx2(src, n, out);
+        } else {
+            // Texels first .. first + step·(n − 1) (+ 1 when the weight is not 0).
+            const int m = config.step * (n - 1) + 1 + (config.wx != 0);
+            const int stride = (std::max(m, config.step * ((n + 15) & ~15)) + kHRowPad + 15) & ~15;
+            if (cache.staging.size() < size_t(stride) * 4) cache.staging.resize(size_t(stride) * 4);
+            uint16_t* const t[4] = {cache.staging.data(), cache.staging.data() + stride,
+                                    cache.staging.data() + 2 * stride, cache.staging.data() + 3 * stride};
+            alignedDeinterleaveAvx2(src, m, t);
+            const uint16_t* const tc[4] = {t[0], t[1], t[2], t[3]};
+            alignedCombineAvx2(tc, n, config.step, config.wx, out);
+        }
+#endif
+        ++cache.built;
+    }
+    hit->stamp = cache.stamp;
+    for (int c = 0; c < 4; ++c) planes[size_t(c)] = hit->data.data() + size_t(c) * size_t(hit->stride);
+    return planes.data();
 }
 
 }  // namespace
@@ -143,6 +208,8 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     if (precision != ps11::Precision::Fx8 || wantZ || merge.fog || !target.color) return false;
     AlignedDraw d;
     if (!executor.tapPlan(d.plan)) return false;
+    static std::atomic<uint64_t> serials{0};
+    d.serial = ++serials;
     d.executor = &executor;
     for (int i = 0; i < d.plan.count; ++i) {
         const int stage = d.plan.stage[size_t(i)];
@@ -199,11 +266,14 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
     }
     out.x0 = s.clip.x0;
     out.x1 = s.clip.x1;
+    out.configs.clear();
     const int n = out.x1 - out.x0;
     std::vector<float> u(size_t(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {
         const AlignedTap& tap = draw.taps[size_t(i)];
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
+        cols.runs.clear();
+        cols.configCount = 0;
         if (!tap.bound) continue;
         const int k = attrTex(tap.coordSet, 0);
         for (int x = 0; x < n; ++x)
@@ -212,18 +282,55 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
         cols.off0.resize(size_t(n));
         cols.off1.resize(size_t(n));
         cols.w.resize(size_t(n));
-        cols.runEnd.resize(size_t(n));
         ps11::fastpath::axisTable(tap.addressU, tap.linear, n, u.data(), tap.width, cols.off0.data(), cols.off1.data(),
                                   cols.w.data());
-        // Runs (runEnd in absolute columns; runEnd == column: not in a run): columns stepping
-        // one texel with one weight, not on the border. The vector kernels read texels i0 and,
-        // when the weight is not 0, i0 + 1 of both rows, so i0 + 1 must then be the pair's second.
-        for (int x = n - 1; x >= 0; --x) {
-            const int32_t i0 = cols.off0[size_t(x)], i1 = cols.off1[size_t(x)], w = cols.w[size_t(x)];
-            const bool ok = i0 >= 0 && (w == 0 || i1 == i0 + 1);
-            const bool joins = ok && x + 1 < n && cols.off0[size_t(x + 1)] == i0 + 1 && cols.w[size_t(x + 1)] == w &&
-                               cols.runEnd[size_t(x + 1)] > out.x0 + x + 1;
-            cols.runEnd[size_t(x)] = ok ? (joins ? cols.runEnd[size_t(x + 1)] : out.x0 + x + 1) : out.x0 + x;
+        // Long runs (vector kernels, AVX2 only): at least kMinAlignedRun columns whose first texel
+        // i0 steps by a fixed 1..kMaxAlignedStep texels with one weight, none on the border, and
+        // i1 = i0 + 1 when the weight is not 0 (the H rows read texels i0 and i0 + 1).
+        cols.run.assign(size_t(n), -1);
+        auto ok = [&](int x) {
+            const int32_t i0 = cols.off0[size_t(x)], w = cols.w[size_t(x)];
+            return i0 >= 0 && (w == 0 || cols.off1[size_t(x)] == i0 + 1);
+        };
+        for (int x = 0; hasAvx2() && x < n;) {
+            int e = x + 1;
+            const int32_t step = x + 1 < n ? cols.off0[size_t(x + 1)] - cols.off0[size_t(x)] : 0;
+            if (ok(x) && step >= 1 && step <= kMaxAlignedStep)
+                while (e < n && ok(e) && cols.w[size_t(e)] == cols.w[size_t(x)] &&
+                       cols.off0[size_t(e)] - cols.off0[size_t(e - 1)] == step)
+                    ++e;
+            if (e - x < kMinAlignedRun) {
+                ++x;
+                continue;
+            }
+            // The H-row configuration: shared by every tap on this texture with the same weight,
+            // step and phase; its range grows to cover the run.
+            const int32_t i0 = cols.off0[size_t(x)], wx = cols.w[size_t(x)];
+            const int32_t phase = i0 % step, j0 = (i0 - phase) / step;
+            int ci = -1;
+            for (size_t c = 0; c < out.configs.size(); ++c) {
+                const HConfig& h = out.configs[c];
+                if (h.texels == tap.texels && h.wx == wx && h.step == step && h.phase == phase) ci = int(c);
+            }
+            if (ci < 0) {
+                out.configs.push_back(HConfig{tap.texels, wx, step, phase, j0, j0 + (e - x)});
+                ci = int(out.configs.size()) - 1;
+            }
+            HConfig& h = out.configs[size_t(ci)];
+            h.jlo = std::min(h.jlo, j0);
+            h.jhi = std::max(h.jhi, j0 + (e - x));
+            int slot = -1;
+            for (int c = 0; c < cols.configCount; ++c)
+                if (cols.configs[size_t(c)] == ci) slot = c;
+            if (slot < 0 && cols.configCount < kMaxTapConfigs) {
+                slot = cols.configCount++;
+                cols.configs[size_t(slot)] = ci;
+            }
+            if (slot >= 0) {
+                cols.runs.push_back(AlignedTriangle::Run{out.x0 + x, out.x0 + e, j0, slot});
+                std::fill(cols.run.begin() + x, cols.run.begin() + e, int32_t(cols.runs.size() - 1));
+            }
+            x = e;
         }
         // Texel indices to byte offsets within a row (−1 stays the border).
         for (int x = 0; x < n; ++x) {
@@ -231,12 +338,16 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
             if (cols.off1[size_t(x)] >= 0) cols.off1[size_t(x)] *= 4;
         }
     }
+    // Run starts relative to their H row's first element, now that the ranges are final.
+    for (int i = 0; i < draw.plan.count; ++i) {
+        AlignedTriangle::Columns& cols = out.taps[size_t(i)];
+        for (AlignedTriangle::Run& r : cols.runs) r.j0 -= out.configs[size_t(cols.configs[size_t(r.config)])].jlo;
+    }
     return true;
 }
 
-void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                     AlignedScratch& sc, AlignedStats& stats) {
-    const int yStart = std::max(y0, s.yMin), yEnd = std::min(y1, s.yMax);
+void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
+                     size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats) {
     const ps11::Executor& exec = *draw.executor;
     Image& target = *draw.target.color;
     const bool x8 = target.format->format == D3DFMT_X8R8G8B8;
@@ -257,68 +368,103 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const 
         const AlignedTriangle* tri;
         const std::array<TapRow, 8>* rows;
         int x;
-    } ctx{&draw, &tri, &rows, 0};
+    } ctx{&draw, nullptr, &rows, 0};
     const ps11::Executor::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         filterTap(f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
                   count, dst);
     };
-    for (int y = yStart; y < yEnd; ++y) {
-        int xl = 0, xr = 0;
-        if (!rowCoverage(s, y, xl, xr)) continue;
-        for (int t = 0; t < taps; ++t)
-            if (draw.taps[size_t(t)].bound) rows[size_t(t)] = tapRow(draw.taps[size_t(t)], s, y);
-        for (int x = xl; x < xr; x += ps11::kMaxSpan) {
-            const int n = std::min(ps11::kMaxSpan, xr - x);
-            for (int t = 0; t < taps; ++t)
-                stats.texels += uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
-            ctx.x = x;
-            for (int k = 0; k < 8; ++k) {
-                const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
-                if (!((draw.colorAttrs >> attr) & 1)) continue;
-                float* dst = sc.color[k];
-                if ((s.constMask >> attr) & 1) {
-                    std::fill_n(dst, n, s.constValue[size_t(attr)]);
-                } else {
-                    const Plane& p = s.attr[size_t(attr)];
-                    const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
-                    for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+    HRowCache& cache = sc.hrows;
+    if (cache.serial != draw.serial) {
+        // Another draw: its textures may have changed since (the slots keep their memory).
+        for (const std::unique_ptr<HRowCache::Slot>& sl : cache.slots) sl->row = nullptr, sl->stamp = 0;
+        cache.serial = draw.serial;
+    }
+    std::array<const uint16_t*, 4> planes{};
+    // Row by row, and within a row the triangles in primitive order (every pixel sees them in
+    // order; the H rows of a pixel row serve all of them).
+    for (int y = y0; y < y1; ++y) {
+        ++cache.stamp;
+        for (size_t ti = 0; ti < count; ++ti) {
+            const AlignedTriangle& tri = *tris[ti];
+            const TriangleSetup& s = *setups[ti];
+            if (y < s.yMin || y >= s.yMax) continue;
+            int xl = 0, xr = 0;
+            if (!rowCoverage(s, y, xl, xr)) continue;
+            ctx.tri = &tri;
+            for (int t = 0; t < taps; ++t) {
+                const AlignedTap& tap = draw.taps[size_t(t)];
+                if (!tap.bound) continue;
+                TapRow& r = rows[size_t(t)];
+                r = tapRow(tap, s, y);
+                // The H rows of the tap's long runs (built on first use, shared by taps and rows).
+                const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+                const bool rowsOk = r.row0 && (r.row1 || r.wy == 0);
+                for (int c = 0; c < cols.configCount; ++c) {
+                    r.ready[size_t(c)] = rowsOk;
+                    if (!rowsOk) continue;
+                    const HConfig& h = tri.configs[size_t(cols.configs[size_t(c)])];
+                    hRow(cache, r.row0, h, planes);
+                    for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
+                    if (r.wy != 0) {
+                        hRow(cache, r.row1, h, planes);
+                        for (int ch = 0; ch < 4; ++ch) r.h1[size_t(c)].p[ch] = planes[size_t(ch)];
+                    }
                 }
             }
-            in.count = n;
-            exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
-            stats.pixels += uint64_t(n);
-            uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
-            if (draw.directStore || draw.directAdd) {
-                int done = 0;
+            for (int x = xl; x < xr; x += ps11::kMaxSpan) {
+                const int n = std::min(ps11::kMaxSpan, xr - x);
+                for (int t = 0; t < taps; ++t)
+                    stats.texels +=
+                        uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
+                ctx.x = x;
+                for (int k = 0; k < 8; ++k) {
+                    const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
+                    if (!((draw.colorAttrs >> attr) & 1)) continue;
+                    float* dst = sc.color[k];
+                    if ((s.constMask >> attr) & 1) {
+                        std::fill_n(dst, n, s.constValue[size_t(attr)]);
+                    } else {
+                        const Plane& p = s.attr[size_t(attr)];
+                        const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
+                        for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+                    }
+                }
+                in.count = n;
+                exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
+                stats.pixels += uint64_t(n);
+                uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
+                if (draw.directStore || draw.directAdd) {
+                    int done = 0;
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-                if (hasAvx2()) done = alignedStoreRowAvx2(draw.directAdd, r0c, n, orMask, row);
+                    if (hasAvx2()) done = alignedStoreRowAvx2(draw.directAdd, r0c, n, orMask, row);
 #endif
-                const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
-                if (draw.directAdd)
-                    storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
-                else
-                    storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
-                stats.written += uint64_t(n);
-                continue;
-            }
-            // Anything else: the output merger over the row.
-            MergeInputs mi;
-            mi.count = n;
-            for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
-            mi.x = sc.x;
-            mi.y = sc.y;
-            for (int c = 0; c < 4; ++c) {
-                for (int i = 0; i < n; ++i) {
-                    sc.grid[c][i] = sc.r0[c][i];
-                    sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
+                    const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
+                    if (draw.directAdd)
+                        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
+                    else
+                        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
+                    stats.written += uint64_t(n);
+                    continue;
                 }
-                mi.color[c] = sc.colorOut[c];
-                mi.grid[c] = sc.grid[c];
+                // Anything else: the output merger over the row.
+                MergeInputs mi;
+                mi.count = n;
+                for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                mi.x = sc.x;
+                mi.y = sc.y;
+                for (int c = 0; c < 4; ++c) {
+                    for (int i = 0; i < n; ++i) {
+                        sc.grid[c][i] = sc.r0[c][i];
+                        sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
+                    }
+                    mi.color[c] = sc.colorOut[c];
+                    mi.grid[c] = sc.grid[c];
+                }
+                MergeStats ms;
+                mergePixels(draw.merge, mi, draw.target, &ms);
+                stats.written += ms.written;
             }
-            MergeStats ms;
-            mergePixels(draw.merge, mi, draw.target, &ms);
-            stats.written += ms.written;
         }
     }
 }

@@ -2,8 +2,8 @@
 // texture coordinates are screen-aligned (u depends on x only, v on y only, no perspective) in
 // fx8, with a program whose texture reads are plain (ps11::Executor::tapPlan), are drawn row by
 // row without quads or per-lane coordinates: each tap's texel columns and weights are tabulated
-// once per triangle and its rows once per pixel row, texels are filtered straight from the level
-// into int16 lanes (fixed-fraction runs vectorised), the executor runs pre-sampled, and 8-bit
+// once per triangle and its rows once per pixel row, texels are filtered into int16 lanes (runs
+// with a fixed weight and step through shared, cached H rows), the executor runs pre-sampled, and 8-bit
 // targets take plain and additive stores directly. Results are bit-identical to the quad path.
 #pragma once
 
@@ -33,6 +33,7 @@ struct AlignedTap {
 
 // What one draw needs, shared read-only by the workers.
 struct AlignedDraw {
+    uint64_t serial = 0;  // unique per draw: H rows cached by workers are valid within one draw only
     const ps11::Executor* executor = nullptr;
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
@@ -51,14 +52,37 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out);
 
 // Per-triangle column tables of every tap: texel byte offsets of the pair (−1 = border) and the
-// 8-bit weight per column, and for each column the end of the run of columns that step one texel
-// with the same weight (filtered with vector loads).
+// 8-bit weight per column; and the long runs: at least kMinAlignedRun columns whose first texel
+// steps by a fixed 1..kMaxAlignedStep texels with one weight, filtered with vector kernels from
+// shared H rows (emu/aligned_pass_kernels.h) when the CPU has AVX2.
+constexpr int kMinAlignedRun = 16;
+constexpr int kMaxAlignedStep = 8;
+constexpr int kMaxTapConfigs = 4;  // H-row configurations per tap (runs past these are filtered per pixel)
+
+// One H-row configuration: texel rows of `texels` filtered horizontally with weight wx at texels
+// i = step·j + phase (and i + 1), j in [jlo, jhi): the union of the runs of every tap that share
+// the texture, weight, step and phase.
+struct HConfig {
+    const uint8_t* texels = nullptr;
+    int32_t wx = 0, step = 1, phase = 0, jlo = 0, jhi = 0;
+};
+
 struct AlignedTriangle {
     int x0 = 0, x1 = 0;  // columns tabulated: [x0, x1)
+    struct Run {
+        int32_t x0 = 0, x1 = 0;  // absolute columns [x0, x1)
+        int32_t j0 = 0;          // element of column x0 in the config's H row (from jlo)
+        int32_t config = 0;      // index into the tap's configs
+    };
     struct Columns {
-        std::vector<int32_t> off0, off1, w, runEnd;
+        std::vector<int32_t> off0, off1, w;
+        std::vector<int32_t> run;  // per column: index into runs, −1 = filtered per pixel
+        std::vector<Run> runs;
+        std::array<int32_t, kMaxTapConfigs> configs{};  // indices into AlignedTriangle::configs
+        int configCount = 0;
     };
     std::array<Columns, 8> taps;
+    std::vector<HConfig> configs;
 };
 
 // True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
@@ -69,6 +93,23 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 // about the clip width per tap per triangle, so meshes stay on the quad path.
 constexpr size_t kMaxAlignedTriangles = 16;
 
+// Per-worker cache of H rows (one texel row filtered horizontally for one HConfig), kept for the
+// rows of one draw: a blur's texel row serves two taps on each of two pixel rows.
+struct HRowCache {
+    struct Slot {
+        const uint8_t* row = nullptr;  // the texel row (identifies texture and row)
+        HConfig config;
+        uint64_t stamp = 0;  // the pixel row that last used it (slots in use are never evicted)
+        int32_t stride = 0;  // elements per plane
+        std::vector<uint16_t> data;
+    };
+    std::vector<std::unique_ptr<Slot>> slots;
+    std::vector<uint16_t> staging;  // deinterleaved texels before the horizontal combine
+    uint64_t serial = 0;            // the draw the slots belong to
+    uint64_t stamp = 0;
+    uint64_t built = 0, hits = 0;  // H rows built and reused (tests and benchmarks)
+};
+
 // Per-worker buffers, allocated once.
 struct AlignedScratch {
     alignas(32) int16_t r0[4][ps11::kMaxSpan];
@@ -76,6 +117,7 @@ struct AlignedScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
+    HRowCache hrows;
 };
 
 struct AlignedStats {
@@ -83,8 +125,9 @@ struct AlignedStats {
     ps11::ExecutorStats exec;
 };
 
-// Draws rows [y0, y1) of a prepared triangle.
-void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                     AlignedScratch& scratch, AlignedStats& stats);
+// Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
+// order): row by row, each row through every triangle in order.
+void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
+                     size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats);
 
 }  // namespace emu

@@ -11,43 +11,24 @@ namespace emu {
 
 namespace {
 
-// 16 b g r a words as int16 (4 registers: pixels 0-3, 4-7, 8-11, 12-15, channels in b g r a
-// order within each pixel) transposed into r g b a planes of 16 lanes, stored at out[c] + lane.
-inline void storePlanes(__m256i p0, __m256i p1, __m256i p2, __m256i p3, int16_t* const out[4], int lane) {
-    // Each register holds pixels (k, k+1) in its low lane and (k+2, k+3) in its high lane:
-    // vpmovzxbw of 4 words keeps them in order. Transpose 4x4 blocks of int16 per 128-bit lane.
-    const __m256i a = _mm256_unpacklo_epi16(p0, p1);  // px0 b0 b4 g0 g4 r0 r4 a0 a4 | ...
-    const __m256i b = _mm256_unpackhi_epi16(p0, p1);
-    const __m256i c = _mm256_unpacklo_epi16(p2, p3);
-    const __m256i d = _mm256_unpackhi_epi16(p2, p3);
-    const __m256i e = _mm256_unpacklo_epi16(a, b);  // b0 b1 b4 b5 g0 g1 g4 g5 | (lane 1: px 2,3,6,7)
-    const __m256i f = _mm256_unpackhi_epi16(a, b);  // r0 r1 r4 r5 a0 a1 a4 a5
-    const __m256i g = _mm256_unpacklo_epi16(c, d);  // b8 b9 b12 b13 g8 ...
-    const __m256i h = _mm256_unpackhi_epi16(c, d);
-    const __m256i bg0 = _mm256_unpacklo_epi64(e, g);  // b0 b1 b4 b5 b8 b9 b12 b13 | b2 b3 b6 b7 b10 ...
-    const __m256i bg1 = _mm256_unpackhi_epi64(e, g);  // g ...
-    const __m256i ra0 = _mm256_unpacklo_epi64(f, h);  // r ...
-    const __m256i ra1 = _mm256_unpackhi_epi64(f, h);  // a ...
-    // Lane 0 holds pixels {0,1,4,5,8,9,12,13}, lane 1 {2,3,6,7,10,11,14,15}: interleave pairs.
-    const __m256i order = _mm256_setr_epi8(0, 1, 2, 3, 8, 9, 10, 11, 4, 5, 6, 7, 12, 13, 14, 15, 0, 1, 2, 3, 8, 9, 10,
-                                           11, 4, 5, 6, 7, 12, 13, 14, 15);
-    auto fix = [&](__m256i v) {
-        // lane0: 0 1 4 5 8 9 12 13 -> shuffle to 0 1 8 9 4 5 12 13; lane1 likewise 2 3 10 11 6 7 14 15
-        v = _mm256_shuffle_epi8(v, order);
-        // 64-bit blocks: [0 1 8 9][4 5 12 13][2 3 10 11][6 7 14 15] -> [0 1 2 3][4 5 6 7]...
-        v = _mm256_permute4x64_epi64(v, 0xD8);  // blocks 0 2 1 3: [0 1 8 9][2 3 10 11][4 5 12 13][6 7 14 15]
-        // now 32-bit pairs: (0 1)(8 9)(2 3)(10 11)(4 5)(12 13)(6 7)(14 15)
-        return _mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7));
-    };
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[2] + lane), fix(bg0));  // b
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[1] + lane), fix(bg1));  // g
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[0] + lane), fix(ra0));  // r
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out[3] + lane), fix(ra1));  // a
-}
+inline __m256i loadu(const void* p) { return _mm256_loadu_si256(static_cast<const __m256i*>(p)); }
+inline void storeu(void* p, __m256i v) { _mm256_storeu_si256(static_cast<__m256i*>(p), v); }
 
-// 4 b g r a words at p as 16 int16 lanes.
-inline __m256i load4(const uint8_t* p) {
-    return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+// 16 texels (64 bytes, b g r a) as r g b a uint16 planes at out[c] + k.
+inline void deinterleave16(const uint8_t* p, uint16_t* const out[4], int k) {
+    // Per 128-bit lane: b0-3 g0-3 r0-3 a0-3 of its four texels.
+    const __m256i gather = _mm256_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15, 0, 4, 8, 12, 1, 5, 9,
+                                            13, 2, 6, 10, 14, 3, 7, 11, 15);
+    const __m256i x = _mm256_shuffle_epi8(loadu(p), gather);       // texels 0-3 | 4-7
+    const __m256i y = _mm256_shuffle_epi8(loadu(p + 32), gather);  // texels 8-11 | 12-15
+    // Dwords: b0-3 b8-11 g0-3 g8-11 | b4-7 b12-15 g4-7 g12-15, then in texel order.
+    const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+    const __m256i bg = _mm256_permutevar8x32_epi32(_mm256_unpacklo_epi32(x, y), order);  // b0-15 | g0-15
+    const __m256i ra = _mm256_permutevar8x32_epi32(_mm256_unpackhi_epi32(x, y), order);  // r0-15 | a0-15
+    storeu(out[2] + k, _mm256_cvtepu8_epi16(_mm256_castsi256_si128(bg)));
+    storeu(out[1] + k, _mm256_cvtepu8_epi16(_mm256_extracti128_si256(bg, 1)));
+    storeu(out[0] + k, _mm256_cvtepu8_epi16(_mm256_castsi256_si128(ra)));
+    storeu(out[3] + k, _mm256_cvtepu8_epi16(_mm256_extracti128_si256(ra, 1)));
 }
 
 // round_half_even(t / 65536) of 32-bit lanes.
@@ -56,73 +37,135 @@ inline __m256i roundBlend8(__m256i t) {
     return _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(t, _mm256_set1_epi32(0x7fff)), odd), 16);
 }
 
+// round_half_even(v / 2^s) of unsigned 16-bit lanes, v + 2^(s-1) < 2^16.
+template <int S>
+inline __m256i roundShift(__m256i v) {
+    const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(v, S), _mm256_set1_epi16(1));
+    return _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(v, _mm256_set1_epi16((1 << (S - 1)) - 1)), odd), S);
+}
+
 }  // namespace
 
-// Pixels [0, count) (count a multiple of 16) whose texels are a0 + 4i, a0 + 4i + 4 on both rows
-// with the fixed weights wx, wy. Four kernels by weight: copy, horizontal or vertical only, both.
-void alignedFilterRunAvx2(const uint8_t* r0, const uint8_t* r1, int32_t wx, int32_t wy, int count, int lane,
-                          int16_t* const out[4]) {
-    if (wx == 0 && wy == 0) {
-        for (int i = 0; i < count; i += 16) {
-            const uint8_t* p = r0 + 4 * i;
-            storePlanes(load4(p), load4(p + 16), load4(p + 32), load4(p + 48), out, lane + i);
+void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]) {
+    int k = 0;
+    for (; k + 16 <= count; k += 16) deinterleave16(row + 4 * k, out, k);
+    if (k < count) {
+        alignas(32) uint8_t last[64] = {};
+        std::memcpy(last, row + 4 * k, size_t(4 * (count - k)));
+        deinterleave16(last, out, k);
+    }
+}
+
+void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]) {
+    const HKind kind = hKindOf(wx);
+    if (step == 1) {
+        for (int c = 0; c < 4; ++c) {
+            const uint16_t* a = t[c];
+            uint16_t* o = out[c];
+            if (kind == HKind::A) {
+                std::memcpy(o, a, sizeof(uint16_t) * size_t(n));
+            } else if (kind == HKind::S) {
+                for (int j = 0; j < n; j += 16) storeu(o + j, _mm256_add_epi16(loadu(a + j), loadu(a + j + 1)));
+            } else {
+                const __m256i wa = _mm256_set1_epi16(int16_t(256 - wx)), wb = _mm256_set1_epi16(int16_t(wx));
+                for (int j = 0; j < n; j += 16)
+                    storeu(o + j, _mm256_add_epi16(_mm256_mullo_epi16(loadu(a + j), wa),
+                                                   _mm256_mullo_epi16(loadu(a + j + 1), wb)));
+            }
         }
         return;
     }
-    if (wy == 0 || wx == 0) {
-        // One axis: round_half_even((a·(256 − w) + b·w) / 256), all in 16 bits (a·(256 − w) + b·w
-        // <= 65280, so +127 + 1 stays below 2^16).
-        const int32_t w = wy == 0 ? wx : wy;
-        const uint8_t* pa = r0;
-        const uint8_t* pb = wy == 0 ? r0 + 4 : r1;
-        const __m256i wa = _mm256_set1_epi16(int16_t(256 - w)), wb = _mm256_set1_epi16(int16_t(w));
-        const __m256i c127 = _mm256_set1_epi16(127), one = _mm256_set1_epi16(1);
-        auto px = [&](const uint8_t* a, const uint8_t* b) {
-            const __m256i h = _mm256_add_epi16(_mm256_mullo_epi16(load4(a), wa), _mm256_mullo_epi16(load4(b), wb));
-            const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(h, 8), one);
-            return _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(h, c127), odd), 8);
-        };
-        for (int i = 0; i < count; i += 16) {
-            const int o = 4 * i;
-            storePlanes(px(pa + o, pb + o), px(pa + o + 16, pb + o + 16), px(pa + o + 32, pb + o + 32),
-                        px(pa + o + 48, pb + o + 48), out, lane + i);
+    if (step == 2) {
+        // Pairs (t[2j], t[2j + 1]) by pmaddwd with weights (1, 0), (1, 1) or (256 − wx, wx): at most
+        // 65280, packed back to uint16 with unsigned saturation (exact).
+        const int32_t wa = kind == HKind::A ? 1 : (kind == HKind::S ? 1 : 256 - wx);
+        const int32_t wb = kind == HKind::A ? 0 : (kind == HKind::S ? 1 : wx);
+        const __m256i w = _mm256_set1_epi32(int32_t(uint32_t(wa) | (uint32_t(wb) << 16)));
+        for (int c = 0; c < 4; ++c) {
+            const uint16_t* a = t[c];
+            uint16_t* o = out[c];
+            for (int j = 0; j < n; j += 16) {
+                const __m256i lo = _mm256_madd_epi16(loadu(a + 2 * j), w);
+                const __m256i hi = _mm256_madd_epi16(loadu(a + 2 * j + 16), w);
+                storeu(o + j, _mm256_permute4x64_epi64(_mm256_packus_epi32(lo, hi), 0xD8));
+            }
         }
         return;
     }
-    if (wx == 128 && wy == 128) {
-        // The half-texel blur tap: round_half_even((a + b + c + d) / 4).
-        const __m256i one = _mm256_set1_epi16(1);
-        auto px = [&](int o) {
-            const __m256i s = _mm256_add_epi16(_mm256_add_epi16(load4(r0 + o), load4(r0 + o + 4)),
-                                               _mm256_add_epi16(load4(r1 + o), load4(r1 + o + 4)));
-            const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(s, 2), one);
-            return _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(s, one), odd), 2);
-        };
-        for (int i = 0; i < count; i += 16) {
-            const int o = 4 * i;
-            storePlanes(px(o), px(o + 16), px(o + 32), px(o + 48), out, lane + i);
+    for (int c = 0; c < 4; ++c)
+        for (int j = 0; j < n; ++j) {
+            const uint32_t a = t[c][step * j], b = t[c][step * j + 1];
+            out[c][j] =
+                uint16_t(kind == HKind::A ? a : (kind == HKind::S ? a + b : a * uint32_t(256 - wx) + b * uint32_t(wx)));
         }
+}
+
+namespace {
+
+// One group of 16 lanes of every channel: f(c, k) gives the vector of channel c at element k.
+template <typename F>
+inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
+    int k = 0;
+    for (; k + 16 <= count; k += 16)
+        for (int c = 0; c < 4; ++c) storeu(out[c] + lane + k, f(c, k));
+    if (k < count) {
+        alignas(32) int16_t tmp[16];
+        for (int c = 0; c < 4; ++c) {
+            storeu(tmp, f(c, k));
+            std::memcpy(out[c] + lane + k, tmp, sizeof(int16_t) * size_t(count - k));
+        }
+    }
+}
+
+}  // namespace
+
+void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                         int lane, int16_t* const out[4]) {
+    if (wy == 0) {
+        switch (kind) {
+            case HKind::A:
+                verticalGroups(count, lane, out, [&](int c, int k) { return loadu(h0[c] + k); });
+                return;
+            case HKind::S:  // round(s / 2)
+                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<1>(loadu(h0[c] + k)); });
+                return;
+            case HKind::H:  // round(h / 256)
+                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<8>(loadu(h0[c] + k)); });
+                return;
+        }
+    }
+    if (kind == HKind::A && wy == 128) {  // round((a0 + a1) / 2)
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<1>(_mm256_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
+        });
         return;
     }
-    // General weights: h = a·(256 − wx) + b·wx <= 65280 per row (exact in unsigned 16 bits), then
-    // t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768): t = madd + 32768·256.
-    const __m256i wa = _mm256_set1_epi16(int16_t(256 - wx)), wb = _mm256_set1_epi16(int16_t(wx));
+    if (kind == HKind::S && wy == 128) {  // round((s0 + s1) / 4): the half-texel blur tap
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<2>(_mm256_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
+        });
+        return;
+    }
+    if (kind == HKind::A) {  // round((a0·(256 − wy) + a1·wy) / 256), at most 65280
+        const __m256i wa = _mm256_set1_epi16(int16_t(256 - wy)), wb = _mm256_set1_epi16(int16_t(wy));
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<8>(
+                _mm256_add_epi16(_mm256_mullo_epi16(loadu(h0[c] + k), wa), _mm256_mullo_epi16(loadu(h1[c] + k), wb)));
+        });
+        return;
+    }
+    // General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768): t = madd +
+    // 32768·256; kind S is widened to h = 128·s first.
+    const int up = kind == HKind::S ? 7 : 0;
     const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
     const __m256i flip = _mm256_set1_epi16(int16_t(0x8000)), bias = _mm256_set1_epi32(32768 * 256);
-    auto px = [&](int o) {
-        const __m256i h0 =
-            _mm256_add_epi16(_mm256_mullo_epi16(load4(r0 + o), wa), _mm256_mullo_epi16(load4(r0 + o + 4), wb));
-        const __m256i h1 =
-            _mm256_add_epi16(_mm256_mullo_epi16(load4(r1 + o), wa), _mm256_mullo_epi16(load4(r1 + o + 4), wb));
-        const __m256i s0 = _mm256_xor_si256(h0, flip), s1 = _mm256_xor_si256(h1, flip);
+    verticalGroups(count, lane, out, [&](int c, int k) {
+        const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), up), flip);
+        const __m256i s1 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h1[c] + k), up), flip);
         const __m256i lo = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(s0, s1), wv), bias));
         const __m256i hi = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(s0, s1), wv), bias));
         return _mm256_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
-    };
-    for (int i = 0; i < count; i += 16) {
-        const int o = 4 * i;
-        storePlanes(px(o), px(o + 16), px(o + 32), px(o + 48), out, lane + i);
-    }
+    });
 }
 
 namespace {

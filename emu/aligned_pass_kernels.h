@@ -1,17 +1,43 @@
 // The vector kernels of the aligned-pass path (emu/aligned_pass.h), built for AVX2 in
 // aligned_pass_avx2.cpp; callers check the CPU first. Internal to emu/aligned_pass*.cpp.
+//
+// Filtering is split in two passes (docs/device.md "Aligned passes"): a horizontal pass turns a
+// texel row into an "H row" once (alignedBuildHRowAvx2), and each tap of each pixel row combines
+// two H rows vertically (alignedVerticalAvx2). An H row of weight wx holds, per output j, planar
+// (r, g, b, a) uint16 values in one of three forms, all exact:
+//   kind A (wx = 0):   a           (h = 256·a)
+//   kind S (wx = 128): a + b       (h = 128·(a + b))
+//   kind H (other wx): a·(256 − wx) + b·wx = h
+// where a, b are the channel bytes of texels i = step·j + phase and i + 1. The blend of the
+// reference sampler is round_half_even((h0·(256 − wy) + h1·wy) / 65536).
 #pragma once
 
 #include <cstdint>
 
 namespace emu {
 
-// Filters `count` pixels (a multiple of 16) whose texels are r0 + 4i and r0 + 4i + 4 (and the
-// same on r1) with the fixed 8-bit weights wx, wy into int16 r g b a planes out[c] + lane: the
-// exact sum rounded once, half to even. r1 is read only when wy != 0, texel i + 1 only when
-// wx != 0.
-void alignedFilterRunAvx2(const uint8_t* r0, const uint8_t* r1, int32_t wx, int32_t wy, int count, int lane,
-                          int16_t* const out[4]);
+enum class HKind : uint8_t { A, S, H };
+
+inline HKind hKindOf(int32_t wx) { return wx == 0 ? HKind::A : (wx == 128 ? HKind::S : HKind::H); }
+
+// Padding (elements) every plane of an H row and of the staging rows keeps past its end: the
+// kernels read and write whole groups of 16.
+constexpr int kHRowPad = 32;
+
+// Texels [0, count) of a b g r a row as r g b a uint16 planes out[c][0 .. count) (and up to the
+// next multiple of 16: whatever the row holds there, or 0 past the row's end; never read past
+// row + 4·count).
+void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]);
+
+// H row j in [0, n) from staged planes t (t[c][k] = channel c of texel i_first + k): texels
+// k = step·j and k + 1 with weight wx, in the form of hKindOf(wx). step 1 and 2 are vectorised,
+// larger steps run one element at a time.
+void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
+
+// Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of kind
+// `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
+void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                         int lane, int16_t* const out[4]);
 
 // Stores the first pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
 // dst, or-ing orMask (additive: a saturating byte add onto what dst holds), in whole groups of

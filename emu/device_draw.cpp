@@ -458,9 +458,9 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
     MergeTarget mtarget{target, depth};
     AlignedDraw aligned;
-    const bool alignedDraw = m_options.alignedPasses && prepareAlignedDraw(executor, m_options.precision, textures,
-                                                                           samplers, merge, mtarget, wantZ, used,
-                                                                           aligned);
+    const bool alignedDraw =
+        m_options.alignedPasses &&
+        prepareAlignedDraw(executor, m_options.precision, textures, samplers, merge, mtarget, wantZ, used, aligned);
     std::vector<AlignedTriangle> alignedTris;
     std::vector<uint8_t> isAligned;
     for (uint32_t first = 0; first < primitiveCount; first += kChunkTriangles) {
@@ -550,14 +550,26 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                     if (b >= bands) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
+                    // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
+                    const AlignedTriangle* group[kMaxAlignedTriangles];
+                    const TriangleSetup* groupSetups[kMaxAlignedTriangles];
+                    size_t grouped = 0;
+                    auto flush = [&] {
+                        if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
+                        grouped = 0;
+                    };
                     for (size_t i = 0; i < setups.size(); ++i) {
                         const TriangleSetup& s = setups[i];
                         if (s.yMax <= by0 || s.yMin >= by1) continue;
-                        if (isAligned[i])
-                            drawAlignedRows(aligned, alignedTris[i], s, by0, by1, ws0.aligned, as);
-                        else
-                            rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                        if (isAligned[i]) {
+                            group[grouped] = &alignedTris[i];
+                            groupSetups[grouped++] = &s;
+                            continue;
+                        }
+                        flush();
+                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                     }
+                    flush();
                 }
                 ws.pixelsCovered += as.pixels;
                 ws.pixelsShaded = es.pixels + as.exec.pixels;

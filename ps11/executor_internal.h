@@ -13,7 +13,7 @@ namespace ps11::exec {
 
 // Lanes processed at once inside run(): a span is cut into chunks of this size so the working
 // set (registers + scratch) stays in L1.
-constexpr int kChunk = 64;
+constexpr int kChunk = 128;
 
 // Register file slots: r0..r5, t0..t5 (1_1-1_3 texture registers), v0, v1.
 constexpr int kSlotR = 0;

@@ -11,7 +11,11 @@
 #include <string>
 #include <vector>
 
+#include "emu/aligned_pass.h"
 #include "emu/device.h"
+#include "emu/format.h"
+#include "ps11/assembler.h"
+#include "ps11/validator.h"
 
 using namespace emu;
 
@@ -108,11 +112,12 @@ Case randomCase(std::mt19937& rng) {
     auto corner = [&](int n) { return uni(0, 1) ? float(uni(-3, n + 3)) - 0.5f : real(-3.0f, float(n) + 3.0f); };
     float x0 = corner(int(c.w)), x1 = corner(int(c.w)), y0 = corner(int(c.h)), y1 = corner(int(c.h));
     // Half the cases are post-processing passes: the whole target through the half-pixel corners,
-    // textures of the target's size (1:1) or twice it (2:1 reduction).
+    // textures of the target's size (1:1) or 2, 3 or 4 times it (integer-ratio reductions).
     const bool post = uni(0, 1);
     if (post) {
         x0 = -0.5f, x1 = float(c.w) - 0.5f, y0 = -0.5f, y1 = float(c.h) - 0.5f;
-        const UINT scale = UINT(uni(1, 2));
+        const UINT scales[5] = {1, 1, 2, 3, 4};  // 1:1 and integer-ratio reductions
+        const UINT scale = scales[uni(0, 4)];
         for (Case::Tex& t : c.tex) {
             t.w = c.w * scale, t.h = c.h * scale;
             t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
@@ -376,4 +381,81 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
         INFO("draw " << iter);
         REQUIRE(result[1] == result[0]);
     }
+}
+
+TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[draw][aligned]") {
+    // The device may place a new texture copy where a freed one was, so two draws can sample the
+    // same address with different texels. Driven below the device: the same buffer, rewritten
+    // between two draws of the same triangles, must give each draw its own texels.
+    const int w = 48, h = 6;
+    ps11::Diagnostics diags;
+    std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, ps11::ExecutorOptions{}, diags);
+    REQUIRE(exec);
+    std::vector<uint8_t> texels(size_t(w) * h * 4);
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = w, target.height = h, target.rowPitch = 4 * w;
+    target.bytes.assign(size_t(w) * h * 4, 0);
+    // The 1:1 quad with the tap a quarter texel right (one weight along whole rows).
+    ScreenTriangle tris[2];
+    const double xs[4] = {-0.5, w - 0.5, w - 0.5, -0.5}, ys[4] = {-0.5, -0.5, h - 0.5, h - 0.5};
+    const int order[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int t = 0; t < 2; ++t)
+        for (int k = 0; k < 3; ++k) {
+            ScreenVertex& v = tris[t].v[size_t(k)];
+            const int c = order[t][k];
+            v.x = xs[c], v.y = ys[c], v.rhw = 1;
+            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + 0.25f / w;
+            v.attr[size_t(attrTex(0, 1))] = c >= 2 ? 1.0f : 0.0f;
+        }
+    const uint64_t used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
+    TriangleSetup setups[2];
+    for (int t = 0; t < 2; ++t) REQUIRE(setupTriangle(tris[t], used, ClipRect{0, 0, w, h}, setups[t]));
+    AlignedScratch* scratch = new AlignedScratch;  // one worker's, kept across the draws
+    std::mt19937 rng(99);
+    for (int draw = 0; draw < 2; ++draw) {
+        for (uint8_t& b : texels) b = uint8_t(rng());
+        AlignedDraw d;
+        // prepareAlignedDraw gives every draw a new serial; the taps are set by hand here.
+        std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+        std::array<ps11::SamplerState, 8> samplers{};
+        MergeState merge;
+        REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr},
+                                   false, used, d));
+        AlignedTap& tap = d.taps[0];
+        tap.bound = true;
+        tap.texels = texels.data();
+        tap.width = w, tap.height = h;
+        tap.linear = true;
+        tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+        AlignedTriangle at[2];
+        for (int t = 0; t < 2; ++t) REQUIRE(prepareAlignedTriangle(d, setups[t], at[t]));
+        const AlignedTriangle* tp[2] = {&at[0], &at[1]};
+        const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
+        AlignedStats stats;
+        // The second draw covers only the row the first ended on: its cached H row has the
+        // same texel address and configuration.
+        const int y0 = draw == 0 ? 0 : h - 1;
+        drawAlignedRows(d, tp, sp, 2, y0, h, *scratch, stats);
+        CHECK(stats.pixels == uint64_t(w) * uint64_t(h - y0));
+        // Expected: round_half_even((a·192 + b·64) / 256) of texels x and x + 1 (clamped).
+        int wrong = 0;
+        for (int y = y0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 4; ++c) {
+                    const uint32_t a = texels[(size_t(y) * w + size_t(x)) * 4 + size_t(c)];
+                    const uint32_t b = texels[(size_t(y) * w + size_t(std::min(x + 1, w - 1))) * 4 + size_t(c)];
+                    const uint32_t t = a * 192 + b * 64;
+                    const uint32_t e = (t + 127 + ((t >> 8) & 1)) >> 8;
+                    wrong += target.bytes[(size_t(y) * w + size_t(x)) * 4 + size_t(c)] != e;
+                }
+        INFO("draw " << draw);
+        CHECK(wrong == 0);
+    }
+    // The vector path really served the second draw from rows it built itself.
+    if (__builtin_cpu_supports("avx2")) CHECK(scratch->hrows.built == uint64_t(h + 1));
+    delete scratch;
 }
