@@ -3,6 +3,7 @@
 // profile), reports E40xx for what it cannot run; run() cuts a span into chunks, loads the
 // inputs, dispatches each op over the chunk's lanes and stores the outputs.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -27,6 +28,12 @@ float clampConst(float v) {
     return std::min(1.0f, std::max(-1.0f, v));
 }
 
+// A process-wide unique, non-zero number per set of constants (see runFast's constsId).
+uint64_t nextConstsId() {
+    static std::atomic<uint64_t> next{0};
+    return ++next;
+}
+
 class ExecutorImpl final : public Executor {
 public:
     ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
@@ -42,6 +49,7 @@ public:
           m_vUsed(vUsed) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < 8; ++i) refreshConstant(i);
+        m_constsId = nextConstsId();
         if (options.path != ExecPath::Generic) {
             const FastKernels* k = options.path == ExecPath::FastBaseline ? fastKernelsBaseline() : fastKernelsBest();
             buildFastProgram(m_p, m_ops, k, m_fast);
@@ -53,6 +61,7 @@ public:
         if (index < 0 || index >= 8) return;
         m_api[size_t(index)] = value;
         refreshConstant(index);
+        m_constsId = nextConstsId();
         if (m_fast.kernels) presampledOps(m_fast, m_p, m_ops, m_presampled);
     }
     void setStageState(int stage, const StageState& state) override {
@@ -108,8 +117,10 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
-    FastProgram m_fast;                // kernels == null: the generic path runs
-    std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
+    FastProgram m_fast;  // kernels == null: the generic path runs
+    std::vector<FastOp> m_presampled;
+    uint64_t m_constsId = 0;  // names the constants (runFast: a thread's bank keeps them)  // m_fast.ops with the sign
+                              // analysis of runPresampled
 };
 
 void ExecutorImpl::loadColors(RunState& st) const {
@@ -186,14 +197,14 @@ bool ExecutorImpl::tapPlan(TapPlan& plan) const {
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    runFastPresampled(m_fast, m_p, m_ops, m_presampled, m_vUsed, inputs, fill, ctx, r0);
+    runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, ctx, r0);
     countRun(stats, count);
 }
 
 void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs, ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.kernels) {
-        runFast(m_fast, m_p, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
+        runFast(m_fast, m_p, m_constsId, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
     } else {
         runGeneric(inputs, sampler, outputs);
     }

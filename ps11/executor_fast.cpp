@@ -133,7 +133,18 @@ bool textureWritesAll(const DOp& op, int minor) {
 struct FastRunState {
     RunState st;
     FastBank bank;
+    uint64_t constsId = 0;  // the constants the bank's c# slots hold (0: none)
 };
+
+// c0..c7 as lanes, unless this thread's bank already holds them (the same constsId).
+void fillConstants(FastRunState& fs, const FastProgram& fp, const Profile& p, uint64_t constsId) {
+    if (constsId != 0 && fs.constsId == constsId) return;
+    for (int i = 0; i < 8; ++i)
+        if ((fp.constsUsed >> i) & 1)
+            for (int c = 0; c < 4; ++c)
+                std::fill_n(fs.bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    fs.constsId = constsId;
+}
 
 void toInt32(const int16_t* s, int32_t* d, int n) {
     for (int i = 0; i < n; ++i) d[i] = s[i];
@@ -242,8 +253,8 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
     return true;
 }
 
-void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed, bool writesDepth,
-             const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) {
+void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops, uint8_t vUsed,
+             bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     ThreadState ts;
     std::unique_ptr<FastRunState>& fs = ts.fs;
@@ -256,10 +267,7 @@ void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& op
     // next multiple of 16) are computed too and never stored; the kernels use only wrapping
     // SIMD arithmetic, so whatever those lanes hold is harmless.
     std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
-    for (int i = 0; i < 8; ++i)
-        if ((fp.constsUsed >> i) & 1)
-            for (int c = 0; c < 4; ++c)
-                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    fillConstants(*fs, fp, p, constsId);
     const FastKernels& kern = *fp.kernels;
     for (int off = 0; off < count; off += kChunk) {
         st.offset = off;
@@ -345,7 +353,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
     }
 }
 
-void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
                        Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
@@ -356,10 +364,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vecto
     // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
     for (int c = 0; c < 4; ++c)
         if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
-    for (int i = 0; i < 8; ++i)
-        if ((fp.constsUsed >> i) & 1)
-            for (int c = 0; c < 4; ++c)
-                std::fill_n(bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
+    fillConstants(*fs, fp, p, constsId);
     const FastKernels& kern = *fp.kernels;
     const int16_t m = int16_t(p.nMax);
     for (int off = 0; off < count; off += kChunk) {

@@ -112,14 +112,16 @@ struct FastProgram {
 bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp);
 
 // run() of the fast path: same inputs, outputs and semantics as the generic run.
-void runFast(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, uint8_t vUsed, bool writesDepth,
-             const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
+// constsId names p's constants (a process-wide unique number per executor and constant change;
+// 0 = unnamed): a thread's bank keeps them between runs with the same id.
+void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops, uint8_t vUsed,
+             bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
 // Executor::runPresampled on the fast path: texture instructions (plain reads, Executor::tapPlan)
 // have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
 // sampled texels are) instead of sampling; r0's int16 lanes are the output.
 // `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.
-void runFastPresampled(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
                        Executor::TapFill fill, void* ctx, int16_t* const r0[4]);
 
