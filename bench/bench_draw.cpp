@@ -43,7 +43,11 @@ struct QuadVertex {
     float uv[4][2];
 };
 
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall };
+// Down2: 1080p texture to a 960×540 target, one bilinear tap on the corner of each 2×2 block.
+// Down4: 1080p texture to 480×270, the blur program's four bilinear taps at ±1 texel around the
+// centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4 };
+constexpr int kPasses = 6;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -56,6 +60,11 @@ struct Scene {
 
     Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
+        if (pass == Pass::Down2) w = kW / 2, h = kH / 2;
+        if (pass == Pass::Down4) w = kW / 4, h = kH / 4;
+        // The texture: the target's size, or 1080p for the reductions.
+        const bool down = pass == Pass::Down2 || pass == Pass::Down4;
+        const UINT tw = down ? kW : w, th = down ? kH : h;
         DeviceOptions o;
         o.threads = threads;
         o.alignedPasses = aligned;
@@ -63,16 +72,17 @@ struct Scene {
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
         if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
-        if (dev->CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
+        if (dev->CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
         D3DLOCKED_RECT lr;
         if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return;
         std::mt19937 rng(42);
-        for (UINT y = 0; y < h; ++y) {
+        for (UINT y = 0; y < th; ++y) {
             auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
-            for (UINT x = 0; x < w; ++x) row[x] = rng();
+            for (UINT x = 0; x < tw; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
-        const int stages = pass == Pass::Blur4 ? 4 : 1;
+        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4;
+        const int stages = fourTaps ? 4 : 1;
         const DWORD filter = pass == Pass::CopyPoint ? D3DTEXF_POINT : D3DTEXF_LINEAR;
         for (int s = 0; s < stages; ++s) {
             dev->SetTexture(DWORD(s), tex);
@@ -81,22 +91,22 @@ struct Scene {
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
         }
-        if (dev->CreatePixelShaderFromText(pass == Pass::Blur4 ? kBlur4 : kCopy, &ps) != D3D_OK) return;
+        if (dev->CreatePixelShaderFromText(fourTaps ? kBlur4 : kCopy, &ps) != D3D_OK) return;
         dev->SetPixelShader(ps);
         const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
         dev->SetPixelShaderConstantF(0, c0, 1);
         dev->SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4);
         // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
-        // averages a 2×2 block), the copy at the texel centres.
-        const float off[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {-0.5f, 0.5f}, {0.5f, 0.5f}};
+        // averages a 2×2 block), the copy at the texel centres; Down4's taps at ±1 texel.
+        const float k = pass == Pass::Down4 ? 1.0f : 0.5f;
+        const float off[4][2] = {{-k, -k}, {k, -k}, {-k, k}, {k, k}};
         const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            QuadVertex q{xs[k], ys[k], 0.0f, 1.0f, {}};
+        for (int c : {0, 1, 2, 0, 2, 3}) {
+            QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
             for (int s = 0; s < 4; ++s) {
-                const bool blur = pass == Pass::Blur4;
-                q.uv[s][0] = us[k] + (blur ? off[s][0] / float(w) : 0.0f);
-                q.uv[s][1] = vs[k] + (blur ? off[s][1] / float(h) : 0.0f);
+                q.uv[s][0] = us[c] + (fourTaps ? off[s][0] / float(tw) : 0.0f);
+                q.uv[s][1] = vs[c] + (fourTaps ? off[s][1] / float(th) : 0.0f);
             }
             quad.push_back(q);
         }
@@ -107,7 +117,7 @@ struct Scene {
 };
 
 Scene& scene(Pass pass, int threads, bool aligned = true) {
-    static std::unique_ptr<Scene> scenes[4][3][2];
+    static std::unique_ptr<Scene> scenes[kPasses][3][2];
     auto& s = scenes[int(pass)][threads][aligned];
     if (!s) s = std::make_unique<Scene>(pass, threads, aligned);
     return *s;
@@ -241,6 +251,16 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, down2_linear_1080p_to_960x540_fx8, Pass::Down2)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, down4_4tap_1080p_to_480x270_fx8, Pass::Down4)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -143,60 +143,78 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
     }
 }
 
-// The H row of texel row `row` for `config` from the worker's cache, built on a miss. Slots used
-// on the current pixel row (stamp) are never evicted, so every pointer handed out for a row stays
-// valid until the next row.
-const uint16_t* const* hRow(HRowCache& cache, const uint8_t* row, const HConfig& config,
-                            std::array<const uint16_t*, 4>& planes) {
-    HRowCache::Slot* hit = nullptr;
+// Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
+// the current pixel row (so every pointer handed out for a row stays valid until the next row),
+// or a new one. `fresh` tells whether it must be filled.
+HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, bool& fresh) {
     HRowCache::Slot* victim = nullptr;
     for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
         HRowCache::Slot& sl = *sp;
-        if (sl.row == row && sl.config.texels == config.texels && sl.config.wx == config.wx &&
-            sl.config.step == config.step && sl.config.phase == config.phase && sl.config.jlo == config.jlo &&
-            sl.config.jhi == config.jhi) {
-            hit = &sl;
-            break;
+        const HConfig& k = sl.config;
+        if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
+            k.jlo == key.jlo && k.jhi == key.jhi) {
+            sl.stamp = cache.stamp;
+            fresh = false;
+            return sl;
         }
         if (sl.stamp != cache.stamp && (!victim || sl.stamp < victim->stamp)) victim = &sl;
     }
-    if (hit) {
-        ++cache.hits;
-    } else {
-        if (!victim) {
-            cache.slots.push_back(std::make_unique<HRowCache::Slot>());
-            victim = cache.slots.back().get();
-        }
-        hit = victim;
-        hit->row = row;
-        hit->config = config;
-        const int n = config.jhi - config.jlo;
-        hit->stride = (n + kHRowPad + 15) & ~15;
-        if (hit->data.size() < size_t(hit->stride) * 4) hit->data.resize(size_t(hit->stride) * 4);
-        uint16_t* const out[4] = {hit->data.data(), hit->data.data() + hit->stride, hit->data.data() + 2 * hit->stride,
-                                  hit->data.data() + 3 * hit->stride};
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-        const int first = config.step * config.jlo + config.phase;
-        const uint8_t* src = row + size_t(first) * 4;
-        if (config.step == 1 && config.wx == 0) {
-            alignedDeinterleaveAvx2(src, n, out);
-        } else {
-            // Texels first .. first + step·(n − 1) (+ 1 when the weight is not 0).
-            const int m = config.step * (n - 1) + 1 + (config.wx != 0);
-            const int stride = (std::max(m, config.step * ((n + 15) & ~15)) + kHRowPad + 15) & ~15;
-            if (cache.staging.size() < size_t(stride) * 4) cache.staging.resize(size_t(stride) * 4);
-            uint16_t* const t[4] = {cache.staging.data(), cache.staging.data() + stride,
-                                    cache.staging.data() + 2 * stride, cache.staging.data() + 3 * stride};
-            alignedDeinterleaveAvx2(src, m, t);
-            const uint16_t* const tc[4] = {t[0], t[1], t[2], t[3]};
-            alignedCombineAvx2(tc, n, config.step, config.wx, out);
-        }
-#endif
-        ++cache.built;
+    if (!victim) {
+        cache.slots.push_back(std::make_unique<HRowCache::Slot>());
+        victim = cache.slots.back().get();
     }
-    hit->stamp = cache.stamp;
-    for (int c = 0; c < 4; ++c) planes[size_t(c)] = hit->data.data() + size_t(c) * size_t(hit->stride);
-    return planes.data();
+    victim->row = row;
+    victim->config = key;
+    victim->stamp = cache.stamp;
+    fresh = true;
+    return *victim;
+}
+
+// Sizes a slot for n elements per plane (plus the kernels' padding) and returns its planes.
+void slotPlanes(HRowCache::Slot& sl, int n, int pad, uint16_t* out[4]) {
+    sl.stride = (n + pad + 15) & ~15;
+    if (sl.data.size() < size_t(sl.stride) * 4) sl.data.resize(size_t(sl.stride) * 4);
+    for (int c = 0; c < 4; ++c) out[c] = sl.data.data() + size_t(c) * size_t(sl.stride);
+}
+
+// The H row of texel row `row` for `config` (planes from element jlo), from the worker's cache.
+// Texel rows are first deinterleaved once per draw (a "staged" slot over the triangle's texel
+// range of that texture), then combined per configuration; weight 0 at step 1 is the staged row
+// itself.
+void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::array<const uint16_t*, 4>& planes) {
+#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+    bool fresh = false;
+    const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
+    HRowCache::Slot& staged = slotFor(cache, row, stageKey, fresh);
+    const int first = config.step * config.jlo + config.phase - config.stageLo;  // staged element of jlo
+    if (fresh) {
+        uint16_t* out[4];
+        slotPlanes(staged, config.stageHi - config.stageLo, kStagePad, out);
+        alignedDeinterleaveAvx2(row + size_t(config.stageLo) * 4, config.stageHi - config.stageLo, out);
+        ++cache.staged;
+    }
+    if (config.step == 1 && config.wx == 0) {
+        for (int c = 0; c < 4; ++c)
+            planes[size_t(c)] = staged.data.data() + size_t(c) * size_t(staged.stride) + size_t(first);
+        return;
+    }
+    HRowCache::Slot& h = slotFor(cache, row, config, fresh);
+    if (fresh) {
+        uint16_t* out[4];
+        slotPlanes(h, config.jhi - config.jlo, kHRowPad, out);
+        const uint16_t* const t[4] = {staged.data.data() + size_t(first),
+                                      staged.data.data() + size_t(staged.stride) + size_t(first),
+                                      staged.data.data() + 2 * size_t(staged.stride) + size_t(first),
+                                      staged.data.data() + 3 * size_t(staged.stride) + size_t(first)};
+        alignedCombineAvx2(t, config.jhi - config.jlo, config.step, config.wx, out);
+        ++cache.built;
+    } else {
+        ++cache.hits;
+    }
+    for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+#else
+    (void)cache, (void)row, (void)config, (void)planes;
+#endif
 }
 
 }  // namespace
@@ -313,7 +331,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
                 if (h.texels == tap.texels && h.wx == wx && h.step == step && h.phase == phase) ci = int(c);
             }
             if (ci < 0) {
-                out.configs.push_back(HConfig{tap.texels, wx, step, phase, j0, j0 + (e - x)});
+                out.configs.push_back(HConfig{tap.texels, wx, step, phase, j0, j0 + (e - x), 0, 0});
                 ci = int(out.configs.size()) - 1;
             }
             HConfig& h = out.configs[size_t(ci)];
@@ -338,6 +356,15 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
             if (cols.off1[size_t(x)] >= 0) cols.off1[size_t(x)] *= 4;
         }
     }
+    // Each texture's staged range: the texels every configuration on it reads.
+    for (HConfig& h : out.configs) {
+        h.stageLo = h.step * h.jlo + h.phase;
+        h.stageHi = h.step * (h.jhi - 1) + h.phase + 1 + (h.wx != 0);
+    }
+    for (HConfig& h : out.configs)
+        for (const HConfig& o : out.configs)
+            if (o.texels == h.texels)
+                h.stageLo = std::min(h.stageLo, o.stageLo), h.stageHi = std::max(h.stageHi, o.stageHi);
     // Run starts relative to their H row's first element, now that the ranges are final.
     for (int i = 0; i < draw.plan.count; ++i) {
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];

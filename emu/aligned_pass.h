@@ -65,6 +65,9 @@ constexpr int kMaxTapConfigs = 4;  // H-row configurations per tap (runs past th
 struct HConfig {
     const uint8_t* texels = nullptr;
     int32_t wx = 0, step = 1, phase = 0, jlo = 0, jhi = 0;
+    // Texels [stageLo, stageHi) of the row: what every configuration on this texture reads,
+    // deinterleaved once per texel row and shared by them.
+    int32_t stageLo = 0, stageHi = 0;
 };
 
 struct AlignedTriangle {
@@ -93,21 +96,22 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 // about the clip width per tap per triangle, so meshes stay on the quad path.
 constexpr size_t kMaxAlignedTriangles = 16;
 
-// Per-worker cache of H rows (one texel row filtered horizontally for one HConfig), kept for the
-// rows of one draw: a blur's texel row serves two taps on each of two pixel rows.
+// Per-worker cache of texel rows, kept for the rows of one draw: staged (deinterleaved into
+// uint16 planes, once per texel row) and H rows (a staged row filtered horizontally for one
+// HConfig). A blur's texel row serves two taps on each of two pixel rows; a 4:1 reduction's
+// serves the two phases of its taps.
 struct HRowCache {
     struct Slot {
         const uint8_t* row = nullptr;  // the texel row (identifies texture and row)
-        HConfig config;
-        uint64_t stamp = 0;  // the pixel row that last used it (slots in use are never evicted)
-        int32_t stride = 0;  // elements per plane
+        HConfig config;                // wx = −1: the staged row, texels [jlo, jhi)
+        uint64_t stamp = 0;            // the pixel row that last used it (slots in use are never evicted)
+        int32_t stride = 0;            // elements per plane
         std::vector<uint16_t> data;
     };
     std::vector<std::unique_ptr<Slot>> slots;
-    std::vector<uint16_t> staging;  // deinterleaved texels before the horizontal combine
-    uint64_t serial = 0;            // the draw the slots belong to
+    uint64_t serial = 0;  // the draw the slots belong to
     uint64_t stamp = 0;
-    uint64_t built = 0, hits = 0;  // H rows built and reused (tests and benchmarks)
+    uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)
 };
 
 // Per-worker buffers, allocated once.

@@ -75,12 +75,33 @@ void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx,
         }
         return;
     }
+    // Steps 2 and 4: pairs (t[k], t[k + 1]) by pmaddwd with weights (1, 0), (1, 1) or
+    // (256 − wx, wx): at most 65280, packed back to uint16 with unsigned saturation (exact).
+    const int32_t wa = kind == HKind::A ? 1 : (kind == HKind::S ? 1 : 256 - wx);
+    const int32_t wb = kind == HKind::A ? 0 : (kind == HKind::S ? 1 : wx);
+    const __m256i w = _mm256_set1_epi32(int32_t(uint32_t(wa) | (uint32_t(wb) << 16)));
+    if (step == 4) {
+        // 64 staged values give 16 outputs: the pairs at 4j are the even dwords of each madd.
+        const __m256i words = _mm256_setr_epi8(0, 1, 4, 5, 2, 3, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15, 0, 1, 4, 5, 2, 3,
+                                               6, 7, 8, 9, 12, 13, 10, 11, 14, 15);
+        const __m256i dwords = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+        for (int c = 0; c < 4; ++c) {
+            const uint16_t* a = t[c];
+            uint16_t* o = out[c];
+            for (int j = 0; j < n; j += 16) {
+                const uint16_t* p = a + 4 * j;
+                const __m256i m0 = _mm256_madd_epi16(loadu(p), w), m1 = _mm256_madd_epi16(loadu(p + 16), w);
+                const __m256i m2 = _mm256_madd_epi16(loadu(p + 32), w), m3 = _mm256_madd_epi16(loadu(p + 48), w);
+                // x: j0 j4 j1 j5 | j2 j6 j3 j7 (dwords), y: j8 j12 j9 j13 | j10 j14 j11 j15.
+                const __m256i x = _mm256_blend_epi32(m0, _mm256_slli_epi64(m1, 32), 0xAA);
+                const __m256i y = _mm256_blend_epi32(m2, _mm256_slli_epi64(m3, 32), 0xAA);
+                const __m256i packed = _mm256_shuffle_epi8(_mm256_packus_epi32(x, y), words);
+                storeu(o + j, _mm256_permutevar8x32_epi32(packed, dwords));
+            }
+        }
+        return;
+    }
     if (step == 2) {
-        // Pairs (t[2j], t[2j + 1]) by pmaddwd with weights (1, 0), (1, 1) or (256 − wx, wx): at most
-        // 65280, packed back to uint16 with unsigned saturation (exact).
-        const int32_t wa = kind == HKind::A ? 1 : (kind == HKind::S ? 1 : 256 - wx);
-        const int32_t wb = kind == HKind::A ? 0 : (kind == HKind::S ? 1 : wx);
-        const __m256i w = _mm256_set1_epi32(int32_t(uint32_t(wa) | (uint32_t(wb) << 16)));
         for (int c = 0; c < 4; ++c) {
             const uint16_t* a = t[c];
             uint16_t* o = out[c];

@@ -20,9 +20,11 @@ enum class HKind : uint8_t { A, S, H };
 
 inline HKind hKindOf(int32_t wx) { return wx == 0 ? HKind::A : (wx == 128 ? HKind::S : HKind::H); }
 
-// Padding (elements) every plane of an H row and of the staging rows keeps past its end: the
-// kernels read and write whole groups of 16.
+// Padding (elements) every plane of an H row keeps past its end: the kernels read and write whole
+// groups of 16. Staged rows keep kStagePad: the combine reads up to 16 groups of `step` past the
+// last element it needs.
 constexpr int kHRowPad = 32;
+constexpr int kStagePad = 16 * 8 + 32;
 
 // Texels [0, count) of a b g r a row as r g b a uint16 planes out[c][0 .. count) (and up to the
 // next multiple of 16: whatever the row holds there, or 0 past the row's end; never read past
@@ -30,8 +32,9 @@ constexpr int kHRowPad = 32;
 void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]);
 
 // H row j in [0, n) from staged planes t (t[c][k] = channel c of texel i_first + k): texels
-// k = step·j and k + 1 with weight wx, in the form of hKindOf(wx). step 1 and 2 are vectorised,
-// larger steps run one element at a time.
+// k = step·j and k + 1 with weight wx, in the form of hKindOf(wx). Steps 1, 2 and 4 are
+// vectorised, others run one element at a time. t's planes must hold kStagePad elements past the
+// last one read.
 void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
 
 // Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of kind
