@@ -2,10 +2,14 @@
 // files the reader accepts are set up on emu::Device and their draws and pixel probes run. The
 // device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
 // format can express; a refused call must carry a message. Sizes are capped so each input
-// stays fast (the limits themselves are tested elsewhere).
+// stays fast (the limits themselves are tested elsewhere). In fx8 every file is also drawn with
+// the aligned-pass path off: after every draw both render targets must be identical bit for bit
+// (docs/device.md "Aligned passes").
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -60,15 +64,29 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             check(!error.empty());
             continue;
         }
+        std::unique_ptr<ps11::DrawRunner> quads;
+        if (p == ps11::Precision::Fx8) {
+            std::string quadError;
+            quads = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, p, quadError, false);
+            check(quads != nullptr);
+        }
         for (const ps11::TestCommand& cmd : file.commands) {
             if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;
             error.clear();
             if (const auto* probe = std::get_if<ps11::Probe>(&cmd.op)) {
                 if (ps11::isEvalProbe(probe->kind)) continue;
                 (void)runner->probe(*probe, error);
-            } else if (!runner->draw(cmd, error)) {
-                check(!error.empty());
+                continue;
             }
+            const bool drawn = runner->draw(cmd, error);
+            if (!drawn) check(!error.empty());
+            if (!quads) continue;
+            std::string quadError;
+            check(quads->draw(cmd, quadError) == drawn);
+            std::vector<ps11::Vec4> a, b;
+            std::string e1, e2;
+            check(runner->targetPixels(a, e1) == quads->targetPixels(b, e2));
+            check(a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0));
         }
     }
     return 0;

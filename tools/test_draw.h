@@ -35,8 +35,9 @@ public:
     // Sets up the device for `file`: render target (and depth buffer), textures, sampler, stage
     // and render states, transforms, constants and the pixel shader (`program`, null = fixed
     // function). Returns null with `error` set ("FILE:LINE: …") when the device refuses a call.
+    // `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer draws both ways).
     static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
-                                              Precision precision, std::string& error);
+                                              Precision precision, std::string& error, bool alignedPasses = true);
     ~DrawRunner();
 
     // Runs a `draw quad` / `draw triangles|strip|fan` command; false with `error` set when the
@@ -47,6 +48,10 @@ public:
     std::string probe(const Probe& probe, std::string& error);
 
     const DrawTally& tally() const { return m_tally; }
+
+    // The render target as read back (8-bit levels, or values on float targets), row by row;
+    // false with `error` set when the device refuses the read-back.
+    bool targetPixels(std::vector<Vec4>& out, std::string& error);
 
 private:
     DrawRunner() = default;
