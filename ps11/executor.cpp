@@ -39,14 +39,8 @@ public:
     ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
                  std::array<std::array<float, 4>, 8> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
                  uint8_t vUsed)
-        : m_options(options),
-          m_p(profile),
-          m_ops(std::move(ops)),
-          m_defs(defs),
-          m_defMask(defMask),
-          m_stagesUsed(stagesUsed),
-          m_writesDepth(depth),
-          m_vUsed(vUsed) {
+        : m_options(options), m_p(profile), m_ops(std::move(ops)), m_defs(defs), m_defMask(defMask),
+          m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < 8; ++i) refreshConstant(i);
         m_constsId = nextConstsId();
@@ -75,7 +69,8 @@ public:
         return m_fast.kernels == fastKernelsAvx2() ? "fast-avx2" : "fast-sse2";
     }
 
-    void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs, ExecutorStats* stats) const override;
+    void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+             ExecutorStats* stats) const override;
     bool tapPlan(TapPlan& plan) const override;
     void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                        ExecutorStats* stats) const override;
@@ -117,10 +112,9 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
-    FastProgram m_fast;  // kernels == null: the generic path runs
-    std::vector<FastOp> m_presampled;
-    uint64_t m_constsId = 0;  // names the constants (runFast: a thread's bank keeps them)  // m_fast.ops with the sign
-                              // analysis of runPresampled
+    FastProgram m_fast;                // kernels == null: the generic path runs
+    std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
+    uint64_t m_constsId = 0;           // names the constants (a thread's fast bank keeps them)
 };
 
 void ExecutorImpl::loadColors(RunState& st) const {
@@ -201,7 +195,8 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* 
     countRun(stats, count);
 }
 
-void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs, ExecutorStats* stats) const {
+void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                       ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.kernels) {
         runFast(m_fast, m_p, m_constsId, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
@@ -302,7 +297,8 @@ struct Decoder {
 }  // namespace
 }  // namespace exec
 
-std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options, Diagnostics& diags) {
+std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
+                                           Diagnostics& diags) {
     using namespace exec;
     Decoder dec{program, diags};
     const Version& ver = program.version;

@@ -171,7 +171,8 @@ void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv)
     if (ops[idx].hold || idx == 0 || !ops[idx - 1].hold) return;
     const DOp& first = ops[idx - 1];
     for (int c = 0; c < 4; ++c)
-        if ((first.mask >> c) & 1) std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
+        if ((first.mask >> c) & 1)
+            std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
 }
 
 // The calling thread's run state, kept between calls (no 60 KB allocation per span); taken out

@@ -34,10 +34,10 @@ struct FastSrc {
 
 struct FastOp {
     FastKind kind = FastKind::Mov;
-    bool hold = false;         // write into the hold buffer (first member of a co-issued pair)
-    bool viaTemp = false;      // write into tmp, then copy (the destination is also a swizzled source)
-    bool half = false;         // products: every source k is even, formed halved (see the kernels)
-    bool small = false;        // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
+    bool hold = false;     // write into the hold buffer (first member of a co-issued pair)
+    bool viaTemp = false;  // write into tmp, then copy (the destination is also a swizzled source)
+    bool half = false;     // products: every source k is even, formed halved (see the kernels)
+    bool small = false;    // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
     bool nonNegative = false;  // small, and both factors unnegated and >= 0 in every lane (set per run)
     uint8_t dst = 0;
     uint8_t mask = kMaskAll;

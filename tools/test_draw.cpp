@@ -18,7 +18,9 @@ namespace {
 // D3D9 names (D3DRS_*, D3DFMT_*, …) live in namespace emu.
 using namespace emu;
 
-std::string where(const std::string& path, uint32_t line) { return line ? path + ":" + std::to_string(line) : path; }
+std::string where(const std::string& path, uint32_t line) {
+    return line ? path + ":" + std::to_string(line) : path;
+}
 
 // "FILE:LINE: <call> failed: E41xx …" from the device's last error.
 std::string refused(const Device& device, const std::string& path, uint32_t line, const char* what) {
@@ -63,8 +65,9 @@ void fillLevel(const emu::FormatInfo& f, const TextureLevel& level, uint8_t* bit
     for (uint32_t z = 0; z < level.depth; ++z)
         for (uint32_t y = 0; y < level.height; ++y)
             for (uint32_t x = 0; x < level.width; ++x) {
-                const Texel& t =
-                    level.hasFill ? level.fill : level.texels[(size_t(z) * level.height + y) * level.width + x];
+                const Texel& t = level.hasFill
+                                     ? level.fill
+                                     : level.texels[(size_t(z) * level.height + y) * level.width + x];
                 storeTexel(f, t, bits + z * slicePitch + y * rowPitch + size_t(x) * f.bytes);
             }
 }
@@ -76,9 +79,8 @@ bool setUpTexture(Device& d, const TextureDesc& t, const std::string& path, std:
     Handle h{};
     if (t.isVolume()) {
         if (levels == 0) {
-            error = where(path, t.line) +
-                    ": `levels 0` on a volume texture: the device generates mips for 2D "
-                    "textures only (D3DUSAGE_AUTOGENMIPMAP); give the levels";
+            error = where(path, t.line) + ": `levels 0` on a volume texture: the device generates mips for 2D "
+                                          "textures only (D3DUSAGE_AUTOGENMIPMAP); give the levels";
             return false;
         }
         if (d.CreateVolumeTexture(t.width, t.height, t.depth, levels, 0, format, D3DPOOL_MANAGED, &h) != D3D_OK) {
@@ -121,9 +123,9 @@ bool setUpTexture(Device& d, const TextureDesc& t, const std::string& path, std:
 bool setUpSampler(Device& d, const SamplerDesc& s, const std::string& path, std::string& error) {
     const DWORD i = DWORD(s.stage);
     const std::pair<D3DSAMPLERSTATETYPE, DWORD> states[] = {
-        {D3DSAMP_MINFILTER, DWORD(s.minFilter.value)}, {D3DSAMP_MAGFILTER, DWORD(s.magFilter.value)},
-        {D3DSAMP_MIPFILTER, DWORD(s.mipFilter.value)}, {D3DSAMP_ADDRESSU, DWORD(s.addressU.value)},
-        {D3DSAMP_ADDRESSV, DWORD(s.addressV.value)},   {D3DSAMP_ADDRESSW, DWORD(s.addressW.value)},
+        {D3DSAMP_MINFILTER, DWORD(s.minFilter.value)},   {D3DSAMP_MAGFILTER, DWORD(s.magFilter.value)},
+        {D3DSAMP_MIPFILTER, DWORD(s.mipFilter.value)},   {D3DSAMP_ADDRESSU, DWORD(s.addressU.value)},
+        {D3DSAMP_ADDRESSV, DWORD(s.addressV.value)},     {D3DSAMP_ADDRESSW, DWORD(s.addressW.value)},
         {D3DSAMP_BORDERCOLOR, argbOf(s.border.value)},
     };
     for (auto [type, value] : states)
@@ -233,17 +235,10 @@ struct VertexLayout {
         f |= DWORD(sets) << D3DFVF_TEXCOUNT_SHIFT;
         for (int i = 0; i < sets; ++i) {
             switch (size[size_t(i)]) {
-                case 1:
-                    f |= D3DFVF_TEXCOORDSIZE1(DWORD(i));
-                    break;
-                case 3:
-                    f |= D3DFVF_TEXCOORDSIZE3(DWORD(i));
-                    break;
-                case 4:
-                    f |= D3DFVF_TEXCOORDSIZE4(DWORD(i));
-                    break;
-                default:
-                    break;  // 2 is 0
+                case 1: f |= D3DFVF_TEXCOORDSIZE1(DWORD(i)); break;
+                case 3: f |= D3DFVF_TEXCOORDSIZE3(DWORD(i)); break;
+                case 4: f |= D3DFVF_TEXCOORDSIZE4(DWORD(i)); break;
+                default: break;  // 2 is 0
             }
         }
         return f;
@@ -431,8 +426,7 @@ bool DrawRunner::readBack(std::string& error) {
     m_pixelWords.assign(n, 0);
     for (uint32_t y = 0; y < m_height; ++y)
         for (uint32_t x = 0; x < m_width; ++x) {
-            const uint8_t* p =
-                static_cast<const uint8_t*>(locked.pBits) + size_t(y) * size_t(locked.Pitch) + x * f.bytes;
+            const uint8_t* p = static_cast<const uint8_t*>(locked.pBits) + size_t(y) * size_t(locked.Pitch) + x * f.bytes;
             const size_t i = size_t(y) * m_width + x;
             if (f.cls == emu::FormatClass::Unorm8) {
                 std::array<uint8_t, 4> b = emu::decodeUnorm8(f, p);
