@@ -111,7 +111,7 @@ std::shared_ptr<const Texture> makeTexture() {
         }
     desc.data.push_back(std::move(level));
     std::string error;
-    std::optional<Texture> texture = textureFromDesc(desc, error);
+    std::optional<Texture> texture = textureFromDesc(desc, SignedDecode::Snorm, error);
     if (!texture) {
         std::fprintf(stderr, "bench: cannot build the texture: %s\n", error.c_str());
         return nullptr;

@@ -54,7 +54,7 @@ std::shared_ptr<const Texture> texture1080p() {
     static const std::shared_ptr<const Texture> t = [] {
         TextureLevelBytes l{kW, kH, 1, imageBytes().data(), kW * 4, size_t(kW) * 4 * kH};
         std::string error;
-        std::optional<Texture> tex = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, error);
+        std::optional<Texture> tex = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error);
         return std::make_shared<const Texture>(std::move(*tex));
     }();
     return t;
@@ -165,7 +165,7 @@ std::optional<Texture> handOverOld(const std::vector<uint8_t>& bytes) {
     }
     desc.data.push_back(std::move(l));
     std::string error;
-    return textureFromDesc(desc, error);
+    return textureFromDesc(desc, SignedDecode::Snorm, error);
 }
 
 void BM_HandOver1080p(benchmark::State& state) {
@@ -179,7 +179,7 @@ void BM_HandOver1080p(benchmark::State& state) {
         auto t1 = Clock::now();
         TextureLevelBytes l{kW, kH, 1, bytes.data(), kW * 4, size_t(kW) * 4 * kH};
         std::string error;
-        std::optional<Texture> b = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, error);
+        std::optional<Texture> b = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error);
         benchmark::DoNotOptimize(b);
         b.reset();
         auto t2 = Clock::now();

@@ -25,6 +25,7 @@ constexpr size_t kMaxShaderTokens = 1u << 16;
 Device::Device(const DeviceOptions& options) : m_options(options) {
     if (m_options.maxResourceBytes == 0 || m_options.maxResourceBytes > kMaxResourceBytes)
         m_options.maxResourceBytes = kMaxResourceBytes;
+    m_hardware = ps11::resolveHardware(m_options.hardware, 1, m_options.precision, m_options.maxValue);
 }
 
 Device::~Device() = default;
@@ -319,11 +320,12 @@ HRESULT Device::CreatePixelShader(std::span<const DWORD> function, Handle* shade
             std::string("CreatePixelShader: version token ") + hex +
                 ((version & 0xFFFF0000u) == 0xFFFE0000u ? " is a vertex shader" : " is not a pixel shader version"));
     }
-    // The device models ps 1.x hardware: D3DCAPS9 PixelShaderVersion = 1.4.
-    if (major != 1 || minor < 1 || minor > 4)
+    // D3DCAPS9::PixelShaderVersion is the hardware class's: 1.1, 1.3 or 1.4.
+    const ps11::HardwareClass& hw = *m_hardware.hardware;
+    if (major != 1 || minor < 1 || minor > DWORD(hw.maxMinor))
         return fail(D3DERR_INVALIDCALL, "E4107",
-                    "CreatePixelShader: version ps_" + num(major) + "_" + num(minor) +
-                        " not taken (this device takes ps_1_1 ... ps_1_4)");
+                    "CreatePixelShader: version ps_" + num(major) + "_" + num(minor) + " not taken (hardware " +
+                        std::string(hw.name) + " runs ps_1_1 ... ps_1_" + num(uint32_t(hw.maxMinor)) + ")");
     ps11::Diagnostics diags;
     const uint32_t file = diags.addFile("CreatePixelShader");
     std::optional<ps11::Program> program = ps11::decode(function, file, diags);
@@ -349,6 +351,12 @@ HRESULT Device::CreatePixelShaderFromText(std::string_view source, Handle* shade
     ps11::Diagnostics diags;
     std::optional<ps11::Program> program = ps11::parseAssembly(source, "CreatePixelShaderFromText", {}, diags);
     if (program) ps11::validate(*program, diags);
+    const ps11::HardwareClass& hw = *m_hardware.hardware;
+    if (program && !diags.hasErrors() && program->version.minor > hw.maxMinor)
+        return fail(D3DERR_INVALIDCALL, "E4107",
+                    "CreatePixelShaderFromText: version ps_1_" + num(uint32_t(program->version.minor)) +
+                        " not taken (hardware " + std::string(hw.name) + " runs ps_1_1 ... ps_1_" +
+                        num(uint32_t(hw.maxMinor)) + ")");
     if (!program || diags.hasErrors()) {
         std::string first;
         for (const ps11::Diagnostic& d : diags.all())

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -15,14 +16,18 @@
 #include "emu/d3d9types.h"
 #include "emu/resources.h"
 #include "emu/state.h"
+#include "ps11/hardware.h"
 #include "ps11/precision.h"
 #include "ps11/texture.h"
 
 namespace emu {
 
 struct DeviceOptions {
-    ps11::Precision precision = ps11::Precision::Fx8;  // profile of draws, StretchRect weights
-    float maxValue = 0;                                // PixelShader1xMaxValue; 0 = the shader version's default
+    // The emulated GPU (ps11/hardware.h): highest ps_1_x version, profile, MaxValue, signed-texel
+    // decode, co-issued cnd, filter weights. Null: the default 1.1-class card.
+    const ps11::HardwareClass* hardware = nullptr;
+    std::optional<ps11::Precision> precision;  // overrides the class's profile (draws, StretchRect weights)
+    float maxValue = 0;                        // overrides the class's PixelShader1xMaxValue (0 = the class's)
     int threads = 0;                                   // worker threads of draws; 0 = all cores
     uint64_t maxResourceBytes = kMaxResourceBytes;     // per resource, checked before allocating
     // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
@@ -62,6 +67,8 @@ public:
     Device& operator=(const Device&) = delete;
 
     const DeviceOptions& options() const { return m_options; }
+    // The class, profile and MaxValue every draw uses (DeviceOptions resolved).
+    const ps11::HardwareConfig& hardware() const { return m_hardware; }
     const DeviceState& state() const { return m_state; }
     const DeviceError& lastError() const { return m_error; }
 
@@ -174,6 +181,7 @@ private:
     std::shared_ptr<DrawContext> m_draw;  // created by the first draw
 
     DeviceOptions m_options;
+    ps11::HardwareConfig m_hardware;
     DeviceState m_state;
     DeviceError m_error;
     uint32_t m_nextHandle = 1;

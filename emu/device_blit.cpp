@@ -122,7 +122,7 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     const FormatInfo& df = *d->format;
     const int64_t sw = sr.right - sr.left, sh = sr.bottom - sr.top;
     const int64_t dw = dr.right - dr.left, dh = dr.bottom - dr.top;
-    const bool fx = ps11::isFixedPoint(m_options.precision);
+    const bool fx = ps11::isFixedPoint(m_hardware.precision);
     const bool unormSource = sf.cls == FormatClass::Unorm8;
     // Channel values in source units: bytes for 8-bit sources (exact sums), values otherwise.
     auto fetch = [&](int64_t x, int64_t y) {
@@ -132,7 +132,7 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
             std::array<uint8_t, 4> b = decodeUnorm8(sf, p);
             for (size_t c = 0; c < 4; ++c) v[c] = b[c];
         } else {
-            std::array<float, 4> f = decodeTexel(sf, p);
+            std::array<float, 4> f = decodeTexel(sf, p, m_hardware.hardware->signedDecode);
             for (size_t c = 0; c < 4; ++c) v[c] = f[c];
         }
         return v;

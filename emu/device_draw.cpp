@@ -250,7 +250,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     // ---- the pixel program ----
     if (!m_draw) m_draw = std::make_shared<DrawContext>(m_options.threads);
     DrawContext& dc = *m_draw;
-    const ps11::ExecutorOptions execOptions{m_options.precision, m_options.maxValue};
+    const ps11::ExecutorOptions execOptions = ps11::executorOptionsFor(m_hardware);
     CachedExecutor* exec = nullptr;
     if (m_state.pixelShader != Handle::Null) {
         const ps11::Program* program = pixelShaderProgram(m_state.pixelShader);
@@ -373,7 +373,6 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     // ---- stage states: texture coordinates and the executor's per-stage values ----
     for (int s = 0; s < kMaxStages; ++s) {
         const DWORD tci = m_state.stageState(s, D3DTSS_TEXCOORDINDEX);
-        const DWORD flags = m_state.stageState(s, D3DTSS_TEXTURETRANSFORMFLAGS);
         const bool slotRead = (exec->attrs >> attrTex(s, 0)) & 0xF;
         if (slotRead && (tci & 0xFFFF0000u))
             return drawFail(
@@ -383,19 +382,25 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                     std::snprintf(b, sizeof b, "%x", unsigned(tci >> 16));
                     return std::string(b);
                 }() + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
-        if ((flags & ~DWORD(D3DTTFF_PROJECTED)) > 4)
-            return drawFail(D3DERR_INVALIDCALL, "E4119",
-                            "stage " + num(uint32_t(s)) + ": D3DTSS_TEXTURETRANSFORMFLAGS " + num(flags) +
-                                " is not COUNT0..4 [| PROJECTED]");
     }
     for (int i = 0; i < kMaxPsConstants; ++i) executor.setConstant(i, m_state.psConstants[size_t(i)]);
     for (int s = 0; s < kMaxStages; ++s) {
+        // D3DTTFF_PROJECTED resolves against the stage's coordinate set in the FVF (any
+        // TEXTURETRANSFORMFLAGS value is taken, as D3D9 takes it; ps11::projectionDivisor).
+        const DWORD set = m_state.stageState(s, D3DTSS_TEXCOORDINDEX) & 0xFFFF;
+        const uint8_t components = set < DWORD(layout->texCount) ? layout->texSize[size_t(set)] : 4;
+        const uint8_t dims = textures[size_t(s)] && textures[size_t(s)]->isVolume() ? 3 : 2;
         if (exec->fixedFunction) {
             // The lowering places the bump values on the stage texbem samples (emu/ffp.h).
-            executor.setStageState(s, exec->stages[size_t(s)]);
+            ps11::StageState st = exec->stages[size_t(s)];
+            st.coordComponents = components;
+            st.textureDimensions = dims;
+            executor.setStageState(s, st);
             continue;
         }
         ps11::StageState st;
+        st.coordComponents = components;
+        st.textureDimensions = dims;
         st.bumpMat = {m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
                       m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
         st.lumScale = m_state.stageStateFloat(s, D3DTSS_BUMPENVLSCALE);
@@ -411,7 +416,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         m_error.message = e;
         return D3DERR_INVALIDCALL;
     }
-    const MergeState merge = MergeState::from(m_state, depth != nullptr, m_options.precision);
+    const MergeState merge = MergeState::from(m_state, depth != nullptr, m_hardware.precision);
     DrawStats stats;
     stats.draws = 1;
     stats.triangles = primitiveCount;
@@ -460,7 +465,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     AlignedDraw aligned;
     const bool alignedDraw =
         m_options.alignedPasses &&
-        prepareAlignedDraw(executor, m_options.precision, textures, samplers, merge, mtarget, wantZ, used, aligned);
+        prepareAlignedDraw(executor, m_hardware.precision, textures, samplers, merge, mtarget, wantZ, used, aligned);
     std::vector<AlignedTriangle> alignedTris;
     std::vector<uint8_t> isAligned;
     for (uint32_t first = 0; first < primitiveCount; first += kChunkTriangles) {
@@ -493,7 +498,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             std::atomic<int> next{0};
             const int workers = std::min(dc.pool.size(), bands);
             std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
-            const bool fx = ps11::isFixedPoint(m_options.precision);
+            const bool fx = ps11::isFixedPoint(m_hardware.precision);
             dc.pool.run(workers, [&](int w) {
                 WorkerScratch& ws0 = *dc.scratch[size_t(w)];
                 ps11::TextureSampler& sampler = ws0.sampler;

@@ -474,7 +474,7 @@ std::shared_ptr<const ps11::Texture> Device::sampledTexture(Handle texture) {
     if (r->sampled && r->sampledGeneration == r->generation) return r->sampled;
     std::string error;
     try {
-        r->sampled = makeSampledTexture(*r, error);
+        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, error);
     } catch (const std::bad_alloc&) {
         r->sampled = nullptr;
         error = "out of memory";

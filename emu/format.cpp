@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "ps11/texture.h"
+
 namespace emu {
 
 namespace {
@@ -40,18 +42,6 @@ constexpr FormatInfo kFormats[] = {
     {D3DFMT_D32, "D32", 4, FormatClass::Depth, false, false, false, 32, 0, TF::A8R8G8B8},
     {D3DFMT_D32F_LOCKABLE, "D32F_LOCKABLE", 4, FormatClass::Depth, false, false, true, 32, 0, TF::A8R8G8B8},
 };
-
-int32_t signExtend(uint32_t v, int bits) {
-    const uint32_t m = uint32_t(1) << (bits - 1);
-    v &= (uint32_t(1) << bits) - 1;
-    return int32_t(v ^ m) - int32_t(m);
-}
-
-float snorm(int32_t v, int32_t den) {
-    // docs/precision.md "Inputs": signed b maps to b/den clamped to [-1, 1] (-128/127 -> -1).
-    const double x = double(v) / double(den);
-    return float(x < -1.0 ? -1.0 : x);
-}
 
 float loadFloat(const uint8_t* p) {
     float f;
@@ -128,26 +118,14 @@ void encodeUnorm8(const FormatInfo& f, const std::array<uint8_t, 4>& c, uint8_t*
     }
 }
 
-std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p) {
+std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p, ps11::SignedDecode decode) {
     if (f.cls == FormatClass::Unorm8) {
         std::array<uint8_t, 4> b = decodeUnorm8(f, p);
         return {float(b[0] / 255.0), float(b[1] / 255.0), float(b[2] / 255.0), float(b[3] / 255.0)};
     }
     const uint32_t w = loadWord(p, f.bytes);
+    if (f.cls == FormatClass::Signed) return ps11::signedTexelValue(f.texFormat, w, decode);
     switch (f.format) {
-        case D3DFMT_V8U8:
-            return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127), 1.0f, 1.0f};
-        case D3DFMT_L6V5U5:
-            return {snorm(signExtend(w, 5), 15), snorm(signExtend(w >> 5, 5), 15), float(((w >> 10) & 63) / 63.0),
-                    1.0f};
-        case D3DFMT_X8L8V8U8:
-            return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127), float(((w >> 16) & 0xff) / 255.0),
-                    1.0f};
-        case D3DFMT_Q8W8V8U8:
-            return {snorm(signExtend(w, 8), 127), snorm(signExtend(w >> 8, 8), 127), snorm(signExtend(w >> 16, 8), 127),
-                    snorm(signExtend(w >> 24, 8), 127)};
-        case D3DFMT_V16U16:
-            return {snorm(signExtend(w, 16), 32767), snorm(signExtend(w >> 16, 16), 32767), 1.0f, 1.0f};
         case D3DFMT_R32F:
             return {loadFloat(p), 1.0f, 1.0f, 1.0f};
         case D3DFMT_A16B16G16R16F: {

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "emu/d3d9types.h"
+#include "ps11/hardware.h"
 #include "ps11/testfile.h"
 
 namespace emu {
@@ -39,9 +40,9 @@ D3DFORMAT d3dFormatOf(ps11::TexFormat format);
 const char* formatName(D3DFORMAT format);
 
 // Channel values of one texel stored at p (D3D layout), as the sampler reads them: r g b a,
-// missing channels 1 except A8's rgb 0 (ps1x-spec §6.4); signed channels b/den clamped to
-// [-1, 1]. Not for depth formats.
-std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p);
+// missing channels 1 except A8's rgb 0 (ps1x-spec §6.4); signed channels decoded by the
+// hardware class's rule (ps11::signedTexelValue). Not for depth formats.
+std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p, ps11::SignedDecode decode);
 // Unorm8 formats only: the four channel bytes r g b a (missing channels 255, A8's rgb 0).
 std::array<uint8_t, 4> decodeUnorm8(const FormatInfo& f, const uint8_t* p);
 // Writes r g b a bytes into a Unorm8 texel (channels the format lacks are dropped; X8's X byte

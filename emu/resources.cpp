@@ -96,7 +96,8 @@ void boxLevel(const Image& src, Image& dst, bool volume) {
                     case FormatClass::Float: {
                         std::array<double, 4> s{};
                         for (int i = 0; i < n; ++i) {
-                            std::array<float, 4> v = decodeTexel(f, taps[i]);
+                            // Float texels: no signed channel, the decode rule is not used.
+                            std::array<float, 4> v = decodeTexel(f, taps[i], ps11::SignedDecode::Snorm);
                             for (size_t c = 0; c < 4; ++c) s[c] += double(v[c]);
                         }
                         std::array<float, 4> avg;
@@ -150,7 +151,8 @@ void generateMips(Resource& r) {
     r.mipsDirty = false;
 }
 
-std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::string& error) {
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode,
+                                                       std::string& error) {
     // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): a row copy
     // for A8R8G8B8, a per-texel expansion for the other formats. No transient per-texel model.
     std::vector<ps11::TextureLevelBytes> levels(r.levels.size());
@@ -159,7 +161,7 @@ std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::
         levels[k] = {im.width, im.height, im.depth, im.bytes.data(), im.rowPitch, size_t(im.slicePitch)};
     }
     std::optional<ps11::Texture> t = ps11::Texture::fromLevels(
-        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), error);
+        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), decode, error);
     if (!t) return nullptr;
     return std::make_shared<const ps11::Texture>(std::move(*t));
 }

@@ -87,6 +87,7 @@ void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth
 // stored representation, the rule ps11/texture.cpp uses for generated chains.
 void generateMips(Resource& r);
 // Builds the sampler's immutable texture from the stored levels; nullptr and `error` on failure.
-std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, std::string& error);
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode,
+                                                       std::string& error);
 
 }  // namespace emu

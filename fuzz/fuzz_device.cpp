@@ -59,7 +59,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     for (ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Float}) {
         std::string error;
-        auto runner = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, p, error);
+        const ps11::HardwareConfig hw = ps11::resolveHardware(file.require.hardware.value, program ? program->version.minor : 1,
+                                                              p, file.require.maxValue.value);
+        auto runner = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, error);
         if (!runner) {
             check(!error.empty());
             continue;
@@ -67,7 +69,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::unique_ptr<ps11::DrawRunner> quads;
         if (p == ps11::Precision::Fx8) {
             std::string quadError;
-            quads = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, p, quadError, false);
+            quads = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
             check(quads != nullptr);
         }
         for (const ps11::TestCommand& cmd : file.commands) {

@@ -175,7 +175,7 @@ bool ExecutorImpl::tapPlan(TapPlan& plan) const {
         if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
         uint8_t set = op.stage;
         if (m_p.minor < 4) {
-            if (m_p.stages[op.stage].transformFlags & kTtffProjected) return false;
+            if (projectionDivisor(m_p.stages[op.stage]) >= 0) return false;
         } else {
             const DSrc& s = op.src[0];
             if (s.kind != SrcKind::TexCoord || s.mod != SrcMod::None || s.sw[0] != 0 || s.sw[1] != 1) return false;
@@ -297,6 +297,22 @@ struct Decoder {
 }  // namespace
 }  // namespace exec
 
+int projectionDivisor(const StageState& stage) {
+    if (!(stage.transformFlags & kTtffProjected)) return -1;
+    uint32_t count = stage.transformFlags & ~kTtffProjected;
+    if (count == 0 || count > stage.coordComponents) count = stage.coordComponents;
+    if (count <= stage.textureDimensions) return -1;
+    return int(count) - 1;
+}
+
+ExecutorOptions executorOptionsFor(const HardwareConfig& hardware) {
+    ExecutorOptions o;
+    o.precision = hardware.precision;
+    o.maxValue = hardware.maxValue;
+    o.coissuedCnd = hardware.hardware->coissuedCnd;
+    return o;
+}
+
 std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
                                            Diagnostics& diags) {
     using namespace exec;
@@ -315,7 +331,7 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
     p.minor = ver.minor;
     p.g = gridScale(options.precision);
     p.clampRange = options.precision != Precision::Ideal;
-    float m = options.maxValue == 0 ? defaultMaxValue(ver.minor) : options.maxValue;
+    float m = options.maxValue == 0 ? defaultHardware(ver.minor).maxValue : options.maxValue;
     // fx lanes are int32 with sources k = 4n + 2G: round(M*G) <= 2^24 keeps every product of the
     // general formula (dp4, lrp, _x8) inside int64, and k inside int32.
     constexpr double kMaxGrid = 16777216.0;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "ps11/diagnostics.h"
+#include "ps11/hardware.h"
 #include "ps11/ir.h"
 #include "ps11/precision.h"
 #include "ps11/sampler.h"
@@ -22,18 +23,33 @@ enum class ExecPath : uint8_t { Auto, Generic, FastBaseline };
 
 struct ExecutorOptions {
     Precision precision = Precision::Fx8;
-    float maxValue = 0;  // PixelShader1xMaxValue; 0 = the version's default (1, or 8 for 1_4)
+    float maxValue = 0;  // PixelShader1xMaxValue; 0 = the default hardware class's for the version
     ExecPath path = ExecPath::Auto;
+    CoissuedCnd coissuedCnd = CoissuedCnd::Parallel;  // what a co-issued cnd reads (hardware class)
 };
+// The options a hardware class (with its overrides) gives.
+ExecutorOptions executorOptionsFor(const HardwareConfig& hardware);
 
 // Texture stage states the pixel shader reads (D3DTSS_*), per stage.
 struct StageState {
     std::array<float, 4> bumpMat{0, 0, 0, 0};  // BUMPENVMAT00, 01, 10, 11
     float lumScale = 0;                        // BUMPENVLSCALE
     float lumOffset = 0;                       // BUMPENVLOFFSET
-    uint32_t transformFlags = 0;               // TEXTURETRANSFORMFLAGS: COUNTn (1-4) | PROJECTED (256)
+    uint32_t transformFlags = 0;               // TEXTURETRANSFORMFLAGS as set: any DWORD (D3D9 checks none)
+    // What D3DTTFF_PROJECTED resolves against (projectionDivisor): the components the draw's
+    // vertex data gives the stage's coordinate set, and the dimensions of its texture.
+    uint8_t coordComponents = 4;    // 1-4
+    uint8_t textureDimensions = 2;  // 2 (2-D texture) or 3 (volume texture)
 };
 constexpr uint32_t kTtffProjected = 256;
+
+// The TC component that ps_1_1 … 1_3 `tex` and `texbem(l)` divide by under D3DTTFF_PROJECTED,
+// or -1 when the stage does not project (docs/precision.md "Projected coordinates", from Wine's
+// projected_textures_test on Windows drivers): the count is the COUNT field, or the set's
+// component count when that field is 0 or larger (PROJECTED alone, 0xffffffff); the division
+// happens only when that count exceeds the texture's dimensions (COUNT1, and COUNT3 on a
+// two-component set, draw unprojected) and is by the count's last component.
+int projectionDivisor(const StageState& stage);
 
 // Interpolated inputs of `count` pixels (count <= kMaxSpan), structure of arrays. A null
 // pointer reads as 0 for every lane.

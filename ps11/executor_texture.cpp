@@ -107,18 +107,16 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
     }
 }
 
-// Static coordinates of TC[m] for tex/texbem(l), projected when the stage says so:
-// D3DTTFF_PROJECTED divides by the component COUNT names (COUNT2 → y, COUNT3 → z, COUNT4 or
-// 0 → w; Wine and nine, spec §7.5). COUNT1 has no divisor component of its own: w is used.
+// Static coordinates of TC[m] for tex/texbem(l), divided by the component projectionDivisor
+// names when the stage projects.
 void staticCoords(const Profile& p, const RunState& st, int m, float* u, float* v, float* w) {
     const int n = st.n;
     const float* tu = texcoordLanes(st, m, 0);
     const float* tv = texcoordLanes(st, m, 1);
     const float* tw = texcoordLanes(st, m, 2);
-    const uint32_t flags = p.stages[size_t(m)].transformFlags;
-    if (flags & kTtffProjected) {
-        const uint32_t count = flags & 0xff;
-        const float* q = texcoordLanes(st, m, count == 2 ? 1 : count == 3 ? 2 : 3);
+    const int divisor = projectionDivisor(p.stages[size_t(m)]);
+    if (divisor >= 0) {
+        const float* q = texcoordLanes(st, m, divisor);
         for (int i = 0; i < n; ++i) {
             u[i] = tu[i] / q[i];
             v[i] = tv[i] / q[i];
@@ -191,7 +189,7 @@ void execTexkill(const Profile& p, const DOp& op, RunState& st) {
 }
 
 void execTex(const Profile& p, const DOp& op, RunState& st) {
-    if (!(p.stages[size_t(op.stage)].transformFlags & kTtffProjected)) {
+    if (projectionDivisor(p.stages[size_t(op.stage)]) < 0) {
         // Not projected: the coordinates are TC[m] as they are, no copy needed.
         sampleInto(p, st, op.stage, 3, texcoordLanes(st, op.stage, 0), texcoordLanes(st, op.stage, 1),
                    texcoordLanes(st, op.stage, 2), op.dstSlot);

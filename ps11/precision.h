@@ -16,8 +16,6 @@ std::optional<Precision> parsePrecision(std::string_view s);  // case-insensitiv
 constexpr bool isFixedPoint(Precision p) { return p == Precision::Fx8 || p == Precision::Fx12; }
 // Grid scale G: a register value is n / G (fx profiles); 1 for float profiles.
 constexpr int32_t gridScale(Precision p) { return p == Precision::Fx8 ? 255 : p == Precision::Fx12 ? 4080 : 1; }
-// PixelShader1xMaxValue default for a ps_1_x minor version: 1 for 1_1-1_3, 8 for 1_4.
-constexpr float defaultMaxValue(int minor) { return minor >= 4 ? 8.0f : 1.0f; }
 
 // round_half_even(num / den) for den > 0, exact in integers.
 constexpr int64_t roundHalfEven(int64_t num, int64_t den) {

@@ -386,8 +386,19 @@ void Parser::requireLine(Args& a, std::string_view kw) {
             a.error("max_value must be > 0");
         else
             assign(r.maxValue, v, line);
+    } else if (iequals(kw, "hardware")) {
+        if (!a.need("hardware class (" + hardwareNames() + ")")) return;
+        std::string_view n = a.next();
+        const HardwareClass* h = findHardware(n);
+        if (!h) {
+            a.error("unknown hardware class " + quote(n) + " (expected " + hardwareNames() + ")");
+            return;
+        }
+        if (r.hardware.isSet()) a.error("hardware given twice (first on line " + std::to_string(r.hardware.line) + ")");
+        r.hardware = {h, line};
     } else {
-        a.error("unknown keyword " + quote(kw) + " in [require] (expected version, precision, backend or max_value)");
+        a.error("unknown keyword " + quote(kw) +
+                " in [require] (expected version, precision, backend, max_value or hardware)");
         return;
     }
     a.end();
@@ -718,19 +729,25 @@ void Parser::stageLine(Args& a, std::string_view kw) {
     } else if (iequals(kw, "loffset")) {
         assign(s.lOffset, a.floatValue("loffset"), line);
     } else if (iequals(kw, "transform")) {
-        if (!a.need("transform flags (disable, count1 ... count4 [projected])")) return;
+        // D3DTTFF_*: SetTextureStageState takes any DWORD, so a raw word is accepted too.
+        const std::string what = "transform flags (disable, count1 ... count4 [projected], projected, or a word)";
+        if (!a.need(what)) return;
         std::string_view f = a.next();
         TransformFlags flags;
         if (iequals(f, "disable")) {
-            flags.count = 0;
+            flags.bits = 0;
+        } else if (iequals(f, "projected")) {
+            flags.bits = 256;  // D3DTTFF_PROJECTED alone (count 0)
         } else if (f.size() == 6 && iequals(f.substr(0, 5), "count") && f[5] >= '1' && f[5] <= '4') {
-            flags.count = uint8_t(f[5] - '0');
+            flags.bits = uint32_t(f[5] - '0');
             if (a.peekIs("projected")) {
                 a.next();
-                flags.projected = true;
+                flags.bits |= 256;
             }
+        } else if (std::optional<uint32_t> w = parseWord(f)) {
+            flags.bits = *w;
         } else {
-            a.error("unknown transform flags " + quote(f) + " (expected disable or count1 ... count4 [projected])");
+            a.error("unknown transform flags " + quote(f) + " (expected " + what.substr(17));
             return;
         }
         s.transformFlags = {flags, line};
@@ -900,6 +917,8 @@ const char* texFormatName(TexFormat f) {
         if (e.value == f) return e.name;
     return "?";
 }
+
+std::optional<TexFormat> parseTexFormat(std::string_view name) { return testfile_detail::lookup(kFormats, name); }
 
 bool isFloatFormat(TexFormat f) {
     return f == TexFormat::A16B16G16R16F || f == TexFormat::A32B32G32R32F || f == TexFormat::R32F;

@@ -6,11 +6,13 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <variant>
 #include <vector>
 
+#include "ps11/hardware.h"
 #include "ps11/precision.h"
 
 namespace ps11 {
@@ -52,6 +54,7 @@ enum class TexFormat : uint8_t {
     R32F,
 };
 const char* texFormatName(TexFormat f);
+std::optional<TexFormat> parseTexFormat(std::string_view name);  // case-insensitive
 bool isFloatFormat(TexFormat f);
 int formatBits(TexFormat f);  // bits per texel of a packed format (0 for float formats)
 
@@ -145,10 +148,10 @@ struct TextureArg {
     bool operator==(const TextureArg&) const = default;
 };
 
-// D3DTSS_TEXTURETRANSFORMFLAGS: count 0 = D3DTTFF_DISABLE.
+// D3DTSS_TEXTURETRANSFORMFLAGS as written: D3DTTFF_COUNTn (the low byte) | D3DTTFF_PROJECTED
+// (256), or any other DWORD (SetTextureStageState takes every value).
 struct TransformFlags {
-    uint8_t count = 0;
-    bool projected = false;
+    uint32_t bits = 0;
     bool operator==(const TransformFlags&) const = default;
 };
 
@@ -241,7 +244,8 @@ struct RequireDesc {
     Setting<int> versionMinor{1};  // ps_1_<versionMinor>
     Setting<Precision> precision{Precision::Fx8};
     Setting<uint8_t> backends{kAllBackends};
-    Setting<float> maxValue{0};  // 0 = the version's default (1, or 8 for ps_1_4)
+    Setting<float> maxValue{0};  // 0 = the hardware class's PixelShader1xMaxValue
+    Setting<const HardwareClass*> hardware{nullptr};  // null = the default class of the shader's version
 };
 
 struct PixelShaderBlock {
@@ -256,11 +260,13 @@ struct PixelShaderBlock {
     std::string textWithFileLines() const;
 };
 
-// `if(...)` / `todo(...)` conditions: a mask of backends and of precisions (0 = any).
+// `if(...)` / `todo(...)` conditions: a mask of backends, of precisions and of hardware classes
+// (bit = hardwareIndex; 0 = any).
 struct Condition {
     uint8_t backends = 0;
     uint8_t precisions = 0;
-    bool matches(Backend b, Precision p) const;
+    uint32_t hardware = 0;
+    bool matches(Backend b, Precision p, const HardwareClass& hw) const;
 };
 
 struct DrawQuad {
@@ -313,7 +319,7 @@ struct TestCommand {
     bool todo = false;  // a known failure where todoIf matches (probes only)
     Condition todoIf;
     std::variant<DrawQuad, DrawPrimitives, Eval, Probe> op;
-    bool isTodo(Backend b, Precision p) const { return todo && todoIf.matches(b, p); }
+    bool isTodo(Backend b, Precision p, const HardwareClass& hw) const { return todo && todoIf.matches(b, p, hw); }
 };
 
 struct TestFile {

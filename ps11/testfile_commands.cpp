@@ -22,10 +22,12 @@ bool Parser::conditionPrefix(Args& a, Condition& cond) {
             cond.backends |= uint8_t(1u << unsigned(*b));
         } else if (std::optional<Precision> p = lookup(kPrecisions, t)) {
             cond.precisions |= uint8_t(1u << unsigned(*p));
+        } else if (const HardwareClass* h = findHardware(t)) {
+            cond.hardware |= 1u << unsigned(hardwareIndex(*h));
         } else {
             a.error("unknown condition " + quote(t) +
-                    " (expected a backend: emu, gl, or a precision: fx8, fx12, "
-                    "float, ideal)");
+                    " (expected a backend: emu, gl, a precision: fx8, fx12, float, ideal, or a hardware class: " +
+                    hardwareNames() + ")");
             return false;
         }
         any = true;
@@ -378,10 +380,11 @@ namespace ps11 {
 
 DrawQuad::DrawQuad() { texRect.fill({0, 0, 1, 1}); }
 
-bool Condition::matches(Backend b, Precision p) const {
+bool Condition::matches(Backend b, Precision p, const HardwareClass& hw) const {
     bool backendOk = backends == 0 || (backends & (1u << unsigned(b)));
     bool precisionOk = precisions == 0 || (precisions & (1u << unsigned(p)));
-    return backendOk && precisionOk;
+    bool hardwareOk = hardware == 0 || (hardware & (1u << unsigned(hardwareIndex(hw))));
+    return backendOk && precisionOk && hardwareOk;
 }
 
 }  // namespace ps11

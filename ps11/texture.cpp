@@ -12,12 +12,14 @@ namespace ps11 {
 
 namespace {
 
-// Per format: how channels are stored and, for integer formats stored Decoded, the denominator
-// of each channel (value = raw / den, clamped to [-1, 1]).
+// Per format: how channels are stored and, for integer formats stored Decoded, each channel's
+// signed width (bump channels, decoded by the hardware class's SignedDecode) or, for the other
+// channels, the denominator (value = raw / den: unsigned L, and the constant 1 of missing ones).
 struct FormatInfo {
     TexelStorage storage = TexelStorage::Unorm8;
     bool floats = false;  // float32/float16 channels
     bool half = false;    // A16B16G16R16F: values rounded to half precision
+    std::array<int8_t, 4> signedBits{0, 0, 0, 0};
     std::array<int32_t, 4> den{1, 1, 1, 1};
 };
 
@@ -31,21 +33,26 @@ FormatInfo formatInfo(TexFormat f) {
         case TexFormat::A8L8:
             break;
         case TexFormat::V8U8:
+            i.storage = TexelStorage::Decoded;
+            i.signedBits = {8, 8, 0, 0};
+            break;
         case TexFormat::Q8W8V8U8:
             i.storage = TexelStorage::Decoded;
-            i.den = {127, 127, 127, 127};
+            i.signedBits = {8, 8, 8, 8};
             break;
         case TexFormat::L6V5U5:
             i.storage = TexelStorage::Decoded;
-            i.den = {15, 15, 63, 1};
+            i.signedBits = {5, 5, 0, 0};
+            i.den = {1, 1, 63, 1};
             break;
         case TexFormat::X8L8V8U8:
             i.storage = TexelStorage::Decoded;
-            i.den = {127, 127, 255, 1};
+            i.signedBits = {8, 8, 0, 0};
+            i.den = {1, 1, 255, 1};
             break;
         case TexFormat::V16U16:
             i.storage = TexelStorage::Decoded;
-            i.den = {32767, 32767, 1, 1};
+            i.signedBits = {16, 16, 0, 0};
             break;
         case TexFormat::A16B16G16R16F:
             i.storage = TexelStorage::Decoded;
@@ -87,12 +94,13 @@ std::array<uint8_t, 4> decodeUnorm8(TexFormat f, uint32_t w) {
     }
 }
 
-// A packed word of a signed (bump) format -> raw channel integers over FormatInfo::den.
+// A packed word of a signed (bump) format -> raw channel integers: signed codes where
+// FormatInfo::signedBits says so, else over FormatInfo::den.
 // Mapping (docs/textures.md): r = U, g = V, b = L or W (else 1), a = Q (else 1).
 std::array<int32_t, 4> decodeSigned(TexFormat f, uint32_t w) {
     switch (f) {
         case TexFormat::V8U8:
-            return {signExtend(w, 8), signExtend(w >> 8, 8), 127, 127};
+            return {signExtend(w, 8), signExtend(w >> 8, 8), 1, 1};
         case TexFormat::L6V5U5:
             return {signExtend(w, 5), signExtend(w >> 5, 5), int32_t((w >> 10) & 63), 1};
         case TexFormat::X8L8V8U8:
@@ -223,7 +231,8 @@ bool Texture::layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height
     return true;
 }
 
-void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf) {
+void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf, SignedDecode decode) {
+    m_signedDecode = decode;
     const FormatInfo info = formatInfo(m_format);
     const size_t n = m_texelCount * 4;
     m_value.resize(n);
@@ -238,17 +247,30 @@ void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<f
             m_grid8[i] = g(Precision::Fx8);
             m_grid12[i] = g(Precision::Fx12);
         } else {
-            // docs/precision.md "Inputs": b -> b/den clamped to [-1, 1]; fx: round_half_even(b*G/den).
-            const int64_t den = info.den[c];
-            const int64_t r = std::clamp<int64_t>(raw[i], -den, den);
-            m_value[i] = float(double(r) / double(den));
-            m_grid8[i] = int32_t(roundHalfEven(r * 255, den));
-            m_grid12[i] = int32_t(roundHalfEven(r * 4080, den));
+            // docs/precision.md "Signed texels": the class's rational num/den; fx grids
+            // round_half_even(num*G/den), exact.
+            const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[i], info.signedBits[c])
+                                                      : SignedValue{raw[i], info.den[c]};
+            m_value[i] = float(double(sv.num) / double(sv.den));
+            m_grid8[i] = int32_t(roundHalfEven(sv.num * 255, sv.den));
+            m_grid12[i] = int32_t(roundHalfEven(sv.num * 4080, sv.den));
         }
     }
 }
 
-std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error) {
+Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
+    const FormatInfo info = formatInfo(f);
+    const std::array<int32_t, 4> raw = decodeSigned(f, word);
+    Vec4 v{0, 0, 0, 1};
+    for (size_t c = 0; c < 4; ++c) {
+        const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[c], info.signedBits[c])
+                                                  : SignedValue{raw[c], info.den[c]};
+        v[c] = float(double(sv.num) / double(sv.den));
+    }
+    return v;
+}
+
+std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error) {
     const TexFormat fmt = desc.format.value;
     const FormatInfo info = formatInfo(fmt);
     const bool volume = desc.isVolume();
@@ -379,7 +401,7 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& err
         }
     }
 
-    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, rawf);
+    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, rawf, decode);
     return t;
 }
 
@@ -463,7 +485,7 @@ void unorm8Row(TexFormat f, const uint8_t* src, uint32_t width, uint8_t* dst) {
 }  // namespace
 
 std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const TextureLevelBytes* levels,
-                                           size_t levelCount, std::string& error) {
+                                           size_t levelCount, SignedDecode decode, std::string& error) {
     static_assert(std::endian::native == std::endian::little, "Unorm8 words are stored little endian");
     if (levelCount == 0 || !levels) {
         error = "texture has no levels";
@@ -552,7 +574,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
             }
         });
     }
-    t.finishDecoded(raw, rawf);
+    t.finishDecoded(raw, rawf, decode);
     return t;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "ps11/hardware.h"
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
 
@@ -81,21 +82,25 @@ public:
     // (level k has the extents of level 0 halved k times). The result is the one
     // textureFromDesc gives for the same texels; A8R8G8B8 levels are copied row by row.
     // On failure returns nullopt and sets `error`; never allocates more than kMaxTextureBytes.
+    // Signed channels decode as `decode` says (the hardware class's rule).
     static std::optional<Texture> fromLevels(TexFormat format, bool volume, const TextureLevelBytes* levels,
-                                             size_t levelCount, std::string& error);
+                                             size_t levelCount, SignedDecode decode, std::string& error);
+    // The rule the signed channels were decoded with (Snorm for textures without them).
+    SignedDecode signedDecode() const { return m_signedDecode; }
 
 private:
-    friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error);
+    friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
     size_t texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const;
     // Sets format and level extents; false (with `error`) beyond kMaxTextureBytes.
     bool layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
                 std::string& error);
     // Signed formats: raw channel integers -> values and grids; float formats: the floats -> grids.
-    void finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf);
+    void finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf, SignedDecode decode);
 
     TexFormat m_format = TexFormat::A8R8G8B8;
     bool m_volume = false;
     TexelStorage m_storage = TexelStorage::Unorm8;
+    SignedDecode m_signedDecode = SignedDecode::Snorm;
     std::vector<TextureLevelInfo> m_levels;
     size_t m_texelCount = 0;
     std::vector<uint8_t> m_u8;
@@ -106,8 +111,12 @@ private:
 // Builds a texture from a parsed [texture N] section: texel words in the format's natural
 // packing (docs/test-format.md) or float tuples, `fill`, and `levels 0` (generate the whole chain
 // from level 0). On failure returns nullopt and sets `error`; never allocates more than
-// kMaxTextureBytes.
-std::optional<Texture> textureFromDesc(const TextureDesc& desc, std::string& error);
+// kMaxTextureBytes. Signed channels decode as `decode` says (the hardware class's rule).
+std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
+
+// The value of one texel word of a signed (bump) format (V8U8, L6V5U5, X8L8V8U8, Q8W8V8U8,
+// V16U16) as the sampler reads it, r g b a, under `decode`.
+Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode);
 
 // Number of levels of a full chain (down to 1x1x1).
 uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);

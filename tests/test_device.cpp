@@ -1060,7 +1060,7 @@ TEST_CASE("device: pixel shaders from tokens and text", "[device]") {
     const DWORD ps20[] = {D3DPS_VERSION(2, 0), 0x0000FFFF};
     CHECK(dev.CreatePixelShader(ps20, &ps3) == D3DERR_INVALIDCALL);
     CHECK(dev.lastError().message ==
-          "E4107 CreatePixelShader: version ps_2_0 not taken (this device takes ps_1_1 ... ps_1_4)");
+          "E4107 CreatePixelShader: version ps_2_0 not taken (hardware geforce4 runs ps_1_1 ... ps_1_3)");
     const DWORD vs[] = {0xFFFE0101u, 0x0000FFFF};
     CHECK(dev.CreatePixelShader(vs, &ps3) == D3DERR_INVALIDCALL);
     CHECK(contains(dev.lastError().message, "vertex shader"));
@@ -1074,7 +1074,26 @@ TEST_CASE("device: pixel shaders from tokens and text", "[device]") {
     CHECK(dev.CreatePixelShaderFromText("ps_1_1\nmov r2, v0\nmov r0, v0\n", &ps3) == D3DERR_INVALIDCALL);
     CHECK(contains(dev.lastError().message, "P2030"));
     CHECK(dev.CreatePixelShaderFromText("ps_2_0\nmov r0, v0\n", &ps3) == D3DERR_INVALIDCALL);
-    CHECK(dev.CreatePixelShaderFromText("ps_1_4\ntexld r0, t0\n", &ps3) == D3D_OK);
+    // D3DCAPS9::PixelShaderVersion is the hardware class's: the default 1.1-class card runs up
+    // to ps_1_3, the 1.4-class card ps_1_4, GeForce3 only ps_1_1.
+    CHECK(dev.CreatePixelShaderFromText("ps_1_4\ntexld r0, t0\n", &ps3) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().message ==
+          "E4107 CreatePixelShaderFromText: version ps_1_4 not taken (hardware geforce4 runs ps_1_1 ... ps_1_3)");
+    {
+        DeviceOptions r200;
+        r200.hardware = ps11::findHardware("radeon8500");
+        Device dev14(r200);
+        Handle ps14{};
+        CHECK(dev14.CreatePixelShaderFromText("ps_1_4\ntexld r0, t0\n", &ps14) == D3D_OK);
+        CHECK(dev14.hardware().maxValue == 8.0f);
+        CHECK(dev14.hardware().precision == ps11::Precision::Fx12);
+        DeviceOptions gf3;
+        gf3.hardware = ps11::findHardware("geforce3");
+        Device dev11(gf3);
+        CHECK(dev11.CreatePixelShaderFromText("ps_1_1\nmov r0, v0\n", &ps14) == D3D_OK);
+        CHECK(dev11.CreatePixelShaderFromText("ps_1_2\nmov r0, v0\n", &ps14) == D3DERR_INVALIDCALL);
+        CHECK(dev11.CreatePixelShader(tokens.data(), &ps14) == D3D_OK);  // tokens: ps_1_1
+    }
 
     // Release unbinds.
     CHECK(dev.Release(ps2) == D3D_OK);

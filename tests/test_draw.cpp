@@ -374,9 +374,6 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
     REQUIRE(dev.SetSamplerState(0, D3DSAMP_ADDRESSU, 0) == D3D_OK);
     expectFail(D3DERR_INVALIDCALL, "E4123", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
     REQUIRE(dev.SetSamplerState(0, D3DSAMP_ADDRESSU, D3DTADDRESS_WRAP) == D3D_OK);
-    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXTURETRANSFORMFLAGS, 5) == D3D_OK);
-    expectFail(D3DERR_INVALIDCALL, "E4119", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
-    REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXTURETRANSFORMFLAGS, 0) == D3D_OK);
     REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXCOORDINDEX, D3DTSS_TCI_SPHEREMAP) == D3D_OK);
     expectFail(D3DERR_INVALIDCALL, "E4119", [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, data, stride); });
     REQUIRE(dev.SetTextureStageState(0, D3DTSS_TEXCOORDINDEX, 0) == D3D_OK);

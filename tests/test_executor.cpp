@@ -305,18 +305,28 @@ TEST_CASE("executor: texcoord, tex with projection, texkill", "[executor]") {
     CHECK(s.calls[0].stage == 1);
     CHECK(s.calls[0].u[0] == 0.25f);
     CHECK(s.calls[0].v[0] == 0.5f);
+    // D3DTTFF_PROJECTED resolves against the set's components and the texture's dimensions
+    // (projectionDivisor; Wine's projected_textures_test): TC1 = (0.25, 0.5, 0.75, 2).
     struct Case {
         uint32_t flags;
+        uint8_t components, dims;
         float div;
-    } cases[] = {{kTtffProjected | 4, 2}, {kTtffProjected, 2}, {kTtffProjected | 3, 0.75f}, {kTtffProjected | 2, 0.5f},
-                 {4, 1}};
+    } cases[] = {
+        {kTtffProjected | 4, 4, 2, 2},       {kTtffProjected, 4, 2, 2},          {kTtffProjected | 3, 4, 2, 0.75f},
+        {kTtffProjected | 2, 4, 2, 1},       {kTtffProjected | 1, 4, 2, 1},      {4, 4, 2, 1},
+        {0xffffffffu, 4, 2, 2},              {0xffffffffu, 3, 2, 0.75f},         {kTtffProjected, 3, 2, 0.75f},
+        {kTtffProjected | 3, 2, 2, 1},       {kTtffProjected | 4, 3, 2, 0.75f},  {kTtffProjected | 3, 4, 3, 1},
+        {kTtffProjected | 4, 4, 3, 2},       {kTtffProjected | 0x2004, 4, 2, 2},
+    };
     for (const Case& c : cases) {
         StageState ss;
         ss.transformFlags = c.flags;
+        ss.coordComponents = c.components;
+        ss.textureDimensions = c.dims;
         tex->setStageState(1, ss);
         s.calls.clear();
         runPixels(*tex, {p}, s);
-        INFO(c.flags);
+        INFO(c.flags << " components " << int(c.components) << " dims " << int(c.dims));
         CHECK(s.calls[0].u[0] == 0.25f / c.div);
         CHECK(s.calls[0].v[0] == 0.5f / c.div);
     }

@@ -427,7 +427,7 @@ std::shared_ptr<const ps11::Texture> smallTexture() {
     }
     desc.data.push_back(std::move(level));
     std::string error;
-    auto t = textureFromDesc(desc, error);
+    auto t = textureFromDesc(desc, SignedDecode::Snorm, error);
     REQUIRE(t);
     return std::make_shared<const Texture>(std::move(*t));
 }

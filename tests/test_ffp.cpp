@@ -703,7 +703,7 @@ ps11::TextureDesc describe(ps11::TexFormat f, uint32_t w, std::initializer_list<
 
 std::shared_ptr<const ps11::Texture> build(const ps11::TextureDesc& d) {
     std::string error;
-    std::optional<ps11::Texture> t = ps11::textureFromDesc(d, error);
+    std::optional<ps11::Texture> t = ps11::textureFromDesc(d, ps11::SignedDecode::Snorm, error);
     INFO(error);
     REQUIRE(t);
     return std::make_shared<const ps11::Texture>(std::move(*t));

@@ -250,7 +250,7 @@ int compareSpan(Pair& pr, Precision p, const float* u, const float* v, int count
 std::shared_ptr<const Texture> randomTexture(std::mt19937& rng, TexFormat f, uint32_t w, uint32_t h, uint32_t levels) {
     D3DLevels L = randomLevels(rng, f, w, h, 1, levels, true);
     std::string error;
-    std::optional<Texture> t = Texture::fromLevels(f, false, L.levels.data(), L.levels.size(), error);
+    std::optional<Texture> t = Texture::fromLevels(f, false, L.levels.data(), L.levels.size(), SignedDecode::Snorm, error);
     INFO(error);
     REQUIRE(t);
     return std::make_shared<const Texture>(std::move(*t));
@@ -281,8 +281,8 @@ TEST_CASE("texture: fromLevels equals textureFromDesc for every format", "[sampl
                 const uint32_t levels = fullMipCount(s.w, s.h, s.volume ? s.d : 1);
                 D3DLevels L = randomLevels(rng, f, s.w, s.h, s.volume ? s.d : 1, levels, finite);
                 std::string e1, e2;
-                std::optional<Texture> a = Texture::fromLevels(f, s.volume, L.levels.data(), L.levels.size(), e1);
-                std::optional<Texture> b = textureFromDesc(descOf(f, s.volume, L), e2);
+                std::optional<Texture> a = Texture::fromLevels(f, s.volume, L.levels.data(), L.levels.size(), SignedDecode::Snorm, e1);
+                std::optional<Texture> b = textureFromDesc(descOf(f, s.volume, L), SignedDecode::Snorm, e2);
                 INFO(e1 << " / " << e2);
                 REQUIRE(a);
                 REQUIRE(b);
@@ -342,7 +342,7 @@ TEST_CASE("texture: the device hands every format over as textureFromDesc builds
             std::shared_ptr<const Texture> got = dev.sampledTexture(tex);
             REQUIRE(got);
             std::string error;
-            std::optional<Texture> want = textureFromDesc(descOf(f, volume, L), error);
+            std::optional<Texture> want = textureFromDesc(descOf(f, volume, L), SignedDecode::Snorm, error);
             INFO(error);
             REQUIRE(want);
             checkSameTexture(*got, *want);
@@ -354,13 +354,13 @@ TEST_CASE("texture: fromLevels stores A8R8G8B8 as D3D's bytes and X8 alpha as 25
     const uint8_t bytes[8] = {0x10, 0x20, 0x40, 0x80, 0x01, 0x02, 0x03, 0x04};
     TextureLevelBytes l{2, 1, 1, bytes, 8, 8};
     std::string error;
-    std::optional<Texture> t = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, error);
+    std::optional<Texture> t = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error);
     REQUIRE(t);
     CHECK(std::memcmp(t->unorm8(), bytes, 8) == 0);
     CHECK(t->texelGrid(0, 0, 0, 0, Precision::Fx8) == std::array<int32_t, 4>{0x40, 0x20, 0x10, 0x80});
     CHECK(t->texelGrid(0, 1, 0, 0, Precision::Fx12) ==
           std::array<int32_t, 4>{0x03 * 16, 0x02 * 16, 0x01 * 16, 0x04 * 16});
-    std::optional<Texture> x = Texture::fromLevels(TexFormat::X8R8G8B8, false, &l, 1, error);
+    std::optional<Texture> x = Texture::fromLevels(TexFormat::X8R8G8B8, false, &l, 1, SignedDecode::Snorm, error);
     REQUIRE(x);
     CHECK(x->texelGrid(0, 0, 0, 0, Precision::Fx8) == std::array<int32_t, 4>{0x40, 0x20, 0x10, 255});
 }
@@ -369,26 +369,26 @@ TEST_CASE("texture: fromLevels refuses bad levels with a message", "[sampler][fa
     std::vector<uint8_t> buf(64 * 64 * 4);
     std::string error;
     TextureLevelBytes l{8, 8, 1, buf.data(), 32, 256};
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 0, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 0, SignedDecode::Snorm, error));
     CHECK(error == "texture has no levels");
     TextureLevelBytes two[2] = {l, {8, 8, 1, buf.data(), 32, 256}};  // level 1 must be 4x4
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, two, 2, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, two, 2, SignedDecode::Snorm, error));
     CHECK(error == "level 1 is 8x8, expected 4x4");
     TextureLevelBytes narrow{8, 8, 1, buf.data(), 16, 128};  // pitch below 8 * 4 bytes
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &narrow, 1, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &narrow, 1, SignedDecode::Snorm, error));
     CHECK(error == "level 0 has no data or a pitch smaller than its rows");
     TextureLevelBytes none{8, 8, 1, nullptr, 32, 256};
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &none, 1, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &none, 1, SignedDecode::Snorm, error));
     TextureLevelBytes big{20000, 1, 1, buf.data(), 80000, 80000};
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &big, 1, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, &big, 1, SignedDecode::Snorm, error));
     CHECK(error.find("beyond the limits") != std::string::npos);
     std::vector<TextureLevelBytes> many(5, TextureLevelBytes{1, 1, 1, buf.data(), 4, 4});
     many[0] = {4, 4, 1, buf.data(), 16, 64};
-    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, many.data(), many.size(), error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::A8R8G8B8, false, many.data(), many.size(), SignedDecode::Snorm, error));
     CHECK(error == "levels 5 is more than the texture has (3)");
     // 16384 x 16384 V16U16 needs 2^28 * 64 bytes decoded: refused before anything is allocated.
     TextureLevelBytes huge{16384, 16384, 1, buf.data(), 65536, 65536ull * 16384};
-    CHECK_FALSE(Texture::fromLevels(TexFormat::V16U16, false, &huge, 1, error));
+    CHECK_FALSE(Texture::fromLevels(TexFormat::V16U16, false, &huge, 1, SignedDecode::Snorm, error));
     CHECK(error.find("more than the limit of 1073741824") != std::string::npos);
 }
 

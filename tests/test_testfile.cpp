@@ -317,7 +317,7 @@ TEST_CASE("testfile: [stage N]", "[testfile]") {
     CHECK(s.bumpEnvMat.value == Vec4{0.5f, 0, 0, 0.5f});
     CHECK(s.lScale.value == 2.0f);
     CHECK(s.lOffset.value == -0.5f);
-    CHECK(s.transformFlags.value == TransformFlags{3, true});
+    CHECK(s.transformFlags.value == TransformFlags{3 | 256});
     CHECK(s.texCoordIndex.value == 0);
     CHECK(s.colorOp.value == TextureOp::BumpEnvMap);
     CHECK(s.colorOp.line == 7);
@@ -338,7 +338,7 @@ TEST_CASE("testfile: [stage N]", "[testfile]") {
     CHECK(!d.file.stage(0)->colorOp.isSet());
     CHECK(d.file.stage(5)->colorOp.value == TextureOp::Disable);
     CHECK(d.file.stage(5)->texCoordIndex.value == 5);
-    CHECK(d.file.stage(5)->transformFlags.value == TransformFlags{0, false});
+    CHECK(d.file.stage(5)->transformFlags.value == TransformFlags{0});
     CHECK(d.file.stage(5)->transformFlags.isSet());
 
     const char* ops[] = {"disable",
@@ -812,27 +812,39 @@ TEST_CASE("testfile: if() and todo() prefixes", "[testfile]") {
         "IF(GL) draw quad\n");
     REQUIRE_OK(p);
     const auto& c = p.file.commands;
+    const HardwareClass& gf4 = *findHardware("geforce4");
     REQUIRE(c.size() == 6);
     CHECK(c[0].onlyIf.backends == kBackendGl);
-    CHECK(c[0].onlyIf.matches(Backend::Gl, Precision::Fx8));
-    CHECK(!c[0].onlyIf.matches(Backend::Emu, Precision::Fx8));
+    CHECK(c[0].onlyIf.matches(Backend::Gl, Precision::Fx8, gf4));
+    CHECK(!c[0].onlyIf.matches(Backend::Emu, Precision::Fx8, gf4));
     CHECK(c[1].onlyIf.precisions == kPrecisionFx8);
-    CHECK(c[1].onlyIf.matches(Backend::Gl, Precision::Fx8));
-    CHECK(!c[1].onlyIf.matches(Backend::Gl, Precision::Ideal));
+    CHECK(c[1].onlyIf.matches(Backend::Gl, Precision::Fx8, gf4));
+    CHECK(!c[1].onlyIf.matches(Backend::Gl, Precision::Ideal, gf4));
     CHECK(c[2].todo);
-    CHECK(c[2].isTodo(Backend::Gl, Precision::Fx8));
-    CHECK(!c[2].isTodo(Backend::Emu, Precision::Fx8));
-    CHECK(c[2].onlyIf.matches(Backend::Emu, Precision::Fx8));
+    CHECK(c[2].isTodo(Backend::Gl, Precision::Fx8, gf4));
+    CHECK(!c[2].isTodo(Backend::Emu, Precision::Fx8, gf4));
+    CHECK(c[2].onlyIf.matches(Backend::Emu, Precision::Fx8, gf4));
     CHECK(c[3].onlyIf.backends == kBackendEmu);
     CHECK(c[3].onlyIf.precisions == kPrecisionFx12);
-    CHECK(c[3].isTodo(Backend::Emu, Precision::Ideal));
-    CHECK(!c[3].isTodo(Backend::Emu, Precision::Fx12));
-    CHECK(c[4].isTodo(Backend::Emu, Precision::Fx8));
-    CHECK(c[4].isTodo(Backend::Gl, Precision::Ideal));
+    CHECK(c[3].isTodo(Backend::Emu, Precision::Ideal, gf4));
+    CHECK(!c[3].isTodo(Backend::Emu, Precision::Fx12, gf4));
+    CHECK(c[4].isTodo(Backend::Emu, Precision::Fx8, gf4));
+    CHECK(c[4].isTodo(Backend::Gl, Precision::Ideal, gf4));
     CHECK(c[5].onlyIf.backends == kBackendGl);
     CHECK(std::holds_alternative<DrawQuad>(c[5].op));
 
     CHECK_ERROR(parse("[test]\nif(d3d) probe 0 0 rgba 0\n"), 2, "unknown condition 'd3d'");
+
+    // Hardware classes as conditions: if(radeon8500) runs only on that class.
+    Parsed h = parse("[test]\nif(radeon8500, D3D9) probe 0 0 rgba 0\ntodo(geforce3) probe 0 0 rgba 0\n");
+    REQUIRE_OK(h);
+    const HardwareClass& r200 = *findHardware("radeon8500");
+    const HardwareClass& d3d9 = *findHardware("d3d9");
+    CHECK(h.file.commands[0].onlyIf.matches(Backend::Emu, Precision::Fx8, r200));
+    CHECK(h.file.commands[0].onlyIf.matches(Backend::Emu, Precision::Fx8, d3d9));
+    CHECK(!h.file.commands[0].onlyIf.matches(Backend::Emu, Precision::Fx8, gf4));
+    CHECK(h.file.commands[1].isTodo(Backend::Emu, Precision::Fx8, *findHardware("geforce3")));
+    CHECK(!h.file.commands[1].isTodo(Backend::Emu, Precision::Fx8, gf4));
     CHECK_ERROR(parse("[test]\nif() probe 0 0 rgba 0\n"), 2, "empty condition '()'");
     CHECK_ERROR(parse("[test]\nif(gl probe 0 0 rgba 0\n"), 2, "unknown condition 'probe'");
     CHECK_ERROR(parse("[test]\nif(gl\n"), 2, "missing ')' after the condition");

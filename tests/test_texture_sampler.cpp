@@ -55,7 +55,7 @@ std::vector<Texel> words(std::initializer_list<uint32_t> w) {
 
 std::shared_ptr<const Texture> build(const TextureDesc& desc) {
     std::string error;
-    std::optional<Texture> t = textureFromDesc(desc, error);
+    std::optional<Texture> t = textureFromDesc(desc, SignedDecode::Snorm, error);
     INFO(error);
     REQUIRE(t);
     return std::make_shared<const Texture>(std::move(*t));
@@ -192,12 +192,12 @@ TEST_CASE("texture: textureFromDesc errors", "[sampler]") {
     std::string error;
     auto fails = [&](const TextureDesc& d, const char* fragment) {
         error.clear();
-        CHECK_FALSE(textureFromDesc(d, error));
+        CHECK_FALSE(textureFromDesc(d, SignedDecode::Snorm, error));
         INFO(error);
         CHECK(error.find(fragment) != std::string::npos);
     };
     TextureDesc ok = makeDesc(TexFormat::L8, 2, 2, 0, words({1, 2, 3, 4}));
-    CHECK(textureFromDesc(ok, error));
+    CHECK(textureFromDesc(ok, SignedDecode::Snorm, error));
 
     TextureDesc noSize = ok;
     noSize.width = 0;

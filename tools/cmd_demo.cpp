@@ -2,8 +2,9 @@
 // the corpus's ps_1_1 shaders (bloom_brightpass, bloom_blur4, bloom_composite) and drawn on
 // emu::Device exactly as a D3D9 program would: a procedural scene texture, half-size render
 // target textures, half-pixel-shifted quads, bilinear taps. Each profile renders the same
-// frame; the table shows each pass's time (median of the runs) and how far the final image is
-// from the `ideal` profile's, in 8-bit levels.
+// frame on each hardware class (ps11/hardware.h), after an `ideal` reference; the table shows
+// each pass's time (median of the runs) and how far the final image is from the reference, in
+// 8-bit levels.
 #include "tools/cmd_demo.h"
 
 #include <algorithm>
@@ -90,10 +91,11 @@ struct PassTimes {
 
 class BloomRun {
 public:
-    BloomRun(Precision p, const BloomDemoOptions& o, const std::array<std::vector<uint32_t>, 3>& shaders,
-             const std::vector<uint32_t>& scene)
+    BloomRun(const HardwareClass* hardware, std::optional<Precision> p, const BloomDemoOptions& o,
+             const std::array<std::vector<uint32_t>, 3>& shaders, const std::vector<uint32_t>& scene)
         : m_options(o), m_shaders(shaders), m_scene(scene) {
         DeviceOptions d;
+        d.hardware = hardware;
         d.precision = p;
         d.threads = o.threads;
         m_device = std::make_unique<Device>(d);
@@ -176,6 +178,8 @@ public:
         return true;
     }
 
+    const HardwareConfig& hardware() const { return m_device->hardware(); }
+
 private:
     bool check(HRESULT hr) {
         if (hr == D3D_OK) return true;
@@ -234,13 +238,23 @@ int runBloomDemo(const std::string& projectDir, const BloomDemoOptions& o) {
     std::printf("(corpus shaders ps_1_1/bloom_*.psh; times are medians of %d frames; error = final image vs ideal, "
                 "in 8-bit levels)\n\n",
                 o.repeats);
-    std::printf("%-8s %9s %9s %12s %9s %8s %9s %10s\n", "profile", "bright", "blur", "composite", "frame", "max err",
-                "mean err", "differing");
+    std::printf("%-11s %-8s %9s %9s %12s %9s %8s %9s %10s\n", "hardware", "profile", "bright", "blur", "composite",
+                "frame", "max err", "mean err", "differing");
 
-    const Precision profiles[] = {Precision::Ideal, Precision::Fx8, Precision::Fx12, Precision::Float};
+    // The reference first: the default class with the ideal profile; then every class (or the
+    // one asked for) with its own profile and MaxValue.
+    struct Row {
+        const HardwareClass* hardware;
+        std::optional<Precision> precision;
+    };
+    std::vector<Row> rows{{nullptr, Precision::Ideal}};
+    for (const HardwareClass& h : hardwareClasses())
+        if (!o.hardware || o.hardware == &h) rows.push_back({&h, std::nullopt});
     std::vector<uint32_t> reference;
-    for (Precision p : profiles) {
-        BloomRun run(p, o, shaders, scene);
+    for (const Row& row : rows) {
+        BloomRun run(row.hardware, row.precision, o, shaders, scene);
+        const HardwareConfig& hw = run.hardware();
+        const Precision p = hw.precision;
         if (!run.setUp()) return cli::kUserError;
         std::vector<double> bright, blur, composite, frame;
         for (int r = 0; r < std::max(o.repeats, 1); ++r) {
@@ -253,7 +267,7 @@ int runBloomDemo(const std::string& projectDir, const BloomDemoOptions& o) {
         }
         std::vector<uint32_t> image;
         if (!run.readBack(image)) return cli::kUserError;
-        if (p == Precision::Ideal) reference = image;
+        if (reference.empty()) reference = image;
         int maxErr = 0;
         uint64_t sumErr = 0, differing = 0;
         for (size_t i = 0; i < image.size(); ++i) {
@@ -269,10 +283,11 @@ int runBloomDemo(const std::string& projectDir, const BloomDemoOptions& o) {
         const double mean = image.empty() ? 0 : double(sumErr) / double(image.size() * 4);
         char diff[32];
         std::snprintf(diff, sizeof diff, "%.2f%%", image.empty() ? 0 : 100.0 * double(differing) / double(image.size()));
-        std::printf("%-8s %7.2fms %7.2fms %10.2fms %7.2fms %8d %9.4f %10s\n", precisionName(p), median(bright),
-                    median(blur), median(composite), median(frame), maxErr, mean, diff);
+        const std::string name = row.hardware ? std::string(hw.hardware->name) : "reference";
+        std::printf("%-11s %-8s %7.2fms %7.2fms %10.2fms %7.2fms %8d %9.4f %10s\n", name.c_str(), precisionName(p),
+                    median(bright), median(blur), median(composite), median(frame), maxErr, mean, diff);
         if (!o.outPrefix.empty()) {
-            const std::string path = o.outPrefix + "-" + precisionName(p) + ".ppm";
+            const std::string path = o.outPrefix + "-" + name + ".ppm";
             if (!writePpm(path, image, o.width, o.height)) return cli::kUserError;
         }
     }

@@ -6,13 +6,16 @@
 #include <cstdint>
 #include <string>
 
+#include "ps11/hardware.h"
+
 namespace ps11 {
 
 struct BloomDemoOptions {
     uint32_t width = 960, height = 540;  // the scene and the final image
     int threads = 0;                     // device worker threads; 0 = every core
     int repeats = 3;                     // runs per profile; times are medians
-    std::string outPrefix;               // if set, PREFIX-<profile>.ppm gets each final image
+    std::string outPrefix;               // if set, PREFIX-<hardware>.ppm gets each final image
+    const HardwareClass* hardware = nullptr;  // only this class (and the reference); null = every class
 };
 
 // Renders and prints the table. `projectDir` holds tests/shaders/corpus. Returns a cli exit

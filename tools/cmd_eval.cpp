@@ -29,9 +29,13 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: ps11 eval SHADER.psh [v0=r,g,b,a] [v1=...] [t0=u,v,w,q] ... [t7=...] [c0=x,y,z,w] ... [c7=...]\n"
-    "                 [--precision fx8|fx12|float|ideal] [--max-value M] [--tex0 0xAARRGGBB] ... [--tex7 ...]\n"
+    "                 [--hardware H] [--precision fx8|fx12|float|ideal] [--max-value M]\n"
+    "                 [--tex0 [FORMAT:]WORD] ... [--tex7 ...]\n"
     "  values take 1-4 comma-separated floats (missing components are 0); v0/v1 also take 0xAARRGGBB;\n"
-    "  --texN binds a 1x1 A8R8G8B8 texture of that colour to stage N (unbound stages sample (0, 0, 0, 1))\n";
+    "  --texN binds a 1x1 texture to stage N: a word in the format's packing (default A8R8G8B8\n"
+    "  0xAARRGGBB; e.g. V8U8:0x807f); unbound stages sample (0, 0, 0, 1);\n"
+    "  --hardware picks the emulated GPU (`ps11 hardware` lists them; default: the 1.1-class card,\n"
+    "  or the 1.4-class card for ps_1_4); --precision and --max-value override its values\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11: eval: " << message << "\n" << kUsage;
@@ -94,9 +98,11 @@ struct EvalArgs {
     std::array<std::optional<Vec4>, 2> color;
     std::array<std::optional<Vec4>, 8> texcoord;
     std::array<std::optional<Vec4>, 8> constant;
-    std::array<std::optional<uint32_t>, 8> texture;  // 1x1 A8R8G8B8 colour per stage
-    Precision precision = Precision::Fx8;
-    float maxValue = 0;  // 0 = the version's default
+    std::array<std::optional<uint32_t>, 8> texture;  // 1x1 texel word per stage
+    std::array<TexFormat, 8> textureFormat{};        // its format (A8R8G8B8 unless FORMAT: given)
+    const HardwareClass* hardware = nullptr;         // null = the default class of the version
+    std::optional<Precision> precision;              // overrides the class's profile
+    float maxValue = 0;                              // overrides the class's MaxValue (0 = none)
 };
 
 // Parses NAME=VALUE; returns an exit code (kOk = consumed).
@@ -130,10 +136,14 @@ int cmdEval(const std::vector<std::string>& args) {
             return cli::kOk;
         }
         bool isTex = a.size() == 6 && a.compare(0, 5, "--tex") == 0 && a[5] >= '0' && a[5] <= '7';
-        if (a == "--precision" || a == "--max-value" || isTex) {
+        if (a == "--precision" || a == "--max-value" || a == "--hardware" || isTex) {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
-            if (a == "--precision") {
+            if (a == "--hardware") {
+                ea.hardware = findHardware(v);
+                if (!ea.hardware)
+                    return usageError("unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+            } else if (a == "--precision") {
                 std::optional<Precision> p = parsePrecision(v);
                 if (!p) return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
                 ea.precision = *p;
@@ -142,9 +152,23 @@ int cmdEval(const std::vector<std::string>& args) {
                 if (!m || *m <= 0) return userError("bad value for --max-value: '" + v + "' (expected a float > 0)");
                 ea.maxValue = *m;
             } else {
-                std::optional<uint32_t> w = parseHexWord(v);
-                if (!w) return userError("bad value for " + a + ": '" + v + "' (expected a colour 0xAARRGGBB)");
-                ea.texture[a[5] - '0'] = *w;
+                const int stage = a[5] - '0';
+                std::string word = v;
+                if (size_t colon = v.find(':'); colon != std::string::npos) {
+                    std::optional<TexFormat> f = parseTexFormat(v.substr(0, colon));
+                    if (!f || isFloatFormat(*f))
+                        return userError("bad format in " + a + ": '" + v.substr(0, colon) +
+                                         "' (expected a packed format: A8R8G8B8, X8R8G8B8, A8, L8, A8L8, V8U8, "
+                                         "L6V5U5, X8L8V8U8, Q8W8V8U8 or V16U16)");
+                    ea.textureFormat[size_t(stage)] = *f;
+                    word = v.substr(colon + 1);
+                }
+                std::optional<uint32_t> w = parseHexWord(word);
+                const int bits = formatBits(ea.textureFormat[size_t(stage)]);
+                if (!w || (bits < 32 && (*w >> bits) != 0))
+                    return userError("bad value for " + a + ": '" + v + "' (expected a hex word of " +
+                                     std::to_string(bits) + " bits, e.g. 0xff808080)");
+                ea.texture[size_t(stage)] = *w;
             }
         } else if (a.size() > 1 && a[0] == '-') {
             return usageError("unknown option '" + a + "'");
@@ -167,9 +191,12 @@ int cmdEval(const std::vector<std::string>& args) {
     std::cerr << diags.formatAll();
     if (!program || diags.hasErrors()) return cli::kUserError;
 
-    ExecutorOptions eo;
-    eo.precision = ea.precision;
-    eo.maxValue = ea.maxValue;
+    const HardwareConfig hw = resolveHardware(ea.hardware, program->version.minor, ea.precision, ea.maxValue);
+    if (program->version.minor > hw.hardware->maxMinor)
+        return userError("hardware " + std::string(hw.hardware->name) + " runs ps_1_1 ... ps_1_" +
+                         std::to_string(hw.hardware->maxMinor) + "; " + name + " is ps_1_" +
+                         std::to_string(program->version.minor));
+    const ExecutorOptions eo = executorOptionsFor(hw);
     Diagnostics execDiags = diags;  // the same file ids as the program's source places
     execDiags.clear();
     std::unique_ptr<Executor> executor = Executor::create(*program, eo, execDiags);
@@ -183,6 +210,7 @@ int cmdEval(const std::vector<std::string>& args) {
         if (!ea.texture[stage]) continue;
         TextureDesc desc;
         desc.stage = stage;
+        desc.format.value = ea.textureFormat[size_t(stage)];
         desc.width = desc.height = 1;
         TextureLevel level;
         level.width = level.height = 1;
@@ -190,7 +218,7 @@ int cmdEval(const std::vector<std::string>& args) {
         level.fill.bits = *ea.texture[stage];
         desc.data.push_back(level);
         std::string why;
-        std::optional<Texture> texture = textureFromDesc(desc, why);
+        std::optional<Texture> texture = textureFromDesc(desc, hw.hardware->signedDecode, why);
         if (!texture) return userError("cannot build the texture of --tex" + std::to_string(stage) + ": " + why);
         sampler.bind(stage, std::make_shared<const Texture>(std::move(*texture)));
     }
@@ -207,10 +235,9 @@ int cmdEval(const std::vector<std::string>& args) {
         if (ea.texcoord[r]) in.texture[r] = &*ea.texcoord[r];
     EvalOutcome out = evalOnePixel(*executor, sampler, in);
 
-    const Precision p = ea.precision;
-    float maxValue = ea.maxValue > 0 ? ea.maxValue : defaultMaxValue(program->version.minor);
-    std::cout << "ps_" << program->version.major << "_" << program->version.minor << ", precision "
-              << precisionName(p) << ", max value " << num(maxValue) << "\n";
+    const Precision p = hw.precision;
+    std::cout << "ps_" << program->version.major << "_" << program->version.minor << ", hardware " << hw.describe()
+              << "\n";
     std::cout << "r0     ";
     for (int c = 0; c < 4; ++c) std::cout << (c ? " " : "") << num(out.color[c]);
     std::cout << "\n";

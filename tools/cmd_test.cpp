@@ -26,7 +26,9 @@ namespace ps11 {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n";
+    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--hardware H] [--precision fx8|fx12|float|ideal]\n"
+    "                 [--stats] [-v]\n"
+    "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists them)\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11 test: " << message << "\n" << kUsage;
@@ -35,7 +37,8 @@ int usageError(const std::string& message) {
 
 struct RunOptions {
     uint8_t backends = kBackendEmu;
-    std::optional<Precision> precision;  // overrides [require] precision when given
+    const HardwareClass* hardware = nullptr;  // overrides [require] hardware when given
+    std::optional<Precision> precision;       // overrides [require] precision when given
     bool verbose = false;
     bool stats = false;  // print executor statistics per file
 };
@@ -46,6 +49,7 @@ struct FileResult {
     Outcome outcome = Outcome::Passed;
     CommandTally tally;   // evals run, probes, commands not runnable yet
     bool skipped = false;  // [require] backend excludes every backend of this run
+    bool skippedHardware = false;  // --hardware names a class that cannot run the file's shader
 };
 
 std::string where(const std::string& path, uint32_t line) { return line ? path + ":" + std::to_string(line) : path; }
@@ -133,28 +137,49 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         return result;
     }
     uint8_t backends = opts.backends & file.require.backends.value;
-    Precision precision = opts.precision.value_or(file.require.precision.value);
+    // The class: --hardware, else [require] hardware, else the default of the shader's version;
+    // --precision, else [require] precision, and [require] max_value override the class's.
+    const RequireDesc& req = file.require;
+    const int minor = program ? program->version.minor : req.versionMinor.value;
+    const HardwareClass* named = opts.hardware ? opts.hardware : req.hardware.value;
+    std::optional<Precision> precisionOverride = opts.precision;
+    if (!precisionOverride && req.precision.isSet()) precisionOverride = req.precision.value;
+    const HardwareConfig hw = resolveHardware(named, minor, precisionOverride, req.maxValue.value);
+    if (minor > hw.hardware->maxMinor) {
+        if (opts.hardware) {
+            if (opts.verbose)
+                std::cout << path << ": skipped: hardware " << hw.hardware->name << " runs ps_1_1 ... ps_1_"
+                          << hw.hardware->maxMinor << ", the file needs ps_1_" << minor << "\n";
+            result.skippedHardware = true;
+            return result;
+        }
+        std::cout << where(path, req.hardware.line) << ": hardware " << hw.hardware->name << " runs ps_1_1 ... ps_1_"
+                  << hw.hardware->maxMinor << ", but the file needs ps_1_" << minor << "\n";
+        result.outcome = Outcome::Failed;
+        return result;
+    }
+    const Precision precision = hw.precision;
     if (backends == 0) {
         result.skipped = !file.commands.empty();
         return result;
     }
     CommandRunOptions run;
     run.backends = backends;
-    run.precision = precision;
+    run.hardware = hw;
     run.verbose = opts.verbose;
     run.shaderDiags = &shaderDiags;
     CommandTally& t = result.tally;
     runCommands(file, path, program ? &*program : nullptr, run, t);
     if (opts.stats && t.evals) {
         const ExecutorStats& s = t.stats;
-        std::cout << path << ": stats (" << precisionName(precision) << "): " << t.evals << " evals, " << s.pixels
+        std::cout << path << ": stats (" << hw.describe() << "): " << t.evals << " evals, " << s.pixels
                   << " pixels, " << s.instructions << " instructions executed";
         if (s.pixels) std::cout << " (" << double(s.instructions) / double(s.pixels) << " per pixel)";
         std::cout << ", " << t.texelsFetched << " texels fetched\n";
     }
     if (opts.stats && t.draws.draws) {
         const DrawTally& d = t.draws;
-        std::cout << path << ": draw stats (" << precisionName(precision) << "): " << d.draws << " draws, "
+        std::cout << path << ": draw stats (" << hw.describe() << "): " << d.draws << " draws, "
                   << d.pixelsShaded << " pixels shaded, " << d.pixelsWritten << " written, " << d.instructions
                   << " instructions executed, " << d.texelsFetched << " texels fetched, " << d.milliseconds
                   << " ms\n";
@@ -173,10 +198,14 @@ int cmdTest(const std::vector<std::string>& args) {
     std::vector<std::string> files;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "--backend" || a == "--precision") {
+        if (a == "--backend" || a == "--precision" || a == "--hardware") {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
-            if (a == "--backend") {
+            if (a == "--hardware") {
+                opts.hardware = findHardware(v);
+                if (!opts.hardware)
+                    return usageError("unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+            } else if (a == "--backend") {
                 if (v == "emu")
                     opts.backends = kBackendEmu;
                 else if (v == "gl")
@@ -223,7 +252,7 @@ int cmdTest(const std::vector<std::string>& args) {
     }
     if (files.empty()) return usageError("no .ps11test files given");
 
-    size_t passed = 0, failed = 0, notRunnable = 0, skipped = 0;
+    size_t passed = 0, failed = 0, notRunnable = 0, skipped = 0, skippedHardware = 0;
     CommandTally total;
     for (const std::string& path : files) {
         FileResult r = runFile(path, opts);
@@ -234,6 +263,10 @@ int cmdTest(const std::vector<std::string>& args) {
         total.probesTodo += t.probesTodo;
         total.pendingGl += t.pendingGl;
         if (r.skipped) ++skipped;
+        if (r.skippedHardware) {
+            ++skippedHardware;
+            continue;
+        }
         switch (r.outcome) {
             case Outcome::Passed:
                 ++passed;
@@ -265,6 +298,9 @@ int cmdTest(const std::vector<std::string>& args) {
     std::cout << "; probes: " << total.probesPassed << " passed, " << total.probesFailed << " failed, "
               << total.probesTodo << " todo";
     if (skipped) std::cout << "; " << skipped << " with commands skipped by [require] backend";
+    if (skippedHardware)
+        std::cout << "; " << skippedHardware << " skipped: their shader version is beyond hardware "
+                  << opts.hardware->name;
     std::cout << "\n";
     return failed ? cli::kUserError : cli::kOk;
 }

@@ -19,6 +19,7 @@
 #include "tools/cmd_eval.h"
 #include "tools/cmd_demo.h"
 #include "tools/cmd_golden.h"
+#include "tools/cmd_hardware.h"
 #include "tools/cmd_test.h"
 
 namespace ps11::cli {
@@ -32,16 +33,18 @@ const char* kUsageText =
     "                         tokens (binary, or hex words with --hex-input) → text\n"
     "  check FILE... [--json] [-D NAME[=VALUE]] [-I DIR]\n"
     "                         validate and print statistics (slots, constants, read ports)\n"
-    "  test FILE.ps11test... [--backend emu|gl|both] [--precision P] [-v]\n"
+    "  test FILE.ps11test... [--backend emu|gl|both] [--hardware H] [--precision P] [-v]\n"
     "                         run .ps11test files\n"
-    "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--precision P] [--max-value M] [--texN 0xAARRGGBB]\n"
+    "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
+    "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
+    "  hardware [--json]      the emulated GPUs (hardware classes) and what each one changes\n"
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
-    "  demo [--size WxH] [--threads N] [--repeats N] [--out PREFIX]\n"
+    "  demo [--size WxH] [--threads N] [--repeats N] [--hardware H] [--out PREFIX]\n"
     "                         the main job: the corpus checked, then a bloom chain rendered on\n"
-    "                         the device in every profile (time per pass, error vs ideal)\n";
+    "                         the device for every hardware class (time per pass, error vs ideal)\n";
 
 int usage(const std::string& message) {
     if (!message.empty()) std::cerr << "ps11: " << message << "\n";
@@ -259,11 +262,15 @@ int cmdDemo(const std::vector<std::string>& args) {
     BloomDemoOptions bloom;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "--size" || a == "--threads" || a == "--repeats" || a == "--out") {
+        if (a == "--size" || a == "--threads" || a == "--repeats" || a == "--out" || a == "--hardware") {
             if (i + 1 >= args.size()) return usage("demo: " + a + " needs a value");
             const std::string& v = args[++i];
             char* end = nullptr;
-            if (a == "--size") {
+            if (a == "--hardware") {
+                bloom.hardware = findHardware(v);
+                if (!bloom.hardware)
+                    return usage("demo: unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+            } else if (a == "--size") {
                 if (!parseSize(v, bloom.width, bloom.height))
                     return usage("demo: --size takes WIDTHxHEIGHT with sides 1..16384, not '" + v + "'");
             } else if (a == "--out") {
@@ -339,6 +346,7 @@ int main(int argc, char** argv) {
     if (cmd == "eval") return ps11::cmdEval(args);
     if (cmd == "golden") return cmdGolden(args);
     if (cmd == "demo") return cmdDemo(args);
+    if (cmd == "hardware") return ps11::cmdHardware(args);
     if (cmd == "isa") {
         std::cout << ps11::isaMarkdownTable();
         return kOk;

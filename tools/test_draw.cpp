@@ -138,7 +138,6 @@ bool setUpSampler(Device& d, const SamplerDesc& s, const std::string& path, std:
 
 bool setUpStage(Device& d, const StageDesc& s, const std::string& path, std::string& error) {
     const DWORD i = DWORD(s.stage);
-    const TransformFlags& tf = s.transformFlags.value;
     const std::pair<D3DTEXTURESTAGESTATETYPE, DWORD> states[] = {
         {D3DTSS_COLOROP, DWORD(s.colorOp.value)},
         {D3DTSS_COLORARG0, argValue(s.colorArg0.value)},
@@ -156,7 +155,7 @@ bool setUpStage(Device& d, const StageDesc& s, const std::string& path, std::str
         {D3DTSS_BUMPENVLSCALE, emu::floatBits(s.lScale.value)},
         {D3DTSS_BUMPENVLOFFSET, emu::floatBits(s.lOffset.value)},
         {D3DTSS_TEXCOORDINDEX, s.texCoordIndex.value},
-        {D3DTSS_TEXTURETRANSFORMFLAGS, DWORD(tf.count) | (tf.projected ? DWORD(D3DTTFF_PROJECTED) : 0u)},
+        {D3DTSS_TEXTURETRANSFORMFLAGS, s.transformFlags.value.bits},
     };
     for (auto [type, value] : states)
         if (d.SetTextureStageState(i, type, value) != D3D_OK) {
@@ -270,13 +269,15 @@ void pushVertex(std::vector<uint32_t>& out, const VertexLayout& layout, const Ve
 DrawRunner::~DrawRunner() = default;
 
 std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::string& path, const Program* program,
-                                               Precision precision, std::string& error, bool alignedPasses) {
+                                               const HardwareConfig& hardware, std::string& error,
+                                               bool alignedPasses) {
     std::unique_ptr<DrawRunner> r(new DrawRunner());
     r->m_path = path;
     emu::DeviceOptions options;
-    options.precision = precision;
+    options.hardware = hardware.hardware;
+    options.precision = hardware.precision;
+    options.maxValue = hardware.maxValue;
     options.alignedPasses = alignedPasses;
-    options.maxValue = file.require.maxValue.value;
     r->m_device = std::make_unique<Device>(options);
     Device& d = *r->m_device;
 
@@ -433,7 +434,7 @@ bool DrawRunner::readBack(std::string& error) {
                 m_pixelWords[i] = uint32_t(b[3]) << 24 | uint32_t(b[0]) << 16 | uint32_t(b[1]) << 8 | b[2];
                 for (int c = 0; c < 4; ++c) m_pixels[i][size_t(c)] = float(b[size_t(c)]);  // levels
             } else {
-                m_pixels[i] = emu::decodeTexel(f, p);
+                m_pixels[i] = emu::decodeTexel(f, p, d.hardware().hardware->signedDecode);
             }
         }
     d.UnlockRect(copy);

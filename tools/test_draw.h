@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "ps11/hardware.h"
 #include "ps11/ir.h"
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
@@ -34,10 +35,12 @@ class DrawRunner {
 public:
     // Sets up the device for `file`: render target (and depth buffer), textures, sampler, stage
     // and render states, transforms, constants and the pixel shader (`program`, null = fixed
-    // function). Returns null with `error` set ("FILE:LINE: …") when the device refuses a call.
-    // `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer draws both ways).
+    // function) on a device of `hardware`. Returns null with `error` set ("FILE:LINE: …") when
+    // the device refuses a call. `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer
+    // draws both ways).
     static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
-                                              Precision precision, std::string& error, bool alignedPasses = true);
+                                              const HardwareConfig& hardware, std::string& error,
+                                              bool alignedPasses = true);
     ~DrawRunner();
 
     // Runs a `draw quad` / `draw triangles|strip|fan` command; false with `error` set when the

@@ -84,9 +84,7 @@ struct EvalState {
 
 bool prepare(const TestFile& file, const std::string& path, const Program& program, const CommandRunOptions& opts,
              EvalState& state) {
-    ExecutorOptions eo;
-    eo.precision = opts.precision;
-    eo.maxValue = file.require.maxValue.value;  // 0 = the version's default
+    const ExecutorOptions eo = executorOptionsFor(opts.hardware);
     Diagnostics diags;
     if (opts.shaderDiags) {
         diags = *opts.shaderDiags;
@@ -94,15 +92,16 @@ bool prepare(const TestFile& file, const std::string& path, const Program& progr
     }
     state.executor = Executor::create(program, eo, diags);
     if (!state.executor) {
-        std::cout << where(path, file.pixelShader.line) << ": the executor cannot run this shader (precision "
-                  << precisionName(opts.precision) << "):\n"
+        std::cout << where(path, file.pixelShader.line) << ": the executor cannot run this shader (hardware "
+                  << opts.hardware.describe() << "):\n"
                   << diags.formatAll();
         return false;
     }
     for (const ConstantDesc& c : file.constants) state.executor->setConstant(c.index, c.value);
-    for (const StageDesc& s : file.stages) state.executor->setStageState(s.stage, stageStateOf(s));
+    for (const StageDesc& s : file.stages)
+        state.executor->setStageState(s.stage, stageStateOf(s, file.texture(s.stage)));
     std::string error;
-    state.sampler = makeTestSampler(file, path, error);
+    state.sampler = makeTestSampler(file, path, *opts.hardware.hardware, error);
     if (!state.sampler) {
         std::cout << error << "\n";
         return false;
@@ -117,21 +116,22 @@ bool prepare(const TestFile& file, const std::string& path, const Program& progr
     return true;
 }
 
-// Counts a checked probe: passed, failed, todo, or a todo that passes (an error).
-void countProbe(const std::string& path, const TestCommand& cmd, const std::string& failure, bool todo, Precision p,
-                bool verbose, CommandTally& tally, const std::string& got = "") {
+// Counts a checked probe: passed, failed, todo, or a todo that passes (an error). Messages name
+// the hardware class, profile and MaxValue that ran.
+void countProbe(const std::string& path, const TestCommand& cmd, const std::string& failure, bool todo,
+                const HardwareConfig& hw, bool verbose, CommandTally& tally, const std::string& got = "") {
     if (failure.empty() && todo) {
         std::cout << where(path, cmd.line) << ": error: todo probe passed (remove the todo)"
-                  << (got.empty() ? "" : ": " + got) << " (precision " << precisionName(p) << ")\n";
+                  << (got.empty() ? "" : ": " + got) << " (hardware " << hw.describe() << ")\n";
         ++tally.probesFailed;
     } else if (failure.empty()) {
         ++tally.probesPassed;
     } else if (todo) {
         ++tally.probesTodo;
         if (verbose)
-            std::cout << where(path, cmd.line) << ": todo: " << failure << " (precision " << precisionName(p) << ")\n";
+            std::cout << where(path, cmd.line) << ": todo: " << failure << " (hardware " << hw.describe() << ")\n";
     } else {
-        std::cout << where(path, cmd.line) << ": probe failed: " << failure << " (precision " << precisionName(p)
+        std::cout << where(path, cmd.line) << ": probe failed: " << failure << " (hardware " << hw.describe()
                   << ")\n";
         ++tally.probesFailed;
     }
@@ -164,21 +164,23 @@ EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalI
     return out;
 }
 
-StageState stageStateOf(const StageDesc& stage) {
+StageState stageStateOf(const StageDesc& stage, const TextureDesc* texture) {
     StageState s;
     s.bumpMat = stage.bumpEnvMat.value;
     s.lumScale = stage.lScale.value;
     s.lumOffset = stage.lOffset.value;
-    const TransformFlags& t = stage.transformFlags.value;
-    s.transformFlags = t.count | (t.projected ? kTtffProjected : 0u);
+    s.transformFlags = stage.transformFlags.value.bits;
+    s.coordComponents = 4;
+    s.textureDimensions = texture && texture->isVolume() ? 3 : 2;
     return s;
 }
 
-std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path, std::string& error) {
+std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path,
+                                         const HardwareClass& hardware, std::string& error) {
     auto sampler = std::make_unique<TextureSampler>();
     for (const TextureDesc& t : file.textures) {
         std::string why;
-        std::optional<Texture> texture = textureFromDesc(t, why);
+        std::optional<Texture> texture = textureFromDesc(t, hardware.signedDecode, why);
         if (!texture) {
             error = where(path, t.line) + ": cannot build [texture " + std::to_string(t.stage) + "]: " + why;
             return nullptr;
@@ -192,7 +194,8 @@ std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string
 
 void runCommands(const TestFile& file, const std::string& path, const Program* program,
                  const CommandRunOptions& opts, CommandTally& tally) {
-    const Precision p = opts.precision;
+    const Precision p = opts.hardware.precision;
+    const HardwareClass& hw = *opts.hardware.hardware;
     EvalState state;
     bool prepared = false;
     for (Backend backend : {Backend::Emu, Backend::Gl}) {
@@ -202,7 +205,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
         std::unique_ptr<DrawRunner> device;
         bool deviceFailed = false;
         for (const TestCommand& cmd : file.commands) {
-            if (!cmd.onlyIf.matches(backend, p)) continue;
+            if (!cmd.onlyIf.matches(backend, p, hw)) continue;
             if (backend == Backend::Gl) {
                 ++tally.pendingGl;  // the GL backend is not built yet
                 continue;
@@ -211,7 +214,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 if (deviceFailed) continue;
                 std::string error;
                 if (!device) {
-                    device = DrawRunner::create(file, path, program, p, error);
+                    device = DrawRunner::create(file, path, program, opts.hardware, error);
                     if (!device) {
                         std::cout << error << "\n";
                         deviceFailed = tally.error = true;
@@ -231,7 +234,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                     deviceFailed = tally.error = true;
                     continue;
                 }
-                countProbe(path, cmd, failure, cmd.isTodo(backend, p), p, opts.verbose, tally);
+                countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally);
                 continue;
             }
             if (const Eval* eval = std::get_if<Eval>(&cmd.op)) {
@@ -254,13 +257,13 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
             }
             const Probe& probe = std::get<Probe>(cmd.op);
             if (!last) {
-                std::cout << where(path, cmd.line) << ": probe failed: no eval ran before this probe (precision "
-                          << precisionName(p) << ")\n";
+                std::cout << where(path, cmd.line) << ": probe failed: no eval ran before this probe (hardware "
+                          << opts.hardware.describe() << ")\n";
                 ++tally.probesFailed;
                 continue;
             }
             std::string failure = checkProbe(probe, *last, p);
-            countProbe(path, cmd, failure, cmd.isTodo(backend, p), p, opts.verbose, tally,
+            countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally,
                        describeOutcome(*last, probe.alpha ? 4 : 3, p));
         }
         if (device) {

@@ -36,11 +36,14 @@ EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalI
                          ExecutorStats* stats = nullptr);
 
 // The sampler of a test file's [texture N] / [sampler N] sections (missing [sampler N]: D3D9
-// defaults). Returns null with `error` set ("FILE:LINE: ...") if a texture cannot be built.
-std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path, std::string& error);
+// defaults), signed texels decoded as `hardware` does. Returns null with `error` set
+// ("FILE:LINE: ...") if a texture cannot be built.
+std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path,
+                                         const HardwareClass& hardware, std::string& error);
 
-// The file's [stage N] state as the executor wants it.
-StageState stageStateOf(const StageDesc& stage);
+// The file's [stage N] state as the executor wants it (an eval gives every coordinate set four
+// components; `texture` is the stage's [texture N], or null).
+StageState stageStateOf(const StageDesc& stage, const TextureDesc* texture);
 
 // What running a file's commands produced.
 struct CommandTally {
@@ -57,7 +60,7 @@ struct CommandTally {
 
 struct CommandRunOptions {
     uint8_t backends = kBackendEmu;  // already intersected with [require] backend
-    Precision precision = Precision::Fx8;
+    HardwareConfig hardware;         // the class, profile and MaxValue the file runs with (resolved)
     bool verbose = false;
     // The diagnostics the [pixel shader] was assembled with: their file names resolve the source
     // places of the executor's E40xx reports.
@@ -66,7 +69,7 @@ struct CommandRunOptions {
 
 // Runs (or counts) every command of `file` whose if(...) matches the run. `program` is the
 // assembled and validated [pixel shader] (null if the file has none). Failures are printed as
-// `FILE:LINE: probe failed: expected ... got ... (precision P)`.
+// `FILE:LINE: probe failed: expected ... got ... (hardware H (class), profile P, max value M)`.
 void runCommands(const TestFile& file, const std::string& path, const Program* program,
                  const CommandRunOptions& options, CommandTally& tally);
 

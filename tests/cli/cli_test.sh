@@ -87,7 +87,7 @@ expect_rc 2 "eval unknown option" "$ps11" eval "$work/e.psh" --bogus
 # test: evals run on the executor; failures name the probe's line.
 printf '[pixel shader]\nps_1_1\nmov r0, v0\n[test]\neval\n  v0 1 0 0 1\nprobe eval rgba 1 0 0 1 tol 0\nprobe eval rgb 0 1 0 tol 0.01\ntodo(fx12) probe eval rgb 1 0 0\ntodo probe eval rgb 0 0 1\n' >"$work/t.ps11test"
 expect_rc 1 "test with a failing eval probe" "$ps11" test "$work/t.ps11test"
-expect_in "$work/out" "t.ps11test:8: probe failed: expected rgb 0 1 0 tol 0.01, got 1 0 0 = [255 0 0]/255 (precision fx8)" "probe failure names file, line, values and precision"
+expect_in "$work/out" "t.ps11test:8: probe failed: expected rgb 0 1 0 tol 0.01, got 1 0 0 = [255 0 0]/255 (hardware geforce4 (1.1-class), fx8, max value 1)" "probe failure names file, line, values and the hardware class"
 expect_in "$work/out" "probes: 2 passed, 1 failed, 1 todo" "probe counts"
 expect_rc 1 "a todo probe that passes is an error" "$ps11" test "$work/t.ps11test" --precision fx12
 expect_in "$work/out" "t.ps11test:9: error: todo probe passed" "passing todo reported"
@@ -102,7 +102,7 @@ expect_in "$work/out" "1 not yet runnable (not runnable on gl yet: 4 commands)" 
 # the first pixel that differs; a draw the device refuses fails with the device's message.
 printf '[render target]\nsize 4 2\nclear 0xff000000\n[pixel shader]\nps_1_1\nmov r0, v0\n[test]\ndraw quad diffuse 0xff0000ff rect 0 0 2 2\nprobe rect 0 0 2 2 rgba 0xff0000ff\nprobe 3 1 rgba 0xff000000\nprobe all rgb 0x0000ff\n' >"$work/d.ps11test"
 expect_rc 1 "draw with a failing pixel probe" "$ps11" test "$work/d.ps11test" --stats
-expect_in "$work/out" "d.ps11test:11: probe failed: expected rgb 0x000000ff tol 0, pixel (2, 0) is 0xff000000 (4 pixels differ) (precision fx8)" "pixel probe failure"
+expect_in "$work/out" "d.ps11test:11: probe failed: expected rgb 0x000000ff tol 0, pixel (2, 0) is 0xff000000 (4 pixels differ) (hardware geforce4 (1.1-class), fx8, max value 1)" "pixel probe failure"
 expect_in "$work/out" "probes: 2 passed, 1 failed, 0 todo" "pixel probe counts"
 expect_in "$work/out" "1 draws, " "draw --stats"
 {
@@ -126,7 +126,7 @@ expect_in "$work/err" "no .ps11test files under" "empty folder named"
 expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
 expect_in "$work/out" "bloom on the emu device: 64x36 scene" "demo header"
 expect_in "$work/out" "fx8 " "demo fx8 row"
-[ -s "$work/demo-fx8.ppm" ] || fail "demo --out wrote no demo-fx8.ppm"
+[ -s "$work/demo-geforce4.ppm" ] || fail "demo --out wrote no demo-geforce4.ppm"
 expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
 expect_rc 2 "demo bad threads" "$ps11" demo --threads many
 expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
