@@ -502,6 +502,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             dc.pool.run(workers, [&](int w) {
                 WorkerScratch& ws0 = *dc.scratch[size_t(w)];
                 ps11::TextureSampler& sampler = ws0.sampler;
+                sampler.setWeightBits(m_hardware.weightBits);
                 for (int s = 0; s < kMaxSamplers; ++s) {
                     // Stages the program does not sample are unbound (no texture kept alive).
                     sampler.bind(s, (sampled >> s) & 1 ? textures[size_t(s)] : nullptr);

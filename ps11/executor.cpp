@@ -393,7 +393,12 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
                 dec.fail("E4006", ins.loc, "co-issued instruction without an arithmetic partner");
                 continue;
             }
-            ops.back().hold = true;
+            // A co-issued ps_1_1 … 1_3 cnd on a CoissuedCnd::Sequential class reads what its
+            // partner has just written (NVIDIA's Windows driver in Wine's cnd_test); every other
+            // pair reads before either member writes.
+            const bool sequential =
+                opc == Opcode::Cnd && ver.minor < 4 && options.coissuedCnd == CoissuedCnd::Sequential;
+            if (!sequential) ops.back().hold = true;
         }
         d.numSrc = ins.info->numSrc;
         for (int s = 0; s < d.numSrc; ++s) {

@@ -119,6 +119,7 @@ HardwareConfig resolveHardware(const HardwareClass* hardware, int minor, std::op
     c.hardware = hardware ? hardware : &defaultHardware(minor);
     c.precision = precision.value_or(c.hardware->precision);
     c.precisionOverridden = precision.has_value() && *precision != c.hardware->precision;
+    c.weightBits = c.precisionOverridden ? (isFixedPoint(c.precision) ? 8 : 0) : c.hardware->bilinearWeightBits;
     c.maxValue = maxValue > 0 ? maxValue : c.hardware->maxValue;
     c.maxValueOverridden = maxValue > 0 && maxValue != c.hardware->maxValue;
     return c;

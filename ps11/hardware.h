@@ -66,6 +66,11 @@ struct HardwareConfig {
     const HardwareClass* hardware = nullptr;  // never null once resolved
     Precision precision = Precision::Fx8;
     float maxValue = 1;
+    // Sub-texel weight bits of bilinear and mip filtering in the float profile: the class's when
+    // its own profile runs; a --precision override brings that profile's definition (fx: 8,
+    // float and ideal: 0, float32 weights), so the override changes arithmetic and filtering
+    // together and the float profile means the same on every class.
+    int weightBits = 8;
     bool precisionOverridden = false;
     bool maxValueOverridden = false;
     // "geforce4 (1.1-class), fx8, max value 1" (overrides marked).

@@ -193,7 +193,7 @@ Filter effective(Filter f) { return f == Filter::Linear ? Filter::Linear : Filte
 // vectors, LOD = log2(rho). Mag filter at LOD <= 0, else min filter; mip none: level 0; point:
 // nearest level (ties up); linear: the two levels around LOD with an 8-bit weight (fx).
 void selectLevels(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
-                  const SamplerState& st, bool fixed, LaneLevels& L) {
+                  const SamplerState& st, bool fixed, bool weights8, LaneLevels& L) {
     const bool magLinear = effective(st.magFilter) == Filter::Linear;
     const bool minLinear = effective(st.minFilter) == Filter::Linear;
     const int levels = tex.levelCount();
@@ -230,10 +230,11 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
                     level0 = int(a);
                     level1 = level0 + 1;
                     const double frac = lod - a;
-                    if (fixed) {
+                    if (fixed || weights8) {
                         mipW = weight8(frac);
                         if (mipW == 256) level0 = level1;  // exactly the upper level
                         slots = mipW == 0 || mipW == 256 ? 1 : 2;
+                        mipF = float(mipW) / 256.0f;
                     } else {
                         mipF = float(frac);
                         slots = mipF == 0.0f ? 1 : 2;
@@ -302,11 +303,12 @@ namespace {
 // the texels fetched.
 uint64_t sampleReference(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
                          const SamplerState& ss, const std::array<int32_t, 4>& borderGrid, int32_t* const* gridDst,
-                         float* const* valueDst) {
+                         float* const* valueDst, bool floatWeights8) {
     const bool fixed = isFixedPoint(req.precision);
+    const bool weights8 = !fixed && floatWeights8;
     const bool volume = tex.isVolume();
     LaneLevels lanes;
-    selectLevels(req, count, coord, tex, ss, fixed, lanes);
+    selectLevels(req, count, coord, tex, ss, fixed, weights8, lanes);
 
     // Per-level extents per axis, then the addressing passes (mode chosen once per axis).
     const int levels = tex.levelCount();
@@ -328,6 +330,12 @@ uint64_t sampleReference(const SampleRequest& req, int count, const float* const
     for (int s = 0; s < (anyTwo ? 2 : 1); ++s)
         for (int a = 0; a < axes; ++a)
             axisPass(modes[a], count, coord[a], extent[a], lanes.level[s], lanes.linear, taps[s][a]);
+    // The class's 8-bit sub-texel weights in the float profile: the same w/256 as fx, lerped in
+    // float32 (docs/precision.md "Sampling").
+    if (weights8)
+        for (int s = 0; s < (anyTwo ? 2 : 1); ++s)
+            for (int a = 0; a < axes; ++a)
+                for (int i = 0; i < count; ++i) taps[s][a].f[i] = float(taps[s][a].w[i]) / 256.0f;
 
     CombineInput in{count, &tex.level(0), &lanes, taps};
     if (fixed) {
@@ -373,6 +381,8 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
 void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
     const int count = std::clamp(req.count, 0, kMaxSpan);
     const bool fixed = isFixedPoint(req.precision);
+    // 8-bit weights in the float profile where the hardware class has them; never in ideal.
+    const bool floatWeights8 = m_weightBits == 8 && req.precision == Precision::Float;
     // Outputs the caller did not ask for go to scratch, so the kernels never test pointers.
     int32_t scratchGrid[4][kMaxSpan];
     float scratchValue[4][kMaxSpan];
@@ -430,7 +440,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 // a linear mip blend of two levels -> the reference path (quad-aligned, so its LOD
                 // is the same).
                 static thread_local LaneLevels lanes;
-                selectLevels(req, count, coord, tex, ss, true, lanes);
+                selectLevels(req, count, coord, tex, ss, true, false, lanes);
                 for (int q = 0; q < count;) {
                     const bool two = lanes.slots[q] == 2;
                     int e = q + 4;
@@ -445,7 +455,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                         sub.count = e - q;
                         const float* c3[3] = {coord[0] + q, coord[1] + q, coord[2] + q};
                         int32_t* g[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
-                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst);
+                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst, floatWeights8);
                     }
                     q = e;
                 }
@@ -455,7 +465,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             return;
         }
     }
-    fetched = sampleReference(req, count, coord, tex, ss, borderGrid, gridDst, valueDst);
+    fetched = sampleReference(req, count, coord, tex, ss, borderGrid, gridDst, valueDst, floatWeights8);
     m_fetched.fetch_add(fetched, std::memory_order_relaxed);
 }
 

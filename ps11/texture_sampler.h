@@ -53,6 +53,11 @@ public:
     // The fast kernels for 8-bit 2-D textures in fx profiles (point and bilinear, one level per
     // quad, every address mode; on by default). Off: the reference path only.
     void setFastPath(bool enabled) { m_fastPath = enabled; }
+    // Sub-texel weight bits of bilinear and mip filtering in the float profile: 8 (a hardware
+    // class's texture unit, w = round_half_even(f·256)/256) or 0 (float32 weights). fx profiles
+    // always weigh with 8 bits, ideal never quantises (docs/precision.md "Sampling").
+    void setWeightBits(int bits) { m_weightBits = bits; }
+    int weightBits() const { return m_weightBits; }
     // Lanes answered by the fast kernels so far (statistics; tests check the fast path ran).
     uint64_t fastLanes() const { return m_fastLanes.load(std::memory_order_relaxed); }
 
@@ -66,6 +71,7 @@ private:
     std::atomic<uint64_t> m_fetched{0};
     std::atomic<uint64_t> m_fastLanes{0};
     bool m_fastPath = true;
+    int m_weightBits = 0;
 };
 
 }  // namespace ps11

@@ -206,6 +206,7 @@ int cmdEval(const std::vector<std::string>& args) {
         if (ea.constant[c]) executor->setConstant(c, *ea.constant[c]);
 
     TextureSampler sampler;
+    sampler.setWeightBits(hw.weightBits);
     for (int stage = 0; stage < 8; ++stage) {
         if (!ea.texture[stage]) continue;
         TextureDesc desc;

@@ -101,7 +101,7 @@ bool prepare(const TestFile& file, const std::string& path, const Program& progr
     for (const StageDesc& s : file.stages)
         state.executor->setStageState(s.stage, stageStateOf(s, file.texture(s.stage)));
     std::string error;
-    state.sampler = makeTestSampler(file, path, *opts.hardware.hardware, error);
+    state.sampler = makeTestSampler(file, path, opts.hardware, error);
     if (!state.sampler) {
         std::cout << error << "\n";
         return false;
@@ -176,11 +176,12 @@ StageState stageStateOf(const StageDesc& stage, const TextureDesc* texture) {
 }
 
 std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path,
-                                         const HardwareClass& hardware, std::string& error) {
+                                         const HardwareConfig& hardware, std::string& error) {
     auto sampler = std::make_unique<TextureSampler>();
+    sampler->setWeightBits(hardware.weightBits);
     for (const TextureDesc& t : file.textures) {
         std::string why;
-        std::optional<Texture> texture = textureFromDesc(t, hardware.signedDecode, why);
+        std::optional<Texture> texture = textureFromDesc(t, hardware.hardware->signedDecode, why);
         if (!texture) {
             error = where(path, t.line) + ": cannot build [texture " + std::to_string(t.stage) + "]: " + why;
             return nullptr;

@@ -39,7 +39,7 @@ EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalI
 // defaults), signed texels decoded as `hardware` does. Returns null with `error` set
 // ("FILE:LINE: ...") if a texture cannot be built.
 std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path,
-                                         const HardwareClass& hardware, std::string& error);
+                                         const HardwareConfig& hardware, std::string& error);
 
 // The file's [stage N] state as the executor wants it (an eval gives every coordinate set four
 // components; `texture` is the stage's [texture N], or null).
