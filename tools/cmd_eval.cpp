@@ -111,10 +111,10 @@ int takeRegister(const std::string& arg, EvalArgs& out) {
         if (name[0] == 't') slot = &out.texcoord[n];
         if (name[0] == 'c') slot = &out.constant[n];
     }
-    if (!slot) return usageError("unknown input '" + arg.substr(0, eq) + "' (expected v0, v1, t0..t7 or c0..c7)");
+    if (!slot) return usageError("unknown input " + quote(arg.substr(0, eq)) + " (expected v0, v1, t0..t7 or c0..c7)");
     if (*slot) return userError(name + " given twice");
     std::optional<Vec4> v = parseVector(value, name[0] == 'v');
-    if (!v) return userError("bad value for " + name + ": '" + value + "'");
+    if (!v) return userError("bad value for " + name + ": " + quote(value));
     *slot = v;
     return cli::kOk;
 }
@@ -135,25 +135,27 @@ int cmdEval(const std::vector<std::string>& args) {
             const std::string& v = args[++i];
             if (a == "--precision") {
                 std::optional<Precision> p = parsePrecision(v);
-                if (!p) return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+                if (!p) return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
                 ea.precision = *p;
             } else if (a == "--max-value") {
                 std::optional<float> m = parseFloat(v);
-                if (!m || *m <= 0) return userError("bad value for --max-value: '" + v + "' (expected a float > 0)");
+                if (!m || *m <= 0)
+                    return userError("bad value for --max-value: " + quote(v) + " (expected a float > 0)");
                 ea.maxValue = *m;
             } else {
                 std::optional<uint32_t> w = parseHexWord(v);
-                if (!w) return userError("bad value for " + a + ": '" + v + "' (expected a colour 0xAARRGGBB)");
+                if (!w) return userError("bad value for " + a + ": " + quote(v) + " (expected a colour 0xAARRGGBB)");
                 ea.texture[a[5] - '0'] = *w;
             }
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError("unknown option '" + a + "'");
+            return usageError(cli::unknownOption(a, {"--precision", "--max-value", "--tex0", "--tex1", "--tex2",
+                                                     "--tex3", "--tex4", "--tex5", "--tex6", "--tex7", "--help"}));
         } else if (a.find('=') != std::string::npos) {
             if (int rc = takeRegister(a, ea); rc != cli::kOk) return rc;
         } else if (ea.shader.empty()) {
             ea.shader = a;
         } else {
-            return usageError("eval takes one shader file ('" + a + "' is a second one)");
+            return usageError("eval takes one shader file (" + quote(a) + " is a second one)");
         }
     }
     if (ea.shader.empty()) return usageError("eval needs a shader file");
