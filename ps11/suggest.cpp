@@ -40,12 +40,14 @@ size_t editDistance(std::string_view a, std::string_view b, size_t limit) {
 }
 
 std::string_view nearestName(std::string_view word, std::span<const std::string_view> candidates) {
+    // A third of the word's length, at least 1 and at most kMaxSuggestDistance.
+    const size_t limit = std::clamp<size_t>(word.size() / 3, 1, kMaxSuggestDistance);
     std::string_view best;
-    size_t bestDistance = kMaxSuggestDistance + 1;
+    size_t bestDistance = limit + 1;
     for (std::string_view c : candidates) {
-        const size_t d = editDistance(word, c, kMaxSuggestDistance);
+        const size_t d = editDistance(word, c, limit);
         if (d == 0) return {};
-        if (d < bestDistance && d < word.size()) {
+        if (d < bestDistance) {
             best = c;
             bestDistance = d;
         }

@@ -16,9 +16,10 @@ namespace ps11 {
 // known to exceed limit, so a huge word costs almost nothing.
 size_t editDistance(std::string_view a, std::string_view b, size_t limit);
 
-// The candidate nearest to word when it is close: distance at most 2 and smaller than the
-// word's length (so "x" never turns into "mov"); ties go to the earlier candidate. Empty when
-// none is close or the word is one of the candidates.
+// The candidate nearest to word when it is close: distance at most 1 for words of up to 5
+// characters, at most 2 from 6 on (a third of the length, so "dcl" or "foo" never turn into
+// "mul" or "mov"); ties go to the earlier candidate. Empty when none is close or the word is
+// one of the candidates.
 std::string_view nearestName(std::string_view word, std::span<const std::string_view> candidates);
 std::string_view nearestName(std::string_view word, std::initializer_list<std::string_view> candidates);
 

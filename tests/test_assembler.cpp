@@ -261,7 +261,8 @@ TEST_CASE("assembler: an unknown instruction suggests the nearest one", "[assemb
     CHECK(errorsOf("ps_1_4\ntexcord r0, t0\n").find("did you mean 'texcrd'?") != std::string::npos);
     // Else any version's (bem is ps_1_4 only, and nothing of ps_1_1 is close to "bemm").
     CHECK(errorsOf("ps_1_1\nbemm r1, c0, r0\n").find("did you mean 'bem'?") != std::string::npos);
-    CHECK(errorsOf("ps_1_1\ndpp4 r0, v0, v1\n").find("did you mean 'dp3'?") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\ndpp4 r0, v0, v1\n").find("did you mean 'dp4'?") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\nfoo r0, v0\n") == "t.psh:2:1: error P1103: unknown instruction 'foo'\n");
     // Nothing close: no suggestion; the reserved texm3x3diff is never offered.
     CHECK(errorsOf("ps_1_1\nfrobnicate r0, v0\n").find("did you mean") == std::string::npos);
     CHECK(errorsOf("ps_1_1\ntexm3x3dif t1, t0\n").find("texm3x3diff'?") == std::string::npos);

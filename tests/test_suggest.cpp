@@ -27,9 +27,15 @@ TEST_CASE("suggest: did you mean", "[suggest]") {
     CHECK(didYouMean("--hx", {"--hex", "--no-validate"}) == "; did you mean '--hex'?");
     CHECK(didYouMean("frobnicate", {"asm", "disasm", "check"}).empty());
     CHECK(didYouMean("mul", {"mov", "mul"}).empty());  // a known name needs no suggestion
-    // The distance must be smaller than the word: "x" is not a typo of "mov".
+    // Short words allow one edit, from 6 characters on two: "x", "dcl" and "foo" are not typos
+    // of "mov" or "mul", "texcrod" is one of "texcoord".
     CHECK(didYouMean("x", {"mov", "add"}).empty());
+    CHECK(didYouMean("dcl", {"mul"}).empty());
+    CHECK(didYouMean("foo", {"mov"}).empty());
     CHECK(didYouMean("ad", {"add"}) == "; did you mean 'add'?");
+    CHECK(didYouMean("texcrood", {"texcoord"}) == "; did you mean 'texcoord'?");
+    CHECK(didYouMean("texcrod", {"texcoord"}) == "; did you mean 'texcoord'?");
+    CHECK(didYouMean("mxlu", {"mul"}).empty());
     // Ties go to the earlier candidate.
     CHECK(nearestName("mo", {"mov", "mod"}) == "mov");
 }
