@@ -23,6 +23,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (!prog) return 0;
     ps11::ShaderStats stats;
     ps11::validate(*prog, diags, &stats);
+    // The assembler refuses every register the version lacks (P1114), so the validator's range
+    // check (P2030) never fires on assembled text.
+    if (diags.has("P2030")) std::abort();
     (void)ps11::statsToJson(stats);
     std::vector<uint32_t> tokens = ps11::encode(*prog);
     if (diags.hasErrors()) return 0;

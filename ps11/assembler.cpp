@@ -1,7 +1,8 @@
 // Assembler front end: lexer and parser for ps_1_1 … ps_1_4 text. Runs on the
 // preprocessor's output lines, builds the IR with the source location of every
 // instruction and operand, and reports syntax errors as P11xx. Version rules are the
-// validator's job; this stage only rejects what cannot be encoded.
+// validator's job; this stage only rejects what cannot be encoded and registers the version
+// does not have (as Microsoft's assembler does even with validation off).
 #include "ps11/assembler.h"
 
 #include <bit>
@@ -10,6 +11,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <string>
+#include <vector>
+
+#include "ps11/suggest.h"
 
 namespace ps11 {
 namespace {
@@ -28,6 +32,7 @@ constexpr const char* kBadNumber = "P1110";
 constexpr const char* kUnexpected = "P1111";
 constexpr const char* kDanglingCoissue = "P1112";
 constexpr const char* kDuplicateVersion = "P1113";
+constexpr const char* kNoSuchRegister = "P1114";
 
 char lower(char c) { return char(std::tolower(static_cast<unsigned char>(c))); }
 bool isIdentStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
@@ -117,7 +122,8 @@ private:
 
 // Parses "ps_1_1", "ps.1.1", "PS_1_4" at the start of the line. Returns true if the line
 // is a version statement (valid or not).
-bool parseVersion(LineParser& p, Program& prog, bool& seen) {
+// `minorOut` is set to the version's minor number when the statement is a valid first version.
+bool parseVersion(LineParser& p, Program& prog, bool& seen, int& minorOut) {
     std::string_view t = p.text();
     size_t start = 0;
     while (start < t.size() && std::isspace(static_cast<unsigned char>(t[start]))) ++start;
@@ -137,23 +143,25 @@ bool parseVersion(LineParser& p, Program& prog, bool& seen) {
         minor = word[5] - '0';
     }
     if (major < 0) {
-        p.error(kBadVersion, at, "malformed version '" + std::string(word) + "'; expected ps_1_1 … ps_1_4 or ps.1.1 … ps.1.4");
+        p.error(kBadVersion, at, "malformed version " + quote(word) + "; expected ps_1_1 … ps_1_4 or ps.1.1 … ps.1.4");
     } else if (major != 1 || minor < 1 || minor > 4) {
         p.error(kBadVersion, at,
-                "unsupported shader version '" + std::string(word) + "'; ps11 handles ps_1_1, ps_1_2, ps_1_3 and ps_1_4");
+                "unsupported shader version " + quote(word) + "; ps11 handles ps_1_1, ps_1_2, ps_1_3 and ps_1_4");
     } else if (seen) {
-        p.error(kDuplicateVersion, at, "second version statement '" + std::string(word) + "'");
+        p.error(kDuplicateVersion, at, "second version statement " + quote(word));
     } else {
         prog.version = {major, minor};
         prog.versionLoc = at;
+        minorOut = minor;
     }
     seen = true;
-    if (!p.atEnd()) p.error(kUnexpected, p.loc(), "unexpected text after the version: '" + std::string(p.rest()) + "'");
+    if (!p.atEnd()) p.error(kUnexpected, p.loc(), "unexpected text after the version: " + quote(p.rest()));
     return true;
 }
 
-// Parses a register name at the cursor: r#, v#, c#, t#.
-bool parseRegister(LineParser& p, RegType& type, uint8_t& index) {
+// Parses a register name at the cursor: r#, v#, c#, t#. With a known version (minor 1-4) a
+// register the version does not have is reported (P1114) but parsing goes on.
+bool parseRegister(LineParser& p, RegType& type, uint8_t& index, int minor) {
     p.skipSpace();
     SourceLoc at = p.loc();
     char c = lower(p.peekRaw());
@@ -167,18 +175,17 @@ bool parseRegister(LineParser& p, RegType& type, uint8_t& index) {
             if (word.empty()) {
                 char got = p.peekRaw();
                 p.error(kBadRegister, at,
-                        got ? std::string("expected a register (r#, v#, c#, t#), found '") + got + "'"
+                        got ? "expected a register (r#, v#, c#, t#), found " + quote(std::string_view(&got, 1))
                             : "expected a register (r#, v#, c#, t#) at the end of the line");
             } else {
-                p.error(kBadRegister, at,
-                        "'" + std::string(word) + "' is not a ps 1.x register (r#, v#, c#, t#)");
+                p.error(kBadRegister, at, quote(word) + " is not a ps 1.x register (r#, v#, c#, t#)");
             }
             return false;
         }
     }
     if (!isDigit(p.peekRaw(1))) {
         std::string_view word = p.identifier();
-        p.error(kBadRegister, at, "'" + std::string(word) + "' is not a ps 1.x register (r#, v#, c#, t#)");
+        p.error(kBadRegister, at, quote(word) + " is not a ps 1.x register (r#, v#, c#, t#)");
         return false;
     }
     p.advance(1);
@@ -200,6 +207,13 @@ bool parseRegister(LineParser& p, RegType& type, uint8_t& index) {
     }
     index = uint8_t(value);
     (void)digits;
+    // Microsoft's assembler refuses these even with D3DCOMPILE_SKIP_VALIDATION (Wine's
+    // d3dcompiler tests/asm.c failure_test: "mov r5, r0" and "tex t5" in ps_1_3; its asmparser.c
+    // checks every source and destination register against the version's register counts).
+    if (minor >= 1 && minor <= 4 && index >= registerCount(type, minor))
+        p.error(kNoSuchRegister, at,
+                "register '" + std::string(regPrefix(type)) + std::to_string(index) + "' does not exist in ps_1_" +
+                    std::to_string(minor) + " (" + registerRange(type, minor) + ")");
     return true;
 }
 
@@ -229,7 +243,8 @@ bool parseWriteMask(LineParser& p, uint8_t& mask) {
     SourceLoc at = p.loc();
     std::string_view word = letters(p);
     if (word.empty() || word.size() > 4) {
-        p.error(kBadMask, at, "write mask '." + std::string(word) + "' must be 1 to 4 of r, g, b, a (or x, y, z, w)");
+        p.error(kBadMask, at,
+                "write mask " + quote("." + std::string(word)) + " must be 1 to 4 of r, g, b, a (or x, y, z, w)");
         return false;
     }
     int set = 0, last = -1;
@@ -260,7 +275,8 @@ bool parseSwizzle(LineParser& p, uint8_t& swizzle) {
     SourceLoc at = p.loc();
     std::string_view word = letters(p);
     if (word.empty() || word.size() > 4) {
-        p.error(kBadSwizzle, at, "source selector '." + std::string(word) + "' must be 1 to 4 component letters");
+        p.error(kBadSwizzle, at,
+                "source selector " + quote("." + std::string(word)) + " must be 1 to 4 component letters");
         return false;
     }
     int set = 0;
@@ -294,11 +310,11 @@ bool parseSuffixModifier(LineParser& p, std::string& suffix) {
         suffix == "da")
         return true;
     p.error(kBadSrcModifier, at,
-            "unknown source modifier '_" + suffix + "' (known: _bias, _bx2, _x2, _dz/_db, _dw/_da)");
+            "unknown source modifier " + quote("_" + suffix) + " (known: _bias, _bx2, _x2, _dz/_db, _dw/_da)");
     return false;
 }
 
-bool parseSource(LineParser& p, Src& src) {
+bool parseSource(LineParser& p, Src& src, int minor) {
     p.skipSpace();
     src.loc = p.loc();
     bool negate = false, complement = false;
@@ -314,7 +330,7 @@ bool parseSource(LineParser& p, Src& src) {
             p.setPos(save);
         }
     }
-    if (!parseRegister(p, src.type, src.index)) return false;
+    if (!parseRegister(p, src.type, src.index, minor)) return false;
     std::string suffix;
     bool haveSwizzle = false;
     // Accept the modifier suffix before or after the selector (r0_bx2.a and r0.a_bx2).
@@ -355,14 +371,14 @@ bool parseSource(LineParser& p, Src& src) {
     return true;
 }
 
-bool parseDest(LineParser& p, Dst& dst) {
+bool parseDest(LineParser& p, Dst& dst, int minor) {
     p.skipSpace();
     dst.loc = p.loc();
     if (p.peekRaw() == '-' || p.peekRaw() == '1') {
         p.error(kBadRegister, dst.loc, "a destination register takes no source modifier");
         return false;
     }
-    if (!parseRegister(p, dst.type, dst.index)) return false;
+    if (!parseRegister(p, dst.type, dst.index, minor)) return false;
     if (p.peekRaw() == '.') {
         p.advance(1);
         if (!parseWriteMask(p, dst.mask)) return false;
@@ -419,7 +435,7 @@ bool parseFloat(LineParser& p, uint32_t& bits) {
     if (!digits || (i < t.size() && (isIdentChar(t[i]) || t[i] == '.'))) {
         size_t end = i;
         while (end < t.size() && t[end] != ',' && !std::isspace(static_cast<unsigned char>(t[end]))) ++end;
-        p.error(kBadNumber, at, "'" + std::string(t.substr(0, std::max(end, mantStart + 1))) + "' is not a number");
+        p.error(kBadNumber, at, quote(t.substr(0, std::max(end, mantStart + 1))) + " is not a number");
         return false;
     }
     // strtof rounds correctly to the nearest float; overflow gives ±inf like the C runtime.
@@ -429,15 +445,29 @@ bool parseFloat(LineParser& p, uint32_t& bits) {
     return true;
 }
 
-// Splits "mov_x2_sat" into the mnemonic and its instruction modifiers.
-bool parseMnemonic(LineParser& p, const Program& prog, Instruction& inst) {
+// "; did you mean 'mul'?" for an unknown mnemonic: the nearest one of the version (minor 1-4)
+// when one is close, else the nearest of any version. Names come from the opcode table.
+std::string suggestMnemonic(std::string_view word, int minor) {
+    std::vector<std::string_view> ofVersion, any;
+    for (const OpcodeInfo& row : opcodeTable()) {
+        if (row.versions == 0) continue;  // reserved (texm3x3diff): never a suggestion
+        any.push_back(row.mnemonic);
+        if (row.versions & versionBit(minor)) ofVersion.push_back(row.mnemonic);
+    }
+    std::string s = didYouMean(word, ofVersion);
+    return s.empty() ? didYouMean(word, any) : s;
+}
+
+// Splits "mov_x2_sat" into the mnemonic and its instruction modifiers. `minor` is the
+// version's minor number, 0 when there is no valid version.
+bool parseMnemonic(LineParser& p, const Program& prog, int minor, Instruction& inst) {
     p.skipSpace();
     SourceLoc at = p.loc();
     inst.loc = at;
     std::string_view word = p.identifier();
     if (word.empty()) {
         char c = p.peekRaw();
-        p.error(kUnexpected, at, std::string("expected an instruction, found '") + c + "'");
+        p.error(kUnexpected, at, "expected an instruction, found " + quote(std::string_view(&c, 1)));
         return false;
     }
     std::string lw = toLower(word);
@@ -446,7 +476,8 @@ bool parseMnemonic(LineParser& p, const Program& prog, Instruction& inst) {
     std::string mnemonic = lw.substr(0, cut);
     inst.info = findOpcode(mnemonic, prog.version.minor);
     if (!inst.info) {
-        p.error(kUnknownMnemonic, at, "unknown instruction '" + std::string(word.substr(0, cut)) + "'");
+        p.error(kUnknownMnemonic, at,
+                "unknown instruction " + quote(word.substr(0, cut)) + suggestMnemonic(mnemonic, minor));
         return false;
     }
     bool haveShift = false;
@@ -474,8 +505,9 @@ bool parseMnemonic(LineParser& p, const Program& prog, Instruction& inst) {
         } else if (mod == "d8") {
             shift = -3;
         } else {
-            p.error(kBadModifier, modAt,
-                    "unknown instruction modifier '_" + mod + "' (known: _x2, _x4, _x8, _d2, _d4, _d8, _sat)");
+            p.error(
+                kBadModifier, modAt,
+                "unknown instruction modifier " + quote("_" + mod) + " (known: _x2, _x4, _x8, _d2, _d4, _d8, _sat)");
             return false;
         }
         if (shift != 0) {
@@ -504,12 +536,12 @@ bool expectComma(LineParser& p, const Instruction& inst, int have) {
                 "'" + std::string(inst.info->mnemonic) + "' takes " + std::to_string(want) + " operands, found " +
                     std::to_string(have));
     } else {
-        p.error(kUnexpected, at, "expected ',' before '" + std::string(p.rest()) + "'");
+        p.error(kUnexpected, at, "expected ',' before " + quote(p.rest()));
     }
     return false;
 }
 
-bool parseOperands(LineParser& p, Instruction& inst) {
+bool parseOperands(LineParser& p, int minor, Instruction& inst) {
     const OpcodeInfo& info = *inst.info;
     int have = 0;
     int want = (info.hasDst ? 1 : 0) + info.numSrc + (info.opcode == Opcode::Def ? 4 : 0);
@@ -520,7 +552,7 @@ bool parseOperands(LineParser& p, Instruction& inst) {
                         (want == 1 ? "" : "s") + ", found 0");
             return false;
         }
-        if (!parseDest(p, inst.dst)) return false;
+        if (!parseDest(p, inst.dst, minor)) return false;
         ++have;
     }
     if (info.opcode == Opcode::Def) {
@@ -532,7 +564,7 @@ bool parseOperands(LineParser& p, Instruction& inst) {
     }
     for (int i = 0; i < info.numSrc; ++i) {
         if (!expectComma(p, inst, have)) return false;
-        if (!parseSource(p, inst.src[size_t(i)])) return false;
+        if (!parseSource(p, inst.src[size_t(i)], minor)) return false;
         ++have;
     }
     if (!p.atEnd()) {
@@ -547,7 +579,7 @@ bool parseOperands(LineParser& p, Instruction& inst) {
                     "'" + std::string(info.mnemonic) + "' takes " + std::to_string(want) + " operand" +
                         (want == 1 ? "" : "s") + ", found " + std::to_string(extra));
         } else {
-            p.error(kUnexpected, at, "unexpected '" + std::string(p.rest()) + "' after the operands");
+            p.error(kUnexpected, at, "unexpected " + quote(p.rest()) + " after the operands");
         }
         return false;
     }
@@ -562,13 +594,14 @@ std::optional<Program> parseAssembly(std::string_view text, const std::string& f
     std::vector<PreprocessedLine> lines = preprocess(text, fileName, options.preprocess, diags);
     Program prog;
     bool seenVersion = false;
+    int minor = 0;                // the version's minor number once a valid version statement was read
     bool pendingCoissue = false;  // a line ended with '+'
     SourceLoc pendingAt;
     for (const PreprocessedLine& line : lines) {
         LineParser p(line, diags);
         if (p.atEnd()) continue;
         if (!seenVersion || (p.peek() == 'p' || p.peek() == 'P')) {
-            if (parseVersion(p, prog, seenVersion)) continue;
+            if (parseVersion(p, prog, seenVersion, minor)) continue;
         }
         if (!seenVersion) {
             p.error(kMissingVersion, p.loc(), "the shader must start with a version statement (ps_1_1 … ps_1_4)");
@@ -587,8 +620,8 @@ std::optional<Program> parseAssembly(std::string_view text, const std::string& f
             pendingCoissue = false;
         }
         inst.coissue = coissue;
-        if (!parseMnemonic(p, prog, inst)) continue;
-        if (!parseOperands(p, inst)) continue;
+        if (!parseMnemonic(p, prog, minor, inst)) continue;
+        if (!parseOperands(p, minor, inst)) continue;
         prog.instructions.push_back(inst);
         if (trailing) {
             pendingCoissue = true;

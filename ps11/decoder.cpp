@@ -388,10 +388,7 @@ std::optional<std::vector<uint32_t>> tokensFromHex(std::string_view text, uint32
         loc.fileId = fileId;
         loc.line = line;
         loc.col = uint32_t(std::min<size_t>(start - lineStart + 1, UINT32_MAX));
-        constexpr size_t kShown = 40;
-        std::string shown(word.substr(0, kShown));
-        if (word.size() > kShown) shown += "...";
-        diags.error("P3002", loc, "bad hex word '" + shown + "' (expected up to 8 hex digits, optional 0x)");
+        diags.error("P3002", loc, "bad hex word " + quote(word) + " (expected up to 8 hex digits, optional 0x)");
         if (++errors == kMaxErrors) {
             diags.note(loc, "too many errors; reading stopped");
             break;

@@ -56,6 +56,32 @@ std::string Diagnostics::format(const Diagnostic& d) const {
     return out;
 }
 
+std::string excerpt(std::string_view text, size_t maxBytes) {
+    size_t cut = text.size();
+    if (cut > maxBytes) {
+        cut = maxBytes;
+        // Back up to the start of a UTF-8 character so the cut never splits one.
+        while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    }
+    std::string out;
+    out.reserve(cut + 8);
+    for (char c : text.substr(0, cut)) {
+        const unsigned char u = static_cast<unsigned char>(c);
+        if (u < 0x20 || u == 0x7f) {
+            static const char* hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[u >> 4];
+            out += hex[u & 15];
+        } else {
+            out += c;
+        }
+    }
+    if (cut < text.size()) out += "…";
+    return out;
+}
+
+std::string quote(std::string_view text, size_t maxBytes) { return "'" + excerpt(text, maxBytes) + "'"; }
+
 std::string Diagnostics::formatAll() const {
     std::string out;
     for (const Diagnostic& d : m_diags) {

@@ -55,4 +55,14 @@ private:
     size_t m_errorCount = 0;
 };
 
+// User text echoed in a message is cut to this many bytes (then "…"), so a 10 MB line or
+// identifier still gives a one-line diagnostic.
+inline constexpr size_t kExcerptBytes = 48;
+
+// User text for a message: at most kExcerptBytes bytes (cut at a UTF-8 character boundary and
+// followed by "…"), control bytes written as \xNN. Every stage quotes input through this.
+std::string excerpt(std::string_view text, size_t maxBytes = kExcerptBytes);
+// excerpt() between single quotes: 'text'.
+std::string quote(std::string_view text, size_t maxBytes = kExcerptBytes);
+
 }  // namespace ps11

@@ -255,13 +255,13 @@ struct Decoder {
     int slotOf(RegType type, int index, SourceLoc loc) {
         switch (type) {
             case RegType::Temp:
-                if (index < (minor >= 4 ? 6 : 2)) return kSlotR + index;
+                if (index < registerCount(type, minor)) return kSlotR + index;
                 break;
-            case RegType::Texture:
-                if (minor < 4 && index < 4) return kSlotT + index;
+            case RegType::Texture:  // a register only in 1_1-1_3; 1_4's t# are coordinates (SrcKind::TexCoord)
+                if (minor < 4 && index < registerCount(type, minor)) return kSlotT + index;
                 break;
             case RegType::Input:
-                if (index < 2) return kSlotV + index;
+                if (index < registerCount(type, minor)) return kSlotV + index;
                 break;
             case RegType::Const:
                 break;
@@ -278,7 +278,8 @@ struct Decoder {
         d.mod = s.mod;
         if (s.type == RegType::Const) {
             d.kind = SrcKind::Const;
-            if (s.index >= 8) fail("E4004", s.loc, "constant c" + std::to_string(s.index) + " out of range");
+            if (s.index >= registerCount(RegType::Const, minor))
+                fail("E4004", s.loc, "constant c" + std::to_string(s.index) + " out of range");
             d.slot = uint8_t(s.index & 7);
         } else if (s.type == RegType::Texture && minor >= 4 && textureOp) {
             d.kind = SrcKind::TexCoord;

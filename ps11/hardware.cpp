@@ -6,6 +6,10 @@
 #include <array>
 #include <cctype>
 #include <cstdio>
+#include <vector>
+
+#include "ps11/diagnostics.h"
+#include "ps11/suggest.h"
 
 namespace ps11 {
 
@@ -64,6 +68,12 @@ std::string hardwareNames() {
         s += h.name;
     }
     return s;
+}
+
+std::string unknownHardwareMessage(std::string_view name) {
+    std::vector<std::string_view> names;
+    for (const HardwareClass& h : kClasses) names.push_back(h.name);
+    return "unknown hardware class " + quote(name) + " (expected " + hardwareNames() + ")" + didYouMean(name, names);
 }
 
 const char* signedDecodeName(SignedDecode d) {

@@ -50,8 +50,11 @@ const HardwareClass* findHardware(std::string_view name);
 // The class a run uses when none is named: the 1.1-class card, or for ps_1_4 (which it cannot
 // run) the 1.4-class card.
 const HardwareClass& defaultHardware(int minor);
-// "geforce3, geforce4, radeon8500, d3d9, geforce7" for messages.
+// "geforce4, geforce3, radeon8500, d3d9, geforce7" for messages.
 std::string hardwareNames();
+// "unknown hardware class 'x' (expected geforce4, …); did you mean 'd3d9'?" for a name
+// findHardware does not know (quoted and cut like every user text).
+std::string unknownHardwareMessage(std::string_view name);
 const char* signedDecodeName(SignedDecode d);
 
 // The value of an n-bit signed channel s (2 ≤ n ≤ 16) as a rational num / den (den > 0), exact.

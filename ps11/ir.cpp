@@ -19,4 +19,8 @@ const char* regPrefix(RegType t) {
     return "?";
 }
 
+std::string registerRange(RegType t, int minor) {
+    return regPrefix(t) + std::string("0-") + regPrefix(t) + std::to_string(registerCount(t, minor) - 1);
+}
+
 }  // namespace ps11

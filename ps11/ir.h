@@ -89,4 +89,23 @@ constexpr uint8_t replicateSwizzle(int c) { return uint8_t(c | (c << 2) | (c << 
 
 const char* regPrefix(RegType t);  // "r", "v", "c", "t"
 
+// How many registers of a file the version has (ps1x-spec.md §1.1): c0-c7, v0-v1 in every
+// version; r0-r1 and t0-t3 in 1_1-1_3, r0-r5 and t0-t5 in 1_4. The one statement of these
+// counts: the assembler (P1114), the validator (P2030) and the executor read it.
+constexpr int registerCount(RegType t, int minor) {
+    switch (t) {
+        case RegType::Temp:
+            return minor == 4 ? 6 : 2;
+        case RegType::Input:
+            return 2;
+        case RegType::Const:
+            return 8;
+        case RegType::Texture:
+            return minor == 4 ? 6 : 4;
+    }
+    return 0;
+}
+// The registers of a file in the version, for messages: "r0-r1".
+std::string registerRange(RegType t, int minor);
+
 }  // namespace ps11

@@ -87,14 +87,6 @@ void tokenize(std::string_view s, size_t begin, size_t end, const std::vector<ui
     }
 }
 
-// Token or user text shown in a message, shortened so binary garbage stays readable.
-std::string shown(std::string_view s) {
-    std::string out;
-    for (char c : s.substr(0, 40)) out += (c >= 0x20 && c < 0x7f) ? c : '?';
-    if (s.size() > 40) out += "...";
-    return out;
-}
-
 std::string trim(std::string_view s) {
     size_t b = 0, e = s.size();
     while (b < e && isSpace(s[b])) ++b;
@@ -354,7 +346,7 @@ void Preprocessor::handleDirective(FileCtx& f, const LogicalLine& ll, int depth)
     const bool active = f.active();
     if (toks[i].kind != TokKind::Ident) {
         if (active)
-            m_diags.error("P1008", at(toks[i].col), "invalid preprocessor directive '#" + shown(toks[i].text) + "'");
+            m_diags.error("P1008", at(toks[i].col), "invalid preprocessor directive '#" + excerpt(toks[i].text) + "'");
         return;
     }
     const std::string name = toks[i].text;
@@ -420,14 +412,14 @@ void Preprocessor::handleDirective(FileCtx& f, const LogicalLine& ll, int depth)
         doInclude(f, ll, toks, i, dirCol, depth);
     } else if (name == "error") {
         const size_t from = i < toks.size() ? toks[i].src : ll.text.size();
-        m_diags.error("P1007", at(dirCol), "#error " + trim(std::string_view(ll.text).substr(from)));
+        m_diags.error("P1007", at(dirCol), "#error " + excerpt(trim(std::string_view(ll.text).substr(from)), 200));
     } else if (name == "pragma") {
         const size_t j = skipSpace(toks, i);
         if (j < toks.size() && toks[j].text == "once") m_onceFiles.insert(normalizePath(f.path));
     } else if (name == "line") {
         doLine(f, ll, toks, i, dirCol);
     } else {
-        m_diags.error("P1008", at(nameCol), "unknown preprocessor directive '#" + shown(name) + "'");
+        m_diags.error("P1008", at(nameCol), "unknown preprocessor directive '#" + excerpt(name) + "'");
     }
 }
 
@@ -435,7 +427,7 @@ void Preprocessor::extraTokens(const std::vector<Token>& toks, size_t i, std::st
     i = skipSpace(toks, i);
     if (i < toks.size())
         m_diags.warning("P1015", at(toks[i].col),
-                        "extra tokens after " + std::string(dir) + " ignored ('" + shown(toks[i].text) + "')");
+                        "extra tokens after " + std::string(dir) + " ignored ('" + excerpt(toks[i].text) + "')");
 }
 
 bool Preprocessor::ifdefName(const std::vector<Token>& toks, size_t i, std::string_view dir, uint32_t endCol,
@@ -474,13 +466,13 @@ void Preprocessor::doInclude(FileCtx& f, const LogicalLine& ll, const std::vecto
         return;
     }
     if (!trim(rest).empty())
-        m_diags.warning("P1015", at(nameCol), "extra tokens after #include ignored ('" + shown(trim(rest)) + "')");
+        m_diags.warning("P1015", at(nameCol), "extra tokens after #include ignored ('" + excerpt(trim(rest)) + "')");
 
     const int maxDepth = std::min(m_opts.maxIncludeDepth, kHardIncludeDepth);
     if (depth + 1 > maxDepth) {
         m_diags.error(
             "P1004", at(nameCol),
-            "#include nested too deeply (limit " + std::to_string(maxDepth) + ") including '" + shown(name) + "'");
+            "#include nested too deeply (limit " + std::to_string(maxDepth) + ") including '" + excerpt(name) + "'");
         return;
     }
     std::vector<std::string> candidates;
@@ -506,14 +498,15 @@ void Preprocessor::doInclude(FileCtx& f, const LogicalLine& ll, const std::vecto
     }
     if (!content) {
         std::string searched;
-        for (const std::string& c : candidates) searched += (searched.empty() ? "" : ", ") + shown(c);
-        m_diags.error("P1003", at(nameCol), "cannot open include file '" + shown(name) + "' (tried " + searched + ")");
+        for (const std::string& c : candidates) searched += (searched.empty() ? "" : ", ") + excerpt(c);
+        m_diags.error("P1003", at(nameCol),
+                      "cannot open include file '" + excerpt(name) + "' (tried " + searched + ")");
         return;
     }
     const std::string key = normalizePath(found);
     if (m_onceFiles.count(key)) return;
     if (std::find(m_includeStack.begin(), m_includeStack.end(), key) != m_includeStack.end()) {
-        m_diags.error("P1004", at(nameCol), "recursive #include of '" + shown(found) + "'");
+        m_diags.error("P1004", at(nameCol), "recursive #include of '" + excerpt(found) + "'");
         return;
     }
     if (m_includeCount >= kMaxIncludes) {

@@ -14,7 +14,7 @@ public:
 
     std::optional<int64_t> run() {
         const int64_t v = ternary(true);
-        if (!m_failed && m_i < m_t.size()) fail(m_t[m_i].col, "unexpected '" + shown(m_t[m_i].text) + "' in #if");
+        if (!m_failed && m_i < m_t.size()) fail(m_t[m_i].col, "unexpected '" + excerpt(m_t[m_i].text) + "' in #if");
         if (m_failed) return std::nullopt;
         return v;
     }
@@ -155,7 +155,7 @@ private:
             if (paren && !accept(")")) fail(curCol(), "missing ')' after 'defined(NAME'");
             return def;
         }
-        fail(t.col, "unexpected '" + shown(t.text) + "' in #if expression");
+        fail(t.col, "unexpected '" + excerpt(t.text) + "' in #if expression");
         return 0;
     }
 
@@ -189,7 +189,7 @@ private:
                 v = v * base + d;  // wraps on overflow, like an unsigned C constant
         }
         if (!ok) {
-            fail(t.col, "invalid integer constant '" + shown(t.text) + "' in #if (only integers are allowed)");
+            fail(t.col, "invalid integer constant '" + excerpt(t.text) + "' in #if (only integers are allowed)");
             return 0;
         }
         return int64_t(v);

@@ -58,9 +58,6 @@ inline size_t skipSpace(const std::vector<Token>& t, size_t i) {
 
 inline bool isPunct(const Token& t, std::string_view s) { return t.kind == TokKind::Punct && t.text == s; }
 
-// Token or user text shown in a message, shortened so binary garbage stays readable.
-std::string shown(std::string_view s);
-
 std::string trim(std::string_view s);
 
 // ---- Source lines -------------------------------------------------------------------------

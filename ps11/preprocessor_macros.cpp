@@ -17,7 +17,7 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
             m_diags.error("P1005", at(endCol), "#define needs a macro name");
         else
             m_diags.error("P1005", at(toks[i].col),
-                          "macro name must be an identifier, not '" + shown(toks[i].text) + "'");
+                          "macro name must be an identifier, not '" + excerpt(toks[i].text) + "'");
         return;
     }
     const Token& nameTok = toks[i];
@@ -34,7 +34,8 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
         for (bool first = true;; first = false) {
             i = skipSpace(toks, i);
             if (i >= toks.size()) {
-                m_diags.error("P1005", at(endCol), "missing ')' in the parameter list of macro '" + nameTok.text + "'");
+                m_diags.error("P1005", at(endCol),
+                              "missing ')' in the parameter list of macro '" + excerpt(nameTok.text) + "'");
                 return;
             }
             const Token& t = toks[i];
@@ -44,7 +45,8 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
             }
             if (t.kind == TokKind::Ident) {
                 if (t.text == "__VA_ARGS__" || std::find(m.params.begin(), m.params.end(), t.text) != m.params.end()) {
-                    m_diags.error("P1005", at(t.col), "duplicate or reserved macro parameter '" + t.text + "'");
+                    m_diags.error("P1005", at(t.col),
+                                  "duplicate or reserved macro parameter '" + excerpt(t.text) + "'");
                     return;
                 }
                 m.params.push_back(t.text);
@@ -52,9 +54,9 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
                 m.variadic = true;
                 m.params.push_back("__VA_ARGS__");
             } else {
-                m_diags.error(
-                    "P1005", at(t.col),
-                    "expected a parameter name in macro '" + nameTok.text + "', found '" + shown(t.text) + "'");
+                m_diags.error("P1005", at(t.col),
+                              "expected a parameter name in macro '" + excerpt(nameTok.text) + "', found '" +
+                                  excerpt(t.text) + "'");
                 return;
             }
             i = skipSpace(toks, i + 1);
@@ -67,8 +69,9 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
                 continue;
             }
             m_diags.error("P1005", at(i < toks.size() ? toks[i].col : endCol),
-                          m.variadic ? "'...' must be the last parameter of macro '" + nameTok.text + "'"
-                                     : "expected ',' or ')' in the parameter list of macro '" + nameTok.text + "'");
+                          m.variadic
+                              ? "'...' must be the last parameter of macro '" + excerpt(nameTok.text) + "'"
+                              : "expected ',' or ')' in the parameter list of macro '" + excerpt(nameTok.text) + "'");
             return;
         }
     }
@@ -88,7 +91,7 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
     if (!m.body.empty() && (isPunct(m.body.front(), "##") || isPunct(m.body.back(), "##"))) {
         const Token& bad = isPunct(m.body.front(), "##") ? m.body.front() : m.body.back();
         m_diags.error("P1005", at(bad.col),
-                      "'##' cannot appear at either end of the body of macro '" + nameTok.text + "'");
+                      "'##' cannot appear at either end of the body of macro '" + excerpt(nameTok.text) + "'");
         return;
     }
     if (m.functionLike) {
@@ -97,8 +100,9 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
             size_t n = k + 1;
             if (n < m.body.size() && m.body[n].kind == TokKind::Space) ++n;
             if (n >= m.body.size() || m.paramIndex(m.body[n]) < 0) {
-                m_diags.error("P1005", at(m.body[k].col),
-                              "'#' is not followed by a parameter in the body of macro '" + nameTok.text + "'");
+                m_diags.error(
+                    "P1005", at(m.body[k].col),
+                    "'#' is not followed by a parameter in the body of macro '" + excerpt(nameTok.text) + "'");
                 return;
             }
         }
@@ -107,8 +111,8 @@ void Preprocessor::doDefine(const std::vector<Token>& toks, size_t i, uint32_t e
     auto it = m_macros.find(nameTok.text);
     if (it != m_macros.end()) {
         if (!it->second.sameAs(m)) {
-            m_diags.warning("P1013", m.loc, "macro '" + nameTok.text + "' redefined with a different body");
-            m_diags.note(it->second.loc, "previous definition of '" + nameTok.text + "' is here");
+            m_diags.warning("P1013", m.loc, "macro '" + excerpt(nameTok.text) + "' redefined with a different body");
+            m_diags.note(it->second.loc, "previous definition of '" + excerpt(nameTok.text) + "' is here");
         }
         it->second = std::move(m);
     } else {
@@ -208,7 +212,8 @@ void Preprocessor::expand(std::vector<Token> input, std::vector<Token>& out, int
                 args.back().push_back(a);
             }
             if (close == SIZE_MAX) {
-                m_diags.error("P1011", at(t.col), "unterminated argument list invoking macro '" + t.text + "'");
+                m_diags.error("P1011", at(t.col),
+                              "unterminated argument list invoking macro '" + excerpt(t.text) + "'");
                 out.push_back(std::move(t));
                 continue;
             }
@@ -223,8 +228,9 @@ void Preprocessor::expand(std::vector<Token> input, std::vector<Token>& out, int
             if (m.variadic && args.size() + 1 == np) args.emplace_back();
             if (args.size() != np) {
                 m_diags.error("P1009", at(t.col),
-                              "macro '" + t.text + "' expects " + std::to_string(np) + (m.variadic ? " or more" : "") +
-                                  " argument" + (np == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
+                              "macro '" + excerpt(t.text) + "' expects " + std::to_string(np) +
+                                  (m.variadic ? " or more" : "") + " argument" + (np == 1 ? "" : "s") + ", got " +
+                                  std::to_string(args.size()));
                 continue;
             }
             const uint32_t hs = m_hs.unite(m_hs.intersect(t.hs, closeHs), m_hs.single(m.nameId));

@@ -295,7 +295,11 @@ void Parser::openSection(uint32_t line, const Tokens& toks) {
     } else {
         std::string name;
         for (size_t i = 0; i < toks.size(); ++i) name += (i ? " " : "") + std::string(toks[i]);
-        error(line, "unknown section [" + name + "]");
+        // Suggest from the two-word names first ("render targt"), then the first word ("texure 0").
+        std::string hint = didYouMean(name, {"render target", "render state", "pixel shader"});
+        if (hint.empty())
+            hint = didYouMean(toks[0], {"require", "transform", "constants", "test", "texture", "sampler", "stage"});
+        error(line, "unknown section [" + excerpt(name) + "]" + hint);
     }
 }
 
@@ -391,14 +395,13 @@ void Parser::requireLine(Args& a, std::string_view kw) {
         std::string_view n = a.next();
         const HardwareClass* h = findHardware(n);
         if (!h) {
-            a.error("unknown hardware class " + quote(n) + " (expected " + hardwareNames() + ")");
+            a.error(unknownHardwareMessage(n));
             return;
         }
         if (r.hardware.isSet()) a.error("hardware given twice (first on line " + std::to_string(r.hardware.line) + ")");
         r.hardware = {h, line};
     } else {
-        a.error("unknown keyword " + quote(kw) +
-                " in [require] (expected version, precision, backend, max_value or hardware)");
+        unknownKeyword(a, kw, "require", {"version", "precision", "backend", "max_value", "hardware"});
         return;
     }
     a.end();
@@ -426,7 +429,7 @@ void Parser::renderTargetLine(Args& a, std::string_view kw) {
         }
         assign(rt.depth, on, line);
     } else {
-        a.error("unknown keyword " + quote(kw) + " in [render target] (expected size, format, clear or depth)");
+        unknownKeyword(a, kw, "render target", {"size", "format", "clear", "depth"});
         return;
     }
     a.end();
@@ -536,7 +539,7 @@ void Parser::textureLine(Args& a, std::string_view kw) {
         t.data.back().hasFill = true;
         t.data.back().fill = *v;
     } else {
-        a.error("unknown keyword " + quote(kw) + " in [texture] (expected size, format, levels, level or fill)");
+        unknownKeyword(a, kw, "texture", {"size", "format", "levels", "level", "fill"});
         return;
     }
     a.end();
@@ -662,7 +665,7 @@ void Parser::samplerLine(Args& a, std::string_view kw) {
     } else if (iequals(kw, "border")) {
         assign(s.border, a.color("border colour"), line);
     } else {
-        a.error("unknown keyword " + quote(kw) + " in [sampler] (expected filter, address or border)");
+        unknownKeyword(a, kw, "sampler", {"filter", "address", "border"});
         return;
     }
     a.end();
@@ -759,9 +762,11 @@ void Parser::stageLine(Args& a, std::string_view kw) {
     } else if (iequals(kw, "alphaop")) {
         assign(s.alphaOp, a.name(kTextureOps, "texture op"), line);
     } else {
-        a.error("unknown keyword " + quote(kw) +
-                " in [stage] (expected bumpenvmat, lscale, loffset, transform, texcoordindex, colorop, "
-                "colorarg0-2, alphaop, alphaarg0-2 or resultarg)");
+        unknownKeyword(a, kw, "stage",
+                       {"bumpenvmat", "lscale", "loffset", "transform", "texcoordindex", "colorop", "colorarg0",
+                        "colorarg1", "colorarg2", "alphaop", "alphaarg0", "alphaarg1", "alphaarg2", "resultarg"},
+                       "bumpenvmat, lscale, loffset, transform, texcoordindex, colorop, colorarg0-2, alphaop, "
+                       "alphaarg0-2 or resultarg");
         return;
     }
     a.end();
@@ -825,9 +830,9 @@ void Parser::renderStateLine(Args& a, std::string_view kw) {
         }
         if (ok) rs.colorWrite = {mask, line};
     } else {
-        a.error("unknown keyword " + quote(kw) +
-                " in [render state] (expected alphablend, srcblend, destblend, blendop, blendfactor, alphatest, "
-                "texturefactor, fog, zfunc, zwrite, cullmode or colorwrite)");
+        unknownKeyword(a, kw, "render state",
+                       {"alphablend", "srcblend", "destblend", "blendop", "blendfactor", "alphatest", "texturefactor",
+                        "fog", "zfunc", "zwrite", "cullmode", "colorwrite"});
         return;
     }
     a.end();
@@ -871,8 +876,10 @@ void Parser::transformLine(Args& a, std::string_view kw) {
         }
         t.viewport = {vp, line};
     } else {
-        a.error("unknown keyword " + quote(kw) +
-                " in [transform] (expected world, view, projection, texture0 ... texture7 or viewport)");
+        unknownKeyword(a, kw, "transform",
+                       {"world", "view", "projection", "texture0", "texture1", "texture2", "texture3", "texture4",
+                        "texture5", "texture6", "texture7", "viewport"},
+                       "world, view, projection, texture0 ... texture7 or viewport");
         return;
     }
     a.end();

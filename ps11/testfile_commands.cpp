@@ -95,7 +95,8 @@ void Parser::testLine(uint32_t line, const Tokens& toks) {
         a.error("interpolant " + quote(kw) + " outside an eval (write 'eval' on the line before)");
         return;
     } else {
-        a.error("unknown command " + quote(kw) + " in [test] (expected draw, eval or probe)");
+        a.error("unknown command " + quote(kw) + " in [test] (expected draw, eval or probe)" +
+                didYouMean(kw, {"draw", "eval", "probe"}));
         return;
     }
     if (cmd.todo && !std::holds_alternative<Probe>(cmd.op)) {
@@ -144,7 +145,8 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
                 }
                 q.hasRect = true;
             } else {
-                a.error("unknown draw quad option " + quote(opt) + " (expected diffuse, specular, t0 ... t7 or rect)");
+                a.error("unknown draw quad option " + quote(opt) + " (expected diffuse, specular, t0 ... t7 or rect)" +
+                        didYouMean(opt, {"diffuse", "specular", "rect"}));
                 return false;
             }
         }
@@ -159,7 +161,8 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
     else if (iequals(prim, "fan"))
         d.type = PrimitiveType::TriangleFan;
     else {
-        a.error("unknown primitive " + quote(prim) + " (expected quad, triangles, strip or fan)");
+        a.error("unknown primitive " + quote(prim) + " (expected quad, triangles, strip or fan)" +
+                didYouMean(prim, {"quad", "triangles", "strip", "fan"}));
         return false;
     }
     if (!a.need("vertex format (xyzrhw or xyz)")) return false;
@@ -298,7 +301,8 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
         if (!x || !y) return false;
         p.rect = {uint32_t(*x), uint32_t(*y), uint32_t(*x + 1), uint32_t(*y + 1)};
     } else {
-        a.error("unknown probe target " + quote(a.peek()) + " (expected X Y, rect, all, eval or eval killed)");
+        a.error("unknown probe target " + quote(a.peek()) + " (expected X Y, rect, all, eval or eval killed)" +
+                didYouMean(a.peek(), {"rect", "all", "eval"}));
         return false;
     }
     if (!a.need("channels (rgba or rgb)")) return false;

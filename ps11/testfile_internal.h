@@ -7,12 +7,15 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "ps11/diagnostics.h"
+#include "ps11/suggest.h"
 #include "ps11/testfile.h"
 
 namespace ps11::testfile_detail {
@@ -35,27 +38,6 @@ inline std::string_view trim(std::string_view s) {
     while (!s.empty() && isSpace(s.front())) s.remove_prefix(1);
     while (!s.empty() && isSpace(s.back())) s.remove_suffix(1);
     return s;
-}
-
-// Quotes a token for a message, cut short and with control bytes escaped.
-inline std::string quote(std::string_view s) {
-    std::string out = "'";
-    size_t n = 0;
-    for (char c : s) {
-        if (++n > 40) {
-            out += "...";
-            break;
-        }
-        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) == 0x7f) {
-            static const char* hex = "0123456789abcdef";
-            out += "\\x";
-            out += hex[(c >> 4) & 15];
-            out += hex[c & 15];
-        } else {
-            out += c;
-        }
-    }
-    return out + "'";
 }
 
 // Splits a line into tokens at white space; '(' ')' ',' are tokens of their own and '%' starts
@@ -144,6 +126,14 @@ inline std::optional<E> lookup(const NameEntry<E> (&table)[N], std::string_view 
     for (const NameEntry<E>& e : table)
         if (iequals(name, e.name)) return e.value;
     return std::nullopt;
+}
+
+// "; did you mean 'linear'?" for a word close to one of the table's names (ps11/suggest.h).
+template <class E, size_t N>
+inline std::string suggestName(const NameEntry<E> (&table)[N], std::string_view word) {
+    std::vector<std::string_view> names;
+    for (const NameEntry<E>& e : table) names.push_back(e.name);
+    return didYouMean(word, names);
 }
 
 template <class E, size_t N>
@@ -267,7 +257,8 @@ public:
         if (!need(what + " (" + namesOf(table) + ")")) return std::nullopt;
         std::string_view t = next();
         std::optional<E> v = lookup(table, t);
-        if (!v) error("unknown " + what + " " + quote(t) + " (expected " + namesOf(table) + ")");
+        if (!v)
+            error("unknown " + what + " " + quote(t) + " (expected " + namesOf(table) + ")" + suggestName(table, t));
         return v;
     }
 
@@ -282,6 +273,20 @@ private:
     uint32_t m_line;
     std::vector<TestFileError>& m_errors;
 };
+
+// "unknown keyword 'sise' in [render target] (expected size, format, clear or depth); did you
+// mean 'size'?". `expected` replaces the listed names in the message where a short form reads
+// better (colorarg0-2); the suggestion always looks at every name.
+inline void unknownKeyword(Args& a, std::string_view kw, std::string_view section,
+                           std::initializer_list<std::string_view> names, std::string_view expected = {}) {
+    std::string list(expected);
+    if (list.empty()) {
+        size_t i = 0;
+        for (std::string_view n : names) list += (i++ ? (i == names.size() ? " or " : ", ") : "") + std::string(n);
+    }
+    a.error("unknown keyword " + quote(kw) + " in [" + std::string(section) + "] (expected " + list + ")" +
+            didYouMean(kw, names));
+}
 
 template <class T>
 void assign(Setting<T>& s, const std::optional<T>& v, uint32_t line) {

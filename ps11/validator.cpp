@@ -236,7 +236,7 @@ void Validator::dataflowWrites(size_t i) {
     const int phase = m_phaseOf[i];
     const Dst& d = in.dst;
     if (op == Opcode::Phase) {
-        for (int r = 0; r < m_limits.count[size_t(RegType::Temp)]; ++r)
+        for (int r = 0; r < registerCount(RegType::Temp, m_minor); ++r)
             if (m_regs[size_t(RegType::Temp)][size_t(r)][3].defined)
                 undefine(RegType::Temp, r, kMaskA,
                          "the alpha of every r# is undefined after phase at " + lineRef(in.loc));

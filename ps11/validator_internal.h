@@ -73,6 +73,8 @@ inline constexpr const char* kTexDepthReg = "P2111";
 inline constexpr const char* kTexDepthPhase = "P2112";
 
 constexpr int kRegSlots = 8;        // array bound for every register file (largest file is c0-c7)
+static_assert(registerCount(RegType::Const, 4) <= kRegSlots && registerCount(RegType::Temp, 4) <= kRegSlots &&
+              registerCount(RegType::Texture, 4) <= kRegSlots);
 constexpr uint8_t kSwXyz = 0xA4;    // .xyz = xyzz (spec §3.4)
 constexpr uint8_t kSwXyw = 0xF4;    // .xyw = xyww
 constexpr uint8_t kSwAlpha = 0xFF;  // .a replicate
@@ -209,17 +211,17 @@ inline Pipe pipeOf(uint8_t mask) {
     return Pipe::Both;
 }
 
-struct RegisterCounts {
-    std::array<int, 4> count;  // by RegType: r, v, c, t
-    std::array<int, 4> ports;  // read ports per instruction (spec §4.3)
+// Per-version limits of the validator (the register counts themselves are registerCount(), ir.h).
+struct VersionLimits {
+    std::array<int, 4> ports;  // read ports per instruction by RegType: r, v, c, t (spec §4.3)
     int texSlots;
     int arithSlots;
 };
 
-inline RegisterCounts limitsFor(int minor) {
-    if (minor == 4) return {{6, 2, 8, 6}, {3, 2, 2, 1}, 6, 8};
-    if (minor == 1) return {{2, 2, 8, 4}, {2, 2, 2, 2}, 4, 8};
-    return {{2, 2, 8, 4}, {2, 2, 2, 3}, 4, 8};
+inline VersionLimits limitsFor(int minor) {
+    if (minor == 4) return {{3, 2, 2, 1}, 6, 8};
+    if (minor == 1) return {{2, 2, 2, 2}, 4, 8};
+    return {{2, 2, 2, 3}, 4, 8};
 }
 
 class Validator {
@@ -245,7 +247,7 @@ private:
     std::string vname() const { return versionName(m_minor); }
     std::string mn(const Instruction& in) const { return std::string(in.info->mnemonic); }
     bool inRange(RegType t, int index) const {
-        return size_t(t) < 4 && index >= 0 && index < m_limits.count[size_t(t)];
+        return size_t(t) < 4 && index >= 0 && index < registerCount(t, m_minor);
     }
     int arithCost(const Instruction& in) const { return is14() ? in.info->arithSlots14 : in.info->arithSlots13; }
     // The instruction before i starts a co-issued pair with i.
@@ -279,7 +281,7 @@ private:
     const ValidateOptions& m_opts;
     ShaderStats& m_stats;
     int m_minor = 1;
-    RegisterCounts m_limits{};
+    VersionLimits m_limits{};
     std::vector<bool> m_legal;
     std::vector<int> m_phaseOf;    // per instruction: 1, 2 (1_4) or 0
     long m_phaseInstruction = -1;  // index of the (first) phase instruction

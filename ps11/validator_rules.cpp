@@ -16,8 +16,7 @@ void Validator::checkRegisters(size_t i) {
         const Dst& d = in.dst;
         if (!inRange(d.type, d.index))
             error(kRegRange, d.loc,
-                  regName(d.type, d.index) + " is out of range: " + vname() + " has " + regPrefix(d.type) + "0-" +
-                      regPrefix(d.type) + std::to_string(m_limits.count[size_t(d.type)] - 1));
+                  regName(d.type, d.index) + " is out of range: " + vname() + " has " + registerRange(d.type, m_minor));
         std::string allowed;
         bool ok = true;
         if (op == Opcode::Def) {
@@ -45,8 +44,8 @@ void Validator::checkRegisters(size_t i) {
         const Src& src = in.src[s];
         if (!inRange(src.type, src.index))
             error(kRegRange, src.loc,
-                  regName(src.type, src.index) + " is out of range: " + vname() + " has " + regPrefix(src.type) + "0-" +
-                      regPrefix(src.type) + std::to_string(m_limits.count[size_t(src.type)] - 1));
+                  regName(src.type, src.index) + " is out of range: " + vname() + " has " +
+                      registerRange(src.type, m_minor));
         const std::string name = regName(src.type, src.index);
         if (isArith(in)) {
             if (is14() && src.type == RegType::Texture)

@@ -206,3 +206,88 @@ TEST_CASE("assembler: every error is collected", "[assembler]") {
     CHECK_FALSE(prog);
     CHECK(diags.errorCount() == 4);
 }
+
+TEST_CASE("assembler: registers the version does not have (P1114)", "[assembler]") {
+    // Microsoft's assembler refuses them even with validation off (Wine's d3dcompiler
+    // tests/asm.c failure_test), so `ps11 asm --no-validate` does too.
+    CHECK(errorsOf("ps_1_3\nmov r5, r0\n") ==
+          "t.psh:2:5: error P1114: register 'r5' does not exist in ps_1_3 (r0-r1)\n");
+    CHECK(errorsOf("ps_1_3\ntex t5\n") == "t.psh:2:5: error P1114: register 't5' does not exist in ps_1_3 (t0-t3)\n");
+    // Every operand is checked, and parsing goes on after one.
+    CHECK(errorsOf("ps_1_1\nmov r2, c8\n") ==
+          "t.psh:2:5: error P1114: register 'r2' does not exist in ps_1_1 (r0-r1)\n"
+          "t.psh:2:9: error P1114: register 'c8' does not exist in ps_1_1 (c0-c7)\n");
+    CHECK(errorsOf("ps_1_2\ndef c8, 1, 1, 1, 1\n").find("t.psh:2:5: error P1114: register 'c8'") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\ntexkill t4\n").find("t.psh:2:9: error P1114: register 't4'") != std::string::npos);
+    CHECK(errorsOf("ps_1_2\nmov r0, -v2_bx2.a\n").find("t.psh:2:10: error P1114: register 'v2'") != std::string::npos);
+    CHECK(errorsOf("ps_1_4\nmov r6, v0\n").find("(r0-r5)") != std::string::npos);
+    CHECK(errorsOf("ps_1_4\ntexld r0, t6\n")
+              .find("t.psh:2:11: error P1114: register 't6' does not exist in "
+                    "ps_1_4 (t0-t5)") != std::string::npos);
+    CHECK(errorsOf("ps_1_4\nmov r0, v2\n").find("(v0-v1)") != std::string::npos);
+    // The last register of each file exists; register types are the validator's (Wine's asm.c
+    // ps_1_4 tests: "texld r1, t4" and "texld r5, c0" assemble without validation).
+    CHECK(hexOf("ps_1_4\nmov r5, c7\n") == "ffff0104 00000001 800f0005 a0e40007 0000ffff");
+    CHECK(hexOf("ps_1_4\ntexld r1, t4\n") == "ffff0104 00000042 800f0001 b0e40004 0000ffff");
+    CHECK(hexOf("ps_1_4\ntexld r5, c0\n") == "ffff0104 00000042 800f0005 a0e40000 0000ffff");
+    CHECK(hexOf("ps_1_1\nmov r1, v1\n+mov t3.a, c7\n").rfind("ffff0101", 0) == 0);
+    // Without a valid version there is nothing to check against: only the version error.
+    CHECK(errorsOf("mov r5, r0\n") ==
+          "t.psh:1:1: error P1101: the shader must start with a version statement (ps_1_1 … ps_1_4)\n");
+    CHECK(errorsOf("ps_2_0\nmov r5, r0\n").find("P1114") == std::string::npos);
+}
+
+TEST_CASE("assembler: Wine's failure_test cases for ps 1.x do not assemble", "[assembler]") {
+    // dlls/d3dcompiler_43/tests/asm.c failure_test: D3DAssemble with D3DCOMPILE_SKIP_VALIDATION
+    // returns D3DXERR_INVALIDDATA for each; here each is a syntax error with its code.
+    CHECK(errorsOf("ps_1_3\nmov_x2_x2 r0, r1\n").find("t.psh:2:7: error P1104:") != std::string::npos);   // shader 8
+    CHECK(errorsOf("ps_1_4\ntexld r5, -r2_dz\n").find("t.psh:2:11: error P1109:") != std::string::npos);  // 10
+    CHECK(errorsOf("ps_1_3\nmov r5, r0\n").find("t.psh:2:5: error P1114:") != std::string::npos);         // 22
+    CHECK(errorsOf("ps_1_3\nadd oC0, r0, r1\n").find("t.psh:2:5: error P1106:") != std::string::npos);    // 26
+    CHECK(errorsOf("ps_1_3\ntex t5\n").find("t.psh:2:5: error P1114:") != std::string::npos);             // 32
+    // What Wine's asmparser.c also refuses in ps 1.x at parse time: the _abs modifier and
+    // relative addressing.
+    CHECK(errorsOf("ps_1_4\nmov r0, r1_abs\n").find("P1109") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\nmov r0, c[a0.x]\n").find("P1106") != std::string::npos);
+}
+
+TEST_CASE("assembler: an unknown instruction suggests the nearest one", "[assembler]") {
+    CHECK(errorsOf("ps_1_1\nmull r0, v0, v1\n") ==
+          "t.psh:2:1: error P1103: unknown instruction 'mull'; did you mean 'mul'?\n");
+    CHECK(errorsOf("ps_1_1\nMOVV_sat r0, v0\n").find("unknown instruction 'MOVV'; did you mean 'mov'?") !=
+          std::string::npos);
+    // The version's own instructions first: texcoord in 1_1-1_3, texcrd in 1_4.
+    CHECK(errorsOf("ps_1_2\ntexcord t0\n").find("did you mean 'texcoord'?") != std::string::npos);
+    CHECK(errorsOf("ps_1_4\ntexcord r0, t0\n").find("did you mean 'texcrd'?") != std::string::npos);
+    // Else any version's (bem is ps_1_4 only, and nothing of ps_1_1 is close to "bemm").
+    CHECK(errorsOf("ps_1_1\nbemm r1, c0, r0\n").find("did you mean 'bem'?") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\ndpp4 r0, v0, v1\n").find("did you mean 'dp4'?") != std::string::npos);
+    CHECK(errorsOf("ps_1_1\nfoo r0, v0\n") == "t.psh:2:1: error P1103: unknown instruction 'foo'\n");
+    // Nothing close: no suggestion; the reserved texm3x3diff is never offered.
+    CHECK(errorsOf("ps_1_1\nfrobnicate r0, v0\n").find("did you mean") == std::string::npos);
+    CHECK(errorsOf("ps_1_1\ntexm3x3dif t1, t0\n").find("texm3x3diff'?") == std::string::npos);
+}
+
+TEST_CASE("assembler: diagnostics quote at most a short excerpt of a huge line", "[assembler]") {
+    const std::string garbage(1 << 20, 'z');
+    std::string e = errorsOf("ps_1_1 " + garbage + "\nmov r0, v0\n");
+    CHECK(e.rfind("t.psh:1:8: error P1111: unexpected text after the version: 'zzz", 0) == 0);
+    CHECK(e.find("…'") != std::string::npos);
+    CHECK(e.size() < 200);
+    // A 1 MB identifier as the instruction, as a register and as a modifier.
+    e = errorsOf("ps_1_1\n" + garbage + " r0, v0\n");
+    CHECK(e.rfind("t.psh:2:1: error P1103: unknown instruction 'zzz", 0) == 0);
+    CHECK(e.size() < 200);
+    e = errorsOf("ps_1_1\nmov r0, " + garbage + "\n");
+    CHECK(e.rfind("t.psh:2:9: error P1106: 'zzz", 0) == 0);
+    CHECK(e.size() < 200);
+    e = errorsOf("ps_1_1\nmov r0, v0_" + garbage + "\n");
+    CHECK(e.rfind("t.psh:2:11: error P1109:", 0) == 0);
+    CHECK(e.size() < 200);
+    e = errorsOf("ps_1_1\nmov r0, v0 " + garbage + "\n");
+    CHECK(e.rfind("t.psh:2:12: error P1111:", 0) == 0);
+    CHECK(e.size() < 200);
+    e = errorsOf("ps_1_1\nmov r0, v0." + garbage + "\n");
+    CHECK(e.rfind("t.psh:2:12: error P1108:", 0) == 0);
+    CHECK(e.size() < 200);
+}

@@ -367,6 +367,15 @@ TEST_CASE("tokensFromHex", "[decoder]") {
         CHECK(all[3].loc.col == 11);
         CHECK(all[0].loc.tokenIndex == -1);
     }
+    SECTION("a huge bad word is quoted as a short excerpt") {
+        const std::string huge = "0x" + std::string(1 << 20, 'g');
+        CHECK_FALSE(tokensFromHex("0xffff0101 " + huge + "\n", file, diags));
+        REQUIRE(diags.errorCount() == 1);
+        const std::string text = diags.format(diags.all()[0]);
+        CHECK(text.rfind("x.hex:1:12: error P3002: bad hex word '0xggg", 0) == 0);
+        CHECK(text.find("…'") != std::string::npos);
+        CHECK(text.size() < 200);
+    }
     SECTION("leading zeros beyond 8 digits are fine") {
         const auto tokens = tokensFromHex("000000000042", file, diags);
         REQUIRE(tokens);

@@ -1070,9 +1070,15 @@ TEST_CASE("device: pixel shaders from tokens and text", "[device]") {
     CHECK(dev.CreatePixelShader(std::span<const DWORD>(tokens.data(), 1), &ps3) == D3DERR_INVALIDCALL);
     CHECK(dev.CreatePixelShader(static_cast<const DWORD*>(nullptr), &ps3) == D3DERR_INVALIDCALL);
     CHECK(dev.CreatePixelShader(tokens.data(), nullptr) == D3DERR_INVALIDCALL);
-    // Validation failures carry the validator's diagnostic.
+    // Validation failures carry the validator's diagnostic; a register the version lacks is the
+    // assembler's (P1114) in text and the validator's (P2030) in tokens.
     CHECK(dev.CreatePixelShaderFromText("ps_1_1\nmov r2, v0\nmov r0, v0\n", &ps3) == D3DERR_INVALIDCALL);
+    CHECK(contains(dev.lastError().message, "P1114"));
+    const DWORD r2Tokens[] = {D3DPS_VERSION(1, 1), 0x00000001, 0x800f0002, 0x90e40000, 0x0000FFFF};
+    CHECK(dev.CreatePixelShader(r2Tokens, &ps3) == D3DERR_INVALIDCALL);
     CHECK(contains(dev.lastError().message, "P2030"));
+    CHECK(dev.CreatePixelShaderFromText("ps_1_1\nmov r0, v0.g\n", &ps3) == D3DERR_INVALIDCALL);
+    CHECK(contains(dev.lastError().message, "P2060"));
     CHECK(dev.CreatePixelShaderFromText("ps_2_0\nmov r0, v0\n", &ps3) == D3DERR_INVALIDCALL);
     // D3DCAPS9::PixelShaderVersion is the hardware class's: the default 1.1-class card runs up
     // to ps_1_3, the 1.4-class card ps_1_4, GeForce3 only ps_1_1.

@@ -520,6 +520,15 @@ TEST_CASE("preprocessor: P1008 unknown directive", "[preprocessor][diag]") {
     CHECK(r.diags.errorCount() == 3);
     CHECK(r.find("P1008")->message.find("#foo") != std::string::npos);
     CHECK(r.find("P1008")->loc.col == 2);
+    // A huge directive name or #error text is quoted as a short excerpt.
+    const std::string huge(1 << 20, 'q');
+    Run big = pp("#" + huge + "\n#error " + huge + "\n");
+    REQUIRE(big.find("P1008"));
+    CHECK(big.find("P1008")->message.size() < 120);
+    CHECK(big.find("P1008")->message.find("…'") != std::string::npos);
+    REQUIRE(big.find("P1007"));
+    CHECK(big.find("P1007")->message.size() < 250);
+    CHECK(big.find("P1007")->loc.line == 2);
 }
 
 TEST_CASE("preprocessor: P1009 macro argument count mismatch", "[preprocessor][diag]") {

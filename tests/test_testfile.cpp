@@ -608,6 +608,43 @@ TEST_CASE("testfile: sections and lexical errors", "[testfile]") {
     CHECK(hasError(many, 4, "unknown section"));
     CHECK(hasError(many, 6, "unknown command 'fly'"));
     CHECK(formatTestFileError("a.ps11test", {6, "boom"}) == "a.ps11test:6: boom");
+}
+
+TEST_CASE("testfile: mistyped names get a suggestion", "[testfile]") {
+    CHECK_ERROR(parse("[render targt]\n"), 1, "unknown section [render targt]; did you mean 'render target'?");
+    CHECK_ERROR(parse("[texure 0]\n"), 1, "unknown section [texure 0]; did you mean 'texture'?");
+    CHECK_ERROR(parse("[vertex shader]\n"), 1, "unknown section [vertex shader]");
+    CHECK(dump(parse("[vertex shader]\n")).find("did you mean") == std::string::npos);
+    CHECK_ERROR(parse("[require]\nprecison fx8\n"), 2,
+                "unknown keyword 'precison' in [require] (expected version, precision, backend, max_value or hardware); "
+                "did you mean 'precision'?");
+    CHECK_ERROR(parse("[require]\nprecision fx9\n"), 2,
+                "unknown precision 'fx9' (expected fx8, fx12, float or "
+                "ideal); did you mean 'fx8'?");
+    CHECK_ERROR(parse("[sampler 0]\nfiltr point\n"), 2, "did you mean 'filter'?");
+    CHECK_ERROR(parse("[sampler 0]\nfilter linaer\n"), 2, "did you mean 'linear'?");
+    CHECK_ERROR(parse("[stage 0]\ncolrop selectarg1\n"), 2,
+                "(expected bumpenvmat, lscale, loffset, transform, texcoordindex, colorop, colorarg0-2, alphaop, "
+                "alphaarg0-2 or resultarg); did you mean 'colorop'?");
+    CHECK_ERROR(parse("[transform]\nveiw 1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1\n"), 2, "did you mean 'view'?");
+    CHECK_ERROR(parse("[render state]\nzwirte on\n"), 2, "did you mean 'zwrite'?");
+    CHECK_ERROR(parse("[test]\ndraww quad\n"), 2,
+                "unknown command 'draww' in [test] (expected draw, eval or probe); "
+                "did you mean 'draw'?");
+    CHECK_ERROR(parse("[test]\ndraw quads\n"), 2, "did you mean 'quad'?");
+}
+
+TEST_CASE("testfile: messages quote a short excerpt of a huge token", "[testfile]") {
+    const std::string huge(1 << 20, 'k');
+    Parsed p = parse("[require]\n" + huge + " 1\n");
+    REQUIRE(p.errors.size() == 1);
+    CHECK(p.errors[0].line == 2);
+    CHECK(p.errors[0].message.rfind("unknown keyword 'kkk", 0) == 0);
+    CHECK(p.errors[0].message.find("…'") != std::string::npos);
+    CHECK(p.errors[0].message.size() < 200);
+    p = parse("[" + huge + "]\n");
+    REQUIRE(p.errors.size() == 1);
+    CHECK(p.errors[0].message.size() < 200);
     CHECK(formatTestFileError("a.ps11test", {0, "boom"}) == "a.ps11test: boom");
 }
 

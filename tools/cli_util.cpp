@@ -12,7 +12,13 @@
 #include <iterator>
 #include <sstream>
 
+#include "ps11/suggest.h"
+
 namespace ps11::cli {
+
+std::string unknownOption(std::string_view arg, std::initializer_list<std::string_view> options) {
+    return "unknown option " + quote(arg) + didYouMean(arg, options);
+}
 
 std::optional<std::string> readFile(const std::string& path) {
     if (path == "-") {

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ps11/assembler.h"
@@ -31,6 +33,10 @@ std::string projectDir();
 
 // Every *.psh under dir, sorted.
 std::vector<std::string> listFiles(const std::string& dir, const std::string& extension);
+
+// "unknown option '--hx'; did you mean '--hex'?" (the argument cut to a readable length; the
+// suggestion from the command's options, ps11/suggest.h).
+std::string unknownOption(std::string_view arg, std::initializer_list<std::string_view> options);
 
 std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine = 8);
 

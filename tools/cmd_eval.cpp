@@ -117,10 +117,10 @@ int takeRegister(const std::string& arg, EvalArgs& out) {
         if (name[0] == 't') slot = &out.texcoord[n];
         if (name[0] == 'c') slot = &out.constant[n];
     }
-    if (!slot) return usageError("unknown input '" + arg.substr(0, eq) + "' (expected v0, v1, t0..t7 or c0..c7)");
+    if (!slot) return usageError("unknown input " + quote(arg.substr(0, eq)) + " (expected v0, v1, t0..t7 or c0..c7)");
     if (*slot) return userError(name + " given twice");
     std::optional<Vec4> v = parseVector(value, name[0] == 'v');
-    if (!v) return userError("bad value for " + name + ": '" + value + "'");
+    if (!v) return userError("bad value for " + name + ": " + quote(value));
     *slot = v;
     return cli::kOk;
 }
@@ -142,14 +142,15 @@ int cmdEval(const std::vector<std::string>& args) {
             if (a == "--hardware") {
                 ea.hardware = findHardware(v);
                 if (!ea.hardware)
-                    return usageError("unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+                    return usageError(unknownHardwareMessage(v));
             } else if (a == "--precision") {
                 std::optional<Precision> p = parsePrecision(v);
-                if (!p) return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+                if (!p) return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
                 ea.precision = *p;
             } else if (a == "--max-value") {
                 std::optional<float> m = parseFloat(v);
-                if (!m || *m <= 0) return userError("bad value for --max-value: '" + v + "' (expected a float > 0)");
+                if (!m || *m <= 0)
+                    return userError("bad value for --max-value: " + quote(v) + " (expected a float > 0)");
                 ea.maxValue = *m;
             } else {
                 const int stage = a[5] - '0';
@@ -157,8 +158,8 @@ int cmdEval(const std::vector<std::string>& args) {
                 if (size_t colon = v.find(':'); colon != std::string::npos) {
                     std::optional<TexFormat> f = parseTexFormat(v.substr(0, colon));
                     if (!f || isFloatFormat(*f))
-                        return userError("bad format in " + a + ": '" + v.substr(0, colon) +
-                                         "' (expected a packed format: A8R8G8B8, X8R8G8B8, A8, L8, A8L8, V8U8, "
+                        return userError("bad format in " + a + ": " + quote(v.substr(0, colon)) +
+                                         " (expected a packed format: A8R8G8B8, X8R8G8B8, A8, L8, A8L8, V8U8, "
                                          "L6V5U5, X8L8V8U8, Q8W8V8U8 or V16U16)");
                     ea.textureFormat[size_t(stage)] = *f;
                     word = v.substr(colon + 1);
@@ -166,18 +167,19 @@ int cmdEval(const std::vector<std::string>& args) {
                 std::optional<uint32_t> w = parseHexWord(word);
                 const int bits = formatBits(ea.textureFormat[size_t(stage)]);
                 if (!w || (bits < 32 && (*w >> bits) != 0))
-                    return userError("bad value for " + a + ": '" + v + "' (expected a hex word of " +
+                    return userError("bad value for " + a + ": " + quote(v) + " (expected a hex word of " +
                                      std::to_string(bits) + " bits, e.g. 0xff808080)");
                 ea.texture[size_t(stage)] = *w;
             }
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError("unknown option '" + a + "'");
+            return usageError(cli::unknownOption(a, {"--hardware", "--precision", "--max-value", "--tex0", "--tex1", "--tex2",
+                                                     "--tex3", "--tex4", "--tex5", "--tex6", "--tex7", "--help"}));
         } else if (a.find('=') != std::string::npos) {
             if (int rc = takeRegister(a, ea); rc != cli::kOk) return rc;
         } else if (ea.shader.empty()) {
             ea.shader = a;
         } else {
-            return usageError("eval takes one shader file ('" + a + "' is a second one)");
+            return usageError("eval takes one shader file (" + quote(a) + " is a second one)");
         }
     }
     if (ea.shader.empty()) return usageError("eval needs a shader file");

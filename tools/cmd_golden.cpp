@@ -76,7 +76,7 @@ int cmdGolden(const std::vector<std::string>& args) {
         } else if (a == "--check") {
             check = true;
         } else if (a.size() > 1 && a[0] == '-') {
-            std::cerr << "ps11: golden: unknown option '" << a << "'\n";
+            std::cerr << "ps11: golden: " << unknownOption(a, {"--check", "--regen"}) << "\n";
             return kUsage;
         } else {
             dir = a;

@@ -204,7 +204,7 @@ int cmdTest(const std::vector<std::string>& args) {
             if (a == "--hardware") {
                 opts.hardware = findHardware(v);
                 if (!opts.hardware)
-                    return usageError("unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+                    return usageError(unknownHardwareMessage(v));
             } else if (a == "--backend") {
                 if (v == "emu")
                     opts.backends = kBackendEmu;
@@ -213,7 +213,7 @@ int cmdTest(const std::vector<std::string>& args) {
                 else if (v == "both")
                     opts.backends = kBackendEmu | kBackendGl;
                 else
-                    return usageError("unknown backend '" + v + "' (expected emu, gl or both)");
+                    return usageError("unknown backend " + quote(v) + " (expected emu, gl or both)");
             } else {
                 if (v == "fx8")
                     opts.precision = Precision::Fx8;
@@ -224,7 +224,7 @@ int cmdTest(const std::vector<std::string>& args) {
                 else if (v == "ideal")
                     opts.precision = Precision::Ideal;
                 else
-                    return usageError("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+                    return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
             }
         } else if (a == "--stats") {
             opts.stats = true;
@@ -234,7 +234,7 @@ int cmdTest(const std::vector<std::string>& args) {
             std::cout << kUsage;
             return cli::kOk;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError("unknown option '" + a + "'");
+            return usageError(cli::unknownOption(a, {"--backend", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
         } else {
             std::error_code ec;
             if (std::filesystem::is_directory(a, ec)) {

@@ -1,5 +1,5 @@
 // The ps11 command line: one binary, one subcommand per job (asm, disasm, check, test,
-// golden, demo). Each subcommand parses its own options; user errors print a message that
+// eval, golden, isa, demo, version). Each subcommand parses its own options; user errors print a message that
 // names the file and place and exit 1, usage errors exit 2.
 #include <cctype>
 #include <cstdio>
@@ -14,10 +14,12 @@
 #include "ps11/disassembler.h"
 #include "ps11/encoder.h"
 #include "ps11/isa_doc.h"
+#include "ps11/suggest.h"
 #include "ps11/validator.h"
+#include "ps11/version.h"
 #include "tools/cli_util.h"
-#include "tools/cmd_eval.h"
 #include "tools/cmd_demo.h"
+#include "tools/cmd_eval.h"
 #include "tools/cmd_golden.h"
 #include "tools/cmd_hardware.h"
 #include "tools/cmd_test.h"
@@ -44,7 +46,9 @@ const char* kUsageText =
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
     "  demo [--size WxH] [--threads N] [--repeats N] [--hardware H] [--out PREFIX]\n"
     "                         the main job: the corpus checked, then a bloom chain rendered on\n"
-    "                         the device for every hardware class (time per pass, error vs ideal)\n";
+    "                         the device for every hardware class (time per pass, error vs ideal)\n"
+    "  version, --version     print the ps11 version\n"
+    "  help, --help           print this text\n";
 
 int usage(const std::string& message) {
     if (!message.empty()) std::cerr << "ps11: " << message << "\n";
@@ -87,7 +91,7 @@ int cmdAsm(const std::vector<std::string>& args) {
         } else if (takePreprocessorOption(args, i, pp, err)) {
             if (!err.empty()) return usage(err);
         } else if (a.size() > 1 && a[0] == '-') {
-            return usage("asm: unknown option '" + a + "'");
+            return usage("asm: " + unknownOption(a, {"--hex", "--no-validate", "-o", "-D", "-I"}));
         } else if (input.empty()) {
             input = a;
         } else {
@@ -167,7 +171,7 @@ int cmdDisasm(const std::vector<std::string>& args) {
         if (a == "--hex-input") {
             hexInput = true;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usage("disasm: unknown option '" + a + "'");
+            return usage("disasm: " + unknownOption(a, {"--hex-input"}));
         } else if (input.empty()) {
             input = a;
         } else {
@@ -197,7 +201,7 @@ int cmdCheck(const std::vector<std::string>& args) {
         } else if (takePreprocessorOption(args, i, pp, err)) {
             if (!err.empty()) return usage(err);
         } else if (a.size() > 1 && a[0] == '-') {
-            return usage("check: unknown option '" + a + "'");
+            return usage("check: " + unknownOption(a, {"--json", "--hex-input", "-D", "-I"}));
         } else {
             inputs.push_back(a);
         }
@@ -269,21 +273,22 @@ int cmdDemo(const std::vector<std::string>& args) {
             if (a == "--hardware") {
                 bloom.hardware = findHardware(v);
                 if (!bloom.hardware)
-                    return usage("demo: unknown hardware class '" + v + "' (expected " + hardwareNames() + ")");
+                    return usage("demo: " + unknownHardwareMessage(v));
             } else if (a == "--size") {
                 if (!parseSize(v, bloom.width, bloom.height))
-                    return usage("demo: --size takes WIDTHxHEIGHT with sides 1..16384, not '" + v + "'");
+                    return usage("demo: --size takes WIDTHxHEIGHT with sides 1..16384, not " + quote(v));
             } else if (a == "--out") {
                 bloom.outPrefix = v;
             } else {
                 long n = std::strtol(v.c_str(), &end, 10);
                 if (*end || n < (a == "--threads" ? 0 : 1) || n > 256)
                     return usage("demo: " + a + " takes a number" + (a == "--threads" ? " 0..256" : " 1..256") +
-                                 ", not '" + v + "'");
+                                 ", not " + quote(v));
                 (a == "--threads" ? bloom.threads : bloom.repeats) = int(n);
             }
         } else {
-            return usage("demo: unknown argument '" + a + "'");
+            return usage("demo: unknown argument " + quote(a) +
+                         didYouMean(a, {"--size", "--threads", "--repeats", "--out", "--hardware"}));
         }
     }
     std::string dir = projectDir();
@@ -339,21 +344,42 @@ int main(int argc, char** argv) {
     if (argc < 2) return usage("");
     std::string cmd = argv[1];
     std::vector<std::string> args(argv + 2, argv + argc);
-    if (cmd == "asm") return cmdAsm(args);
-    if (cmd == "disasm") return cmdDisasm(args);
-    if (cmd == "check") return cmdCheck(args);
-    if (cmd == "test") return ps11::cmdTest(args);
-    if (cmd == "eval") return ps11::cmdEval(args);
-    if (cmd == "golden") return cmdGolden(args);
-    if (cmd == "demo") return cmdDemo(args);
-    if (cmd == "hardware") return ps11::cmdHardware(args);
-    if (cmd == "isa") {
-        std::cout << ps11::isaMarkdownTable();
-        return kOk;
+    // The commands, in one table: dispatch and the "did you mean" of an unknown command.
+    struct Command {
+        std::string_view name;
+        int (*run)(const std::vector<std::string>&);
+    };
+    static const Command kCommands[] = {
+        {"asm", cmdAsm},
+        {"disasm", cmdDisasm},
+        {"check", cmdCheck},
+        {"test", ps11::cmdTest},
+        {"eval", ps11::cmdEval},
+        {"golden", cmdGolden},
+        {"demo", cmdDemo},
+        {"hardware", ps11::cmdHardware},
+        {"isa",
+         [](const std::vector<std::string>&) {
+             std::cout << ps11::isaMarkdownTable();
+             return int(kOk);
+         }},
+        {"version",
+         [](const std::vector<std::string>&) {
+             std::cout << "ps11 " << ps11::versionString() << "\n";
+             return int(kOk);
+         }},
+        {"help",
+         [](const std::vector<std::string>&) {
+             std::cout << kUsageText;
+             return int(kOk);
+         }},
+    };
+    if (cmd == "--version") cmd = "version";
+    if (cmd == "-h" || cmd == "--help") cmd = "help";
+    std::vector<std::string_view> names;
+    for (const Command& c : kCommands) {
+        if (c.name == cmd) return c.run(args);
+        names.push_back(c.name);
     }
-    if (cmd == "-h" || cmd == "--help" || cmd == "help") {
-        std::cout << kUsageText;
-        return kOk;
-    }
-    return usage("unknown command '" + cmd + "'");
+    return usage("unknown command " + ps11::quote(cmd) + ps11::didYouMean(cmd, names));
 }

@@ -60,6 +60,30 @@ expect_rc 1 "disasm truncated" "$ps11" disasm "$work/trunc.bin"
 expect_in "$work/err" "P3001" "odd-size binary"
 expect_rc 1 "write into a missing folder" "$ps11" asm "$work/a.psh" -o "$work/no/such/dir.bin"
 
+# Registers the version does not have are the assembler's error (P1114), with validation off
+# too, as Microsoft's assembler does (Wine's d3dcompiler tests/asm.c failure_test).
+printf 'ps_1_3\nmov r5, r0\n' >"$work/r5.psh"
+expect_rc 1 "asm --no-validate refuses r5 in ps_1_3" "$ps11" asm "$work/r5.psh" --no-validate
+expect_in "$work/err" "r5.psh:2:5: error P1114: register 'r5' does not exist in ps_1_3 (r0-r1)" "P1114 names file:line:col"
+printf 'ps_1_3\ntex t5\n' >"$work/t5.psh"
+expect_rc 1 "asm --no-validate refuses t5 in ps_1_3" "$ps11" asm "$work/t5.psh" --no-validate
+expect_in "$work/err" "t5.psh:2:5: error P1114: register 't5'" "P1114 for tex t5"
+printf 'ps_1_4\nmov r5, r0\n' >"$work/r5ok.psh"
+expect_rc 0 "asm --no-validate takes r5 in ps_1_4" "$ps11" asm "$work/r5ok.psh" --no-validate
+# The same register in a token stream reaches the validator: still an error (P2030).
+printf '0xffff0103 0x00000001 0x800f0005 0x80e40000 0x0000ffff\n' >"$work/r5.hex"
+expect_rc 1 "check tokens with r5 in ps_1_3" "$ps11" check "$work/r5.hex"
+expect_in "$work/err" "error P2030: r5 is out of range: ps_1_3 has r0-r1" "P2030 on decoded tokens"
+
+# Mistyped names get a suggestion; quoted source is cut to a readable length.
+printf 'ps_1_1\nmull r0, v0, v1\n' >"$work/mull.psh"
+expect_rc 1 "unknown instruction" "$ps11" asm "$work/mull.psh" --no-validate
+expect_in "$work/err" "mull.psh:2:1: error P1103: unknown instruction 'mull'; did you mean 'mul'?" "instruction suggestion"
+{ printf 'ps_1_1 '; head -c 1048576 /dev/zero | tr '\0' 'x'; printf '\nmov r0, v0\n'; } >"$work/long.psh"
+expect_rc 1 "a 1 MB line" "$ps11" asm "$work/long.psh"
+expect_in "$work/err" "long.psh:1:8: error P1111: unexpected text after the version: 'xxx" "long line names line:col"
+[ "$(wc -c <"$work/err")" -lt 300 ] || fail "a 1 MB line gave $(wc -c <"$work/err") bytes of diagnostics"
+
 # eval: one pixel on the executor.
 printf 'ps_1_1\nmov r0, v0\n' >"$work/e.psh"
 expect_rc 0 "eval" "$ps11" eval "$work/e.psh" v0=0.5,0.25,1
@@ -134,7 +158,22 @@ expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"
 expect_rc 2 "unknown command" "$ps11" frobnicate
+expect_in "$work/err" "ps11: unknown command 'frobnicate'" "unknown command named"
+grep -q "did you mean" "$work/err" && fail "no suggestion expected for frobnicate"
+expect_rc 2 "mistyped command" "$ps11" asmm "$work/a.psh"
+expect_in "$work/err" "ps11: unknown command 'asmm'; did you mean 'asm'?" "command suggestion"
 expect_rc 2 "unknown option" "$ps11" asm "$work/a.psh" --bogus
+expect_rc 2 "mistyped option" "$ps11" asm "$work/a.psh" --hx
+expect_in "$work/err" "ps11: asm: unknown option '--hx'; did you mean '--hex'?" "option suggestion"
+expect_rc 2 "mistyped test option" "$ps11" test "$work/t.ps11test" --stat
+expect_in "$work/err" "did you mean '--stats'?" "test option suggestion"
+expect_rc 0 "--version" "$ps11" --version
+grep -qE '^ps11 [0-9]+\.[0-9]+\.[0-9]+$' "$work/out" || fail "--version printed '$(cat "$work/out")'"
+cp "$work/out" "$work/version1"
+expect_rc 0 "version" "$ps11" version
+cmp -s "$work/out" "$work/version1" || fail "'ps11 version' and 'ps11 --version' differ"
+expect_rc 0 "help lists --version" "$ps11" help
+expect_in "$work/out" "--version" "usage mentions --version"
 expect_rc 2 "asm without input" "$ps11" asm
 expect_rc 2 "-D without name" "$ps11" asm "$work/a.psh" -D
 expect_rc 0 "help" "$ps11" --help
