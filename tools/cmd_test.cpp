@@ -28,7 +28,8 @@ namespace {
 constexpr const char* kUsage =
     "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--hardware H] [--precision fx8|fx12|float|ideal]\n"
     "                 [--stats] [-v]\n"
-    "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists them)\n";
+    "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists\n"
+    "                 them); `all` runs the files once per class\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11 test: " << message << "\n" << kUsage;
@@ -158,7 +159,6 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         result.outcome = Outcome::Failed;
         return result;
     }
-    const Precision precision = hw.precision;
     if (backends == 0) {
         result.skipped = !file.commands.empty();
         return result;
@@ -191,10 +191,15 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
     return result;
 }
 
+// Runs every file once with `opts` and prints the summary line (prefixed with the class when
+// --hardware all runs the files once per class). Returns the exit code.
+int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool perClass);
+
 }  // namespace
 
 int cmdTest(const std::vector<std::string>& args) {
     RunOptions opts;
+    bool allHardware = false;
     std::vector<std::string> files;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
@@ -202,9 +207,9 @@ int cmdTest(const std::vector<std::string>& args) {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
             if (a == "--hardware") {
-                opts.hardware = findHardware(v);
-                if (!opts.hardware)
-                    return usageError(unknownHardwareMessage(v));
+                allHardware = v == "all";
+                opts.hardware = allHardware ? nullptr : findHardware(v);
+                if (!opts.hardware && !allHardware) return usageError(unknownHardwareMessage(v));
             } else if (a == "--backend") {
                 if (v == "emu")
                     opts.backends = kBackendEmu;
@@ -251,7 +256,18 @@ int cmdTest(const std::vector<std::string>& args) {
         }
     }
     if (files.empty()) return usageError("no .ps11test files given");
+    if (!allHardware) return runFiles(files, opts, false);
+    int rc = cli::kOk;
+    for (const HardwareClass& h : hardwareClasses()) {
+        opts.hardware = &h;
+        if (runFiles(files, opts, true) != cli::kOk) rc = cli::kUserError;
+    }
+    return rc;
+}
 
+namespace {
+
+int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool perClass) {
     size_t passed = 0, failed = 0, notRunnable = 0, skipped = 0, skippedHardware = 0;
     CommandTally total;
     for (const std::string& path : files) {
@@ -292,6 +308,7 @@ int cmdTest(const std::vector<std::string>& args) {
     auto plural = [](size_t n, const char* one, const char* many) {
         return std::to_string(n) + " " + (n == 1 ? one : many);
     };
+    if (perClass) std::cout << opts.hardware->name << ": ";
     std::cout << plural(files.size(), "file", "files") << ": " << passed << " passed, " << failed << " failed, "
               << notRunnable << " not yet runnable";
     if (total.pendingGl) std::cout << " (not runnable on gl yet: " << plural(total.pendingGl, "command", "commands") << ")";
@@ -304,5 +321,7 @@ int cmdTest(const std::vector<std::string>& args) {
     std::cout << "\n";
     return failed ? cli::kUserError : cli::kOk;
 }
+
+}  // namespace
 
 }  // namespace ps11

@@ -313,7 +313,277 @@ draw quad
     write('signed_q8w8v8u8_alpha.ps11test', text)
 
 
+# ---- Wine's cnd_test: plain, co-issued colour cnd, co-issued alpha cnd with r1 = c0 + c0 = 2 ----
+CND_SHADERS_13 = {
+    'plain': """def c0, 1, 0, 0, 0
+texcoord t0
+mov r0, t0
+dp3 r1, r0, c0
+mov r0.a, r1.a
+cnd r0, r0.a, c1, c2""",
+    'coissue': """def c0, 1, 0, 0, 0
+def c3, 0.5, 0.5, 0.5, 0
+texcoord t0
+mov r0, t0
+sub r0, r0, c3
+add r1, c0, c0
+dp3 r1, r0, r1
+mov r0.a, r1.a
++cnd r0.xyz, r0.a, c1, c2""",
+    'coissue_alpha': """def c0, 1, 0, 0, 0
+def c3, 0.5, 0.5, 0.5, 0
+texcoord t0
+mov r0, t0
+sub r0, r0, c3
+add r1, c0, c0
+dp3 r1, r0, r1
+mov r0, r1
+mov r0.xyz, r1.a
++cnd r0.a, r0.a, c1, c2
+mov r0.xyz, r0.a""",
+}
+CND_SHADERS_14 = {
+    'plain': """def c0, 0, 0, 0, 1
+texcrd r0.xyz, t0
+mov r0.a, c0.a
+cnd r0, r0, c1, c2""",
+    'coissue': """def c0, 0, 0, 0, 1
+texcrd r0.xyz, t0
+mov r0.a, c0.a
++cnd r0.xyz, r0, c1, c2""",
+    'coissue_alpha': """def c0, 0, 0, 0, 1
+texcrd r0.xyz, t0
+mov r0.a, r0.x
+mov r1.xyz, c0.a
++cnd r1.a, r0.a, c1, c2
+mov r0.xyz, r1.a
+mov r0.a, c0.a""",
+}
+CND_CONSTS = {'plain': ((0, 0, 0, 0), (1, 1, 1, 1)), 'coissue': ((0, 1, 0, 0), (1, 0, 1, 1)),
+              'coissue_alpha': ((0, 1, 0, 0), (1, 0, 1, 1))}
+D3D9_CLASSES = 'd3d9, geforce7, radeon8500'  # every class that runs ps_1_4 ran cnd_test's hardware
+
+
+def cnd_probes(kind, minor):
+    """(condition, x, y, rgb, tol, comment) of one quadrant 320x240, Wine's probe points moved
+    into it (x 158/162 -> u 0.494/0.506, x 238/242 -> u 0.744/0.756; y 118/122 -> v 0.508/0.492)."""
+    P = []
+    if minor == 4:
+        table = {'plain': {(158, 118): 0xff00ff, (162, 118): 0x0000ff, (158, 122): 0xffffff, (162, 122): 0x00ffff},
+                 'coissue': {(158, 118): 0xffffff, (162, 118): 0x00ffff, (158, 122): 0xff00ff, (162, 122): 0x0000ff},
+                 'coissue_alpha': {(158, 118): 0xffffff, (158, 122): 0xffffff, (162, 118): 0x000000,
+                                   (162, 122): 0x000000}}[kind]
+        for (x, y), c in table.items():
+            P.append(('', x, y, c, 0, 'Wine (exact), every ps_1_4 part'))
+        return P
+    if kind == 'plain':
+        for y in (118, 122):
+            P.append(('', 158, y, 0xffffff, 0, 'Wine (exact): u < 0.5 -> c2'))
+            P.append(('', 162, y, 0x000000, 1, 'Wine (+-1): u > 0.5 -> c1'))
+    elif kind == 'coissue':
+        for x in (158, 162):
+            for y in (118, 122):
+                P.append((D3D9_CLASSES.replace('geforce7, ', ''), x, y, 0x00ff00, 1,
+                          'Wine: a co-issued colour cnd always gives c1'))
+                P.append(('geforce7', x, y, 0xff00ff, 1, 'Wine: "The Win7 nvidia driver always selects c2"'))
+                P.append(('geforce4, geforce3', x, y, 0x00ff00, 0,
+                          'model: parallel read of r0.a = 1 (texcoord w) -> c1'))
+    else:
+        for y in (118, 122):
+            P.append((D3D9_CLASSES, 238, y, 0xffffff, 1, 'Wine: 2u - 1 < 0.5 -> c2.a'))
+            P.append((D3D9_CLASSES, 242, y, 0x000000, 1, 'Wine: 2u - 1 > 0.5 (needs r1 = 2.0) -> c1.a'))
+            P.append(('geforce4, geforce3', 238, y, 0xffffff, 0, 'model: MaxValue 1 clamps c0 + c0 to 1'))
+            P.append(('geforce4, geforce3', 242, y, 0xffffff, 0, 'model: u - 0.5 never exceeds 0.5'))
+    return P
+
+
+def cnd_file(kind, minor):
+    body = (CND_SHADERS_14 if minor == 4 else CND_SHADERS_13)[kind]
+    c1, c2 = CND_CONSTS[kind]
+    lines = []
+    for cond, x, y, c, tol, why in cnd_probes(kind, minor):
+        prefix = 'if(%s) ' % cond if cond else ''
+        lines.append('%sprobe %d %d rgb 0x%06x tol %d   %% %s' % (prefix, x, y, c, tol, why))
+    text = f"""% Wine's cnd_test, {kind.replace('_', ' ')} pass, ps_1_{minor} (dlls/d3d9/tests/visual.c,
+% wine-9.7-99-g25c58e68876; the d3d8 test has the same shaders and results). One quadrant of the
+% test's 640x480 target: 320x240, u = x/320 left to right, v = 0 at the bottom, as the test's quad
+% gives at D3D9 pixel centres. Hardware rows carry the test's tolerance; model rows (1.1-class
+% cards, which never ran the test: it needs ps_1_4) say what docs/precision.md's rules give.
+% Run per class with ps11 test --hardware CLASS (ctest does).
+
+[render target]
+size 320 240
+clear 0xff00ffff
+
+[constants]
+c1 {' '.join(str(v) for v in c1)}
+c2 {' '.join(str(v) for v in c2)}
+
+[pixel shader]
+ps_1_{minor}
+{body}
+
+[test]
+draw strip xyzrhw
+  0 0 0.1 1  0xffffffff 0  t0 0 1
+  320 0 0.1 1  0xffffffff 0  t0 1 1
+  0 240 0.1 1  0xffffffff 0  t0 0 0
+  320 240 0.1 1  0xffffffff 0  t0 1 0
+""" + '\n'.join(lines) + '\n'
+    write('cnd_%s_ps1%d.ps11test' % (kind, minor), text)
+
+
+# ---- constant_clamp_ps_test: constants read as clamp(c, -1, 1) in every ps_1_x ----
+def constant_clamp_file(minor):
+    shader = 'mov r1, c1\nadd r0, r1, c2'
+    if minor == 4:
+        shader = 'def c2, -0.5, 1.25, 2, 1\n' + shader
+    text = f"""% Wine's constant_clamp_ps_test, ps_1_{minor} (dlls/d3d9/tests/visual.c, wine-9.7-99-g25c58e68876):
+% c1 = (1.25, -0.5, -1.5, 1) and c2 = (-0.5, 1.25, 2, 1) read as clamp(c, -1, 1) in every ps_1_x
+% {'(the def too: "It gets clamped too, although the binary contains the bigger numbers")' if minor == 4 else ''}
+% so r0 = (0.5, 0.5, 0): 0x808000 +-1 on the hardware that ran it, and on every class here
+% (constants are clamped on load in every profile, docs/precision.md "Inputs").
+
+[render target]
+size 4 4
+clear 0xff00ffff
+
+[constants]
+c1 1.25 -0.5 -1.5 1
+c2 -0.5 1.25 2 1
+
+[pixel shader]
+ps_1_{minor}
+{shader}
+
+[test]
+draw quad
+probe all rgb 0x808000 tol 1
+"""
+    write('constant_clamp_ps1%d.ps11test' % minor, text)
+
+
+# ---- test_color_clamping: v0 + v1 = 2 survives in a ps_1_1 temporary on D3D9-class parts ----
+def color_clamping_file():
+    text = """% Wine's test_color_clamping (dlls/d3d9/tests/visual.c, wine-9.7-99-g25c58e68876; d3d8 the same):
+% `add r0, v0, v1; mul r0, r0, c0` with c0 = 0.25. Left half: diffuse and specular white (the
+% test's vs_1_1 case: oD0 = oD1 = 2.0 arrive clamped to 1), so r0 = 2 · 0.25 = 0.5: 0x7f7f7f +-1
+% on every part that ran it (no broken() alternative): ps_1_1 temporaries keep 2.0. Right half:
+% specular black (the fixed-function vertex case), 1 · 0.25: 0x404040 everywhere. Model rows:
+% the 1.1-class cards clamp v0 + v1 to MaxValue 1, so the left half is 0x404040 there.
+
+[render target]
+size 8 4
+clear 0xff000000
+
+[pixel shader]
+ps_1_1
+def c0, 0.25, 0.25, 0.25, 0.25
+add r0, v0, v1
+mul r0, r0, c0
+
+[test]
+draw quad diffuse 0xffffffff specular 0xffffffff rect 0 0 4 4
+draw quad diffuse 0xffffffff specular 0x00000000 rect 4 0 8 4
+if(d3d9, geforce7, radeon8500) probe rect 0 0 4 4 rgb 0x7f7f7f tol 1
+if(geforce4, geforce3) probe rect 0 0 4 4 rgb 0x404040 tol 0
+probe rect 4 0 8 4 rgb 0x404040 tol 1
+"""
+    write('color_clamping_ps11.ps11test', text)
+
+
+# ---- projected_textures_test: D3DTTFF_PROJECTED through ps_1_3 tex and the fixed function ----
+PROJ_RUNS = [
+    # (name, flags, texcoord components, pixel shader?, quadrant, white rect l t r b, Wine's message)
+    ('count4_projected', 'count4 projected', 4, True, 0, (120, 300, 240, 390), 'D3DTTFF_COUNT4 | D3DTTFF_PROJECTED'),
+    ('count3_projected', 'count3 projected', 4, True, 1, (400, 360, 480, 420), 'D3DTTFF_COUNT3 | D3DTTFF_PROJECTED'),
+    ('ffffffff_4', '0xffffffff', 4, True, 2, (120, 60, 240, 150), '0xffffffff (draws like COUNT4 | PROJECTED)'),
+    ('count3_projected_2', 'count3 projected', 2, True, 3, (340, 210, 360, 225),
+     'D3DTTFF_COUNT3 | D3DTTFF_PROJECTED (draws non-projected)'),
+    ('projected_4', 'projected', 4, True, 0, (120, 300, 240, 390),
+     'D3DTTFF_PROJECTED (like COUNT4 | PROJECTED, texcoord has 4 components)'),
+    ('projected_3', 'projected', 3, True, 1, (400, 360, 480, 420),
+     'D3DTTFF_PROJECTED (like COUNT3 | PROJECTED, texcoord has only 3 components)'),
+    ('ffffffff_3', '0xffffffff', 3, True, 2, (80, 120, 160, 180),
+     '0xffffffff (like COUNT3 | PROJECTED, texcoord has only 3 components)'),
+    ('count1_2', 'count1', 2, True, 3, (340, 210, 360, 225), 'D3DTTFF_COUNT1 (draws non-projected)'),
+    ('projected_4_ffp', 'projected', 4, False, 3, (440, 60, 560, 150),
+     'D3DTTFF_PROJECTED (like COUNT4 | PROJECTED), fixed-function pixel pipeline'),
+]
+QUADRANTS = [(-1, -1, 0, 0), (0, -1, 1, 0), (-1, 0, 0, 1), (0, 0, 1, 1)]  # x0 y0 x1 y1 in clip space
+
+
+def projected_file(run):
+    name, flags, comps, ps, quad, (l, t, r, b), message = run
+    x0, y0, x1, y1 = QUADRANTS[quad]
+
+    def tc(u, v):
+        vals = [u, v, 4, 6][:comps]
+        return 't0 ' + ' '.join(str(c) for c in vals)
+
+    verts = [(x0, y0, tc(0, 0)), (x0, y1, tc(0, 4)), (x1, y0, tc(4, 0)), (x1, y1, tc(4, 4))]
+    vlines = '\n'.join('  %d %d 0.1  0xffffffff 0  %s' % (x, y, c) for x, y, c in verts)
+    probes = []
+    for px in (l - 1, l + 1, r + 1, r - 1):
+        for py in (t - 1, t + 1, b + 1, b - 1):
+            if not (0 <= px < 640 and 0 <= py < 480):
+                continue
+            inside = px in (l + 1, r - 1) and py in (t + 1, b - 1)
+            probes.append('probe %d %d rgba 0x%08x' % (px, py, 0xffffffff if inside else 0xff000000))
+    shader = """
+[pixel shader]
+ps_1_3
+tex t0
+mov r0, t0
+""" if ps else """colorop selectarg1
+colorarg1 texture
+alphaop selectarg1
+alphaarg1 texture
+"""
+    text = f"""% Wine's projected_textures_test: "{message}" (dlls/d3d9/tests/visual.c,
+% wine-9.7-99-g25c58e68876; no vertex shader). A 4x4 L8 texture, white only at texel (1, 1); the
+% quad's coordinates run (0..4, 0..4, 4, 6) over one quadrant of the 640x480 target, sent with
+% {comps} component{'s' if comps > 1 else ''}. Windows drivers drew texel (1, 1) exactly inside
+% ({l}, {t})-({r}, {b}): the probes are the test's check_rect points, white inside, black just outside,
+% exact. Projection resolves against the set's components and the texture's dimensions
+% (docs/precision.md "Projected coordinates"); the same on every class.
+
+[render target]
+size 640 480
+clear 0xff203040
+
+[texture 0]
+size 4 4
+format L8
+level 0
+0x00 0x00 0x00 0x00
+0x00 0xff 0x00 0x00
+0x00 0x00 0x00 0x00
+0x00 0x00 0x00 0x00
+
+[sampler 0]
+filter point
+address clamp
+
+[stage 0]
+transform {flags}
+{shader}
+[test]
+draw strip xyz
+{vlines}
+""" + '\n'.join(probes) + '\n'
+    write('projected_%s.ps11test' % name, text)
+
+
 if __name__ == '__main__':
     for f in SIGNED:
         signed_file(f)
     alpha_file()
+    for kind in ('plain', 'coissue', 'coissue_alpha'):
+        for minor in (1, 2, 3, 4):
+            cnd_file(kind, minor)
+    for minor in (1, 2, 4):
+        constant_clamp_file(minor)
+    color_clamping_file()
+    for run in PROJ_RUNS:
+        projected_file(run)
