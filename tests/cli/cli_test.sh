@@ -97,6 +97,37 @@ expect_in "$work/out" "grid   128 128 128 255" "eval samples the 1x1 texture"
 printf 'ps_1_1\ntexkill t0\nmov r0, v0\n' >"$work/ek.psh"
 expect_rc 0 "eval texkill" "$ps11" eval "$work/ek.psh" t0=-1
 expect_in "$work/out" "killed" "eval reports killed"
+# Hardware classes: eval names the class; signed texels decode by the class's rule.
+printf 'ps_1_1\ndef c0, 0.5, 0.5, 0.5, 0.5\ntex t0\nmad r0, t0, c0, c0\n' >"$work/sf.psh"
+expect_rc 0 "eval default class" "$ps11" eval "$work/sf.psh" --tex0 L6V5U5:0x0011 t0=0.5,0.5
+expect_in "$work/out" "ps_1_1, hardware geforce4 (1.1-class), fx8, max value 1" "eval names the default class"
+expect_in "$work/out" "r0     0 0.501961 0.501961 1" "geforce4: L6V5U5 -15 reads -1 (snorm)"
+expect_rc 0 "eval --hardware d3d9" "$ps11" eval "$work/sf.psh" --tex0 L6V5U5:0x0011 --hardware d3d9 t0=0.5,0.5
+expect_in "$work/out" "hardware d3d9 (D3D9-class), float, max value 65504" "eval names the chosen class"
+expect_in "$work/out" "r0     0.03125 0.5 0.5 1" "d3d9: L6V5U5 -15 reads -15/16 (asymmetric)"
+expect_rc 0 "eval --hardware geforce7" "$ps11" eval "$work/sf.psh" --tex0 L6V5U5:0x0011 --hardware geforce7 t0=0.5,0.5
+expect_in "$work/out" "r0     0.0433071 0.5 0.5 1" "geforce7: L6V5U5 -15 widened to 0x8c"
+expect_rc 0 "eval --hardware with --precision" "$ps11" eval "$work/sf.psh" --hardware d3d9 --precision fx8
+expect_in "$work/out" "hardware d3d9 (D3D9-class), fx8 (override), max value 65504" "an override is marked"
+printf 'ps_1_4\nmov r0, c0\n' >"$work/p14.psh"
+expect_rc 0 "eval ps_1_4 default class" "$ps11" eval "$work/p14.psh"
+expect_in "$work/out" "hardware radeon8500 (1.4-class), fx12, max value 8" "ps_1_4 runs on the 1.4-class card by default"
+expect_rc 1 "eval beyond the class's version" "$ps11" eval "$work/p14.psh" --hardware geforce3
+expect_in "$work/err" "hardware geforce3 runs ps_1_1 ... ps_1_1" "the class's version limit is named"
+expect_rc 2 "eval unknown class" "$ps11" eval "$work/e.psh" --hardware d3d99
+expect_in "$work/err" "unknown hardware class 'd3d99'" "unknown class named"
+expect_in "$work/err" "did you mean 'd3d9'?" "nearest class suggested"
+expect_rc 1 "eval texel word too wide" "$ps11" eval "$work/sf.psh" --tex0 V8U8:0x10000
+expect_in "$work/err" "hex word of 16 bits" "the format's width named"
+expect_rc 1 "eval unknown texel format" "$ps11" eval "$work/sf.psh" --tex0 R5G6B5:0x1
+expect_in "$work/err" "bad format in --tex0: 'R5G6B5'" "bad format named"
+expect_rc 0 "hardware" "$ps11" hardware
+expect_in "$work/out" "geforce4    1.1-class  ps_1_3" "hardware lists the default class"
+expect_in "$work/out" "(default for ps_1_4)" "hardware marks the ps_1_4 default"
+expect_rc 0 "hardware --json" "$ps11" hardware --json
+expect_in "$work/out" '"name": "geforce7", "kind": "D3D9-class"' "hardware --json"
+expect_in "$work/out" '"coissued_cnd": "sequential"' "hardware --json behaviours"
+expect_rc 2 "hardware bad option" "$ps11" hardware --bogus
 expect_rc 1 "eval bad value" "$ps11" eval "$work/e.psh" t0=x
 expect_in "$work/err" "ps11: eval: bad value for t0: 'x'" "eval names the bad argument"
 expect_rc 1 "eval too many components" "$ps11" eval "$work/e.psh" v0=1,2,3,4,5
@@ -146,10 +177,25 @@ expect_in "$work/out" "2 files: 1 passed, 1 failed" "a folder's files all run"
 expect_rc 1 "test on a folder without test files" "$ps11" test "$work/empty"
 expect_in "$work/err" "no .ps11test files under" "empty folder named"
 
+# test --hardware: a class that cannot run the file is skipped; all runs every class.
+printf '[pixel shader]\nps_1_2\nmov r0, v0\n[test]\neval\n  v0 1 0 0 1\nprobe eval rgba 1 0 0 1\n' >"$work/h.ps11test"
+expect_rc 0 "test --hardware all" "$ps11" test --hardware all "$work/h.ps11test"
+expect_in "$work/out" "geforce3: 1 file: 0 passed, 0 failed, 0 not yet runnable; probes: 0 passed, 0 failed, 0 todo; 1 skipped" "geforce3 skips ps_1_2"
+expect_in "$work/out" "d3d9: 1 file: 1 passed" "d3d9 runs it"
+printf '[require]\nhardware geforce3\n[pixel shader]\nps_1_2\nmov r0, v0\n' >"$work/h3.ps11test"
+expect_rc 1 "test [require] hardware beyond the version" "$ps11" test "$work/h3.ps11test"
+expect_in "$work/out" "h3.ps11test:2: hardware geforce3 runs ps_1_1 ... ps_1_1, but the file needs ps_1_2" "the [require] line named"
+expect_rc 2 "test unknown class" "$ps11" test --hardware voodoo "$work/h.ps11test"
+
 # demo: options and their usage errors.
 expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
 expect_in "$work/out" "bloom on the emu device: 64x36 scene" "demo header"
-expect_in "$work/out" "fx8 " "demo fx8 row"
+expect_in "$work/out" "geforce4    fx8 " "demo geforce4 row"
+expect_in "$work/out" "radeon8500  fx12 " "demo radeon8500 row"
+expect_rc 0 "demo one class" "$ps11" demo --size 32x18 --repeats 1 --threads 1 --hardware d3d9
+expect_in "$work/out" "d3d9        float " "demo d3d9 row"
+grep -q "geforce4    fx8" "$work/out" && fail "demo --hardware d3d9 still ran geforce4"
+expect_rc 2 "demo unknown class" "$ps11" demo --hardware voodoo
 [ -s "$work/demo-geforce4.ppm" ] || fail "demo --out wrote no demo-geforce4.ppm"
 expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
 expect_rc 2 "demo bad threads" "$ps11" demo --threads many
