@@ -575,6 +575,60 @@ draw strip xyz
     write('projected_%s.ps11test' % name, text)
 
 
+# ---- every signed format at -max-1, -max, 0 and +max, per class (model values) ----
+EXTREME_FORMATS = {
+    # format: (bits of the signed channels, word of one value s in every signed channel)
+    'V8U8': (8, lambda s: (s & 0xff) | (s & 0xff) << 8),
+    'Q8W8V8U8': (8, lambda s: sum((s & 0xff) << (8 * i) for i in range(4))),
+    'X8L8V8U8': (8, lambda s: (s & 0xff) | (s & 0xff) << 8 | 0xff << 16),
+    'L6V5U5': (5, lambda s: (s & 31) | (s & 31) << 5 | 63 << 10),
+    'V16U16': (16, lambda s: (s & 0xffff) | (s & 0xffff) << 16),
+}
+
+
+def extremes_file(fmt):
+    bits, word = EXTREME_FORMATS[fmt]
+    top = 1 << (bits - 1)
+    values = [-top, -(top - 1), 0, top - 1]  # -max-1, -max, 0, +max
+    words = [word(v) for v in values]
+    digits = 8 if bits != 8 or fmt != 'V8U8' else 4
+    if fmt == 'L6V5U5':
+        digits = 4
+    lines = []
+    for i, (v, w) in enumerate(zip(values, words)):
+        lines.append('eval')
+        lines.append('  t0 %g 0.5' % ((i + 0.5) / 4))
+        for cls in CLASSES:
+            m = Machine(cls)
+            c = m.const(0.5)
+            out = [m.mad(m.texel(value(m.rule, ch)), c, c) for ch in channels(fmt, w)]
+            vals = [float(Fraction(o, m.G)) if m.fx else o for o in out]
+            tol = '0.00001' if m.fx else '0.000001'
+            lines.append('if(%s) probe eval rgba %s tol %s   %% s = %d: %s'
+                         % (cls, ' '.join('%.9g' % x for x in vals), tol, v,
+                            ', '.join(str(value(m.rule, ch)) for ch in channels(fmt, w))))
+    text = f"""% {fmt} at its extremes, per hardware class (docs/precision.md "Signed texels"): a 4x1 texture
+% holding s = -max-1, -max, 0, +max in every signed channel, sampled by four evals through Wine's
+% `mad r0, t0, c0, c0` (c0 = 0.5). Model values from generate.py (exact rationals per class rule,
+% then the class's profile); the comment after each probe gives the decoded r g b a.
+
+[texture 0]
+size 4 1
+format {fmt}
+level 0
+{' '.join('0x%0*x' % (digits, w) for w in words)}
+
+[pixel shader]
+ps_1_1
+def c0, 0.5, 0.5, 0.5, 0.5
+tex t0
+mad r0, t0, c0, c0
+
+[test]
+""" + '\n'.join(lines) + '\n'
+    write('signed_extremes_%s.ps11test' % fmt.lower(), text)
+
+
 if __name__ == '__main__':
     for f in SIGNED:
         signed_file(f)
@@ -585,5 +639,7 @@ if __name__ == '__main__':
     for minor in (1, 2, 4):
         constant_clamp_file(minor)
     color_clamping_file()
+    for f in EXTREME_FORMATS:
+        extremes_file(f)
     for run in PROJ_RUNS:
         projected_file(run)
