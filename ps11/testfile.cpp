@@ -673,6 +673,16 @@ void Parser::samplerLine(Args& a, std::string_view kw) {
 
 std::optional<TextureArg> Parser::textureArg(Args& a, bool resultArg) {
     TextureArg arg;
+    if (a.peekNumeric()) {
+        // Any DWORD SetTextureStageState takes: D3DTA_SELECTMASK, COMPLEMENT, ALPHAREPLICATE.
+        std::optional<uint32_t> w = a.word("argument word");
+        if (!w) return std::nullopt;
+        arg.source = ArgSource(*w & 0xf);
+        arg.complement = (*w & 0x10) != 0;
+        arg.alphaReplicate = (*w & 0x20) != 0;
+        arg.otherBits = *w & ~0x3fu;
+        return arg;
+    }
     if (resultArg) {
         if (!a.need("result (current or temp)")) return std::nullopt;
         std::string_view t = a.next();
@@ -755,12 +765,17 @@ void Parser::stageLine(Args& a, std::string_view kw) {
         }
         s.transformFlags = {flags, line};
     } else if (iequals(kw, "texcoordindex")) {
-        std::optional<int64_t> n = a.integer("texcoordindex", 0, 7);
-        if (n) s.texCoordIndex = {uint32_t(*n), line};
-    } else if (iequals(kw, "colorop")) {
-        assign(s.colorOp, a.name(kTextureOps, "texture op"), line);
-    } else if (iequals(kw, "alphaop")) {
-        assign(s.alphaOp, a.name(kTextureOps, "texture op"), line);
+        // The set (low word) and any D3DTSS_TCI_* mode (high word), as SetTextureStageState takes.
+        std::optional<uint32_t> n = a.word("texcoordindex");
+        if (n) s.texCoordIndex = {*n, line};
+    } else if (iequals(kw, "colorop") || iequals(kw, "alphaop")) {
+        std::optional<TextureOp> op;
+        if (a.peekNumeric()) {
+            if (std::optional<uint32_t> w = a.word("texture op")) op = TextureOp(*w);
+        } else {
+            op = a.name(kTextureOps, "texture op");
+        }
+        assign(iequals(kw, "colorop") ? s.colorOp : s.alphaOp, op, line);
     } else {
         unknownKeyword(a, kw, "stage",
                        {"bumpenvmat", "lscale", "loffset", "transform", "texcoordindex", "colorop", "colorarg0",

@@ -108,7 +108,9 @@ struct SamplerDesc {
 };
 
 // D3DTOP_* (values as in d3d9types.h).
-enum class TextureOp : uint8_t {
+// D3DTOP_* (values as in d3d9types.h); a file may also write any other DWORD (a number), which
+// SetTextureStageState takes.
+enum class TextureOp : uint32_t {
     Disable = 1,
     SelectArg1,
     SelectArg2,
@@ -142,9 +144,10 @@ const char* textureOpName(TextureOp op);  // lower case, as written in the file
 enum class ArgSource : uint8_t { Diffuse = 0, Current = 1, Texture = 2, TFactor = 3, Specular = 4, Temp = 5 };
 
 struct TextureArg {
-    ArgSource source = ArgSource::Current;
+    ArgSource source = ArgSource::Current;  // D3DTA_SELECTMASK bits (a number may give any 0-15)
     bool complement = false;      // D3DTA_COMPLEMENT: 1 - x
     bool alphaReplicate = false;  // D3DTA_ALPHAREPLICATE: x.aaaa
+    uint32_t otherBits = 0;       // bits above D3DTA_ALPHAREPLICATE a number may set
     bool operator==(const TextureArg&) const = default;
 };
 

@@ -341,6 +341,32 @@ TEST_CASE("testfile: [stage N]", "[testfile]") {
     CHECK(d.file.stage(5)->transformFlags.value == TransformFlags{0});
     CHECK(d.file.stage(5)->transformFlags.isSet());
 
+    // Every value SetTextureStageState takes can be written: PROJECTED alone, any transform
+    // word, texture ops, arguments and texcoordindex as numbers (high-word TCI modes too).
+    Parsed w = parse(
+        "[stage 2]\ntransform projected\n[stage 3]\ntransform 0xffffffff\ncolorop 99\nalphaop 0x7\n"
+        "colorarg1 0x22\nalphaarg2 0xffffffff\nresultarg 5\ntexcoordindex 0x10001\n");
+    REQUIRE_OK(w);
+    CHECK(w.file.stage(2)->transformFlags.value == TransformFlags{256});
+    const StageDesc& raw = *w.file.stage(3);
+    CHECK(raw.transformFlags.value == TransformFlags{0xffffffffu});
+    CHECK(uint32_t(raw.colorOp.value) == 99);
+    CHECK(raw.alphaOp.value == TextureOp::Add);
+    CHECK(raw.colorArg1.value == TextureArg{ArgSource::Texture, false, true});
+    CHECK(raw.alphaArg2.value == TextureArg{ArgSource(15), true, true, 0xffffffc0u});
+    CHECK(raw.resultArg.value.source == ArgSource::Temp);
+    CHECK(raw.texCoordIndex.value == 0x10001u);
+    CHECK_ERROR(parse("[stage 0]\ntransform count5\n"), 2, "unknown transform flags 'count5'");
+    CHECK_ERROR(parse("[stage 0]\ncolorop 0x1ffffffff\n"), 2, "texture op");
+
+    // [require] hardware names a class; a wrong or repeated one is an error.
+    Parsed hw = parse("[require]\nhardware D3D9\n");
+    REQUIRE_OK(hw);
+    CHECK(hw.file.require.hardware.value == findHardware("d3d9"));
+    CHECK(hw.file.require.hardware.line == 2);
+    CHECK_ERROR(parse("[require]\nhardware voodoo3\n"), 2, "unknown hardware class 'voodoo3'");
+    CHECK_ERROR(parse("[require]\nhardware geforce3\nhardware d3d9\n"), 3, "hardware given twice");
+
     const char* ops[] = {"disable",
                          "selectarg1",
                          "selectarg2",
@@ -387,7 +413,8 @@ TEST_CASE("testfile: [stage N]", "[testfile]") {
     CHECK_ERROR(parse("[stage 0]\nbumpenvmat 1 0 0 1 0\n"), 2, "unexpected '0'");
     CHECK_ERROR(parse("[stage 0]\ntransform count5\n"), 2, "unknown transform flags 'count5'");
     CHECK_ERROR(parse("[stage 0]\ntransform disable projected\n"), 2, "unexpected 'projected'");
-    CHECK_ERROR(parse("[stage 0]\ntexcoordindex 8\n"), 2, "texcoordindex '8' is out of range");
+    CHECK_ERROR(parse("[stage 0]\ntexcoordindex -1\n"), 2, "bad texcoordindex '-1'");
+    CHECK(parse("[stage 0]\ntexcoordindex 8\n").ok);  // a set no FVF has: the draw reads (0, 0, 0, 1)
     CHECK_ERROR(parse("[stage 0]\nlscale\n"), 2, "missing lscale");
     CHECK_ERROR(parse("[stage 0]\nmagic 1\n"), 2, "unknown keyword 'magic' in [stage]");
     CHECK_ERROR(parse("[stage -1]\n"), 1, "out of range");

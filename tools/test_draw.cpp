@@ -40,7 +40,8 @@ D3DCOLOR argbOf(const Color& c) {
 }
 
 DWORD argValue(const TextureArg& a) {
-    return DWORD(a.source) | (a.complement ? D3DTA_COMPLEMENT : 0u) | (a.alphaReplicate ? D3DTA_ALPHAREPLICATE : 0u);
+    return DWORD(a.source) | (a.complement ? D3DTA_COMPLEMENT : 0u) | (a.alphaReplicate ? D3DTA_ALPHAREPLICATE : 0u) |
+           a.otherBits;
 }
 
 D3DMATRIX matrixOf(const Matrix4& m) {
