@@ -159,6 +159,15 @@ EXPECTED_ALPHA = [[0x808000, 0x7f7f00, 0xffff00, 0x000000], [0x909000, 0xa0a000,
 GEFORCE7_L6V5U5 = {15: 0xfb, -7: 0x4d, -3: 0x6e}
 
 
+# The shader of test_signed_formats: r0 = t0 · 0.5 + 0.5.
+SIGNED_SHADER = """[pixel shader]
+ps_1_1
+def c0, 0.5, 0.5, 0.5, 0.5
+tex t0
+mad r0, t0, c0, c0
+"""
+
+
 def madsigned(cls, fmt, w):
     m = Machine(cls)
     c = m.const(0.5)
@@ -243,12 +252,7 @@ size 4 4
 
 {texture_block(fmt, rows, digits)}
 
-[pixel shader]
-ps_1_1
-def c0, 0.5, 0.5, 0.5, 0.5
-tex t0
-mad r0, t0, c0, c0
-
+{SIGNED_SHADER}
 [test]
 draw quad
 """ + '\n'.join(lines) + '\n'
@@ -618,12 +622,7 @@ format {fmt}
 level 0
 {' '.join('0x%0*x' % (digits, w) for w in words)}
 
-[pixel shader]
-ps_1_1
-def c0, 0.5, 0.5, 0.5, 0.5
-tex t0
-mad r0, t0, c0, c0
-
+{SIGNED_SHADER}
 [test]
 """ + '\n'.join(lines) + '\n'
     write('signed_extremes_%s.ps11test' % fmt.lower(), text)
