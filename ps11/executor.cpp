@@ -333,10 +333,8 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
     p.g = gridScale(options.precision);
     p.clampRange = options.precision != Precision::Ideal;
     float m = options.maxValue == 0 ? defaultHardware(ver.minor).maxValue : options.maxValue;
-    // fx lanes are int32 with sources k = 4n + 2G: round(M*G) <= 2^24 keeps every product of the
-    // general formula (dp4, lrp, _x8) inside int64, and k inside int32.
-    constexpr double kMaxGrid = 16777216.0;
-    if (!(m > 0) || !(m <= 1e6) || (isFixedPoint(p.precision) && std::nearbyint(double(m) * p.g) > kMaxGrid) ||
+    // kMaxGridBound keeps the fx lanes' products inside int64 (precision.h).
+    if (!(m > 0) || !(m <= 1e6) || (isFixedPoint(p.precision) && std::nearbyint(double(m) * p.g) > kMaxGridBound) ||
         (isFixedPoint(p.precision) && std::nearbyint(double(m) * p.g) < 1)) {
         diags.error("E4003", program.versionLoc,
                     "max value " + std::to_string(m) + " out of range for profile " + precisionName(p.precision) +

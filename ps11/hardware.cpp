@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 
@@ -17,7 +18,8 @@ namespace {
 
 // MaxValue of the D3D9-class rows: float registers keep values far past ±1 between instructions
 // (Wine's cnd_test relies on a 2.0); the caps value such drivers report is not public, so the
-// bound is one that no ps_1_x program reaches from [−1, 1] inputs (docs/precision.md).
+// bound is the largest half-float, beyond what ps_1_x programs reach from [−1, 1] inputs short
+// of long _x4 chains (docs/precision.md).
 constexpr float kD3D9MaxValue = 65504.0f;
 
 constexpr std::array<HardwareClass, 5> kClasses{{
@@ -120,6 +122,7 @@ std::string HardwareConfig::describe() const {
     if (precisionOverridden) s += " (override)";
     s += ", max value " + number(maxValue);
     if (maxValueOverridden) s += " (override)";
+    if (maxValueCapped) s += " (the class's, capped by " + std::string(precisionName(precision)) + ")";
     return s;
 }
 
@@ -132,6 +135,10 @@ HardwareConfig resolveHardware(const HardwareClass* hardware, int minor, std::op
     c.weightBits = c.precisionOverridden ? (isFixedPoint(c.precision) ? 8 : 0) : c.hardware->bilinearWeightBits;
     c.maxValue = maxValue > 0 ? maxValue : c.hardware->maxValue;
     c.maxValueOverridden = maxValue > 0 && maxValue != c.hardware->maxValue;
+    if (!(maxValue > 0) && double(c.maxValue) > maxRepresentableValue(c.precision)) {
+        c.maxValue = float(std::floor(maxRepresentableValue(c.precision)));
+        c.maxValueCapped = true;
+    }
     return c;
 }
 

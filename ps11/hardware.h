@@ -76,12 +76,14 @@ struct HardwareConfig {
     int weightBits = 8;
     bool precisionOverridden = false;
     bool maxValueOverridden = false;
+    bool maxValueCapped = false;  // the class's MaxValue is beyond what an overriding fx profile holds
     // "geforce4 (1.1-class), fx8, max value 1" (overrides marked).
     std::string describe() const;
 };
 
 // Resolves a class for a shader version: `hardware` null = defaultHardware(minor); `precision` /
-// `maxValue` (0 = none) override the class's values.
+// `maxValue` (0 = none) override the class's values. A class MaxValue an overriding fx profile
+// cannot hold (d3d9's 65504 in fx12) is capped to the largest it holds (maxRepresentableValue).
 HardwareConfig resolveHardware(const HardwareClass* hardware, int minor, std::optional<Precision> precision,
                                float maxValue);
 

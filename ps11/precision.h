@@ -17,6 +17,14 @@ constexpr bool isFixedPoint(Precision p) { return p == Precision::Fx8 || p == Pr
 // Grid scale G: a register value is n / G (fx profiles); 1 for float profiles.
 constexpr int32_t gridScale(Precision p) { return p == Precision::Fx8 ? 255 : p == Precision::Fx12 ? 4080 : 1; }
 
+// Largest round(M·G) an fx profile runs with: fx lanes are int32 with sources k = 4n + 2G, and
+// round(M·G) <= 2^24 keeps every product of the general formula (dp4, lrp, _x8) inside int64.
+constexpr double kMaxGridBound = 16777216.0;
+// The largest MaxValue profile p can represent (fx: 2^24 / G; float profiles: no bound).
+constexpr double maxRepresentableValue(Precision p) {
+    return p == Precision::Fx8 || p == Precision::Fx12 ? kMaxGridBound / gridScale(p) : 3.4e38;
+}
+
 // round_half_even(num / den) for den > 0, exact in integers.
 constexpr int64_t roundHalfEven(int64_t num, int64_t den) {
     int64_t q = num / den, r = num % den;
