@@ -460,6 +460,7 @@ void Lowering::assemble(LoweredStages& out) const {
             m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(from, D3DTSS_BUMPENVMAT11)};
         es.lumScale = m_state.stageStateFloat(from, D3DTSS_BUMPENVLSCALE);
         es.lumOffset = m_state.stageStateFloat(from, D3DTSS_BUMPENVLOFFSET);
+        es.clampLuminance = true;  // BUMPENVMAPLUMINANCE clamps its factor (ps11::StageState)
         if (!((m_sampled >> i) & 1)) continue;
         Instruction tex;
         Dst t;

@@ -35,6 +35,10 @@ struct StageState {
     std::array<float, 4> bumpMat{0, 0, 0, 0};  // BUMPENVMAT00, 01, 10, 11
     float lumScale = 0;                        // BUMPENVLSCALE
     float lumOffset = 0;                       // BUMPENVLOFFSET
+    // The luminance factor LSCALE·b + LOFFSET clamped to [0, 1]: the fixed-function
+    // BUMPENVMAPLUMINANCE does (Wine's fixed_function_bumpmap_test on Windows drivers); ps_1_x
+    // texbeml does not (docs/precision.md).
+    bool clampLuminance = false;
     uint32_t transformFlags = 0;               // TEXTURETRANSFORMFLAGS as set: any DWORD (D3D9 checks none)
     // What D3DTTFF_PROJECTED resolves against (projectionDivisor): the components the draw's
     // vertex data gives the stage's coordinate set, and the dimensions of its texture.

@@ -221,12 +221,15 @@ void execTexbem(const Profile& p, const DOp& op, RunState& st) {
 
 void execTexbeml(const Profile& p, const DOp& op, RunState& st) {
     execTexbem(p, op, st);
-    // L = T[n].b · LSCALE + LOFFSET, not clamped (docs, Wine, nine; spec §7.4); every channel
-    // is multiplied and rounded once.
+    // L = T[n].b · LSCALE + LOFFSET, not clamped for ps_1_x texbeml (docs, Wine, nine; spec
+    // §7.4), clamped to [0, 1] for the fixed-function stage (StageState::clampLuminance); every
+    // channel is multiplied and rounded once.
     Lanes b;
     regFloat(p, st, op.src[0].slot, 2, op.src[0].mod, b);
     const StageState& ss = p.stages[op.stage];
     for (int i = 0; i < st.n; ++i) b[i] = b[i] * ss.lumScale + ss.lumOffset;
+    if (ss.clampLuminance)
+        for (int i = 0; i < st.n; ++i) b[i] = b[i] < 0.0f ? 0.0f : (b[i] > 1.0f ? 1.0f : b[i]);
     const int n = st.n;
     if (isFixedPoint(p.precision)) {
         const double m = p.nMax;

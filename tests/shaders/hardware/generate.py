@@ -628,6 +628,46 @@ level 0
     write('signed_extremes_%s.ps11test' % fmt.lower(), text)
 
 
+# ---- fixed_function_bumpmap_test, luminance part: the factor clamps to [0, 1] ----
+def luminance_file(name, lscale, loffset, want, tol, why):
+    text = f"""% Wine's fixed_function_bumpmap_test, luminance part (dlls/d3d9/tests/visual.c,
+% wine-9.7-99-g25c58e68876): stage 0 BUMPENVMAPLUMINANCE over a 1x1 L6V5U5 texel 0x4000 (U = V = 0,
+% L = 16/63), stage 1 SELECTARG1 of a 1x1 X8R8G8B8 texel 0x00ff80c0. LSCALE {lscale}, LOFFSET {loffset}:
+% {why}. Windows drivers gave 0x{want:06x} +-{tol}, no other result accepted; the same on every class.
+
+[render target]
+size 4 4
+
+[texture 0]
+size 1 1
+format L6V5U5
+level 0
+0x4000
+
+[texture 1]
+size 1 1
+format X8R8G8B8
+level 0
+0x00ff80c0
+
+[stage 0]
+colorop bumpenvmapluminance
+colorarg1 texture
+colorarg2 current
+lscale {lscale}
+loffset {loffset}
+
+[stage 1]
+colorop selectarg1
+colorarg1 texture
+
+[test]
+draw quad
+probe all rgb 0x{want:06x} tol {tol}
+"""
+    write('ffp_bumpenvmapluminance_%s.ps11test' % name, text)
+
+
 if __name__ == '__main__':
     for f in SIGNED:
         signed_file(f)
@@ -640,5 +680,8 @@ if __name__ == '__main__':
     color_clamping_file()
     for f in EXTREME_FORMATS:
         extremes_file(f)
+    luminance_file('scale2', '2', '0.1', 0x994c72, 5, 'the factor 0.25 * 2 + 0.1 = 0.6 scales the texel')
+    luminance_file('scale10', '10', '10', 0xff80c0, 1, 'the factor 12.5 clamps to 1')
+    luminance_file('scale1000', '1000', '-1', 0xff80c0, 1, 'the factor 253 clamps to 1')
     for run in PROJ_RUNS:
         projected_file(run)
