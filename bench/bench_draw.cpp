@@ -66,8 +66,8 @@ struct Scene {
         const bool down = pass == Pass::Down2 || pass == Pass::Down4;
         const UINT tw = down ? kW : w, th = down ? kH : h;
         DeviceOptions o;
-        o.threads = threads;
-        o.alignedPasses = aligned;
+        o.software.threads = threads;
+        o.software.alignedPasses = aligned;
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;

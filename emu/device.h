@@ -15,6 +15,7 @@
 
 #include "emu/d3d9types.h"
 #include "emu/resources.h"
+#include "emu/software_renderer.h"
 #include "emu/state.h"
 #include "ps11/hardware.h"
 #include "ps11/precision.h"
@@ -28,11 +29,9 @@ struct DeviceOptions {
     const ps11::HardwareClass* hardware = nullptr;
     std::optional<ps11::Precision> precision;  // overrides the class's profile (draws, StretchRect weights)
     float maxValue = 0;                        // overrides the class's PixelShader1xMaxValue (0 = the class's)
-    int threads = 0;                                   // worker threads of draws; 0 = all cores
-    uint64_t maxResourceBytes = kMaxResourceBytes;     // per resource, checked before allocating
-    // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
-    // no helper lanes, so fewer pixels shaded). Off: every draw goes through 2x2 quads.
-    bool alignedPasses = true;
+    uint64_t maxResourceBytes = kMaxResourceBytes;  // per resource, checked before allocating
+    // The software renderer's own options (threads, aligned passes).
+    SoftwareRendererOptions software;
 };
 
 // What the last call reported. Every call resets it; a failed call sets hr, an E41xx code and
@@ -43,21 +42,7 @@ struct DeviceError {
     std::string message;  // "E4101 SetTextureStageState: stage 9 out of range 0..7"
 };
 
-// Counts of one draw (Device::lastDrawStats) or of all draws so far (Device::totalDrawStats).
-struct DrawStats {
-    uint64_t draws = 0;           // DrawPrimitiveUP calls that succeeded
-    uint64_t triangles = 0;       // input triangles
-    uint64_t trianglesDrawn = 0;  // triangles rasterised (after clipping, culling; a clipped polygon is a fan)
-    uint64_t pixelsCovered = 0;   // pixels inside a triangle and the clip rect
-    uint64_t pixelsShaded = 0;    // lanes the executor ran: covered pixels plus quad helper lanes
-    uint64_t pixelsWritten = 0;   // pixels that reached the colour or depth store (output merger)
-    uint64_t texelsFetched = 0;   // texels read by the sampler
-    uint64_t instructions = 0;    // instruction executions (per lane)
-    double milliseconds = 0;      // wall time of the call
-    DrawStats& operator+=(const DrawStats& o);
-};
-
-struct DrawContext;  // emu/device_draw.cpp: worker pool, executor cache
+struct DrawContext;  // emu/device_draw.cpp: the front's lowered fixed-function programs
 
 class Device {
 public:
@@ -179,6 +164,7 @@ private:
 
     DrawStats m_lastDraw, m_totalDraw;
     std::shared_ptr<DrawContext> m_draw;  // created by the first draw
+    std::unique_ptr<Renderer> m_renderer;  // draws what the front resolved (emu/renderer.h)
 
     DeviceOptions m_options;
     ps11::HardwareConfig m_hardware;

@@ -1,23 +1,18 @@
-// Device stage: DrawPrimitiveUP. Validation of the call and of the state the draw reads, then
-// vertex processing (emu/vertex.h), triangle setup and rasterisation (emu/raster.h) in bands of
-// rows over the worker pool, the executor over 2×2-quad spans (pixel shader or the lowered
-// fixed-function stages, emu/ffp.h) with a TextureSampler per worker, and the output merger
-// (emu/output_merger.h). docs/device.md "Drawing".
+// Device front: DrawPrimitiveUP. Validation of the call and of the state the draw reads, the
+// pixel program (a shader, or the fixed-function stages lowered by emu/ffp.h), sampler, stage
+// and render states resolved into a DrawCall with vertex processing (emu/vertex.h), handed to the
+// renderer (emu/renderer.h). docs/device.md "Drawing".
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <list>
 #include <unordered_map>
 
-#include "emu/aligned_pass.h"
 #include "emu/device.h"
 #include "emu/ffp.h"
 #include "emu/output_merger.h"
-#include "emu/raster.h"
-#include "emu/thread_pool.h"
+#include "emu/renderer.h"
 #include "emu/vertex.h"
-#include "ps11/diagnostics.h"
 #include "ps11/executor.h"
 #include "ps11/texture_sampler.h"
 
@@ -31,12 +26,8 @@ std::string num(uint64_t v) { return std::to_string(v); }
 // any FVF's size (D3DCAPS9 MaxStreamStride was 255–512 on ps 1.x parts).
 constexpr uint64_t kMaxPrimitiveCount = 0xFFFFF;
 constexpr uint32_t kMaxStride = 2048;
-// Rows per band handed to a worker: even (quads) and small enough to balance two threads.
-constexpr int kBandRows = 16;
-// Executors kept per device (cleared when full).
-constexpr size_t kMaxCachedExecutors = 64;
-// Triangles processed per chunk (vertex processing, setup, rasterisation).
-constexpr uint32_t kChunkTriangles = 1024;
+// Lowered fixed-function programs kept per device (cleared when full).
+constexpr size_t kMaxLoweredPrograms = 64;
 
 bool drawableFormat(D3DFORMAT f) {
     return f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8 || f == D3DFMT_R32F || f == D3DFMT_A16B16G16R16F ||
@@ -129,43 +120,21 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
     return *this;
 }
 
-struct CachedExecutor {
-    std::unique_ptr<ps11::Executor> executor;
-    uint64_t attrs = 0;  // attributesRead of its program
-    bool kills = false;  // the program has texkill
-    bool fixedFunction = false;
-    std::array<ps11::StageState, kMaxStages> stages{};  // fixed function: LoweredStages::executorStages
+// A lowered fixed-function program, kept while the state the lowering read stays the same.
+struct LoweredProgram {
+    FfpKey key;
+    LoweredStages lowered;
+    uint64_t id = 0;  // DrawProgram::key
+    uint64_t attrs = 0;
+    bool kills = false;
 };
 
-// Per-device draw machinery: the worker pool and the executors, cached by program identity.
-// Executor outputs and the merged live mask of one span.
-struct Lanes {
-    alignas(32) float color[4][ps11::kMaxSpan];
-    alignas(32) int32_t grid[4][ps11::kMaxSpan];
-    alignas(32) uint8_t killed[ps11::kMaxSpan];
-    alignas(32) uint8_t live[ps11::kMaxSpan];
-    alignas(32) float depth[ps11::kMaxSpan];
-};
-
-// What a worker keeps between draws (no allocation per draw): its span, lanes and sampler.
-struct WorkerScratch {
-    QuadSpan span;
-    Lanes lanes;
-    ps11::TextureSampler sampler;
-    AlignedScratch aligned;
-};
-
+// What the front keeps between draws: the lowered fixed-function programs by the state words
+// the lowering reads (hash buckets), each with a program identity for the renderer's caches.
 struct DrawContext {
-    explicit DrawContext(int threads) : pool(threads) {
-        for (int i = 0; i < pool.size(); ++i) scratch.push_back(std::make_unique<WorkerScratch>());
-    }
-    ThreadPool pool;
-    std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
-    // Pixel shaders: by handle (handles are never reused) and profile.
-    std::unordered_map<uint64_t, CachedExecutor> shaders;
-    // Fixed function: by the state words the lowering reads.
-    std::unordered_map<size_t, std::list<std::pair<FfpKey, CachedExecutor>>> ffp;
+    std::unordered_map<size_t, std::list<LoweredProgram>> ffp;
     size_t ffpCount = 0;
+    uint64_t nextId = uint64_t(1) << 32;  // above every shader handle
 };
 
 HRESULT Device::drawFail(HRESULT hr, const char* code, std::string message) {
@@ -248,37 +217,36 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             "D3DRS_FILLMODE " + num(fill) + ": only D3DFILL_SOLID (3) is drawn (no point or wireframe fill)");
 
     // ---- the pixel program ----
-    if (!m_draw) m_draw = std::make_shared<DrawContext>(m_options.threads);
+    if (!m_draw) m_draw = std::make_shared<DrawContext>();
     DrawContext& dc = *m_draw;
-    const ps11::ExecutorOptions execOptions = ps11::executorOptionsFor(m_hardware);
-    CachedExecutor* exec = nullptr;
+    DrawCall call;
+    call.hardware = m_hardware;
+    DrawProgram& prog = call.program;
     if (m_state.pixelShader != Handle::Null) {
         const ps11::Program* program = pixelShaderProgram(m_state.pixelShader);
         if (!program)
             return drawFail(D3DERR_INVALIDCALL, "E4102",
                             "pixel shader " + num(uint32_t(m_state.pixelShader)) + " is not a pixel shader");
-        const uint64_t key = uint64_t(uint32_t(m_state.pixelShader));
-        auto it = dc.shaders.find(key);
-        if (it == dc.shaders.end()) {
-            ps11::Diagnostics diags;
-            CachedExecutor ce;
-            ce.executor = ps11::Executor::create(*program, execOptions, diags);
-            if (!ce.executor)
-                return drawFail(D3DERR_INVALIDCALL, "E4121",
-                                "the executor refused pixel shader " + num(uint32_t(m_state.pixelShader)));
-            ce.attrs = attributesRead(*program);
-            ce.kills = hasTexkill(*program);
-            if (dc.shaders.size() >= kMaxCachedExecutors) dc.shaders.clear();
-            it = dc.shaders.emplace(key, std::move(ce)).first;
+        prog.program = program;
+        prog.key = uint64_t(uint32_t(m_state.pixelShader));  // handles are never reused
+        prog.attributesRead = attributesRead(*program);
+        prog.kills = hasTexkill(*program);
+        for (int s = 0; s < kMaxStages; ++s) {
+            ps11::StageState& st = prog.stages[size_t(s)];
+            st.bumpMat = {m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00),
+                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
+                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10),
+                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
+            st.lumScale = m_state.stageStateFloat(s, D3DTSS_BUMPENVLSCALE);
+            st.lumOffset = m_state.stageStateFloat(s, D3DTSS_BUMPENVLOFFSET);
         }
-        exec = &it->second;
     } else {
         FfpKey key = ffpKey(m_state);
         const size_t h = hashWords(key.words);
-        auto& bucket = dc.ffp[h];
-        for (auto& entry : bucket)
-            if (entry.first == key) exec = &entry.second;
-        if (!exec) {
+        const LoweredProgram* found = nullptr;
+        for (const LoweredProgram& entry : dc.ffp[h])
+            if (entry.key == key) found = &entry;
+        if (!found) {
             std::string error;
             std::optional<LoweredStages> lowered = lowerFixedFunction(m_state, error);
             if (!lowered) {
@@ -290,31 +258,35 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                 m_error.message = code + " DrawPrimitiveUP: " + text;
                 return D3DERR_INVALIDCALL;
             }
-            ps11::Diagnostics diags;
-            CachedExecutor ce;
-            ce.executor = ps11::Executor::create(lowered->program, execOptions, diags);
-            if (!ce.executor)
-                return drawFail(D3DERR_INVALIDCALL, "E4121", "the executor refused the fixed-function program");
-            ce.attrs = attributesRead(lowered->program);
-            ce.kills = hasTexkill(lowered->program);
-            ce.fixedFunction = true;
-            ce.stages = lowered->executorStages;
-            if (dc.ffpCount >= kMaxCachedExecutors) {
+            if (dc.ffpCount >= kMaxLoweredPrograms) {
                 dc.ffp.clear();
                 dc.ffpCount = 0;
             }
-            auto& b = dc.ffp[h];
-            b.emplace_back(std::move(key), std::move(ce));
+            LoweredProgram entry;
+            entry.attrs = attributesRead(lowered->program);
+            entry.kills = hasTexkill(lowered->program);
+            entry.key = std::move(key);
+            entry.lowered = std::move(*lowered);
+            entry.id = dc.nextId++;
+            auto& bucket = dc.ffp[h];
+            bucket.push_back(std::move(entry));
             ++dc.ffpCount;
-            exec = &b.back().second;
+            found = &bucket.back();
         }
+        prog.program = &found->lowered.program;
+        prog.key = found->id;
+        prog.fixedFunction = true;
+        prog.attributesRead = found->attrs;
+        prog.kills = found->kills;
+        // The lowering places the bump values on the stage texbem samples (emu/ffp.h).
+        prog.stages = found->lowered.executorStages;
     }
-    ps11::Executor& executor = *exec->executor;
+    for (int i = 0; i < kMaxPsConstants; ++i) prog.constants[size_t(i)] = m_state.psConstants[size_t(i)];
 
     // ---- textures and sampler states of the stages the program samples ----
-    const uint32_t sampled = executor.sampledStages();
-    std::array<std::shared_ptr<const ps11::Texture>, kMaxSamplers> textures;
-    std::array<ps11::SamplerState, kMaxSamplers> samplers;
+    const uint32_t sampled = ps11::sampledStages(*prog.program);
+    std::array<std::shared_ptr<const ps11::Texture>, kMaxSamplers>& textures = call.textures;
+    std::array<ps11::SamplerState, kMaxSamplers>& samplers = call.samplers;
     for (int s = 0; s < kMaxSamplers; ++s) {
         if (!((sampled >> s) & 1)) continue;
         ps11::SamplerState ss;
@@ -373,7 +345,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     // ---- stage states: texture coordinates and the executor's per-stage values ----
     for (int s = 0; s < kMaxStages; ++s) {
         const DWORD tci = m_state.stageState(s, D3DTSS_TEXCOORDINDEX);
-        const bool slotRead = (exec->attrs >> attrTex(s, 0)) & 0xF;
+        const bool slotRead = (prog.attributesRead >> attrTex(s, 0)) & 0xF;
         if (slotRead && (tci & 0xFFFF0000u))
             return drawFail(
                 D3DERR_INVALIDCALL,
@@ -383,30 +355,14 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                     return std::string(b);
                 }() + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
     }
-    for (int i = 0; i < kMaxPsConstants; ++i) executor.setConstant(i, m_state.psConstants[size_t(i)]);
     for (int s = 0; s < kMaxStages; ++s) {
         // D3DTTFF_PROJECTED resolves against the stage's coordinate set in the FVF (any
         // TEXTURETRANSFORMFLAGS value is taken, as D3D9 takes it; ps11::projectionDivisor).
+        ps11::StageState& st = prog.stages[size_t(s)];
         const DWORD set = m_state.stageState(s, D3DTSS_TEXCOORDINDEX) & 0xFFFF;
-        const uint8_t components = set < DWORD(layout->texCount) ? layout->texSize[size_t(set)] : 4;
-        const uint8_t dims = textures[size_t(s)] && textures[size_t(s)]->isVolume() ? 3 : 2;
-        if (exec->fixedFunction) {
-            // The lowering places the bump values on the stage texbem samples (emu/ffp.h).
-            ps11::StageState st = exec->stages[size_t(s)];
-            st.coordComponents = components;
-            st.textureDimensions = dims;
-            executor.setStageState(s, st);
-            continue;
-        }
-        ps11::StageState st;
-        st.coordComponents = components;
-        st.textureDimensions = dims;
-        st.bumpMat = {m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
-                      m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
-        st.lumScale = m_state.stageStateFloat(s, D3DTSS_BUMPENVLSCALE);
-        st.lumOffset = m_state.stageStateFloat(s, D3DTSS_BUMPENVLOFFSET);
-        st.transformFlags = m_state.stageState(s, D3DTSS_TEXTURETRANSFORMFLAGS);
-        executor.setStageState(s, st);
+        st.coordComponents = set < DWORD(layout->texCount) ? layout->texSize[size_t(set)] : 4;
+        st.textureDimensions = textures[size_t(s)] && textures[size_t(s)]->isVolume() ? 3 : 2;
+        if (!prog.fixedFunction) st.transformFlags = m_state.stageState(s, D3DTSS_TEXTURETRANSFORMFLAGS);
     }
 
     // ---- output merger ----
@@ -416,7 +372,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         m_error.message = e;
         return D3DERR_INVALIDCALL;
     }
-    const MergeState merge = MergeState::from(m_state, depth != nullptr, m_hardware.precision);
+    call.merge = MergeState::from(m_state, depth != nullptr, m_hardware.precision);
+    const MergeState& merge = call.merge;
     DrawStats stats;
     stats.draws = 1;
     stats.triangles = primitiveCount;
@@ -427,19 +384,10 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         m_totalDraw += stats;
         return D3D_OK;
     }
-    const bool shaderDepth = executor.writesDepth();
-    const bool kills = exec->kills;
-    const bool wantZ = merge.depthTest || (merge.depthWrite && depth);
-    uint64_t used = exec->attrs;
+    uint64_t used = prog.attributesRead;
     if (merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
-
-    // ---- vertices → screen triangles → setups ----
-    VertexSetup vs;
-    vs.layout = &*layout;
-    vs.usedAttrs = used;
-    VertexStats vstats;
-
-    ClipRect clip;
+    call.usedAttributes = used;
+    call.target = MergeTarget{target, depth};
     {
         const D3DVIEWPORT9& vp = m_state.viewport;
         int64_t x0 = vp.X, y0 = vp.Y, x1 = int64_t(vp.X) + vp.Width, y1 = int64_t(vp.Y) + vp.Height;
@@ -450,150 +398,23 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             x1 = std::min<int64_t>(x1, sc.right);
             y1 = std::min<int64_t>(y1, sc.bottom);
         }
-        clip.x0 = int(std::clamp<int64_t>(x0, 0, target->width));
-        clip.y0 = int(std::clamp<int64_t>(y0, 0, target->height));
-        clip.x1 = int(std::clamp<int64_t>(x1, 0, target->width));
-        clip.y1 = int(std::clamp<int64_t>(y1, 0, target->height));
+        call.clip.x0 = int(std::clamp<int64_t>(x0, 0, target->width));
+        call.clip.y0 = int(std::clamp<int64_t>(y0, 0, target->height));
+        call.clip.x1 = int(std::clamp<int64_t>(x1, 0, target->width));
+        call.clip.y1 = int(std::clamp<int64_t>(y1, 0, target->height));
     }
-    // Triangles go through in chunks (memory stays bounded for any count); chunks run one after
-    // the other, so primitive order holds across them.
-    std::vector<ScreenTriangle> tris;
-    std::vector<TriangleSetup> setups;
-    bool wrote = false;
-    // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
-    MergeTarget mtarget{target, depth};
-    AlignedDraw aligned;
-    const bool alignedDraw =
-        m_options.alignedPasses &&
-        prepareAlignedDraw(executor, m_hardware.precision, textures, samplers, merge, mtarget, wantZ, used, aligned);
-    std::vector<AlignedTriangle> alignedTris;
-    std::vector<uint8_t> isAligned;
-    for (uint32_t first = 0; first < primitiveCount; first += kChunkTriangles) {
-        const uint32_t chunk = std::min(kChunkTriangles, primitiveCount - first);
-        tris.clear();
-        setups.clear();
-        processTriangles(m_state, vs, type, first, chunk, static_cast<const uint8_t*>(vertexData), stride, tris,
-                         &vstats);
-        int yLo = clip.y1, yHi = clip.y0;
-        for (const ScreenTriangle& t : tris) {
-            TriangleSetup s;
-            if (!setupTriangle(t, used, clip, s)) continue;
-            yLo = std::min(yLo, s.yMin);
-            yHi = std::max(yHi, s.yMax);
-            setups.push_back(s);
-        }
-        stats.trianglesDrawn += setups.size();
-        isAligned.assign(setups.size(), 0);
-        if (alignedDraw && setups.size() <= kMaxAlignedTriangles) {
-            alignedTris.resize(setups.size());
-            for (size_t i = 0; i < setups.size(); ++i)
-                isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
-        }
 
-        // ---- rows in bands over the workers ----
-        if (!setups.empty()) {
-            const int firstBand = (yLo & ~1) / kBandRows;
-            const int lastBand = (yHi + kBandRows - 1) / kBandRows;
-            const int bands = lastBand - firstBand;
-            std::atomic<int> next{0};
-            const int workers = std::min(dc.pool.size(), bands);
-            std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
-            const bool fx = ps11::isFixedPoint(m_hardware.precision);
-            dc.pool.run(workers, [&](int w) {
-                WorkerScratch& ws0 = *dc.scratch[size_t(w)];
-                ps11::TextureSampler& sampler = ws0.sampler;
-                sampler.setWeightBits(m_hardware.weightBits);
-                for (int s = 0; s < kMaxSamplers; ++s) {
-                    // Stages the program does not sample are unbound (no texture kept alive).
-                    sampler.bind(s, (sampled >> s) & 1 ? textures[size_t(s)] : nullptr);
-                    if ((sampled >> s) & 1) sampler.setSamplerState(s, samplers[size_t(s)]);
-                }
-                const uint64_t fetchedBefore = sampler.texelsFetched();
-                QuadSpan* span = &ws0.span;
-                Lanes* lanes = &ws0.lanes;
-                ps11::PixelInputs in;
-                in.quads = true;
-                for (int c = 0; c < 4; ++c) {
-                    if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
-                    if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
-                    for (int t = 0; t < kMaxTexSets; ++t)
-                        if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
-                }
-                ps11::PixelOutputs outp;
-                for (int c = 0; c < 4; ++c) {
-                    outp.color[c] = lanes->color[c];
-                    if (fx) outp.grid[c] = lanes->grid[c];
-                }
-                outp.killed = lanes->killed;
-                outp.depth = shaderDepth ? lanes->depth : nullptr;
-                ps11::ExecutorStats es;
-                MergeStats ms;
-                DrawStats& ws = workerStats[size_t(w)];
-                auto emit = [&](QuadSpan& sp) {
-                    in.count = sp.count;
-                    executor.run(in, sampler, outp, &es);
-                    if (kills)
-                        for (int L = 0; L < sp.count; ++L)
-                            lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
-                    MergeInputs mi;
-                    mi.count = sp.count;
-                    mi.x = sp.x;
-                    mi.y = sp.y;
-                    mi.live = kills ? lanes->live : sp.live;
-                    for (int c = 0; c < 4; ++c) {
-                        mi.color[c] = lanes->color[c];
-                        mi.grid[c] = fx ? lanes->grid[c] : nullptr;
-                    }
-                    mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
-                    mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
-                    mergePixels(merge, mi, mtarget, &ms);
-                    ws.pixelsCovered += uint64_t(sp.liveCount);
-                };
-                const std::function<void(QuadSpan&)> emitFn = emit;
-                AlignedStats as;
-                for (;;) {
-                    const int b = next.fetch_add(1, std::memory_order_relaxed);
-                    if (b >= bands) break;
-                    const int by0 = (firstBand + b) * kBandRows;
-                    const int by1 = by0 + kBandRows;
-                    // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
-                    const AlignedTriangle* group[kMaxAlignedTriangles];
-                    const TriangleSetup* groupSetups[kMaxAlignedTriangles];
-                    size_t grouped = 0;
-                    auto flush = [&] {
-                        if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
-                        grouped = 0;
-                    };
-                    for (size_t i = 0; i < setups.size(); ++i) {
-                        const TriangleSetup& s = setups[i];
-                        if (s.yMax <= by0 || s.yMin >= by1) continue;
-                        if (isAligned[i]) {
-                            group[grouped] = &alignedTris[i];
-                            groupSetups[grouped++] = &s;
-                            continue;
-                        }
-                        flush();
-                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
-                    }
-                    flush();
-                }
-                ws.pixelsCovered += as.pixels;
-                ws.pixelsShaded = es.pixels + as.exec.pixels;
-                ws.instructions = es.instructions + as.exec.instructions;
-                ws.pixelsWritten = ms.written + as.written;
-                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore + as.texels;
-            });
-            for (const DrawStats& ws : workerStats) {
-                stats.pixelsCovered += ws.pixelsCovered;
-                stats.pixelsShaded += ws.pixelsShaded;
-                stats.instructions += ws.instructions;
-                stats.pixelsWritten += ws.pixelsWritten;
-                stats.texelsFetched += ws.texelsFetched;
-            }
-            wrote = true;
-        }
-    }
-    if (wrote) {
+    // ---- vertices → screen triangles, pulled by the renderer chunk by chunk ----
+    VertexSetup vs;
+    vs.layout = &*layout;
+    vs.usedAttrs = used;
+    call.primitiveCount = primitiveCount;
+    call.assemble = [&](uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out) {
+        processTriangles(m_state, vs, type, first, count, static_cast<const uint8_t*>(vertexData), stride, out);
+    };
+    RendererError rerr;
+    if (!m_renderer->draw(call, stats, rerr)) return drawFail(rerr.hr, rerr.code.c_str(), rerr.message);
+    if (stats.trianglesDrawn) {
         markWritten(*rt, rtRef.level);
         if (depth && merge.depthWrite) markWritten(*ds, dsRef.level);
     }

@@ -433,27 +433,8 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
             padRun = isPad ? padRun + 1 : 0;
             if (ver.minor < 4 && ins.info->hasDst && ins.dst.type != RegType::Texture && opc != Opcode::TexDepth)
                 dec.fail("E4004", ins.dst.loc, "texture instruction destination must be t#");
-            switch (opc) {
-                case Opcode::Tex:
-                case Opcode::TexBem:
-                case Opcode::TexBemL:
-                case Opcode::TexReg2AR:
-                case Opcode::TexReg2GB:
-                case Opcode::TexReg2RGB:
-                case Opcode::TexM3x2Tex:
-                case Opcode::TexM3x3Tex:
-                case Opcode::TexM3x3Spec:
-                case Opcode::TexM3x3VSpec:
-                case Opcode::TexDp3Tex:
-                    stages |= 1u << d.stage;
-                    break;
-                case Opcode::TexM3x2Depth:
-                case Opcode::TexDepth:
-                    depth = true;
-                    break;
-                default:
-                    break;
-            }
+            if (samplesStage(opc)) stages |= 1u << d.stage;
+            if (replacesDepth(opc)) depth = true;
             if (opc == Opcode::TexKill && ver.minor < 4) {
                 // 1_1-1_3 texkill names t(m) but tests TC[m] (spec §7.9).
                 d.src[0].kind = SrcKind::TexCoord;

@@ -23,4 +23,12 @@ std::string registerRange(RegType t, int minor) {
     return regPrefix(t) + std::string("0-") + regPrefix(t) + std::to_string(registerCount(t, minor) - 1);
 }
 
+uint32_t sampledStages(const Program& program) {
+    uint32_t stages = 0;
+    for (const Instruction& ins : program.instructions)
+        if (ins.info && ins.info->cls == OpClass::Texture && samplesStage(ins.opcode()))
+            stages |= 1u << (ins.dst.index & 7);
+    return stages;
+}
+
 }  // namespace ps11

@@ -108,4 +108,8 @@ constexpr int registerCount(RegType t, int minor) {
 // The registers of a file in the version, for messages: "r0-r1".
 std::string registerRange(RegType t, int minor);
 
+// Stages the program's texture instructions sample (bit per stage; samplesStage in
+// ps11/opcodes.h), what the device must bind before it draws.
+uint32_t sampledStages(const Program& program);
+
 }  // namespace ps11

@@ -74,6 +74,25 @@ const OpcodeInfo* findOpcode(std::string_view mnemonic, int minor) {
     return any;
 }
 
+bool samplesStage(Opcode op) {
+    switch (op) {
+        case Opcode::Tex:
+        case Opcode::TexBem:
+        case Opcode::TexBemL:
+        case Opcode::TexReg2AR:
+        case Opcode::TexReg2GB:
+        case Opcode::TexReg2RGB:
+        case Opcode::TexM3x2Tex:
+        case Opcode::TexM3x3Tex:
+        case Opcode::TexM3x3Spec:
+        case Opcode::TexM3x3VSpec:
+        case Opcode::TexDp3Tex:
+            return true;
+        default:
+            return false;
+    }
+}
+
 const OpcodeInfo* findOpcodeToken(uint32_t opcode, int minor) {
     for (const OpcodeInfo& row : kTable)
         if (uint32_t(row.opcode) == opcode && (row.tokenVersions & versionBit(minor))) return &row;

@@ -85,4 +85,11 @@ const OpcodeInfo* findOpcode(std::string_view mnemonic, int minor);
 // Row whose token layout applies to this opcode number in the version, or nullptr.
 const OpcodeInfo* findOpcodeToken(uint32_t opcode, int minor);
 
+// A texture instruction that samples the stage its destination names (tex/texld, texbem(l),
+// texreg2*, texm3x2tex, texm3x3tex/spec/vspec, texdp3tex); the pads, texcoord/texcrd, texkill,
+// texdp3, texm3x3 and the depth instructions compute without sampling.
+bool samplesStage(Opcode op);
+// texm3x2depth and texdepth replace the pixel's depth.
+constexpr bool replacesDepth(Opcode op) { return op == Opcode::TexM3x2Depth || op == Opcode::TexDepth; }
+
 }  // namespace ps11

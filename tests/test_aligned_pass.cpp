@@ -230,8 +230,8 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     for (int i = 0; i < 400; ++i) {
         const Case c = randomCase(rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.alignedPasses = false;
-        quadOpt.threads = rowOpt.threads = 1 + (i & 1);
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         // ps_1_4 programs run on the 1.4-class card, in fx8 (the aligned path's profile).
         if (c.program.rfind("ps_1_4", 0) == 0) {
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
@@ -275,7 +275,7 @@ TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path"
     DrawStats a, b;
     Device rowDev;
     DeviceOptions quadOpt;
-    quadOpt.alignedPasses = false;
+    quadOpt.software.alignedPasses = false;
     Device quadDev(quadOpt);
     CHECK(drawCase(rowDev, c, a) == drawCase(quadDev, c, b));
     CHECK(a.pixelsShaded == b.pixelsShaded);  // both through quads
@@ -307,8 +307,8 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     const UINT w = 203, h = 19;
     DeviceOptions quadOpt, rowOpt;
-    quadOpt.alignedPasses = false;
-    quadOpt.threads = rowOpt.threads = 2;
+    quadOpt.software.alignedPasses = false;
+    quadOpt.software.threads = rowOpt.software.threads = 2;
     Device quadDev(quadOpt), rowDev(rowOpt);
     Device* devs[2] = {&quadDev, &rowDev};
     Handle src[2], ping[2][2], surf[2][2], ps[2];

@@ -209,7 +209,7 @@ TEST_CASE("draw: one and two threads give identical images", "[draw]") {
     std::vector<std::vector<uint32_t>> images;
     for (int threads : {1, 2, 3}) {
         DeviceOptions o;
-        o.threads = threads;
+        o.software.threads = threads;
         Device dev(o);
         const UINT W = 150, H = 97;
         Handle rt = target(dev, W, H);
@@ -242,7 +242,7 @@ TEST_CASE("draw: one and two threads give identical images", "[draw]") {
 TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]") {
     // The quad path (the aligned-pass path shades no helper lanes: see the last section).
     DeviceOptions opt;
-    opt.alignedPasses = false;
+    opt.software.alignedPasses = false;
     Device dev(opt);
     const UINT W = 8, H = 8;
     target(dev, W, H);
@@ -314,7 +314,7 @@ TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[dra
 
 TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]") {
     DeviceOptions o;
-    o.threads = 1;
+    o.software.threads = 1;
     Device dev(o);
     const UINT W = 8, H = 8;
     auto v = quad(W, H, 0xffffffff);
@@ -418,7 +418,7 @@ TEST_CASE("draw: every error path returns its code and changes nothing", "[draw]
 TEST_CASE("draw: thousands of triangles keep primitive order across chunks and threads", "[draw]") {
     for (int threads : {1, 2}) {
         DeviceOptions o;
-        o.threads = threads;
+        o.software.threads = threads;
         Device dev(o);
         const int W = 100, H = 50;
         Handle rt = target(dev, W, H, 0);

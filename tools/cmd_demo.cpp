@@ -97,7 +97,7 @@ public:
         DeviceOptions d;
         d.hardware = hardware;
         d.precision = p;
-        d.threads = o.threads;
+        d.software.threads = o.threads;
         m_device = std::make_unique<Device>(d);
     }
 

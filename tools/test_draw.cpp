@@ -278,7 +278,7 @@ std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::
     options.hardware = hardware.hardware;
     options.precision = hardware.precision;
     options.maxValue = hardware.maxValue;
-    options.alignedPasses = alignedPasses;
+    options.software.alignedPasses = alignedPasses;
     r->m_device = std::make_unique<Device>(options);
     Device& d = *r->m_device;
 

@@ -1,0 +1,228 @@
+// Renderer stage: the software renderer. A resolved DrawCall (emu/renderer.h) becomes screen
+// triangles in chunks, triangle setups, rows in bands over the worker pool, the executor over
+// 2×2-quad spans (or the aligned-pass row path) and the output merger. docs/device.md "Drawing".
+#include "emu/software_renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <unordered_map>
+
+#include "emu/aligned_pass.h"
+#include "emu/thread_pool.h"
+#include "ps11/diagnostics.h"
+
+namespace emu {
+
+namespace {
+
+// Rows per band handed to a worker: even (quads) and small enough to balance two threads.
+constexpr int kBandRows = 16;
+// Executors kept per renderer (cleared when full).
+constexpr size_t kMaxCachedExecutors = 64;
+// Triangles processed per chunk (vertex processing, setup, rasterisation).
+constexpr uint32_t kChunkTriangles = 1024;
+
+// Executor outputs and the merged live mask of one span.
+struct Lanes {
+    alignas(32) float color[4][ps11::kMaxSpan];
+    alignas(32) int32_t grid[4][ps11::kMaxSpan];
+    alignas(32) uint8_t killed[ps11::kMaxSpan];
+    alignas(32) uint8_t live[ps11::kMaxSpan];
+    alignas(32) float depth[ps11::kMaxSpan];
+};
+
+// What a worker keeps between draws (no allocation per draw): its span, lanes and sampler.
+struct WorkerScratch {
+    QuadSpan span;
+    Lanes lanes;
+    ps11::TextureSampler sampler;
+    AlignedScratch aligned;
+};
+
+}  // namespace
+
+struct SoftwareDrawContext {
+    explicit SoftwareDrawContext(int threads) : pool(threads) {
+        for (int i = 0; i < pool.size(); ++i) scratch.push_back(std::make_unique<WorkerScratch>());
+    }
+    ThreadPool pool;
+    std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
+    // Executors by DrawProgram::key (a program's identity for the device's lifetime).
+    std::unordered_map<uint64_t, std::unique_ptr<ps11::Executor>> executors;
+};
+
+SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_options(options) {}
+
+SoftwareRenderer::~SoftwareRenderer() = default;
+
+bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& error) {
+    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+    SoftwareDrawContext& dc = *m_context;
+    const DrawProgram& prog = call.program;
+
+    // ---- the executor of the program (one per program identity) ----
+    auto it = dc.executors.find(prog.key);
+    if (it == dc.executors.end()) {
+        ps11::Diagnostics diags;
+        std::unique_ptr<ps11::Executor> e =
+            ps11::Executor::create(*prog.program, ps11::executorOptionsFor(call.hardware), diags);
+        if (!e) {
+            error.hr = D3DERR_INVALIDCALL;
+            error.code = "E4121";
+            error.message = prog.fixedFunction ? "the executor refused the fixed-function program"
+                                               : "the executor refused the pixel shader";
+            return false;
+        }
+        if (dc.executors.size() >= kMaxCachedExecutors) dc.executors.clear();
+        it = dc.executors.emplace(prog.key, std::move(e)).first;
+    }
+    ps11::Executor& executor = *it->second;
+    for (int i = 0; i < kMaxPsConstants; ++i) executor.setConstant(i, prog.constants[size_t(i)]);
+    for (int s = 0; s < kMaxStages; ++s) executor.setStageState(s, prog.stages[size_t(s)]);
+
+    const uint32_t sampled = executor.sampledStages();
+    const MergeState& merge = call.merge;
+    const MergeTarget& mtarget = call.target;
+    const bool shaderDepth = executor.writesDepth();
+    const bool kills = prog.kills;
+    const bool wantZ = merge.depthTest || (merge.depthWrite && mtarget.depth);
+    const uint64_t used = call.usedAttributes;
+    const ClipRect clip = call.clip;
+    const ps11::Precision precision = call.hardware.precision;
+
+    // Triangles go through in chunks (memory stays bounded for any count); chunks run one after
+    // the other, so primitive order holds across them.
+    std::vector<ScreenTriangle> tris;
+    std::vector<TriangleSetup> setups;
+    // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
+    AlignedDraw aligned;
+    const bool alignedDraw = m_options.alignedPasses && prepareAlignedDraw(executor, precision, call.textures,
+                                                                           call.samplers, merge, mtarget, wantZ,
+                                                                           used, aligned);
+    std::vector<AlignedTriangle> alignedTris;
+    std::vector<uint8_t> isAligned;
+    for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
+        const uint32_t chunk = std::min(kChunkTriangles, call.primitiveCount - first);
+        tris.clear();
+        setups.clear();
+        call.assemble(first, chunk, tris);
+        int yLo = clip.y1, yHi = clip.y0;
+        for (const ScreenTriangle& t : tris) {
+            TriangleSetup s;
+            if (!setupTriangle(t, used, clip, s)) continue;
+            yLo = std::min(yLo, s.yMin);
+            yHi = std::max(yHi, s.yMax);
+            setups.push_back(s);
+        }
+        stats.trianglesDrawn += setups.size();
+        isAligned.assign(setups.size(), 0);
+        if (alignedDraw && setups.size() <= kMaxAlignedTriangles) {
+            alignedTris.resize(setups.size());
+            for (size_t i = 0; i < setups.size(); ++i)
+                isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
+        }
+        if (setups.empty()) continue;
+
+        // ---- rows in bands over the workers ----
+        const int firstBand = (yLo & ~1) / kBandRows;
+        const int lastBand = (yHi + kBandRows - 1) / kBandRows;
+        const int bands = lastBand - firstBand;
+        std::atomic<int> next{0};
+        const int workers = std::min(dc.pool.size(), bands);
+        std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
+        const bool fx = ps11::isFixedPoint(precision);
+        dc.pool.run(workers, [&](int w) {
+            WorkerScratch& ws0 = *dc.scratch[size_t(w)];
+            ps11::TextureSampler& sampler = ws0.sampler;
+            sampler.setWeightBits(call.hardware.weightBits);
+            for (int s = 0; s < kMaxSamplers; ++s) {
+                // Stages the program does not sample are unbound (no texture kept alive).
+                sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);
+                if ((sampled >> s) & 1) sampler.setSamplerState(s, call.samplers[size_t(s)]);
+            }
+            const uint64_t fetchedBefore = sampler.texelsFetched();
+            QuadSpan* span = &ws0.span;
+            Lanes* lanes = &ws0.lanes;
+            ps11::PixelInputs in;
+            in.quads = true;
+            for (int c = 0; c < 4; ++c) {
+                if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
+                if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
+                for (int t = 0; t < kMaxTexSets; ++t)
+                    if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
+            }
+            ps11::PixelOutputs outp;
+            for (int c = 0; c < 4; ++c) {
+                outp.color[c] = lanes->color[c];
+                if (fx) outp.grid[c] = lanes->grid[c];
+            }
+            outp.killed = lanes->killed;
+            outp.depth = shaderDepth ? lanes->depth : nullptr;
+            ps11::ExecutorStats es;
+            MergeStats ms;
+            DrawStats& ws = workerStats[size_t(w)];
+            auto emit = [&](QuadSpan& sp) {
+                in.count = sp.count;
+                executor.run(in, sampler, outp, &es);
+                if (kills)
+                    for (int L = 0; L < sp.count; ++L) lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
+                MergeInputs mi;
+                mi.count = sp.count;
+                mi.x = sp.x;
+                mi.y = sp.y;
+                mi.live = kills ? lanes->live : sp.live;
+                for (int c = 0; c < 4; ++c) {
+                    mi.color[c] = lanes->color[c];
+                    mi.grid[c] = fx ? lanes->grid[c] : nullptr;
+                }
+                mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
+                mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
+                mergePixels(merge, mi, mtarget, &ms);
+                ws.pixelsCovered += uint64_t(sp.liveCount);
+            };
+            const std::function<void(QuadSpan&)> emitFn = emit;
+            AlignedStats as;
+            for (;;) {
+                const int b = next.fetch_add(1, std::memory_order_relaxed);
+                if (b >= bands) break;
+                const int by0 = (firstBand + b) * kBandRows;
+                const int by1 = by0 + kBandRows;
+                // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
+                const AlignedTriangle* group[kMaxAlignedTriangles];
+                const TriangleSetup* groupSetups[kMaxAlignedTriangles];
+                size_t grouped = 0;
+                auto flush = [&] {
+                    if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
+                    grouped = 0;
+                };
+                for (size_t i = 0; i < setups.size(); ++i) {
+                    const TriangleSetup& s = setups[i];
+                    if (s.yMax <= by0 || s.yMin >= by1) continue;
+                    if (isAligned[i]) {
+                        group[grouped] = &alignedTris[i];
+                        groupSetups[grouped++] = &s;
+                        continue;
+                    }
+                    flush();
+                    rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                }
+                flush();
+            }
+            ws.pixelsCovered += as.pixels;
+            ws.pixelsShaded = es.pixels + as.exec.pixels;
+            ws.instructions = es.instructions + as.exec.instructions;
+            ws.pixelsWritten = ms.written + as.written;
+            ws.texelsFetched = sampler.texelsFetched() - fetchedBefore + as.texels;
+        });
+        for (const DrawStats& ws : workerStats) {
+            stats.pixelsCovered += ws.pixelsCovered;
+            stats.pixelsShaded += ws.pixelsShaded;
+            stats.instructions += ws.instructions;
+            stats.pixelsWritten += ws.pixelsWritten;
+            stats.texelsFetched += ws.texelsFetched;
+        }
+    }
+    return true;
+}
+
+}  // namespace emu

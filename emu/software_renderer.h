@@ -1,0 +1,36 @@
+// The software renderer (docs/device.md "Drawing"): triangle setup and rasterisation
+// (emu/raster.h) in bands of rows over a worker pool, the executor over 2×2-quad spans with a
+// TextureSampler per worker, screen-aligned passes on the row path (emu/aligned_pass.h), and the
+// output merger (emu/output_merger.h). It draws what the device front resolved (emu/renderer.h).
+#pragma once
+
+#include <memory>
+
+#include "emu/renderer.h"
+
+namespace emu {
+
+// What only the software renderer has.
+struct SoftwareRendererOptions {
+    int threads = 0;  // worker threads of draws; 0 = all cores
+    // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
+    // no helper lanes, so fewer pixels shaded). Off: every draw goes through 2x2 quads.
+    bool alignedPasses = true;
+};
+
+struct SoftwareDrawContext;  // the worker pool and the executor cache (software_renderer.cpp)
+
+class SoftwareRenderer final : public Renderer {
+public:
+    explicit SoftwareRenderer(const SoftwareRendererOptions& options);
+    ~SoftwareRenderer() override;
+    bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) override;
+    const char* name() const override { return "software"; }
+    const SoftwareRendererOptions& options() const { return m_options; }
+
+private:
+    SoftwareRendererOptions m_options;
+    std::unique_ptr<SoftwareDrawContext> m_context;  // created by the first draw (threads start then)
+};
+
+}  // namespace emu
