@@ -79,7 +79,7 @@ HRESULT Device::CreateTexture(UINT width, UINT height, UINT levels, DWORD usage,
                     "CreateTexture: D3DUSAGE_DYNAMIC and D3DUSAGE_RENDERTARGET exclude each other");
     if ((usage & D3DUSAGE_DYNAMIC) && pool == D3DPOOL_MANAGED)
         return fail(D3DERR_INVALIDCALL, "E4112", "CreateTexture: D3DUSAGE_DYNAMIC cannot be used with D3DPOOL_MANAGED");
-    const uint32_t full = fullChainLength(width, height, 1);
+    const uint32_t full = ps11::fullMipCount(width, height, 1);
     Resource r;
     r.kind = ResourceKind::Texture;
     r.format = f;
@@ -131,7 +131,7 @@ HRESULT Device::CreateVolumeTexture(UINT width, UINT height, UINT depth, UINT le
     if ((usage & D3DUSAGE_DYNAMIC) && pool == D3DPOOL_MANAGED)
         return fail(D3DERR_INVALIDCALL, "E4112",
                     "CreateVolumeTexture: D3DUSAGE_DYNAMIC cannot be used with D3DPOOL_MANAGED");
-    const uint32_t full = fullChainLength(width, height, depth);
+    const uint32_t full = ps11::fullMipCount(width, height, depth);
     const uint32_t count = levels == 0 ? full : levels;
     if (count > full)
         return fail(D3DERR_INVALIDCALL, "E4105",

@@ -159,36 +159,4 @@ void encodeFloat(const FormatInfo& f, const std::array<float, 4>& v, uint8_t* p)
     }
 }
 
-uint16_t floatToHalf(float v) {
-    const uint32_t x = std::bit_cast<uint32_t>(v);
-    const uint16_t sign = uint16_t((x >> 16) & 0x8000);
-    if (std::isnan(v)) return uint16_t(sign | 0x7e00);
-    const double a = std::fabs(double(v));
-    if (a >= 65520.0) return uint16_t(sign | 0x7c00);  // beyond the largest half + half a step
-    if (a == 0.0) return sign;
-    int e = 0;
-    std::frexp(a, &e);                                            // a = m * 2^e, m in [0.5, 1)
-    const int quantumExp = std::max(e - 11, -24);                 // 11 significant bits; subnormals step 2^-24
-    const double q = std::nearbyint(std::ldexp(a, -quantumExp));  // ties to even
-    const double r = std::ldexp(q, quantumExp);
-    if (r < std::ldexp(1.0, -14)) return uint16_t(sign | uint16_t(std::ldexp(r, 24)));  // subnormal
-    int re = 0;
-    const double m = std::frexp(r, &re);  // r = m * 2^re, m in [0.5, 1)
-    const uint32_t exponent = uint32_t(re - 1 + 15);
-    const uint32_t mantissa = uint32_t(std::ldexp(m * 2.0 - 1.0, 10));
-    return uint16_t(sign | (exponent << 10) | mantissa);
-}
-
-float halfToFloat(uint16_t h) {
-    const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
-    double v;
-    if (exponent == 0)
-        v = std::ldexp(double(mantissa), -24);
-    else if (exponent == 31)
-        v = mantissa ? std::nan("") : INFINITY;
-    else
-        v = std::ldexp(double(mantissa + 1024), exponent - 25);
-    return float(sign ? -v : v);
-}
-
 }  // namespace emu

@@ -9,6 +9,7 @@
 #include "emu/d3d9types.h"
 #include "ps11/hardware.h"
 #include "ps11/testfile.h"
+#include "ps11/texture.h"
 
 namespace emu {
 
@@ -53,8 +54,9 @@ void encodeFloat(const FormatInfo& f, const std::array<float, 4>& rgba, uint8_t*
 // The texel word a packed (<= 32-bit) format stores at p, little endian.
 uint32_t loadWord(const uint8_t* p, uint32_t bytes);
 
-// IEEE half <-> float (round to nearest even, overflow to infinity).
-uint16_t floatToHalf(float v);
-float halfToFloat(uint16_t h);
+// IEEE half <-> float (round to nearest even, overflow to infinity): ps11/texture.h's, the one
+// conversion of the project.
+using ps11::floatToHalf;
+using ps11::halfToFloat;
 
 }  // namespace emu

@@ -113,13 +113,6 @@ void boxLevel(const Image& src, Image& dst, bool volume) {
 
 }  // namespace
 
-uint32_t fullChainLength(uint32_t width, uint32_t height, uint32_t depth) {
-    uint32_t m = std::max({width, height, depth, 1u});
-    uint32_t n = 1;
-    while (m > 1) m >>= 1, ++n;
-    return n;
-}
-
 uint32_t rowPitchOf(const FormatInfo& f, uint32_t width) { return (width * f.bytes + 3u) & ~3u; }
 
 uint64_t resourceBytes(const FormatInfo& f, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels) {

@@ -74,8 +74,6 @@ constexpr uint32_t kMaxTextureSide = 16384;  // D3DCAPS9 MaxTextureWidth/Height
 constexpr uint32_t kMaxVolumeSide = 2048;    // D3DCAPS9 MaxVolumeExtent
 constexpr uint64_t kMaxResourceBytes = uint64_t(1) << 30;
 
-// Number of levels of a full chain down to 1x1x1.
-uint32_t fullChainLength(uint32_t width, uint32_t height, uint32_t depth);
 // Row pitch of a level in bytes: width * texel size rounded up to 4 bytes (D3D9 pitches are
 // DWORD aligned; callers must use the pitch, never width * size).
 uint32_t rowPitchOf(const FormatInfo& f, uint32_t width);

@@ -158,16 +158,36 @@ uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth) {
     return n;
 }
 
-float roundToHalf(float v) {
-    if (!std::isfinite(v) || v == 0.0f) return v;
-    double a = std::fabs(double(v));
-    if (a >= 65520.0) return std::copysign(INFINITY, v);  // beyond the largest half + half a step
+uint16_t floatToHalf(float v) {
+    const uint32_t x = std::bit_cast<uint32_t>(v);
+    const uint16_t sign = uint16_t((x >> 16) & 0x8000);
+    if (std::isnan(v)) return uint16_t(sign | 0x7e00);
+    const double a = std::fabs(double(v));
+    if (a >= 65520.0) return uint16_t(sign | 0x7c00);  // beyond the largest half + half a step
+    if (a == 0.0) return sign;
     int e = 0;
-    std::frexp(a, &e);                       // a = m * 2^e, m in [0.5, 1)
-    int quantumExp = std::max(e - 11, -24);  // 11 significant bits; subnormals step 2^-24
-    double q = std::ldexp(1.0, quantumExp);
-    double r = std::nearbyint(a / q) * q;  // ties to even
-    return float(std::copysign(r, double(v)));
+    std::frexp(a, &e);                                            // a = m * 2^e, m in [0.5, 1)
+    const int quantumExp = std::max(e - 11, -24);                 // 11 significant bits; subnormals step 2^-24
+    const double q = std::nearbyint(std::ldexp(a, -quantumExp));  // ties to even
+    const double r = std::ldexp(q, quantumExp);
+    if (r < std::ldexp(1.0, -14)) return uint16_t(sign | uint16_t(std::ldexp(r, 24)));  // subnormal
+    int re = 0;
+    const double m = std::frexp(r, &re);  // r = m * 2^re, m in [0.5, 1)
+    const uint32_t exponent = uint32_t(re - 1 + 15);
+    const uint32_t mantissa = uint32_t(std::ldexp(m * 2.0 - 1.0, 10));
+    return uint16_t(sign | (exponent << 10) | mantissa);
+}
+
+float halfToFloat(uint16_t h) {
+    const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
+    double v;
+    if (exponent == 0)
+        v = std::ldexp(double(mantissa), -24);
+    else if (exponent == 31)
+        v = mantissa ? double(NAN) : double(INFINITY);
+    else
+        v = std::ldexp(double(mantissa + 1024), exponent - 25);
+    return float(sign ? -v : v);
 }
 
 const float* Texture::unorm8Values() {
@@ -420,19 +440,6 @@ uint32_t bytesPerTexel(TexFormat f) {
 
 namespace {
 
-// IEEE half -> float32 (exact).
-float halfBitsToFloat(uint16_t h) {
-    const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
-    double v;
-    if (exponent == 0)
-        v = std::ldexp(double(mantissa), -24);
-    else if (exponent == 31)
-        v = mantissa ? double(NAN) : double(INFINITY);
-    else
-        v = std::ldexp(double(mantissa + 1024), exponent - 25);
-    return float(sign ? -v : v);
-}
-
 inline uint32_t loadLE(const uint8_t* p, uint32_t bytes) {
     uint32_t w = 0;
     for (uint32_t i = 0; i < bytes; ++i) w |= uint32_t(p[i]) << (8 * i);
@@ -558,7 +565,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
                 if (fmt == TexFormat::R32F) {
                     d[0] = loadF32(p), d[1] = d[2] = d[3] = 1.0f;
                 } else if (fmt == TexFormat::A16B16G16R16F) {
-                    for (int c = 0; c < 4; ++c) d[c] = halfBitsToFloat(uint16_t(loadLE(p + 2 * c, 2)));
+                    for (int c = 0; c < 4; ++c) d[c] = halfToFloat(uint16_t(loadLE(p + 2 * c, 2)));
                 } else {
                     for (int c = 0; c < 4; ++c) d[c] = loadF32(p + 4 * c);
                 }

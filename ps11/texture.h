@@ -124,7 +124,11 @@ uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);
 // Bytes per texel of a format in D3D's memory layout.
 uint32_t bytesPerTexel(TexFormat f);
 
-// float32 -> nearest IEEE half (ties to even, overflow to infinity) -> float32.
-float roundToHalf(float v);
+// float32 -> nearest IEEE half bits (ties to even, overflow to infinity, NaN kept quiet).
+uint16_t floatToHalf(float v);
+// IEEE half bits -> float32 (exact).
+float halfToFloat(uint16_t h);
+// float32 -> nearest IEEE half -> float32.
+inline float roundToHalf(float v) { return halfToFloat(floatToHalf(v)); }
 
 }  // namespace ps11
