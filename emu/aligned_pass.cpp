@@ -13,6 +13,7 @@
 #include <cstring>
 
 #include "emu/aligned_pass_kernels.h"
+#include "ps11/cpu_features.h"
 #include "ps11/texture_sampler_fast.h"
 
 namespace emu {
@@ -67,10 +68,7 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
 }
 
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-bool hasAvx2() {
-    static const bool has = __builtin_cpu_supports("avx2");
-    return has;
-}
+bool hasAvx2() { return ps11::cpuFeatures().avx2Fma(); }
 #else
 bool hasAvx2() { return false; }
 #endif

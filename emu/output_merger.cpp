@@ -10,10 +10,10 @@
 #include <cstring>
 #include <string>
 
+#include "ps11/cpu_features.h"
 #include "ps11/sampler.h"
 
 #if defined(__x86_64__)
-#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -801,18 +801,8 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
 // A16B16G16R16F stores with the F16C conversion (VCVTPS2PH, round to nearest even: the same
 // halves as halfOf for every non-NaN value; a NaN stays a NaN), chosen at run time.
 // CPUID: F16C, AVX and OSXSAVE, and XCR0 saying the OS keeps the AVX state (VCVTPS2PH is
-// VEX-encoded). cpuid.h rather than __builtin_cpu_supports, which clang 14 lacks "f16c" for.
-bool hasF16c() {
-    static const bool ok = [] {
-        unsigned a = 0, b = 0, c = 0, d = 0;
-        if (!__get_cpuid(1, &a, &b, &c, &d)) return false;
-        if (((c >> 27) & 7u) != 7u) return false;  // OSXSAVE (27), AVX (28), F16C (29)
-        uint32_t lo = 0, hi = 0;
-        __asm__("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
-        return (lo & 6u) == 6u;  // SSE and AVX state enabled
-    }();
-    return ok;
-}
+// VEX-encoded): ps11::cpuFeatures.
+bool hasF16c() { return ps11::cpuFeatures().f16c; }
 __attribute__((target("f16c"))) uint64_t storeHalfF16c(const Surf& cs, const Lanes& lanes, const MergeInputs& in,
                                                        const float* const f[4], uint32_t channels) {
     const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];

@@ -1,5 +1,6 @@
 // The fx8 fast-path kernels compiled for AVX2 (+FMA): CMakeLists.txt gives this file -mavx2 -mfma.
 // Only called after fastKernelsAvx2() has checked the CPU (executor_fast.cpp).
+#include "ps11/cpu_features.h"
 #include "ps11/executor_fast.h"
 
 #if defined(__x86_64__) && defined(__AVX2__) && defined(__FMA__)
@@ -22,10 +23,7 @@ namespace ps11::exec::avx2 {
 namespace ps11::exec {
 const FastKernels* fastKernelsAvx2() {
 #ifdef PS11_HAVE_AVX2_KERNELS
-    // __builtin_cpu_supports also checks that the OS saves the AVX state; cpu_init makes the
-    // check valid even if an executor is created during static initialisation.
-    static const bool ok = (__builtin_cpu_init(), __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"));
-    return ok ? &avx2::kKernels : nullptr;
+    return cpuFeatures().avx2Fma() ? &avx2::kKernels : nullptr;
 #else
     return nullptr;
 #endif

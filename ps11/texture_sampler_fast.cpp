@@ -1,6 +1,7 @@
 // The fast Unorm8 kernels for any x86-64 (or other) CPU, and the runtime choice between them
 // and the AVX2 build (texture_sampler_fast_avx2.cpp).
 #define PS11_FAST_KERNEL sampleUnorm8Generic
+#include "ps11/cpu_features.h"
 #include "ps11/texture_sampler_fast_impl.h"
 
 #include <atomic>
@@ -14,8 +15,7 @@ std::atomic<bool> g_forceGeneric{false};
 
 bool hasAvx2Kernel() {
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-    static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    return has;
+    return cpuFeatures().avx2Fma();
 #else
     return false;
 #endif

@@ -26,7 +26,7 @@ using Unorm8Kernel = void (*)(const Unorm8Run& run, int count, const float* u, c
 void sampleUnorm8Generic(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
 // Built with AVX2 + FMA; call only when the CPU has both.
 void sampleUnorm8Avx2(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
-// The best kernel this CPU runs (chosen once, by __builtin_cpu_supports), or the generic one
+// The best kernel this CPU runs (chosen once, by ps11::cpuFeatures), or the generic one
 // while setForceGeneric(true) (tests compare both builds on a CPU that has AVX2).
 Unorm8Kernel unorm8Kernel();
 void setForceGeneric(bool generic);

@@ -118,3 +118,14 @@ TEST_CASE("hardware: the device decodes signed textures by its class", "[hardwar
         CHECK(t[3] == 1.0f);
     }
 }
+
+#include "ps11/cpu_features.h"
+
+TEST_CASE("cpu features: the one query agrees with the compiler's", "[cpu]") {
+#if defined(__x86_64__)
+    __builtin_cpu_init();
+    CHECK(ps11::cpuFeatures().avx2 == bool(__builtin_cpu_supports("avx2")));
+    CHECK(ps11::cpuFeatures().fma == bool(__builtin_cpu_supports("fma")));
+#endif
+    CHECK(&ps11::cpuFeatures() == &ps11::cpuFeatures());  // queried once
+}

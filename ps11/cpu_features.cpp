@@ -1,0 +1,40 @@
+// The one CPU feature query (ps11/cpu_features.h): CPUID leaves 1 and 7 and XGETBV, so a feature
+// counts only when the OS also saves the registers it needs (Intel SDM vol. 1, 14.3 "Detection of
+// Intel AVX instructions").
+#include "ps11/cpu_features.h"
+
+#include <cstdint>
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
+#endif
+
+namespace ps11 {
+
+namespace {
+
+CpuFeatures query() {
+    CpuFeatures f;
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+    unsigned a = 0, b = 0, c = 0, d = 0;
+    if (!__get_cpuid(1, &a, &b, &c, &d)) return f;
+    const bool osxsave = (c >> 27) & 1u, avx = (c >> 28) & 1u;
+    if (!osxsave || !avx) return f;
+    uint32_t lo = 0, hi = 0;
+    __asm__("xgetbv" : "=a"(lo), "=d"(hi) : "c"(0));
+    if ((lo & 6u) != 6u) return f;  // the OS keeps SSE and AVX state
+    f.fma = (c >> 12) & 1u;
+    f.f16c = (c >> 29) & 1u;
+    if (__get_cpuid_count(7, 0, &a, &b, &c, &d)) f.avx2 = (b >> 5) & 1u;
+#endif
+    return f;
+}
+
+}  // namespace
+
+const CpuFeatures& cpuFeatures() {
+    static const CpuFeatures features = query();
+    return features;
+}
+
+}  // namespace ps11

@@ -1,0 +1,17 @@
+// What this CPU and operating system can run, queried once for the whole program (CPUID and
+// XGETBV on x86-64). Every SIMD path chooses its kernels from here.
+#pragma once
+
+namespace ps11 {
+
+struct CpuFeatures {
+    bool avx2 = false;  // AVX2 with the OS keeping the AVX state
+    bool fma = false;   // FMA3 (the AVX2 kernels are built with it)
+    bool f16c = false;  // VCVTPS2PH / VCVTPH2PS
+    bool avx2Fma() const { return avx2 && fma; }
+};
+
+// The query, made on the first call (thread-safe); all false off x86-64.
+const CpuFeatures& cpuFeatures();
+
+}  // namespace ps11
