@@ -1,8 +1,9 @@
 // Hardware classes (ps11/hardware.h): the table, the signed-texel rules at their extremes, and
-// the resolution of a class with its overrides.
+// the resolution of a class with its overrides; the one CPU feature query.
 #include <catch2/catch.hpp>
 
 #include "emu/device.h"
+#include "ps11/cpu_features.h"
 #include "ps11/hardware.h"
 #include "ps11/texture.h"
 
@@ -118,8 +119,6 @@ TEST_CASE("hardware: the device decodes signed textures by its class", "[hardwar
         CHECK(t[3] == 1.0f);
     }
 }
-
-#include "ps11/cpu_features.h"
 
 TEST_CASE("cpu features: the one query agrees with the compiler's", "[cpu]") {
 #if defined(__x86_64__)
