@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
 
 namespace emu {
 
@@ -20,23 +22,13 @@ constexpr double kClipGuard = 32;
 // Smallest w kept: vertices at w -> 0 would project to infinity.
 constexpr double kMinW = 1e-7;
 
-using Mat4 = std::array<std::array<double, 4>, 4>;
-
-Mat4 toMat(const D3DMATRIX& m) {
-    Mat4 r;
+// D3D transforms row vectors (v' = v·M, M[row][column]); GLM multiplies column vectors, so a
+// D3D matrix goes in as its transpose: GLM column i holds D3D row i, and v·M is toMat(M) * v.
+// Products keep D3D's order: (W·V)·P is toMat(P) * (toMat(V) * toMat(W)). Double precision.
+glm::dmat4 toMat(const D3DMATRIX& m) {
+    glm::dmat4 r;
     for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < 4; ++j) r[size_t(i)][size_t(j)] = m.m[i][j];
-    return r;
-}
-
-Mat4 mul(const Mat4& a, const Mat4& b) {
-    Mat4 r{};
-    for (size_t i = 0; i < 4; ++i)
-        for (size_t j = 0; j < 4; ++j) {
-            double s = 0;
-            for (size_t k = 0; k < 4; ++k) s += a[i][k] * b[k][j];
-            r[i][j] = s;
-        }
+        for (int j = 0; j < 4; ++j) r[i][j] = m.m[i][j];
     return r;
 }
 
@@ -64,10 +56,10 @@ struct ClipVertex {
 struct Pipeline {
     const VertexLayout* layout = nullptr;
     uint64_t usedAttrs = 0;
-    Mat4 wvp{};
+    glm::dmat4 wvp{1.0};
     std::array<int, kMaxTexSets> slotSet{};    // vertex set each slot reads (-1: none, defaults)
     std::array<int, kMaxTexSets> slotCount{};  // texture transform output count (0 = no transform)
-    std::array<Mat4, kMaxTexSets> texMat{};
+    std::array<glm::dmat4, kMaxTexSets> texMat{};
     double vpX = 0, vpY = 0, vpW = 0, vpH = 0, minZ = 0, maxZ = 1;
     D3DCULL cull = D3DCULL_CCW;
     bool flat = false;
@@ -79,7 +71,8 @@ void readVertex(const Pipeline& p, const uint8_t* v, ClipVertex& out) {
     if (L.pretransformed) {
         out.pos = {x, y, z, double(readFloat(v + 12))};  // w slot holds rhw here
     } else {
-        for (size_t j = 0; j < 4; ++j) out.pos[j] = x * p.wvp[0][j] + y * p.wvp[1][j] + z * p.wvp[2][j] + p.wvp[3][j];
+        const glm::dvec4 c = p.wvp * glm::dvec4(x, y, z, 1.0);
+        for (int j = 0; j < 4; ++j) out.pos[size_t(j)] = c[j];
     }
     out.attr.fill(0.0f);
     if (L.hasDiffuse) {
@@ -115,9 +108,8 @@ void readVertex(const Pipeline& p, const uint8_t* v, ClipVertex& out) {
             for (int c = 0; c < n; ++c) src[size_t(c)] = in[size_t(c)];
             if (n < 4) src[size_t(n)] = 1;
             if (set < 0) src = {0, 0, 0, 1};
-            const Mat4& m = p.texMat[size_t(slot)];
-            for (size_t j = 0; j < 4; ++j)
-                t[j] = src[0] * m[0][j] + src[1] * m[1][j] + src[2] * m[2][j] + src[3] * m[3][j];
+            const glm::dvec4 r = p.texMat[size_t(slot)] * glm::dvec4(src[0], src[1], src[2], src[3]);
+            for (int j = 0; j < 4; ++j) t[size_t(j)] = r[j];
             for (int c = count; c < 4; ++c) t[size_t(c)] = c == 3 ? 1.0 : 0.0;
         }
         for (int c = 0; c < 4; ++c) out.attr[size_t(attrTex(slot, c))] = float(t[size_t(c)]);
@@ -379,7 +371,7 @@ void processTriangles(const DeviceState& state, const VertexSetup& setup, D3DPRI
     p.layout = setup.layout;
     p.usedAttrs = setup.usedAttrs;
     const VertexLayout& L = *setup.layout;
-    p.wvp = mul(mul(toMat(state.world), toMat(state.view)), toMat(state.projection));
+    p.wvp = toMat(state.projection) * (toMat(state.view) * toMat(state.world));
     for (int slot = 0; slot < kMaxTexSets; ++slot) {
         const DWORD index = state.stageState(slot, D3DTSS_TEXCOORDINDEX) & 0xFFFF;
         p.slotSet[size_t(slot)] = index < DWORD(L.texCount) ? int(index) : -1;
