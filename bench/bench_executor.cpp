@@ -125,7 +125,7 @@ std::unique_ptr<Sampler> makeSampler(bool textured) {
     auto sampler = std::make_unique<TextureSampler>();
     SamplerDesc desc;
     desc.minFilter.value = desc.magFilter.value = Filter::Linear;
-    desc.addressU.value = desc.addressV.value = desc.addressW.value = AddressMode::Clamp;
+    desc.addressU.value = desc.addressV.value = desc.addressW.value = TextureAddress::Clamp;
     for (int stage = 0; stage < 4; ++stage) {
         sampler->bind(stage, texture);
         sampler->setSamplerState(stage, samplerStateFromDesc(desc));

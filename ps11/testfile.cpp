@@ -19,21 +19,6 @@ namespace ps11 {
 namespace testfile_detail {
 namespace {
 
-const NameEntry<TexFormat> kFormats[] = {
-    {"A8R8G8B8", TexFormat::A8R8G8B8},
-    {"X8R8G8B8", TexFormat::X8R8G8B8},
-    {"A8", TexFormat::A8},
-    {"L8", TexFormat::L8},
-    {"A8L8", TexFormat::A8L8},
-    {"V8U8", TexFormat::V8U8},
-    {"L6V5U5", TexFormat::L6V5U5},
-    {"X8L8V8U8", TexFormat::X8L8V8U8},
-    {"Q8W8V8U8", TexFormat::Q8W8V8U8},
-    {"V16U16", TexFormat::V16U16},
-    {"A16B16G16R16F", TexFormat::A16B16G16R16F},
-    {"A32B32G32R32F", TexFormat::A32B32G32R32F},
-    {"R32F", TexFormat::R32F},
-};
 const NameEntry<TexFormat> kTargetFormats[] = {
     {"A8R8G8B8", TexFormat::A8R8G8B8},
     {"X8R8G8B8", TexFormat::X8R8G8B8},
@@ -42,11 +27,9 @@ const NameEntry<TexFormat> kTargetFormats[] = {
 };
 const NameEntry<Filter> kFilters[] = {{"point", Filter::Point}, {"linear", Filter::Linear}};
 const NameEntry<Filter> kMipFilters[] = {{"none", Filter::None}, {"point", Filter::Point}, {"linear", Filter::Linear}};
-const NameEntry<AddressMode> kAddressModes[] = {
-    {"wrap", AddressMode::Wrap},
-    {"clamp", AddressMode::Clamp},
-    {"mirror", AddressMode::Mirror},
-    {"border", AddressMode::Border},
+const NameEntry<TextureAddress> kAddressModes[] = {
+    {"wrap", TextureAddress::Wrap},     {"clamp", TextureAddress::Clamp},           {"mirror", TextureAddress::Mirror},
+    {"border", TextureAddress::Border}, {"mirroronce", TextureAddress::MirrorOnce},
 };
 const NameEntry<TextureOp> kTextureOps[] = {
     {"disable", TextureOp::Disable},
@@ -494,7 +477,7 @@ void Parser::textureLine(Args& a, std::string_view kw) {
         }
     } else if (iequals(kw, "format")) {
         if (!beforeData("format")) return;
-        assign(t.format, a.name(kFormats, "texture format"), line);
+        assign(t.format, a.name(kTexFormatNames, "texture format"), line);
     } else if (iequals(kw, "levels")) {
         if (!beforeData("levels")) return;
         std::optional<int64_t> n = a.integer("levels", 0, 15);
@@ -655,8 +638,8 @@ void Parser::samplerLine(Args& a, std::string_view kw) {
             assign(s.mipFilter, a.name(kMipFilters, "mip filter"), line);
         }
     } else if (iequals(kw, "address")) {
-        std::optional<AddressMode> u = a.name(kAddressModes, "address mode");
-        std::optional<AddressMode> v = u, w = u;
+        std::optional<TextureAddress> u = a.name(kAddressModes, "address mode");
+        std::optional<TextureAddress> v = u, w = u;
         if (!a.atEnd()) v = w = a.name(kAddressModes, "v address mode");
         if (!a.atEnd()) w = a.name(kAddressModes, "w address mode");
         assign(s.addressU, u, line);
@@ -921,7 +904,6 @@ void Parser::constantsLine(Args& a, std::string_view kw) {
 
 }  // namespace testfile_detail
 
-using testfile_detail::kFormats;
 using testfile_detail::kPrecisions;
 using testfile_detail::kTextureOps;
 using testfile_detail::Parser;
@@ -932,36 +914,6 @@ const char* precisionName(Precision p) {
     for (const auto& e : kPrecisions)
         if (e.value == p) return e.name;
     return "?";
-}
-
-const char* texFormatName(TexFormat f) {
-    for (const auto& e : kFormats)
-        if (e.value == f) return e.name;
-    return "?";
-}
-
-std::optional<TexFormat> parseTexFormat(std::string_view name) { return testfile_detail::lookup(kFormats, name); }
-
-bool isFloatFormat(TexFormat f) {
-    return f == TexFormat::A16B16G16R16F || f == TexFormat::A32B32G32R32F || f == TexFormat::R32F;
-}
-
-int formatBits(TexFormat f) {
-    switch (f) {
-        case TexFormat::A8:
-        case TexFormat::L8:
-            return 8;
-        case TexFormat::A8L8:
-        case TexFormat::V8U8:
-        case TexFormat::L6V5U5:
-            return 16;
-        case TexFormat::A16B16G16R16F:
-        case TexFormat::A32B32G32R32F:
-        case TexFormat::R32F:
-            return 0;
-        default:
-            return 32;
-    }
 }
 
 const char* textureOpName(TextureOp op) {

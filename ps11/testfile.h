@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "ps11/formats.h"
 #include "ps11/hardware.h"
 #include "ps11/precision.h"
 
@@ -36,27 +37,6 @@ enum : uint8_t { kBackendEmu = 1, kBackendGl = 2, kAllBackends = 3 };
 enum : uint8_t { kPrecisionFx8 = 1, kPrecisionFx12 = 2, kPrecisionFloat = 4, kPrecisionIdeal = 8 };
 
 const char* backendName(Backend b);
-
-// Surface formats a test may name (D3DFMT_* without the prefix).
-enum class TexFormat : uint8_t {
-    A8R8G8B8,
-    X8R8G8B8,
-    A8,
-    L8,
-    A8L8,
-    V8U8,
-    L6V5U5,
-    X8L8V8U8,
-    Q8W8V8U8,
-    V16U16,
-    A16B16G16R16F,
-    A32B32G32R32F,
-    R32F,
-};
-const char* texFormatName(TexFormat f);
-std::optional<TexFormat> parseTexFormat(std::string_view name);  // case-insensitive
-bool isFloatFormat(TexFormat f);
-int formatBits(TexFormat f);  // bits per texel of a packed format (0 for float formats)
 
 // A colour as written: one word 0xAARRGGBB (`packed`), or four floats r g b a. `rgba` always
 // holds the value (a packed word converted channel / 255).
@@ -96,14 +76,12 @@ struct TextureDesc {
     bool isVolume() const { return depth > 0; }
 };
 
-enum class Filter : uint8_t { None = 0, Point = 1, Linear = 2 };                   // D3DTEXF_*
-enum class AddressMode : uint8_t { Wrap = 1, Mirror = 2, Clamp = 3, Border = 4 };  // D3DTADDRESS_*
 
 struct SamplerDesc {
     uint32_t line = 0;
     int stage = 0;
     Setting<Filter> minFilter{Filter::Point}, magFilter{Filter::Point}, mipFilter{Filter::None};
-    Setting<AddressMode> addressU{AddressMode::Wrap}, addressV{AddressMode::Wrap}, addressW{AddressMode::Wrap};
+    Setting<TextureAddress> addressU{TextureAddress::Wrap}, addressV{TextureAddress::Wrap}, addressW{TextureAddress::Wrap};
     Setting<Color> border;
 };
 

@@ -115,11 +115,6 @@ inline std::optional<uint32_t> parseWord(std::string_view s) {
     return uint32_t(*v);
 }
 
-template <class E>
-struct NameEntry {
-    const char* name;
-    E value;
-};
 
 template <class E, size_t N>
 inline std::optional<E> lookup(const NameEntry<E> (&table)[N], std::string_view name) {

@@ -263,9 +263,9 @@ SamplerState samplerStateFromDesc(const SamplerDesc& desc) {
     s.minFilter = desc.minFilter.value;
     s.magFilter = desc.magFilter.value;
     s.mipFilter = desc.mipFilter.value;
-    s.addressU = TextureAddress(desc.addressU.value);  // D3DTADDRESS_* values 1..4 coincide
-    s.addressV = TextureAddress(desc.addressV.value);
-    s.addressW = TextureAddress(desc.addressW.value);
+    s.addressU = desc.addressU.value;
+    s.addressV = desc.addressV.value;
+    s.addressW = desc.addressW.value;
     s.border = desc.border.value.rgba;
     return s;
 }

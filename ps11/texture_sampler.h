@@ -18,8 +18,6 @@ namespace ps11 {
 // Sampler stages the device has (D3D9 ps 1.x: 8).
 constexpr int kMaxSamplerStages = 8;
 
-// D3DTADDRESS_* including MIRRORONCE, which the .ps11test format does not name (yet).
-enum class TextureAddress : uint8_t { Wrap = 1, Mirror = 2, Clamp = 3, Border = 4, MirrorOnce = 5 };
 
 // D3DSAMP_* state of one stage. Filter::None as min/mag filter acts as point.
 struct SamplerState {

@@ -125,7 +125,7 @@ TEST_CASE("device: the .ps11test model's names map onto D3D9 values", "[device]"
     CHECK(DWORD(ps11::CompareFunc::GreaterEqual) == D3DCMP_GREATEREQUAL);
     CHECK(DWORD(ps11::CullMode::Ccw) == D3DCULL_CCW);
     CHECK(DWORD(ps11::Filter::Linear) == D3DTEXF_LINEAR);
-    CHECK(DWORD(ps11::AddressMode::Border) == D3DTADDRESS_BORDER);
+    CHECK(DWORD(ps11::TextureAddress::Border) == D3DTADDRESS_BORDER);
     CHECK(DWORD(ps11::TextureAddress::MirrorOnce) == D3DTADDRESS_MIRRORONCE);
     CHECK(ps11::kTtffProjected == DWORD(D3DTTFF_PROJECTED));
     CHECK(DWORD(ps11::kWriteA) == D3DCOLORWRITEENABLE_ALPHA);

@@ -270,18 +270,18 @@ TEST_CASE("testfile: [sampler N]", "[testfile]") {
     CHECK(s.minFilter.value == Filter::Linear);
     CHECK(s.magFilter.value == Filter::Linear);
     CHECK(s.mipFilter.value == Filter::Point);
-    CHECK(s.addressU.value == AddressMode::Clamp);
-    CHECK(s.addressV.value == AddressMode::Wrap);
-    CHECK(s.addressW.value == AddressMode::Mirror);
+    CHECK(s.addressU.value == TextureAddress::Clamp);
+    CHECK(s.addressV.value == TextureAddress::Wrap);
+    CHECK(s.addressW.value == TextureAddress::Mirror);
     CHECK(s.border.value.argb == 0xff00ff00u);
     const SamplerDesc& t = *p.file.sampler(3);
     CHECK(t.minFilter.value == Filter::Point);
     CHECK(t.magFilter.value == Filter::Linear);
     CHECK(!t.mipFilter.isSet());
     CHECK(t.mipFilter.value == Filter::None);
-    CHECK(t.addressU.value == AddressMode::Border);
-    CHECK(t.addressV.value == AddressMode::Border);
-    CHECK(t.addressW.value == AddressMode::Border);
+    CHECK(t.addressU.value == TextureAddress::Border);
+    CHECK(t.addressV.value == TextureAddress::Border);
+    CHECK(t.addressW.value == TextureAddress::Border);
     CHECK(t.border.value.rgba == Vec4{0, 0.5f, 1, 1});
     CHECK(p.file.sampler(0) == nullptr);
 
@@ -289,7 +289,11 @@ TEST_CASE("testfile: [sampler N]", "[testfile]") {
     CHECK_ERROR(parse("[sampler 0]\nfilter linear mip cubic\n"), 2, "unknown mip filter 'cubic'");
     CHECK_ERROR(parse("[sampler 0]\nfilter linear mip\n"), 2, "missing mip filter");
     CHECK_ERROR(parse("[sampler 0]\naddress clamp clamp clamp clamp\n"), 2, "unexpected 'clamp'");
-    CHECK_ERROR(parse("[sampler 0]\naddress mirroronce\n"), 2, "unknown address mode 'mirroronce'");
+    CHECK_ERROR(parse("[sampler 0]\naddress mirrortwice\n"), 2, "unknown address mode 'mirrortwice'");
+    Parsed once = parse("[sampler 0]\naddress mirroronce clamp\n");  // every D3DTADDRESS_* value
+    REQUIRE_OK(once);
+    CHECK(once.file.sampler(0)->addressU.value == TextureAddress::MirrorOnce);
+    CHECK(once.file.sampler(0)->addressV.value == TextureAddress::Clamp);
     CHECK_ERROR(parse("[sampler 0]\nborder\n"), 2, "missing border colour");
     CHECK_ERROR(parse("[sampler 0]\nlodbias 1\n"), 2, "unknown keyword 'lodbias' in [sampler]");
     CHECK_ERROR(parse("[sampler 1]\n[sampler 1]\n"), 2, "duplicate section [sampler 1]");
