@@ -22,6 +22,7 @@
 #include "tools/cmd_eval.h"
 #include "tools/cmd_golden.h"
 #include "tools/cmd_hardware.h"
+#include "tools/cmd_info.h"
 #include "tools/cmd_test.h"
 
 namespace ps11::cli {
@@ -41,6 +42,8 @@ const char* kUsageText =
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
     "  hardware [--json]      the emulated GPUs (hardware classes) and what each one changes\n"
+    "  info [--gl osmesa|egl] [--json]\n"
+    "                         version, default hardware, executor kernels, the OpenGL context\n"
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
@@ -358,6 +361,7 @@ int main(int argc, char** argv) {
         {"golden", cmdGolden},
         {"demo", cmdDemo},
         {"hardware", ps11::cmdHardware},
+        {"info", ps11::cmdInfo},
         {"isa",
          [](const std::vector<std::string>&) {
              std::cout << ps11::isaMarkdownTable();

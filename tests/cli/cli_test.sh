@@ -224,6 +224,41 @@ expect_rc 2 "asm without input" "$ps11" asm
 expect_rc 2 "-D without name" "$ps11" asm "$work/a.psh" -D
 expect_rc 0 "help" "$ps11" --help
 
+# ps11 info: the build and the OpenGL context (docs/gl-backend.md "Contexts"). Both kinds work on
+# Debian 12 with .ci/setup's packages; a build without them (PS11_GL=OFF) reports that instead.
+expect_rc 0 "info" "$ps11" info
+expect_in "$work/out" "$(cat "$work/version1")" "info prints the version"
+expect_in "$work/out" "default hardware: geforce4" "info names the default hardware class"
+expect_in "$work/out" "executor kernels: " "info names the executor kernels"
+expect_rc 0 "info --json" "$ps11" info --json
+expect_in "$work/out" '"hardware": "geforce4"' "info --json"
+if grep -q "PS11_GL=OFF" "$work/out"; then
+    expect_rc 1 "info --gl egl without the GL backend" "$ps11" info --gl egl
+else
+    expect_in "$work/out" '"GL_RENDERER": ' "info --json has the GL context"
+    expect_rc 0 "info --gl egl" "$ps11" info --gl egl
+    expect_in "$work/out" "GL context: egl (EGL " "info --gl egl names the kind and platform"
+    expect_in "$work/out" "GL_RENDERER: " "info --gl egl prints GL_RENDERER"
+    expect_in "$work/out" "GL_VERSION: " "info --gl egl prints GL_VERSION"
+    # Without an EGL vendor library (GLVND finds none), --gl egl is the user's error, named.
+    expect_rc 1 "info --gl egl without a vendor" env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$ps11" info --gl egl
+    expect_in "$work/err" "ps11: info: EGL: " "the EGL failure is named"
+    "$ps11" info --gl osmesa >"$work/out" 2>&1
+    if ! grep -q "PS11_GL_OSMESA=OFF" "$work/out"; then
+        expect_rc 0 "info --gl osmesa" "$ps11" info --gl osmesa
+        expect_in "$work/out" "GL context: osmesa (OSMesa)" "info --gl osmesa"
+        # Mesa capped below 3.3: the core profile request is refused, and said so.
+        expect_rc 1 "info --gl osmesa below 3.3" env MESA_GL_VERSION_OVERRIDE=3.1 "$ps11" info --gl osmesa
+        expect_in "$work/err" "ps11: info: OSMesa: OSMesaCreateContextAttribs refused" "the OSMesa failure is named"
+        # Without --gl, no context is still a report, not an error.
+        expect_rc 0 "info without any context" env MESA_GL_VERSION_OVERRIDE=3.1 \
+            __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$ps11" info
+        expect_in "$work/out" "GL context: none (OSMesa: " "info reports why there is no context"
+    fi
+fi
+expect_rc 2 "info --gl unknown kind" "$ps11" info --gl glx
+expect_in "$work/err" "ps11: info: --gl takes osmesa or egl, not 'glx'" "info names the kinds"
+
 if [ "$failures" != 0 ]; then
     echo "$failures CLI check(s) failed"
     exit 1
