@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "ps11/cpu_features.h"
 #include "ps11/executor_fast.h"
 #include "ps11/hardware.h"
 #include "ps11/suggest.h"
@@ -99,10 +100,17 @@ int cmdInfo(const std::vector<std::string>& args) {
     const HardwareClass& hw = defaultHardware(1);
     const exec::FastKernels* kernels = exec::fastKernelsBest();
     const char* kernelName = kernels ? kernels->name : "none";
+    const CpuFeatures& cpu = cpuFeatures();
+    std::string cpuText;
+    for (auto [name, has] : {std::pair{"avx2", cpu.avx2}, std::pair{"fma", cpu.fma}, std::pair{"f16c", cpu.f16c}})
+        if (has) cpuText += cpuText.empty() ? name : std::string(" ") + name;
+    if (cpuText.empty()) cpuText = "none of avx2, fma, f16c";
     GlReport r = probeGl(gl);
     if (json) {
         std::cout << "{\"version\": " << jsonString(versionString()) << ", \"hardware\": " << jsonString(hw.name)
-                  << ", \"executor_kernels\": " << jsonString(kernelName) << ", \"gl\": {";
+                  << ", \"executor_kernels\": " << jsonString(kernelName) << ", \"cpu\": {\"avx2\": "
+                  << (cpu.avx2 ? "true" : "false") << ", \"fma\": " << (cpu.fma ? "true" : "false")
+                  << ", \"f16c\": " << (cpu.f16c ? "true" : "false") << "}, \"gl\": {";
         if (r.ok) {
             std::cout << "\"kind\": " << jsonString(r.kind) << ", \"platform\": " << jsonString(r.platform)
                       << ", \"GL_RENDERER\": " << jsonString(r.renderer)
@@ -115,6 +123,7 @@ int cmdInfo(const std::vector<std::string>& args) {
     } else {
         std::cout << "ps11 " << versionString() << "\n"
                   << "default hardware: " << hw.name << " (" << hw.kind << ")\n"
+                  << "cpu features: " << cpuText << "\n"
                   << "executor kernels: " << kernelName << "\n";
         if (r.ok) {
             std::cout << "GL context: " << r.kind << " (" << r.platform << ")\n"
