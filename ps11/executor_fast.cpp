@@ -108,26 +108,8 @@ bool textureWritesDst(const DOp& op) {
 // Texture ops that write all four components of their destination for every lane, so the
 // int32 copy of the destination need not be brought up to date first.
 bool textureWritesAll(const DOp& op, int minor) {
-    switch (op.op) {
-        case Opcode::TexCoord:
-            return minor < 4;  // 1_4 texcrd writes its mask only
-        case Opcode::Tex:
-        case Opcode::TexBem:
-        case Opcode::TexBemL:
-        case Opcode::TexReg2AR:
-        case Opcode::TexReg2GB:
-        case Opcode::TexReg2RGB:
-        case Opcode::TexM3x2Tex:
-        case Opcode::TexM3x3Tex:
-        case Opcode::TexM3x3:
-        case Opcode::TexM3x3Spec:
-        case Opcode::TexM3x3VSpec:
-        case Opcode::TexDp3Tex:
-        case Opcode::TexDp3:
-            return true;
-        default:
-            return false;
-    }
+    if (op.op == Opcode::TexCoord) return minor < 4;  // 1_4 texcrd writes its mask only
+    return samplesStage(op.op) || op.op == Opcode::TexM3x3 || op.op == Opcode::TexDp3;
 }
 
 struct FastRunState {
