@@ -9,6 +9,7 @@
 #include "emu/d3d9types.h"
 #include "emu/format.h"
 #include "emu/state.h"
+#include "ps11/caps.h"
 #include "ps11/ir.h"
 #include "ps11/texture.h"
 
@@ -70,9 +71,9 @@ struct PixelShaderObject {
 };
 
 // Refusals before any allocation (docs/device.md "Limits").
-constexpr uint32_t kMaxTextureSide = 16384;  // D3DCAPS9 MaxTextureWidth/Height
-constexpr uint32_t kMaxVolumeSide = 2048;    // D3DCAPS9 MaxVolumeExtent
-constexpr uint64_t kMaxResourceBytes = uint64_t(1) << 30;
+using ps11::kMaxResourceBytes;  // ps11/caps.h
+using ps11::kMaxTextureSide;
+using ps11::kMaxVolumeSide;
 
 // Row pitch of a level in bytes: width * texel size rounded up to 4 bytes (D3D9 pitches are
 // DWORD aligned; callers must use the pitch, never width * size).

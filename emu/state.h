@@ -10,6 +10,8 @@
 #include <functional>
 
 #include "emu/d3d9types.h"
+#include "ps11/caps.h"
+#include "ps11/ir.h"
 
 namespace emu {
 
@@ -17,12 +19,11 @@ namespace emu {
 // NULL; the device checks the kind at every call.
 enum class Handle : uint32_t { Null = 0 };
 
-// Stages and samplers of a ps 1.x-class device (D3DCAPS9 MaxTextureBlendStages = 8,
-// MaxSimultaneousTextures = 8).
-constexpr int kMaxStages = 8;
-constexpr int kMaxSamplers = 8;
-// ps_1_x constant registers c0..c7.
-constexpr int kMaxPsConstants = 8;
+// Stages and samplers of the device (ps11/caps.h).
+constexpr int kMaxStages = ps11::kMaxTextureStages;
+constexpr int kMaxSamplers = ps11::kMaxTextureStages;
+// ps_1_x constant registers c0..c7 (the register file, ps11/ir.h).
+constexpr int kMaxPsConstants = ps11::registerCount(ps11::RegType::Const, 1);
 
 struct DeviceState {
     // D3DRS_* values indexed by D3DRENDERSTATETYPE; float states hold their bit pattern.

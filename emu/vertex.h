@@ -17,7 +17,7 @@
 
 namespace emu {
 
-constexpr int kMaxTexSets = 8;
+constexpr int kMaxTexSets = ps11::kMaxTexCoordSets;  // ps11/caps.h
 
 // Interpolated attributes of a vertex: diffuse rgba, specular rgba (alpha = vertex fog factor),
 // then the eight executor texture-coordinate slots u v w q (slot i, not vertex set i: the

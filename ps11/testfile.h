@@ -12,6 +12,7 @@
 #include <variant>
 #include <vector>
 
+#include "ps11/caps.h"
 #include "ps11/formats.h"
 #include "ps11/hardware.h"
 #include "ps11/precision.h"
@@ -336,8 +337,8 @@ bool parseTestFile(std::string_view text, const std::string& fileName, TestFile&
 std::string formatTestFileError(const std::string& fileName, const TestFileError& error);
 
 // Limits that keep hostile input from asking for absurd allocations.
-constexpr uint32_t kMaxSurfaceSize = 16384;
-constexpr uint32_t kMaxVolumeDepth = 2048;
-constexpr uint64_t kMaxTexels = uint64_t(16384) * 16384;
+constexpr uint32_t kMaxSurfaceSize = kMaxTextureSide;  // ps11/caps.h
+constexpr uint32_t kMaxVolumeDepth = kMaxVolumeSide;
+constexpr uint64_t kMaxTexels = uint64_t(kMaxTextureSide) * kMaxTextureSide;
 
 }  // namespace ps11

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "ps11/caps.h"
 #include "ps11/sampler.h"
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
@@ -16,7 +17,7 @@
 namespace ps11 {
 
 // Sampler stages the device has (D3D9 ps 1.x: 8).
-constexpr int kMaxSamplerStages = 8;
+constexpr int kMaxSamplerStages = kMaxTextureStages;  // ps11/caps.h
 
 
 // D3DSAMP_* state of one stage. Filter::None as min/mag filter acts as point.
