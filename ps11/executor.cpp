@@ -19,14 +19,20 @@ const float* texcoordLanes(const RunState& st, int set, int comp) {
     return p ? p + st.offset : st.zeros;
 }
 
-namespace {
-
-// fx: D3D9 constants are clamped to [-1, 1] on load (Wine, DXVK, nine; spec §7.2), then
-// rounded to the grid exactly (docs/precision.md "Inputs").
-float clampConst(float v) {
-    if (!(v == v)) return 0;
-    return std::min(1.0f, std::max(-1.0f, v));
+void constantOf(Precision precision, float v, int32_t& grid, float& value) {
+    // D3D9 constants are clamped to [-1, 1] on load (Wine, DXVK, nine; spec §7.2), then rounded
+    // to the grid exactly in fx profiles (docs/precision.md "Inputs").
+    const float f = v == v ? std::min(1.0f, std::max(-1.0f, v)) : 0.0f;
+    if (isFixedPoint(precision)) {
+        grid = toGrid(double(f), precision);
+        value = float(grid) / float(gridScale(precision));
+    } else {
+        grid = 0;
+        value = f;
+    }
 }
+
+namespace {
 
 // A process-wide unique, non-zero number per set of constants (see runFast's constsId).
 uint64_t nextConstsId() {
@@ -79,16 +85,8 @@ private:
     void refreshConstant(int i) {
         // A def in the shader overrides the API value (spec §1.1, def page).
         const std::array<float, 4>& v = (m_defMask >> i) & 1 ? m_defs[size_t(i)] : m_api[size_t(i)];
-        for (int c = 0; c < 4; ++c) {
-            float f = clampConst(v[size_t(c)]);
-            if (isFixedPoint(m_p.precision)) {
-                int32_t n = toGrid(double(f), m_p.precision);
-                m_p.constGrid[size_t(i)][size_t(c)] = n;
-                m_p.constF[size_t(i)][size_t(c)] = float(n) / float(m_p.g);
-            } else {
-                m_p.constF[size_t(i)][size_t(c)] = f;
-            }
-        }
+        for (int c = 0; c < 4; ++c)
+            constantOf(m_p.precision, v[size_t(c)], m_p.constGrid[size_t(i)][size_t(c)], m_p.constF[size_t(i)][size_t(c)]);
     }
     void runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const;
     // Adds count pixels and their executed instructions (phase excluded) to stats, if given.
@@ -314,8 +312,8 @@ ExecutorOptions executorOptionsFor(const HardwareConfig& hardware) {
     return o;
 }
 
-std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
-                                           Diagnostics& diags) {
+bool exec::decodeProgram(const Program& program, const ExecutorOptions& options, Diagnostics& diags,
+                         DecodedProgram& out) {
     using namespace exec;
     Decoder dec{program, diags};
     const Version& ver = program.version;
@@ -323,7 +321,7 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
         diags.error("E4001", program.versionLoc,
                     "unsupported shader version ps_" + std::to_string(ver.major) + "_" + std::to_string(ver.minor) +
                         ": the executor runs ps_1_1 to ps_1_4");
-        return nullptr;
+        return false;
     }
     dec.minor = ver.minor;
 
@@ -339,7 +337,7 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
         diags.error("E4003", program.versionLoc,
                     "max value " + std::to_string(m) + " out of range for profile " + precisionName(p.precision) +
                         " (needs 0 < M <= 1e6 and 1 <= round(M*G) <= 2^24)");
-        return nullptr;
+        return false;
     }
     p.maxValue = m;
     p.nMax = isFixedPoint(p.precision) ? int32_t(std::nearbyint(double(m) * p.g)) : 0;
@@ -461,8 +459,17 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
     if (!ops.empty() && ops.back().hold) {
         dec.fail("E4006", program.instructions.back().loc, "co-issued pair without its second member");
     }
-    if (!dec.ok) return nullptr;
-    return std::make_unique<ExecutorImpl>(options, p, std::move(ops), defs, defMask, stages, depth, vUsed);
+    if (!dec.ok) return false;
+    out = DecodedProgram{p, std::move(ops), defs, defMask, stages, depth, vUsed};
+    return true;
+}
+
+std::unique_ptr<Executor> Executor::create(const Program& program, const ExecutorOptions& options,
+                                           Diagnostics& diags) {
+    exec::DecodedProgram d;
+    if (!exec::decodeProgram(program, options, diags, d)) return nullptr;
+    return std::make_unique<exec::ExecutorImpl>(options, d.profile, std::move(d.ops), d.defs, d.defMask,
+                                                d.stagesUsed, d.writesDepth, d.vUsed);
 }
 
 }  // namespace ps11

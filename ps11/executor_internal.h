@@ -93,6 +93,26 @@ void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[
 // Texture-address instruction.
 void execTexture(const Profile& p, const DOp& op, RunState& st);
 
+// A validated program decoded once for running (Executor::create) or translating (the GL
+// renderer's GLSL, emu/gl/glsl.h): the op list with register slots, the profile, the def
+// constants (defMask: which of c0..c7 a def sets), the stages sampled, whether depth is
+// replaced, and which of v0/v1 are read.
+struct DecodedProgram {
+    Profile profile;
+    std::vector<DOp> ops;
+    std::array<std::array<float, 4>, 8> defs{};
+    uint8_t defMask = 0;
+    uint32_t stagesUsed = 0;
+    bool writesDepth = false;
+    uint8_t vUsed = 0;
+};
+// Decodes `program` for `options`; false with E40xx diagnostics when it cannot be run.
+bool decodeProgram(const Program& program, const ExecutorOptions& options, Diagnostics& diags, DecodedProgram& out);
+
+// A constant as the profile loads it: clamped to [-1, 1] (NaN: 0); fx: grid = round_half_even(v·G)
+// and value = grid / G; float profiles: value only (grid 0).
+void constantOf(Precision precision, float v, int32_t& grid, float& value);
+
 // Pointer to TC[set][comp] lanes of the chunk (zeros when absent).
 const float* texcoordLanes(const RunState& st, int set, int comp);
 
