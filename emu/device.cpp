@@ -26,7 +26,8 @@ Device::Device(const DeviceOptions& options) : m_options(options) {
     if (m_options.maxResourceBytes == 0 || m_options.maxResourceBytes > kMaxResourceBytes)
         m_options.maxResourceBytes = kMaxResourceBytes;
     m_hardware = ps11::resolveHardware(m_options.hardware, 1, m_options.precision, m_options.maxValue);
-    m_renderer = std::make_unique<SoftwareRenderer>(m_options.software);
+    if (m_options.renderer) m_renderer = m_options.renderer();
+    if (!m_renderer) m_renderer = std::make_unique<SoftwareRenderer>(m_options.software);
 }
 
 Device::~Device() = default;

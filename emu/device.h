@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -32,6 +33,9 @@ struct DeviceOptions {
     uint64_t maxResourceBytes = kMaxResourceBytes;  // per resource, checked before allocating
     // The software renderer's own options (threads, aligned passes).
     SoftwareRendererOptions software;
+    // Another renderer (emu/renderer.h), made when the device is: the GL renderer
+    // (emu/gl/gl_renderer.h) comes this way. Empty: the software renderer.
+    std::function<std::unique_ptr<Renderer>()> renderer;
 };
 
 // What the last call reported. Every call resets it; a failed call sets hr, an E41xx code and

@@ -10,6 +10,12 @@
 
 #include <string>
 
+// glcorearb.h declares no pointer types for the OpenGL 1.1 entry points.
+typedef void(APIENTRYP PFNGLGENTEXTURESPROC)(GLsizei n, GLuint* textures);
+typedef void(APIENTRYP PFNGLDELETETEXTURESPROC)(GLsizei n, const GLuint* textures);
+typedef void(APIENTRYP PFNGLBINDTEXTUREPROC)(GLenum target, GLuint texture);
+typedef void(APIENTRYP PFNGLDRAWARRAYSPROC)(GLenum mode, GLint first, GLsizei count);
+
 namespace emu::gl {
 
 using GlProc = void (*)();
@@ -33,7 +39,59 @@ using GlProc = void (*)();
     X(PFNGLGENRENDERBUFFERSPROC, GenRenderbuffers, "glGenRenderbuffers")                      \
     X(PFNGLDELETERENDERBUFFERSPROC, DeleteRenderbuffers, "glDeleteRenderbuffers")             \
     X(PFNGLBINDRENDERBUFFERPROC, BindRenderbuffer, "glBindRenderbuffer")                      \
-    X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage, "glRenderbufferStorage")
+    X(PFNGLRENDERBUFFERSTORAGEPROC, RenderbufferStorage, "glRenderbufferStorage") \
+    X(PFNGLGETSTRINGIPROC, GetStringi, "glGetStringi") \
+    X(PFNGLCREATESHADERPROC, CreateShader, "glCreateShader") \
+    X(PFNGLSHADERSOURCEPROC, ShaderSource, "glShaderSource") \
+    X(PFNGLCOMPILESHADERPROC, CompileShader, "glCompileShader") \
+    X(PFNGLGETSHADERIVPROC, GetShaderiv, "glGetShaderiv") \
+    X(PFNGLGETSHADERINFOLOGPROC, GetShaderInfoLog, "glGetShaderInfoLog") \
+    X(PFNGLDELETESHADERPROC, DeleteShader, "glDeleteShader") \
+    X(PFNGLCREATEPROGRAMPROC, CreateProgram, "glCreateProgram") \
+    X(PFNGLATTACHSHADERPROC, AttachShader, "glAttachShader") \
+    X(PFNGLLINKPROGRAMPROC, LinkProgram, "glLinkProgram") \
+    X(PFNGLGETPROGRAMIVPROC, GetProgramiv, "glGetProgramiv") \
+    X(PFNGLGETPROGRAMINFOLOGPROC, GetProgramInfoLog, "glGetProgramInfoLog") \
+    X(PFNGLDELETEPROGRAMPROC, DeleteProgram, "glDeleteProgram") \
+    X(PFNGLUSEPROGRAMPROC, UseProgram, "glUseProgram") \
+    X(PFNGLGETUNIFORMLOCATIONPROC, GetUniformLocation, "glGetUniformLocation") \
+    X(PFNGLUNIFORM1IPROC, Uniform1i, "glUniform1i") \
+    X(PFNGLUNIFORM4FPROC, Uniform4f, "glUniform4f") \
+    X(PFNGLUNIFORM4IVPROC, Uniform4iv, "glUniform4iv") \
+    X(PFNGLUNIFORM4FVPROC, Uniform4fv, "glUniform4fv") \
+    X(PFNGLUNIFORM2FVPROC, Uniform2fv, "glUniform2fv") \
+    X(PFNGLGENTEXTURESPROC, GenTextures, "glGenTextures") \
+    X(PFNGLDELETETEXTURESPROC, DeleteTextures, "glDeleteTextures") \
+    X(PFNGLBINDTEXTUREPROC, BindTexture, "glBindTexture") \
+    X(PFNGLACTIVETEXTUREPROC, ActiveTexture, "glActiveTexture") \
+    X(PFNGLTEXIMAGE2DPROC, TexImage2D, "glTexImage2D") \
+    X(PFNGLTEXIMAGE3DPROC, TexImage3D, "glTexImage3D") \
+    X(PFNGLTEXPARAMETERIPROC, TexParameteri, "glTexParameteri") \
+    X(PFNGLTEXBUFFERPROC, TexBuffer, "glTexBuffer") \
+    X(PFNGLGENBUFFERSPROC, GenBuffers, "glGenBuffers") \
+    X(PFNGLDELETEBUFFERSPROC, DeleteBuffers, "glDeleteBuffers") \
+    X(PFNGLBINDBUFFERPROC, BindBuffer, "glBindBuffer") \
+    X(PFNGLBUFFERDATAPROC, BufferData, "glBufferData") \
+    X(PFNGLGENVERTEXARRAYSPROC, GenVertexArrays, "glGenVertexArrays") \
+    X(PFNGLBINDVERTEXARRAYPROC, BindVertexArray, "glBindVertexArray") \
+    X(PFNGLDELETEVERTEXARRAYSPROC, DeleteVertexArrays, "glDeleteVertexArrays") \
+    X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer, "glVertexAttribPointer") \
+    X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray, "glEnableVertexAttribArray") \
+    X(PFNGLDRAWARRAYSPROC, DrawArrays, "glDrawArrays") \
+    X(PFNGLFRAMEBUFFERTEXTURE2DPROC, FramebufferTexture2D, "glFramebufferTexture2D") \
+    X(PFNGLDRAWBUFFERSPROC, DrawBuffers, "glDrawBuffers") \
+    X(PFNGLCOLORMASKIPROC, ColorMaski, "glColorMaski") \
+    X(PFNGLSCISSORPROC, Scissor, "glScissor") \
+    X(PFNGLENABLEPROC, Enable, "glEnable") \
+    X(PFNGLDISABLEPROC, Disable, "glDisable") \
+    X(PFNGLCLIPCONTROLPROC, ClipControl, "glClipControl") \
+    X(PFNGLTEXTUREBARRIERPROC, TextureBarrier, "glTextureBarrier") \
+    X(PFNGLGETTEXIMAGEPROC, GetTexImage, "glGetTexImage") \
+    X(PFNGLGENQUERIESPROC, GenQueries, "glGenQueries") \
+    X(PFNGLDELETEQUERIESPROC, DeleteQueries, "glDeleteQueries") \
+    X(PFNGLBEGINQUERYPROC, BeginQuery, "glBeginQuery") \
+    X(PFNGLENDQUERYPROC, EndQuery, "glEndQuery") \
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v, "glGetQueryObjectui64v")
 
 // Called as gl.Clear(GL_COLOR_BUFFER_BIT): the GL name without its "gl".
 struct GlFunctions {

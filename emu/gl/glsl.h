@@ -1,0 +1,58 @@
+// ps_1_x → GLSL for the GL renderer (docs/gl-backend.md "Shaders"). One fragment shader per
+// draw configuration: the decoded program (ps11/executor_internal.h, the op list the executor
+// runs), the precision profile, the sampled stages' texture kinds and sampler states, and the
+// output merger's plan (emu/merge_plan.h). Two modes follow from the profile:
+// - exact (fx8, fx12): registers are grid integers, every instruction forms the executor's exact
+//   numerator and rounds once (ties to even), bilinear and mip filtering by hand with
+//   texelFetch and 8-bit weights, the merge on the grid;
+// - float (float, ideal): float32 registers evaluated in the executor's order without
+//   contraction (`precise`), the same filtering formulas in float32.
+// Attributes are not interpolated by GL: each fragment evaluates the rasteriser's planes
+// (emu/raster.h) from a per-triangle record, so both renderers shade the same inputs.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "emu/merge_plan.h"
+#include "emu/raster.h"
+#include "ps11/executor_internal.h"
+#include "ps11/texture_sampler.h"
+
+namespace emu::gl {
+
+// A sampled stage as the shader sees it.
+struct StageSpec {
+    bool bound = false;   // a texture is bound; otherwise the stage samples (0, 0, 0, 1)
+    bool volume = false;  // sampler3D / isampler3D
+    int levels = 1;
+    ps11::SamplerState state;  // filters and address modes (the border colour is a uniform)
+};
+
+struct FragmentSpec {
+    const ps11::exec::DecodedProgram* program = nullptr;
+    ps11::Precision precision = ps11::Precision::Fx8;
+    int weightBits = 8;  // float profile: 8-bit sub-texel weights (0: float32 weights)
+    std::array<StageSpec, 8> stages{};
+    uint64_t usedAttributes = 0;  // attributes in the triangle record (emu/vertex.h indices)
+    Plan merge;                   // the output merger's plan (colour/depth pointers unused)
+    bool shaderDepth = false;     // r0's depth comes from texdepth / texm3x2depth
+    bool wantZ = false;           // the depth plane is evaluated (depth test or write)
+};
+
+// The GLSL version and extensions the shaders need (checked by the renderer).
+constexpr int kGlslVersion = 450;
+
+std::string vertexSource();
+std::string fragmentSource(const FragmentSpec& spec);
+
+// The triangle record (a usamplerBuffer of RGBA32UI texels): texel 0 = (perspective,
+// constant-mask low, high, 0), then doubles two per texel: ox, oy, the rhw plane, the z plane
+// and, for each attribute of `used` in ascending order, its plane (base, dx, dy) or, when the
+// attribute is constant over the triangle, (value, 0, 0).
+int recordTexels(uint64_t used);
+void writeRecord(const TriangleSetup& setup, uint64_t used, uint32_t* out);
+
+}  // namespace emu::gl
