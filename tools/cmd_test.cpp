@@ -42,6 +42,7 @@ struct RunOptions {
     std::optional<Precision> precision;       // overrides [require] precision when given
     bool verbose = false;
     bool stats = false;  // print executor statistics per file
+    RendererFactory glRenderer;  // --backend gl|both
 };
 
 enum class Outcome { Passed, Failed, NotRunnable };
@@ -168,6 +169,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
     run.hardware = hw;
     run.verbose = opts.verbose;
     run.shaderDiags = &shaderDiags;
+    run.glRenderer = opts.glRenderer;
     CommandTally& t = result.tally;
     runCommands(file, path, program ? &*program : nullptr, run, t);
     if (opts.stats && t.evals) {
@@ -184,7 +186,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
                   << " instructions executed, " << d.texelsFetched << " texels fetched, " << d.milliseconds
                   << " ms\n";
     }
-    if (t.error || t.probesFailed)
+    if (t.error || t.probesFailed || t.disagreements)
         result.outcome = Outcome::Failed;
     else if (t.pendingGl)
         result.outcome = Outcome::NotRunnable;
@@ -256,6 +258,14 @@ int cmdTest(const std::vector<std::string>& args) {
         }
     }
     if (files.empty()) return usageError("no .ps11test files given");
+    if (opts.backends & kBackendGl) {
+        std::string error;
+        opts.glRenderer = glRendererFactory(error);
+        if (!opts.glRenderer) {
+            std::cerr << "ps11 test: --backend " << (opts.backends & kBackendEmu ? "both" : "gl") << ": " << error << "\n";
+            return cli::kUserError;
+        }
+    }
     if (!allHardware) return runFiles(files, opts, false);
     int rc = cli::kOk;
     for (const HardwareClass& h : hardwareClasses()) {
@@ -278,6 +288,12 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
         total.probesFailed += t.probesFailed;
         total.probesTodo += t.probesTodo;
         total.pendingGl += t.pendingGl;
+        total.comparedDraws += t.comparedDraws;
+        total.comparedPixels += t.comparedPixels;
+        total.exactPixels += t.exactPixels;
+        total.overOnePixels += t.overOnePixels;
+        total.maxDiff = std::max(total.maxDiff, t.maxDiff);
+        total.disagreements += t.disagreements;
         if (r.skipped) ++skipped;
         if (r.skippedHardware) {
             ++skippedHardware;
@@ -311,7 +327,7 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
     if (perClass) std::cout << opts.hardware->name << ": ";
     std::cout << plural(files.size(), "file", "files") << ": " << passed << " passed, " << failed << " failed, "
               << notRunnable << " not yet runnable";
-    if (total.pendingGl) std::cout << " (not runnable on gl yet: " << plural(total.pendingGl, "command", "commands") << ")";
+    if (total.pendingGl) std::cout << " (not runnable on gl: " << plural(total.pendingGl, "command", "commands") << ")";
     std::cout << "; probes: " << total.probesPassed << " passed, " << total.probesFailed << " failed, "
               << total.probesTodo << " todo";
     if (skipped) std::cout << "; " << skipped << " with commands skipped by [require] backend";
@@ -319,6 +335,14 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
         std::cout << "; " << skippedHardware << " skipped: their shader version is beyond hardware "
                   << opts.hardware->name;
     std::cout << "\n";
+    if (total.comparedDraws) {
+        std::cout << (perClass ? std::string(opts.hardware->name) + ": " : std::string()) << "cross-check ("
+                  << glRendererDescription() << "): " << plural(total.comparedDraws, "draw", "draws") << ", "
+                  << total.comparedPixels << " pixels, " << total.exactPixels << " exact ("
+                  << (total.comparedPixels ? 100.0 * double(total.exactPixels) / double(total.comparedPixels) : 100.0)
+                  << " %), " << total.overOnePixels << " past the target, max |d| " << total.maxDiff << "; "
+                  << plural(total.disagreements, "disagreement", "disagreements") << "\n";
+    }
     return failed ? cli::kUserError : cli::kOk;
 }
 

@@ -271,7 +271,7 @@ DrawRunner::~DrawRunner() = default;
 
 std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::string& path, const Program* program,
                                                const HardwareConfig& hardware, std::string& error,
-                                               bool alignedPasses) {
+                                               bool alignedPasses, const RendererFactory& renderer) {
     std::unique_ptr<DrawRunner> r(new DrawRunner());
     r->m_path = path;
     emu::DeviceOptions options;
@@ -279,6 +279,7 @@ std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::
     options.precision = hardware.precision;
     options.maxValue = hardware.maxValue;
     options.software.alignedPasses = alignedPasses;
+    options.renderer = renderer;
     r->m_device = std::make_unique<Device>(options);
     Device& d = *r->m_device;
 
@@ -443,6 +444,8 @@ bool DrawRunner::readBack(std::string& error) {
     m_readBackValid = true;
     return true;
 }
+
+bool DrawRunner::floatTarget() const { return isFloatFormat(m_format); }
 
 bool DrawRunner::targetPixels(std::vector<Vec4>& out, std::string& error) {
     if (!readBack(error)) return false;

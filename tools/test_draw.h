@@ -14,6 +14,7 @@
 #include "ps11/ir.h"
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
+#include "tools/gl_backend.h"
 
 namespace emu {
 class Device;
@@ -37,10 +38,10 @@ public:
     // and render states, transforms, constants and the pixel shader (`program`, null = fixed
     // function) on a device of `hardware`. Returns null with `error` set ("FILE:LINE: …") when
     // the device refuses a call. `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer
-    // draws both ways).
+    // draws both ways); `renderer` makes the device's renderer (empty: the software renderer).
     static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
                                               const HardwareConfig& hardware, std::string& error,
-                                              bool alignedPasses = true);
+                                              bool alignedPasses = true, const RendererFactory& renderer = {});
     ~DrawRunner();
 
     // Runs a `draw quad` / `draw triangles|strip|fan` command; false with `error` set when the
@@ -55,6 +56,10 @@ public:
     // The render target as read back (8-bit levels, or values on float targets), row by row;
     // false with `error` set when the device refuses the read-back.
     bool targetPixels(std::vector<Vec4>& out, std::string& error);
+    uint32_t width() const { return m_width; }
+    uint32_t height() const { return m_height; }
+    // The target stores floats (values), not 8-bit levels.
+    bool floatTarget() const;
 
 private:
     DrawRunner() = default;

@@ -193,48 +193,110 @@ std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string
     return sampler;
 }
 
+// --backend both: keeps the emu renderer's target after a draw; on gl compares with it pixel by
+// pixel (8-bit levels, or values on float targets) and reports a draw past the cross-check's
+// target (more than one level, or 1e-4 on float targets) as a disagreement.
+static void compareDraw(const std::string& path, const TestCommand& cmd, bool gl, DrawRunner& device,
+                 std::vector<Vec4>& emuTarget, CommandTally& tally) {
+    std::vector<Vec4> pixels;
+    std::string error;
+    if (!device.targetPixels(pixels, error)) return;
+    if (!gl) {
+        emuTarget = std::move(pixels);
+        return;
+    }
+    if (emuTarget.size() != pixels.size()) return;
+    const bool values = device.floatTarget();
+    uint64_t exact = 0, overOne = 0;
+    double maxDiff = 0;
+    size_t firstBad = pixels.size();
+    for (size_t i = 0; i < pixels.size(); ++i) {
+        double d = 0;
+        for (int c = 0; c < 4; ++c) {
+            const double a = pixels[i][size_t(c)], b = emuTarget[i][size_t(c)];
+            const double diff = (a == b || (a != a && b != b)) ? 0.0 : std::fabs(a - b);
+            d = std::max(d, diff != diff ? 1e30 : diff);
+        }
+        exact += d == 0;
+        if (d > (values ? 1e-4 : 1.0)) {
+            ++overOne;
+            if (firstBad == pixels.size()) firstBad = i;
+        }
+        maxDiff = std::max(maxDiff, d);
+    }
+    ++tally.comparedDraws;
+    tally.comparedPixels += pixels.size();
+    tally.exactPixels += exact;
+    tally.overOnePixels += overOne;
+    tally.maxDiff = std::max(tally.maxDiff, maxDiff);
+    if (overOne) {
+        ++tally.disagreements;
+        const uint32_t w = std::max<uint32_t>(device.width(), 1);
+        std::cout << where(path, cmd.line) << ": disagreement: gl and emu differ past the target on " << overOne << " of "
+                  << pixels.size() << " pixels (max |d| " << maxDiff << (values ? "" : " levels") << "), first at ("
+                  << firstBad % w << ", " << firstBad / w << ")\n";
+    }
+}
+
 void runCommands(const TestFile& file, const std::string& path, const Program* program,
                  const CommandRunOptions& opts, CommandTally& tally) {
     const Precision p = opts.hardware.precision;
     const HardwareClass& hw = *opts.hardware.hardware;
     EvalState state;
     bool prepared = false;
+    const bool both = (opts.backends & kBackendEmu) && (opts.backends & kBackendGl);
+    // --backend both: the emu renderer's target after each draw and each probe's outcome, by
+    // command index, for the gl pass to compare with.
+    std::vector<std::vector<Vec4>> emuTargets(file.commands.size());
+    std::vector<int8_t> emuProbePassed(file.commands.size(), -1);
     for (Backend backend : {Backend::Emu, Backend::Gl}) {
         if (!(opts.backends & (1u << unsigned(backend)))) continue;
+        const bool gl = backend == Backend::Gl;
         // The last thing a probe looks at: an eval's r0 or the device's render target.
         std::optional<EvalOutcome> last;
         std::unique_ptr<DrawRunner> device;
         bool deviceFailed = false;
-        for (const TestCommand& cmd : file.commands) {
+        for (size_t ci = 0; ci < file.commands.size(); ++ci) {
+            const TestCommand& cmd = file.commands[ci];
             if (!cmd.onlyIf.matches(backend, p, hw)) continue;
-            if (backend == Backend::Gl) {
-                ++tally.pendingGl;  // the GL backend is not built yet
+            if (gl && (!isDeviceCommand(cmd) || !opts.glRenderer)) {
+                ++tally.pendingGl;  // evals run on the executor only; no GL renderer
                 continue;
             }
             if (isDeviceCommand(cmd)) {
                 if (deviceFailed) continue;
                 std::string error;
                 if (!device) {
-                    device = DrawRunner::create(file, path, program, opts.hardware, error);
+                    device = DrawRunner::create(file, path, program, opts.hardware, error, true,
+                                                gl ? opts.glRenderer : RendererFactory{});
                     if (!device) {
-                        std::cout << error << "\n";
+                        std::cout << error << (gl ? " [gl]" : "") << "\n";
                         deviceFailed = tally.error = true;
                         continue;
                     }
                 }
                 if (!std::holds_alternative<Probe>(cmd.op)) {
                     if (!device->draw(cmd, error)) {
-                        std::cout << error << "\n";
+                        std::cout << error << (gl ? " [gl]" : "") << "\n";
                         deviceFailed = tally.error = true;
+                        continue;
                     }
+                    if (both) compareDraw(path, cmd, gl, *device, emuTargets[ci], tally);
                     continue;
                 }
                 std::string failure = device->probe(std::get<Probe>(cmd.op), error);
                 if (!error.empty()) {
-                    std::cout << error << "\n";
+                    std::cout << error << (gl ? " [gl]" : "") << "\n";
                     deviceFailed = tally.error = true;
                     continue;
                 }
+                if (both && !gl) emuProbePassed[ci] = failure.empty() ? 1 : 0;
+                if (both && gl && emuProbePassed[ci] >= 0 && emuProbePassed[ci] != (failure.empty() ? 1 : 0)) {
+                    std::cout << where(path, cmd.line) << ": disagreement: the probe " << (failure.empty() ? "passes" : "fails")
+                              << " on gl and " << (failure.empty() ? "fails" : "passes") << " on emu\n";
+                    ++tally.disagreements;
+                }
+                if (gl && !failure.empty()) failure = "[gl] " + failure;
                 countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally);
                 continue;
             }

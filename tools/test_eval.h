@@ -51,7 +51,12 @@ struct CommandTally {
     size_t probesPassed = 0;    // eval probes that passed
     size_t probesFailed = 0;    // eval probes that failed, and todo probes that passed
     size_t probesTodo = 0;      // todo probes that failed as expected
-    size_t pendingGl = 0;       // commands asked on gl (not runnable on gl yet)
+    size_t pendingGl = 0;       // commands asked on gl that it cannot run (evals; no GL renderer)
+    // --backend both: every draw's render target compared between the renderers.
+    size_t comparedDraws = 0;
+    uint64_t comparedPixels = 0, exactPixels = 0, overOnePixels = 0;
+    double maxDiff = 0;           // 8-bit levels (values on float targets)
+    size_t disagreements = 0;     // draws past the target, probes passing on one renderer only
     bool error = false;         // the executor or the device refused the file's setup or a draw
     ExecutorStats stats;        // executor statistics over every eval
     uint64_t texelsFetched = 0;
@@ -65,6 +70,7 @@ struct CommandRunOptions {
     // The diagnostics the [pixel shader] was assembled with: their file names resolve the source
     // places of the executor's E40xx reports.
     const Diagnostics* shaderDiags = nullptr;
+    RendererFactory glRenderer;  // the gl backend's renderer (empty: gl commands are not runnable)
 };
 
 // Runs (or counts) every command of `file` whose if(...) matches the run. `program` is the

@@ -1,0 +1,66 @@
+// The process's GL renderer (tools/gl_backend.h).
+#include "tools/gl_backend.h"
+
+#ifdef PS11_HAVE_GL
+#include "emu/gl/gl_renderer.h"
+#endif
+
+namespace ps11 {
+
+#ifdef PS11_HAVE_GL
+namespace {
+
+struct Shared {
+    std::shared_ptr<emu::gl::GlRenderer> renderer;
+    std::string error;
+    bool tried = false;
+};
+Shared& shared() {
+    static Shared s;
+    return s;
+}
+
+// A device's handle on the shared renderer.
+class SharedGlRenderer final : public emu::Renderer {
+public:
+    explicit SharedGlRenderer(std::shared_ptr<emu::gl::GlRenderer> r) : m_renderer(std::move(r)) {}
+    bool draw(const emu::DrawCall& call, emu::DrawStats& stats, emu::RendererError& error) override {
+        return m_renderer->draw(call, stats, error);
+    }
+    const char* name() const override { return "gl"; }
+
+private:
+    std::shared_ptr<emu::gl::GlRenderer> m_renderer;
+};
+
+}  // namespace
+
+RendererFactory glRendererFactory(std::string& error) {
+    Shared& s = shared();
+    if (!s.tried) {
+        s.tried = true;
+        s.renderer = emu::gl::GlRenderer::create({}, s.error);
+    }
+    if (!s.renderer) {
+        error = "no GL renderer: " + s.error;
+        return {};
+    }
+    std::shared_ptr<emu::gl::GlRenderer> r = s.renderer;
+    return [r] { return std::unique_ptr<emu::Renderer>(new SharedGlRenderer(r)); };
+}
+
+std::string glRendererDescription() {
+    const Shared& s = shared();
+    if (!s.renderer) return "";
+    return s.renderer->context().renderer() + ", OpenGL " + s.renderer->context().version() + " (" +
+           s.renderer->context().platform() + ")";
+}
+#else
+RendererFactory glRendererFactory(std::string& error) {
+    error = "no GL renderer: the OpenGL backend is not in this build (configured with PS11_GL=OFF)";
+    return {};
+}
+std::string glRendererDescription() { return ""; }
+#endif
+
+}  // namespace ps11
