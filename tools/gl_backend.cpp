@@ -15,9 +15,11 @@ struct Shared {
     std::string error;
     bool tried = false;
 };
+// Never destroyed: at exit, libOSMesa's own state may already be gone when a static
+// destructor would release the context (it crashed there).
 Shared& shared() {
-    static Shared s;
-    return s;
+    static Shared* s = new Shared;
+    return *s;
 }
 
 // A device's handle on the shared renderer.

@@ -22,7 +22,7 @@ namespace {
 
 constexpr size_t kMaxCachedTextures = 64;
 constexpr size_t kMaxCachedPrograms = 256;
-constexpr int kUnitTri = 8, kUnitDstColor = 9, kUnitDstDepth = 10;
+constexpr int kUnitTri = 8, kUnitDstColor = 9, kUnitDstDepth = 10, kUnitUpload = 11;
 
 struct TextureEntry {
     std::shared_ptr<const ps11::Texture> texture;  // kept alive: its address is the key
@@ -151,7 +151,7 @@ struct GlState {
         GLuint name = 0;
         gl.GenTextures(1, &name);
         const GLenum target = tex->isVolume() ? GL_TEXTURE_3D : GL_TEXTURE_2D;
-        gl.ActiveTexture(GL_TEXTURE0);
+        gl.ActiveTexture(GL_TEXTURE0 + kUnitUpload);  // not a unit a draw samples
         gl.BindTexture(target, name);
         gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -302,15 +302,19 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             const size_t at = records.size();
             records.resize(at + size_t(stride) * 4);
             writeRecord(s, used, records.data() + at);
+            // GL draws the pixels of the triangle's bounding rectangle inside the clip rect; the
+            // shader keeps those the rasteriser covers (its edge functions, from the record).
             double xl = 1e300, xh = -1e300;
-            for (const ScreenVertex& v : t.v) {
-                // Snapped as setupTriangle snaps; pixel centres are at integers here, at .5 in GL.
-                const double x = double(std::llround(v.x * 256.0)) / 256.0, y = double(std::llround(v.y * 256.0)) / 256.0;
-                positions.push_back(float(x + 0.5));
-                positions.push_back(float(y + 0.5));
-                xl = std::min(xl, x), xh = std::max(xh, x);
+            for (const ScreenVertex& v : t.v) xl = std::min(xl, v.x), xh = std::max(xh, v.x);
+            const int x0 = std::max(call.clip.x0, int(std::max(-1e9, std::floor(xl)))),
+                      x1 = std::min(call.clip.x1, int(std::min(1e9, std::ceil(xh))) + 1);
+            if (x0 >= x1) {
+                records.resize(at);
+                continue;
             }
-            boxes.push_back(Box{int(std::floor(xl)) - 1, s.yMin, int(std::ceil(xh)) + 1, s.yMax});
+            const float fx0 = float(x0), fx1 = float(x1), fy0 = float(s.yMin), fy1 = float(s.yMax);
+            positions.insert(positions.end(), {fx0, fy0, fx1, fy0, fx0, fy1, fx1, fy0, fx1, fy1, fx0, fy1});
+            boxes.push_back(Box{x0, s.yMin, x1, s.yMax});
         }
     }
     stats.trianglesDrawn += boxes.size();
@@ -377,7 +381,7 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.Uniform1i(gl.GetUniformLocation(program, "uTri"), kUnitTri);
     gl.Uniform1i(gl.GetUniformLocation(program, "uDstColor"), kUnitDstColor);
     gl.Uniform1i(gl.GetUniformLocation(program, "uDstDepth"), kUnitDstDepth);
-    // Window x, y (pixel centres at .5, rows down) to clip space under GL_UPPER_LEFT.
+    // Window x, y (pixel edges at integers, rows down) to clip space under GL_UPPER_LEFT.
     gl.Uniform4f(gl.GetUniformLocation(program, "uXform"), 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
     const GLint primBase = gl.GetUniformLocation(program, "uPrimBase");
 
@@ -426,7 +430,7 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             ++end;
         }
         gl.Uniform1i(primBase, GLint(begin));
-        gl.DrawArrays(GL_TRIANGLES, GLint(begin * 3), GLsizei((end - begin) * 3));
+        gl.DrawArrays(GL_TRIANGLES, GLint(begin * 6), GLsizei((end - begin) * 6));
         gl.TextureBarrier();
         begin = end;
     }

@@ -619,7 +619,8 @@ struct Gen {
         o << "layout(location = 0) out uvec4 oColor;\nlayout(location = 1) out uint oDepth;\n";
         o << kCommon;
         o << "int gBase;\n"
-             "double recD(int i) { uvec4 t = texelFetch(uTri, gBase + 1 + (i >> 1)); return packDouble2x32((i & 1) == 0 ? t.xy : t.zw); }\n"
+             "double recD(int i) { uvec4 t = texelFetch(uTri, gBase + 6 + (i >> 1)); return packDouble2x32((i & 1) == 0 ? t.xy : t.zw); }\n"
+             "int64_t recE(int i) { uvec4 t = texelFetch(uTri, gBase + 1 + (i >> 1)); return int64_t(packUint2x32((i & 1) == 0 ? t.xy : t.zw)); }\n"
              "// The rasteriser's plane value at pixel p (emu/raster.h planeValue).\n"
              "float planeAt(int i, ivec2 p, double ox, double oy) {\n"
              "    precise double row = recD(i) + recD(i + 1) * (0.0lf - ox) + recD(i + 2) * (double(p.y) - oy);\n"
@@ -629,9 +630,15 @@ struct Gen {
             if ((spec.program->stagesUsed >> s) & 1) sampler(s);
         mergeFunctions();
         o << "void main() {\n";
-        o << "    ivec2 P = ivec2(gl_FragCoord.xy);\n    gBase = (uPrimBase + gl_PrimitiveID) * uStride;\n";
+        o << "    ivec2 P = ivec2(gl_FragCoord.xy);\n    gBase = (uPrimBase + (gl_PrimitiveID >> 1)) * uStride;\n";
         o << "    uvec4 head = texelFetch(uTri, gBase);\n    bool persp = head.x != 0u;\n"
              "    uint64_t cmask = packUint2x32(head.yz);\n";
+        // Coverage exactly as the rasteriser decides it (emu/raster.h: edge functions in 1/256
+        // pixel, the top-left rule): GL draws each triangle's bounding rectangle.
+        o << "    bool covered = true;\n"
+             "    for (int e = 0; e < 3; ++e) {\n"
+             "        int64_t E = recE(e) * int64_t(P.x * 256) + recE(3 + e) * int64_t(P.y * 256) + recE(6 + e);\n"
+             "        if (E < int64_t((head.w >> uint(e)) & 1u)) covered = false;\n    }\n";
         o << "    double ox = recD(0), oy = recD(1);\n";
         o << "    float inv = 1.0;\n    if (persp) { float r = planeAt(2, P, ox, oy); r = r < 1e-30 ? 1e-30 : r; inv = fdiv(1.0, r); }\n";
         // Attributes: v0, v1 (diffuse, specular), TC[0..7].
@@ -680,7 +687,7 @@ struct Gen {
                     if ((first.mask >> c) & 1) o << "    R[" << int(first.dstSlot) << "]." << kComp[c] << " = H." << kComp[c] << ";\n";
             }
         }
-        o << "    if (killed) discard;\n";
+        o << "    if (killed || !covered) discard;\n";
         mergeMain();
         o << "}\n";
         return o.str();
@@ -945,9 +952,12 @@ std::string fragmentSource(const FragmentSpec& spec) {
     return g.run();
 }
 
+// Texels before the doubles: the header, then the edge functions' a b c (9 int64, two a texel).
+constexpr int kRecordHead = 6;
+
 int recordTexels(uint64_t used) {
     int doubles = 8 + 3 * __builtin_popcountll(used);
-    return 1 + (doubles + 1) / 2;
+    return kRecordHead + (doubles + 1) / 2;
 }
 
 void writeRecord(const TriangleSetup& s, uint64_t used, uint32_t* out) {
@@ -956,6 +966,9 @@ void writeRecord(const TriangleSetup& s, uint64_t used, uint32_t* out) {
     out[0] = s.perspective ? 1u : 0u;
     out[1] = uint32_t(s.constMask & used);
     out[2] = uint32_t((s.constMask & used) >> 32);
+    out[3] = uint32_t(s.t[0] | (s.t[1] << 1) | (s.t[2] << 2));
+    const int64_t edges[9] = {s.a[0], s.a[1], s.a[2], s.b[0], s.b[1], s.b[2], s.c[0], s.c[1], s.c[2]};
+    std::memcpy(out + 4, edges, sizeof edges);
     std::vector<double> d = {s.ox, s.oy, s.rhw.base, s.rhw.dx, s.rhw.dy, s.z.base, s.z.dx, s.z.dy};
     for (int a = 0; a < kAttrCount; ++a) {
         if (!((used >> a) & 1)) continue;
@@ -966,7 +979,7 @@ void writeRecord(const TriangleSetup& s, uint64_t used, uint32_t* out) {
             d.insert(d.end(), {pl.base, pl.dx, pl.dy});
         }
     }
-    std::memcpy(out + 4, d.data(), d.size() * sizeof(double));
+    std::memcpy(out + 4 * kRecordHead, d.data(), d.size() * sizeof(double));
 }
 
 }  // namespace emu::gl

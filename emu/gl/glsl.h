@@ -49,7 +49,8 @@ std::string vertexSource();
 std::string fragmentSource(const FragmentSpec& spec);
 
 // The triangle record (a usamplerBuffer of RGBA32UI texels): texel 0 = (perspective,
-// constant-mask low, high, 0), then doubles two per texel: ox, oy, the rhw plane, the z plane
+// constant-mask low, high, top-left bits), texels 1..5 = the edge functions a0 a1 a2 b0 b1 b2 c0
+// c1 c2 (int64, two a texel), then doubles two per texel: ox, oy, the rhw plane, the z plane
 // and, for each attribute of `used` in ascending order, its plane (base, dx, dy) or, when the
 // attribute is constant over the triangle, (value, 0, 0).
 int recordTexels(uint64_t used);
