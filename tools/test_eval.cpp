@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <optional>
 #include <variant>
@@ -14,6 +15,9 @@
 #include "ps11/diagnostics.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
+#include "emu/format.h"
+#include "emu/renderer.h"
+#include "ps11/opcodes.h"
 #include "tools/test_draw.h"
 
 namespace ps11 {
@@ -196,6 +200,33 @@ std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string
 // --backend both: keeps the emu renderer's target after a draw; on gl compares with it pixel by
 // pixel (8-bit levels, or values on float targets) and reports a draw past the cross-check's
 // target (more than one level, or 1e-4 on float targets) as a disagreement.
+// --backend both: an eval's outcome on gl against the executor's (r0's grid integers in fx
+// profiles, float32 values otherwise, the kill and the depth): any difference is a disagreement.
+static void compareEval(const std::string& path, const TestCommand& cmd, const EvalOutcome& emu, const EvalOutcome& gl,
+                        Precision p, CommandTally& tally) {
+    ++tally.comparedDraws;
+    ++tally.comparedPixels;
+    bool same = emu.killed == gl.killed && emu.hasDepth == gl.hasDepth && (!emu.hasDepth || emu.depth == gl.depth);
+    double d = 0;
+    if (!emu.killed && !gl.killed)
+        for (int c = 0; c < 4; ++c) {
+            const double a = emu.color[size_t(c)], b = gl.color[size_t(c)];
+            d = std::max(d, a == b ? 0.0 : std::fabs(a - b) * (isFixedPoint(p) ? 255.0 : 1.0));
+            if (isFixedPoint(p) ? emu.grid[size_t(c)] != gl.grid[size_t(c)] : a != b) same = false;
+        }
+    tally.maxDiff = std::max(tally.maxDiff, d);
+    if (same) {
+        ++tally.exactPixels;
+        return;
+    }
+    if (d > (isFixedPoint(p) ? 1.0 : 1e-4) || emu.killed != gl.killed || emu.hasDepth != gl.hasDepth) {
+        ++tally.overOnePixels;
+        ++tally.disagreements;
+        std::cout << where(path, cmd.line) << ": disagreement: the eval gives " << describeOutcome(gl, 4, p)
+                  << " on gl and " << describeOutcome(emu, 4, p) << " on emu\n";
+    }
+}
+
 static void compareDraw(const std::string& path, const TestCommand& cmd, bool gl, DrawRunner& device,
                  std::vector<Vec4>& emuTarget, CommandTally& tally) {
     std::vector<Vec4> pixels;
@@ -249,6 +280,8 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
     // command index, for the gl pass to compare with.
     std::vector<std::vector<Vec4>> emuTargets(file.commands.size());
     std::vector<int8_t> emuProbePassed(file.commands.size(), -1);
+    std::vector<std::optional<EvalOutcome>> emuEvals(file.commands.size());
+    std::unique_ptr<RendererEval> glEval;
     for (Backend backend : {Backend::Emu, Backend::Gl}) {
         if (!(opts.backends & (1u << unsigned(backend)))) continue;
         const bool gl = backend == Backend::Gl;
@@ -259,8 +292,8 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
         for (size_t ci = 0; ci < file.commands.size(); ++ci) {
             const TestCommand& cmd = file.commands[ci];
             if (!cmd.onlyIf.matches(backend, p, hw)) continue;
-            if (gl && (!isDeviceCommand(cmd) || !opts.glRenderer)) {
-                ++tally.pendingGl;  // evals run on the executor only; no GL renderer
+            if (gl && !opts.glRenderer) {
+                ++tally.pendingGl;  // no GL renderer
                 continue;
             }
             if (isDeviceCommand(cmd)) {
@@ -314,7 +347,28 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                     if (eval->color[r].isSet()) in.color[r] = &eval->color[r].value;
                 for (int r = 0; r < 8; ++r)
                     if (eval->texture[r].isSet()) in.texture[r] = &eval->texture[r].value;
-                last = evalOnePixel(*state.executor, *state.sampler, in, &tally.stats);
+                if (gl) {
+                    if (!glEval) {
+                        std::string error;
+                        glEval = RendererEval::create(file, path, *program, opts.hardware, opts.glRenderer, error);
+                        if (!glEval) {
+                            std::cout << error << " [gl]\n";
+                            tally.error = true;
+                            return;
+                        }
+                    }
+                    std::string error;
+                    last = glEval->eval(in, error);
+                    if (!last) {
+                        std::cout << where(path, cmd.line) << ": " << error << " [gl]\n";
+                        tally.error = true;
+                        return;
+                    }
+                    if (both && emuEvals[ci]) compareEval(path, cmd, *emuEvals[ci], *last, p, tally);
+                } else {
+                    last = evalOnePixel(*state.executor, *state.sampler, in, &tally.stats);
+                    if (both) emuEvals[ci] = *last;
+                }
                 ++tally.evals;
                 continue;
             }
@@ -326,6 +380,13 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 continue;
             }
             std::string failure = checkProbe(probe, *last, p);
+            if (both && !gl) emuProbePassed[ci] = failure.empty() ? 1 : 0;
+            if (both && gl && emuProbePassed[ci] >= 0 && emuProbePassed[ci] != (failure.empty() ? 1 : 0)) {
+                std::cout << where(path, cmd.line) << ": disagreement: the probe " << (failure.empty() ? "passes" : "fails")
+                          << " on gl and " << (failure.empty() ? "fails" : "passes") << " on emu\n";
+                ++tally.disagreements;
+            }
+            if (gl && !failure.empty()) failure = "[gl] " + failure;
             countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally,
                        describeOutcome(*last, probe.alpha ? 4 : 3, p));
         }
@@ -340,6 +401,105 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
         }
     }
     if (state.sampler) tally.texelsFetched = state.sampler->texelsFetched();
+}
+
+struct RendererEval::Impl {
+    std::unique_ptr<emu::Renderer> renderer;
+    emu::DrawCall call;
+    bool writesDepth = false;
+    emu::Image color, depth;
+};
+
+RendererEval::~RendererEval() = default;
+
+std::unique_ptr<RendererEval> RendererEval::create(const TestFile& file, const std::string& path,
+                                                   const Program& program, const HardwareConfig& hardware,
+                                                   const RendererFactory& factory, std::string& error) {
+    std::unique_ptr<RendererEval> r(new RendererEval);
+    r->m_impl = std::make_unique<Impl>();
+    Impl& m = *r->m_impl;
+    m.renderer = factory();
+    if (!m.renderer) {
+        error = path + ": no renderer for evals";
+        return nullptr;
+    }
+    emu::DrawCall& call = m.call;
+    call.hardware = hardware;
+    call.program.program = &program;
+    call.program.key = 1;
+    for (const ConstantDesc& c : file.constants) call.program.constants[size_t(c.index)] = c.value;
+    for (const StageDesc& sd : file.stages) call.program.stages[size_t(sd.stage)] = stageStateOf(sd, file.texture(sd.stage));
+    for (const TextureDesc& t : file.textures) {
+        std::string why;
+        std::optional<Texture> texture = textureFromDesc(t, hardware.hardware->signedDecode, why);
+        if (!texture) {
+            error = where(path, t.line) + ": cannot build [texture " + std::to_string(t.stage) + "]: " + why;
+            return nullptr;
+        }
+        call.textures[size_t(t.stage)] = std::make_shared<const Texture>(std::move(*texture));
+    }
+    for (const SamplerDesc& sd : file.samplers) call.samplers[size_t(sd.stage)] = samplerStateFromDesc(sd);
+    for (const Instruction& ins : program.instructions)
+        if (ins.info && replacesDepth(ins.opcode())) m.writesDepth = true;
+    auto image = [](emu::Image& img, emu::D3DFORMAT f) {
+        img.format = emu::formatInfo(f);
+        img.width = img.height = 1;
+        img.rowPitch = img.format->bytes;
+        img.slicePitch = img.rowPitch;
+        img.bytes.assign(img.format->bytes, 0);
+    };
+    image(m.color, emu::D3DFMT_A32B32G32R32F);
+    image(m.depth, emu::D3DFMT_D32F_LOCKABLE);
+    call.merge.precision = hardware.precision;
+    if (m.writesDepth) {
+        call.merge.depthTest = true;
+        call.merge.depthWrite = true;
+        call.merge.depthFunc = emu::D3DCMP_ALWAYS;
+    }
+    call.target.color = &m.color;
+    call.target.depth = m.writesDepth ? &m.depth : nullptr;
+    call.clip = emu::ClipRect{0, 0, 1, 1};
+    call.usedAttributes = (uint64_t(1) << emu::kAttrCount) - 1;
+    call.primitiveCount = 1;
+    return r;
+}
+
+std::optional<EvalOutcome> RendererEval::eval(const EvalInputs& in, std::string& error) {
+    Impl& m = *m_impl;
+    emu::ScreenTriangle tri;
+    // Pixel (0, 0) strictly inside; every vertex carries the same attributes.
+    const double xy[3][2] = {{-1, -1}, {3, -1}, {-1, 3}};
+    for (int v = 0; v < 3; ++v) {
+        emu::ScreenVertex& sv = tri.v[size_t(v)];
+        sv.x = xy[v][0], sv.y = xy[v][1];
+        for (int r = 0; r < 2; ++r)
+            for (int c = 0; c < 4; ++c)
+                sv.attr[size_t((r ? emu::kAttrSpecular : emu::kAttrDiffuse) + c)] = in.color[size_t(r)] ? (*in.color[size_t(r)])[size_t(c)] : 0.0f;
+        for (int t = 0; t < 8; ++t)
+            for (int c = 0; c < 4; ++c)
+                sv.attr[size_t(emu::attrTex(t, c))] = in.texture[size_t(t)] ? (*in.texture[size_t(t)])[size_t(c)] : 0.0f;
+    }
+    m.call.assemble = [&tri](uint32_t, uint32_t, std::vector<emu::ScreenTriangle>& out) { out.push_back(tri); };
+    std::fill(m.color.bytes.begin(), m.color.bytes.end(), uint8_t(0));
+    emu::DrawStats stats;
+    emu::RendererError rerr;
+    if (!m.renderer->draw(m.call, stats, rerr)) {
+        error = rerr.code + " " + rerr.message;
+        return std::nullopt;
+    }
+    EvalOutcome out;
+    out.killed = stats.pixelsWritten == 0;
+    const Precision p = m.call.hardware.precision;
+    float v[4];
+    std::memcpy(v, m.color.bytes.data(), sizeof v);
+    for (int c = 0; c < 4; ++c) {
+        out.color[size_t(c)] = v[c];
+        // fx: the float target holds float(n / G); n is the nearest grid integer.
+        if (isFixedPoint(p)) out.grid[size_t(c)] = int32_t(std::lround(double(v[c]) * gridScale(p)));
+    }
+    out.hasDepth = m.writesDepth;
+    if (m.writesDepth) std::memcpy(&out.depth, m.depth.bytes.data(), sizeof(float));
+    return out;
 }
 
 }  // namespace ps11

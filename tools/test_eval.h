@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "ps11/diagnostics.h"
@@ -40,6 +41,26 @@ EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalI
 // ("FILE:LINE: ...") if a texture cannot be built.
 std::unique_ptr<Sampler> makeTestSampler(const TestFile& file, const std::string& path,
                                          const HardwareConfig& hardware, std::string& error);
+
+// Evals on a device renderer (the GL renderer): each eval is one pixel drawn into a 1×1
+// A32B32G32R32F target (and a D32F depth surface when the program replaces depth) from a
+// triangle whose attributes are the eval's inputs at every vertex, so the renderer shades
+// exactly those values; r0 is read back from the float target (the grid integers recovered in
+// fx profiles), a pixel the renderer did not write was killed. No quad has distinct lanes, so
+// sampling takes level 0 as the executor's evals do.
+class RendererEval {
+public:
+    static std::unique_ptr<RendererEval> create(const TestFile& file, const std::string& path, const Program& program,
+                                                const HardwareConfig& hardware, const RendererFactory& factory,
+                                                std::string& error);
+    ~RendererEval();
+    std::optional<EvalOutcome> eval(const EvalInputs& inputs, std::string& error);
+
+private:
+    RendererEval() = default;
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
 
 // The file's [stage N] state as the executor wants it (an eval gives every coordinate set four
 // components; `texture` is the stage's [texture N], or null).
