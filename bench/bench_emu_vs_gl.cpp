@@ -1,0 +1,288 @@
+// BM_EmuVsGl: the emulator's speed against its peer, the project's GL renderer
+// (emu::gl::GlRenderer) on Mesa llvmpipe (PERF.md "The peer"), in one process. Every pass runs on
+// two emu::Devices, one with the software renderer (2 worker threads) and one whose renderer is a
+// GlRenderer (LP_NUM_THREADS=2 unless set), registered emu, gl, emu, gl … so that
+// --benchmark_enable_random_interleaving mixes their repetitions under the same machine load.
+// Both report the draw alone (manual time): for emu the wall time of DrawPrimitiveUP, for gl
+// GlRenderer::lastDrawMilliseconds() (first GL draw call to glFinish; the target's upload, the
+// texture upload and the read-back are outside it). Before any timing, each pass is drawn once
+// on both devices and the render targets are compared byte for byte.
+// How to run and read the ratios: bench/README.md "bench_emu_vs_gl".
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/device.h"
+#include "emu/gl/gl_renderer.h"
+
+namespace {
+
+using namespace emu;
+
+constexpr UINT kW = 1920, kH = 1080;
+
+// bench_draw.cpp's blur: four taps weighted by c0 = 0.25.
+constexpr const char* kBlur4 =
+    "ps_1_1\n"
+    "tex t0\n"
+    "tex t1\n"
+    "tex t2\n"
+    "tex t3\n"
+    "mul r0, t0, c0\n"
+    "mad r0, t1, c0, r0\n"
+    "mad r0, t2, c0, r0\n"
+    "mad r0, t3, c0, r0\n";
+
+constexpr const char* kCopy =
+    "ps_1_1\n"
+    "tex t0\n"
+    "mov r0, t0\n";
+
+// Scene (t0, 1:1) plus the magnified half-size bloom (t1) scaled by c0 = 0.5.
+constexpr const char* kComposite =
+    "ps_1_1\n"
+    "tex t0\n"
+    "tex t1\n"
+    "mad r0, t1, c0, t0\n";
+
+enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite };
+constexpr int kPasses = 5;
+enum class Kind { Emu, Gl };
+
+struct StageDef {
+    int texture;     // index into PassDef::textures
+    float du, dv;    // tap offset in texels of that texture
+};
+
+struct PassDef {
+    const char* name;
+    UINT w, h;                                   // render target
+    std::vector<std::pair<UINT, UINT>> textures;  // sizes; texture i is filled with seed 42 + i
+    std::vector<StageDef> stages;
+    const char* shader;
+    float c0;
+};
+
+PassDef passDef(Pass p) {
+    switch (p) {
+    case Pass::Blur4:  // taps at (±½, ±½) texel: each averages a 2×2 block
+        return {"blur4_1080p", kW, kH, {{kW, kH}}, {{0, -0.5f, -0.5f}, {0, 0.5f, -0.5f}, {0, -0.5f, 0.5f}, {0, 0.5f, 0.5f}},
+                kBlur4, 0.25f};
+    case Pass::Copy:  // bilinear at the texel centres
+        return {"copy_1080p", kW, kH, {{kW, kH}}, {{0, 0, 0}}, kCopy, 0};
+    case Pass::Down2:  // one tap on the corner shared by each 2×2 block
+        return {"down2_1080p", kW / 2, kH / 2, {{kW, kH}}, {{0, 0, 0}}, kCopy, 0};
+    case Pass::Down4:  // taps at ±1 texel around the centre of each 4×4 block
+        return {"down4_1080p", kW / 4, kH / 4, {{kW, kH}}, {{0, -1, -1}, {0, 1, -1}, {0, -1, 1}, {0, 1, 1}}, kBlur4, 0.25f};
+    case Pass::Magnify2Composite:  // t0 1:1 at 1080p, t1 a 960×540 texture magnified 2×
+        return {"magnify2_composite_1080p", kW, kH, {{kW, kH}, {kW / 2, kH / 2}}, {{0, 0, 0}, {1, 0, 0}}, kComposite, 0.5f};
+    }
+    return {};
+}
+
+// One device drawing one pass, its state set once. Never destroyed (see scene()).
+struct Scene {
+    std::unique_ptr<Device> dev;
+    gl::GlRenderer* glr = nullptr;  // owned by dev
+    Handle rt{};
+    std::vector<float> vertices;
+    UINT stride = 0;
+    std::string error;  // empty: ready
+
+    Scene(Pass pass, Kind kind) { setup(pass, kind); }
+    void setup(Pass pass, Kind kind);
+    bool draw() {
+        return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, vertices.data(), stride) == D3D_OK;
+    }
+    // The render target's bytes (rows packed), or empty with `error` set.
+    std::vector<uint8_t> image();
+};
+
+std::string glError;  // why no GL renderer could be made (first failure)
+
+void Scene::setup(Pass pass, Kind kind) {
+    const PassDef pd = passDef(pass);
+    DeviceOptions o;
+    o.software.threads = 2;
+    if (kind == Kind::Gl) {
+        // llvmpipe reads its thread count when the context's screen is made.
+        setenv("LP_NUM_THREADS", "2", 0);
+        std::string why;
+        std::unique_ptr<gl::GlRenderer> r = gl::GlRenderer::create({}, why);
+        if (!r) {
+            error = "no GL renderer: " + why;
+            if (glError.empty()) glError = error;
+            return;
+        }
+        glr = r.get();
+        auto owned = std::make_shared<std::unique_ptr<gl::GlRenderer>>(std::move(r));
+        o.renderer = [owned]() -> std::unique_ptr<Renderer> { return std::move(*owned); };  // once
+    }
+    dev = std::make_unique<Device>(o);
+    auto refused = [&](const char* call) {
+        error = std::string(call) + " refused: " + dev->lastError().message;
+    };
+    if (dev->CreateRenderTarget(pd.w, pd.h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return refused("CreateRenderTarget");
+    if (dev->SetRenderTarget(0, rt) != D3D_OK) return refused("SetRenderTarget");
+    std::vector<Handle> textures;
+    for (size_t i = 0; i < pd.textures.size(); ++i) {
+        const auto [tw, th] = pd.textures[i];
+        Handle tex{};
+        if (dev->CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK)
+            return refused("CreateTexture");
+        D3DLOCKED_RECT lr;
+        if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return refused("LockRect");
+        std::mt19937 rng(uint32_t(42 + i));
+        for (UINT y = 0; y < th; ++y) {
+            auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
+            for (UINT x = 0; x < tw; ++x) row[x] = rng();
+        }
+        dev->UnlockRect(tex, 0);
+        textures.push_back(tex);
+    }
+    for (size_t s = 0; s < pd.stages.size(); ++s) {
+        const DWORD st = DWORD(s);
+        dev->SetTexture(st, textures[size_t(pd.stages[s].texture)]);
+        dev->SetSamplerState(st, D3DSAMP_MINFILTER, D3DTEXF_LINEAR);
+        dev->SetSamplerState(st, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR);
+        dev->SetSamplerState(st, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
+        dev->SetSamplerState(st, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
+    }
+    Handle ps{};
+    if (dev->CreatePixelShaderFromText(pd.shader, &ps) != D3D_OK) return refused("CreatePixelShaderFromText");
+    if (dev->SetPixelShader(ps) != D3D_OK) return refused("SetPixelShader");
+    const float c0[4] = {pd.c0, pd.c0, pd.c0, pd.c0};
+    dev->SetPixelShaderConstantF(0, c0, 1);
+    const UINT sets = UINT(pd.stages.size());
+    if (dev->SetFVF(D3DFVF_XYZRHW | (sets << D3DFVF_TEXCOUNT_SHIFT)) != D3D_OK) return refused("SetFVF");
+    // The half-pixel quad (corners at −0.5), uv 0..1 over the target plus each stage's offset.
+    const float xs[4] = {-0.5f, float(pd.w) - 0.5f, float(pd.w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(pd.h) - 0.5f, float(pd.h) - 0.5f};
+    const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+    stride = UINT(sizeof(float)) * (4 + 2 * sets);
+    for (int c : {0, 1, 2, 0, 2, 3}) {
+        vertices.insert(vertices.end(), {xs[c], ys[c], 0.0f, 1.0f});
+        for (const StageDef& sd : pd.stages) {
+            const auto [tw, th] = pd.textures[size_t(sd.texture)];
+            vertices.push_back(us[c] + sd.du / float(tw));
+            vertices.push_back(vs[c] + sd.dv / float(th));
+        }
+    }
+    // Warm-up: the sampler's copy of the textures, the executor or the GL program and textures.
+    if (!draw()) return refused("DrawPrimitiveUP");
+}
+
+std::vector<uint8_t> Scene::image() {
+    D3DSURFACE_DESC desc{};
+    Handle copy{};
+    std::vector<uint8_t> out;
+    if (dev->GetDesc(rt, &desc) != D3D_OK ||
+        dev->CreateOffscreenPlainSurface(desc.Width, desc.Height, desc.Format, D3DPOOL_SYSTEMMEM, &copy) != D3D_OK ||
+        dev->GetRenderTargetData(rt, copy) != D3D_OK) {
+        error = "GetRenderTargetData refused: " + dev->lastError().message;
+        return out;
+    }
+    D3DLOCKED_RECT lr;
+    if (dev->LockRect(copy, &lr, nullptr, D3DLOCK_READONLY) != D3D_OK) {
+        error = "LockRect refused: " + dev->lastError().message;
+        dev->Release(copy);
+        return out;
+    }
+    out.resize(size_t(desc.Width) * desc.Height * 4);
+    for (UINT y = 0; y < desc.Height; ++y)
+        std::memcpy(&out[size_t(y) * desc.Width * 4], static_cast<const uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch),
+                    size_t(desc.Width) * 4);
+    dev->UnlockRect(copy);
+    dev->Release(copy);
+    return out;
+}
+
+struct PassScenes {
+    Scene* emu = nullptr;
+    Scene* gl = nullptr;
+    std::string mismatch;  // non-empty: the images differ (or could not be compared)
+};
+
+// Both devices of a pass, made on first use and compared once. Never destroyed: at exit,
+// libOSMesa's own state may be gone before a static destructor would release a context
+// (tools/gl_backend.cpp).
+PassScenes& scenes(Pass pass) {
+    static PassScenes* all = new PassScenes[kPasses];
+    PassScenes& p = all[int(pass)];
+    if (!p.emu) {
+        p.emu = new Scene(pass, Kind::Emu);
+        p.gl = new Scene(pass, Kind::Gl);
+        if (p.emu->error.empty() && p.gl->error.empty()) {
+            const std::vector<uint8_t> a = p.emu->image(), b = p.gl->image();
+            if (a.empty() || b.empty())
+                p.mismatch = "read-back failed: " + p.emu->error + p.gl->error;
+            else {
+                size_t differ = 0;
+                for (size_t i = 0; i < a.size(); i += 4) differ += std::memcmp(&a[i], &b[i], 4) != 0;
+                if (differ) p.mismatch = "emu and gl images differ: " + std::to_string(differ) + " pixels";
+            }
+        }
+    }
+    return p;
+}
+
+void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
+    PassScenes& ps = scenes(pass);
+    Scene& sc = kind == Kind::Emu ? *ps.emu : *ps.gl;
+    if (!sc.error.empty()) {
+        state.SkipWithError(sc.error.c_str());
+        return;
+    }
+    if (!ps.mismatch.empty()) {
+        state.SkipWithError(ps.mismatch.c_str());
+        return;
+    }
+    double drawSum = 0, callSum = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const bool ok = sc.draw();
+        const double call = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (!ok) {
+            state.SkipWithError(sc.dev->lastError().message.c_str());
+            return;
+        }
+        // gl: the GL work alone; emu: the whole call is the draw.
+        const double draw = kind == Kind::Gl ? sc.glr->lastDrawMilliseconds() / 1000.0 : call;
+        state.SetIterationTime(draw);
+        drawSum += draw;
+        callSum += call;
+    }
+    const PassDef pd = passDef(pass);
+    const double n = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
+    const double pixels = double(pd.w) * pd.h;
+    state.counters["Mpix/s"] = drawSum > 0 ? pixels * n / drawSum * 1e-6 : 0;
+    // The whole DrawPrimitiveUP (gl: with the uploads and the read-back), ms per call.
+    state.counters["call_ms"] = callSum / n * 1e3;
+    state.SetLabel(kind == Kind::Emu ? "software, 2 threads" : sc.glr->context().renderer());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    // emu and gl of each pass registered alternately.
+    for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite})
+        for (Kind k : {Kind::Emu, Kind::Gl}) {
+            const std::string name =
+                std::string("BM_EmuVsGl/") + passDef(p).name + (k == Kind::Emu ? "/emu" : "/gl");
+            benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)
+                ->Unit(benchmark::kMillisecond)
+                ->UseManualTime();
+        }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
