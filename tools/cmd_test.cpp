@@ -26,8 +26,11 @@ namespace ps11 {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--hardware H] [--precision fx8|fx12|float|ideal]\n"
-    "                 [--stats] [-v]\n"
+    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--gl osmesa|egl] [--hardware H]\n"
+    "                 [--precision fx8|fx12|float|ideal] [--stats] [-v]\n"
+    "  --backend B    emu (the software renderer), gl (the OpenGL renderer) or both: every draw and eval\n"
+    "                 on both renderers, their results compared (disagreements fail the file)\n"
+    "  --gl KIND      the OpenGL context: osmesa or egl (default: the first that works)\n"
     "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists\n"
     "                 them); `all` runs the files once per class\n";
 
@@ -202,13 +205,17 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
 int cmdTest(const std::vector<std::string>& args) {
     RunOptions opts;
     bool allHardware = false;
+    std::string glKind;
     std::vector<std::string> files;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "--backend" || a == "--precision" || a == "--hardware") {
+        if (a == "--backend" || a == "--precision" || a == "--hardware" || a == "--gl") {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
-            if (a == "--hardware") {
+            if (a == "--gl") {
+                if (v != "osmesa" && v != "egl") return usageError("unknown GL context " + quote(v) + " (expected osmesa or egl)");
+                glKind = v;
+            } else if (a == "--hardware") {
                 allHardware = v == "all";
                 opts.hardware = allHardware ? nullptr : findHardware(v);
                 if (!opts.hardware && !allHardware) return usageError(unknownHardwareMessage(v));
@@ -241,7 +248,7 @@ int cmdTest(const std::vector<std::string>& args) {
             std::cout << kUsage;
             return cli::kOk;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError(cli::unknownOption(a, {"--backend", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
+            return usageError(cli::unknownOption(a, {"--backend", "--gl", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
         } else {
             std::error_code ec;
             if (std::filesystem::is_directory(a, ec)) {
@@ -260,7 +267,7 @@ int cmdTest(const std::vector<std::string>& args) {
     if (files.empty()) return usageError("no .ps11test files given");
     if (opts.backends & kBackendGl) {
         std::string error;
-        opts.glRenderer = glRendererFactory(error);
+        opts.glRenderer = glRendererFactory(glKind, error);
         if (!opts.glRenderer) {
             std::cerr << "ps11 test: --backend " << (opts.backends & kBackendEmu ? "both" : "gl") << ": " << error << "\n";
             return cli::kUserError;

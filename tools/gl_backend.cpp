@@ -37,11 +37,14 @@ private:
 
 }  // namespace
 
-RendererFactory glRendererFactory(std::string& error) {
+RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool hardwareFiltering) {
     Shared& s = shared();
     if (!s.tried) {
         s.tried = true;
-        s.renderer = emu::gl::GlRenderer::create({}, s.error);
+        emu::gl::GlRendererOptions options;
+        options.context.kind = emu::gl::parseContextKind(kind);
+        options.hardwareFiltering = hardwareFiltering;
+        s.renderer = emu::gl::GlRenderer::create(options, s.error);
     }
     if (!s.renderer) {
         error = "no GL renderer: " + s.error;
@@ -58,7 +61,7 @@ std::string glRendererDescription() {
            s.renderer->context().platform() + ")";
 }
 #else
-RendererFactory glRendererFactory(std::string& error) {
+RendererFactory glRendererFactory(const std::string&, std::string& error, bool) {
     error = "no GL renderer: the OpenGL backend is not in this build (configured with PS11_GL=OFF)";
     return {};
 }

@@ -14,9 +14,11 @@ namespace ps11 {
 using RendererFactory = std::function<std::unique_ptr<emu::Renderer>()>;
 
 // A factory of devices' renderers that all draw through the process's GL renderer, made on the
-// first call; an empty function with `error` set when there is none (no context, no OpenGL 4.5,
-// or a build without the GL backend).
-RendererFactory glRendererFactory(std::string& error);
+// first call on a context of `kind` ("osmesa", "egl"; "" = the first that works, OSMesa then
+// EGL); an empty function with `error` set when there is none (no context, no OpenGL 4.5, or a
+// build without the GL backend). Later calls return the same renderer whatever kind they name.
+// `hardwareFiltering`: float profiles filter with GL's texture unit (GlRendererOptions).
+RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool hardwareFiltering = false);
 
 // The GL renderer's description for reports ("llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 …"),
 // or "" before glRendererFactory succeeded.

@@ -91,7 +91,12 @@ using GlProc = void (*)();
     X(PFNGLDELETEQUERIESPROC, DeleteQueries, "glDeleteQueries") \
     X(PFNGLBEGINQUERYPROC, BeginQuery, "glBeginQuery") \
     X(PFNGLENDQUERYPROC, EndQuery, "glEndQuery") \
-    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v, "glGetQueryObjectui64v")
+    X(PFNGLGETQUERYOBJECTUI64VPROC, GetQueryObjectui64v, "glGetQueryObjectui64v") \
+    X(PFNGLGENSAMPLERSPROC, GenSamplers, "glGenSamplers") \
+    X(PFNGLDELETESAMPLERSPROC, DeleteSamplers, "glDeleteSamplers") \
+    X(PFNGLBINDSAMPLERPROC, BindSampler, "glBindSampler") \
+    X(PFNGLSAMPLERPARAMETERIPROC, SamplerParameteri, "glSamplerParameteri") \
+    X(PFNGLSAMPLERPARAMETERFVPROC, SamplerParameterfv, "glSamplerParameterfv")
 
 // Called as gl.Clear(GL_COLOR_BUFFER_BIT): the GL name without its "gl".
 struct GlFunctions {

@@ -28,6 +28,7 @@ struct TextureEntry {
     std::shared_ptr<const ps11::Texture> texture;  // kept alive: its address is the key
     bool fx = false;
     ps11::Precision precision = ps11::Precision::Fx8;
+    bool hardware = false;  // for GL's texture unit: 8-bit textures as GL_RGBA8
     GLuint name = 0;
     uint64_t lastUse = 0;
 };
@@ -65,6 +66,7 @@ struct GlState {
     const GlFunctions& gl;
     explicit GlState(const GlFunctions& f) : gl(f) {}
     GLuint vao = 0, vbo = 0, triBuffer = 0, triTexture = 0, fbo = 0, query = 0;
+    GLuint samplers[8] = {};  // GL sampler objects of hardware filtering
     GLuint colorTex = 0, depthTex = 0;
     GLuint vertexShader = 0;
     std::unordered_map<std::string, ProgramEntry> programs;
@@ -81,6 +83,7 @@ struct GlState {
         gl.DeleteVertexArrays(1, &vao);
         gl.DeleteFramebuffers(1, &fbo);
         gl.DeleteQueries(1, &query);
+        gl.DeleteSamplers(8, samplers);
         if (vertexShader) gl.DeleteShader(vertexShader);
     }
 
@@ -135,10 +138,10 @@ struct GlState {
     }
 
     // The GL texture of a ps11 texture in the profile's terms (grid integers or float32).
-    GLuint texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::Precision precision) {
+    GLuint texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::Precision precision, bool hardware) {
         const bool fx = ps11::isFixedPoint(precision);
         for (TextureEntry& e : textures)
-            if (e.texture == tex && e.fx == fx && (!fx || e.precision == precision)) {
+            if (e.texture == tex && e.fx == fx && e.hardware == hardware && (!fx || e.precision == precision)) {
                 e.lastUse = ++clock;
                 return e.name;
             }
@@ -161,7 +164,16 @@ struct GlState {
         for (int l = 0; l < tex->levelCount(); ++l) {
             const ps11::TextureLevelInfo& li = tex->level(l);
             const size_t n = size_t(li.width) * li.height * li.depth;
-            if (fx) {
+            if (hardware && !fx && tex->storage() == ps11::TexelStorage::Unorm8) {
+                // b g r a bytes: GL_BGRA with GL_UNSIGNED_BYTE reads them as they are.
+                const uint8_t* bytes = tex->unorm8() + li.offset * 4;
+                if (tex->isVolume())
+                    gl.TexImage3D(target, l, GL_RGBA8, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
+                                  GL_BGRA, GL_UNSIGNED_BYTE, bytes);
+                else
+                    gl.TexImage2D(target, l, GL_RGBA8, GLsizei(li.width), GLsizei(li.height), 0, GL_BGRA,
+                                  GL_UNSIGNED_BYTE, bytes);
+            } else if (fx) {
                 std::vector<int32_t> data(n * 4);
                 size_t i = 0;
                 for (uint32_t z = 0; z < li.depth; ++z)
@@ -193,7 +205,7 @@ struct GlState {
                                   data.data());
             }
         }
-        textures.push_back(TextureEntry{tex, fx, precision, name, ++clock});
+        textures.push_back(TextureEntry{tex, fx, precision, hardware, name, ++clock});
         return name;
     }
 };
@@ -223,6 +235,8 @@ std::unique_ptr<GlRenderer> GlRenderer::create(const GlRendererOptions& options,
     gl.GenTextures(1, &st.depthTex);
     gl.GenFramebuffers(1, &st.fbo);
     gl.GenQueries(1, &st.query);
+    gl.GenSamplers(8, st.samplers);
+    r->m_hardwareFiltering = options.hardwareFiltering;
     // D3D's window convention: y down, pixel rows from the top (the fill rule follows it).
     gl.ClipControl(GL_UPPER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     return r;
@@ -269,6 +283,7 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     spec.merge = plan;
     spec.shaderDepth = decoded.writesDepth;
     spec.wantZ = call.merge.depthTest || (call.merge.depthWrite && call.target.depth);
+    spec.hardwareFiltering = m_hardwareFiltering && !fx;
     for (int s = 0; s < 8; ++s) {
         if (!((decoded.stagesUsed >> s) & 1)) continue;
         const auto& tex = call.textures[size_t(s)];
@@ -348,9 +363,38 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.UseProgram(program);
     for (int s = 0; s < 8; ++s) {
         if (!spec.stages[size_t(s)].bound) continue;
-        const GLuint name = st.texture(call.textures[size_t(s)], precision);
+        const GLuint name = st.texture(call.textures[size_t(s)], precision, spec.hardwareFiltering);
         gl.ActiveTexture(GL_TEXTURE0 + GLenum(s));
         gl.BindTexture(spec.stages[size_t(s)].volume ? GL_TEXTURE_3D : GL_TEXTURE_2D, name);
+        if (spec.hardwareFiltering) {
+            // D3D's sampler state as GL's (D3DTEXF_NONE as a min/mag filter acts as point).
+            const ps11::SamplerState& sm = call.samplers[size_t(s)];
+            const GLuint so = st.samplers[s];
+            const bool magLin = sm.magFilter == ps11::Filter::Linear, minLin = sm.minFilter == ps11::Filter::Linear;
+            const GLint minf = sm.mipFilter == ps11::Filter::None
+                                   ? (minLin ? GL_LINEAR : GL_NEAREST)
+                                   : sm.mipFilter == ps11::Filter::Point ? (minLin ? GL_LINEAR_MIPMAP_NEAREST : GL_NEAREST_MIPMAP_NEAREST)
+                                                                         : (minLin ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR);
+            gl.SamplerParameteri(so, GL_TEXTURE_MIN_FILTER, minf);
+            gl.SamplerParameteri(so, GL_TEXTURE_MAG_FILTER, magLin ? GL_LINEAR : GL_NEAREST);
+            const ps11::TextureAddress modes[3] = {sm.addressU, sm.addressV, sm.addressW};
+            const GLenum names[3] = {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R};
+            for (int a = 0; a < 3; ++a) {
+                GLint m = GL_REPEAT;
+                switch (modes[a]) {
+                    case ps11::TextureAddress::Mirror: m = GL_MIRRORED_REPEAT; break;
+                    case ps11::TextureAddress::Clamp: m = GL_CLAMP_TO_EDGE; break;
+                    case ps11::TextureAddress::Border: m = GL_CLAMP_TO_BORDER; break;
+                    case ps11::TextureAddress::MirrorOnce: m = GL_MIRROR_CLAMP_TO_EDGE; break;
+                    default: break;
+                }
+                gl.SamplerParameteri(so, names[a], m);
+            }
+            gl.SamplerParameterfv(so, GL_TEXTURE_BORDER_COLOR, sm.border.data());
+            gl.BindSampler(GLuint(s), so);
+        } else {
+            gl.BindSampler(GLuint(s), 0);
+        }
         gl.Uniform1i(gl.GetUniformLocation(program, ("uT" + std::to_string(s)).c_str()), s);
     }
     int32_t constG[8][4];

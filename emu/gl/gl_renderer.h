@@ -16,6 +16,9 @@ namespace emu::gl {
 
 struct GlRendererOptions {
     ContextOptions context;  // which context (OSMesa first, then EGL, by default)
+    // float and ideal profiles: filter with GL's texture unit (FragmentSpec::hardwareFiltering),
+    // not the emulator's formulas: measures a GPU's filtering, no longer a bit-exact renderer.
+    bool hardwareFiltering = false;
 };
 
 struct GlState;  // programs, textures and buffers of the context (gl_renderer.cpp)
@@ -39,6 +42,7 @@ private:
     GlRenderer() = default;
     std::unique_ptr<Context> m_context;
     std::unique_ptr<GlState> m_state;
+    bool m_hardwareFiltering = false;
     double m_lastDrawMs = 0;
 };
 

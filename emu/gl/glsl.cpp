@@ -152,6 +152,10 @@ struct Gen {
         const bool vol = st.volume;
         const int axes = vol ? 3 : 2;
         const std::string tex = "uT" + std::to_string(s);
+        if (spec.hardwareFiltering && !fx) {
+            o << "    return texture(" << tex << ", " << (vol ? "vec3(u, v, w)" : "vec2(u, v)") << ");\n}\n";
+            return;
+        }
         auto effLinear = [](ps11::Filter f) { return f == ps11::Filter::Linear; };
         const bool magLin = effLinear(st.state.magFilter), minLin = effLinear(st.state.minFilter);
         const bool weights8 = !fx && spec.weightBits == 8 && spec.precision == Precision::Float;

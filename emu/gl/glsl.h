@@ -40,6 +40,10 @@ struct FragmentSpec {
     Plan merge;                   // the output merger's plan (colour/depth pointers unused)
     bool shaderDepth = false;     // r0's depth comes from texdepth / texm3x2depth
     bool wantZ = false;           // the depth plane is evaluated (depth test or write)
+    // float profiles: sample with GL's own texture unit (texture(), the sampler state as a GL
+    // sampler object, 8-bit textures as GL_RGBA8) instead of the emulator's filtering formulas:
+    // the experiment that measures a GPU's filtering against the emulator's model.
+    bool hardwareFiltering = false;
 };
 
 // The GLSL version and extensions the shaders need (checked by the renderer).
