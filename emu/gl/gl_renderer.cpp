@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <unordered_map>
 
@@ -58,6 +60,33 @@ void toWords(const Image& img, TargetKind kind, uint32_t x, uint32_t y, uint32_t
 }
 void fromWords(Image& img, uint32_t x, uint32_t y, const uint32_t* w) {
     std::memcpy(img.texel(x, y), w, std::min<uint32_t>(img.format->bytes, 16));
+}
+
+// The triangle (window coordinates) with each edge moved out by `d`: the new corners are where
+// neighbouring moved edges meet. False when a corner would move further than `reach` (a sharp
+// corner) or the triangle is degenerate.
+bool expandTriangle(const double* x, const double* y, double d, double reach, double* ox, double* oy) {
+    const double area = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (!(std::fabs(area) > 0)) return false;
+    const double sign = area > 0 ? 1.0 : -1.0;
+    // Edge i from corner i to i+1: outward unit normal n and offset c (n·p = c on the moved edge).
+    double nx[3], ny[3], c[3];
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        const double dx = x[j] - x[i], dy = y[j] - y[i], len = std::hypot(dx, dy);
+        if (!(len > 0)) return false;
+        nx[i] = sign * dy / len, ny[i] = -sign * dx / len;
+        c[i] = nx[i] * x[i] + ny[i] * y[i] + d;
+    }
+    for (int k = 0; k < 3; ++k) {
+        const int a = (k + 2) % 3, b = k;  // the edges meeting at corner k
+        const double det = nx[a] * ny[b] - ny[a] * nx[b];
+        if (!(std::fabs(det) > 1e-12)) return false;
+        ox[k] = (c[a] * ny[b] - ny[a] * c[b]) / det;
+        oy[k] = (nx[a] * c[b] - c[a] * nx[b]) / det;
+        if (!(std::hypot(ox[k] - x[k], oy[k] - y[k]) <= reach)) return false;
+    }
+    return true;
 }
 
 }  // namespace
@@ -109,6 +138,14 @@ struct GlState {
         if (it != programs.end()) {
             it->second.lastUse = ++clock;
             return it->second.program;
+        }
+        if (const char* dir = std::getenv("PS11_GL_DUMP_SHADERS")) {
+            // Every new fragment shader as DIR/ps11_fs_N.frag, for reading and debugging.
+            const std::string path = std::string(dir) + "/ps11_fs_" + std::to_string(programs.size()) + ".frag";
+            if (FILE* f = std::fopen(path.c_str(), "w")) {
+                std::fwrite(fragment.data(), 1, fragment.size(), f);
+                std::fclose(f);
+            }
         }
         if (!vertexShader && !(vertexShader = compile(GL_VERTEX_SHADER, vertexSource(), log))) return 0;
         GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, log);
@@ -172,6 +209,15 @@ struct GlState {
                                   GL_BGRA, GL_UNSIGNED_BYTE, bytes);
                 else
                     gl.TexImage2D(target, l, GL_RGBA8, GLsizei(li.width), GLsizei(li.height), 0, GL_BGRA,
+                                  GL_UNSIGNED_BYTE, bytes);
+            } else if (fx && tex->storage() == ps11::TexelStorage::Unorm8) {
+                // The bytes as they are (b g r a: GL_BGRA_INTEGER); the shader scales them to the grid.
+                const uint8_t* bytes = tex->unorm8() + li.offset * 4;
+                if (tex->isVolume())
+                    gl.TexImage3D(target, l, GL_RGBA8UI, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
+                                  GL_BGRA_INTEGER, GL_UNSIGNED_BYTE, bytes);
+                else
+                    gl.TexImage2D(target, l, GL_RGBA8UI, GLsizei(li.width), GLsizei(li.height), 0, GL_BGRA_INTEGER,
                                   GL_UNSIGNED_BYTE, bytes);
             } else if (fx) {
                 std::vector<int32_t> data(n * 4);
@@ -293,6 +339,12 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
         ss.volume = tex->isVolume();
         ss.levels = tex->levelCount();
         ss.state = call.samplers[size_t(s)];
+        ss.unorm8 = fx && tex->storage() == ps11::TexelStorage::Unorm8;
+        ss.borderInRange = true;
+        for (int c = 0; c < 4 && fx; ++c) {
+            const int32_t g = ps11::toGrid(double(ss.state.border[size_t(c)]), precision);
+            ss.borderInRange = ss.borderInRange && g >= 0 && g <= ps11::gridScale(precision);
+        }
     }
     std::string log;
     const GLuint program = st.program(fragmentSource(spec), log);
@@ -317,19 +369,32 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             const size_t at = records.size();
             records.resize(at + size_t(stride) * 4);
             writeRecord(s, used, records.data() + at);
-            // GL draws the pixels of the triangle's bounding rectangle inside the clip rect; the
-            // shader keeps those the rasteriser covers (its edge functions, from the record).
-            double xl = 1e300, xh = -1e300;
-            for (const ScreenVertex& v : t.v) xl = std::min(xl, v.x), xh = std::max(xh, v.x);
-            const int x0 = std::max(call.clip.x0, int(std::max(-1e9, std::floor(xl)))),
-                      x1 = std::min(call.clip.x1, int(std::min(1e9, std::ceil(xh))) + 1);
-            if (x0 >= x1) {
-                records.resize(at);
-                continue;
+            // GL draws a superset of the pixels the rasteriser covers: the triangle with every
+            // edge pushed out by 3/4 pixel (a pixel centre on or inside the triangle is then
+            // strictly inside, whatever GL's fill rule), or, where a sharp corner would reach far,
+            // its bounding rectangle. The shader keeps the covered pixels (the edge functions in
+            // the record). Two GL triangles a record (gl_PrimitiveID / 2).
+            double X[3], Y[3];
+            for (int k = 0; k < 3; ++k) X[k] = double(std::llround(t.v[size_t(k)].x * 256.0)) / 256.0 + 0.5,
+                                        Y[k] = double(std::llround(t.v[size_t(k)].y * 256.0)) / 256.0 + 0.5;
+            double ex[3], ey[3];
+            Box box;
+            if (expandTriangle(X, Y, 0.75, 6.0, ex, ey)) {
+                positions.insert(positions.end(), {float(ex[0]), float(ey[0]), float(ex[1]), float(ey[1]), float(ex[2]),
+                                                   float(ey[2]), 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
+                box = Box{int(std::floor(std::min({ex[0], ex[1], ex[2]}))), int(std::floor(std::min({ey[0], ey[1], ey[2]}))),
+                          int(std::ceil(std::max({ex[0], ex[1], ex[2]}))), int(std::ceil(std::max({ey[0], ey[1], ey[2]})))};
+            } else {
+                const double xl = std::min({X[0], X[1], X[2]}), xh = std::max({X[0], X[1], X[2]});
+                const int x0 = std::max(call.clip.x0, int(std::max(-1e9, std::floor(xl)))),
+                          x1 = std::min(call.clip.x1, int(std::min(1e9, std::ceil(xh))));
+                const float fx0 = float(x0), fx1 = float(x1), fy0 = float(s.yMin), fy1 = float(s.yMax);
+                positions.insert(positions.end(), {fx0, fy0, fx1, fy0, fx0, fy1, fx1, fy0, fx1, fy1, fx0, fy1});
+                box = Box{x0, s.yMin, x1, s.yMax};
             }
-            const float fx0 = float(x0), fx1 = float(x1), fy0 = float(s.yMin), fy1 = float(s.yMax);
-            positions.insert(positions.end(), {fx0, fy0, fx1, fy0, fx0, fy1, fx1, fy0, fx1, fy1, fx0, fy1});
-            boxes.push_back(Box{x0, s.yMin, x1, s.yMax});
+            box.x0 = std::max(box.x0, call.clip.x0), box.x1 = std::min(box.x1, call.clip.x1);
+            box.y0 = std::max(box.y0, call.clip.y0), box.y1 = std::min(box.y1, call.clip.y1);
+            boxes.push_back(box);
         }
     }
     stats.trianglesDrawn += boxes.size();

@@ -76,6 +76,10 @@ int gridOf(float v, double g, double lo, double hi) {
     x = x < hi ? x : hi;
     return int(x);
 }
+)";
+
+// The sampling helpers, in shaders that sample a texture.
+const char* kSampling = R"(
 // log2 in double: frexp, then 2·atanh((m − 1)/(m + 1)) / ln 2 with m in [√½, √2).
 double log2d(double x) {
     int e;
@@ -159,7 +163,38 @@ struct Gen {
         auto effLinear = [](ps11::Filter f) { return f == ps11::Filter::Linear; };
         const bool magLin = effLinear(st.state.magFilter), minLin = effLinear(st.state.minFilter);
         const bool weights8 = !fx && spec.weightBits == 8 && spec.precision == Precision::Float;
+        const std::string scale = std::to_string(p.g / 255);
+        // One texel of level lv as grid integers (8-bit texels scaled to the grid).
+        auto texel = [&](const std::string& coord, const std::string& lv) {
+            const std::string f = "texelFetch(" + tex + ", " + coord + ", " + lv + ")";
+            return st.unorm8 && fx ? "(ivec4(" + f + ") * " + scale + ")" : f;
+        };
+        if (fx && st.unorm8 && !vol && lodFree(st) && st.borderInRange) {
+            // One 2-D level of 8-bit texels: the same taps and weights, summed in 32 bits
+            // (255·16 · 2^16 < 2^31) and rounded once: round_half_even(acc / 2^16).
+            const std::string b = "uBorderG[" + std::to_string(s) + "]";
+            auto tap = [&](const std::string& x, const std::string& y) {
+                return "((" + x + " | " + y + ") < 0 ? " + b + " : " + texel("ivec2(" + x + ", " + y + ")", "0") + ")";
+            };
+            o << "    ivec2 sz = textureSize(" << tex << ", 0);\n    double fl, fr;\n"
+              << "    texelPos(u, sz.x, " << (magLin ? "true" : "false") << ", fl, fr); ivec2 ix = address("
+              << int(st.state.addressU) << ", fl, sz.x); int wx = weight8(fr);\n"
+              << "    texelPos(v, sz.y, " << (magLin ? "true" : "false") << ", fl, fr); ivec2 iy = address("
+              << int(st.state.addressV) << ", fl, sz.y); int wy = weight8(fr);\n";
+            if (!magLin) {
+                o << "    return " << tap("ix.x", "iy.x") << ";\n}\n";
+                return;
+            }
+            o << "    ivec4 acc = " << tap("ix.x", "iy.x") << " * ((256 - wx) * (256 - wy)) + " << tap("ix.y", "iy.x")
+              << " * (wx * (256 - wy))\n        + " << tap("ix.x", "iy.y") << " * ((256 - wx) * wy) + "
+              << tap("ix.y", "iy.y") << " * (wx * wy);\n"
+              << "    return (acc + 32767 + ((acc >> 16) & 1)) >> 16;\n}\n";
+            return;
+        }
         o << "    float c[3] = float[3](u, v, w);\n";
+        if (lodFree(st)) {
+            o << "    bool minified = false;\n";
+        } else {
         o << "    ivec3 size0 = ivec3(textureSize(" << tex << ", 0)" << (vol ? "" : ", 1") << ");\n";
         // Level selection from the quad (ddx = top-right − top-left, ddy = bottom-left − top-left).
         o << "    double dx2 = 0.0lf, dy2 = 0.0lf;\n";
@@ -169,6 +204,7 @@ struct Gen {
           << "        dx2 += ddx * ddx; dy2 += ddy * ddy;\n    }\n";
         o << "    double rho2 = max(dx2, dy2);\n";
         o << "    bool minified = rho2 > 1.0lf;\n";  // lod > 0 (NaN and 0 are not)
+        }
         o << "    int level0 = 0, level1 = 0, slots = 1, mipW = 0; float mipF = 0.0;\n";
         if (st.levels > 1 && st.state.mipFilter == ps11::Filter::Point) {
             o << "    if (minified) { double lod = 0.5lf * log2d(rho2); double nl = floor(lod + 0.5lf);\n"
@@ -202,8 +238,7 @@ struct Gen {
               << "          ia[" << a << "] = address(" << modes[a] << ", fl, sz[" << a << "]);\n"
               << "          wa[" << a << "] = linear ? weight8(fr) : 0; fa[" << a << "] = linear ? "
               << (weights8 ? "float(wa[" + std::to_string(a) + "]) / 256.0" : "float(fr)") << " : 0.0; }\n";
-        const std::string fetch = vol ? "texelFetch(" + tex + ", ivec3(X, Y, Z), lv)"
-                                      : "texelFetch(" + tex + ", ivec2(X, Y), lv)";
+        const std::string fetch = vol ? texel("ivec3(X, Y, Z)", "lv") : texel("ivec2(X, Y)", "lv");
         auto tap = [&](const std::string& x, const std::string& y, const std::string& z) {
             std::string f = fetch;
             auto rep = [&](const std::string& k, const std::string& v) { f.replace(f.find(k), k.size(), v); };
@@ -618,10 +653,15 @@ struct Gen {
         for (int s = 0; s < 8; ++s) {
             const StageSpec& st = spec.stages[size_t(s)];
             if (!st.bound) continue;
-            o << "uniform " << (fx ? "isampler" : "sampler") << (st.volume ? "3D" : "2D") << " uT" << s << ";\n";
+            o << "uniform " << (fx ? (st.unorm8 ? "usampler" : "isampler") : "sampler") << (st.volume ? "3D" : "2D")
+              << " uT" << s << ";\n";
         }
         o << "layout(location = 0) out uvec4 oColor;\nlayout(location = 1) out uint oDepth;\n";
         o << kCommon;
+        bool samples = false;
+        for (int s = 0; s < 8; ++s)
+            samples = samples || (((spec.program->stagesUsed >> s) & 1) && spec.stages[size_t(s)].bound);
+        if (samples) o << kSampling;
         o << "int gBase;\n"
              "double recD(int i) { uvec4 t = texelFetch(uTri, gBase + 6 + (i >> 1)); return packDouble2x32((i & 1) == 0 ? t.xy : t.zw); }\n"
              "int64_t recE(int i) { uvec4 t = texelFetch(uTri, gBase + 1 + (i >> 1)); return int64_t(packUint2x32((i & 1) == 0 ? t.xy : t.zw)); }\n"
@@ -643,6 +683,14 @@ struct Gen {
              "    for (int e = 0; e < 3; ++e) {\n"
              "        int64_t E = recE(e) * int64_t(P.x * 256) + recE(3 + e) * int64_t(P.y * 256) + recE(6 + e);\n"
              "        if (E < int64_t((head.w >> uint(e)) & 1u)) covered = false;\n    }\n";
+        // Without derivatives (no stage's level or filter depends on them) an uncovered pixel
+        // has nothing to contribute to its quad: it leaves at once.
+        bool early = true;
+        for (int s = 0; s < 8; ++s)
+            if ((spec.program->stagesUsed >> s) & 1 && spec.stages[size_t(s)].bound && !lodFree(spec.stages[size_t(s)]) &&
+                !(spec.hardwareFiltering && !fx))
+                early = false;
+        if (early) o << "    if (!covered) discard;\n";
         o << "    double ox = recD(0), oy = recD(1);\n";
         o << "    float inv = 1.0;\n    if (persp) { float r = planeAt(2, P, ox, oy); r = r < 1e-30 ? 1e-30 : r; inv = fdiv(1.0, r); }\n";
         // Attributes: v0, v1 (diffuse, specular), TC[0..7].

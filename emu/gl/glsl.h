@@ -29,7 +29,20 @@ struct StageSpec {
     bool volume = false;  // sampler3D / isampler3D
     int levels = 1;
     ps11::SamplerState state;  // filters and address modes (the border colour is a uniform)
+    // fx profiles: 8-bit texels (ps11::TexelStorage::Unorm8), uploaded as GL_RGBA8UI and scaled
+    // to the grid in the shader; others are GL_RGBA32I grid integers.
+    bool unorm8 = false;
+    // The border colour's grid values are within [0, G] (what a D3DCOLOR gives): 32-bit sums
+    // suffice for a one-level 2-D bilinear tap.
+    bool borderInRange = false;
 };
+
+// The level and filter of a stage do not depend on the quad's derivatives: one level (or no
+// mip filter) and the same filter for minification and magnification.
+inline bool lodFree(const StageSpec& s) {
+    const bool magLin = s.state.magFilter == ps11::Filter::Linear, minLin = s.state.minFilter == ps11::Filter::Linear;
+    return (s.levels == 1 || s.state.mipFilter == ps11::Filter::None) && magLin == minLin;
+}
 
 struct FragmentSpec {
     const ps11::exec::DecodedProgram* program = nullptr;
