@@ -34,9 +34,8 @@ bool drawableFormat(D3DFORMAT f) {
            f == D3DFMT_A32B32G32R32F;
 }
 
-// The attributes a program reads: v0/v1 as diffuse/specular, t# as texture-coordinate slots.
-// Conservative: any t# operand (destination of a texture-address instruction in 1_1–1_3, texld/
-// texcrd source in 1_4) marks its slot.
+}  // namespace
+
 uint64_t attributesRead(const ps11::Program& program) {
     uint64_t used = 0;
     auto slot = [&](int i) {
@@ -55,6 +54,8 @@ uint64_t attributesRead(const ps11::Program& program) {
     }
     return used;
 }
+
+namespace {
 
 bool hasTexkill(const ps11::Program& program) {
     for (const ps11::Instruction& ins : program.instructions)

@@ -53,6 +53,11 @@ struct DrawProgram {
     std::array<ps11::StageState, kMaxStages> stages{};               // per-stage executor values
 };
 
+// The attributes a program reads (emu/vertex.h indices): v0/v1 as diffuse/specular, t# as
+// texture-coordinate slots. Conservative: any t# operand (destination of a texture-address
+// instruction in 1_1–1_3, texld/texcrd source in 1_4) marks its slot.
+uint64_t attributesRead(const ps11::Program& program);
+
 // One DrawPrimitiveUP, resolved by the front.
 struct DrawCall {
     ps11::HardwareConfig hardware;  // class, profile, MaxValue, filter weights

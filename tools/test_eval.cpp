@@ -459,7 +459,7 @@ std::unique_ptr<RendererEval> RendererEval::create(const TestFile& file, const s
     call.target.color = &m.color;
     call.target.depth = m.writesDepth ? &m.depth : nullptr;
     call.clip = emu::ClipRect{0, 0, 1, 1};
-    call.usedAttributes = (uint64_t(1) << emu::kAttrCount) - 1;
+    call.usedAttributes = emu::attributesRead(program);
     call.primitiveCount = 1;
     return r;
 }
