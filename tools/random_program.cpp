@@ -631,12 +631,12 @@ std::string textureSection(Dice& dice, int stage, bool signedTexels) {
 
 // Everything but the shader: the file around `shader`, whose [pixel shader] block comes last
 // before [test].
-std::string testTextOf(Dice& dice, const ps11::Program& program, const std::string& shader, int size) {
+std::string testTextOf(Dice& dice, const ps11::Program& program, const std::string& shader, int width, int height) {
     const int minor = program.version.minor;
     std::string out = "% a random ps_1_" + std::to_string(minor) +
                       " case (tools/random_program.cpp): one draw, no probes\n[require]\nversion ps_1_" +
-                      std::to_string(minor) + "\n\n[render target]\nsize " + std::to_string(size) + " " +
-                      std::to_string(size) + "\nclear " + hexWord(dice.word()) + "\n\n";
+                      std::to_string(minor) + "\n\n[render target]\nsize " + std::to_string(width) + " " +
+                      std::to_string(height) + "\nclear " + hexWord(dice.word()) + "\n\n";
     const uint32_t sampled = ps11::sampledStages(program);
     const BumpStages bump = bumpStagesOf(program);
     for (int stage = 0; stage < 8; ++stage)
@@ -659,8 +659,8 @@ std::string testTextOf(Dice& dice, const ps11::Program& program, const std::stri
     // two triangles 0 1 2 and 0 2 3. u and v range over [-0.5, 1.5] so wrap, mirror, clamp and
     // border all show; the third and fourth components (the divisors of _dz and _dw) stay in
     // [0.25, 1.5], away from zero.
-    const double lo = -0.5, hi = size - 0.5;
-    const std::array<std::array<double, 2>, 4> corners = {{{lo, lo}, {hi, lo}, {hi, hi}, {lo, hi}}};
+    const double lo = -0.5, hx = width - 0.5, hy = height - 0.5;
+    const std::array<std::array<double, 2>, 4> corners = {{{lo, lo}, {hx, lo}, {hx, hy}, {lo, hy}}};
     std::array<std::string, 4> vertices;
     for (size_t k = 0; k < 4; ++k) {
         std::string& v = vertices[k];
@@ -699,7 +699,23 @@ RandomCase randomCase(std::mt19937_64& rng, const RandomCaseOptions& options) {
         c.lines = {"mov r0, v0"};
         program = assembleCleanly(c.shaderText());
     }
-    c.testText = testTextOf(dice, *program, c.shaderText(), std::max(1, options.size));
+    c.testText = testTextOf(dice, *program, c.shaderText(), std::max(1, options.width), std::max(1, options.height));
+    return c;
+}
+
+RandomCase caseForProgram(std::mt19937_64& rng, int minor, const std::vector<std::string>& lines,
+                          const RandomCaseOptions& options) {
+    Dice dice(rng);
+    RandomCase c;
+    c.minor = minor;
+    c.lines = lines;
+    // A user's shader may carry warnings; errors leave the case empty.
+    ps11::Diagnostics diags;
+    std::optional<ps11::Program> program = ps11::parseAssembly(c.shaderText(), "shader.psh", {}, diags);
+    if (program) ps11::validate(*program, diags);
+    if (program && !diags.hasErrors())
+        c.testText =
+            testTextOf(dice, *program, c.shaderText(), std::max(1, options.width), std::max(1, options.height));
     return c;
 }
 

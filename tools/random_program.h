@@ -14,14 +14,14 @@ namespace ps11tools {
 struct RandomCaseOptions {
     int minor = 0;     // 1..4 = that ps_1_x version; 0 = pick one at random per case
     int maxArith = 6;  // most arithmetic instructions (the version's slot limit still applies)
-    int size = 8;      // render target width and height of the generated draw
+    int width = 8, height = 8;  // the render target of the generated draw
 };
 
 struct RandomCase {
     int minor = 1;
     std::vector<std::string> lines;  // the shader body, one instruction (or def) per line, without the ps_1_x line
     std::string shaderText() const;  // "ps_1_x\n" + lines joined with '\n'
-    // A complete .ps11test: [require], [render target] (size × size), a [texture N] and
+    // A complete .ps11test: [require], [render target] (width × height), a [texture N] and
     // [sampler N] for every stage the shader samples (random texels, formats, filters and
     // address modes; V8U8 only on the stages that feed texbem, texbeml or bem), [stage N] bump
     // matrices where texbem, texbeml or bem read them, c0..c7 in [constants], the [pixel shader],
@@ -34,6 +34,13 @@ struct RandomCase {
 // error, and no warning: warnings mark results D3D leaves undefined), with its test file.
 // The same rng state gives the same case with every standard library.
 RandomCase randomCase(std::mt19937_64& rng, const RandomCaseOptions& options);
+
+// The random inputs of randomCase (textures of the formats the instructions need, samplers,
+// bump stages, constants, the draw's colours and coordinates) around a given program: what
+// `ps11 compare SHADER.psh` draws. The lines must assemble and validate as ps_1_<minor>
+// (warnings allowed); otherwise testText is empty.
+RandomCase caseForProgram(std::mt19937_64& rng, int minor, const std::vector<std::string>& lines,
+                          const RandomCaseOptions& options);
 
 // c.testText with its [pixel shader] block replaced by c.shaderText() (appended when the file
 // has none): the same textures, states, constants and draw for a changed instruction list.
