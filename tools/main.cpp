@@ -23,6 +23,7 @@
 #include "tools/cmd_golden.h"
 #include "tools/cmd_hardware.h"
 #include "tools/cmd_info.h"
+#include "tools/cmd_compare.h"
 #include "tools/cmd_test.h"
 
 namespace ps11::cli {
@@ -36,8 +37,12 @@ const char* kUsageText =
     "                         tokens (binary, or hex words with --hex-input) → text\n"
     "  check FILE... [--json] [-D NAME[=VALUE]] [-I DIR]\n"
     "                         validate and print statistics (slots, constants, read ports)\n"
-    "  test FILE.ps11test... [--backend emu|gl|both] [--hardware H] [--precision P] [-v]\n"
-    "                         run .ps11test files\n"
+    "  test FILE.ps11test... [--backend emu|gl|both] [--gl osmesa|egl] [--hardware H] [--precision P] [-v]\n"
+    "                         run .ps11test files (both: cross-check the two renderers)\n"
+    "  compare SHADER.psh|FILE.ps11test [--size WxH] [--seed S] [--hardware H] [--precision P]\n"
+    "          [--heatmap OUT.png] [--json] [--gl osmesa|egl]\n"
+    "  compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json]\n"
+    "                         the emulator against the GL renderer, draw by draw\n"
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
@@ -357,6 +362,7 @@ int main(int argc, char** argv) {
         {"disasm", cmdDisasm},
         {"check", cmdCheck},
         {"test", ps11::cmdTest},
+        {"compare", ps11::cmdCompare},
         {"eval", ps11::cmdEval},
         {"golden", cmdGolden},
         {"demo", cmdDemo},
