@@ -28,7 +28,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: ps11 compare SHADER.psh|FILE.ps11test [--size WxH] [--seed S] [--hardware H] [--precision P]\n"
-    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl]\n"
+    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-filtering]\n"
     "       ps11 compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json] [--gl osmesa|egl]\n";
 
 int usageError(const std::string& msg) {
@@ -46,12 +46,14 @@ struct Options {
     long random = -1;  // --random N
     int minor = 0;
     std::string outDir = ".";
+    bool glFiltering = false;  // float profiles: GL's texture unit filters (GlRendererOptions)
 };
 
 // One draw compared.
 struct DrawDiff {
     uint32_t line = 0;
     uint64_t pixels = 0, exact = 0, overOne = 0;
+    uint64_t distinctEmu = 0, distinctGl = 0;  // distinct colours in each target
     double maxDiff = 0;  // 8-bit levels, or values on float targets
     bool values = false;
 };
@@ -93,6 +95,12 @@ DrawDiff diffTargets(const std::vector<Vec4>& a, const std::vector<Vec4>& b, boo
         d.overOne += m > (values ? 1e-4 : 1.0);
         d.maxDiff = std::max(d.maxDiff, m);
     }
+    auto distinct = [](std::vector<Vec4> v) {
+        std::sort(v.begin(), v.end());
+        return uint64_t(std::unique(v.begin(), v.end()) - v.begin());
+    };
+    d.distinctGl = distinct(a);
+    d.distinctEmu = distinct(b);
     return d;
 }
 
@@ -191,7 +199,7 @@ void printReport(const std::string& path, const Report& r, const Options& opts) 
             std::cout << (i ? ", " : "") << "{\"line\": " << d.line << ", \"pixels\": " << d.pixels
                       << ", \"exact\": " << d.exact << ", \"over_one\": " << d.overOne
                       << ", \"max_diff\": " << number(d.maxDiff) << ", \"unit\": \"" << (d.values ? "value" : "level")
-                      << "\"}";
+                      << "\", \"distinct_emu\": " << d.distinctEmu << ", \"distinct_gl\": " << d.distinctGl << "}";
         }
         std::cout << "], \"unsupported\": [";
         for (size_t i = 0; i < r.unsupported.size(); ++i)
@@ -204,7 +212,8 @@ void printReport(const std::string& path, const Report& r, const Options& opts) 
     for (const DrawDiff& d : r.draws)
         std::cout << path << ":" << d.line << ": draw: " << d.pixels << " pixels, " << d.exact << " exact, "
                   << d.overOne << " more than " << (d.values ? "1e-4" : "one level") << " apart, max |d| "
-                  << number(d.maxDiff) << (d.values ? "" : " levels") << "\n";
+                  << number(d.maxDiff) << (d.values ? "" : " levels") << "; distinct colours: " << d.distinctEmu
+                  << " emu, " << d.distinctGl << " gl\n";
     for (const auto& [line, why] : r.unsupported)
         std::cout << path << ":" << line << ": unsupported on gl: " << why << "\n";
     const uint64_t pixels = r.sum(&DrawDiff::pixels), exact = r.sum(&DrawDiff::exact);
@@ -346,6 +355,8 @@ int cmdCompare(const std::vector<std::string>& args) {
             return cli::kOk;
         } else if (a == "--json") {
             opts.json = true;
+        } else if (a == "--gl-filtering") {
+            opts.glFiltering = true;
         } else if (a == "--size") {
             unsigned w = 0, h = 0;
             char x = 0;
@@ -380,7 +391,8 @@ int cmdCompare(const std::vector<std::string>& args) {
             if (!value(glName) || (glName != "osmesa" && glName != "egl")) return usageError("--gl takes osmesa or egl");
         } else if (!a.empty() && a[0] == '-') {
             return usageError(cli::unknownOption(a, {"--size", "--seed", "--random", "--minor", "--out", "--heatmap",
-                                                     "--hardware", "--precision", "--json", "--gl", "--help"}));
+                                                     "--hardware", "--precision", "--json", "--gl", "--gl-filtering",
+                                                     "--help"}));
         } else if (input.empty()) {
             input = a;
         } else {
@@ -390,7 +402,7 @@ int cmdCompare(const std::vector<std::string>& args) {
     if (opts.random < 0 && input.empty()) return usageError("missing SHADER.psh or FILE.ps11test (or --random N)");
     if (opts.random >= 0 && !input.empty()) return usageError("--random takes no input file");
     std::string error;
-    const RendererFactory gl = glRendererFactory(glName, error);
+    const RendererFactory gl = glRendererFactory(glName, error, opts.glFiltering);
     if (!gl) {
         std::cerr << "ps11 compare: " << error << "\n";
         return cli::kUserError;

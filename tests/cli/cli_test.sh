@@ -150,8 +150,10 @@ sed -i '8d' "$work/t.ps11test"
 expect_rc 0 "test with passing eval probes" "$ps11" test "$work/t.ps11test" --stats
 expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "summary"
 expect_in "$work/out" "1 pixels, 1 instructions executed" "--stats"
-expect_rc 0 "evals on gl are not runnable" "$ps11" test "$work/t.ps11test" --backend gl
-expect_in "$work/out" "1 not yet runnable (not runnable on gl yet: 4 commands)" "gl commands counted apart"
+if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
+    expect_rc 0 "evals run on gl as one-pixel draws" "$ps11" test "$work/t.ps11test" --backend gl
+    expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "gl evals"
+fi
 
 # test: draws run on the device; a pixel probe failure names the line, the expected colour and
 # the first pixel that differs; a draw the device refuses fails with the device's message.
@@ -256,6 +258,40 @@ else
         expect_in "$work/out" "GL context: none (OSMesa: " "info reports why there is no context"
     fi
 fi
+# The GL renderer: ps11 test --backend gl|both and ps11 compare (docs/gl-backend.md "Cross-check").
+if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
+    printf '[require]\nversion ps_1_1\n\n[render target]\nsize 4 4\n\n[texture 0]\nsize 2 2\nformat A8R8G8B8\nlevel 0\n0xff102030 0xff405060\n0xff708090 0xffa0b0c0\n\n[sampler 0]\nfilter linear\n\n[pixel shader]\nps_1_1\ntex t0\nmul_x2 r0, t0, v0\n\n[test]\ndraw quad\neval\n  v0 0.5 0.25 1 1\n  t0 0.25 0.75\nprobe eval rgba 0.25 0.25 0.25 1 tol 1\n' >"$work/x.ps11test"
+    expect_rc 0 "test --backend both" "$ps11" test --backend both "$work/x.ps11test"
+    expect_in "$work/out" "cross-check (" "test --backend both prints the cross-check"
+    expect_in "$work/out" "2 draws, 17 pixels, 17 exact (100 %), 0 past the target, max |d| 0; 0 disagreements" "draw and eval agree"
+    expect_rc 0 "test --backend gl --gl egl" "$ps11" test --backend gl --gl egl "$work/x.ps11test"
+    expect_rc 2 "test --gl unknown kind" "$ps11" test --gl glx "$work/x.ps11test"
+    expect_in "$work/err" "unknown GL context 'glx'" "test names the GL kinds"
+    expect_rc 1 "test --backend gl without a context" env MESA_GL_VERSION_OVERRIDE=3.1 \
+        __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$ps11" test --backend gl "$work/x.ps11test"
+    expect_in "$work/err" "ps11 test: --backend gl: no GL renderer: " "no GL renderer is the user's error, named"
+    expect_rc 0 "compare a test file" "$ps11" compare "$work/x.ps11test" --json
+    expect_in "$work/out" '"pixels": 16, "exact": 16, "over_one": 0, "max_diff": 0, "draws": [{"line": ' "compare --json totals"
+    expect_in "$work/out" '"unsupported": []' "compare --json lists nothing unsupported"
+    printf 'ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, v0, c0\n' >"$work/bem.psh"
+    expect_rc 0 "compare a bare shader" "$ps11" compare "$work/bem.psh" --size 16x8 --seed 7 --heatmap "$work/heat.png"
+    expect_in "$work/out" "128 pixels, 128 exact" "compare draws the shader over random inputs"
+    [ "$(head -c 8 "$work/heat.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "compare --heatmap wrote no PNG"
+    expect_rc 0 "compare --random" "$ps11" compare --random 3 --seed 11 --out "$work"
+    expect_in "$work/out" "random: 3 programs (seeds 11..13)" "compare --random counts its programs"
+    expect_rc 1 "compare an invalid shader" "$ps11" compare "$work/bad.psh"
+    expect_in "$work/err" "bad.psh:3:9: error P2090" "compare names the shader's error"
+    expect_rc 1 "compare a missing file" "$ps11" compare "$work/none.ps11test"
+    expect_in "$work/err" "none.ps11test" "compare names the missing file"
+    expect_rc 1 "compare --heatmap into a missing folder" "$ps11" compare "$work/bem.psh" --heatmap "$work/no/dir/h.png"
+    expect_in "$work/err" "no/dir/h.png" "the heat map's path is named"
+fi
+expect_rc 2 "compare without input" "$ps11" compare
+expect_in "$work/err" "missing SHADER.psh or FILE.ps11test" "compare says what is missing"
+expect_rc 2 "compare --size bad" "$ps11" compare x.psh --size 0x4
+expect_rc 2 "compare --random with a file" "$ps11" compare x.psh --random 3
+expect_rc 2 "compare unknown option" "$ps11" compare x.psh --heatmpa h.png
+expect_in "$work/err" "did you mean '--heatmap'?" "compare suggests the option"
 expect_rc 2 "info --gl unknown kind" "$ps11" info --gl glx
 expect_in "$work/err" "ps11: info: --gl takes osmesa or egl, not 'glx'" "info names the kinds"
 
