@@ -50,18 +50,6 @@ bool hasExtension(const GlFunctions& gl, const char* name) {
     return false;
 }
 
-// Raw words of one pixel of a surface (the GL side keeps them as RGBA32UI / R32UI).
-void toWords(const Image& img, TargetKind kind, uint32_t x, uint32_t y, uint32_t* w) {
-    const uint8_t* p = img.texel(x, y);
-    w[0] = w[1] = w[2] = w[3] = 0;
-    const uint32_t bytes = img.format->bytes;
-    std::memcpy(w, p, std::min<uint32_t>(bytes, 16));
-    (void)kind;
-}
-void fromWords(Image& img, uint32_t x, uint32_t y, const uint32_t* w) {
-    std::memcpy(img.texel(x, y), w, std::min<uint32_t>(img.format->bytes, 16));
-}
-
 // The triangle (window coordinates) with each edge moved out by `d`: the new corners are where
 // neighbouring moved edges meet. False when a corner would move further than `reach` (a sharp
 // corner) or the triangle is degenerate.
@@ -400,29 +388,46 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     stats.trianglesDrawn += boxes.size();
     if (boxes.empty()) return true;
 
-    // ---- surfaces as raw words ----
+    // ---- surfaces as raw words: 1, 2 or 4 32-bit words a pixel (R32UI, RG32UI, RGBA32UI) ----
     const uint32_t W = color ? color->width : depth->width, H = color ? color->height : depth->height;
     std::vector<uint32_t> words;
-    auto upload = [&](GLuint tex, const Image* img, bool rgba, uint32_t w, uint32_t h) {
-        words.assign(size_t(w) * h * (rgba ? 4 : 1), 0);
-        if (img)
-            for (uint32_t y = 0; y < h; ++y)
-                for (uint32_t x = 0; x < w; ++x) {
-                    uint32_t px[4];
-                    toWords(*img, plan.target, x, y, px);
-                    std::memcpy(&words[(size_t(y) * w + x) * (rgba ? 4 : 1)], px, rgba ? 16 : 4);
-                }
+    auto wordsOf = [](const Image& img) { return (img.format->bytes + 3) / 4; };
+    auto formats = [](uint32_t n, GLenum& internal, GLenum& format) {
+        internal = n == 1 ? GL_R32UI : n == 2 ? GL_RG32UI : GL_RGBA32UI;
+        format = n == 1 ? GL_RED_INTEGER : n == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER;
+    };
+    auto upload = [&](GLuint tex, const Image& img) {
+        const uint32_t n = wordsOf(img), bytes = img.format->bytes;
+        words.assign(size_t(img.width) * img.height * n, 0);
+        for (uint32_t y = 0; y < img.height; ++y) {
+            uint8_t* dst = reinterpret_cast<uint8_t*>(&words[size_t(y) * img.width * n]);
+            if (bytes == 4 * n)
+                std::memcpy(dst, img.texel(0, y), size_t(img.width) * bytes);
+            else
+                for (uint32_t x = 0; x < img.width; ++x) std::memcpy(dst + size_t(x) * 4 * n, img.texel(x, y), bytes);
+        }
+        GLenum internal, format;
+        formats(n, internal, format);
         gl.BindTexture(GL_TEXTURE_2D, tex);
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-        gl.TexImage2D(GL_TEXTURE_2D, 0, rgba ? GL_RGBA32UI : GL_R32UI, GLsizei(w), GLsizei(h), 0,
-                      rgba ? GL_RGBA_INTEGER : GL_RED_INTEGER, GL_UNSIGNED_INT, words.data());
+        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        gl.TexImage2D(GL_TEXTURE_2D, 0, GLint(internal), GLsizei(img.width), GLsizei(img.height), 0, format,
+                      GL_UNSIGNED_INT, words.data());
     };
+    // Without a colour target the colour attachment only sizes the framebuffer (never written).
+    emu::Image none;
+    if (!color) {
+        none.format = depth->format;
+        none.width = W, none.height = H;
+        none.rowPitch = W * depth->format->bytes;
+        none.bytes.assign(size_t(none.rowPitch) * H, 0);
+    }
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstColor);
-    upload(st.colorTex, color, true, color ? color->width : W, color ? color->height : H);
+    upload(st.colorTex, color ? *color : none);
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstDepth);
-    upload(st.depthTex, depth, false, depth ? depth->width : W, depth ? depth->height : H);
+    if (depth) upload(st.depthTex, *depth);
 
     // ---- textures and uniforms ----
     gl.UseProgram(program);
@@ -509,13 +514,13 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     // ---- the framebuffer: raw colour words, raw depth words ----
     gl.BindFramebuffer(GL_FRAMEBUFFER, st.fbo);
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, st.colorTex, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, st.depthTex, 0);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, depth ? st.depthTex : 0, 0);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, depth ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
     gl.DrawBuffers(2, buffers);
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) return refuse("its framebuffer is incomplete");
     const bool writeColor = color && plan.channels != 0;
     gl.ColorMaski(0, writeColor, writeColor, writeColor, writeColor);
-    gl.ColorMaski(1, plan.depthWrite, plan.depthWrite, plan.depthWrite, plan.depthWrite);
+    if (depth) gl.ColorMaski(1, plan.depthWrite, plan.depthWrite, plan.depthWrite, plan.depthWrite);
     gl.Viewport(0, 0, GLsizei(W), GLsizei(H));
     gl.Enable(GL_SCISSOR_TEST);
     gl.Scissor(call.clip.x0, call.clip.y0, call.clip.x1 - call.clip.x0, call.clip.y1 - call.clip.y0);
@@ -552,19 +557,26 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.Disable(GL_SCISSOR_TEST);
 
     // ---- read back ----
-    auto readBack = [&](GLuint tex, Image* img, bool rgba) {
-        words.assign(size_t(img->width) * img->height * (rgba ? 4 : 1), 0);
+    auto readBack = [&](GLuint tex, Image& img) {
+        const uint32_t n = wordsOf(img), bytes = img.format->bytes;
+        words.assign(size_t(img.width) * img.height * n, 0);
+        GLenum internal, format;
+        formats(n, internal, format);
         gl.BindTexture(GL_TEXTURE_2D, tex);
         gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-        gl.GetTexImage(GL_TEXTURE_2D, 0, rgba ? GL_RGBA_INTEGER : GL_RED_INTEGER, GL_UNSIGNED_INT, words.data());
-        for (uint32_t y = 0; y < img->height; ++y)
-            for (uint32_t x = 0; x < img->width; ++x)
-                fromWords(*img, x, y, &words[(size_t(y) * img->width + x) * (rgba ? 4 : 1)]);
+        gl.GetTexImage(GL_TEXTURE_2D, 0, format, GL_UNSIGNED_INT, words.data());
+        for (uint32_t y = 0; y < img.height; ++y) {
+            const uint8_t* src = reinterpret_cast<const uint8_t*>(&words[size_t(y) * img.width * n]);
+            if (bytes == 4 * n)
+                std::memcpy(img.texel(0, y), src, size_t(img.width) * bytes);
+            else
+                for (uint32_t x = 0; x < img.width; ++x) std::memcpy(img.texel(x, y), src + size_t(x) * 4 * n, bytes);
+        }
     };
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstColor);
-    if (writeColor) readBack(st.colorTex, color, true);
+    if (writeColor) readBack(st.colorTex, *color);
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstDepth);
-    if (plan.depthWrite) readBack(st.depthTex, depth, false);
+    if (plan.depthWrite) readBack(st.depthTex, *depth);
     if (GLenum e = gl.GetError(); e != GL_NO_ERROR) return refuse("OpenGL reported error 0x" + [&] {
         char b[16];
         std::snprintf(b, sizeof b, "%x", unsigned(e));
