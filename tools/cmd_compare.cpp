@@ -28,7 +28,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: ps11 compare SHADER.psh|FILE.ps11test [--size WxH] [--seed S] [--hardware H] [--precision P]\n"
-    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-filtering]\n"
+    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-filtering] [-v]\n"
     "       ps11 compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json] [--gl osmesa|egl]\n";
 
 int usageError(const std::string& msg) {
@@ -47,6 +47,7 @@ struct Options {
     int minor = 0;
     std::string outDir = ".";
     bool glFiltering = false;  // float profiles: GL's texture unit filters (GlRendererOptions)
+    bool verbose = false;      // -v: the first differing pixels of each draw
 };
 
 // One draw compared.
@@ -162,6 +163,19 @@ void compareText(const std::string& text, const std::string& path, const Options
         DrawDiff d = diffTargets(report.glPixels, report.emuPixels, report.values);
         d.line = cmd.line;
         report.draws.push_back(d);
+        if (opts.verbose && d.exact < d.pixels) {
+            int shown = 0;
+            for (size_t i = 0; i < report.emuPixels.size() && shown < 20; ++i) {
+                if (report.emuPixels[i] == report.glPixels[i]) continue;
+                ++shown;
+                std::cerr << path << ":" << cmd.line << ": pixel (" << i % report.width << ", " << i / report.width
+                          << "): emu";
+                for (float v : report.emuPixels[i]) std::cerr << " " << v;
+                std::cerr << ", gl";
+                for (float v : report.glPixels[i]) std::cerr << " " << v;
+                std::cerr << "\n";
+            }
+        }
     }
 }
 
@@ -317,7 +331,9 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
         const std::string out = (std::filesystem::path(opts.outDir) / ("compare_random_" + std::to_string(seed) + ".ps11test")).string();
         if (!cli::writeFile(out, head.str() + small.testText)) return cli::kUserError;
         mismatches.emplace_back(seed, out);
-        if (!opts.json) std::cout << "seed " << seed << ": mismatch, shrunk to " << small.lines.size() << " lines: " << out << "\n";
+        if (!opts.json)
+            std::cout << "seed " << seed << ": mismatch, shrunk to " << small.lines.size() << " lines: " << out
+                      << std::endl;  // at once: a long run may be stopped
     }
     if (opts.json) {
         std::cout << "{\"programs\": " << programs << ", \"pixels\": " << pixels << ", \"exact\": " << exact
@@ -355,6 +371,8 @@ int cmdCompare(const std::vector<std::string>& args) {
             return cli::kOk;
         } else if (a == "--json") {
             opts.json = true;
+        } else if (a == "-v" || a == "--verbose") {
+            opts.verbose = true;
         } else if (a == "--gl-filtering") {
             opts.glFiltering = true;
         } else if (a == "--size") {
@@ -392,7 +410,7 @@ int cmdCompare(const std::vector<std::string>& args) {
         } else if (!a.empty() && a[0] == '-') {
             return usageError(cli::unknownOption(a, {"--size", "--seed", "--random", "--minor", "--out", "--heatmap",
                                                      "--hardware", "--precision", "--json", "--gl", "--gl-filtering",
-                                                     "--help"}));
+                                                     "--verbose", "--help"}));
         } else if (input.empty()) {
             input = a;
         } else {

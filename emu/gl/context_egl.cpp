@@ -155,13 +155,18 @@ public:
                 return false;
             }
         }
-        // clang-format off
-        const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3,
-                                  EGL_CONTEXT_MINOR_VERSION, 3,
-                                  EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                  EGL_NONE};
-        // clang-format on
-        m_ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
+        // OpenGL 4.5 core first (the GL renderer's shaders need it; NVIDIA's driver gives exactly
+        // the version asked for, Mesa the highest it has), then 3.3 core.
+        for (EGLint minorVersion : {5, 3}) {
+            // clang-format off
+            const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, minorVersion == 5 ? 4 : 3,
+                                      EGL_CONTEXT_MINOR_VERSION, minorVersion,
+                                      EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                      EGL_NONE};
+            // clang-format on
+            m_ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
+            if (m_ctx != EGL_NO_CONTEXT) break;
+        }
         if (m_ctx == EGL_NO_CONTEXT) {
             error = prefix + "eglCreateContext refused OpenGL 3.3 core (" + lastEglError() + ")";
             return false;

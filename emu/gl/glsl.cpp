@@ -91,25 +91,66 @@ double log2d(double x) {
     for (int k = 39; k >= 1; k -= 2) t = t * s2 + 1.0lf / double(k);
     return double(e) + 2.0lf * s * t * 1.4426950408889634074lf;
 }
+// The values of v at the quad's top-left, top-right and bottom-left pixels, exactly: v's four
+// bytes as floats go through fine derivatives (differences of small integers are exact), each
+// pixel undoes its own offset in the quad. The signs of dFdx/dFdy are measured, not assumed.
+uint packBytes(vec4 b) { return uint(b.x) | (uint(b.y) << 8) | (uint(b.z) << 16) | (uint(b.w) << 24); }
+vec3 quadValues(float v) {
+    uint u = floatBitsToUint(v);
+    vec4 by = vec4(float(u & 255u), float((u >> 8) & 255u), float((u >> 16) & 255u), float(u >> 24));
+    float sx = dFdxFine(gl_FragCoord.x), sy = dFdyFine(gl_FragCoord.y);
+    bool right = (int(gl_FragCoord.x) & 1) != 0, bottom = (int(gl_FragCoord.y) & 1) != 0;
+    vec4 dx = sx * dFdxFine(by);
+    vec4 left = right ? by - dx : by, rightv = right ? by : by + dx;
+    vec4 dyL = sy * dFdyFine(left), dyR = sy * dFdyFine(rightv);
+    vec4 tl = bottom ? left - dyL : left, tr = bottom ? rightv - dyR : rightv, bl = bottom ? left : left + dyL;
+    return vec3(uintBitsToFloat(packBytes(tl)), uintBitsToFloat(packBytes(tr)), uintBitsToFloat(packBytes(bl)));
+}
+// The level of detail 0.5·log2(rho2) as the sampler takes it: NaN counts as 0, +inf (an
+// overflowed derivative) as far beyond every level, 0 as magnified. No isinf/frexp on
+// infinities, which llvmpipe does not evaluate reliably for doubles.
+double lodOf(double rho2) {
+    if (isnan(rho2)) return 0.0lf;
+    if (rho2 > 1.7976931348623157e308lf) return 1e300lf;
+    if (!(rho2 > 0.0lf)) return -1e300lf;
+    return 0.5lf * log2d(rho2);
+}
 // The 8-bit sub-texel weight round_half_even(f · 256).
 int weight8(double f) { return int(roundEven(f * 256.0lf)); }
 // Texel-space position of one coordinate (ps11/texture_sampler_internal.h texelPosition): NaN
 // samples as 0, infinities as a far texel.
 void texelPos(float u, int n, bool linear, out double fl, out double fr) {
     precise double x = double(u) * double(n) - (linear ? 0.5lf : 0.0lf);
-    if (isnan(x)) { fl = 0.0lf; fr = 0.0lf; return; }
-    if (isinf(x)) { fl = x > 0.0lf ? 1e18lf : -1e18lf; fr = 0.0lf; return; }
+    // (comparisons, not isnan/isinf: llvmpipe does not evaluate those reliably for doubles)
+    if (!(x == x)) { fl = 0.0lf; fr = 0.0lf; return; }
+    if (abs(x) > 1.7976931348623157e308lf) { fl = x > 0.0lf ? 1e18lf : -1e18lf; fr = 0.0lf; return; }
     fl = floor(x);
     fr = x - fl;
 }
 int64_t posMod(int64_t k, int64_t n) { return k - floorDiv64(k, n) * n; }
+// fl mod n in [0, n) for an integer-valued fl of any size, exactly (fl = m·2^e: m mod n times
+// 2^e mod n); the sampler takes std::fmod beyond 1e15.
+int64_t posModBig(double fl, int64_t n) {
+    if (abs(fl) < 1e15lf) return posMod(int64_t(fl), n);
+    int e;
+    double m = frexp(abs(fl), e);
+    int64_t r = posMod(int64_t(m * 9007199254740992.0lf), n);
+    e -= 53;
+    int64_t b = posMod(2l, n);
+    for (int i = 0; i < 11 && e > 0; ++i) {
+        if ((e & 1) != 0) r = posMod(r * b, n);
+        b = posMod(b * b, n);
+        e >>= 1;
+    }
+    return fl < 0.0lf ? posMod(-r, n) : r;
+}
 int mirrorIndex(int64_t k, int64_t n) { return int(k < n ? k : 2l * n - 1l - k); }
 // The two texel indices of an axis under an address mode (-1: border).
 ivec2 address(int mode, double fl, int n) {
     int64_t nn = int64_t(n);
     if (mode == 2) {  // mirror
         int64_t p = 2l * nn;
-        int64_t k = posMod(int64_t(fl), p);
+        int64_t k = posModBig(fl, p);
         return ivec2(mirrorIndex(k, nn), mirrorIndex(k + 1l == p ? 0l : k + 1l, nn));
     }
     if (mode == 3) {  // clamp
@@ -125,7 +166,7 @@ ivec2 address(int mode, double fl, int n) {
         int a = k < 0 ? -k - 1 : k, b = k + 1 < 0 ? -k - 2 : k + 1;
         return ivec2(clamp(a, 0, n - 1), clamp(b, 0, n - 1));
     }
-    int64_t k = posMod(int64_t(fl), nn);  // wrap
+    int64_t k = posModBig(fl, nn);  // wrap
     return ivec2(int(k), k + 1l == nn ? 0 : int(k + 1l));
 }
 // round_half_even(v / 2^32) (the sampler's roundShift).
@@ -199,18 +240,20 @@ struct Gen {
         // Level selection from the quad (ddx = top-right − top-left, ddy = bottom-left − top-left).
         o << "    double dx2 = 0.0lf, dy2 = 0.0lf;\n";
         o << "    for (int a = 0; a < " << axes << "; ++a) {\n"
-          << "        precise double ddx = double(dFdxCoarse(c[a])) * double(size0[a]);\n"
-          << "        precise double ddy = double(dFdyCoarse(c[a])) * double(size0[a]);\n"
+          << "        vec3 q = quadValues(c[a]);\n"
+          << "        precise double c0 = double(q.x) * double(size0[a]);\n"
+          << "        precise double ddx = double(q.y) * double(size0[a]) - c0;\n"
+          << "        precise double ddy = double(q.z) * double(size0[a]) - c0;\n"
           << "        dx2 += ddx * ddx; dy2 += ddy * ddy;\n    }\n";
-        o << "    double rho2 = max(dx2, dy2);\n";
-        o << "    bool minified = rho2 > 1.0lf;\n";  // lod > 0 (NaN and 0 are not)
+        o << "    double rho2 = dx2 < dy2 ? dy2 : dx2;\n";  // std::max's choice when one is NaN
+        o << "    double lod = lodOf(rho2);\n    bool minified = lod > 0.0lf;\n";
         }
         o << "    int level0 = 0, level1 = 0, slots = 1, mipW = 0; float mipF = 0.0;\n";
         if (st.levels > 1 && st.state.mipFilter == ps11::Filter::Point) {
-            o << "    if (minified) { double lod = 0.5lf * log2d(rho2); double nl = floor(lod + 0.5lf);\n"
+            o << "    if (minified) { double nl = floor(lod + 0.5lf);\n"
               << "        level0 = nl >= " << st.levels - 1 << ".0lf ? " << st.levels - 1 << " : int(nl); }\n";
         } else if (st.levels > 1 && st.state.mipFilter == ps11::Filter::Linear) {
-            o << "    if (minified) { double lod = 0.5lf * log2d(rho2); double a = floor(lod);\n"
+            o << "    if (minified) { double a = floor(lod);\n"
               << "        if (a >= " << st.levels - 1 << ".0lf) level0 = " << st.levels - 1 << ";\n"
               << "        else { level0 = int(a); level1 = level0 + 1; double fr = lod - a;\n";
             if (fx || weights8)
