@@ -273,7 +273,9 @@ struct Gen {
         }
         o << "    for (int sl = 0; sl < slots; ++sl) {\n"
           << "        int lv = sl == 0 ? level0 : level1;\n"
-          << "        ivec3 sz = ivec3(textureSize(" << tex << ", lv)" << (vol ? "" : ", 1") << ");\n"
+          // Level extents halve from level 0 (a full chain). Not textureSize(tex, lv): llvmpipe
+          // answers it with one lane's level for the whole SIMD group when levels differ.
+          << "        ivec3 sz = max(ivec3(1), ivec3(textureSize(" << tex << ", 0)" << (vol ? "" : ", 1") << ") >> lv);\n"
           << "        ivec2 ia[3]; int wa[3]; float fa[3];\n"
           << "        for (int a = 0; a < 3; ++a) { ia[a] = ivec2(0); wa[a] = 0; fa[a] = 0.0; }\n";
         for (int a = 0; a < axes; ++a)
