@@ -74,7 +74,6 @@ struct Plan {
     DepthKind depthKind = DepthKind::D16;
 };
 
-
 // The plan of one call; `ok` false for a colour target of another format or a depth target of
 // a non-depth format (the caller's programming error).
 Plan makePlan(const MergeState& state, const MergeTarget& target, bool& ok);

@@ -48,7 +48,8 @@ std::vector<uint8_t> surfaceBytes(Device& dev, Handle s, UINT w, UINT h, UINT bp
     D3DLOCKED_RECT lr;
     REQUIRE(dev.LockRect(s, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
     std::vector<uint8_t> out(size_t(w) * h * bpp);
-    for (UINT y = 0; y < h; ++y) std::memcpy(&out[y * w * bpp], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, w * bpp);
+    for (UINT y = 0; y < h; ++y)
+        std::memcpy(&out[y * w * bpp], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, w * bpp);
     REQUIRE(dev.UnlockRect(s) == D3D_OK);
     return out;
 }
@@ -86,7 +87,8 @@ std::pair<std::vector<uint8_t>, std::vector<uint8_t>> draw(Device& dev, const Sc
     REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
     std::uniform_real_distribution<float> px(-6.0f, 43.0f), z(0.0f, 1.0f), uv(-1.0f, 2.0f);
     std::vector<Vertex> v;
-    for (int i = 0; i < 3 * 120; ++i) v.push_back(Vertex{px(rng), px(rng), z(rng), 1.0f, DWORD(rng()), uv(rng), uv(rng)});
+    for (int i = 0; i < 3 * 120; ++i)
+        v.push_back(Vertex{px(rng), px(rng), z(rng), 1.0f, DWORD(rng()), uv(rng), uv(rng)});
     REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 120, v.data(), sizeof(Vertex)) == D3D_OK);
     const UINT cb = sc.color == D3DFMT_A16B16G16R16F ? 8 : sc.color == D3DFMT_A32B32G32R32F ? 16 : 4;
     // D3D9 locks only the lockable depth formats; D24S8 is checked through the colour it leaves.
@@ -146,7 +148,8 @@ TEST_CASE("gl renderer: random valid programs draw the emulator's images bit for
         REQUIRE(emu);
         REQUIRE(glr);
         for (const ps11::TestCommand& cmd : file.commands) {
-            if (!std::holds_alternative<ps11::DrawPrimitives>(cmd.op) && !std::holds_alternative<ps11::DrawQuad>(cmd.op))
+            if (!std::holds_alternative<ps11::DrawPrimitives>(cmd.op) &&
+                !std::holds_alternative<ps11::DrawQuad>(cmd.op))
                 continue;
             INFO("seed " << seed << "\n" << c.shaderText() << "\n" << error);
             REQUIRE(emu->draw(cmd, error));

@@ -55,7 +55,7 @@ struct DrawDiff {
     uint32_t line = 0;
     uint64_t pixels = 0, exact = 0, overOne = 0;
     uint64_t distinctEmu = 0, distinctGl = 0;  // distinct colours in each target
-    double maxDiff = 0;  // 8-bit levels, or values on float targets
+    double maxDiff = 0;                        // 8-bit levels, or values on float targets
     bool values = false;
 };
 
@@ -106,8 +106,8 @@ DrawDiff diffTargets(const std::vector<Vec4>& a, const std::vector<Vec4>& b, boo
 }
 
 // Runs every draw of a .ps11test on both renderers (probes and evals are not compared).
-void compareText(const std::string& text, const std::string& path, const Options& opts,
-                 const RendererFactory& gl, Report& report) {
+void compareText(const std::string& text, const std::string& path, const Options& opts, const RendererFactory& gl,
+                 Report& report) {
     TestFile file;
     std::vector<TestFileError> errors;
     if (!parseTestFile(text, path, file, errors)) {
@@ -136,7 +136,8 @@ void compareText(const std::string& text, const std::string& path, const Options
         report.error = error;
         return;
     }
-    std::unique_ptr<DrawRunner> glr = DrawRunner::create(file, path, program ? &*program : nullptr, hw, error, true, gl);
+    std::unique_ptr<DrawRunner> glr =
+        DrawRunner::create(file, path, program ? &*program : nullptr, hw, error, true, gl);
     if (!glr) {
         report.unsupported.emplace_back(0, error);
         return;
@@ -328,7 +329,8 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
              << "% (" << (sr.unsupported.empty() ? "" : "gl refuses: " + sr.unsupported[0].second + "; ")
              << sr.sum(&DrawDiff::overOne) << " pixels past the target, max |d| " << number(sr.maxDiff())
              << "); shrunk from " << c.lines.size() << " to " << small.lines.size() << " lines.\n";
-        const std::string out = (std::filesystem::path(opts.outDir) / ("compare_random_" + std::to_string(seed) + ".ps11test")).string();
+        const std::string out =
+            (std::filesystem::path(opts.outDir) / ("compare_random_" + std::to_string(seed) + ".ps11test")).string();
         if (!cli::writeFile(out, head.str() + small.testText)) return cli::kUserError;
         mismatches.emplace_back(seed, out);
         if (!opts.json)
@@ -347,7 +349,8 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
                   << "random: " << programs << " programs (seeds " << opts.seed << ".." << opts.seed + programs - 1
                   << "), " << pixels << " pixels, " << exact << " exact ("
                   << (pixels ? 100.0 * double(exact) / double(pixels) : 100.0) << " %), " << overOne
-                  << " past the target, max |d| " << number(maxDiff) << "; " << mismatches.size() << " mismatching programs\n";
+                  << " past the target, max |d| " << number(maxDiff) << "; " << mismatches.size()
+                  << " mismatching programs\n";
     }
     return mismatches.empty() ? cli::kOk : cli::kUserError;
 }
@@ -404,13 +407,15 @@ int cmdCompare(const std::vector<std::string>& args) {
         } else if (a == "--precision") {
             if (!value(v)) return usageError("--precision needs a profile");
             opts.precision = parsePrecision(v);
-            if (!opts.precision) return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
+            if (!opts.precision)
+                return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
         } else if (a == "--gl") {
-            if (!value(glName) || (glName != "osmesa" && glName != "egl")) return usageError("--gl takes osmesa or egl");
+            if (!value(glName) || (glName != "osmesa" && glName != "egl"))
+                return usageError("--gl takes osmesa or egl");
         } else if (!a.empty() && a[0] == '-') {
-            return usageError(cli::unknownOption(a, {"--size", "--seed", "--random", "--minor", "--out", "--heatmap",
-                                                     "--hardware", "--precision", "--json", "--gl", "--gl-filtering",
-                                                     "--verbose", "--help"}));
+            return usageError(
+                cli::unknownOption(a, {"--size", "--seed", "--random", "--minor", "--out", "--heatmap", "--hardware",
+                                       "--precision", "--json", "--gl", "--gl-filtering", "--verbose", "--help"}));
         } else if (input.empty()) {
             input = a;
         } else {

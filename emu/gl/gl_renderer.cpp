@@ -153,8 +153,9 @@ struct GlState {
             return 0;
         }
         if (programs.size() >= kMaxCachedPrograms) {
-            auto oldest = std::min_element(programs.begin(), programs.end(),
-                                           [](const auto& a, const auto& b) { return a.second.lastUse < b.second.lastUse; });
+            auto oldest = std::min_element(programs.begin(), programs.end(), [](const auto& a, const auto& b) {
+                return a.second.lastUse < b.second.lastUse;
+            });
             gl.DeleteProgram(oldest->second.program);
             programs.erase(oldest);
         }
@@ -220,8 +221,8 @@ struct GlState {
                     gl.TexImage3D(target, l, GL_RGBA32I, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
                                   GL_RGBA_INTEGER, GL_INT, data.data());
                 else
-                    gl.TexImage2D(target, l, GL_RGBA32I, GLsizei(li.width), GLsizei(li.height), 0, GL_RGBA_INTEGER, GL_INT,
-                                  data.data());
+                    gl.TexImage2D(target, l, GL_RGBA32I, GLsizei(li.width), GLsizei(li.height), 0, GL_RGBA_INTEGER,
+                                  GL_INT, data.data());
             } else {
                 std::vector<float> data(n * 4);
                 size_t i = 0;
@@ -297,7 +298,8 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     ps11::Diagnostics diags;
     ps11::exec::DecodedProgram decoded;
     if (!ps11::exec::decodeProgram(*prog.program, ps11::executorOptionsFor(call.hardware), diags, decoded))
-        return refuse("the program cannot be run (" + (diags.all().empty() ? std::string("?") : diags.all()[0].message) + ")");
+        return refuse("the program cannot be run (" +
+                      (diags.all().empty() ? std::string("?") : diags.all()[0].message) + ")");
     for (int s = 0; s < 8; ++s) decoded.profile.stages[size_t(s)] = prog.stages[size_t(s)];
     const ps11::Precision precision = call.hardware.precision;
     const bool fx = ps11::isFixedPoint(precision);
@@ -363,15 +365,17 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             // its bounding rectangle. The shader keeps the covered pixels (the edge functions in
             // the record). Two GL triangles a record (gl_PrimitiveID / 2).
             double X[3], Y[3];
-            for (int k = 0; k < 3; ++k) X[k] = double(std::llround(t.v[size_t(k)].x * 256.0)) / 256.0 + 0.5,
-                                        Y[k] = double(std::llround(t.v[size_t(k)].y * 256.0)) / 256.0 + 0.5;
+            for (int k = 0; k < 3; ++k)
+                X[k] = double(std::llround(t.v[size_t(k)].x * 256.0)) / 256.0 + 0.5,
+                Y[k] = double(std::llround(t.v[size_t(k)].y * 256.0)) / 256.0 + 0.5;
             double ex[3], ey[3];
             Box box;
             if (expandTriangle(X, Y, 0.75, 6.0, ex, ey)) {
                 positions.insert(positions.end(), {float(ex[0]), float(ey[0]), float(ex[1]), float(ey[1]), float(ex[2]),
                                                    float(ey[2]), 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f});
-                box = Box{int(std::floor(std::min({ex[0], ex[1], ex[2]}))), int(std::floor(std::min({ey[0], ey[1], ey[2]}))),
-                          int(std::ceil(std::max({ex[0], ex[1], ex[2]}))), int(std::ceil(std::max({ey[0], ey[1], ey[2]})))};
+                box = Box{
+                    int(std::floor(std::min({ex[0], ex[1], ex[2]}))), int(std::floor(std::min({ey[0], ey[1], ey[2]}))),
+                    int(std::ceil(std::max({ex[0], ex[1], ex[2]}))), int(std::ceil(std::max({ey[0], ey[1], ey[2]})))};
             } else {
                 const double xl = std::min({X[0], X[1], X[2]}), xh = std::max({X[0], X[1], X[2]});
                 const int x0 = std::max(call.clip.x0, int(std::max(-1e9, std::floor(xl)))),
@@ -441,10 +445,10 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             const ps11::SamplerState& sm = call.samplers[size_t(s)];
             const GLuint so = st.samplers[s];
             const bool magLin = sm.magFilter == ps11::Filter::Linear, minLin = sm.minFilter == ps11::Filter::Linear;
-            const GLint minf = sm.mipFilter == ps11::Filter::None
-                                   ? (minLin ? GL_LINEAR : GL_NEAREST)
-                                   : sm.mipFilter == ps11::Filter::Point ? (minLin ? GL_LINEAR_MIPMAP_NEAREST : GL_NEAREST_MIPMAP_NEAREST)
-                                                                         : (minLin ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR);
+            const GLint minf = sm.mipFilter == ps11::Filter::None ? (minLin ? GL_LINEAR : GL_NEAREST)
+                               : sm.mipFilter == ps11::Filter::Point
+                                   ? (minLin ? GL_LINEAR_MIPMAP_NEAREST : GL_NEAREST_MIPMAP_NEAREST)
+                                   : (minLin ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR);
             gl.SamplerParameteri(so, GL_TEXTURE_MIN_FILTER, minf);
             gl.SamplerParameteri(so, GL_TEXTURE_MAG_FILTER, magLin ? GL_LINEAR : GL_NEAREST);
             const ps11::TextureAddress modes[3] = {sm.addressU, sm.addressV, sm.addressW};
@@ -452,11 +456,20 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             for (int a = 0; a < 3; ++a) {
                 GLint m = GL_REPEAT;
                 switch (modes[a]) {
-                    case ps11::TextureAddress::Mirror: m = GL_MIRRORED_REPEAT; break;
-                    case ps11::TextureAddress::Clamp: m = GL_CLAMP_TO_EDGE; break;
-                    case ps11::TextureAddress::Border: m = GL_CLAMP_TO_BORDER; break;
-                    case ps11::TextureAddress::MirrorOnce: m = GL_MIRROR_CLAMP_TO_EDGE; break;
-                    default: break;
+                    case ps11::TextureAddress::Mirror:
+                        m = GL_MIRRORED_REPEAT;
+                        break;
+                    case ps11::TextureAddress::Clamp:
+                        m = GL_CLAMP_TO_EDGE;
+                        break;
+                    case ps11::TextureAddress::Border:
+                        m = GL_CLAMP_TO_BORDER;
+                        break;
+                    case ps11::TextureAddress::MirrorOnce:
+                        m = GL_MIRROR_CLAMP_TO_EDGE;
+                        break;
+                    default:
+                        break;
                 }
                 gl.SamplerParameteri(so, names[a], m);
             }
@@ -517,7 +530,8 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, depth ? st.depthTex : 0, 0);
     const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, depth ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
     gl.DrawBuffers(2, buffers);
-    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) return refuse("its framebuffer is incomplete");
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return refuse("its framebuffer is incomplete");
     const bool writeColor = color && plan.channels != 0;
     gl.ColorMaski(0, writeColor, writeColor, writeColor, writeColor);
     if (depth) gl.ColorMaski(1, plan.depthWrite, plan.depthWrite, plan.depthWrite, plan.depthWrite);
@@ -577,11 +591,12 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     if (writeColor) readBack(st.colorTex, *color);
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstDepth);
     if (plan.depthWrite) readBack(st.depthTex, *depth);
-    if (GLenum e = gl.GetError(); e != GL_NO_ERROR) return refuse("OpenGL reported error 0x" + [&] {
-        char b[16];
-        std::snprintf(b, sizeof b, "%x", unsigned(e));
-        return std::string(b);
-    }());
+    if (GLenum e = gl.GetError(); e != GL_NO_ERROR)
+        return refuse("OpenGL reported error 0x" + [&] {
+            char b[16];
+            std::snprintf(b, sizeof b, "%x", unsigned(e));
+            return std::string(b);
+        }());
     return true;
 }
 
