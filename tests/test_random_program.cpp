@@ -1,10 +1,16 @@
 // tools/random_program: random ps_1_x cases for differential fuzzing. A seed gives one case;
 // 2000 cases (500 per version) assemble and validate without a diagnostic and cover every
-// instruction of each version with the modifiers, selectors, shifts and pairs the versions have;
-// 300 generated .ps11test files parse, round-trip their shader through the disassembler and draw
-// on the emu device; the shrinker reduces and keeps what its predicate needs.
+// instruction of each version with the modifiers, selectors, shifts and pairs the versions have,
+// and their environments every feature the renderers must agree on (texture formats, volumes,
+// mip chains, filters, address modes, perspective, depth, blending, alpha test, fog, write masks,
+// float targets, hardware classes and profiles), each in some cases only; 300 generated
+// .ps11test files (and 100 on a 13x5 target) parse, round-trip their shader through the
+// disassembler and draw on the emu device; the shrinker reduces the program and the environment
+// and keeps what its predicate needs.
 #include <catch2/catch.hpp>
 
+#include <array>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -26,11 +32,37 @@ using namespace ps11tools;
 
 namespace {
 
-ps11tools::RandomCase caseOf(uint64_t seed, int minor) {
+ps11tools::RandomCase caseOf(uint64_t seed, int minor, int width = 8, int height = 8) {
     std::mt19937_64 rng(seed);
     RandomCaseOptions options;
     options.minor = minor;
+    options.width = width, options.height = height;
     return randomCase(rng, options);
+}
+
+ps11::TestFile parsed(const std::string& text) {
+    ps11::TestFile file;
+    std::vector<ps11::TestFileError> errors;
+    const bool ok = ps11::parseTestFile(text, "random.ps11test", file, errors);
+    for (const ps11::TestFileError& e : errors) UNSCOPED_INFO(ps11::formatTestFileError("random.ps11test", e));
+    REQUIRE(ok);
+    return file;
+}
+
+// True when the device may skip the draw without changing a pixel (docs/output-merger.md
+// "writesNothing()"), so that it shades nothing.
+bool writesNothing(const ps11::TestFile& file) {
+    const ps11::RenderStateDesc& rs = file.renderState;
+    const bool depth = file.renderTarget.depth.value;
+    if (rs.alphaTest.value && rs.alphaFunc.value == ps11::CompareFunc::Never) return true;
+    if (depth && rs.zFunc.value == ps11::CompareFunc::Never) return true;
+    if (depth && rs.zWrite.value) return false;
+    if (rs.colorWrite.value == 0) return true;
+    // Blended as 0·src + 1·dst on every channel.
+    using B = ps11::Blend;
+    const ps11::BlendOp op = rs.blendOp.value;
+    return rs.alphaBlend.value && rs.srcBlend.value == B::Zero && rs.destBlend.value == B::One &&
+           (op == ps11::BlendOp::Add || op == ps11::BlendOp::RevSubtract);
 }
 
 // The 2000 cases of the validity and coverage tests: seed s is version 1 + s % 4.
@@ -155,17 +187,130 @@ TEST_CASE("random programs: every instruction and modifier of each version appea
     }
 }
 
+TEST_CASE("random programs: the environments cover every feature, each in some cases only", "[random]") {
+    // Counted over the 2000 cases: cases with the feature (or, for texture features, sampled
+    // stages with it). Each feature is drawn with its own probability (30-45 %), so it must
+    // appear, and the main ones must stay out of most cases too.
+    std::map<std::string, int> cases, stages;
+    std::set<ps11::TexFormat> formats;
+    std::set<ps11::Blend> blends;
+    std::set<ps11::BlendOp> blendOps;
+    std::set<ps11::CompareFunc> alphaFuncs, zFuncs;
+    std::set<std::string> classes;
+    std::set<ps11::Precision> precisions;
+    std::set<ps11::TexFormat> targetFormats;
+    std::set<ps11::TextureAddress> addressModes;
+    int totalStages = 0;
+    for (const RandomCase& c : corpus()) {
+        const ps11::TestFile file = parsed(c.testText);
+        const ps11::RequireDesc& req = file.require;
+        if (req.hardware.isSet()) {
+            ++cases["hardware"];
+            classes.insert(std::string(req.hardware.value->name));
+            CHECK(req.hardware.value->maxMinor >= c.minor);
+        }
+        if (req.precision.isSet()) ++cases["precision"], precisions.insert(req.precision.value);
+        const ps11::RenderTargetDesc& rt = file.renderTarget;
+        targetFormats.insert(rt.format.value);
+        if (ps11::isFloatFormat(rt.format.value)) ++cases["float target"];
+        if (rt.depth.value) {
+            ++cases["depth"];
+            if (rt.depthClear != 1.0f) ++cases["depth clear"];
+        }
+        const ps11::RenderStateDesc& rs = file.renderState;
+        if (rs.alphaBlend.value) {
+            ++cases["blend"];
+            blends.insert(rs.srcBlend.value), blends.insert(rs.destBlend.value), blendOps.insert(rs.blendOp.value);
+            if (rs.blendFactor.isSet()) ++cases["blend factor"];
+        }
+        if (rs.alphaTest.value) ++cases["alpha test"], alphaFuncs.insert(rs.alphaFunc.value);
+        if (rs.fog.value) ++cases["fog"];
+        if (rs.zFunc.isSet()) zFuncs.insert(rs.zFunc.value);
+        if (rs.zWrite.isSet() && !rs.zWrite.value) ++cases["zwrite off"];
+        if (rs.colorWrite.value != 15) ++cases["colour write mask"];
+        if (rs.colorWrite.value == 0) ++cases["colour write none"];
+        CHECK((rs.zFunc.isSet() || rs.zWrite.isSet()) <= rt.depth.value);
+
+        const auto& draw = std::get<ps11::DrawPrimitives>(file.commands.at(0).op);
+        std::set<float> rhw, z;
+        bool wide = false;
+        for (const ps11::Vertex& v : draw.vertices) {
+            rhw.insert(v.position[3]);
+            z.insert(v.position[2]);
+            for (int t = 0; t < 8; ++t)
+                if (v.texComponents[size_t(t)]) wide = wide || std::fabs(v.tex[size_t(t)][0]) > 1.5f;
+        }
+        if (rhw.size() > 1) ++cases["perspective"];
+        if (z.size() > 1) ++cases["varying z"];
+        CHECK((z.size() > 1) <= rt.depth.value);
+        if (draw.vertices.size() > 6) ++cases["extra triangles"];
+        if (wide) ++cases["wide coordinates"];
+
+        for (const ps11::TextureDesc& t : file.textures) {
+            ++totalStages;
+            formats.insert(t.format.value);
+            if (t.isVolume()) ++stages["volume"];
+            if (t.levels.value == 0) ++stages["generated chain"];
+            if (t.levels.value > 1) ++stages["given chain"];
+            if (t.levels.value > 1 && t.isVolume()) ++stages["volume chain"];
+            if ((t.width & (t.width - 1)) || (t.height & (t.height - 1))) ++stages["not a power of two"];
+            const ps11::SamplerDesc* s = file.sampler(t.stage);
+            REQUIRE(s);
+            if (s->minFilter.value != s->magFilter.value) ++stages["min != mag"];
+            if (s->mipFilter.value == ps11::Filter::Point) ++stages["mip point"];
+            if (s->mipFilter.value == ps11::Filter::Linear) ++stages["mip linear"];
+            if (s->mipFilter.value != ps11::Filter::None && t.levels.value != 1) ++stages["mip filter on a chain"];
+            addressModes.insert(s->addressU.value), addressModes.insert(s->addressV.value);
+            if (t.isVolume()) {
+                addressModes.insert(s->addressW.value);
+                if (s->addressW.value == ps11::TextureAddress::MirrorOnce) ++stages["mirroronce w"];
+            }
+        }
+    }
+    for (const auto& [name, n] : cases) UNSCOPED_INFO(name << ": " << n << " of 2000 cases");
+    for (const auto& [name, n] : stages) UNSCOPED_INFO(name << ": " << n << " of " << totalStages << " stages");
+    // Every feature appears …
+    for (const char* name : {"hardware", "precision", "float target", "depth", "depth clear", "blend", "blend factor",
+                             "alpha test", "fog", "zwrite off", "colour write mask", "colour write none", "perspective",
+                             "varying z", "extra triangles", "wide coordinates"})
+        CHECK(cases[name] > 20);
+    for (const char* name : {"volume", "generated chain", "given chain", "volume chain", "not a power of two",
+                             "min != mag", "mip point", "mip linear", "mip filter on a chain", "mirroronce w"})
+        CHECK(stages[name] > 20);
+    // … and the ones drawn per case stay out of most cases (probabilities 25-45 %).
+    for (const char* name : {"hardware", "precision", "float target", "depth", "blend", "alpha test", "fog",
+                             "colour write mask", "perspective", "extra triangles", "wide coordinates"}) {
+        INFO(name);
+        CHECK(cases[name] > 300);
+        CHECK(cases[name] < 1100);
+    }
+    CHECK(stages["volume"] < totalStages / 2);
+    // Every texture format, render target format, class, profile, address mode, blend factor,
+    // blend operation and compare function.
+    CHECK(formats.size() == 13);
+    CHECK(targetFormats == std::set<ps11::TexFormat>{ps11::TexFormat::A8R8G8B8, ps11::TexFormat::X8R8G8B8,
+                                                     ps11::TexFormat::A16B16G16R16F, ps11::TexFormat::A32B32G32R32F});
+    CHECK(classes.size() == ps11::hardwareClasses().size());
+    CHECK(precisions.size() == 4);
+    CHECK(addressModes.size() == 5);
+    CHECK(blends.size() == 15);
+    CHECK(blendOps.size() == 5);
+    CHECK(alphaFuncs.size() == 8);
+    CHECK(zFuncs.size() == 8);
+}
+
 TEST_CASE("random programs: 300 generated files parse and draw on the emu device", "[random]") {
-    for (uint64_t seed = 10000; seed < 10300; ++seed) {
-        const RandomCase c = caseOf(seed, 0);
+    // Seeds 10000 … 10299 on the default 8x8 target, then 100 on a 13x5 one (odd sides: partial
+    // quads at the edges).
+    int shaded = 0, skipped = 0;
+    for (uint64_t seed = 10000; seed < 10400; ++seed) {
+        const bool wide = seed >= 10300;
+        const RandomCase c = caseOf(seed, 0, wide ? 13 : 8, wide ? 5 : 8);
         INFO("seed " << seed << "\n" << c.testText);
-        ps11::TestFile file;
-        std::vector<ps11::TestFileError> errors;
-        const bool parsed = ps11::parseTestFile(c.testText, "random.ps11test", file, errors);
-        for (const ps11::TestFileError& e : errors) UNSCOPED_INFO(ps11::formatTestFileError("random.ps11test", e));
-        REQUIRE(parsed);
+        const ps11::TestFile file = parsed(c.testText);
         REQUIRE(file.pixelShader.present());
         CHECK(file.require.versionMinor.value == c.minor);
+        CHECK(file.renderTarget.size.value == std::array<uint32_t, 2>{wide ? 13u : 8u, wide ? 5u : 8u});
 
         ps11::Diagnostics diags;
         std::optional<ps11::Program> program = assemble(file.pixelShader.textWithFileLines(), diags);
@@ -187,17 +332,35 @@ TEST_CASE("random programs: 300 generated files parse and draw on the emu device
         const auto* draw = std::get_if<ps11::DrawPrimitives>(&file.commands[0].op);
         REQUIRE(draw);
         CHECK(draw->pretransformed);
-        CHECK(draw->vertices.size() == 6);
+        CHECK(draw->type == ps11::PrimitiveType::TriangleList);
+        CHECK(draw->vertices.size() >= 6);
+        CHECK(draw->vertices.size() <= 15);
+        CHECK(draw->vertices.size() % 3 == 0);
 
-        const ps11::HardwareConfig hw = ps11::resolveHardware(nullptr, c.minor, std::nullopt, 0);
+        // The class, profile and MaxValue `ps11 test` and `ps11 compare` use for the file.
+        const ps11::RequireDesc& req = file.require;
+        std::optional<ps11::Precision> precision;
+        if (req.precision.isSet()) precision = req.precision.value;
+        const ps11::HardwareConfig hw = ps11::resolveHardware(req.hardware.value, c.minor, precision, 0);
         std::string error;
         std::unique_ptr<ps11::DrawRunner> runner =
             ps11::DrawRunner::create(file, "random.ps11test", &*program, hw, error);
         INFO(error);
         REQUIRE(runner);
         CHECK(runner->draw(file.commands[0], error));
-        CHECK(runner->tally().pixelsShaded > 0);
+        if (writesNothing(file)) {
+            ++skipped;
+        } else {
+            CHECK(runner->tally().pixelsShaded > 0);
+            ++shaded;
+        }
+        std::vector<ps11::Vec4> pixels;
+        CHECK(runner->targetPixels(pixels, error));
+        CHECK(pixels.size() == size_t(wide ? 65 : 64));
     }
+    // The draws that can change nothing are few.
+    CHECK(shaded > 360);
+    CHECK(skipped < 40);
 }
 
 TEST_CASE("random programs: the shrinker keeps a mul and little else", "[random]") {
@@ -218,6 +381,52 @@ TEST_CASE("random programs: the shrinker keeps a mul and little else", "[random]
         std::vector<ps11::TestFileError> errors;
         CHECK(ps11::parseTestFile(small.testText, "small.ps11test", file, errors));
     }
+}
+
+TEST_CASE("random programs: the shrinker leaves out the environment a failure does not need", "[random]") {
+    // A "failure" that needs a mul, fog and some texture: every other state, section, extra
+    // triangle, mip level and the perspective go; one texture, at level 0, stays.
+    const auto needs = [](const RandomCase& c) {
+        return containsMul(c) && c.testText.find("\nfog on") != std::string::npos &&
+               c.testText.find("\n[texture ") != std::string::npos;
+    };
+    int shrunk = 0;
+    for (uint64_t seed = 0; shrunk < 4 && seed < 2000; ++seed) {
+        const RandomCase start = caseOf(seed, int(1 + seed % 4));
+        const std::string& text = start.testText;
+        if (!needs(start) || text.find("depth on") == std::string::npos || text.find("\nlevels ") == std::string::npos)
+            continue;
+        ++shrunk;
+        INFO("seed " << seed << "\n" << text);
+        const RandomCase small = shrinkCase(start, needs);
+        INFO("shrunk to\n" << small.testText);
+        CHECK(needs(small));
+        CHECK(small.lines.size() <= 2);
+        CHECK(small.testText == caseTestText(small));
+        const ps11::TestFile file = parsed(small.testText);
+        CHECK_FALSE(file.require.hardware.isSet());
+        CHECK_FALSE(file.require.precision.isSet());
+        CHECK_FALSE(file.renderTarget.format.isSet());
+        CHECK_FALSE(file.renderTarget.clear.isSet());
+        CHECK_FALSE(file.renderTarget.depth.value);
+        const ps11::RenderStateDesc& rs = file.renderState;
+        CHECK(rs.fog.value);
+        CHECK_FALSE(rs.alphaBlend.value);
+        CHECK_FALSE(rs.alphaTest.value);
+        CHECK(rs.colorWrite.value == 15);
+        CHECK(file.textures.size() == 1);
+        CHECK(file.textures.at(0).levels.value == 1);
+        CHECK(file.samplers.empty());
+        CHECK(file.stages.empty());
+        CHECK(file.constants.empty());
+        const auto& draw = std::get<ps11::DrawPrimitives>(file.commands.at(0).op);
+        CHECK(draw.vertices.size() == 6);
+        for (const ps11::Vertex& v : draw.vertices) {
+            CHECK(v.position[2] == 0);
+            CHECK(v.position[3] == 1);
+        }
+    }
+    CHECK(shrunk == 4);
 }
 
 TEST_CASE("random programs: the shrinker returns a case that never fails unchanged", "[random]") {
