@@ -155,18 +155,19 @@ public:
                 return false;
             }
         }
-        // OpenGL 4.5 core first (the GL renderer's shaders need it; NVIDIA's driver gives exactly
-        // the version asked for, Mesa the highest it has), then 3.3 core.
-        for (EGLint minorVersion : {5, 3}) {
+        // OpenGL 3.3 core; where the driver gives exactly that and no more (NVIDIA's does; Mesa
+        // gives the highest it has), 4.5 core again, which the GL renderer's shaders need. (Asking
+        // Mesa for 4.5 directly leaves 128 bytes behind that LeakSanitizer reports.)
+        auto create = [&](EGLint major, EGLint minor) {
             // clang-format off
-            const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, minorVersion == 5 ? 4 : 3,
-                                      EGL_CONTEXT_MINOR_VERSION, minorVersion,
+            const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, major,
+                                      EGL_CONTEXT_MINOR_VERSION, minor,
                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                       EGL_NONE};
             // clang-format on
-            m_ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
-            if (m_ctx != EGL_NO_CONTEXT) break;
-        }
+            return eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs);
+        };
+        m_ctx = create(3, 3);
         if (m_ctx == EGL_NO_CONTEXT) {
             error = prefix + "eglCreateContext refused OpenGL 3.3 core (" + lastEglError() + ")";
             return false;
@@ -174,6 +175,24 @@ public:
         if (!makeCurrent()) {
             error = prefix + "eglMakeCurrent with EGL_NO_SURFACE failed (" + lastEglError() + ")";
             return false;
+        }
+        auto getIntegerv = reinterpret_cast<PFNGLGETINTEGERVPROC>(eglGetProcAddress("glGetIntegerv"));
+        GLint glMajor = 0, glMinor = 0;
+        if (getIntegerv) {
+            getIntegerv(GL_MAJOR_VERSION, &glMajor);
+            getIntegerv(GL_MINOR_VERSION, &glMinor);
+        }
+        if (glMajor * 10 + glMinor < 45) {
+            const EGLContext higher = create(4, 5);
+            if (higher != EGL_NO_CONTEXT) {
+                eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+                eglDestroyContext(dpy, m_ctx);
+                m_ctx = higher;
+                if (!makeCurrent()) {
+                    error = prefix + "eglMakeCurrent with EGL_NO_SURFACE failed (" + lastEglError() + ")";
+                    return false;
+                }
+            }
         }
         return finishSetup(prefix, error);
     }
