@@ -13,30 +13,18 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_shaders.h"
 #include "emu/device.h"
 #include "emu/raster.h"
 
 namespace {
 
+using bench::kBlur4;
+using bench::kCopy;
+
 using namespace emu;
 
 constexpr UINT kW = 1920, kH = 1080;
-
-constexpr const char* kBlur4 =
-    "ps_1_1\n"
-    "tex t0\n"
-    "tex t1\n"
-    "tex t2\n"
-    "tex t3\n"
-    "mul r0, t0, c0\n"
-    "mad r0, t1, c0, r0\n"
-    "mad r0, t2, c0, r0\n"
-    "mad r0, t3, c0, r0\n";
-
-constexpr const char* kCopy =
-    "ps_1_1\n"
-    "tex t0\n"
-    "mov r0, t0\n";
 
 struct QuadVertex {
     float x, y, z, rhw;

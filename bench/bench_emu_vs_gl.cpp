@@ -19,31 +19,18 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_shaders.h"
 #include "emu/device.h"
 #include "emu/gl/gl_renderer.h"
 
 namespace {
 
+using bench::kBlur4;
+using bench::kCopy;
+
 using namespace emu;
 
 constexpr UINT kW = 1920, kH = 1080;
-
-// bench_draw.cpp's blur: four taps weighted by c0 = 0.25.
-constexpr const char* kBlur4 =
-    "ps_1_1\n"
-    "tex t0\n"
-    "tex t1\n"
-    "tex t2\n"
-    "tex t3\n"
-    "mul r0, t0, c0\n"
-    "mad r0, t1, c0, r0\n"
-    "mad r0, t2, c0, r0\n"
-    "mad r0, t3, c0, r0\n";
-
-constexpr const char* kCopy =
-    "ps_1_1\n"
-    "tex t0\n"
-    "mov r0, t0\n";
 
 // Scene (t0, 1:1) plus the magnified half-size bloom (t1) scaled by c0 = 0.5.
 constexpr const char* kComposite =

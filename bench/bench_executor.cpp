@@ -5,6 +5,8 @@
 // own cost from the cost of sampling. How to run: bench/README.md.
 #include <benchmark/benchmark.h>
 
+#include "bench/bench_shaders.h"
+
 #include <array>
 #include <cstdint>
 #include <cstdio>
@@ -25,6 +27,8 @@
 
 namespace {
 
+using bench::kBlur4;
+
 using namespace ps11;
 
 struct BenchProgram {
@@ -32,18 +36,6 @@ struct BenchProgram {
     const char* text;
     bool textured;
 };
-
-// The 4-tap blur pass of bloom/glare techniques: four bilinear taps weighted by c0.
-constexpr const char* kBlur4 =
-    "ps_1_1\n"
-    "tex t0\n"
-    "tex t1\n"
-    "tex t2\n"
-    "tex t3\n"
-    "mul r0, t0, c0\n"
-    "mad r0, t1, c0, r0\n"
-    "mad r0, t2, c0, r0\n"
-    "mad r0, t3, c0, r0\n";
 
 // Bright pass: what exceeds the threshold c0, boosted and tinted.
 constexpr const char* kBright =

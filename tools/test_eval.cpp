@@ -281,6 +281,18 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
     std::vector<std::vector<Vec4>> emuTargets(file.commands.size());
     std::vector<int8_t> emuProbePassed(file.commands.size(), -1);
     std::vector<std::optional<EvalOutcome>> emuEvals(file.commands.size());
+    // A probe's outcome on emu is kept; on gl one that differs is a disagreement. Failures on gl
+    // are marked.
+    auto crossCheckProbe = [&](size_t ci, const TestCommand& cmd, bool gl, std::string& failure) {
+        const int8_t passed = failure.empty() ? 1 : 0;
+        if (both && !gl) emuProbePassed[ci] = passed;
+        if (both && gl && emuProbePassed[ci] >= 0 && emuProbePassed[ci] != passed) {
+            std::cout << where(path, cmd.line) << ": disagreement: the probe " << (passed ? "passes" : "fails")
+                      << " on gl and " << (passed ? "fails" : "passes") << " on emu\n";
+            ++tally.disagreements;
+        }
+        if (gl && !failure.empty()) failure = "[gl] " + failure;
+    };
     std::unique_ptr<RendererEval> glEval;
     for (Backend backend : {Backend::Emu, Backend::Gl}) {
         if (!(opts.backends & (1u << unsigned(backend)))) continue;
@@ -323,13 +335,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                     deviceFailed = tally.error = true;
                     continue;
                 }
-                if (both && !gl) emuProbePassed[ci] = failure.empty() ? 1 : 0;
-                if (both && gl && emuProbePassed[ci] >= 0 && emuProbePassed[ci] != (failure.empty() ? 1 : 0)) {
-                    std::cout << where(path, cmd.line) << ": disagreement: the probe " << (failure.empty() ? "passes" : "fails")
-                              << " on gl and " << (failure.empty() ? "fails" : "passes") << " on emu\n";
-                    ++tally.disagreements;
-                }
-                if (gl && !failure.empty()) failure = "[gl] " + failure;
+                crossCheckProbe(ci, cmd, gl, failure);
                 countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally);
                 continue;
             }
@@ -380,13 +386,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 continue;
             }
             std::string failure = checkProbe(probe, *last, p);
-            if (both && !gl) emuProbePassed[ci] = failure.empty() ? 1 : 0;
-            if (both && gl && emuProbePassed[ci] >= 0 && emuProbePassed[ci] != (failure.empty() ? 1 : 0)) {
-                std::cout << where(path, cmd.line) << ": disagreement: the probe " << (failure.empty() ? "passes" : "fails")
-                          << " on gl and " << (failure.empty() ? "fails" : "passes") << " on emu\n";
-                ++tally.disagreements;
-            }
-            if (gl && !failure.empty()) failure = "[gl] " + failure;
+            crossCheckProbe(ci, cmd, gl, failure);
             countProbe(path, cmd, failure, cmd.isTodo(backend, p, hw), opts.hardware, opts.verbose, tally,
                        describeOutcome(*last, probe.alpha ? 4 : 3, p));
         }
