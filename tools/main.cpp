@@ -24,6 +24,8 @@
 #include "tools/cmd_hardware.h"
 #include "tools/cmd_info.h"
 #include "tools/cmd_compare.h"
+#include "tools/cmd_glare.h"
+#include "tools/cmd_shade.h"
 #include "tools/cmd_test.h"
 
 namespace ps11::cli {
@@ -43,6 +45,14 @@ const char* kUsageText =
     "          [--heatmap OUT.png] [--json] [--gl osmesa|egl]\n"
     "  compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json]\n"
     "                         the emulator against the GL renderer, draw by draw\n"
+    "  shade SHADER.psh [--texN IMG] [--filterN point|linear] [--cN x,y,z,w] [--size WxH] [--backend emu|gl]\n"
+    "        [--hardware H | --precision P] -o OUT.png\n"
+    "                         run one shader over a full-screen quad on images\n"
+    "  glare --list | --report [--json|--markdown]\n"
+    "  glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH] [--backend emu|gl]\n"
+    "        [--hardware H | --precision P] [--quality Q] [--set name=value] [--dump-passes DIR]\n"
+    "        [--graph OUT.dot] [--compare] [--json]\n"
+    "                         the glare techniques on a built-in scene or an image, pass by pass\n"
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
@@ -363,6 +373,8 @@ int main(int argc, char** argv) {
         {"check", cmdCheck},
         {"test", ps11::cmdTest},
         {"compare", ps11::cmdCompare},
+        {"glare", ps11::cmdGlare},
+        {"shade", ps11::cmdShade},
         {"eval", ps11::cmdEval},
         {"golden", cmdGolden},
         {"demo", cmdDemo},

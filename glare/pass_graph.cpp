@@ -1,0 +1,296 @@
+#include "glare/pass_graph.h"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "emu/format.h"
+
+namespace glare {
+
+using emu::Handle;
+
+const char* passKindName(PassKind kind) {
+    switch (kind) {
+        case PassKind::Shader: return "shader";
+        case PassKind::FixedFunction: return "fixed-function";
+        case PassKind::StretchRect: return "StretchRect";
+        case PassKind::Clear: return "Clear";
+        case PassKind::DeviceSide: return "device side";
+    }
+    return "?";
+}
+
+// ---- TexturePool ----
+
+TexturePool::~TexturePool() {
+    for (const auto& [handle, desc] : m_all) m_device.Release(Handle{handle});
+}
+
+Handle TexturePool::acquire(const TextureDesc& desc, std::string& error) {
+    auto it = m_free.find(desc);
+    if (it != m_free.end()) {
+        const Handle h = it->second;
+        m_free.erase(it);
+        return h;
+    }
+    Handle h{};
+    if (m_device.CreateTexture(desc.width, desc.height, 1, D3DUSAGE_RENDERTARGET, desc.format, D3DPOOL_DEFAULT, &h) !=
+        D3D_OK) {
+        error = m_device.lastError().message;
+        return Handle::Null;
+    }
+    m_all.emplace(uint32_t(h), desc);
+    return h;
+}
+
+void TexturePool::release(Handle texture) {
+    auto it = m_all.find(uint32_t(texture));
+    if (it != m_all.end()) m_free.emplace(it->second, texture);
+}
+
+// ---- building ----
+
+TextureId PassBuilder::create(const std::string& name, const TextureDesc& desc) { return m_graph.create(name, desc); }
+
+TextureId PassGraph::create(const std::string& name, const TextureDesc& desc) {
+    TextureNode node;
+    node.name = name;
+    node.desc = desc;
+    m_textures.push_back(node);
+    m_compiled = false;
+    return TextureId{uint32_t(m_textures.size() - 1)};
+}
+
+TextureId PassBuilder::read(TextureId texture) {
+    auto& reads = m_graph.m_passes[m_pass].reads;
+    if (std::find(reads.begin(), reads.end(), texture) == reads.end()) reads.push_back(texture);
+    return texture;
+}
+
+TextureId PassBuilder::write(TextureId texture) {
+    auto& writes = m_graph.m_passes[m_pass].writes;
+    if (std::find(writes.begin(), writes.end(), texture) == writes.end()) writes.push_back(texture);
+    return texture;
+}
+
+TextureId PassGraph::createData(const std::string& name) {
+    TextureNode node;
+    node.name = name;
+    node.desc = {0, 0, D3DFMT_UNKNOWN};
+    node.data = true;
+    m_textures.push_back(node);
+    m_compiled = false;
+    return TextureId{uint32_t(m_textures.size() - 1)};
+}
+
+TextureId PassGraph::import(const std::string& name, const TextureDesc& desc, Handle texture, bool output) {
+    TextureNode node;
+    node.name = name;
+    node.desc = desc;
+    node.imported = true;
+    node.output = output;
+    node.importedTexture = texture;
+    m_textures.push_back(node);
+    m_compiled = false;
+    return TextureId{uint32_t(m_textures.size() - 1)};
+}
+
+void PassGraph::addPass(const PassInfo& info, const std::function<void(PassBuilder&)>& setup, Execute execute) {
+    PassNode node;
+    node.info = info;
+    node.execute = std::move(execute);
+    m_passes.push_back(std::move(node));
+    PassBuilder builder(*this, uint32_t(m_passes.size() - 1));
+    if (setup) setup(builder);
+    m_compiled = false;
+}
+
+// Culling walks the passes backwards with the set of textures whose current content someone still
+// needs: the outputs at the end. A pass is live when it writes a needed texture; then what it reads
+// becomes needed, and what it writes without reading is no longer needed before it (it overwrote it).
+void PassGraph::compile() {
+    std::set<uint32_t> needed;
+    for (uint32_t t = 0; t < m_textures.size(); ++t)
+        if (m_textures[t].output) needed.insert(t);
+    for (size_t i = m_passes.size(); i-- > 0;) {
+        PassNode& p = m_passes[i];
+        p.live = false;
+        for (TextureId w : p.writes)
+            if (needed.count(w.index)) p.live = true;
+        if (!p.live) continue;
+        for (TextureId w : p.writes)
+            if (std::find(p.reads.begin(), p.reads.end(), w) == p.reads.end()) needed.erase(w.index);
+        for (TextureId r : p.reads) needed.insert(r.index);
+    }
+    for (TextureNode& t : m_textures) t.firstUse = t.lastUse = -1;
+    for (size_t i = 0; i < m_passes.size(); ++i) {
+        if (!m_passes[i].live) continue;
+        auto touch = [&](TextureId id) {
+            TextureNode& t = m_textures[id.index];
+            if (t.firstUse < 0) t.firstUse = int(i);
+            t.lastUse = int(i);
+        };
+        for (TextureId r : m_passes[i].reads) touch(r);
+        for (TextureId w : m_passes[i].writes) touch(w);
+    }
+    m_compiled = true;
+}
+
+std::vector<std::string> PassGraph::livePassNames() const {
+    std::vector<std::string> names;
+    for (const PassNode& p : m_passes)
+        if (p.live) names.push_back(p.info.name);
+    return names;
+}
+
+// ---- running ----
+
+bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook) {
+    if (!m_compiled) compile();
+    std::map<uint32_t, int> physicalOf;  // device handle → small id, for the aliasing report
+    for (TextureNode& t : m_textures) {
+        t.device = t.imported ? t.importedTexture : Handle::Null;
+        t.physical = -1;
+    }
+    auto releaseAll = [&]() {
+        for (TextureNode& t : m_textures)
+            if (!t.imported && t.device != Handle::Null) {
+                pool.release(t.device);
+                t.device = Handle::Null;
+            }
+    };
+    for (size_t i = 0; i < m_passes.size(); ++i) {
+        PassNode& p = m_passes[i];
+        if (!p.live) continue;
+        for (TextureNode& t : m_textures)
+            if (!t.imported && !t.data && t.firstUse == int(i)) {
+                t.device = pool.acquire(t.desc, error);
+                if (t.device == Handle::Null) {
+                    error = "pass " + p.info.name + ": texture " + t.name + ": " + error;
+                    releaseAll();
+                    return false;
+                }
+                auto [it, inserted] = physicalOf.emplace(uint32_t(t.device), int(physicalOf.size()));
+                t.physical = it->second;
+            }
+        if (hook && !hook(uint32_t(i), false, error)) {
+            releaseAll();
+            return false;
+        }
+        PassStats s;
+        s.pass = p.info.name;
+        PassContext ctx{pool.device(), s, error, *this};
+        const auto start = std::chrono::steady_clock::now();
+        const bool ok = p.execute ? p.execute(ctx) : true;
+        s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        if (!ok) {
+            if (error.empty()) error = "pass " + p.info.name + " failed";
+            releaseAll();
+            return false;
+        }
+        stats.push_back(s);
+        if (hook && !hook(uint32_t(i), true, error)) {
+            releaseAll();
+            return false;
+        }
+        for (TextureNode& t : m_textures)
+            if (!t.imported && t.lastUse == int(i)) {
+                pool.release(t.device);
+                t.device = Handle::Null;
+            }
+    }
+    return true;
+}
+
+Handle PassContext::texture(TextureId id) const { return graph.texture(id).device; }
+
+Handle PassContext::surface(TextureId id) const {
+    Handle s{};
+    device.GetSurfaceLevel(texture(id), 0, &s);
+    return s;
+}
+
+const TextureDesc& PassContext::desc(TextureId id) const { return graph.texture(id).desc; }
+
+bool PassContext::check(HRESULT hr) {
+    if (hr == D3D_OK) return true;
+    error = "pass " + stats.pass + ": " + device.lastError().message;
+    return false;
+}
+
+bool PassContext::setTarget(TextureId target) { return check(device.SetRenderTarget(0, surface(target))); }
+
+bool PassContext::clear(TextureId target, D3DCOLOR colour) {
+    if (!setTarget(target) || !check(device.Clear(0, nullptr, D3DCLEAR_TARGET, colour, 1, 0))) return false;
+    stats.pixels += uint64_t(desc(target).width) * desc(target).height;
+    return true;
+}
+
+bool PassContext::stretch(TextureId source, TextureId dest, D3DTEXTUREFILTERTYPE filter) {
+    if (!check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter))) return false;
+    const uint64_t px = uint64_t(desc(dest).width) * desc(dest).height;
+    stats.pixels += px;
+    stats.texels += px * (filter == D3DTEXF_LINEAR ? 4 : 1);
+    return true;
+}
+
+bool PassContext::draw(D3DPRIMITIVETYPE type, UINT count, const void* vertices, UINT stride) {
+    if (!check(device.DrawPrimitiveUP(type, count, vertices, stride))) return false;
+    const emu::DrawStats& d = device.lastDrawStats();
+    stats.draws += 1;
+    stats.pixels += d.pixelsCovered;
+    stats.texels += d.texelsFetched;
+    stats.instructions += d.instructions;
+    return true;
+}
+
+bool PassContext::drawQuad(const std::array<emu::QuadCoords, 4>& coords, DWORD diffuse) {
+    D3DVIEWPORT9 vp{};
+    if (!check(device.GetViewport(&vp)) || !check(device.SetFVF(emu::kQuadFvf))) return false;
+    const auto v = emu::halfPixelQuad(float(vp.X), float(vp.Y), float(vp.X + vp.Width), float(vp.Y + vp.Height), coords,
+                                      diffuse);
+    return draw(D3DPT_TRIANGLESTRIP, 2, v.data(), sizeof(emu::QuadVertex));
+}
+
+// ---- Graphviz ----
+
+namespace {
+std::string quoted(const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        out += c;
+    }
+    return out + "\"";
+}
+}  // namespace
+
+std::string PassGraph::graphviz(const std::string& title) const {
+    std::string g = "digraph " + quoted(title) + " {\n  rankdir=LR;\n  node [fontname=\"Helvetica\", fontsize=10];\n";
+    for (size_t t = 0; t < m_textures.size(); ++t) {
+        const TextureNode& n = m_textures[t];
+        if (n.data) {
+            g += "  t" + std::to_string(t) + " [shape=note, label=" + quoted(n.name + "\\n(CPU data)") + "];\n";
+            continue;
+        }
+        std::string label = n.name + "\\n" + std::to_string(n.desc.width) + "x" + std::to_string(n.desc.height) + " " +
+                            emu::formatName(n.desc.format);
+        if (n.physical >= 0 && !n.imported) label += "\\ndevice texture #" + std::to_string(n.physical);
+        g += "  t" + std::to_string(t) + " [shape=ellipse, label=" + quoted(label) +
+             (n.imported ? ", style=filled, fillcolor=\"#dde8f8\"" : "") + (n.firstUse < 0 ? ", style=dashed" : "") + "];\n";
+    }
+    for (size_t i = 0; i < m_passes.size(); ++i) {
+        const PassNode& p = m_passes[i];
+        std::string label = p.info.name + "\\n" + (p.info.kind == PassKind::Shader ? p.info.shader : passKindName(p.info.kind));
+        g += "  p" + std::to_string(i) + " [shape=box, label=" + quoted(label) +
+             (p.live ? (p.info.kind == PassKind::DeviceSide ? ", style=filled, fillcolor=\"#f8dddd\"" : "")
+                     : ", style=dashed, fontcolor=gray") +
+             "];\n";
+        for (TextureId r : p.reads) g += "  t" + std::to_string(r.index) + " -> p" + std::to_string(i) + ";\n";
+        for (TextureId w : p.writes) g += "  p" + std::to_string(i) + " -> t" + std::to_string(w.index) + ";\n";
+    }
+    return g + "}\n";
+}
+
+}  // namespace glare

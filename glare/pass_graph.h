@@ -1,0 +1,184 @@
+// The pass graph (docs/glare/README.md "Pass graph"), in the style of Filament's FrameGraph: a
+// pass is a name, a setup that declares the textures it reads and writes, and an execute step
+// that draws through emu::Device only, so one graph runs on the software and the GL renderer.
+// compile() culls the passes whose output nobody reads and gives every transient texture a
+// lifetime (first to last use); run() takes device textures from a TexturePool when a texture's
+// life starts and gives them back when it ends, so textures of the same description that are
+// never alive together share one device texture (aliasing).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emu/d3d9types.h"
+#include "emu/device.h"
+#include "emu/fullscreen.h"
+
+namespace glare {
+
+// The techniques are D3D9 programs: the device's D3D9 names (D3DFORMAT, D3DFMT_*, D3DTEXF_*, …)
+// are used unqualified, as a D3D9 program would.
+using namespace emu;
+
+// A texture's description: what a pool matches on.
+struct TextureDesc {
+    uint32_t width = 1, height = 1;
+    D3DFORMAT format = D3DFMT_A8R8G8B8;
+    bool operator==(const TextureDesc&) const = default;
+    auto operator<=>(const TextureDesc&) const = default;
+};
+
+// A virtual texture of one graph.
+struct TextureId {
+    uint32_t index = ~0u;
+    bool valid() const { return index != ~0u; }
+    bool operator==(const TextureId&) const = default;
+};
+
+// What a pass is, for the fits-ps_1_1 report (glare/report.h).
+enum class PassKind : uint8_t {
+    Shader,          // a ps_1_x pixel shader over a quad: `shader` names glare/shaders/<shader>
+    FixedFunction,   // texture stages only (the D3D7 path): 1.1-class hardware runs it
+    StretchRect,     // a device blit (filtered copy), no shader
+    Clear,           // a device clear
+    DeviceSide,      // work the CPU does on the device side: not 1.1 hardware (`note` says why)
+};
+const char* passKindName(PassKind kind);
+
+// Per-pass statistics of one run: device draws (their pixels, texels, instructions), blits and
+// clears (the pixels they write; a LINEAR blit reads 4 texels per pixel, POINT 1), wall time.
+struct PassStats {
+    std::string pass;
+    double milliseconds = 0;
+    uint64_t draws = 0, pixels = 0, texels = 0, instructions = 0;
+};
+
+// Device textures by description, kept between frames and runs: a graph takes one when a
+// transient texture's life starts and returns it when the life ends. Render-target textures,
+// D3DPOOL_DEFAULT, one level.
+class TexturePool {
+public:
+    explicit TexturePool(emu::Device& device) : m_device(device) {}
+    ~TexturePool();
+    TexturePool(const TexturePool&) = delete;
+    TexturePool& operator=(const TexturePool&) = delete;
+    // A free texture of `desc` (made when none is free); Null with `error` set on failure.
+    emu::Handle acquire(const TextureDesc& desc, std::string& error);
+    void release(emu::Handle texture);
+    size_t created() const { return m_all.size(); }
+    emu::Device& device() { return m_device; }
+
+private:
+    emu::Device& m_device;
+    std::multimap<TextureDesc, emu::Handle> m_free;
+    std::map<uint32_t, TextureDesc> m_all;
+};
+
+class PassGraph;
+struct PassContext;
+
+// Declares a pass's reads and writes during setup.
+class PassBuilder {
+public:
+    TextureId create(const std::string& name, const TextureDesc& desc);  // a transient texture
+    TextureId read(TextureId texture);
+    TextureId write(TextureId texture);
+    // Reads and writes (blending onto it, or drawing only part of it).
+    TextureId readWrite(TextureId texture) { return write(read(texture)); }
+
+private:
+    friend class PassGraph;
+    PassBuilder(PassGraph& graph, uint32_t pass) : m_graph(graph), m_pass(pass) {}
+    PassGraph& m_graph;
+    uint32_t m_pass;
+};
+
+struct PassInfo {
+    std::string name;
+    PassKind kind = PassKind::Shader;
+    std::string shader;  // Shader: the .psh file name
+    std::string note;    // what the pass does, or why it is not 1.1
+};
+
+// What a pass's execute step sees.
+struct PassContext {
+    emu::Device& device;
+    PassStats& stats;
+    std::string& error;
+    const PassGraph& graph;
+    // The device texture and its level-0 surface behind a virtual texture (valid while it lives).
+    emu::Handle texture(TextureId id) const;
+    emu::Handle surface(TextureId id) const;
+    const TextureDesc& desc(TextureId id) const;
+
+    // Device calls that also count into `stats` and set `error` ("pass NAME: message") on failure.
+    bool check(HRESULT hr);
+    bool setTarget(TextureId target);  // render target = the texture's surface, viewport = all of it
+    bool clear(TextureId target, D3DCOLOR colour);
+    bool stretch(TextureId source, TextureId dest, D3DTEXTUREFILTERTYPE filter);
+    // One draw of the half-pixel full-screen quad (emu/fullscreen.h) on the current target, counted.
+    bool drawQuad(const std::array<emu::QuadCoords, 4>& coords = {}, DWORD diffuse = 0xffffffff);
+    // DrawPrimitiveUP, counted.
+    bool draw(D3DPRIMITIVETYPE type, UINT count, const void* vertices, UINT stride);
+};
+
+class PassGraph {
+public:
+    using Execute = std::function<bool(PassContext&)>;
+
+    // A texture from outside the graph (the scene, the output, state kept between frames).
+    // Imports are never culled away from: `output` marks it as a result whose writers must run.
+    TextureId import(const std::string& name, const TextureDesc& desc, emu::Handle texture, bool output);
+    // A transient texture: a device texture from the pool for the span of passes that use it.
+    TextureId create(const std::string& name, const TextureDesc& desc);
+    // A CPU-side result (a list the device side computed): an edge in the graph, never a device texture.
+    TextureId createData(const std::string& name);
+    // Adds a pass; `setup` declares its textures now, `execute` draws when the graph runs.
+    void addPass(const PassInfo& info, const std::function<void(PassBuilder&)>& setup, Execute execute);
+
+    // Culls and computes lifetimes. Must be called before run(); may be called again after adding.
+    void compile();
+    // Runs the live passes in order on the pool's device. Before and after each pass `hook` (when
+    // set) is called with the pass index, to let a comparison capture or replace textures. False
+    // with `error` set at the first failure. `stats` gets one entry per live pass.
+    using Hook = std::function<bool(uint32_t pass, bool after, std::string& error)>;
+    bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {});
+
+    // ---- introspection (reports, tests, --graph) ----
+    struct TextureNode {
+        std::string name;
+        TextureDesc desc;
+        bool imported = false, output = false;
+        bool data = false;  // createData: no device texture
+        emu::Handle importedTexture{};
+        int firstUse = -1, lastUse = -1;  // live pass indices; -1 when no live pass touches it
+        emu::Handle device{};             // while the graph runs (or after, for imports)
+        int physical = -1;                // after run(): which device texture it had (aliasing)
+    };
+    struct PassNode {
+        PassInfo info;
+        std::vector<TextureId> reads, writes;
+        Execute execute;
+        bool live = true;
+    };
+    const std::vector<PassNode>& passes() const { return m_passes; }
+    const std::vector<TextureNode>& textures() const { return m_textures; }
+    const TextureNode& texture(TextureId id) const { return m_textures.at(id.index); }
+    // The live passes' names in run order.
+    std::vector<std::string> livePassNames() const;
+    // Graphviz: passes as boxes (culled ones dashed), textures as ellipses, reads and writes as edges.
+    std::string graphviz(const std::string& title) const;
+
+private:
+    friend class PassBuilder;
+    friend struct PassContext;
+    std::vector<PassNode> m_passes;
+    std::vector<TextureNode> m_textures;
+    bool m_compiled = false;
+};
+
+}  // namespace glare

@@ -1,0 +1,212 @@
+#include "glare/runner.h"
+
+#include <chrono>
+#include <cstring>
+
+#include "emu/format.h"
+#include "emu/fullscreen.h"
+#include "glare/scene.h"
+#include "glare/shader_library.h"
+
+namespace glare {
+
+using emu::Handle;
+
+const std::string_view* shaderText(std::string_view file) {
+    for (const EmbeddedShader& s : embeddedShaders())
+        if (s.name == file) return &s.text;
+    return nullptr;
+}
+
+TextureId FrameBuild::persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial) {
+    std::string error;
+    const Handle h = runner.persistent(name, desc, initial, error);
+    return graph.import(name, desc, h, true);
+}
+
+Runner::Runner(const RunnerOptions& options) : m_options(options) {
+    m_device = std::make_unique<emu::Device>(options.device);
+    m_pool = std::make_unique<TexturePool>(*m_device);
+    const D3DFORMAT f = intermediateFormat();
+    m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, f, D3DPOOL_DEFAULT, &m_scene);
+    m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT,
+                            &m_output);
+}
+
+Runner::~Runner() = default;
+
+D3DFORMAT Runner::intermediateFormat() const {
+    return m_device->hardware().precision == ps11::Precision::Ideal ? D3DFMT_A32B32G32R32F : D3DFMT_A8R8G8B8;
+}
+
+bool Runner::setImage(const emu::RgbaImage& image, std::string& error) {
+    emu::FloatImage f;
+    f.width = image.width;
+    f.height = image.height;
+    f.rgba.resize(image.rgba.size());
+    for (size_t i = 0; i < image.rgba.size(); ++i) f.rgba[i] = float(image.rgba[i]) / 255.0f;
+    return setImage(f, error);
+}
+
+bool Runner::setImage(const emu::FloatImage& image, std::string& error) {
+    if (image.width != m_options.width || image.height != m_options.height) {
+        error = "the image is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", the run " +
+                std::to_string(m_options.width) + "x" + std::to_string(m_options.height);
+        return false;
+    }
+    const D3DFORMAT f = intermediateFormat();
+    const emu::FormatInfo& info = *emu::formatInfo(f);
+    emu::SurfacePixels px;
+    px.width = image.width;
+    px.height = image.height;
+    px.format = f;
+    px.bytesPerPixel = info.bytes;
+    px.bytes.resize(size_t(image.width) * image.height * info.bytes);
+    for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
+        const float* v = &image.rgba[i * 4];
+        if (f == D3DFMT_A8R8G8B8) {
+            std::array<uint8_t, 4> rgba{};
+            for (int c = 0; c < 4; ++c) {
+                const float x = v[c] < 0 ? 0 : v[c] > 1 ? 1 : v[c];
+                rgba[size_t(c)] = uint8_t(x * 255.0f + 0.5f);
+            }
+            emu::encodeUnorm8(info, rgba, &px.bytes[i * info.bytes]);
+        } else {
+            emu::encodeFloat(info, {v[0], v[1], v[2], v[3]}, &px.bytes[i * info.bytes]);
+        }
+    }
+    Handle surface{};
+    if (m_device->GetSurfaceLevel(m_scene, 0, &surface) != D3D_OK) {
+        error = m_device->lastError().message;
+        return false;
+    }
+    return emu::writeSurface(*m_device, surface, px, error);
+}
+
+bool Runner::renderScene(Scene& scene, int frame, int frameCount, double& milliseconds, std::string& error) {
+    const auto start = std::chrono::steady_clock::now();
+    // Scenes draw into an A8R8G8B8 target (the back buffer); under ideal it is copied to the float scene.
+    Handle target{};
+    if (intermediateFormat() == D3DFMT_A8R8G8B8) {
+        if (m_device->GetSurfaceLevel(m_scene, 0, &target) != D3D_OK) {
+            error = m_device->lastError().message;
+            return false;
+        }
+        if (!scene.render(*m_device, target, frame, frameCount, error)) return false;
+    } else {
+        const Handle tex = m_pool->acquire({m_options.width, m_options.height, D3DFMT_A8R8G8B8}, error);
+        if (tex == Handle::Null) return false;
+        Handle dst{};
+        const bool ok = m_device->GetSurfaceLevel(tex, 0, &target) == D3D_OK &&
+                        scene.render(*m_device, target, frame, frameCount, error) &&
+                        m_device->GetSurfaceLevel(m_scene, 0, &dst) == D3D_OK &&
+                        m_device->StretchRect(target, nullptr, dst, nullptr, D3DTEXF_POINT) == D3D_OK;
+        if (!ok && error.empty()) error = m_device->lastError().message;
+        m_pool->release(tex);
+        if (!ok) return false;
+    }
+    milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return true;
+}
+
+void Runner::buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
+                        PassGraph& graph) {
+    const TextureId scene = graph.import("scene", {m_options.width, m_options.height, intermediateFormat()}, m_scene, false);
+    const TextureId output = graph.import("output", {m_options.width, m_options.height, D3DFMT_A8R8G8B8}, m_output, true);
+    FrameBuild fb{graph, *this, settings, scene, output, frame, frameCount, intermediateFormat(),
+                  m_device->hardware().precision};
+    technique.build(fb);
+    graph.compile();
+}
+
+bool Runner::runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
+                      FrameResult& result, std::string& error, const PassGraph::Hook& hook,
+                      const std::function<void(PassGraph&)>& built) {
+    PassGraph graph;
+    buildFrame(technique, settings, frame, frameCount, graph);
+    if (!m_persistentError.empty()) {
+        error = m_persistentError;
+        return false;
+    }
+    if (built) built(graph);
+    const auto start = std::chrono::steady_clock::now();
+    result.passes.clear();
+    const bool ok = graph.run(*m_pool, result.passes, error, hook);
+    result.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (ok && built) built(graph);  // again, with the aliasing filled in
+    return ok;
+}
+
+std::optional<emu::RgbaImage> Runner::readTexture(Handle texture, std::string& error) {
+    Handle surface{};
+    if (m_device->GetSurfaceLevel(texture, 0, &surface) != D3D_OK) {
+        error = m_device->lastError().message;
+        return std::nullopt;
+    }
+    std::optional<emu::SurfacePixels> px = emu::readSurface(*m_device, surface, error);
+    if (!px) return std::nullopt;
+    emu::RgbaImage img;
+    img.width = px->width;
+    img.height = px->height;
+    img.rgba.resize(size_t(px->width) * px->height * 4);
+    const emu::FormatInfo& info = *emu::formatInfo(px->format);
+    for (size_t i = 0; i < size_t(px->width) * px->height; ++i) {
+        const uint8_t* p = &px->bytes[i * px->bytesPerPixel];
+        if (info.cls == emu::FormatClass::Unorm8) {
+            const auto rgba = emu::decodeUnorm8(info, p);
+            std::memcpy(&img.rgba[i * 4], rgba.data(), 4);
+        } else {
+            const auto v = emu::decodeTexel(info, p, ps11::SignedDecode{});
+            for (int c = 0; c < 4; ++c) {
+                const float x = v[size_t(c)] < 0 ? 0 : v[size_t(c)] > 1 ? 1 : v[size_t(c)];
+                img.rgba[i * 4 + size_t(c)] = uint8_t(x * 255.0f + 0.5f);
+            }
+        }
+    }
+    return img;
+}
+
+std::optional<emu::RgbaImage> Runner::readOutput(std::string& error) { return readTexture(m_output, error); }
+
+Handle Runner::shader(const std::string& file, std::string& error) {
+    auto it = m_shaders.find(file);
+    if (it != m_shaders.end()) return it->second;
+    const std::string_view* text = shaderText(file);
+    if (!text) {
+        error = "no shader glare/shaders/" + file;
+        return Handle::Null;
+    }
+    Handle h{};
+    if (m_device->CreatePixelShaderFromText(*text, &h) != D3D_OK) {
+        error = "glare/shaders/" + file + ": " + m_device->lastError().message;
+        return Handle::Null;
+    }
+    m_shaders.emplace(file, h);
+    return h;
+}
+
+Handle Runner::persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial, std::string& error) {
+    auto it = m_persistent.find(name);
+    if (it != m_persistent.end() && it->second.second == desc) return it->second.first;
+    if (it != m_persistent.end()) {
+        m_device->Release(it->second.first);
+        m_persistent.erase(it);
+    }
+    Handle h{}, surface{};
+    if (m_device->CreateTexture(desc.width, desc.height, 1, D3DUSAGE_RENDERTARGET, desc.format, D3DPOOL_DEFAULT, &h) !=
+            D3D_OK ||
+        m_device->GetSurfaceLevel(h, 0, &surface) != D3D_OK || m_device->SetRenderTarget(0, surface) != D3D_OK ||
+        m_device->Clear(0, nullptr, D3DCLEAR_TARGET, initial, 1, 0) != D3D_OK) {
+        error = m_persistentError = "persistent texture " + name + ": " + m_device->lastError().message;
+        return Handle::Null;
+    }
+    m_persistent.emplace(name, std::make_pair(h, desc));
+    return h;
+}
+
+void Runner::resetPersistent() {
+    for (auto& [name, entry] : m_persistent) m_device->Release(entry.first);
+    m_persistent.clear();
+}
+
+}  // namespace glare

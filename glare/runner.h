@@ -1,0 +1,85 @@
+// Runs techniques frame by frame on one emu::Device (either renderer): holds the device, the
+// texture pool, the persistent textures, the techniques' pixel shaders and the scene input.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "emu/device.h"
+#include "emu/image_file.h"
+#include "glare/pass_graph.h"
+#include "glare/technique.h"
+
+namespace glare {
+
+class Scene;
+
+struct RunnerOptions {
+    emu::DeviceOptions device;  // hardware class, profile, renderer (software or GL)
+    uint32_t width = 0, height = 0;
+};
+
+// One frame's result.
+struct FrameResult {
+    std::vector<PassStats> passes;
+    double milliseconds = 0;  // the technique's passes (not the scene)
+    double sceneMilliseconds = 0;
+};
+
+class Runner {
+public:
+    explicit Runner(const RunnerOptions& options);
+    ~Runner();
+    Runner(const Runner&) = delete;
+    Runner& operator=(const Runner&) = delete;
+
+    emu::Device& device() { return *m_device; }
+    uint32_t width() const { return m_options.width; }
+    uint32_t height() const { return m_options.height; }
+    // A8R8G8B8 for the fx profiles and `float`; A32B32G32R32F under `ideal`.
+    D3DFORMAT intermediateFormat() const;
+
+    // The scene input: an 8-bit image, a float image (ideal takes values above 1 as they are;
+    // other profiles see them clamped and rounded to 8 bits), or a built-in scene's frame.
+    bool setImage(const emu::RgbaImage& image, std::string& error);
+    bool setImage(const emu::FloatImage& image, std::string& error);
+    bool renderScene(Scene& scene, int frame, int frameCount, double& milliseconds, std::string& error);
+
+    // Builds the technique's graph for a frame (`build` called before compile, for inspection),
+    // and runs it; the output stays in outputTexture().
+    bool runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, FrameResult& result,
+                  std::string& error, const PassGraph::Hook& hook = {},
+                  const std::function<void(PassGraph&)>& built = {});
+    // Builds (and compiles) without running: for reports and --graph.
+    void buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
+
+    emu::Handle sceneTexture() const { return m_scene; }
+    emu::Handle outputTexture() const { return m_output; }
+    std::optional<emu::RgbaImage> readOutput(std::string& error);
+    std::optional<emu::RgbaImage> readTexture(emu::Handle texture, std::string& error);
+
+    // A pixel shader of glare/shaders by file name, assembled and validated on first use.
+    emu::Handle shader(const std::string& file, std::string& error);
+    // Persistent textures (FrameBuild::persistent).
+    emu::Handle persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial, std::string& error);
+    void resetPersistent();  // the next frame starts from the initial state (a new sequence)
+    TexturePool& pool() { return *m_pool; }
+
+private:
+    RunnerOptions m_options;
+    std::unique_ptr<emu::Device> m_device;
+    std::unique_ptr<TexturePool> m_pool;
+    emu::Handle m_scene{}, m_output{};
+    std::map<std::string, emu::Handle> m_shaders;
+    std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
+    std::string m_persistentError;
+};
+
+// The shader text of glare/shaders/<file>, or nullptr.
+const std::string_view* shaderText(std::string_view file);
+
+}  // namespace glare

@@ -1,0 +1,35 @@
+// Glare sprites (Ando, Torigoe, Toriyama, Ichimiya, GRAPP 2006): GLARE.md §5,
+// docs/glare/sprites.md. The sensor step (vertex texture fetch in the paper: vs_3_0, not 1.1)
+// runs on the device side; its grouping is exposed here for tests.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace glare {
+
+struct Sprite {
+    float x = 0, y = 0;           // centre, in pixels (pixel centres at integers)
+    float energy[3] = {0, 0, 0};  // Σ of the sensors' colours × strength, per channel
+    float radius = 0;             // half the quad's side, in pixels
+    bool cluster = false;
+};
+
+struct SensorSettings {
+    float threshold = 0.9f;  // a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold
+    int group = 1;           // N: each N x N block of pixels gives at most one sprite
+    bool clusters = true;    // an 8x8 block >= 90 % bright gives one cluster sprite, the others none
+    float strength = 0.05f;  // glare energy per unit of pixel colour
+    float radius = 32;       // sprite radius in pixels (cluster sprites: twice)
+};
+
+// The sprites of an RGBA8 frame (rows top to bottom, rgba bytes). Grouping: a group's sprite sits
+// at the luminance-weighted centre of its firing pixels, Σ L_i p_i / Σ L_i, and carries the sum of
+// their colours, so its energy equals that of the N² single-pixel sprites it replaces. A cluster
+// sprite has twice the radius (four times the area) and carries the same sum.
+std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t height, const SensorSettings& s);
+
+// The glare image (size x size, values in [0, 1], peak 1 at the centre): radial streaks plus a halo.
+std::vector<float> glareImage(uint32_t size, int streaks);
+
+}  // namespace glare

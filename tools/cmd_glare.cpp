@@ -1,0 +1,581 @@
+// `ps11 glare` and `ps11 shade` (tools/cmd_glare.h).
+#include "tools/cmd_glare.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <optional>
+
+#include "emu/format.h"
+#include "emu/fullscreen.h"
+#include "emu/image_file.h"
+#include "glare/report.h"
+#include "glare/runner.h"
+#include "glare/scene.h"
+#include "glare/shade.h"
+#include "ps11/hardware.h"
+#include "tools/cli_util.h"
+#include "tools/gl_backend.h"
+
+namespace ps11 {
+
+namespace {
+
+constexpr const char* kGlareUsage =
+    "usage: ps11 glare --list\n"
+    "       ps11 glare --report [--json | --markdown]\n"
+    "       ps11 glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH]\n"
+    "                  [--backend emu|gl] [--gl osmesa|egl] [--hardware H | --precision P]\n"
+    "                  [--quality low|medium|high|published] [--set name=value]... [--exposure STOPS]\n"
+    "                  [--dump-passes DIR] [--graph OUT.dot] [--compare] [--json]\n";
+
+int glareUsage(const std::string& msg) {
+    std::cerr << "ps11 glare: " << msg << "\n" << kGlareUsage;
+    return cli::kUsage;
+}
+
+std::string fmt(const char* f, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+bool parseSize(const std::string& v, uint32_t& w, uint32_t& h) {
+    unsigned a = 0, b = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(v.c_str(), "%u%c%u%c", &a, &x, &b, &extra) != 3 || x != 'x' || a < 1 || b < 1 || a > 8192 || b > 8192)
+        return false;
+    w = a, h = b;
+    return true;
+}
+
+struct GlareOptions {
+    bool list = false, report = false, markdown = false, json = false, compare = false;
+    std::string technique, scene, in, out, dumpDir, graph;
+    int frames = 1;
+    uint32_t width = 0, height = 0;
+    std::string backend = "emu", glKind;
+    const HardwareClass* hardware = nullptr;
+    std::optional<Precision> precision;
+    std::string quality = "published";
+    std::vector<std::string> sets;
+    float exposure = 0;
+};
+
+// Per-pass agreement of the cross-check (GLARE.md §6 metric 6), summed over frames.
+struct PassAgreement {
+    std::string pass;
+    uint64_t pixels = 0, exact = 0, overOne = 0;
+    double maxDiff = 0;  // 8-bit levels
+};
+
+// Channel values of a read-back texel in 8-bit levels (float formats scaled by 255).
+void levelsOf(const emu::SurfacePixels& px, size_t i, double out[4]) {
+    const emu::FormatInfo& info = *emu::formatInfo(px.format);
+    const uint8_t* p = &px.bytes[i * px.bytesPerPixel];
+    if (info.cls == emu::FormatClass::Unorm8) {
+        const auto b = emu::decodeUnorm8(info, p);
+        for (int c = 0; c < 4; ++c) out[c] = b[size_t(c)];
+    } else {
+        const auto v = emu::decodeTexel(info, p, SignedDecode{});
+        for (int c = 0; c < 4; ++c) out[c] = double(v[size_t(c)]) * 255.0;
+    }
+}
+
+void accumulate(PassAgreement& a, const emu::SurfacePixels& x, const emu::SurfacePixels& y) {
+    const size_t n = size_t(x.width) * x.height;
+    for (size_t i = 0; i < n; ++i) {
+        double p[4], q[4], m = 0;
+        levelsOf(x, i, p);
+        levelsOf(y, i, q);
+        for (int c = 0; c < 4; ++c) m = std::max(m, std::fabs(p[c] - q[c]));
+        ++a.pixels;
+        a.exact += m == 0;
+        a.overOne += m > 1;
+        a.maxDiff = std::max(a.maxDiff, m);
+    }
+}
+
+emu::RgbaImage opaque(emu::RgbaImage img) {
+    for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
+    return img;
+}
+
+std::string numbered(const std::string& path, int frame, int frames) {
+    if (frames <= 1) return path;
+    const std::filesystem::path p(path);
+    char n[16];
+    std::snprintf(n, sizeof n, "_%04d", frame);
+    return (p.parent_path() / (p.stem().string() + n + p.extension().string())).string();
+}
+
+std::string safeName(const std::string& s) {
+    std::string out;
+    for (char c : s) out += (std::isalnum(uint8_t(c)) || c == '_' || c == '-') ? c : '_';
+    return out;
+}
+
+// A grid of thumbnails (each fitted into 256x144, nearest sampling), in pass order.
+emu::RgbaImage contactSheet(const std::vector<emu::RgbaImage>& images) {
+    const uint32_t cw = 256, ch = 144, cols = 4, gap = 4;
+    const uint32_t rows = uint32_t((images.size() + cols - 1) / cols);
+    emu::RgbaImage sheet;
+    sheet.width = cols * (cw + gap) + gap;
+    sheet.height = std::max(rows, 1u) * (ch + gap) + gap;
+    sheet.rgba.assign(size_t(sheet.width) * sheet.height * 4, 48);
+    for (size_t k = 0; k < images.size(); ++k) {
+        const emu::RgbaImage& im = images[k];
+        const double scale = std::min(double(cw) / im.width, double(ch) / im.height);
+        const uint32_t tw = std::max(1u, uint32_t(im.width * scale)), th = std::max(1u, uint32_t(im.height * scale));
+        const uint32_t ox = gap + uint32_t(k % cols) * (cw + gap), oy = gap + uint32_t(k / cols) * (ch + gap);
+        for (uint32_t y = 0; y < th; ++y)
+            for (uint32_t x = 0; x < tw; ++x) {
+                const uint32_t sx = std::min(im.width - 1, uint32_t(x / scale)), sy = std::min(im.height - 1, uint32_t(y / scale));
+                const uint8_t* s = &im.rgba[(size_t(sy) * im.width + sx) * 4];
+                uint8_t* d = &sheet.rgba[(size_t(oy + y) * sheet.width + ox + x) * 4];
+                d[0] = s[0], d[1] = s[1], d[2] = s[2];
+            }
+    }
+    for (size_t i = 3; i < sheet.rgba.size(); i += 4) sheet.rgba[i] = 255;
+    return sheet;
+}
+
+int listTechniques() {
+    for (const glare::Technique* t : glare::techniques()) {
+        std::printf("%-8s %s\n         %s\n", std::string(t->name()).c_str(), std::string(t->title()).c_str(),
+                    std::string(t->summary()).c_str());
+        std::printf("         %-13s %-34s %s\n", "setting", "low / medium / high / published", "range");
+        for (const glare::ParamInfo& p : t->params()) {
+            std::string presets;
+            for (double v : p.presets) presets += (presets.empty() ? "" : " / ") + glare::settingText(p, v);
+            std::string range;
+            if (!p.choices.empty())
+                for (const std::string& c : p.choices) range += (range.empty() ? "" : "|") + c;
+            else
+                range = fmt("%g", p.min) + " .. " + fmt("%g", p.max) + (p.unit.empty() ? "" : " " + p.unit);
+            std::printf("         %-13s %-34s %s\n", p.name.c_str(), presets.c_str(), range.c_str());
+        }
+        std::printf("\n");
+    }
+    std::printf("scenes (--scene):\n");
+    for (const glare::SceneInfo& s : glare::sceneList())
+        std::printf("  %-7s %s (%d frames by default)\n", std::string(s.name).c_str(), std::string(s.description).c_str(),
+                    s.defaultFrames);
+    return cli::kOk;
+}
+
+int report(const GlareOptions& o) {
+    const glare::FitsReport r = glare::fitsReport();
+    if (o.json) {
+        std::cout << glare::fitsReportJson(r);
+        return cli::kOk;
+    }
+    if (o.markdown) {
+        std::cout << glare::fitsReportMarkdown(r);
+        return cli::kOk;
+    }
+    std::printf("%-9s %-10s %-16s %-15s %-24s %-6s %-6s %-10s %s\n", "technique", "preset", "pass", "kind", "shader",
+                "tex", "arith", "target", "fits ps_1_1");
+    for (const glare::PassFit& f : r.passes) {
+        const bool shader = f.kind == glare::PassKind::Shader;
+        std::printf("%-9s %-10s %-16s %-15s %-24s %-6s %-6s %-10s %s\n", f.technique.c_str(), f.preset.c_str(),
+                    f.pass.c_str(), glare::passKindName(f.kind), shader ? f.shader.c_str() : "-",
+                    shader ? (std::to_string(f.texSlots) + "/" + std::to_string(f.texLimit)).c_str() : "-",
+                    shader ? (std::to_string(f.arithSlots) + "/" + std::to_string(f.arithLimit)).c_str() : "-",
+                    f.width ? (std::to_string(f.width) + "x" + std::to_string(f.height)).c_str() : "CPU",
+                    f.fits ? "yes" : ("NO: " + f.note).c_str());
+    }
+    return cli::kOk;
+}
+
+class Progress {
+public:
+    explicit Progress(int frames) : m_frames(frames), m_start(std::chrono::steady_clock::now()) {}
+    ~Progress() {
+        if (m_shown) std::fprintf(stderr, "\n");
+    }
+    void update(int frame, const std::string& pass) {
+        const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+        if (s < 1.0) return;
+        m_shown = true;
+        std::fprintf(stderr, "\rps11 glare: frame %d/%d, %-24s %6.1f s", frame + 1, m_frames, pass.c_str(), s);
+        std::fflush(stderr);
+    }
+
+private:
+    int m_frames;
+    std::chrono::steady_clock::time_point m_start;
+    bool m_shown = false;
+};
+
+int runGlare(const GlareOptions& o) {
+    const glare::Technique* technique = glare::findTechnique(o.technique);
+    if (!technique) {
+        std::string names;
+        for (const glare::Technique* t : glare::techniques()) names += (names.empty() ? "" : ", ") + std::string(t->name());
+        return glareUsage("unknown technique '" + o.technique + "' (techniques: " + names + ")");
+    }
+    std::optional<glare::Settings> settings = glare::presetSettings(*technique, o.quality);
+    if (!settings) return glareUsage("unknown --quality '" + o.quality + "' (low, medium, high, published)");
+    for (const std::string& s : o.sets) {
+        std::string err;
+        if (!glare::applySetting(*technique, *settings, s, err)) return glareUsage(err);
+    }
+
+    // The input: an image file (its size) or a scene (--size, 1920x1080 by default).
+    std::optional<emu::FloatImage> image;
+    std::unique_ptr<glare::Scene> scene;
+    uint32_t width = o.width, height = o.height;
+    if (!o.in.empty()) {
+        std::string err;
+        std::optional<emu::LoadedImage> loaded = emu::readImage(o.in, err);
+        if (!loaded) {
+            std::cerr << "ps11 glare: " << err << "\n";
+            return cli::kUserError;
+        }
+        image = loaded->hdr ? emu::exposeUnclamped(loaded->image, o.exposure) : loaded->image;
+        width = image->width;
+        height = image->height;
+    } else {
+        std::string err;
+        scene = glare::makeScene(o.scene, err);
+        if (!scene) return glareUsage(err);
+        if (!width) width = 1920, height = 1080;
+    }
+    if (width < 8 || height < 8) {
+        std::cerr << "ps11 glare: the frame is " << width << "x" << height << "; the techniques need at least 8x8\n";
+        return cli::kUserError;
+    }
+
+    auto makeRunner = [&](bool gl, std::string& err) -> std::unique_ptr<glare::Runner> {
+        glare::RunnerOptions ro;
+        ro.width = width;
+        ro.height = height;
+        ro.device.hardware = o.hardware;
+        ro.device.precision = o.precision;
+        if (gl) {
+            ro.device.renderer = glRendererFactory(o.glKind, err);
+            if (!ro.device.renderer) return nullptr;
+        }
+        return std::make_unique<glare::Runner>(ro);
+    };
+    std::string err;
+    std::unique_ptr<glare::Runner> main = makeRunner(o.backend == "gl" && !o.compare, err);
+    std::unique_ptr<glare::Runner> other;
+    if (!main || (o.compare && !(other = makeRunner(true, err)))) {
+        std::cerr << "ps11 glare: the GL renderer is not available: " << err << "\n";
+        return cli::kUserError;
+    }
+
+    // --graph without -o: the graph as built, not run.
+    if (!o.graph.empty() && o.out.empty() && !o.compare && o.dumpDir.empty()) {
+        glare::PassGraph g;
+        main->buildFrame(*technique, *settings, 0, o.frames, g);
+        return cli::writeFile(o.graph, g.graphviz(std::string(technique->name()))) ? cli::kOk : cli::kUserError;
+    }
+
+    if (image && !main->setImage(*image, err)) {
+        std::cerr << "ps11 glare: " << o.in << ": " << err << "\n";
+        return cli::kUserError;
+    }
+    if (image && other && !other->setImage(*image, err)) {
+        std::cerr << "ps11 glare: " << o.in << ": " << err << "\n";
+        return cli::kUserError;
+    }
+    if (!o.dumpDir.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.dumpDir, ec);
+        if (ec) {
+            std::cerr << "ps11 glare: cannot create " << o.dumpDir << ": " << ec.message() << "\n";
+            return cli::kUserError;
+        }
+    }
+
+    std::unique_ptr<glare::Scene> otherScene;  // the scene's resources on the GL device
+    if (scene && other && !(otherScene = glare::makeScene(o.scene, err))) return glareUsage(err);
+    Progress progress(o.frames);
+    std::vector<glare::PassStats> lastStats;
+    std::vector<double> frameMs;
+    std::vector<PassAgreement> agreement;
+    PassAgreement sceneAgreement{"scene (rendered on both)"};
+    for (int f = 0; f < o.frames; ++f) {
+        double sceneMs = 0;
+        if (scene) {
+            if (!main->renderScene(*scene, f, o.frames, sceneMs, err)) {
+                std::cerr << "ps11 glare: " << err << "\n";
+                return cli::kUserError;
+            }
+            if (other) {
+                // The scene drawn on GL too (compared), then the emulator's frame handed over so both
+                // techniques start from the same pixels.
+                double ms = 0;
+                emu::Handle ms1{}, gs1{};
+                main->device().GetSurfaceLevel(main->sceneTexture(), 0, &ms1);
+                other->device().GetSurfaceLevel(other->sceneTexture(), 0, &gs1);
+                if (!other->renderScene(*otherScene, f, o.frames, ms, err)) {
+                    std::cerr << "ps11 glare: GL: " << err << "\n";
+                    return cli::kUserError;
+                }
+                std::optional<emu::SurfacePixels> a = emu::readSurface(main->device(), ms1, err);
+                std::optional<emu::SurfacePixels> b = a ? emu::readSurface(other->device(), gs1, err) : std::nullopt;
+                if (!a || !b || !emu::writeSurface(other->device(), gs1, *a, err)) {
+                    std::cerr << "ps11 glare: " << err << "\n";
+                    return cli::kUserError;
+                }
+                accumulate(sceneAgreement, *a, *b);
+            }
+        }
+        // Hooks: progress; the last frame's dumps; the cross-check's captures.
+        glare::PassGraph* graph = nullptr;
+        const bool dump = !o.dumpDir.empty() && f == o.frames - 1;
+        std::vector<emu::RgbaImage> sheet;
+        std::map<uint32_t, std::vector<std::pair<uint32_t, emu::SurfacePixels>>> inputs, outputs;
+        auto capture = [&](glare::Runner& r, glare::TextureId id, std::string& e) -> std::optional<emu::SurfacePixels> {
+            emu::Handle s{};
+            if (r.device().GetSurfaceLevel(graph->texture(id).device, 0, &s) != emu::D3D_OK) {
+                e = r.device().lastError().message;
+                return std::nullopt;
+            }
+            return emu::readSurface(r.device(), s, e);
+        };
+        auto hook = [&](uint32_t pass, bool after, std::string& e) {
+            const glare::PassGraph::PassNode& n = graph->passes()[pass];
+            progress.update(f, n.info.name);
+            if (other) {
+                auto& store = after ? outputs[pass] : inputs[pass];
+                std::vector<glare::TextureId> ids = n.writes;
+                if (!after) ids.insert(ids.end(), n.reads.begin(), n.reads.end());
+                for (glare::TextureId id : ids) {
+                    if (graph->texture(id).data) continue;
+                    std::optional<emu::SurfacePixels> px = capture(*main, id, e);
+                    if (!px) return false;
+                    store.emplace_back(id.index, std::move(*px));
+                }
+            }
+            if (after && dump)
+                for (glare::TextureId id : n.writes) {
+                    if (graph->texture(id).data) continue;
+                    std::optional<emu::RgbaImage> img = main->readTexture(graph->texture(id).device, e);
+                    if (!img) return false;
+                    char prefix[16];
+                    std::snprintf(prefix, sizeof prefix, "%02u_", pass);
+                    const std::string path = o.dumpDir + "/" + prefix + safeName(n.info.name) + "-" +
+                                             safeName(graph->texture(id).name) + ".png";
+                    if (!emu::writePng(path, opaque(*img), e)) return false;
+                    sheet.push_back(opaque(*img));
+                }
+            return true;
+        };
+        glare::FrameResult result;
+        auto built = [&](glare::PassGraph& g) { graph = &g; };
+        if (!main->runFrame(*technique, *settings, f, o.frames, result, err, hook, built)) {
+            std::cerr << "ps11 glare: " << err << "\n";
+            return cli::kUserError;
+        }
+        if (f == 0 && !o.graph.empty() && !cli::writeFile(o.graph, graph->graphviz(std::string(technique->name()))))
+            return cli::kUserError;
+        if (dump) {
+            if (!emu::writePng(o.dumpDir + "/contact_sheet.png", contactSheet(sheet), err)) {
+                std::cerr << "ps11 glare: " << err << "\n";
+                return cli::kUserError;
+            }
+        }
+        if (other) {
+            // The same frame on GL, each pass fed the emulator's inputs; its outputs compared.
+            glare::PassGraph* glGraph = nullptr;
+            auto glHook = [&](uint32_t pass, bool after, std::string& e) {
+                const glare::PassGraph::PassNode& n = glGraph->passes()[pass];
+                if (!after) {
+                    for (auto& [id, px] : inputs[pass]) {
+                        emu::Handle s{};
+                        if (other->device().GetSurfaceLevel(glGraph->textures()[id].device, 0, &s) != emu::D3D_OK ||
+                            !emu::writeSurface(other->device(), s, px, e))
+                            return false;
+                    }
+                    return true;
+                }
+                PassAgreement* a = nullptr;
+                for (PassAgreement& x : agreement)
+                    if (x.pass == n.info.name) a = &x;
+                if (!a) a = &agreement.emplace_back(PassAgreement{n.info.name});
+                for (auto& [id, px] : outputs[pass]) {
+                    emu::Handle s{};
+                    if (other->device().GetSurfaceLevel(glGraph->textures()[id].device, 0, &s) != emu::D3D_OK) return false;
+                    std::optional<emu::SurfacePixels> g = emu::readSurface(other->device(), s, e);
+                    if (!g) return false;
+                    accumulate(*a, px, *g);
+                }
+                return true;
+            };
+            glare::FrameResult glResult;
+            if (!other->runFrame(*technique, *settings, f, o.frames, glResult, err, glHook,
+                                 [&](glare::PassGraph& g) { glGraph = &g; })) {
+                std::cerr << "ps11 glare: GL: " << err << "\n";
+                return cli::kUserError;
+            }
+        }
+        lastStats = result.passes;
+        frameMs.push_back(result.milliseconds);
+        if (!o.out.empty()) {
+            std::optional<emu::RgbaImage> img = main->readOutput(err);
+            if (!img || !emu::writePng(numbered(o.out, f, o.frames), opaque(*img), err)) {
+                std::cerr << "ps11 glare: " << err << "\n";
+                return cli::kUserError;
+            }
+        }
+    }
+
+    const std::string profile = precisionName(main->device().hardware().precision);
+    const std::string hw(main->device().hardware().hardware->name);
+    if (o.compare) {
+        uint64_t over = sceneAgreement.overOne;
+        for (const PassAgreement& a : agreement) over += a.overOne;
+        if (o.json) {
+            std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"gl\": \"%s\", \"frames\": %d, "
+                        "\"passes\": [\n",
+                        std::string(technique->name()).c_str(), hw.c_str(), profile.c_str(),
+                        glRendererDescription().c_str(), o.frames);
+            std::vector<PassAgreement> all;
+            if (scene) all.push_back(sceneAgreement);
+            all.insert(all.end(), agreement.begin(), agreement.end());
+            for (size_t i = 0; i < all.size(); ++i)
+                std::printf("  {\"pass\": \"%s\", \"pixels\": %llu, \"exact\": %llu, \"over_one\": %llu, \"max_diff\": %g}%s\n",
+                            all[i].pass.c_str(), (unsigned long long)all[i].pixels, (unsigned long long)all[i].exact,
+                            (unsigned long long)all[i].overOne, all[i].maxDiff, i + 1 < all.size() ? "," : "");
+            std::printf("]}\n");
+        } else {
+            std::printf("%s on %ux%u, %d frame(s), %s / %s: the emulator against %s, pass-isolated\n",
+                        std::string(technique->name()).c_str(), width, height, o.frames, hw.c_str(), profile.c_str(),
+                        glRendererDescription().c_str());
+            std::printf("%-26s %12s %9s %10s %9s\n", "pass", "pixels", "exact", "|d|>1", "max |d|");
+            auto row = [](const PassAgreement& a) {
+                std::printf("%-26s %12llu %8.3f%% %10llu %9.3g\n", a.pass.c_str(), (unsigned long long)a.pixels,
+                            a.pixels ? 100.0 * double(a.exact) / double(a.pixels) : 100.0, (unsigned long long)a.overOne,
+                            a.maxDiff);
+            };
+            if (scene) row(sceneAgreement);
+            for (const PassAgreement& a : agreement) row(a);
+            std::printf("%s\n", over == 0 ? "agreement: every pass within 1 level" : "DISAGREEMENT: pixels differ by more than 1 level");
+        }
+        return over == 0 ? cli::kOk : cli::kUserError;
+    }
+    if (o.json) {
+        std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"size\": [%u, %u], \"frames\": %d, "
+                    "\"passes\": [\n",
+                    std::string(technique->name()).c_str(), hw.c_str(), profile.c_str(), width, height, o.frames);
+        for (size_t i = 0; i < lastStats.size(); ++i) {
+            const glare::PassStats& s = lastStats[i];
+            std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
+                        "\"instructions\": %llu}%s\n",
+                        s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
+                        (unsigned long long)s.texels, (unsigned long long)s.instructions, i + 1 < lastStats.size() ? "," : "");
+        }
+        std::printf("]}\n");
+        return cli::kOk;
+    }
+    std::vector<double> sorted = frameMs;
+    std::sort(sorted.begin(), sorted.end());
+    std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
+                std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
+                hw.c_str(), profile.c_str(), o.backend.c_str(), o.frames, sorted[sorted.size() / 2]);
+    std::printf("%-22s %9s %6s %11s %11s %13s\n", "pass (last frame)", "ms", "draws", "pixels", "texels", "instructions");
+    for (const glare::PassStats& s : lastStats)
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu\n", s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws,
+                    (unsigned long long)s.pixels, (unsigned long long)s.texels, (unsigned long long)s.instructions);
+    if (!o.out.empty())
+        std::printf("wrote %s\n", o.frames > 1 ? (numbered(o.out, 0, o.frames) + " …").c_str() : o.out.c_str());
+    return cli::kOk;
+}
+
+}  // namespace
+
+int cmdGlare(const std::vector<std::string>& args) {
+    GlareOptions o;
+    for (size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        auto value = [&](std::string& out) {
+            if (i + 1 >= args.size()) return false;
+            out = args[++i];
+            return true;
+        };
+        std::string v;
+        if (a == "--help" || a == "-h") {
+            std::cout << kGlareUsage;
+            return cli::kOk;
+        } else if (a == "--list") {
+            o.list = true;
+        } else if (a == "--report") {
+            o.report = true;
+        } else if (a == "--markdown") {
+            o.markdown = true;
+        } else if (a == "--json") {
+            o.json = true;
+        } else if (a == "--compare") {
+            o.compare = true;
+        } else if (a == "--technique" || a == "-t") {
+            if (!value(o.technique)) return glareUsage("--technique needs a name");
+        } else if (a == "--scene") {
+            if (!value(o.scene)) return glareUsage("--scene needs a name");
+        } else if (a == "--in") {
+            if (!value(o.in)) return glareUsage("--in needs an image file");
+        } else if (a == "-o" || a == "--out") {
+            if (!value(o.out)) return glareUsage("-o needs a file name");
+        } else if (a == "--dump-passes") {
+            if (!value(o.dumpDir)) return glareUsage("--dump-passes needs a folder");
+        } else if (a == "--graph") {
+            if (!value(o.graph)) return glareUsage("--graph needs a file name");
+        } else if (a == "--frames") {
+            if (!value(v) || v.empty() || v.size() > 5 || v.find_first_not_of("0123456789") != std::string::npos ||
+                std::stoi(v) < 1)
+                return glareUsage("--frames takes a count 1..99999");
+            o.frames = std::stoi(v);
+        } else if (a == "--size") {
+            if (!value(v) || !parseSize(v, o.width, o.height)) return glareUsage("--size takes WxH with sides 1..8192");
+        } else if (a == "--backend") {
+            if (!value(o.backend) || (o.backend != "emu" && o.backend != "gl"))
+                return glareUsage("--backend takes emu or gl");
+        } else if (a == "--gl") {
+            if (!value(o.glKind) || (o.glKind != "osmesa" && o.glKind != "egl")) return glareUsage("--gl takes osmesa or egl");
+        } else if (a == "--hardware") {
+            if (!value(v)) return glareUsage("--hardware needs a class");
+            o.hardware = findHardware(v);
+            if (!o.hardware) return glareUsage(unknownHardwareMessage(v));
+        } else if (a == "--precision") {
+            if (!value(v)) return glareUsage("--precision needs a profile");
+            o.precision = parsePrecision(v);
+            if (!o.precision) return glareUsage("unknown precision '" + v + "' (expected fx8, fx12, float or ideal)");
+        } else if (a == "--quality") {
+            if (!value(o.quality)) return glareUsage("--quality needs low, medium, high or published");
+        } else if (a == "--set") {
+            if (!value(v)) return glareUsage("--set needs name=value");
+            o.sets.push_back(v);
+        } else if (a == "--exposure") {
+            char* end = nullptr;
+            if (!value(v)) return glareUsage("--exposure needs a number of stops");
+            o.exposure = std::strtof(v.c_str(), &end);
+            if (end == v.c_str() || *end || !std::isfinite(o.exposure) || std::fabs(o.exposure) > 64)
+                return glareUsage("--exposure takes stops in -64 .. 64");
+        } else {
+            return glareUsage(cli::unknownOption(
+                a, {"--list", "--report", "--markdown", "--json", "--compare", "--technique", "--scene", "--in", "-o",
+                    "--dump-passes", "--graph", "--frames", "--size", "--backend", "--gl", "--hardware", "--precision",
+                    "--quality", "--set", "--exposure", "--help"}));
+        }
+    }
+    if (o.list) return listTechniques();
+    if (o.report) return report(o);
+    if (o.technique.empty()) return glareUsage("say which technique (--technique T), or --list, or --report");
+    if (o.scene.empty() == o.in.empty()) return glareUsage("give one input: --scene NAME or --in IMAGE");
+    if (!o.in.empty() && o.width) return glareUsage("--size applies to --scene; an --in image keeps its own size");
+    if (o.hardware && o.precision) return glareUsage("give --hardware or --precision, not both");
+    if (o.out.empty() && o.graph.empty() && o.dumpDir.empty() && !o.compare)
+        return glareUsage("say where the result goes: -o OUT.png (or --dump-passes, --graph, --compare)");
+    return runGlare(o);
+}
+
+}  // namespace ps11
