@@ -1,5 +1,6 @@
-// Image files, the PNG stage: readPng/readPngMemory decode any PNG into RGBA8 and writePng encodes
-// RGBA8, both through libpng (docs/images.md). libpng reports errors by longjmp out of its error
+// Image files: readPng/readPngMemory decode any PNG into RGBA8 and writePng encodes RGBA8, both
+// through libpng; readImage picks the reader by content (.hdr in image_hdr.cpp, .exr in
+// image_exr.cpp); the exposure mapping of linear images (docs/images.md). libpng reports errors by longjmp out of its error
 // callback: the functions here that call setjmp hold only plain C data and pointers (no object with
 // a destructor lives across the jump), the callback keeps libpng's message, and nothing is printed.
 #include "emu/image_file.h"
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
@@ -287,6 +289,97 @@ std::optional<RgbaImage> readPngMemory(const uint8_t* data, size_t size, const s
     s.size = data ? size : 0;
     s.total = s.size;
     return decodePng(s, name, error);
+}
+
+std::optional<LoadedImage> readImage(const std::string& path, std::string& error) {
+    uint8_t start[kSignatureBytes] = {};
+    size_t got = 0;
+    {
+        const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+        if (!file) {
+            error = path + ": cannot open: " + std::strerror(errno);
+            return std::nullopt;
+        }
+        struct stat st {};
+        if (fstat(fileno(file.get()), &st) == 0 && S_ISDIR(st.st_mode)) {
+            error = path + ": cannot read: " + std::strerror(EISDIR);
+            return std::nullopt;
+        }
+        got = std::fread(start, 1, sizeof start, file.get());
+        if (got < sizeof start && std::ferror(file.get())) {
+            error = path + ": read error: " + std::strerror(errno ? errno : EIO);
+            return std::nullopt;
+        }
+    }
+    const auto startsWith = [&](const char* text) {
+        const size_t n = std::min(std::strlen(text), got);
+        return n > 0 && std::memcmp(start, text, n) == 0 && (n == std::strlen(text) || n == got);
+    };
+    LoadedImage loaded;
+    if (got == 0) {
+        error = path + ": empty file, not an image";
+        return std::nullopt;
+    }
+    if (startsWith("#?RADIANCE") || startsWith("#?RGBE")) {
+        auto image = readHdr(path, error);
+        if (!image) return std::nullopt;
+        loaded.image = std::move(*image);
+        loaded.hdr = true;
+        return loaded;
+    }
+    if (startsWith("\x76\x2f\x31\x01")) {
+        auto image = readExr(path, error);
+        if (!image) return std::nullopt;
+        loaded.image = std::move(*image);
+        loaded.hdr = true;
+        return loaded;
+    }
+    if (png_sig_cmp(start, 0, got) == 0) {
+        auto png = readPng(path, error);
+        if (!png) return std::nullopt;
+        const uint64_t pixels = uint64_t(png->width) * png->height;
+        if (pixels * kFloatPixelBytes > kMaxImageBytes) {
+            error = path + ": the image is " + sizeText(png->width, png->height) +
+                    " and its float RGBA pixels take more than 1 GiB";
+            return std::nullopt;
+        }
+        loaded.image.width = png->width;
+        loaded.image.height = png->height;
+        try {
+            loaded.image.rgba.resize(size_t(pixels) * 4);
+        } catch (const std::bad_alloc&) {
+            error = path + ": out of memory for a " + sizeText(png->width, png->height) + " image";
+            return std::nullopt;
+        }
+        for (size_t i = 0; i < loaded.image.rgba.size(); ++i) loaded.image.rgba[i] = float(png->rgba[i]) / 255.0f;
+        return loaded;
+    }
+    error = path + ": not a PNG, Radiance HDR or OpenEXR image (it starts with " + hexBytes(start, got) + ")";
+    return std::nullopt;
+}
+
+FloatImage exposeUnclamped(const FloatImage& linear, float stops) {
+    FloatImage out = linear;
+    const double scale = std::exp2(double(stops));
+    for (size_t i = 0; i < out.rgba.size(); ++i) {
+        if (i % 4 == 3) continue;  // alpha
+        const double v = double(out.rgba[i]) * scale;
+        out.rgba[i] = float(v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055);
+    }
+    return out;
+}
+
+RgbaImage toRgba8(const FloatImage& image) {
+    RgbaImage out;
+    out.width = image.width;
+    out.height = image.height;
+    out.rgba.resize(image.rgba.size());
+    for (size_t i = 0; i < image.rgba.size(); ++i) {
+        const float v = image.rgba[i];
+        const float clamped = v > 0 ? std::min(v, 1.0f) : 0.0f;  // NaN fails v > 0: 0
+        out.rgba[i] = uint8_t(std::lround(clamped * 255.0f));
+    }
+    return out;
 }
 
 }  // namespace emu

@@ -1,5 +1,7 @@
-// Image files on disk: PNG through libpng, read into and written from 8-bit RGBA
-// (docs/images.md). Errors are returned as "PATH: what went wrong", never thrown or printed.
+// Image files on disk (docs/images.md): PNG through libpng, read into and written from 8-bit RGBA;
+// Radiance .hdr through stb_image and OpenEXR through the OpenEXR library, read into linear float
+// RGBA; readImage for any of the three by content; the exposure mapping of linear images onto 8 bits.
+// Errors are returned as "PATH: what went wrong", never thrown or printed.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +23,10 @@ struct RgbaImage {
 // byte limit binds only if the side limit is raised.
 inline constexpr uint32_t kMaxImageSide = 16384;
 inline constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;
+// A float image counts its float RGBA pixels (16 bytes each) against kMaxImageBytes: at most 2^26
+// pixels (8192x8192), besides kMaxImageSide a side. Checked against a file's header before any pixel
+// memory is allocated, like the limits above.
+inline constexpr uint64_t kFloatPixelBytes = 16;
 
 // Writes an 8-bit RGBA PNG (no interlace). False with `error` = "PATH: what went wrong" (cannot create, disk full,
 // an image whose size or buffer is wrong); a file left half written is removed.
@@ -34,5 +40,51 @@ std::optional<RgbaImage> readPng(const std::string& path, std::string& error);
 
 // readPng from memory (what the fuzzer drives); `name` stands for the path in messages.
 std::optional<RgbaImage> readPngMemory(const uint8_t* data, size_t size, const std::string& name, std::string& error);
+
+// A linear float image: r g b a per pixel, rows top to bottom (rgba.size() == width*height*4).
+struct FloatImage {
+    uint32_t width = 0, height = 0;
+    std::vector<float> rgba;
+};
+
+// Reads a Radiance RGBE file ("#?RADIANCE" or "#?RGBE", FORMAT=32-bit_rle_rgbe, "-Y H +X W", flat or
+// run-length encoded scanlines) through stb_image: r g b as stored (linear), a = 1. nullopt with
+// `error` = "PATH: what is wrong" for a missing file, not-a-Radiance-file, a header stb_image does not
+// take (other FORMATs, orientations), truncated or corrupt pixels, or a size past the float limits.
+std::optional<FloatImage> readHdr(const std::string& path, std::string& error);
+
+// readHdr from memory (what fuzz/fuzz_hdr drives); `name` stands for the path in messages.
+std::optional<FloatImage> readHdrMemory(const uint8_t* data, size_t size, const std::string& name, std::string& error);
+
+// Reads a single-part flat OpenEXR image, scanline or tiled (level 0 of a mip/rip map), in any
+// compression OpenEXR 3.1 has (NONE, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A, DWAA, DWAB) and half, float
+// or uint channels, through the OpenEXR library: R G B (and A), or Y as grey (r = g = b = Y); a = 1 where
+// there is no A. The data window is the image (its top-left corner is pixel (0, 0)); negative values
+// become 0. nullopt with `error` = "PATH: what is wrong" for a missing file, not-an-EXR, truncated or
+// corrupt data (with OpenEXR's message), unsupported files (multi-part, deep, no R G B or Y channels,
+// luminance/chroma, subsampled channels), a size past the float limits, or a NaN or infinite pixel.
+std::optional<FloatImage> readExr(const std::string& path, std::string& error);
+
+// readExr from memory (what fuzz/fuzz_exr drives); `name` stands for the path in messages.
+std::optional<FloatImage> readExrMemory(const uint8_t* data, size_t size, const std::string& name, std::string& error);
+
+// Any supported file by its content (PNG signature, "#?RADIANCE"/"#?RGBE", EXR magic 76 2f 31 01), not its
+// extension. PNG samples become v/255 (not linearised; `hdr` false); .hdr/.exr are linear (`hdr` true).
+// The errors are those of the reader, or "PATH: not a PNG, Radiance HDR or OpenEXR image (it starts with
+// ...)"; a PNG past the float limits is refused after reading it.
+struct LoadedImage {
+    FloatImage image;
+    bool hdr = false;
+};
+std::optional<LoadedImage> readImage(const std::string& path, std::string& error);
+
+// Exposure mapping of a linear HDR image onto an 8-bit back buffer (docs/images.md "Exposure"):
+// v' = v * 2^stops, then the sRGB transfer function (IEC 61966-2-1) per colour channel, alpha unchanged:
+// 12.92 v' for v' <= 0.0031308, else 1.055 v'^(1/2.4) - 0.055. exposeUnclamped keeps values above 1 (for
+// the `ideal` profile's float textures); a NaN stays NaN.
+FloatImage exposeUnclamped(const FloatImage& linear, float stops);
+
+// Each value clamped to [0, 1] (NaN as 0) and rounded to nearest to 8 bits: round(v * 255).
+RgbaImage toRgba8(const FloatImage& image);
 
 }  // namespace emu

@@ -1,0 +1,337 @@
+// OpenEXR files (emu/image_file.h, docs/images.md) through the OpenEXR 3.1 library (libopenexr-dev).
+//
+// Its C++ API (Imf::InputFile), not the OpenEXRCore C API: in 3.1 one InputFile reads scanline and
+// tiled files alike, runs every decompressor, converts half and uint channels to float and fills the
+// channels a file lacks, in a few calls; Core leaves chunk iteration, tile levels and conversion to the
+// caller. It reports errors by exception: every one is caught here and becomes the message.
+//
+// OpenEXR sizes its tables and buffers from the header as soon as an InputFile opens, so the header is
+// read alone first (Imf::Header::readFrom) and checked: the limits, the channels, the size of a chunk's
+// buffer, and whether the chunk offset table and chunk headers can fit in the bytes that follow it.
+// Pixels are then read in bands of rows into a band buffer, so a small file that claims a large image
+// fails at its first missing chunk without the whole image ever being written.
+#include <Iex.h>
+#include <ImfChannelList.h>
+#include <ImfCompression.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfTileDescription.h>
+#include <ImfVersion.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <new>
+
+#include "emu/image_file.h"
+
+namespace emu {
+namespace {
+
+constexpr uint8_t kMagic[4] = {0x76, 0x2f, 0x31, 0x01};
+// Each chunk has an 8-byte entry in the offset table and a header: y and size for a scanline block,
+// tile x, y, level x, level y and size for a tile.
+constexpr uint64_t kScanlineChunkBytes = 8 + 8, kTileChunkBytes = 8 + 20;
+// Rows decoded at a time: about 16 MiB of float RGBA.
+constexpr uint64_t kBandFloats = uint64_t(1) << 22;
+
+// The file as OpenEXR reads it: `size` bytes at `data`, or `file` of `size` bytes. A read past the end
+// throws, and says so in `ended`.
+class ExrStream final : public Imf::IStream {
+public:
+    ExrStream(const std::string& name, const uint8_t* data, size_t size)
+        : Imf::IStream(name.c_str()), m_data(data), m_size(data ? size : 0) {}
+    ExrStream(const std::string& name, FILE* file, uint64_t size)
+        : Imf::IStream(name.c_str()), m_file(file), m_size(size) {}
+
+    bool read(char c[], int n) override {
+        if (n < 0) throw Iex::InputExc("a negative read");
+        if (m_pos > m_size || uint64_t(n) > m_size - m_pos) {
+            ended = true;
+            throw Iex::InputExc("unexpected end of data");
+        }
+        if (n == 0) return m_pos < m_size;
+        if (m_file) {
+            if (m_filePos != m_pos && fseeko(m_file, off_t(m_pos), SEEK_SET) != 0) fail();
+            if (std::fread(c, 1, size_t(n), m_file) != size_t(n)) fail();
+            m_filePos = m_pos + uint64_t(n);
+        } else {
+            std::memcpy(c, m_data + m_pos, size_t(n));
+        }
+        m_pos += uint64_t(n);
+        return m_pos < m_size;
+    }
+    uint64_t tellg() override { return m_pos; }
+    void seekg(uint64_t pos) override { m_pos = pos; }
+    uint64_t size() const { return m_size; }
+
+    bool ended = false;  // OpenEXR asked for bytes past the end
+    int ioErrno = 0;     // errno of a failed read of the file
+
+private:
+    [[noreturn]] void fail() {
+        m_filePos = UINT64_MAX;
+        if (std::feof(m_file)) {  // the file shrank while it was read
+            ended = true;
+            throw Iex::InputExc("unexpected end of data");
+        }
+        ioErrno = errno ? errno : EIO;
+        throw Iex::InputExc("read error");
+    }
+
+    const uint8_t* m_data = nullptr;
+    FILE* m_file = nullptr;
+    uint64_t m_size = 0, m_pos = 0, m_filePos = 0;
+};
+
+std::string hexBytes(const uint8_t* p, size_t n) {
+    std::string s;
+    char buf[4];
+    for (size_t i = 0; i < n; ++i) {
+        std::snprintf(buf, sizeof buf, "%02x", p[i]);
+        if (i) s += ' ';
+        s += buf;
+    }
+    return s;
+}
+
+// Text from the file or the library fit for a one-line message: unprintable bytes as '?', at most `most`.
+std::string printable(const std::string& text, size_t most) {
+    std::string s;
+    for (size_t i = 0; i < std::min(text.size(), most); ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        s += (c >= 0x20 && c < 0x7f) ? char(c) : (c == '\n' || c == '\r' || c == '\t') ? ' ' : '?';
+    }
+    return text.size() > most ? s + "..." : s;
+}
+
+// Scanlines in a chunk, for each compression (OpenEXR's file layout).
+uint64_t linesPerChunk(Imf::Compression c) {
+    switch (c) {
+    case Imf::ZIP_COMPRESSION:
+    case Imf::PXR24_COMPRESSION: return 16;
+    case Imf::PIZ_COMPRESSION:
+    case Imf::B44_COMPRESSION:
+    case Imf::B44A_COMPRESSION:
+    case Imf::DWAA_COMPRESSION: return 32;
+    case Imf::DWAB_COMPRESSION: return 256;
+    default: return 1;  // NONE, RLE, ZIPS
+    }
+}
+
+// Which channels are read, and into which of r g b a: Y into r (then copied to g and b).
+struct ExrLayout {
+    bool grey = false;
+    const char* names[4] = {"R", "G", "B", "A"};
+};
+
+// Why the channels cannot be read, or "" with `layout` set.
+std::string channelProblem(const Imf::Header& header, ExrLayout& layout) {
+    const Imf::ChannelList& channels = header.channels();
+    if (channels.findChannel("RY") || channels.findChannel("BY"))
+        return "unsupported EXR: a luminance/chroma image (channels RY, BY); only RGB and Y images are read";
+    std::string have, lack;
+    for (const char* name : {"R", "G", "B"}) (channels.findChannel(name) ? have : lack) += std::string(", ") + name;
+    if (!have.empty() && !lack.empty())
+        return "unsupported EXR: it has channel " + have.substr(2) + " but not " + lack.substr(2) +
+               " (an RGB image needs R, G and B)";
+    if (have.empty()) {
+        if (!channels.findChannel("Y")) {
+            std::string all;
+            int count = 0;
+            for (auto it = channels.begin(); it != channels.end(); ++it, ++count)
+                if (count < 8) all += std::string(count ? ", " : "") + printable(it.name(), 32);
+            if (count > 8) all += ", ...";
+            return "unsupported EXR: no R, G, B or Y channel (its channels: " + (count ? all : "none") + ")";
+        }
+        layout.grey = true;
+        layout.names[0] = "Y";
+    }
+    for (int i = 0; i < 4; ++i) {
+        if (layout.grey && (i == 1 || i == 2)) continue;
+        const Imf::Channel* c = channels.findChannel(layout.names[i]);
+        if (c && (c->xSampling != 1 || c->ySampling != 1))
+            return std::string("unsupported EXR: channel ") + layout.names[i] + " is subsampled (" +
+                   std::to_string(c->xSampling) + "x" + std::to_string(c->ySampling) +
+                   "); only full-resolution channels are read";
+    }
+    return "";
+}
+
+std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::string& error) {
+    const auto fail = [&](const std::string& what) {
+        error = name + ": " + what;
+        return std::nullopt;
+    };
+    const uint64_t total = s.size();
+    if (total == 0) return fail("empty file, not an OpenEXR image");
+    uint8_t start[8] = {};
+    const size_t got = size_t(std::min<uint64_t>(total, 8));
+    try {  // cannot end early (`got` bytes are there): only a failing file throws
+        s.read(reinterpret_cast<char*>(start), int(got));
+    } catch (const std::exception&) {
+        return fail(std::string("read error: ") + std::strerror(s.ioErrno ? s.ioErrno : EIO));
+    }
+    if (std::memcmp(start, kMagic, std::min<size_t>(got, 4)) != 0)
+        return fail("not an OpenEXR file (it starts with " + hexBytes(start, got) +
+                    "; an OpenEXR file starts with 76 2f 31 01)");
+    if (got < 8) return fail("truncated EXR: the data ends after " + std::to_string(got) + " bytes");
+    int version = int(uint32_t(start[4]) | uint32_t(start[5]) << 8 | uint32_t(start[6]) << 16 | uint32_t(start[7]) << 24);
+    if (Imf::getVersion(version) != 2)
+        return fail("unsupported EXR version " + std::to_string(Imf::getVersion(version)) + " (OpenEXR files are version 2)");
+    if (Imf::isMultiPart(version))
+        return fail("unsupported EXR: a multi-part file; only single-part images are read");
+    if (Imf::isNonImage(version))
+        return fail("unsupported EXR: deep data (a varying number of samples per pixel); only flat images are read");
+    if (!Imf::supportsFlags(Imf::getFlags(version)))
+        return fail("unsupported EXR: unknown feature flags in its version field (" + hexBytes(start + 4, 4) + ")");
+    const bool tiled = Imf::isTiled(version);
+
+    const auto libraryFailure = [&](const char* what) {
+        const std::string message = printable(what ? what : "unknown error", 300);
+        if (s.ioErrno) return fail(std::string("read error: ") + std::strerror(s.ioErrno));
+        if (s.ended)
+            return fail("truncated EXR: the data ends after " + std::to_string(total) + " bytes (OpenEXR: " + message + ")");
+        return fail("corrupt EXR: OpenEXR: " + message);
+    };
+
+    Imf::Header header;
+    try {
+        header.readFrom(s, version);
+        header.sanityCheck(tiled);
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory for the EXR header");
+    } catch (const std::exception& e) {
+        return libraryFailure(e.what());
+    } catch (...) {
+        return libraryFailure(nullptr);
+    }
+
+    const Imath::Box2i window = header.dataWindow();
+    const uint64_t width = uint64_t(int64_t(window.max.x) - window.min.x + 1);
+    const uint64_t height = uint64_t(int64_t(window.max.y) - window.min.y + 1);
+    const std::string sizeText = std::to_string(width) + "x" + std::to_string(height);
+    if (width > kMaxImageSide || height > kMaxImageSide)
+        return fail("the image is " + sizeText + " and a side is larger than " + std::to_string(kMaxImageSide) +
+                    " pixels; refused before reading its pixels");
+    if (width * height * kFloatPixelBytes > kMaxImageBytes)
+        return fail("the image is " + sizeText +
+                    " and its float RGBA pixels take more than 1 GiB; refused before reading its pixels");
+    ExrLayout layout;
+    if (const std::string problem = channelProblem(header, layout); !problem.empty()) return fail(problem);
+
+    // What OpenEXR will allocate for a chunk (all of the file's channels), and the least the chunks take.
+    uint64_t pixelBytes = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        pixelBytes += it.channel().type == Imf::HALF ? 2 : 4;
+    uint64_t chunkRows = 0, chunkWidth = width, chunks = 0, leastBytes = 0;
+    if (tiled) {
+        const Imf::TileDescription& tiles = header.tileDescription();
+        const uint64_t tileW = tiles.xSize, tileH = tiles.ySize;
+        if (tileW > kMaxImageSide || tileH > kMaxImageSide)
+            return fail("unsupported EXR: tiles of " + std::to_string(tileW) + "x" + std::to_string(tileH) +
+                        " pixels; at most " + std::to_string(kMaxImageSide) + " a side are read");
+        chunkRows = tileH;  // InputFile keeps a whole row of tiles
+        chunks = ((width + tileW - 1) / tileW) * ((height + tileH - 1) / tileH);
+        leastBytes = chunks * kTileChunkBytes;
+    } else {
+        chunkRows = linesPerChunk(header.compression());
+        chunks = (height + chunkRows - 1) / chunkRows;
+        leastBytes = chunks * kScanlineChunkBytes;
+    }
+    if (pixelBytes * chunkWidth * chunkRows > kMaxImageBytes)
+        return fail("unsupported EXR: a block of " + std::to_string(chunkRows) + " rows of its channels (" +
+                    std::to_string(pixelBytes) + " bytes a pixel) takes more than 1 GiB");
+    const uint64_t follow = total - std::min(total, s.tellg());
+    if (follow < leastBytes)
+        return fail("truncated EXR: a " + sizeText + " image " + (tiled ? "in " : "of ") + std::to_string(chunks) +
+                    (tiled ? " tiles" : " blocks of rows") + " needs at least " + std::to_string(leastBytes) +
+                    " bytes of offsets and chunk headers but only " + std::to_string(follow) +
+                    " bytes follow its header");
+
+    FloatImage image;
+    image.width = uint32_t(width);
+    image.height = uint32_t(height);
+    try {
+        s.seekg(0);
+        Imf::InputFile file(s);
+        s.ended = false;  // a scanline file's broken offset table is rebuilt by reading to the end
+        const uint64_t bandRows = std::max<uint64_t>(1, kBandFloats / (width * 4));
+        std::vector<float> band(size_t(std::min(bandRows, height) * width * 4));
+        for (uint64_t y0 = 0; y0 < height; y0 += bandRows) {
+            const uint64_t rows = std::min(bandRows, height - y0);
+            const int first = int(int64_t(window.min.y) + int64_t(y0));
+            Imf::FrameBuffer buffer;
+            for (int c = 0; c < 4; ++c) {
+                if (layout.grey && (c == 1 || c == 2)) continue;
+                buffer.insert(layout.names[c],
+                              Imf::Slice::Make(Imf::FLOAT, band.data() + c, Imath::V2i(window.min.x, first),
+                                               int64_t(width), int64_t(rows), kFloatPixelBytes,
+                                               kFloatPixelBytes * width, 1, 1, c == 3 ? 1.0 : 0.0));
+            }
+            file.setFrameBuffer(buffer);
+            file.readPixels(first, first + int(rows) - 1);
+            for (uint64_t i = 0; i < rows * width; ++i) {
+                float* px = band.data() + i * 4;
+                if (layout.grey) px[1] = px[2] = px[0];
+                for (int c = 0; c < 4; ++c) {
+                    if (!std::isfinite(px[c]))
+                        return fail("pixel (" + std::to_string(i % width) + ", " + std::to_string(y0 + i / width) +
+                                    ") channel " + layout.names[c] + " is " + (std::isnan(px[c]) ? "NaN" : "infinite") +
+                                    "; images must be finite");
+                    if (px[c] < 0) px[c] = 0;
+                }
+            }
+            // The whole image is reserved once its first band has decoded: a file that claims a large
+            // image and has nothing behind its header fails before it costs that much.
+            if (y0 == 0) image.rgba.reserve(size_t(width * height * 4));
+            image.rgba.insert(image.rgba.end(), band.begin(), band.begin() + ptrdiff_t(rows * width * 4));
+        }
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory for a " + sizeText + " image");
+    } catch (const std::exception& e) {
+        return libraryFailure(e.what());
+    } catch (...) {
+        return libraryFailure(nullptr);
+    }
+    return image;
+}
+
+}  // namespace
+
+std::optional<FloatImage> readExr(const std::string& path, std::string& error) {
+    const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
+    if (!file) {
+        error = path + ": cannot open: " + std::strerror(errno);
+        return std::nullopt;
+    }
+    struct stat st {};
+    if (fstat(fileno(file.get()), &st) != 0) {
+        error = path + ": cannot read: " + std::strerror(errno);
+        return std::nullopt;
+    }
+    if (S_ISDIR(st.st_mode)) {
+        error = path + ": cannot read: " + std::strerror(EISDIR);
+        return std::nullopt;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        error = path + ": cannot read: not a regular file (OpenEXR seeks in its files)";
+        return std::nullopt;
+    }
+    ExrStream stream(path, file.get(), uint64_t(st.st_size));
+    return decodeExr(stream, path, error);
+}
+
+std::optional<FloatImage> readExrMemory(const uint8_t* data, size_t size, const std::string& name, std::string& error) {
+    ExrStream stream(name, data, size);
+    return decodeExr(stream, name, error);
+}
+
+}  // namespace emu
