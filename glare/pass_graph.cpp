@@ -259,7 +259,7 @@ namespace {
 std::string quoted(const std::string& s) {
     std::string out = "\"";
     for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\';
+        if (c == '"') out += '\\';  // a backslash stays: labels use \n
         out += c;
     }
     return out + "\"";

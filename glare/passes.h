@@ -29,10 +29,10 @@ Tap texelTap(const FrameBuild& fb, TextureId texture, float dx, float dy, D3DTEX
 Tap pointTap(TextureId texture, float u, float v, D3DTEXTUREFILTERTYPE filter = D3DTEXF_POINT);
 
 struct QuadPass {
-    std::string shader;  // glare/shaders/<shader>
-    TextureId target;
-    std::vector<Tap> taps;  // stage i = taps[i], at most 4
-    std::vector<std::pair<int, std::array<float, 4>>> constants;
+    std::string shader = {};  // glare/shaders/<shader>
+    TextureId target = {};
+    std::vector<Tap> taps = {};  // stage i = taps[i], at most 4
+    std::vector<std::pair<int, std::array<float, 4>>> constants = {};
     Blend blend = Blend::None;
 };
 

@@ -129,11 +129,13 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
         return false;
     }
     if (built) built(graph);
-    const auto start = std::chrono::steady_clock::now();
     result.passes.clear();
     const bool ok = graph.run(*m_pool, result.passes, error, hook);
-    result.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    // The passes' own time: what the hooks (dumps, captures) take is not the technique's.
+    result.milliseconds = 0;
+    for (const PassStats& s : result.passes) result.milliseconds += s.milliseconds;
     if (ok && built) built(graph);  // again, with the aliasing filled in
+    if (ok) m_lastGraphviz = graph.graphviz(std::string(technique.name()));
     return ok;
 }
 
@@ -152,7 +154,10 @@ std::optional<emu::RgbaImage> Runner::readTexture(Handle texture, std::string& e
     const emu::FormatInfo& info = *emu::formatInfo(px->format);
     for (size_t i = 0; i < size_t(px->width) * px->height; ++i) {
         const uint8_t* p = &px->bytes[i * px->bytesPerPixel];
-        if (info.cls == emu::FormatClass::Unorm8) {
+        if (px->format == D3DFMT_A8R8G8B8) {  // b g r a
+            uint8_t* d = &img.rgba[i * 4];
+            d[0] = p[2], d[1] = p[1], d[2] = p[0], d[3] = p[3];
+        } else if (info.cls == emu::FormatClass::Unorm8) {
             const auto rgba = emu::decodeUnorm8(info, p);
             std::memcpy(&img.rgba[i * 4], rgba.data(), 4);
         } else {

@@ -26,7 +26,7 @@ struct RunnerOptions {
 // One frame's result.
 struct FrameResult {
     std::vector<PassStats> passes;
-    double milliseconds = 0;  // the technique's passes (not the scene)
+    double milliseconds = 0;  // the sum of the passes' times (not the scene, not the hooks)
     double sceneMilliseconds = 0;
 };
 
@@ -57,6 +57,8 @@ public:
     // Builds (and compiles) without running: for reports and --graph.
     void buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
 
+    // The Graphviz of the last frame's graph as it ran (with the aliasing it got).
+    const std::string& lastGraphviz() const { return m_lastGraphviz; }
     emu::Handle sceneTexture() const { return m_scene; }
     emu::Handle outputTexture() const { return m_output; }
     std::optional<emu::RgbaImage> readOutput(std::string& error);
@@ -77,6 +79,7 @@ private:
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
     std::string m_persistentError;
+    std::string m_lastGraphviz;
 };
 
 // The shader text of glare/shaders/<file>, or nullptr.

@@ -107,7 +107,8 @@ public:
     }
     const std::vector<ParamInfo>& params() const override {
         static const std::vector<ParamInfo> p = {
-            {"threshold", "", "a sensor fires where luminance >= threshold", 0, 1, {0.9, 0.9, 0.9, 0.9}, {}, false},
+            {"threshold", "", "a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold", 0, 1, {0.8, 0.8, 0.8, 0.8},
+             {}, false},
             {"group", "pixels", "N: N x N pixels share one sprite (1 = a sensor per pixel, as the paper's base method)",
              1, 8, {4, 2, 1, 1}, {}, true},
             {"clusters", "", "8x8 blocks >= 90 % bright become one cluster sprite", 0, 1, {1, 1, 1, 1}, {"off", "on"},
@@ -116,7 +117,7 @@ public:
              {0.04, 0.06, 0.08, 0.06}, {}, false},
             {"streaks", "", "radial streaks of the glare image (each a ray and its opposite)", 0, 16, {3, 4, 6, 4}, {},
              true},
-            {"strength", "", "glare energy per unit of pixel colour", 0, 1, {0.05, 0.05, 0.05, 0.05}, {}, false},
+            {"strength", "", "the glare image's peak per unit of pixel colour", 0, 1, {0.25, 0.25, 0.25, 0.25}, {}, false},
             {"shrink", "", "shrink sprites whose outer ring is below 0.5/255 (texture coordinates follow)", 0, 1,
              {1, 1, 1, 1}, {"off", "on"}, false},
         };

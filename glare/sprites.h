@@ -16,10 +16,10 @@ struct Sprite {
 };
 
 struct SensorSettings {
-    float threshold = 0.9f;  // a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold
+    float threshold = 0.8f;  // a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold
     int group = 1;           // N: each N x N block of pixels gives at most one sprite
     bool clusters = true;    // an 8x8 block >= 90 % bright gives one cluster sprite, the others none
-    float strength = 0.05f;  // glare energy per unit of pixel colour
+    float strength = 0.25f;  // the glare image's peak per unit of pixel colour
     float radius = 32;       // sprite radius in pixels (cluster sprites: twice)
 };
 

@@ -14,6 +14,7 @@
 #include "emu/format.h"
 #include "emu/fullscreen.h"
 #include "emu/image_file.h"
+#include "glare/compare.h"
 #include "glare/report.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
@@ -66,40 +67,6 @@ struct GlareOptions {
     std::vector<std::string> sets;
     float exposure = 0;
 };
-
-// Per-pass agreement of the cross-check (GLARE.md §6 metric 6), summed over frames.
-struct PassAgreement {
-    std::string pass;
-    uint64_t pixels = 0, exact = 0, overOne = 0;
-    double maxDiff = 0;  // 8-bit levels
-};
-
-// Channel values of a read-back texel in 8-bit levels (float formats scaled by 255).
-void levelsOf(const emu::SurfacePixels& px, size_t i, double out[4]) {
-    const emu::FormatInfo& info = *emu::formatInfo(px.format);
-    const uint8_t* p = &px.bytes[i * px.bytesPerPixel];
-    if (info.cls == emu::FormatClass::Unorm8) {
-        const auto b = emu::decodeUnorm8(info, p);
-        for (int c = 0; c < 4; ++c) out[c] = b[size_t(c)];
-    } else {
-        const auto v = emu::decodeTexel(info, p, SignedDecode{});
-        for (int c = 0; c < 4; ++c) out[c] = double(v[size_t(c)]) * 255.0;
-    }
-}
-
-void accumulate(PassAgreement& a, const emu::SurfacePixels& x, const emu::SurfacePixels& y) {
-    const size_t n = size_t(x.width) * x.height;
-    for (size_t i = 0; i < n; ++i) {
-        double p[4], q[4], m = 0;
-        levelsOf(x, i, p);
-        levelsOf(y, i, q);
-        for (int c = 0; c < 4; ++c) m = std::max(m, std::fabs(p[c] - q[c]));
-        ++a.pixels;
-        a.exact += m == 0;
-        a.overOne += m > 1;
-        a.maxDiff = std::max(a.maxDiff, m);
-    }
-}
 
 emu::RgbaImage opaque(emu::RgbaImage img) {
     for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
@@ -301,8 +268,8 @@ int runGlare(const GlareOptions& o) {
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
     std::vector<double> frameMs;
-    std::vector<PassAgreement> agreement;
-    PassAgreement sceneAgreement{"scene (rendered on both)"};
+    std::vector<glare::PassAgreement> agreement;
+    glare::PassAgreement sceneAgreement{"scene (rendered on both)"};
     for (int f = 0; f < o.frames; ++f) {
         double sceneMs = 0;
         if (scene) {
@@ -327,97 +294,48 @@ int runGlare(const GlareOptions& o) {
                     std::cerr << "ps11 glare: " << err << "\n";
                     return cli::kUserError;
                 }
-                accumulate(sceneAgreement, *a, *b);
+                glare::accumulate(sceneAgreement, *a, *b);
             }
         }
-        // Hooks: progress; the last frame's dumps; the cross-check's captures.
-        glare::PassGraph* graph = nullptr;
+        // Hooks: progress and the last frame's dumps (the cross-check captures in glare/compare.cpp).
         const bool dump = !o.dumpDir.empty() && f == o.frames - 1;
         std::vector<emu::RgbaImage> sheet;
-        std::map<uint32_t, std::vector<std::pair<uint32_t, emu::SurfacePixels>>> inputs, outputs;
-        auto capture = [&](glare::Runner& r, glare::TextureId id, std::string& e) -> std::optional<emu::SurfacePixels> {
-            emu::Handle s{};
-            if (r.device().GetSurfaceLevel(graph->texture(id).device, 0, &s) != emu::D3D_OK) {
-                e = r.device().lastError().message;
-                return std::nullopt;
-            }
-            return emu::readSurface(r.device(), s, e);
-        };
-        auto hook = [&](uint32_t pass, bool after, std::string& e) {
-            const glare::PassGraph::PassNode& n = graph->passes()[pass];
+        auto hook = [&](glare::PassGraph& g, uint32_t pass, bool after, std::string& e) {
+            const glare::PassGraph::PassNode& n = g.passes()[pass];
             progress.update(f, n.info.name);
-            if (other) {
-                auto& store = after ? outputs[pass] : inputs[pass];
-                std::vector<glare::TextureId> ids = n.writes;
-                if (!after) ids.insert(ids.end(), n.reads.begin(), n.reads.end());
-                for (glare::TextureId id : ids) {
-                    if (graph->texture(id).data) continue;
-                    std::optional<emu::SurfacePixels> px = capture(*main, id, e);
-                    if (!px) return false;
-                    store.emplace_back(id.index, std::move(*px));
-                }
-            }
             if (after && dump)
                 for (glare::TextureId id : n.writes) {
-                    if (graph->texture(id).data) continue;
-                    std::optional<emu::RgbaImage> img = main->readTexture(graph->texture(id).device, e);
+                    if (g.texture(id).data) continue;
+                    std::optional<emu::RgbaImage> img = main->readTexture(g.texture(id).device, e);
                     if (!img) return false;
                     char prefix[16];
                     std::snprintf(prefix, sizeof prefix, "%02u_", pass);
                     const std::string path = o.dumpDir + "/" + prefix + safeName(n.info.name) + "-" +
-                                             safeName(graph->texture(id).name) + ".png";
+                                             safeName(g.texture(id).name) + ".png";
                     if (!emu::writePng(path, opaque(*img), e)) return false;
                     sheet.push_back(opaque(*img));
                 }
             return true;
         };
         glare::FrameResult result;
-        auto built = [&](glare::PassGraph& g) { graph = &g; };
-        if (!main->runFrame(*technique, *settings, f, o.frames, result, err, hook, built)) {
+        bool ok;
+        if (other) {
+            ok = glare::compareFrame(*main, *other, *technique, *settings, f, o.frames, agreement, result, err, hook);
+        } else {
+            glare::PassGraph* built = nullptr;
+            ok = main->runFrame(
+                *technique, *settings, f, o.frames, result, err,
+                [&](uint32_t pass, bool after, std::string& e) { return hook(*built, pass, after, e); },
+                [&](glare::PassGraph& g) { built = &g; });
+        }
+        if (!ok) {
             std::cerr << "ps11 glare: " << err << "\n";
             return cli::kUserError;
         }
-        if (f == 0 && !o.graph.empty() && !cli::writeFile(o.graph, graph->graphviz(std::string(technique->name()))))
+        if (f == 0 && !o.graph.empty() && !cli::writeFile(o.graph, main->lastGraphviz())) return cli::kUserError;
+        if (dump && !emu::writePng(o.dumpDir + "/contact_sheet.png", contactSheet(sheet), err)) {
+            std::cerr << "ps11 glare: " << err << "\n";
             return cli::kUserError;
-        if (dump) {
-            if (!emu::writePng(o.dumpDir + "/contact_sheet.png", contactSheet(sheet), err)) {
-                std::cerr << "ps11 glare: " << err << "\n";
-                return cli::kUserError;
-            }
-        }
-        if (other) {
-            // The same frame on GL, each pass fed the emulator's inputs; its outputs compared.
-            glare::PassGraph* glGraph = nullptr;
-            auto glHook = [&](uint32_t pass, bool after, std::string& e) {
-                const glare::PassGraph::PassNode& n = glGraph->passes()[pass];
-                if (!after) {
-                    for (auto& [id, px] : inputs[pass]) {
-                        emu::Handle s{};
-                        if (other->device().GetSurfaceLevel(glGraph->textures()[id].device, 0, &s) != emu::D3D_OK ||
-                            !emu::writeSurface(other->device(), s, px, e))
-                            return false;
-                    }
-                    return true;
-                }
-                PassAgreement* a = nullptr;
-                for (PassAgreement& x : agreement)
-                    if (x.pass == n.info.name) a = &x;
-                if (!a) a = &agreement.emplace_back(PassAgreement{n.info.name});
-                for (auto& [id, px] : outputs[pass]) {
-                    emu::Handle s{};
-                    if (other->device().GetSurfaceLevel(glGraph->textures()[id].device, 0, &s) != emu::D3D_OK) return false;
-                    std::optional<emu::SurfacePixels> g = emu::readSurface(other->device(), s, e);
-                    if (!g) return false;
-                    accumulate(*a, px, *g);
-                }
-                return true;
-            };
-            glare::FrameResult glResult;
-            if (!other->runFrame(*technique, *settings, f, o.frames, glResult, err, glHook,
-                                 [&](glare::PassGraph& g) { glGraph = &g; })) {
-                std::cerr << "ps11 glare: GL: " << err << "\n";
-                return cli::kUserError;
-            }
         }
         lastStats = result.passes;
         frameMs.push_back(result.milliseconds);
@@ -434,13 +352,13 @@ int runGlare(const GlareOptions& o) {
     const std::string hw(main->device().hardware().hardware->name);
     if (o.compare) {
         uint64_t over = sceneAgreement.overOne;
-        for (const PassAgreement& a : agreement) over += a.overOne;
+        for (const glare::PassAgreement& a : agreement) over += a.overOne;
         if (o.json) {
             std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"gl\": \"%s\", \"frames\": %d, "
                         "\"passes\": [\n",
                         std::string(technique->name()).c_str(), hw.c_str(), profile.c_str(),
                         glRendererDescription().c_str(), o.frames);
-            std::vector<PassAgreement> all;
+            std::vector<glare::PassAgreement> all;
             if (scene) all.push_back(sceneAgreement);
             all.insert(all.end(), agreement.begin(), agreement.end());
             for (size_t i = 0; i < all.size(); ++i)
@@ -453,13 +371,13 @@ int runGlare(const GlareOptions& o) {
                         std::string(technique->name()).c_str(), width, height, o.frames, hw.c_str(), profile.c_str(),
                         glRendererDescription().c_str());
             std::printf("%-26s %12s %9s %10s %9s\n", "pass", "pixels", "exact", "|d|>1", "max |d|");
-            auto row = [](const PassAgreement& a) {
+            auto row = [](const glare::PassAgreement& a) {
                 std::printf("%-26s %12llu %8.3f%% %10llu %9.3g\n", a.pass.c_str(), (unsigned long long)a.pixels,
                             a.pixels ? 100.0 * double(a.exact) / double(a.pixels) : 100.0, (unsigned long long)a.overOne,
                             a.maxDiff);
             };
             if (scene) row(sceneAgreement);
-            for (const PassAgreement& a : agreement) row(a);
+            for (const glare::PassAgreement& a : agreement) row(a);
             std::printf("%s\n", over == 0 ? "agreement: every pass within 1 level" : "DISAGREEMENT: pixels differ by more than 1 level");
         }
         return over == 0 ? cli::kOk : cli::kUserError;
