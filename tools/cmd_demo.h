@@ -1,6 +1,6 @@
-// The second half of `ps11 demo`: a bloom chain of the corpus's ps_1_1 shaders rendered on the
-// emu device in every precision profile, with the time of each pass and the error of each
-// profile against `ideal`.
+// `ps11 demo`, the main job (README): the five glare techniques on the built-in scenes, on the
+// emulated 1.1-class card and under the ideal profile, with each technique's time per frame, its
+// error against ideal and its fits-ps_1_1 summary; the images are written to a folder.
 #pragma once
 
 #include <cstdint>
@@ -10,16 +10,15 @@
 
 namespace ps11 {
 
-struct BloomDemoOptions {
-    uint32_t width = 960, height = 540;  // the scene and the final image
-    int threads = 0;                     // device worker threads; 0 = every core
-    int repeats = 3;                     // runs per profile; times are medians
-    std::string outPrefix;               // if set, PREFIX-<hardware>.ppm gets each final image
-    const HardwareClass* hardware = nullptr;  // only this class (and the reference); null = every class
+struct GlareDemoOptions {
+    uint32_t width = 960, height = 540;
+    int threads = 0;   // device worker threads; 0 = every core
+    int repeats = 3;   // frames timed per run; the time is their median
+    std::string outDir = "ps11-demo";
+    const HardwareClass* hardware = nullptr;  // the class to emulate; null = the default 1.1-class card
 };
 
-// Renders and prints the table. `projectDir` holds tests/shaders/corpus. Returns a cli exit
-// code (0, or 1 when a shader or a device call fails, with the message printed).
-int runBloomDemo(const std::string& projectDir, const BloomDemoOptions& options);
+// Prints the tables and writes OUT/<technique>-<scene>-{fx,ideal}.png. Returns a cli exit code.
+int runGlareDemo(const GlareDemoOptions& options);
 
 }  // namespace ps11

@@ -62,9 +62,9 @@ const char* kUsageText =
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
-    "  demo [--size WxH] [--threads N] [--repeats N] [--hardware H] [--out PREFIX]\n"
-    "                         the main job: the corpus checked, then a bloom chain rendered on\n"
-    "                         the device for every hardware class (time per pass, error vs ideal)\n"
+    "  demo [--size WxH] [--threads N] [--repeats N] [--hardware H] [--out DIR]\n"
+    "                         the main job: the five glare techniques on the built-in scenes,\n"
+    "                         emulated and ideal (time per frame, error), and the fits-ps_1_1 table\n"
     "  version, --version     print the ps11 version\n"
     "  help, --help           print this text\n";
 
@@ -278,10 +278,10 @@ bool parseSize(const std::string& s, uint32_t& w, uint32_t& h) {
     return true;
 }
 
-// The main job until the glare techniques land: check the project's shader corpus, then render
-// the corpus's bloom chain on the device in every profile (tools/cmd_demo.cpp).
+// The main job (README): the project's shader corpus checked in one line, then the five glare
+// techniques on the built-in scenes (tools/cmd_demo.cpp).
 int cmdDemo(const std::vector<std::string>& args) {
-    BloomDemoOptions bloom;
+    GlareDemoOptions demo;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         if (a == "--size" || a == "--threads" || a == "--repeats" || a == "--out" || a == "--hardware") {
@@ -289,69 +289,59 @@ int cmdDemo(const std::vector<std::string>& args) {
             const std::string& v = args[++i];
             char* end = nullptr;
             if (a == "--hardware") {
-                bloom.hardware = findHardware(v);
-                if (!bloom.hardware)
-                    return usage("demo: " + unknownHardwareMessage(v));
+                demo.hardware = findHardware(v);
+                if (!demo.hardware) return usage("demo: " + unknownHardwareMessage(v));
             } else if (a == "--size") {
-                if (!parseSize(v, bloom.width, bloom.height))
-                    return usage("demo: --size takes WIDTHxHEIGHT with sides 1..16384, not " + quote(v));
+                if (!parseSize(v, demo.width, demo.height) || demo.width < 8 || demo.height < 8 || demo.width > 8192 ||
+                    demo.height > 8192)
+                    return usage("demo: --size takes WIDTHxHEIGHT with sides 8..8192, not " + quote(v));
             } else if (a == "--out") {
-                bloom.outPrefix = v;
+                demo.outDir = v;
             } else {
                 long n = std::strtol(v.c_str(), &end, 10);
                 if (*end || n < (a == "--threads" ? 0 : 1) || n > 256)
                     return usage("demo: " + a + " takes a number" + (a == "--threads" ? " 0..256" : " 1..256") +
                                  ", not " + quote(v));
-                (a == "--threads" ? bloom.threads : bloom.repeats) = int(n);
+                (a == "--threads" ? demo.threads : demo.repeats) = int(n);
             }
         } else {
             return usage("demo: unknown argument " + quote(a) +
                          didYouMean(a, {"--size", "--threads", "--repeats", "--out", "--hardware"}));
         }
     }
-    std::string dir = projectDir();
-    if (dir.empty()) {
-        std::cerr << "ps11: demo: cannot find the shader corpus (tests/shaders/corpus); run from the project folder\n";
-        return kUserError;
-    }
-    std::vector<std::string> files = listFiles(dir + "/tests/shaders/corpus", ".psh");
-    if (files.empty()) {
-        std::cerr << "ps11: demo: no shaders under " << dir << "/tests/shaders/corpus\n";
-        return kUserError;
-    }
-    std::printf("ps11 demo: assembling, validating and round-tripping %zu corpus shaders\n\n", files.size());
-    std::printf("%-52s %-7s %-9s %-9s %s\n", "shader", "version", "tex", "arith", "round trip");
-    int failures = 0;
-    for (const std::string& path : files) {
-        Diagnostics diags;
-        ShaderStats stats;
-        std::optional<Program> prog = assembleFile(path, {}, true, &stats, diags);
-        std::string rel = path.substr(dir.size() + 1);
-        if (!prog || diags.hasErrors()) {
-            std::cerr << diags.formatAll();
-            std::printf("%-52s INVALID\n", rel.c_str());
-            ++failures;
-            continue;
+    // The corpus: every shader assembled, validated and round-tripped through tokens and text.
+    const std::string dir = projectDir();
+    if (!dir.empty()) {
+        std::vector<std::string> files = listFiles(dir + "/tests/shaders/corpus", ".psh");
+        int failures = 0;
+        for (const std::string& path : files) {
+            Diagnostics diags;
+            ShaderStats stats;
+            std::optional<Program> prog = assembleFile(path, {}, true, &stats, diags);
+            const std::string rel = path.substr(dir.size() + 1);
+            bool roundTrip = false;
+            if (prog && !diags.hasErrors()) {
+                std::vector<uint32_t> tokens = encode(*prog);
+                Diagnostics d2;
+                std::optional<Program> back = decode(tokens, d2.addFile(rel), d2);
+                if (back) {
+                    Diagnostics d3;
+                    std::optional<Program> again = parseAssembly(disassemble(*back), rel, {}, d3);
+                    roundTrip = again && encode(*again) == tokens;
+                }
+            } else {
+                std::cerr << diags.formatAll();
+            }
+            if (!roundTrip) {
+                std::printf("corpus: %s: %s\n", rel.c_str(), prog ? "round trip differs" : "invalid");
+                ++failures;
+            }
         }
-        std::vector<uint32_t> tokens = encode(*prog);
-        Diagnostics d2;
-        std::optional<Program> back = decode(tokens, d2.addFile(rel), d2);
-        bool roundTrip = false;
-        if (back) {
-            Diagnostics d3;
-            std::optional<Program> again = parseAssembly(disassemble(*back), rel, {}, d3);
-            roundTrip = again && encode(*again) == tokens;
-        }
-        if (!roundTrip) ++failures;
-        char tex[32], arith[32];
-        std::snprintf(tex, sizeof tex, "%d/%d", stats.texSlots, stats.texLimit);
-        std::snprintf(arith, sizeof arith, "%d/%d", stats.arithSlots, stats.arithLimit);
-        std::printf("%-52s ps_%d_%d  %-9s %-9s %s\n", rel.c_str(), stats.version.major, stats.version.minor, tex,
-                    arith, roundTrip ? "identical" : "DIFFERS");
+        std::printf("ps11 demo: %zu corpus shaders assembled, validated and round-tripped: %s\n\n", files.size(),
+                    failures ? "FAILURES above" : "all identical");
+        if (failures) return kUserError;
     }
-    std::printf("\n%zu shaders, %d failed\n\n", files.size(), failures);
-    if (failures) return kUserError;
-    return runBloomDemo(dir, bloom);
+    return runGlareDemo(demo);
 }
 
 }  // namespace
