@@ -3,13 +3,52 @@
 #include <algorithm>
 #include <cmath>
 
+#include "glare/glow.h"
 #include "glare/passes.h"
 #include "glare/runner.h"
 
 namespace glare {
-namespace {
 
+namespace {
 constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+// The normalised 1D kernel over −radius … +radius.
+std::vector<double> glowKernel(const Settings& s) {
+    const int r = int(s.at("radius"));
+    std::vector<double> w;
+    double sum = 0;
+    for (int x = -r; x <= r; ++x) {
+        double v = 0;
+        const double ax = std::abs(double(x));
+        switch (int(s.at("profile"))) {
+            case 0: {
+                const double sb = s.at("sigma_broad"), sn = s.at("sigma_narrow"), m = s.at("narrow_share");
+                // Each Gaussian normalised on its own, then mixed: the narrow one carries `m` of the sum.
+                v = (1 - m) * std::exp(-ax * ax / (2 * sb * sb)) / (sb * std::sqrt(2 * kPi)) +
+                    m * std::exp(-ax * ax / (2 * sn * sn)) / (sn * std::sqrt(2 * kPi));
+                break;
+            }
+            case 1: {
+                const double sb = s.at("sigma_broad");
+                v = std::exp(-ax * ax / (2 * sb * sb));
+                break;
+            }
+            default: {
+                const double p = s.at("period");
+                v = (1 - std::fmod(ax, p) / p) * (1 - ax / double(r + 1));
+                break;
+            }
+        }
+        w.push_back(v);
+        sum += v;
+    }
+    for (double& v : w) v /= sum;
+    return w;
+}
+
+
+namespace {
 
 class Glow final : public Technique {
 public:
@@ -42,40 +81,6 @@ public:
             {"ramp_period", "frames", "period of the ramp", 2, 1000, {60, 60, 60, 60}, {}, true},
         };
         return p;
-    }
-
-    // The normalised 1D kernel over −radius … +radius.
-    static std::vector<double> kernel(const FrameBuild& fb) {
-        const int r = int(fb.get("radius"));
-        std::vector<double> w;
-        double sum = 0;
-        for (int x = -r; x <= r; ++x) {
-            double v = 0;
-            const double ax = std::abs(double(x));
-            switch (fb.choice("profile")) {
-                case 0: {
-                    const double sb = fb.get("sigma_broad"), sn = fb.get("sigma_narrow"), m = fb.get("narrow_share");
-                    // Each Gaussian normalised on its own, then mixed: the narrow one carries `m` of the sum.
-                    v = (1 - m) * std::exp(-ax * ax / (2 * sb * sb)) / (sb * std::sqrt(2 * kPi)) +
-                        m * std::exp(-ax * ax / (2 * sn * sn)) / (sn * std::sqrt(2 * kPi));
-                    break;
-                }
-                case 1: {
-                    const double sb = fb.get("sigma_broad");
-                    v = std::exp(-ax * ax / (2 * sb * sb));
-                    break;
-                }
-                default: {
-                    const double p = fb.get("period");
-                    v = (1 - std::fmod(ax, p) / p) * (1 - ax / double(r + 1));
-                    break;
-                }
-            }
-            w.push_back(v);
-            sum += v;
-        }
-        for (double& v : w) v /= sum;
-        return w;
     }
 
 public:
@@ -187,7 +192,7 @@ public:
                         QuadPass{"scale.psh", raw, {texelTap(fb, previousGlow, 0, 0, D3DTEXF_POINT)},
                                  {{0, {k, k, k, k}}}, Blend::Add});
         }
-        const std::vector<double> kern = kernel(fb);
+        const std::vector<double> kern = glowKernel(fb.settings);
         const TextureId horizontal = g.create("glow h", gd);
         const TextureId glow = g.create("glow", gd);
         convolve(fb, src, horizontal, true, kern);

@@ -1,0 +1,461 @@
+// The glare techniques (glare/): shaders, the pass graph, every technique on both renderers, and
+// GLARE.md's behaviours with thresholds derived from its formulas.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+
+#include "emu/fullscreen.h"
+#include "glare/compare.h"
+#include "glare/glow.h"
+#include "glare/passes.h"
+#include "glare/report.h"
+#include "glare/runner.h"
+#include "glare/scene.h"
+#include "glare/shader_library.h"
+#include "glare/sprites.h"
+#include "ps11/assembler.h"
+#include "ps11/validator.h"
+#include "tools/gl_backend.h"
+
+using namespace glare;
+
+namespace {
+
+emu::FloatImage uniform(uint32_t w, uint32_t h, float r, float g, float b, float a = 1) {
+    emu::FloatImage img{w, h, {}};
+    for (size_t i = 0; i < size_t(w) * h; ++i) img.rgba.insert(img.rgba.end(), {r, g, b, a});
+    return img;
+}
+
+// The value of a 1x1 (or the first texel of a) texture, as stored: floats read exactly.
+std::array<double, 4> texel(Runner& r, emu::Handle texture) {
+    emu::Handle s{};
+    REQUIRE(r.device().GetSurfaceLevel(texture, 0, &s) == D3D_OK);
+    std::string err;
+    std::optional<emu::SurfacePixels> px = emu::readSurface(r.device(), s, err);
+    REQUIRE(px);
+    std::array<double, 4> v{};
+    if (px->format == D3DFMT_A8R8G8B8) {
+        v = {px->bytes[2] / 255.0, px->bytes[1] / 255.0, px->bytes[0] / 255.0, px->bytes[3] / 255.0};
+    } else {
+        float f[4];
+        std::memcpy(f, px->bytes.data(), 16);
+        v = {f[0], f[1], f[2], f[3]};
+    }
+    return v;
+}
+
+RunnerOptions options(uint32_t w, uint32_t h, std::optional<ps11::Precision> p = std::nullopt) {
+    RunnerOptions ro;
+    ro.width = w;
+    ro.height = h;
+    ro.device.precision = p;
+    return ro;
+}
+
+Settings preset(const char* technique, const char* name = "published") {
+    return *presetSettings(*findTechnique(technique), name);
+}
+
+}  // namespace
+
+TEST_CASE("every glare shader assembles and validates as ps_1_1", "[glare]") {
+    REQUIRE(embeddedShaders().size() >= 10);
+    for (const EmbeddedShader& s : embeddedShaders()) {
+        INFO(s.name);
+        ps11::Diagnostics diags;
+        std::optional<ps11::Program> p = ps11::parseAssembly(s.text, std::string(s.name), {}, diags);
+        REQUIRE(p);
+        ps11::ShaderStats stats;
+        CHECK(ps11::validate(*p, diags, &stats));
+        CHECK(stats.version.minor == 1);
+        CHECK(stats.texSlots <= stats.texLimit);
+        CHECK(stats.arithSlots <= stats.arithLimit);
+    }
+}
+
+TEST_CASE("the embedded shaders are the files in glare/shaders", "[glare]") {
+    for (const EmbeddedShader& s : embeddedShaders()) {
+        std::ifstream f(std::string(PS11_SOURCE_DIR) + "/glare/shaders/" + std::string(s.name), std::ios::binary);
+        REQUIRE(f);
+        std::stringstream text;
+        text << f.rdbuf();
+        CHECK(text.str() == s.text);
+    }
+}
+
+TEST_CASE("pass graph: culling, order, lifetimes and aliasing", "[glare][graph]") {
+    emu::Device device;
+    TexturePool pool(device);
+    emu::Handle out{};
+    REQUIRE(device.CreateTexture(16, 16, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &out) == D3D_OK);
+    PassGraph g;
+    const TextureId output = g.import("output", {16, 16}, out, true);
+    const TextureDesc small{8, 8};
+    const TextureId a = g.create("a", small), b = g.create("b", small), c = g.create("c", small),
+                    unused = g.create("unused", small);
+    std::vector<std::string> ran;
+    auto clearPass = [&](const char* name, std::vector<TextureId> reads, TextureId write) {
+        g.addPass(
+            PassInfo{name, PassKind::Clear, "", ""},
+            [&](PassBuilder& pb) {
+                for (TextureId r : reads) pb.read(r);
+                pb.write(write);
+            },
+            [&ran, name, write](PassContext& ctx) {
+                ran.push_back(name);
+                return ctx.clear(write, 0xff102030);
+            });
+    };
+    clearPass("make_a", {}, a);
+    clearPass("make_unused", {a}, unused);  // nobody reads it: culled
+    clearPass("a_to_b", {a}, b);
+    clearPass("b_to_c", {b}, c);  // a is dead from here: c may take a's device texture
+    clearPass("overwritten", {}, output);  // the next pass overwrites output without reading: culled
+    clearPass("c_to_output", {c}, output);
+    g.compile();
+    CHECK(g.livePassNames() == std::vector<std::string>{"make_a", "a_to_b", "b_to_c", "c_to_output"});
+    std::vector<PassStats> stats;
+    std::string err;
+    REQUIRE(g.run(pool, stats, err));
+    CHECK(ran == std::vector<std::string>{"make_a", "a_to_b", "b_to_c", "c_to_output"});
+    CHECK(stats.size() == 4);
+    CHECK(g.texture(a).firstUse == 0);
+    CHECK(g.texture(a).lastUse == 2);
+    CHECK(g.texture(unused).firstUse == -1);
+    // a and b live together (a_to_b); c starts after a's last use, so it reuses a's texture.
+    CHECK(g.texture(a).physical != g.texture(b).physical);
+    CHECK(g.texture(c).physical == g.texture(a).physical);
+    CHECK(pool.created() == 2);
+    const std::string dot = g.graphviz("test");
+    CHECK(dot.find("make_unused") != std::string::npos);
+    CHECK(dot.find("style=dashed, fontcolor=gray") != std::string::npos);
+    // Running again takes the same pooled textures: nothing new is made.
+    stats.clear();
+    REQUIRE(g.run(pool, stats, err));
+    CHECK(pool.created() == 2);
+}
+
+TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
+    std::string error;
+    const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
+    REQUIRE(gl);
+    for (const Technique* t : techniques())
+        for (std::string_view presetName : kPresetNames) {
+            INFO(std::string(t->name()) + " " + std::string(presetName));
+            Runner emuRun(options(96, 64));
+            RunnerOptions glOptions = options(96, 64);
+            glOptions.device.renderer = gl;
+            Runner glRun(glOptions);
+            std::string sceneError;
+            std::unique_ptr<Scene> scene = makeScene(t->name() == "sprites" ? "lights" : "box", sceneError);
+            REQUIRE(scene);
+            double ms = 0;
+            REQUIRE(emuRun.renderScene(*scene, 3, 8, ms, error));
+            std::optional<emu::RgbaImage> frame = emuRun.readTexture(emuRun.sceneTexture(), error);
+            REQUIRE(frame);
+            REQUIRE(glRun.setImage(*frame, error));
+            std::vector<PassAgreement> agreement;
+            FrameResult result;
+            const Settings s = *presetSettings(*t, presetName);
+            for (int f = 0; f < 2; ++f) REQUIRE(compareFrame(emuRun, glRun, *t, s, f, 2, agreement, result, error));
+            REQUIRE(!agreement.empty());
+            for (const PassAgreement& a : agreement) {
+                INFO(a.pass << ": " << a.overOne << " of " << a.pixels << " pixels past 1 level, max " << a.maxDiff);
+                CHECK(a.overOne == 0);
+            }
+        }
+}
+
+TEST_CASE("adaptive: the glare amount follows A_n = a·L + (1 − a)·A_(n−1), and stops short in 8 bits", "[glare]") {
+    // A uniform grey 0.5: avg = 0.5, 4·avg² = 1 per channel, luminance 1.0 (clamped), so L = 1.
+    // From black, ideal: A_n = 1 − (1 − a)^n. fx8 with round-to-nearest stops where the step
+    // a·(L − A) falls below half a level: about 0.5/a = 20 levels short (GLARE.md §7).
+    const Technique& t = *findTechnique("adaptive");
+    Settings s = preset("adaptive");
+    s["start"] = 1;  // black
+    const double a = s.at("smoothing");
+    for (auto p : {ps11::Precision::Ideal, ps11::Precision::Fx8}) {
+        Runner run(options(16, 16, p));
+        std::string err;
+        REQUIRE(run.setImage(uniform(16, 16, 0.5f, 0.5f, 0.5f), err));
+        std::vector<double> values;
+        for (int f = 0; f < 400; ++f) {
+            FrameResult r;
+            REQUIRE(run.runFrame(t, s, f, 400, r, err));
+            values.push_back(texel(run, run.persistent("adapted glare amount", {1, 1, run.intermediateFormat()}, 0, err))[0]);
+        }
+        if (p == ps11::Precision::Ideal) {
+            for (int n : {1, 10, 50, 100, 200}) {
+                INFO("frame " << n);
+                CHECK(values[size_t(n - 1)] == Approx(1 - std::pow(1 - a, n)).margin(1e-4));
+            }
+        } else {
+            // The 8-bit recurrence, exactly: the smoothing constant sits on the grid (a8 = round(a·255)),
+            // the blend computes L·a8 + A·(255 − a8) exactly and rounds once to a level, ties to even.
+            const int a8 = int(std::lround(a * 255));
+            int level = 0;
+            for (int f = 0; f < 400; ++f) {
+                const double exact = (255.0 * a8 + double(level) * (255 - a8)) / 255.0;
+                level = int(std::nearbyint(exact));
+                INFO("frame " << f);
+                REQUIRE(values[size_t(f)] * 255 == Approx(level).margin(1e-6));
+            }
+            // Stuck below 1.0 by the dead band: about 0.5/a' levels short (a' = a8/255), and no longer moving.
+            const double levelsShort = 255 - values.back() * 255;
+            CHECK(levelsShort >= 0.5 * 255 / a8 - 1);
+            CHECK(levelsShort <= 0.5 * 255 / a8 + 1);
+            CHECK(values[399] == values[300]);
+        }
+    }
+}
+
+TEST_CASE("adaptive: the ps_1_1 bright pass computes b·min(4b, 1), ideal computes 4b²", "[glare]") {
+    const Technique& t = *findTechnique("adaptive");
+    for (float c : {0.5f, 0.6f, 0.8f}) {
+        const double b = c - 0.4, intended = std::min(4 * b * b, 1.0), hardware = b * std::min(4 * b, 1.0);
+        for (auto p : {ps11::Precision::Ideal, ps11::Precision::Fx8}) {
+            Runner run(options(16, 16, p));
+            std::string err;
+            REQUIRE(run.setImage(uniform(16, 16, c, c, c), err));
+            Settings s = preset("adaptive");
+            s["glare_amount"] = 1;
+            s["blur_passes"] = 0;
+            s["start"] = 1;      // black, and
+            s["smoothing"] = 0;  // kept black: A = 0, 1 − A = 1
+            std::optional<TextureId> bright;
+            PassGraph* graph = nullptr;
+            double value = -1;
+            FrameResult r;
+            // Read the bright pass's target right after it ran (A is that frame's amount).
+            REQUIRE(run.runFrame(
+                t, s, 0, 1, r, err,
+                [&](uint32_t pass, bool after, std::string&) {
+                    if (after && graph->passes()[pass].info.name == "bright_pass")
+                        value = texel(run, graph->texture(graph->passes()[pass].writes[0]).device)[0];
+                    return true;
+                },
+                [&](PassGraph& g) { graph = &g; }));
+            INFO("c = " << c << " profile " << int(p));
+            if (p == ps11::Precision::Ideal)
+                CHECK(value == Approx(intended).margin(0.02));
+            else
+                CHECK(value == Approx(hardware).margin(0.02));
+        }
+    }
+}
+
+TEST_CASE("error-diffused weights keep the kernel's sum on the grid", "[glare]") {
+    // GLARE.md §7: rounding each 8-bit weight of a normalised kernel gives Σw ≈ 1.0039; carrying the
+    // remainder keeps the quantised sum equal to the quantised real sum.
+    const std::vector<std::vector<double>> kernels = {
+        {5.0 / 16, 6.0 / 16, 5.0 / 16}, {0.25, 0.25, 0.25, 0.25}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+    for (const auto& k : kernels) {
+        const double sum = std::accumulate(k.begin(), k.end(), 0.0);
+        const std::vector<double> q = quantiseWeights(k, ps11::Precision::Fx8);
+        CHECK(std::accumulate(q.begin(), q.end(), 0.0) * 255 == Approx(std::nearbyint(sum * 255)).margin(1e-9));
+        for (size_t i = 0; i < q.size(); ++i) {
+            CHECK(std::fabs(q[i] * 255 - std::nearbyint(q[i] * 255)) < 1e-9);  // on the grid
+            CHECK(std::fabs(q[i] - k[i]) <= 1.0 / 255);                       // within a level of the real weight
+        }
+    }
+    // The pyramid's 5/16, 6/16, 5/16 rounded one by one sum to 256/255: the reason diffusion exists.
+    double naive = 0;
+    for (double w : kernels[0]) naive += std::nearbyint(w * 255);
+    CHECK(naive == 256);
+    // Float profiles keep the weights as they are.
+    CHECK(quantiseWeights(kernels[0], ps11::Precision::Ideal) == kernels[0]);
+}
+
+TEST_CASE("pyramid: DC gain 4 when summed plainly, 1 when energy-normalised", "[glare]") {
+    // A uniform 0.1 with threshold 0: the bright pass keeps 0.1; every level stays 0.1; the sum of
+    // four levels is 0.4 plainly and 0.1 normalised; the composite adds it to the scene.
+    const Technique& t = *findTechnique("pyramid");
+    for (int sum : {0, 1})
+        for (auto p : {ps11::Precision::Ideal, ps11::Precision::Fx8}) {
+            Runner run(options(64, 64, p));
+            std::string err;
+            REQUIRE(run.setImage(uniform(64, 64, 0.1f, 0.1f, 0.1f), err));
+            Settings s = preset("pyramid");
+            s["threshold"] = 0;
+            s["sum"] = sum;
+            s["size"] = 64;
+            FrameResult r;
+            REQUIRE(run.runFrame(t, s, 0, 1, r, err));
+            std::optional<emu::RgbaImage> out = run.readOutput(err);
+            REQUIRE(out);
+            const double expected = 0.1 + (sum == 0 ? 0.4 : 0.1);
+            INFO("sum " << sum << " profile " << ps11::precisionName(p));
+            // The output is 8-bit: the scene copy (25.5 levels) and the sum each round by up to half a
+            // level; fx8 also rounds the input and every pass (four levels weighted and summed).
+            CHECK(int(out->rgba[size_t(32 * 64 + 32) * 4]) == Approx(expected * 255).margin(p == ps11::Precision::Ideal ? 1 : 4));
+        }
+}
+
+TEST_CASE("glow: feedback decays by k per frame, and 8-bit rounding leaves a residue that never fades", "[glare]") {
+    // A uniform source (alpha 1), then black. Uniform images make the blur an identity (the
+    // kernel sums to 1), so the glow is y ← s + k·y: y → s/(1 − k), then y ← k·y once s = 0.
+    // With rounding, y ← Q(k·y) stops at a residue of about 0.5/(1 − k) levels (GLARE.md §7).
+    const Technique& t = *findTechnique("glow");
+    Settings s = preset("glow");
+    s["afterimage"] = 2;  // feedback
+    s["decay"] = 0.8;
+    s["radius"] = 2;
+    for (auto p : {ps11::Precision::Ideal, ps11::Precision::Fx8}) {
+        Runner run(options(32, 32, p));
+        std::string err;
+        std::vector<double> glow;
+        for (int f = 0; f < 60; ++f) {
+            REQUIRE(run.setImage(f < 20 ? uniform(32, 32, 0.1f, 0.1f, 0.1f) : uniform(32, 32, 0, 0, 0), err));
+            FrameResult r;
+            REQUIRE(run.runFrame(t, s, f, 60, r, err));
+            glow.push_back(texel(run, run.persistent("previous glow", {8, 8, run.intermediateFormat()}, 0, err))[0]);
+        }
+        INFO("profile " << int(p));
+        // Converged near s/(1 − k) = 0.5 after 20 frames (0.8^20 ≈ 1 %).
+        CHECK(glow[19] == Approx(0.5).margin(p == ps11::Precision::Ideal ? 0.01 : 0.03));
+        if (p == ps11::Precision::Ideal) {
+            for (int f = 21; f < 30; ++f) CHECK(glow[size_t(f)] == Approx(0.8 * glow[size_t(f - 1)]).epsilon(1e-3));
+            CHECK(glow[59] * 255 < 0.5);  // fades below half a level
+        } else {
+            // Once the source is black: y ← B_v(B_h(round(k8·y/255))). A 4-tap pass of a uniform level
+            // Y is the mul/mad chain r ← round(Y·w_i/255 + r), each instruction rounding once, ties
+            // to even; the passes after the first add exactly (ONE, ONE). Predicted frame by frame
+            // from frame 19's value, it must match exactly, and it stops at a residue that never fades.
+            const std::vector<double> q = quantiseWeights(glowKernel(s), ps11::Precision::Fx8);
+            auto roundEven = [](double x) { return std::nearbyint(x); };
+            auto blur = [&](double y) {
+                double sum = 0;
+                for (size_t first = 0; first < q.size(); first += 4) {
+                    double r = 0;
+                    for (size_t i = first; i < std::min(first + 4, q.size()); ++i)
+                        r = roundEven(y * double(std::lround(q[i] * 255)) / 255 + r);
+                    sum += r;
+                }
+                return sum;
+            };
+            const double k8 = double(std::lround(0.8 * 255));
+            double y = std::nearbyint(glow[19] * 255);
+            for (int f = 20; f < 60; ++f) {
+                y = blur(blur(roundEven(y * k8 / 255)));
+                INFO("frame " << f);
+                REQUIRE(glow[size_t(f)] * 255 == Approx(y).margin(1e-6));
+            }
+            CHECK(y >= 1);
+            CHECK(glow[59] == glow[50]);
+        }
+    }
+}
+
+TEST_CASE("sprites: grouping keeps the total glare energy", "[glare]") {
+    // Scattered bright pixels (some adjacent) on black.
+    const uint32_t w = 64, h = 48;
+    std::vector<uint8_t> img(size_t(w) * h * 4, 0);
+    auto set = [&](uint32_t x, uint32_t y, uint8_t r, uint8_t g, uint8_t b) {
+        uint8_t* p = &img[(size_t(y) * w + x) * 4];
+        p[0] = r, p[1] = g, p[2] = b, p[3] = 255;
+    };
+    for (uint32_t i = 0; i < 40; ++i) set((i * 37) % w, (i * 23 + i / 3) % h, 255, 240, uint8_t(200 + i));
+    set(10, 10, 255, 255, 255);
+    set(11, 10, 255, 255, 255);
+    set(10, 11, 255, 255, 255);
+    for (uint32_t y = 24; y < 32; ++y)
+        for (uint32_t x = 40; x < 48; ++x) set(x, y, 255, 255, 255);  // an 8x8 block: a cluster
+    SensorSettings base;
+    base.strength = 0.1f;
+    auto energy = [&](const std::vector<Sprite>& sprites) {
+        std::array<double, 3> e{};
+        for (const Sprite& s : sprites)
+            for (int c = 0; c < 3; ++c) e[size_t(c)] += s.energy[c];
+        return e;
+    };
+    base.group = 1;
+    const auto single = senseSprites(img.data(), w, h, base);
+    const auto e1 = energy(single);
+    size_t clusters = 0;
+    for (const Sprite& s : single) clusters += s.cluster;
+    CHECK(clusters == 1);
+    for (int n : {2, 4, 8}) {
+        SensorSettings s = base;
+        s.group = n;
+        const auto grouped = senseSprites(img.data(), w, h, s);
+        CHECK(grouped.size() < single.size());
+        const auto e = energy(grouped);
+        for (int c = 0; c < 3; ++c) CHECK(e[size_t(c)] == Approx(e1[size_t(c)]).epsilon(1e-5));
+    }
+    // Without clusters, the 64 block pixels give 64 sprites with the same energy as the cluster.
+    SensorSettings noClusters = base;
+    noClusters.clusters = false;
+    const auto e0 = energy(senseSprites(img.data(), w, h, noClusters));
+    for (int c = 0; c < 3; ++c) CHECK(e0[size_t(c)] == Approx(e1[size_t(c)]).epsilon(1e-5));
+}
+
+TEST_CASE("sprites: the drawn glare buffer keeps its energy when pixels are grouped", "[glare]") {
+    // The same scattered lights drawn with N = 1 and N = 2 under the ideal profile (float glare
+    // buffer): the buffers' sums agree within the bilinear footprint's rounding.
+    const Technique& t = *findTechnique("sprites");
+    // Sprites larger than the 128-texel glare image (radius 0.4·192 = 77 px) so bilinear sampling
+    // magnifies it and the drawn sum does not depend on sub-pixel position; lights near the centre
+    // so no sprite is clipped.
+    const uint32_t w = 256, h = 192;
+    emu::FloatImage img = uniform(w, h, 0, 0, 0);
+    const uint32_t spots[][2] = {{120, 90}, {131, 97}, {100, 84}, {141, 101}};
+    for (const auto& p : spots)
+        for (uint32_t dy = 0; dy < 2; ++dy)
+            for (uint32_t dx = 0; dx < 2; ++dx)
+                for (int c = 0; c < 3; ++c) img.rgba[(size_t(p[1] + dy) * w + p[0] + dx) * 4 + size_t(c)] = 1;
+    std::array<double, 2> totals{};
+    for (int n : {1, 2}) {
+        Runner run(options(w, h, ps11::Precision::Ideal));
+        std::string err;
+        REQUIRE(run.setImage(img, err));
+        Settings s = preset("sprites");
+        s["group"] = n;
+        s["shrink"] = 0;
+        s["strength"] = 15.0 / 255;  // vertex colours 15/255 (N = 1) and 60/255 (N = 2): both exact bytes
+        s["radius"] = 0.4;
+        double total = 0;
+        PassGraph* graph = nullptr;
+        FrameResult r;
+        REQUIRE(run.runFrame(
+            t, s, 0, 1, r, err,
+            [&](uint32_t pass, bool after, std::string& e) {
+                if (!after || graph->passes()[pass].info.name != "draw_sprites") return true;
+                emu::Handle surface{};
+                run.device().GetSurfaceLevel(graph->texture(graph->passes()[pass].writes[0]).device, 0, &surface);
+                std::optional<emu::SurfacePixels> px = emu::readSurface(run.device(), surface, e);
+                if (!px) return false;
+                for (size_t i = 0; i < size_t(w) * h; ++i) {
+                    float v;
+                    std::memcpy(&v, &px->bytes[i * 16], 4);
+                    total += v;
+                }
+                return true;
+            },
+            [&](PassGraph& g) { graph = &g; }));
+        totals[size_t(n - 1)] = total;
+    }
+    CHECK(totals[0] > 0);
+    CHECK(totals[1] == Approx(totals[0]).epsilon(0.03));
+}
+
+TEST_CASE("docs/fits-ps11.md is what ps11 glare --report --markdown prints", "[glare][docs]") {
+    std::ifstream f(std::string(PS11_SOURCE_DIR) + "/docs/fits-ps11.md", std::ios::binary);
+    REQUIRE(f);
+    std::stringstream text;
+    text << f.rdbuf();
+    const FitsReport r = fitsReport();
+    CHECK(text.str() == fitsReportMarkdown(r));
+    // Every shader pass fits; the only step past 1.1 is Ando's sensors.
+    for (const PassFit& p : r.passes) {
+        INFO(p.technique << " " << p.preset << " " << p.pass);
+        if (p.pass == "sensors")
+            CHECK_FALSE(p.fits);
+        else
+            CHECK(p.fits);
+    }
+}
