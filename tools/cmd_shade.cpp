@@ -7,7 +7,9 @@
 
 #include "emu/image_file.h"
 #include "glare/shade.h"
+#include "ps11/assembler.h"
 #include "ps11/hardware.h"
+#include "ps11/validator.h"
 #include "tools/cli_util.h"
 #include "tools/gl_backend.h"
 
@@ -113,6 +115,16 @@ int cmdShade(const std::vector<std::string>& args) {
     std::optional<std::string> text = cli::readFile(shaderPath);
     if (!text) return cli::kUserError;
     request.shaderText = *text;
+    {
+        // Every diagnostic with the file's own places, as `ps11 check` prints them.
+        Diagnostics diags;
+        std::optional<Program> program = parseAssembly(*text, shaderPath, AssembleOptions{}, diags);
+        if (program) validate(*program, diags);
+        if (!program || diags.hasErrors()) {
+            std::cerr << diags.formatAll();
+            return cli::kUserError;
+        }
+    }
     for (size_t s = 0; s < textures.size(); ++s) {
         if (textures[s].empty()) continue;
         std::string err;
@@ -138,9 +150,6 @@ int cmdShade(const std::vector<std::string>& args) {
     }
     std::optional<emu::FloatImage> result = glare::shade(options, request, err);
     if (!result) {
-        // Shader errors carry their place ("CreatePixelShaderFromText:3:1: …"): name the file instead.
-        const std::string tag = "CreatePixelShaderFromText";
-        for (size_t at; (at = err.find(tag + ":")) != std::string::npos;) err.replace(at, tag.size(), shaderPath);
         std::cerr << "ps11 shade: " << err << "\n";
         return cli::kUserError;
     }

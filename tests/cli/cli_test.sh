@@ -191,14 +191,16 @@ expect_rc 2 "test unknown class" "$ps11" test --hardware voodoo "$work/h.ps11tes
 
 # demo: options and their usage errors.
 expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
-expect_in "$work/out" "bloom on the emu device: 64x36 scene" "demo header"
-expect_in "$work/out" "geforce4    fx8 " "demo geforce4 row"
-expect_in "$work/out" "radeon8500  fx12 " "demo radeon8500 row"
-expect_rc 0 "demo one class" "$ps11" demo --size 32x18 --repeats 1 --threads 1 --hardware d3d9
-expect_in "$work/out" "d3d9        float " "demo d3d9 row"
-grep -q "geforce4    fx8" "$work/out" && fail "demo --hardware d3d9 still ran geforce4"
+expect_in "$work/out" "The five glare techniques, each on its scene at 64x36" "demo header"
+expect_in "$work/out" "emulated on geforce4 (fx8)" "demo runs the default class"
+for row in "adaptive  box" "glow      neon" "pyramid   sky" "quarter   neon" "sprites   lights"; do
+    expect_in "$work/out" "$row" "demo row $row"
+done
+expect_in "$work/out" "sensors: sensors need vertex texture fetch (vs_3_0)" "demo's fits table names the non-1.1 step"
+expect_rc 0 "demo one class" "$ps11" demo --size 32x18 --repeats 1 --threads 1 --hardware d3d9 --out "$work/demo9"
+expect_in "$work/out" "emulated on d3d9 (float)" "demo --hardware d3d9"
 expect_rc 2 "demo unknown class" "$ps11" demo --hardware voodoo
-[ -s "$work/demo-geforce4.ppm" ] || fail "demo --out wrote no demo-geforce4.ppm"
+[ -s "$work/demo/adaptive-box-emulated.png" ] && [ -s "$work/demo/sprites-lights-ideal.png" ] || fail "demo --out wrote no images"
 expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
 expect_rc 2 "demo bad threads" "$ps11" demo --threads many
 expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
@@ -294,6 +296,66 @@ expect_rc 2 "compare unknown option" "$ps11" compare x.psh --heatmpa h.png
 expect_in "$work/err" "did you mean '--heatmap'?" "compare suggests the option"
 expect_rc 2 "info --gl unknown kind" "$ps11" info --gl glx
 expect_in "$work/err" "ps11: info: --gl takes osmesa or egl, not 'glx'" "info names the kinds"
+
+# ps11 shade and ps11 glare (docs/glare/README.md).
+printf 'ps_1_1\nmov r0, c0\n' >"$work/flat.psh"
+expect_rc 0 "shade a constant" "$ps11" shade "$work/flat.psh" --c0 0.5,0.25,1,1 --size 24x16 -o "$work/flat.png"
+expect_in "$work/out" "wrote $work/flat.png (24x16)" "shade reports the image"
+printf 'ps_1_1\ntex t0\nmul_x2 r0, t0, c0\n' >"$work/tex.psh"
+expect_rc 0 "shade an image" "$ps11" shade "$work/tex.psh" --tex0 "$work/flat.png" --filter0 point --c0 1,1,1,1 -o "$work/tex.png"
+expect_in "$work/out" "(24x16)" "shade takes texture 0's size"
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n\200\100\040\201\200\100\040\201\200\100\040\201\200\100\040\201' >"$work/tiny.hdr"
+expect_rc 0 "shade an HDR image" "$ps11" shade "$work/tex.psh" --tex0 "$work/tiny.hdr" --exposure -1 --c0 0.5,0.5,0.5,1 -o "$work/hdr.png"
+expect_in "$work/out" "(2x2)" "shade reads Radiance .hdr"
+expect_rc 1 "shade an invalid shader" "$ps11" shade "$work/bad.psh" --size 4x4 -o "$work/x.png"
+expect_in "$work/err" "bad.psh:3:9" "shade names the shader's place"
+expect_rc 1 "shade a missing image" "$ps11" shade "$work/tex.psh" --tex0 "$work/none.png" -o "$work/x.png"
+expect_in "$work/err" "none.png" "shade names the missing image"
+head -c 20 "$work/flat.png" >"$work/cut.png"
+expect_rc 1 "shade a truncated PNG" "$ps11" shade "$work/tex.psh" --tex0 "$work/cut.png" -o "$work/x.png"
+expect_in "$work/err" "cut.png: truncated PNG" "a truncated PNG is named"
+expect_rc 2 "shade without -o" "$ps11" shade "$work/tex.psh" --tex0 "$work/flat.png"
+expect_rc 2 "shade --c9" "$ps11" shade "$work/tex.psh" --c9 1,1,1,1 -o "$work/x.png"
+expect_rc 2 "shade bad constant" "$ps11" shade "$work/tex.psh" --c0 1,2 -o "$work/x.png"
+expect_in "$work/err" "--c0 takes four numbers" "shade explains the constant"
+
+expect_rc 0 "glare --list" "$ps11" glare --list
+for t in adaptive glow pyramid quarter sprites; do expect_in "$work/out" "$t " "glare --list names $t"; done
+expect_in "$work/out" "box " "glare --list names the scenes"
+expect_rc 0 "glare --report --json" "$ps11" glare --report --json
+expect_in "$work/out" '"pass": "sensors", "kind": "device side"' "the report labels the device-side step"
+expect_in "$work/out" '"fits_ps_1_1": false' "the report says what does not fit"
+expect_rc 0 "glare on a scene" "$ps11" glare --technique adaptive --scene box --size 64x36 --frames 2 -o "$work/g.png"
+[ -s "$work/g_0000.png" ] && [ -s "$work/g_0001.png" ] || fail "glare --frames 2 did not write g_0000.png and g_0001.png"
+expect_in "$work/out" "bright_pass" "glare prints its passes"
+expect_rc 0 "glare on an image, dumped" "$ps11" glare --technique quarter --in "$work/tex.png" --dump-passes "$work/dump" -o "$work/q.png"
+[ -s "$work/dump/contact_sheet.png" ] && [ -s "$work/dump/00_downsample-quarter.png" ] || fail "glare --dump-passes wrote no pass images"
+expect_rc 0 "glare --graph without -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p.dot"
+expect_in "$work/p.dot" 'digraph "pyramid"' "glare --graph writes Graphviz"
+expect_rc 0 "glare --json" "$ps11" glare --technique glow --scene neon --size 64x36 --set path=ffp -o "$work/f.png" --json
+expect_in "$work/out" '"pass": "blur_h_0"' "glare --json lists the passes"
+expect_rc 2 "glare unknown technique" "$ps11" glare --technique bloom --scene box -o "$work/x.png"
+expect_in "$work/err" "unknown technique 'bloom' (techniques: adaptive, glow, pyramid, quarter, sprites)" "glare lists the techniques"
+expect_rc 2 "glare two inputs" "$ps11" glare --technique glow --scene box --in "$work/tex.png" -o "$work/x.png"
+expect_rc 2 "glare unknown scene" "$ps11" glare --technique glow --scene moon -o "$work/x.png"
+expect_in "$work/err" "unknown scene 'moon'" "glare names the scenes"
+expect_rc 2 "glare --set unknown" "$ps11" glare --technique glow --scene box --set radious=3 -o "$work/x.png"
+expect_in "$work/err" "technique glow has no setting 'radious'" "glare names the setting"
+expect_rc 2 "glare --set out of range" "$ps11" glare --technique glow --scene box --set radius=99 -o "$work/x.png"
+expect_in "$work/err" "setting radius: 99 is outside the whole numbers 1 .. 32 texels" "glare gives the range"
+expect_rc 2 "glare --set bad choice" "$ps11" glare --technique adaptive --scene box --set composite=multiply -o "$work/x.png"
+expect_in "$work/err" "is not one of screen, add, luminance" "glare lists the choices"
+expect_rc 2 "glare --quality" "$ps11" glare --technique glow --scene box --quality ultra -o "$work/x.png"
+expect_rc 1 "glare a missing image" "$ps11" glare --technique glow --in "$work/none.exr" -o "$work/x.png"
+expect_in "$work/err" "none.exr" "glare names the missing image"
+expect_rc 1 "glare an image too small" "$ps11" glare --technique glow --in "$work/hdr.png" -o "$work/x.png"
+expect_in "$work/err" "at least 8x8" "glare says the frame is too small"
+if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
+    expect_rc 0 "glare --compare" "$ps11" glare --technique adaptive --scene box --size 64x36 --compare
+    expect_in "$work/out" "agreement: every pass within 1 level" "glare --compare agrees"
+    expect_rc 0 "glare --compare --json" "$ps11" glare --technique sprites --scene lights --size 64x36 --compare --json
+    expect_in "$work/out" '"pass": "draw_sprites", "pixels": 2304, "exact": 2304, "over_one": 0' "glare --compare --json per pass"
+fi
 
 if [ "$failures" != 0 ]; then
     echo "$failures CLI check(s) failed"
