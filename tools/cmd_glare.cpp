@@ -11,6 +11,8 @@
 #include <map>
 #include <optional>
 
+#include <unistd.h>
+
 #include "emu/format.h"
 #include "emu/fullscreen.h"
 #include "emu/image_file.h"
@@ -162,13 +164,15 @@ int report(const GlareOptions& o) {
 
 class Progress {
 public:
-    explicit Progress(int frames) : m_frames(frames), m_start(std::chrono::steady_clock::now()) {}
+    // Only on a terminal: a log or a pipe gets no carriage-return lines.
+    explicit Progress(int frames)
+        : m_frames(frames), m_start(std::chrono::steady_clock::now()), m_terminal(isatty(2) != 0) {}
     ~Progress() {
         if (m_shown) std::fprintf(stderr, "\n");
     }
     void update(int frame, const std::string& pass) {
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
-        if (s < 1.0) return;
+        if (!m_terminal || s < 1.0) return;
         m_shown = true;
         std::fprintf(stderr, "\rps11 glare: frame %d/%d, %-24s %6.1f s", frame + 1, m_frames, pass.c_str(), s);
         std::fflush(stderr);
@@ -177,6 +181,7 @@ public:
 private:
     int m_frames;
     std::chrono::steady_clock::time_point m_start;
+    bool m_terminal;
     bool m_shown = false;
 };
 
