@@ -323,27 +323,32 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     }
     if (depth) {
         const FormatInfo& f = *depth->format;
+        // The stored word is (old & keep) | set, computed once: depth as the nearest of 2^bits − 1
+        // steps (D32F_LOCKABLE: the float), stencil in the low 8 bits of D24S8.
+        uint32_t keep = 0xffffffffu, set = 0;
+        if (flags & D3DCLEAR_ZBUFFER) {
+            uint32_t zw;
+            if (f.format == D3DFMT_D32F_LOCKABLE) {
+                std::memcpy(&zw, &z, 4);
+                keep = 0, set = zw;
+            } else if (f.depthBits == 16) {
+                keep = 0, set = uint32_t(std::nearbyint(double(z) * 65535.0));
+            } else if (f.depthBits == 24) {
+                keep = 0xffu, set = uint32_t(std::nearbyint(double(z) * 16777215.0)) << 8;
+            } else {
+                keep = 0, set = uint32_t(std::nearbyint(double(z) * 4294967295.0));
+            }
+        }
+        if ((flags & D3DCLEAR_STENCIL) && f.stencilBits == 8) keep &= ~0xffu, set = (set & ~0xffu) | (stencil & 0xffu);
         for (const Box& b : boxes) {
             const Box c = b.meet(Box{0, 0, depth->width, depth->height});
-            for (int64_t y = c.y0; y < c.y1; ++y)
-                for (int64_t x = c.x0; x < c.x1; ++x) {
-                    uint8_t* p = depth->texel(uint32_t(x), uint32_t(y));
-                    uint32_t w = loadWord(p, f.bytes);
-                    if (flags & D3DCLEAR_ZBUFFER) {
-                        // Depth stored as the nearest of 2^bits - 1 steps (D32F_LOCKABLE: the float).
-                        if (f.format == D3DFMT_D32F_LOCKABLE) {
-                            std::memcpy(&w, &z, 4);
-                        } else if (f.depthBits == 16) {
-                            w = uint32_t(std::nearbyint(double(z) * 65535.0));
-                        } else if (f.depthBits == 24) {
-                            w = (w & 0xffu) | (uint32_t(std::nearbyint(double(z) * 16777215.0)) << 8);
-                        } else {
-                            w = uint32_t(std::nearbyint(double(z) * 4294967295.0));
-                        }
-                    }
-                    if ((flags & D3DCLEAR_STENCIL) && f.stencilBits == 8) w = (w & ~0xffu) | (stencil & 0xffu);
+            for (int64_t y = c.y0; y < c.y1; ++y) {
+                uint8_t* p = c.x0 < c.x1 ? depth->texel(uint32_t(c.x0), uint32_t(y)) : nullptr;
+                for (int64_t x = c.x0; x < c.x1; ++x, p += f.bytes) {
+                    const uint32_t w = (loadWord(p, f.bytes) & keep) | set;
                     for (uint32_t k = 0; k < f.bytes; ++k) p[k] = uint8_t(w >> (8 * k));
                 }
+            }
         }
         if (!boxes.empty()) markWritten(*ds, dsRef.level);
     }
