@@ -15,12 +15,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "bench/bench_shaders.h"
 #include "emu/device.h"
+#include "emu/fullscreen.h"
 #include "emu/gl/gl_renderer.h"
 
 namespace {
@@ -167,28 +169,12 @@ void Scene::setup(Pass pass, Kind kind) {
 }
 
 std::vector<uint8_t> Scene::image() {
-    D3DSURFACE_DESC desc{};
-    Handle copy{};
-    std::vector<uint8_t> out;
-    if (dev->GetDesc(rt, &desc) != D3D_OK ||
-        dev->CreateOffscreenPlainSurface(desc.Width, desc.Height, desc.Format, D3DPOOL_SYSTEMMEM, &copy) != D3D_OK ||
-        dev->GetRenderTargetData(rt, copy) != D3D_OK) {
-        error = "GetRenderTargetData refused: " + dev->lastError().message;
-        return out;
+    std::optional<SurfacePixels> px = readSurface(*dev, rt, error);
+    if (!px) {
+        error = "read-back refused: " + error;
+        return {};
     }
-    D3DLOCKED_RECT lr;
-    if (dev->LockRect(copy, &lr, nullptr, D3DLOCK_READONLY) != D3D_OK) {
-        error = "LockRect refused: " + dev->lastError().message;
-        dev->Release(copy);
-        return out;
-    }
-    out.resize(size_t(desc.Width) * desc.Height * 4);
-    for (UINT y = 0; y < desc.Height; ++y)
-        std::memcpy(&out[size_t(y) * desc.Width * 4], static_cast<const uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch),
-                    size_t(desc.Width) * 4);
-    dev->UnlockRect(copy);
-    dev->Release(copy);
-    return out;
+    return std::move(px->bytes);
 }
 
 struct PassScenes {
