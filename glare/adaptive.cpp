@@ -26,7 +26,7 @@ public:
             {"start", "", "the adapted amount before the first frame: converged (frame 0 is not blended) or black",
              0, 1, {0, 0, 0, 0}, {"converged", "black"}, false},
             {"divisor", "", "the bright pass is (W/divisor) x (H/divisor)", 2, 32, {16, 8, 4, 8}, {}, true},
-            {"blur_passes", "", "pinwheel blur passes (pass k samples at radius ~k+0.5 texels)", 0, 5, {3, 4, 5, 5},
+            {"blur_passes", "", "pinwheel blur passes (pass k: taps at (±(0.5k + 0.5), ±(k + 0.5)) texels)", 0, 5, {3, 4, 5, 5},
              {}, true},
             {"composite", "", "screen S+G(1-S), add S+G, or luminance lerp(S+G, S, lum S)", 0, 2, {0, 0, 0, 0},
              {"screen", "add", "luminance"}, false},
@@ -79,7 +79,9 @@ public:
         for (int k = 0; k < passes; ++k) {
             const TextureId dst = g.create("blur " + std::to_string(k), bd);
             const float s = 0.5f * float(k) + 0.5f, l = float(k) + 0.5f;
-            addQuadPass(fb, "blur_" + std::to_string(k), "4 bilinear taps, weight 0.25, pinwheel radius " + std::to_string(k + 1),
+            addQuadPass(fb, "blur_" + std::to_string(k),
+                        "4 bilinear taps, weight 0.25, at (±" + std::to_string(s).substr(0, 4) + ", ±" +
+                            std::to_string(l).substr(0, 4) + ") texels, rotating",
                         QuadPass{"blur4.psh",
                                  dst,
                                  {texelTap(fb, src, +s, +l), texelTap(fb, src, -l, +s), texelTap(fb, src, -s, -l),

@@ -103,7 +103,12 @@ public:
             const std::string name = "blur_" + dir + "_" + std::to_string(pass);
             if (!ffp) {
                 QuadPass qp{"weighted4.psh", dst, taps, {}, blend};
-                for (size_t i = 0; i < weights.size(); ++i) qp.constants.push_back({int(i), {weights[i], weights[i], weights[i], weights[i]}});
+                // A last pass with fewer taps: the unused stages sample nothing ((0, 0, 0, 1)) and
+                // get weight 0, so they add nothing, alpha included.
+                for (size_t i = 0; i < 4; ++i) {
+                    const float w = i < weights.size() ? weights[i] : 0.0f;
+                    qp.constants.push_back({int(i), {w, w, w, w}});
+                }
                 addQuadPass(fb, name, std::to_string(taps.size()) + " taps" + (pass ? ", added (ONE, ONE)" : ""), qp);
             } else {
                 addFixedFunctionPass(fb, name, dst, taps, weights, blend);
@@ -157,7 +162,8 @@ public:
                 // Back to D3D9's defaults for the stages touched.
                 return ok && tss(0, D3DTSS_ALPHAARG1, D3DTA_TEXTURE) && tss(0, D3DTSS_COLORARG2, D3DTA_CURRENT) &&
                        tss(1, D3DTSS_COLOROP, D3DTOP_DISABLE) && tss(1, D3DTSS_ALPHAOP, D3DTOP_DISABLE) &&
-                       setBlend(c, Blend::None);
+                       tss(1, D3DTSS_COLORARG1, D3DTA_TEXTURE) && tss(1, D3DTSS_COLORARG2, D3DTA_CURRENT) &&
+                       tss(1, D3DTSS_ALPHAARG1, D3DTA_TEXTURE) && setBlend(c, Blend::None);
             });
     }
 

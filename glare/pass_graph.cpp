@@ -277,8 +277,10 @@ std::string PassGraph::graphviz(const std::string& title) const {
         std::string label = n.name + "\\n" + std::to_string(n.desc.width) + "x" + std::to_string(n.desc.height) + " " +
                             emu::formatName(n.desc.format);
         if (n.physical >= 0 && !n.imported) label += "\\ndevice texture #" + std::to_string(n.physical);
-        g += "  t" + std::to_string(t) + " [shape=ellipse, label=" + quoted(label) +
-             (n.imported ? ", style=filled, fillcolor=\"#dde8f8\"" : "") + (n.firstUse < 0 ? ", style=dashed" : "") + "];\n";
+        std::string style;
+        if (n.imported) style = n.firstUse < 0 ? ", style=\"filled,dashed\", fillcolor=\"#dde8f8\"" : ", style=filled, fillcolor=\"#dde8f8\"";
+        else if (n.firstUse < 0) style = ", style=dashed";
+        g += "  t" + std::to_string(t) + " [shape=ellipse, label=" + quoted(label) + style + "];\n";
     }
     for (size_t i = 0; i < m_passes.size(); ++i) {
         const PassNode& p = m_passes[i];

@@ -26,6 +26,8 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
         double sl = 0, sx = 0, sy = 0, e[3] = {0, 0, 0};
         for (uint32_t y = y0; y < y1; ++y)
             for (uint32_t x = x0; x < x1; ++x) {
+                // A group's pixels inside a cluster block belong to the cluster sprite only.
+                if (!cluster && s.clusters && clustered[size_t(y / 8) * cw + x / 8]) continue;
                 const uint8_t* p = &rgba[(size_t(y) * width + x) * 4];
                 const float l = luminance(p);
                 if (l < s.threshold) continue;
@@ -58,8 +60,6 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
     for (uint32_t y0 = 0; y0 < height; y0 += n)
         for (uint32_t x0 = 0; x0 < width; x0 += n) {
             const uint32_t x1 = std::min(x0 + n, width), y1 = std::min(y0 + n, height);
-            // A group inside a cluster block is suppressed (groups never straddle blocks when N divides 8).
-            if (s.clusters && clustered[size_t(y0 / 8) * cw + x0 / 8]) continue;
             addSprite(x0, y0, x1, y1, false);
         }
     return out;
@@ -85,9 +85,9 @@ std::vector<float> glareImage(uint32_t size, int streaks) {
                 const double across = d * r * double(size) / 2;  // distance to the ray in texels
                 v += 0.6 * std::exp(-across * across / (0.6 + 2 * r)) * fade * fade;
             }
-            img[size_t(y) * size + x] = float(std::min(v / 1.0, 1.0));
+            img[size_t(y) * size + x] = float(v);
         }
-    // Peak exactly 1 at the centre texel(s).
+    // Normalised: the brightest texel (the centre) is exactly 1.
     float peak = 0;
     for (float v : img) peak = std::max(peak, v);
     if (peak > 0)
@@ -138,11 +138,12 @@ public:
         const uint32_t imageSize = 128;
 
         const TextureId image = g.create("glare image", {imageSize, imageSize, D3DFMT_A8R8G8B8});
+        const auto glare = std::make_shared<const std::vector<float>>(glareImage(imageSize, streaks));
         g.addPass(PassInfo{"glare_image", PassKind::DeviceSide, "",
-                           "the precomputed glare image (streaks + halo), made on the CPU and uploaded"},
+                           "the precomputed glare image (streaks + halo), computed on the CPU and uploaded each frame"},
                   [&](PassBuilder& b) { b.write(image); },
                   [=](PassContext& c) {
-                      const std::vector<float> img = glareImage(imageSize, streaks);
+                      const std::vector<float>& img = *glare;
                       emu::SurfacePixels px{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
                       px.bytes.resize(img.size() * 4);
                       for (size_t i = 0; i < img.size(); ++i) {
@@ -174,7 +175,7 @@ public:
         const TextureId buffer = g.create("glare buffer", {sd.width, sd.height, fb.format});
         // The radial maximum of the glare image, for shrinking.
         const std::vector<float> radial = [&] {
-            const std::vector<float> img = glareImage(imageSize, streaks);
+            const std::vector<float>& img = *glare;
             std::vector<float> m(imageSize, 0);
             const float cc = (float(imageSize) - 1) / 2;
             for (uint32_t y = 0; y < imageSize; ++y)
@@ -210,14 +211,15 @@ public:
                       std::vector<emu::QuadVertex> v;
                       const float half = float(imageSize) / 2;
                       for (const Sprite& s : *sprites) {
-                          const float peak = std::max({s.energy[0], s.energy[1], s.energy[2]});
+                          // A cluster sprite is twice the size (four times the area): its colour is a quarter.
+                          const float area = s.cluster ? 4.0f : 1.0f;
+                          const float peak = std::max({s.energy[0], s.energy[1], s.energy[2]}) / area;
                           // Colour above 1 does not fit a vertex colour: the sprite is drawn in layers.
                           const int layers = std::max(1, int(std::ceil(peak - 1e-6f)));
-                          const float area = s.cluster ? 4.0f : 1.0f;
                           float rad = s.radius, uvHalf = 0.5f;
                           if (shrink) {
                               // The outermost texel ring still visible: peak·G(r) >= 0.5/255 per layer.
-                              const float layerPeak = peak / float(layers) / area;
+                              const float layerPeak = peak / float(layers);
                               size_t keep = 0;
                               for (size_t r = 0; r < radial.size(); ++r)
                                   if (layerPeak * radial[r] >= 0.5f / 255.0f) keep = r + 1;

@@ -379,7 +379,7 @@ TEST_CASE("sprites: grouping keeps the total glare energy", "[glare]") {
     size_t clusters = 0;
     for (const Sprite& s : single) clusters += s.cluster;
     CHECK(clusters == 1);
-    for (int n : {2, 4, 8}) {
+    for (int n : {2, 3, 4, 5, 8}) {  // 3 and 5: groups straddle the cluster block
         SensorSettings s = base;
         s.group = n;
         const auto grouped = senseSprites(img.data(), w, h, s);

@@ -63,6 +63,7 @@ struct GlareOptions {
     int frames = 1;
     uint32_t width = 0, height = 0;
     std::string backend = "emu", glKind;
+    bool backendGiven = false;
     const HardwareClass* hardware = nullptr;
     std::optional<Precision> precision;
     std::string quality = "published";
@@ -377,9 +378,12 @@ int runGlare(const GlareOptions& o) {
                         glRendererDescription().c_str());
             std::printf("%-26s %12s %9s %10s %9s\n", "pass", "pixels", "exact", "|d|>1", "max |d|");
             auto row = [](const glare::PassAgreement& a) {
+                if (a.pixels == 0) {  // a device-side step: no texture to compare
+                    std::printf("%-26s %12s %9s %10s %9s\n", a.pass.c_str(), "0", "-", "-", "-");
+                    return;
+                }
                 std::printf("%-26s %12llu %8.3f%% %10llu %9.3g\n", a.pass.c_str(), (unsigned long long)a.pixels,
-                            a.pixels ? 100.0 * double(a.exact) / double(a.pixels) : 100.0, (unsigned long long)a.overOne,
-                            a.maxDiff);
+                            100.0 * double(a.exact) / double(a.pixels), (unsigned long long)a.overOne, a.maxDiff);
             };
             if (scene) row(sceneAgreement);
             for (const glare::PassAgreement& a : agreement) row(a);
@@ -462,6 +466,7 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else if (a == "--backend") {
             if (!value(o.backend) || (o.backend != "emu" && o.backend != "gl"))
                 return glareUsage("--backend takes emu or gl");
+            o.backendGiven = true;
         } else if (a == "--gl") {
             if (!value(o.glKind) || (o.glKind != "osmesa" && o.glKind != "egl")) return glareUsage("--gl takes osmesa or egl");
         } else if (a == "--hardware") {
@@ -496,6 +501,7 @@ int cmdGlare(const std::vector<std::string>& args) {
     if (o.scene.empty() == o.in.empty()) return glareUsage("give one input: --scene NAME or --in IMAGE");
     if (!o.in.empty() && o.width) return glareUsage("--size applies to --scene; an --in image keeps its own size");
     if (o.hardware && o.precision) return glareUsage("give --hardware or --precision, not both");
+    if (o.compare && o.backendGiven) return glareUsage("--compare runs both renderers; --backend does not apply");
     if (o.out.empty() && o.graph.empty() && o.dumpDir.empty() && !o.compare)
         return glareUsage("say where the result goes: -o OUT.png (or --dump-passes, --graph, --compare)");
     return runGlare(o);
