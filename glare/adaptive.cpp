@@ -36,7 +36,7 @@ public:
 
     void build(FrameBuild& fb) const override {
         PassGraph& g = fb.graph;
-        const TextureDesc& sd = fb.sceneDesc();
+        const TextureDesc sd = fb.sceneDesc();
         const D3DFORMAT f = fb.format;
 
         // Luminance: 128x128 and its chain down to 2x2 (each level a bilinear 2:1 StretchRect,

@@ -169,7 +169,7 @@ public:
 
     void build(FrameBuild& fb) const override {
         PassGraph& g = fb.graph;
-        const TextureDesc& sd = fb.sceneDesc();
+        const TextureDesc sd = fb.sceneDesc();
         const uint32_t d = uint32_t(fb.get("divisor"));
         const TextureDesc gd{std::max(sd.width / d, 1u), std::max(sd.height / d, 1u), fb.format};
         const float o = float(d) / 4.0f;

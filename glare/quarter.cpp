@@ -27,7 +27,7 @@ public:
 
     void build(FrameBuild& fb) const override {
         PassGraph& g = fb.graph;
-        const TextureDesc& sd = fb.sceneDesc();
+        const TextureDesc sd = fb.sceneDesc();
         const uint32_t d = uint32_t(fb.get("divisor"));
         const TextureDesc qd{std::max(sd.width / d, 1u), std::max(sd.height / d, 1u), fb.format};
         // Four bilinear taps at ±d/4 source texels from the block centre: each averages a 2x2,

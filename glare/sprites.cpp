@@ -126,7 +126,7 @@ public:
 
     void build(FrameBuild& fb) const override {
         PassGraph& g = fb.graph;
-        const TextureDesc& sd = fb.sceneDesc();
+        const TextureDesc sd = fb.sceneDesc();
         SensorSettings ss;
         ss.threshold = float(fb.get("threshold"));
         ss.group = int(fb.get("group"));

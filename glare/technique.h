@@ -48,7 +48,7 @@ struct FrameBuild {
     ps11::Precision precision = ps11::Precision::Fx8;  // the device's profile
     double get(const std::string& name) const { return settings.at(name); }
     int choice(const std::string& name) const { return int(settings.at(name)); }
-    const TextureDesc& sceneDesc() const { return graph.texture(scene).desc; }
+    TextureDesc sceneDesc() const { return graph.texture(scene).desc; }  // a copy: creating textures moves the nodes
     // A texture kept between frames, made (and cleared to `initial`) the first time it is asked
     // for; imported as an output so the passes that update it always run.
     TextureId persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial = 0);
