@@ -227,7 +227,6 @@ TEST_CASE("adaptive: the ps_1_1 bright pass computes b·min(4b, 1), ideal comput
             s["blur_passes"] = 0;
             s["start"] = 1;      // black, and
             s["smoothing"] = 0;  // kept black: A = 0, 1 − A = 1
-            std::optional<TextureId> bright;
             PassGraph* graph = nullptr;
             double value = -1;
             FrameResult r;
