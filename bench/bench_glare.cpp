@@ -23,8 +23,6 @@
 namespace {
 
 constexpr uint32_t kW = 1920, kH = 1080;
-const std::map<std::string, std::string> kSceneOf = {
-    {"adaptive", "box"}, {"glow", "neon"}, {"pyramid", "sky"}, {"quarter", "neon"}, {"sprites", "lights"}};
 
 int threads() {
     const char* t = std::getenv("PS11_THREADS");
@@ -56,7 +54,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
         state.SkipWithError(("no GL renderer: " + err).c_str());
         return;
     }
-    std::unique_ptr<glare::Scene> scene = glare::makeScene(kSceneOf.at(name), err);
+    std::unique_ptr<glare::Scene> scene = glare::makeScene(t.scene(), err);
     double ms = 0;
     std::optional<emu::RgbaImage> frame;
     if (!emuRun->renderScene(*scene, 0, 8, ms, err) || !(frame = emuRun->readTexture(emuRun->sceneTexture(), err)) ||

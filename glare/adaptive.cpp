@@ -12,6 +12,7 @@ class Adaptive final : public Technique {
 public:
     std::string_view name() const override { return "adaptive"; }
     std::string_view title() const override { return "Adaptive glare (Sousa, ShaderX3 4.2)"; }
+    std::string_view scene() const override { return "box"; }
     std::string_view summary() const override {
         return "eye-adapted glare amount, W/8 point-sampled bright pass, 5-pass pinwheel blur, screen composite";
     }

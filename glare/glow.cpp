@@ -54,6 +54,7 @@ class Glow final : public Technique {
 public:
     std::string_view name() const override { return "glow"; }
     std::string_view title() const override { return "Real-time glow (James & O'Rorke, GPU Gems 21)"; }
+    std::string_view scene() const override { return "neon"; }
     std::string_view summary() const override {
         return "glow sources RGB×alpha at 1/4 size, separable 4-tap multipass convolution (or the D3D7 2-texture path), additive";
     }

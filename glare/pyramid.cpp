@@ -11,6 +11,7 @@ class Pyramid final : public Technique {
 public:
     std::string_view name() const override { return "pyramid"; }
     std::string_view title() const override { return "Pyramid bloom (Sylphis3D, Kalogirou 2006)"; }
+    std::string_view scene() const override { return "sky"; }
     std::string_view summary() const override {
         return "bright pass at 128, 128→64→32→16, 5x5 Gaussian per level, four levels summed in one pass";
     }

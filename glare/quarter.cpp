@@ -11,6 +11,7 @@ class Quarter final : public Technique {
 public:
     std::string_view name() const override { return "quarter"; }
     std::string_view title() const override { return "Fullscreen glow at quarter size (2009)"; }
+    std::string_view scene() const override { return "neon"; }
     std::string_view summary() const override {
         return "1/4-size copy with luminance in alpha, 3x3 Gaussian from 4 bilinear taps, additive composite";
     }

@@ -1,6 +1,8 @@
 #include "glare/runner.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 
 #include "emu/format.h"
@@ -212,6 +214,49 @@ Handle Runner::persistent(const std::string& name, const TextureDesc& desc, D3DC
 void Runner::resetPersistent() {
     for (auto& [name, entry] : m_persistent) m_device->Release(entry.first);
     m_persistent.clear();
+}
+
+SceneRun runOnScene(const Technique& technique, const RunnerOptions& options, int frames, std::string& error) {
+    SceneRun run;
+    Runner runner(options);
+    std::unique_ptr<Scene> scene = makeScene(technique.scene(), error);
+    if (!scene) return run;
+    const Settings settings = *presetSettings(technique, "published");
+    std::vector<double> ms;
+    double sceneMs = 0;
+    frames = std::max(frames, 1);
+    for (int f = 0; f < frames; ++f) {
+        FrameResult r;
+        if (!runner.renderScene(*scene, 0, 8, sceneMs, error) || !runner.runFrame(technique, settings, f, frames, r, error))
+            return run;
+        ms.push_back(r.milliseconds);
+        run.passes = r.passes.size();
+    }
+    std::sort(ms.begin(), ms.end());
+    run.medianMs = ms[ms.size() / 2];
+    run.image = runner.readOutput(error);
+    if (run.image)
+        for (size_t i = 3; i < run.image->rgba.size(); i += 4) run.image->rgba[i] = 255;
+    return run;
+}
+
+ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b) {
+    ImageError e;
+    const size_t px = std::min(a.rgba.size(), b.rgba.size()) / 4;
+    uint64_t sum = 0, over = 0;
+    for (size_t i = 0; i < px; ++i) {
+        int worst = 0;
+        for (size_t c = 0; c < 3; ++c) {
+            const int d = std::abs(int(a.rgba[i * 4 + c]) - int(b.rgba[i * 4 + c]));
+            worst = std::max(worst, d);
+            sum += uint64_t(d);
+        }
+        e.max = std::max(e.max, worst);
+        over += worst > 1;
+    }
+    e.mean = px ? double(sum) / double(px * 3) : 0;
+    e.overOnePercent = px ? 100.0 * double(over) / double(px) : 0;
+    return e;
 }
 
 }  // namespace glare

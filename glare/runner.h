@@ -82,6 +82,23 @@ private:
     std::string m_lastGraphviz;
 };
 
+// One technique on its own built-in scene (Technique::scene, the scene's first frame), published
+// settings, `frames` frames timed (the state carries over; the first starts converged).
+struct SceneRun {
+    std::optional<emu::RgbaImage> image;  // the last frame's output, alpha 255
+    double medianMs = 0;                  // the technique's passes per frame
+    size_t passes = 0;
+};
+SceneRun runOnScene(const Technique& technique, const RunnerOptions& options, int frames, std::string& error);
+
+// RGB difference of two images of one size, in 8-bit levels.
+struct ImageError {
+    int max = 0;
+    double mean = 0;
+    double overOnePercent = 0;  // pixels whose largest channel difference is more than 1 level
+};
+ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b);
+
 // The shader text of glare/shaders/<file>, or nullptr.
 const std::string_view* shaderText(std::string_view file);
 

@@ -101,6 +101,7 @@ class Sprites final : public Technique {
 public:
     std::string_view name() const override { return "sprites"; }
     std::string_view title() const override { return "Glare sprites (Ando et al., GRAPP 2006)"; }
+    std::string_view scene() const override { return "lights"; }
     std::string_view summary() const override {
         return "sensors over bright pixels (device side: vertex texture fetch is not 1.1), N×N grouping, clusters, "
                "sprites of a glare image drawn additively";

@@ -60,6 +60,9 @@ public:
     virtual std::string_view name() const = 0;     // "adaptive"
     virtual std::string_view title() const = 0;    // "Adaptive glare (Sousa, ShaderX3 4.2)"
     virtual std::string_view summary() const = 0;  // one line for --list
+    // The built-in scene made to show it (docs/glare/scenes.md): the demo, the benchmark and the
+    // fits report's accuracy table run it there.
+    virtual std::string_view scene() const = 0;
     virtual const std::vector<ParamInfo>& params() const = 0;
     // Adds this frame's passes to fb.graph (scene → … → output).
     virtual void build(FrameBuild& fb) const = 0;

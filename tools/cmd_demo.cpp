@@ -18,47 +18,6 @@ namespace ps11 {
 
 namespace {
 
-// The scene each technique is shown on (GLARE.md: each scene exists for one technique).
-const std::map<std::string, std::string> kSceneOf = {
-    {"adaptive", "box"}, {"glow", "neon"}, {"pyramid", "sky"}, {"quarter", "neon"}, {"sprites", "lights"}};
-
-struct Run {
-    std::optional<emu::RgbaImage> image;
-    double medianMs = 0;
-    size_t passes = 0;
-};
-
-Run runOnce(const glare::Technique& t, const std::string& sceneName, const GlareDemoOptions& o,
-            const HardwareClass* hardware, std::optional<Precision> precision, std::string& err) {
-    glare::RunnerOptions ro;
-    ro.width = o.width;
-    ro.height = o.height;
-    ro.device.hardware = hardware;
-    ro.device.precision = precision;
-    ro.device.software.threads = o.threads;
-    glare::Runner runner(ro);
-    std::unique_ptr<glare::Scene> scene = glare::makeScene(sceneName, err);
-    Run run;
-    if (!scene) return run;
-    const glare::Settings settings = *glare::presetSettings(t, "published");
-    std::vector<double> ms;
-    double sceneMs = 0;
-    // The same frame each time (the scene's first: for box, inside the box); the first run starts converged.
-    const int frames = std::max(o.repeats, 1);
-    for (int f = 0; f < frames; ++f) {
-        glare::FrameResult r;
-        if (!runner.renderScene(*scene, 0, 8, sceneMs, err) || !runner.runFrame(t, settings, f, frames, r, err)) return run;
-        ms.push_back(r.milliseconds);
-        run.passes = r.passes.size();
-    }
-    std::sort(ms.begin(), ms.end());
-    run.medianMs = ms[ms.size() / 2];
-    run.image = runner.readOutput(err);
-    if (run.image)
-        for (size_t i = 3; i < run.image->rgba.size(); i += 4) run.image->rgba[i] = 255;
-    return run;
-}
-
 }  // namespace
 
 int runGlareDemo(const GlareDemoOptions& o) {
@@ -77,30 +36,24 @@ int runGlareDemo(const GlareDemoOptions& o) {
     std::printf("%-9s %-7s %7s %11s %11s %9s %10s %11s\n", "technique", "scene", "passes", "emulated", "ideal", "max err",
                 "mean err", "err > 1");
     for (const glare::Technique* t : glare::techniques()) {
-        const std::string name(t->name()), sceneName = kSceneOf.at(name);
+        const std::string name(t->name()), sceneName(t->scene());
         std::string err;
-        Run fx = runOnce(*t, sceneName, o, &cls, std::nullopt, err);
-        Run ideal = fx.image ? runOnce(*t, sceneName, o, &cls, Precision::Ideal, err) : Run{};
+        glare::RunnerOptions ro;
+        ro.width = o.width;
+        ro.height = o.height;
+        ro.device.hardware = &cls;
+        ro.device.software.threads = o.threads;
+        const glare::SceneRun fx = glare::runOnScene(*t, ro, o.repeats, err);
+        ro.device.precision = Precision::Ideal;
+        const glare::SceneRun ideal = fx.image ? glare::runOnScene(*t, ro, o.repeats, err) : glare::SceneRun{};
         if (!fx.image || !ideal.image) {
             std::fprintf(stderr, "ps11: demo: %s: %s\n", name.c_str(), err.c_str());
             return cli::kUserError;
         }
-        int maxErr = 0;
-        uint64_t sum = 0, over = 0;
-        const size_t px = fx.image->rgba.size() / 4;
-        for (size_t i = 0; i < px; ++i) {
-            int worst = 0;
-            for (int c = 0; c < 3; ++c) {
-                const int e = std::abs(int(fx.image->rgba[i * 4 + size_t(c)]) - int(ideal.image->rgba[i * 4 + size_t(c)]));
-                worst = std::max(worst, e);
-                sum += uint64_t(e);
-            }
-            maxErr = std::max(maxErr, worst);
-            over += worst > 1;
-        }
+        const glare::ImageError e = glare::imageError(*fx.image, *ideal.image);
         std::printf("%-9s %-7s %7zu %9.2fms %9.2fms %9d %10.3f %10.2f%%\n", name.c_str(), sceneName.c_str(), fx.passes,
-                    fx.medianMs, ideal.medianMs, maxErr, double(sum) / double(px * 3), 100.0 * double(over) / double(px));
-        for (const auto& [suffix, run] : {std::pair<const char*, Run*>{"emulated", &fx}, {"ideal", &ideal}}) {
+                    fx.medianMs, ideal.medianMs, e.max, e.mean, e.overOnePercent);
+        for (const auto& [suffix, run] : {std::pair<const char*, const glare::SceneRun*>{"emulated", &fx}, {"ideal", &ideal}}) {
             const std::string path = o.outDir + "/" + name + "-" + sceneName + "-" + suffix + ".png";
             if (!emu::writePng(path, *run->image, err)) {
                 std::fprintf(stderr, "ps11: demo: %s\n", err.c_str());
