@@ -353,6 +353,11 @@ expect_in "$work/err" "at least 8x8" "glare says the frame is too small"
 if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "glare --compare" "$ps11" glare --technique adaptive --scene box --size 64x36 --compare
     expect_in "$work/out" "agreement: every pass within 1 level" "glare --compare agrees"
+    # End to end (not pass-isolated): the whole frame drawn on GL is the emulator's, byte for byte.
+    expect_rc 0 "glare --backend gl" "$ps11" glare --technique pyramid --scene sky --size 64x36 --backend gl -o "$work/pgl.png"
+    expect_rc 0 "glare --backend emu" "$ps11" glare --technique pyramid --scene sky --size 64x36 -o "$work/pemu.png"
+    cmp -s "$work/pgl.png" "$work/pemu.png" || fail "glare --backend gl wrote another image than the emulator"
+    expect_rc 2 "glare --compare with --backend" "$ps11" glare --technique pyramid --scene sky --compare --backend gl
     expect_rc 0 "glare --compare --json" "$ps11" glare --technique sprites --scene lights --size 64x36 --compare --json
     expect_in "$work/out" '"pass": "draw_sprites", "pixels": 2304, "exact": 2304, "over_one": 0' "glare --compare --json per pass"
 fi
