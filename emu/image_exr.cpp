@@ -31,6 +31,7 @@
 #include <new>
 
 #include "emu/image_file.h"
+#include "emu/image_file_internal.h"
 
 namespace emu {
 namespace {
@@ -90,17 +91,6 @@ private:
     FILE* m_file = nullptr;
     uint64_t m_size = 0, m_pos = 0, m_filePos = 0;
 };
-
-std::string hexBytes(const uint8_t* p, size_t n) {
-    std::string s;
-    char buf[4];
-    for (size_t i = 0; i < n; ++i) {
-        std::snprintf(buf, sizeof buf, "%02x", p[i]);
-        if (i) s += ' ';
-        s += buf;
-    }
-    return s;
-}
 
 // Text from the file or the library fit for a one-line message: unprintable bytes as '?', at most `most`.
 std::string printable(const std::string& text, size_t most) {
@@ -180,7 +170,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
         return fail(std::string("read error: ") + std::strerror(s.ioErrno ? s.ioErrno : EIO));
     }
     if (std::memcmp(start, kMagic, std::min<size_t>(got, 4)) != 0)
-        return fail("not an OpenEXR file (it starts with " + hexBytes(start, got) +
+        return fail("not an OpenEXR file (it starts with " + image_detail::hexBytes(start, got) +
                     "; an OpenEXR file starts with 76 2f 31 01)");
     if (got < 8) return fail("truncated EXR: the data ends after " + std::to_string(got) + " bytes");
     int version = int(uint32_t(start[4]) | uint32_t(start[5]) << 8 | uint32_t(start[6]) << 16 | uint32_t(start[7]) << 24);
@@ -191,7 +181,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
     if (Imf::isNonImage(version))
         return fail("unsupported EXR: deep data (a varying number of samples per pixel); only flat images are read");
     if (!Imf::supportsFlags(Imf::getFlags(version)))
-        return fail("unsupported EXR: unknown feature flags in its version field (" + hexBytes(start + 4, 4) + ")");
+        return fail("unsupported EXR: unknown feature flags in its version field (" + image_detail::hexBytes(start + 4, 4) + ")");
     const bool tiled = Imf::isTiled(version);
 
     const auto libraryFailure = [&](const char* what) {
@@ -307,20 +297,9 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
 }  // namespace
 
 std::optional<FloatImage> readExr(const std::string& path, std::string& error) {
-    const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!file) {
-        error = path + ": cannot open: " + std::strerror(errno);
-        return std::nullopt;
-    }
     struct stat st {};
-    if (fstat(fileno(file.get()), &st) != 0) {
-        error = path + ": cannot read: " + std::strerror(errno);
-        return std::nullopt;
-    }
-    if (S_ISDIR(st.st_mode)) {
-        error = path + ": cannot read: " + std::strerror(EISDIR);
-        return std::nullopt;
-    }
+    const image_detail::FilePtr file = image_detail::openImageFile(path, st, error);
+    if (!file) return std::nullopt;
     if (!S_ISREG(st.st_mode)) {
         error = path + ": cannot read: not a regular file (OpenEXR seeks in its files)";
         return std::nullopt;

@@ -4,6 +4,7 @@
 // callback: the functions here that call setjmp hold only plain C data and pointers (no object with
 // a destructor lives across the jump), the callback keeps libpng's message, and nothing is printed.
 #include "emu/image_file.h"
+#include "emu/image_file_internal.h"
 
 #include <png.h>
 #include <sys/stat.h>
@@ -143,17 +144,6 @@ bool writeImage(png_structp png, png_infop info, const RgbaImage& image) {
     return true;
 }
 
-std::string hexBytes(const uint8_t* p, size_t n) {
-    std::string s;
-    char buf[4];
-    for (size_t i = 0; i < n; ++i) {
-        std::snprintf(buf, sizeof buf, "%02x", p[i]);
-        if (i) s += ' ';
-        s += buf;
-    }
-    return s;
-}
-
 std::string sizeText(uint64_t width, uint64_t height) { return std::to_string(width) + "x" + std::to_string(height); }
 
 // Why a size is past kMaxImageSide / kMaxImageBytes, or "" when it is within them.
@@ -189,7 +179,7 @@ std::optional<RgbaImage> decodePng(PngSession& s, const std::string& name, std::
     if (s.ioErrno) return fail(std::string("read error: ") + std::strerror(s.ioErrno));
     if (got == 0) return fail("empty file, not a PNG");
     if (png_sig_cmp(signature, 0, got) != 0)
-        return fail("not a PNG file (it starts with " + hexBytes(signature, got) +
+        return fail("not a PNG file (it starts with " + image_detail::hexBytes(signature, got) +
                     "; a PNG starts with 89 50 4e 47 0d 0a 1a 0a)");
     if (got < kSignatureBytes) return fail("truncated PNG: the data ends after " + std::to_string(got) + " bytes");
 
@@ -265,21 +255,12 @@ bool writePng(const std::string& path, const RgbaImage& image, std::string& erro
 }
 
 std::optional<RgbaImage> readPng(const std::string& path, std::string& error) {
-    const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!file) {
-        error = path + ": cannot open: " + std::strerror(errno);
-        return std::nullopt;
-    }
+    struct stat st {};
+    const image_detail::FilePtr file = image_detail::openImageFile(path, st, error);
+    if (!file) return std::nullopt;
     PngSession s;
     s.file = file.get();
-    struct stat st {};
-    if (fstat(fileno(file.get()), &st) == 0) {
-        if (S_ISDIR(st.st_mode)) {
-            error = path + ": cannot read: " + std::strerror(EISDIR);
-            return std::nullopt;
-        }
-        if (S_ISREG(st.st_mode)) s.total = uint64_t(st.st_size);
-    }
+    if (S_ISREG(st.st_mode)) s.total = uint64_t(st.st_size);
     return decodePng(s, path, error);
 }
 
@@ -295,16 +276,9 @@ std::optional<LoadedImage> readImage(const std::string& path, std::string& error
     uint8_t start[kSignatureBytes] = {};
     size_t got = 0;
     {
-        const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-        if (!file) {
-            error = path + ": cannot open: " + std::strerror(errno);
-            return std::nullopt;
-        }
         struct stat st {};
-        if (fstat(fileno(file.get()), &st) == 0 && S_ISDIR(st.st_mode)) {
-            error = path + ": cannot read: " + std::strerror(EISDIR);
-            return std::nullopt;
-        }
+        const image_detail::FilePtr file = image_detail::openImageFile(path, st, error);
+        if (!file) return std::nullopt;
         got = std::fread(start, 1, sizeof start, file.get());
         if (got < sizeof start && std::ferror(file.get())) {
             error = path + ": read error: " + std::strerror(errno ? errno : EIO);
@@ -354,7 +328,7 @@ std::optional<LoadedImage> readImage(const std::string& path, std::string& error
         for (size_t i = 0; i < loaded.image.rgba.size(); ++i) loaded.image.rgba[i] = float(png->rgba[i]) / 255.0f;
         return loaded;
     }
-    error = path + ": not a PNG, Radiance HDR or OpenEXR image (it starts with " + hexBytes(start, got) + ")";
+    error = path + ": not a PNG, Radiance HDR or OpenEXR image (it starts with " + image_detail::hexBytes(start, got) + ")";
     return std::nullopt;
 }
 
@@ -381,5 +355,36 @@ RgbaImage toRgba8(const FloatImage& image) {
     }
     return out;
 }
+
+namespace image_detail {
+
+FilePtr openImageFile(const std::string& path, struct stat& st, std::string& error) {
+    FilePtr file(std::fopen(path.c_str(), "rb"), std::fclose);
+    st = {};
+    if (!file) {
+        error = path + ": cannot open: " + std::strerror(errno);
+        return file;
+    }
+    if (fstat(fileno(file.get()), &st) != 0) {
+        st = {};
+    } else if (S_ISDIR(st.st_mode)) {
+        error = path + ": cannot read: " + std::strerror(EISDIR);
+        return FilePtr(nullptr, std::fclose);
+    }
+    return file;
+}
+
+std::string hexBytes(const uint8_t* p, size_t n) {
+    std::string s;
+    char buf[4];
+    for (size_t i = 0; i < n; ++i) {
+        std::snprintf(buf, sizeof buf, "%02x", p[i]);
+        if (i) s += ' ';
+        s += buf;
+    }
+    return s;
+}
+
+}  // namespace image_detail
 
 }  // namespace emu

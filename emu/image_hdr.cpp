@@ -21,6 +21,7 @@
 #include <new>
 
 #include "emu/image_file.h"
+#include "emu/image_file_internal.h"
 
 namespace emu {
 namespace {
@@ -29,17 +30,6 @@ constexpr char kFormatLine[] = "FORMAT=32-bit_rle_rgbe";
 // stb_image decodes scanlines of 8 to 32767 pixels run-length encoded when they start with 2 2 and a
 // 15-bit length; a run takes 2 bytes for at most 127 pixels of one component.
 constexpr uint64_t kMaxRun = 127;
-
-std::string hexBytes(const uint8_t* p, size_t n) {
-    std::string s;
-    char buf[4];
-    for (size_t i = 0; i < n; ++i) {
-        std::snprintf(buf, sizeof buf, "%02x", p[i]);
-        if (i) s += ' ';
-        s += buf;
-    }
-    return s;
-}
 
 // A header line as text fit for a one-line message: at most 40 characters, anything unprintable as '?'.
 std::string quoted(const uint8_t* p, size_t n) {
@@ -101,7 +91,7 @@ std::optional<FloatImage> decodeHdr(const uint8_t* data, size_t size, const std:
         if (size < std::strlen(signature) && std::memcmp(data, signature, size) == 0)
             return fail("truncated Radiance HDR: the data ends after " + std::to_string(size) + " bytes");
     if (!startsWith(data, size, "#?RADIANCE\n") && !startsWith(data, size, "#?RGBE\n"))
-        return fail("not a Radiance HDR file (it starts with " + hexBytes(data, std::min<size_t>(size, 11)) +
+        return fail("not a Radiance HDR file (it starts with " + image_detail::hexBytes(data, std::min<size_t>(size, 11)) +
                     "; one starts with \"#?RADIANCE\" or \"#?RGBE\" and a newline)");
 
     // The header: lines up to an empty one, then the resolution line; the pixels follow it.
@@ -197,16 +187,9 @@ std::optional<FloatImage> decodeHdr(const uint8_t* data, size_t size, const std:
 }  // namespace
 
 std::optional<FloatImage> readHdr(const std::string& path, std::string& error) {
-    const std::unique_ptr<FILE, int (*)(FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-    if (!file) {
-        error = path + ": cannot open: " + std::strerror(errno);
-        return std::nullopt;
-    }
     struct stat st {};
-    if (fstat(fileno(file.get()), &st) == 0 && S_ISDIR(st.st_mode)) {
-        error = path + ": cannot read: " + std::strerror(EISDIR);
-        return std::nullopt;
-    }
+    const image_detail::FilePtr file = image_detail::openImageFile(path, st, error);
+    if (!file) return std::nullopt;
     // The largest image allowed takes 256 MiB of flat pixels; a file past 1 GiB is not one.
     std::vector<uint8_t> bytes;
     uint8_t buffer[65536];

@@ -142,13 +142,7 @@ public:
                 for (DWORD s = 0; s < 2; ++s) {
                     const Tap& t = taps[std::min<size_t>(s, taps.size() - 1)];
                     coords[s] = t.coords;
-                    if (!c.check(d.SetTexture(s, c.texture(t.texture))) ||
-                        !c.check(d.SetSamplerState(s, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP)) ||
-                        !c.check(d.SetSamplerState(s, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP)) ||
-                        !c.check(d.SetSamplerState(s, D3DSAMP_MINFILTER, t.filter)) ||
-                        !c.check(d.SetSamplerState(s, D3DSAMP_MAGFILTER, t.filter)) ||
-                        !c.check(d.SetSamplerState(s, D3DSAMP_MIPFILTER, D3DTEXF_NONE)))
-                        return false;
+                    if (!bindTap(c, s, t)) return false;
                 }
                 const bool second = taps.size() > 1;
                 if (!tss(0, D3DTSS_COLOROP, D3DTOP_MODULATE) || !tss(0, D3DTSS_COLORARG1, D3DTA_TEXTURE) ||

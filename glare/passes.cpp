@@ -51,6 +51,16 @@ bool setBlend(PassContext& c, Blend blend) {
     return true;
 }
 
+bool bindTap(PassContext& c, DWORD stage, const Tap& tap) {
+    emu::Device& d = c.device;
+    return c.check(d.SetTexture(stage, c.texture(tap.texture))) &&
+           c.check(d.SetSamplerState(stage, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP)) &&
+           c.check(d.SetSamplerState(stage, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP)) &&
+           c.check(d.SetSamplerState(stage, D3DSAMP_MINFILTER, tap.filter)) &&
+           c.check(d.SetSamplerState(stage, D3DSAMP_MAGFILTER, tap.filter)) &&
+           c.check(d.SetSamplerState(stage, D3DSAMP_MIPFILTER, D3DTEXF_NONE));
+}
+
 bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q) {
     emu::Device& d = c.device;
     std::string err;
@@ -66,15 +76,8 @@ bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q) {
             if (!c.check(d.SetTexture(s, emu::Handle::Null))) return false;
             continue;
         }
-        const Tap& t = q.taps[s];
-        coords[s] = t.coords;
-        if (!c.check(d.SetTexture(s, c.texture(t.texture))) ||
-            !c.check(d.SetSamplerState(s, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP)) ||
-            !c.check(d.SetSamplerState(s, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP)) ||
-            !c.check(d.SetSamplerState(s, D3DSAMP_MINFILTER, t.filter)) ||
-            !c.check(d.SetSamplerState(s, D3DSAMP_MAGFILTER, t.filter)) ||
-            !c.check(d.SetSamplerState(s, D3DSAMP_MIPFILTER, D3DTEXF_NONE)))
-            return false;
+        coords[s] = q.taps[s].coords;
+        if (!bindTap(c, s, q.taps[s])) return false;
     }
     for (const auto& [reg, value] : q.constants)
         if (!c.check(d.SetPixelShaderConstantF(UINT(reg), value.data(), 1))) return false;

@@ -50,7 +50,10 @@ bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q);
 void addStretchPass(FrameBuild& fb, const std::string& name, TextureId source, TextureId dest,
                     D3DTEXTUREFILTERTYPE filter);
 void addClearPass(FrameBuild& fb, const std::string& name, TextureId target, D3DCOLOR colour);
-// The device state a quad pass leaves behind, reset: blending off, fixed-function stages off.
+// Blending for the next draws (None: off).
 bool setBlend(PassContext& c, Blend blend);
+// Binds the tap's texture to `stage` with its filter for minification and magnification, clamp
+// addressing and no mip filtering (what every pass of the techniques samples with).
+bool bindTap(PassContext& c, DWORD stage, const Tap& tap);
 
 }  // namespace glare

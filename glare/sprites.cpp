@@ -198,11 +198,7 @@ public:
                   [=](PassContext& c) {
                       emu::Device& d = c.device;
                       if (!c.clear(buffer, 0) || !setBlend(c, Blend::Add) || !c.check(d.SetPixelShader(emu::Handle::Null)) ||
-                          !c.check(d.SetTexture(0, c.texture(image))) ||
-                          !c.check(d.SetSamplerState(0, D3DSAMP_MINFILTER, D3DTEXF_LINEAR)) ||
-                          !c.check(d.SetSamplerState(0, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR)) ||
-                          !c.check(d.SetSamplerState(0, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP)) ||
-                          !c.check(d.SetSamplerState(0, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP)) ||
+                          !bindTap(c, 0, Tap{image, {}, D3DTEXF_LINEAR}) ||
                           !c.check(d.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_MODULATE)) ||
                           !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_TEXTURE)) ||
                           !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_DIFFUSE)) ||
