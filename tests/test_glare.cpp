@@ -140,6 +140,38 @@ TEST_CASE("pass graph: culling, order, lifetimes and aliasing", "[glare][graph]"
     CHECK(pool.created() == 2);
 }
 
+TEST_CASE("pass graph: a technique's transient textures share device textures where their lives allow", "[glare][graph]") {
+    // glow (published, no after-image): sources → h blur → v blur → composite. "glow h" lives from
+    // the first h pass to the last v pass, with "glow sources" until the last h pass; "glow" starts at
+    // the first v pass, after the sources' last use, so it takes their texture.
+    Runner run(options(96, 64));
+    std::string err;
+    REQUIRE(run.setImage(uniform(96, 64, 0.5f, 0.5f, 0.5f), err));
+    const Technique& t = *findTechnique("glow");
+    const Settings s = preset("glow");
+    std::vector<PassGraph::TextureNode> nodes;
+    std::vector<std::string> live;
+    FrameResult r;
+    REQUIRE(run.runFrame(t, s, 0, 1, r, err, {}, [&](PassGraph& g) {
+        nodes = g.textures();
+        live = g.livePassNames();
+    }));
+    auto node = [&](const std::string& name) {
+        for (const auto& n : nodes)
+            if (n.name == name) return n;
+        FAIL("no texture " << name);
+        return nodes.front();
+    };
+    CHECK(node("glow sources").physical == node("glow").physical);
+    CHECK(node("glow h").physical != node("glow").physical);
+    CHECK(node("glow h").physical != node("glow sources").physical);
+    CHECK(live.front() == "glow_source");
+    CHECK(live.back() == "composite");
+    CHECK(r.passes.size() == live.size());
+    // Two textures of the glow buffer's size serve three transient textures.
+    CHECK(run.pool().created() == 2);
+}
+
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
     std::string error;
     const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
