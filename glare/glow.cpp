@@ -80,6 +80,11 @@ public:
             {"ramp", "", "ramping: the strength pulses by this fraction over `ramp_period` frames (0: steady)", 0, 1,
              {0, 0, 0, 0}, {}, false},
             {"ramp_period", "frames", "period of the ramp", 2, 1000, {60, 60, 60, 60}, {}, true},
+            {"fog_start", "scene units", "glow-only black fog on built-in scenes: glow masks fade linearly from this "
+                                         "distance from the camera…",
+             0, 10000, {0, 0, 0, 0}, {}, false},
+            {"fog_end", "scene units", "…to none at this one (fog_end <= fog_start: no fog)", 0, 10000, {0, 0, 0, 0},
+             {}, false},
         };
         return p;
     }
@@ -160,6 +165,10 @@ public:
                        tss(1, D3DTSS_COLORARG1, D3DTA_TEXTURE) && tss(1, D3DTSS_COLORARG2, D3DTA_CURRENT) &&
                        tss(1, D3DTSS_ALPHAARG1, D3DTA_TEXTURE) && setBlend(c, Blend::None);
             });
+    }
+
+    std::pair<float, float> sceneGlowFog(const Settings& s) const override {
+        return {float(s.at("fog_start")), float(s.at("fog_end"))};
     }
 
     void build(FrameBuild& fb) const override {

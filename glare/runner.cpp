@@ -222,6 +222,8 @@ SceneRun runOnScene(const Technique& technique, const RunnerOptions& options, in
     std::unique_ptr<Scene> scene = makeScene(technique.scene(), error);
     if (!scene) return run;
     const Settings settings = *presetSettings(technique, "published");
+    const auto [fogStart, fogEnd] = technique.sceneGlowFog(settings);
+    scene->setGlowFog(fogStart, fogEnd);
     std::vector<double> ms;
     double sceneMs = 0;
     frames = std::max(frames, 1);

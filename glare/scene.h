@@ -37,6 +37,17 @@ public:
     // False with `error` set ("scene box: Device::DrawPrimitiveUP failed: <device message>",
     // "scene box: frame 7 out of range 0..3", …) on failure.
     virtual bool render(emu::Device& device, emu::Handle target, int frame, int frameCount, std::string& error) = 0;
+    // Glow-only black fog (James & O'Rorke): the glow mask (alpha) of every vertex is scaled by
+    // D3D's linear fog factor (end − d)/(end − start), clamped to [0, 1], d its distance from the
+    // camera in scene units, so distant glow sources fade while the scene's colours stay as they
+    // are. end <= start: off (the default).
+    void setGlowFog(float start, float end) {
+        m_glowFogStart = start;
+        m_glowFogEnd = end;
+    }
+
+protected:
+    float m_glowFogStart = 0, m_glowFogEnd = 0;
 };
 
 // The scene named `name` (see sceneList), or nullptr with `error` =

@@ -398,12 +398,23 @@ protected:
     bool drawMesh(const Mesh& mesh, bool depth = false) {
         if (mesh.vertices.empty()) return true;
         if (!depth) return drawScreen(toScreen(mesh), D3DCULL_CCW);
+        std::vector<Vertex> vertices = mesh.vertices;
+        for (Vertex& v : vertices) v.color = fogged(v);
         return check(m_device->SetRenderState(D3DRS_ZENABLE, D3DZB_TRUE), "SetRenderState") &&
                check(m_device->SetFVF(kVertexFvf), "SetFVF") &&
                check(m_device->SetRenderState(D3DRS_CULLMODE, D3DCULL_CCW), "SetRenderState") &&
-               check(m_device->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(mesh.vertices.size() / 3),
-                                               mesh.vertices.data(), sizeof(Vertex)),
+               check(m_device->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(vertices.size() / 3), vertices.data(),
+                                               sizeof(Vertex)),
                      "DrawPrimitiveUP");
+    }
+
+    // The vertex's colour with its glow mask faded by the glow-only fog (Scene::setGlowFog).
+    DWORD fogged(const Vertex& v) const {
+        if (!(m_glowFogEnd > m_glowFogStart) || (v.color >> 24) == 0) return v.color;
+        const glm::vec4 eye = m_view * glm::vec4(v.x, v.y, v.z, 1.0f);
+        const float d = glm::length(glm::vec3(eye));
+        const float f = std::clamp((m_glowFogEnd - d) / (m_glowFogEnd - m_glowFogStart), 0.0f, 1.0f);
+        return DWORD(std::lround(float(v.color >> 24) * f)) << 24 | (v.color & 0xffffffu);
     }
 
     // Screen-space triangles (XYZRHW, no depth test), at most 16 a draw (the row path's limit).
@@ -446,7 +457,7 @@ protected:
             poly.clear();
             for (size_t k = 0; k < 3; ++k) {
                 const Vertex& v = mesh.vertices[t + k];
-                poly.push_back({vp * glm::dvec4(v.x, v.y, v.z, 1.0), unpack(v.color)});
+                poly.push_back({vp * glm::dvec4(v.x, v.y, v.z, 1.0), unpack(fogged(v))});
             }
             for (const glm::dvec4& plane : planes) {
                 next.clear();

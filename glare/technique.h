@@ -66,6 +66,9 @@ public:
     virtual const std::vector<ParamInfo>& params() const = 0;
     // Adds this frame's passes to fb.graph (scene → … → output).
     virtual void build(FrameBuild& fb) const = 0;
+    // What the technique asks of a built-in scene before it is drawn: the glow-only fog's start and
+    // end distance (Scene::setGlowFog; end <= start: none). Images have no depth and get none.
+    virtual std::pair<float, float> sceneGlowFog(const Settings&) const { return {0.0f, 0.0f}; }
 };
 
 const std::vector<const Technique*>& techniques();

@@ -325,3 +325,29 @@ TEST_CASE("scene: the GL renderer draws the same bytes", "[scene][gl]") {
         }
     }
 }
+
+TEST_CASE("glow-only black fog fades the glow masks with distance and leaves the colours", "[scene]") {
+    Device dev;
+    std::string error;
+    std::unique_ptr<glare::Scene> plain = glare::makeScene("neon", error), fogged = glare::makeScene("neon", error);
+    REQUIRE(plain);
+    REQUIRE(fogged);
+    fogged->setGlowFog(4.0f, 9.0f);  // the neon wall stands about 6 to 9 units from the camera
+    const Frame a = render(dev, *plain, 192, 108, 2, 8);
+    const Frame b = render(dev, *fogged, 192, 108, 2, 8);
+    uint64_t alphaA = 0, alphaB = 0, partial = 0;
+    for (size_t i = 0; i < a.argb.size(); ++i) {
+        CHECK((a.argb[i] & 0xffffff) == (b.argb[i] & 0xffffff));  // colours unchanged
+        const uint32_t x = a.argb[i] >> 24, y = b.argb[i] >> 24;
+        CHECK(y <= x);
+        alphaA += x;
+        alphaB += y;
+        partial += y > 0 && y < 255;
+    }
+    CHECK(alphaB < alphaA);
+    CHECK(alphaB > 0);
+    CHECK(partial > 0);
+    // end <= start turns it off again.
+    fogged->setGlowFog(5.0f, 5.0f);
+    CHECK(render(dev, *fogged, 192, 108, 2, 8).argb == a.argb);
+}

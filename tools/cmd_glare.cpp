@@ -271,6 +271,9 @@ int runGlare(const GlareOptions& o) {
 
     std::unique_ptr<glare::Scene> otherScene;  // the scene's resources on the GL device
     if (scene && other && !(otherScene = glare::makeScene(o.scene, err))) return glareUsage(err);
+    const auto [fogStart, fogEnd] = technique->sceneGlowFog(*settings);
+    for (glare::Scene* s : {scene.get(), otherScene.get()})
+        if (s) s->setGlowFog(fogStart, fogEnd);
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
     std::vector<double> frameMs;
