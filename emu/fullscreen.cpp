@@ -1,5 +1,6 @@
 #include "emu/fullscreen.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "emu/format.h"
@@ -57,6 +58,28 @@ std::optional<SurfacePixels> readSurface(Device& device, Handle surface, std::st
     device.UnlockRect(copy);
     device.Release(copy);
     return out;
+}
+
+SurfacePixels surfacePixels(const FloatImage& image, D3DFORMAT format) {
+    const FormatInfo& info = *formatInfo(format);
+    SurfacePixels px;
+    px.width = image.width;
+    px.height = image.height;
+    px.format = format;
+    px.bytesPerPixel = info.bytes;
+    px.bytes.resize(size_t(image.width) * image.height * info.bytes);
+    for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
+        const float* v = &image.rgba[i * 4];
+        uint8_t* p = &px.bytes[i * info.bytes];
+        if (info.cls == FormatClass::Float) {
+            encodeFloat(info, {v[0], v[1], v[2], v[3]}, p);
+        } else {
+            std::array<uint8_t, 4> b{};
+            for (size_t c = 0; c < 4; ++c) b[c] = uint8_t(std::lround(std::fmin(std::fmax(v[c], 0.0f), 1.0f) * 255.0f));
+            encodeUnorm8(info, b, p);
+        }
+    }
+    return px;
 }
 
 bool writeSurface(Device& device, Handle surface, const SurfacePixels& pixels, std::string& error) {

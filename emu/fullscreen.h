@@ -13,6 +13,7 @@
 
 #include "emu/d3d9types.h"
 #include "emu/device.h"
+#include "emu/image_file.h"
 
 namespace emu {
 
@@ -52,6 +53,10 @@ struct SurfacePixels {
 };
 // nullopt with `error` = the device's message on failure.
 std::optional<SurfacePixels> readSurface(Device& device, Handle surface, std::string& error);
+// A float image in `format`'s layout: 8-bit formats clamp to [0, 1] and round to nearest, float
+// formats keep the values (A8R8G8B8 and A32B32G32R32F, what the glare runner and `ps11 shade` use;
+// any Unorm8 or Float-class format works).
+SurfacePixels surfacePixels(const FloatImage& image, D3DFORMAT format);
 // Writes `pixels` (same size and format) into a DEFAULT-pool surface (a render target or a render-
 // target texture level) through a DEFAULT offscreen plain surface and a 1:1 POINT StretchRect.
 bool writeSurface(Device& device, Handle surface, const SurfacePixels& pixels, std::string& error);

@@ -56,27 +56,7 @@ bool Runner::setImage(const emu::FloatImage& image, std::string& error) {
                 std::to_string(m_options.width) + "x" + std::to_string(m_options.height);
         return false;
     }
-    const D3DFORMAT f = intermediateFormat();
-    const emu::FormatInfo& info = *emu::formatInfo(f);
-    emu::SurfacePixels px;
-    px.width = image.width;
-    px.height = image.height;
-    px.format = f;
-    px.bytesPerPixel = info.bytes;
-    px.bytes.resize(size_t(image.width) * image.height * info.bytes);
-    for (size_t i = 0; i < size_t(image.width) * image.height; ++i) {
-        const float* v = &image.rgba[i * 4];
-        if (f == D3DFMT_A8R8G8B8) {
-            std::array<uint8_t, 4> rgba{};
-            for (int c = 0; c < 4; ++c) {
-                const float x = v[c] < 0 ? 0 : v[c] > 1 ? 1 : v[c];
-                rgba[size_t(c)] = uint8_t(x * 255.0f + 0.5f);
-            }
-            emu::encodeUnorm8(info, rgba, &px.bytes[i * info.bytes]);
-        } else {
-            emu::encodeFloat(info, {v[0], v[1], v[2], v[3]}, &px.bytes[i * info.bytes]);
-        }
-    }
+    const emu::SurfacePixels px = emu::surfacePixels(image, intermediateFormat());
     Handle surface{};
     if (m_device->GetSurfaceLevel(m_scene, 0, &surface) != D3D_OK) {
         error = m_device->lastError().message;

@@ -39,19 +39,10 @@ std::optional<FloatImage> shade(const DeviceOptions& options, const ShadeRequest
         if (d.CreateTexture(t.image.width, t.image.height, 1, 0, f, D3DPOOL_MANAGED, &tex) != D3D_OK ||
             d.LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK)
             return fail("");
+        const SurfacePixels px = surfacePixels(t.image, f);
+        const size_t row = size_t(t.image.width) * px.bytesPerPixel;
         for (uint32_t y = 0; y < t.image.height; ++y)
-            for (uint32_t x = 0; x < t.image.width; ++x) {
-                const float* v = &t.image.rgba[(size_t(y) * t.image.width + x) * 4];
-                uint8_t* p = static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch) + size_t(x) * info.bytes;
-                if (ideal) {
-                    encodeFloat(info, {v[0], v[1], v[2], v[3]}, p);
-                } else {
-                    std::array<uint8_t, 4> b{};
-                    for (int c = 0; c < 4; ++c)
-                        b[size_t(c)] = uint8_t(std::lround(std::fmin(std::fmax(v[c], 0.0f), 1.0f) * 255.0f));
-                    encodeUnorm8(info, b, p);
-                }
-            }
+            std::memcpy(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), &px.bytes[y * row], row);
         const DWORD stage = DWORD(s);
         if (d.UnlockRect(tex, 0) != D3D_OK || d.SetTexture(stage, tex) != D3D_OK ||
             d.SetSamplerState(stage, D3DSAMP_MINFILTER, t.filter) != D3D_OK ||
