@@ -1,16 +1,19 @@
-// BM_EmuVsGl: the emulator's speed against its peer, the project's GL renderer
-// (emu::gl::GlRenderer) on Mesa llvmpipe (PERF.md "The peer"), in one process. Every pass runs on
-// two emu::Devices, one with the software renderer (2 worker threads) and one whose renderer is a
-// GlRenderer (LP_NUM_THREADS=2 unless set), registered emu, gl, emu, gl … so that
-// --benchmark_enable_random_interleaving mixes their repetitions under the same machine load.
-// Both report the draw alone (manual time): for emu the wall time of DrawPrimitiveUP, for gl
-// GlRenderer::lastDrawMilliseconds() (first GL draw call to glFinish; the target's upload, the
-// texture upload and the read-back are outside it). Before any timing, each pass is drawn once
-// on both devices and the render targets are compared byte for byte.
+// BM_EmuVsGl: the emulator's speed against its peer, the GL renderer's native mode on Mesa
+// llvmpipe (PERF.md "The peer"), in one process. Every pass runs on four emu::Devices: the
+// software renderer (2 worker threads) in the 1.1-class card's fx8 and in `ideal`, and the GL
+// renderer (LP_NUM_THREADS=2 unless set) in native mode and in exact mode, registered emu_fx8,
+// emu_ideal, gl_native, gl_exact, … so that --benchmark_enable_random_interleaving mixes their
+// repetitions under the same machine load. Each reports the wall time of DrawPrimitiveUP followed
+// by Device::finish (GL's work done); the GL devices keep their surfaces resident, so nothing is
+// uploaded or read back per draw. Before any timing, each pass is drawn once on every device:
+// emu_fx8 and gl_exact must agree byte for byte; gl_native's distance from emu_fx8 is reported
+// (`native_max_diff`).
 // How to run and read the ratios: bench/README.md "bench_emu_vs_gl".
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -24,6 +27,7 @@
 #include "emu/device.h"
 #include "emu/fullscreen.h"
 #include "emu/gl/gl_renderer.h"
+#include "tools/gl_backend.h"
 
 namespace {
 
@@ -43,7 +47,22 @@ constexpr const char* kComposite =
 
 enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite };
 constexpr int kPasses = 5;
-enum class Kind { Emu, Gl };
+enum class Kind { EmuFx8, EmuIdeal, GlNative, GlExact };
+constexpr Kind kKinds[] = {Kind::EmuFx8, Kind::EmuIdeal, Kind::GlNative, Kind::GlExact};
+const char* kindName(Kind k) {
+    switch (k) {
+        case Kind::EmuFx8:
+            return "emu_fx8";
+        case Kind::EmuIdeal:
+            return "emu_ideal";
+        case Kind::GlNative:
+            return "gl_native";
+        case Kind::GlExact:
+            return "gl_exact";
+    }
+    return "";
+}
+bool isGl(Kind k) { return k == Kind::GlNative || k == Kind::GlExact; }
 
 struct StageDef {
     int texture;     // index into PassDef::textures
@@ -79,7 +98,6 @@ PassDef passDef(Pass p) {
 // One device drawing one pass, its state set once. Never destroyed (see scene()).
 struct Scene {
     std::unique_ptr<Device> dev;
-    gl::GlRenderer* glr = nullptr;  // owned by dev
     Handle rt{};
     std::vector<float> vertices;
     UINT stride = 0;
@@ -88,7 +106,9 @@ struct Scene {
     Scene(Pass pass, Kind kind) { setup(pass, kind); }
     void setup(Pass pass, Kind kind);
     bool draw() {
-        return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, vertices.data(), stride) == D3D_OK;
+        const bool ok = dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, vertices.data(), stride) == D3D_OK;
+        dev->finish();
+        return ok;
     }
     // The render target's bytes (rows packed), or empty with `error` set.
     std::vector<uint8_t> image();
@@ -100,19 +120,17 @@ void Scene::setup(Pass pass, Kind kind) {
     const PassDef pd = passDef(pass);
     DeviceOptions o;
     o.software.threads = 2;
-    if (kind == Kind::Gl) {
+    if (kind == Kind::EmuIdeal) o.precision = ps11::Precision::Ideal;
+    if (isGl(kind)) {
         // llvmpipe reads its thread count when the context's screen is made.
         setenv("LP_NUM_THREADS", "2", 0);
         std::string why;
-        std::unique_ptr<gl::GlRenderer> r = gl::GlRenderer::create({}, why);
-        if (!r) {
-            error = "no GL renderer: " + why;
+        o.renderer = ps11::glRendererFactory("osmesa", why, kind == Kind::GlNative);
+        if (!o.renderer) {
+            error = why;
             if (glError.empty()) glError = error;
             return;
         }
-        glr = r.get();
-        auto owned = std::make_shared<std::unique_ptr<gl::GlRenderer>>(std::move(r));
-        o.renderer = [owned]() -> std::unique_ptr<Renderer> { return std::move(*owned); };  // once
     }
     dev = std::make_unique<Device>(o);
     auto refused = [&](const char* call) {
@@ -178,9 +196,9 @@ std::vector<uint8_t> Scene::image() {
 }
 
 struct PassScenes {
-    Scene* emu = nullptr;
-    Scene* gl = nullptr;
-    std::string mismatch;  // non-empty: the images differ (or could not be compared)
+    Scene* scenes[4] = {};  // by Kind
+    std::string mismatch;   // non-empty: emu_fx8 and gl_exact differ (or could not be compared)
+    int nativeMaxDiff = -1;  // gl_native against emu_fx8, 8-bit levels
 };
 
 // Both devices of a pass, made on first use and compared once. Never destroyed: at exit,
@@ -189,17 +207,21 @@ struct PassScenes {
 PassScenes& scenes(Pass pass) {
     static PassScenes* all = new PassScenes[kPasses];
     PassScenes& p = all[int(pass)];
-    if (!p.emu) {
-        p.emu = new Scene(pass, Kind::Emu);
-        p.gl = new Scene(pass, Kind::Gl);
-        if (p.emu->error.empty() && p.gl->error.empty()) {
-            const std::vector<uint8_t> a = p.emu->image(), b = p.gl->image();
-            if (a.empty() || b.empty())
-                p.mismatch = "read-back failed: " + p.emu->error + p.gl->error;
+    if (!p.scenes[0]) {
+        for (Kind k : kKinds) p.scenes[int(k)] = new Scene(pass, k);
+        Scene& fx8 = *p.scenes[int(Kind::EmuFx8)];
+        Scene& exact = *p.scenes[int(Kind::GlExact)];
+        Scene& native = *p.scenes[int(Kind::GlNative)];
+        if (fx8.error.empty() && exact.error.empty() && native.error.empty()) {
+            const std::vector<uint8_t> a = fx8.image(), b = exact.image(), c = native.image();
+            if (a.empty() || b.empty() || c.empty())
+                p.mismatch = "read-back failed: " + fx8.error + exact.error + native.error;
             else {
                 size_t differ = 0;
                 for (size_t i = 0; i < a.size(); i += 4) differ += std::memcmp(&a[i], &b[i], 4) != 0;
-                if (differ) p.mismatch = "emu and gl images differ: " + std::to_string(differ) + " pixels";
+                if (differ) p.mismatch = "emu_fx8 and gl_exact images differ: " + std::to_string(differ) + " pixels";
+                p.nativeMaxDiff = 0;
+                for (size_t i = 0; i < a.size(); ++i) p.nativeMaxDiff = std::max(p.nativeMaxDiff, std::abs(int(a[i]) - int(c[i])));
             }
         }
     }
@@ -208,7 +230,7 @@ PassScenes& scenes(Pass pass) {
 
 void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
     PassScenes& ps = scenes(pass);
-    Scene& sc = kind == Kind::Emu ? *ps.emu : *ps.gl;
+    Scene& sc = *ps.scenes[int(kind)];
     if (!sc.error.empty()) {
         state.SkipWithError(sc.error.c_str());
         return;
@@ -217,38 +239,38 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
         state.SkipWithError(ps.mismatch.c_str());
         return;
     }
-    double drawSum = 0, callSum = 0;
+    double drawSum = 0;
+    const emu::TransferStats before = sc.dev->transfers();
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
         const bool ok = sc.draw();
-        const double call = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const double draw = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         if (!ok) {
             state.SkipWithError(sc.dev->lastError().message.c_str());
             return;
         }
-        // gl: the GL work alone; emu: the whole call is the draw.
-        const double draw = kind == Kind::Gl ? sc.glr->lastDrawMilliseconds() / 1000.0 : call;
         state.SetIterationTime(draw);
         drawSum += draw;
-        callSum += call;
     }
+    const emu::TransferStats after = sc.dev->transfers();
     const PassDef pd = passDef(pass);
     const double n = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
     const double pixels = double(pd.w) * pd.h;
     state.counters["Mpix/s"] = drawSum > 0 ? pixels * n / drawSum * 1e-6 : 0;
-    // The whole DrawPrimitiveUP (gl: with the uploads and the read-back), ms per call.
-    state.counters["call_ms"] = callSum / n * 1e3;
-    state.SetLabel(kind == Kind::Emu ? "software, 2 threads" : sc.glr->context().renderer());
+    // Surfaces crossing per draw (0 once resident) and the native mode's distance from fx8.
+    state.counters["uploads"] = double(after.uploads - before.uploads) / n;
+    state.counters["readbacks"] = double(after.readBacks - before.readBacks) / n;
+    if (kind == Kind::GlNative) state.counters["native_max_diff"] = ps.nativeMaxDiff;
+    state.SetLabel(isGl(kind) ? ps11::glRendererDescription() : "software, 2 threads");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    // emu and gl of each pass registered alternately.
+    // The four devices of each pass registered alternately.
     for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite})
-        for (Kind k : {Kind::Emu, Kind::Gl}) {
-            const std::string name =
-                std::string("BM_EmuVsGl/") + passDef(p).name + (k == Kind::Emu ? "/emu" : "/gl");
+        for (Kind k : kKinds) {
+            const std::string name = std::string("BM_EmuVsGl/") + passDef(p).name + "/" + kindName(k);
             benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)
                 ->Unit(benchmark::kMillisecond)
                 ->UseManualTime();

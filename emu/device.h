@@ -141,6 +141,13 @@ public:
     // Statistics of the last successful draw and the running total of all draws.
     const DrawStats& lastDrawStats() const { return m_lastDraw; }
     const DrawStats& totalDrawStats() const { return m_totalDraw; }
+    // What has crossed between the front's images and the renderer's copies so far (zero for the
+    // software renderer, which keeps none).
+    TransferStats transfers() const { return m_renderer->transfers(); }
+    // Not D3D9 API: returns when the renderer has finished every call so far (timings).
+    void finish() { m_renderer->finish(); }
+    // The renderer's name ("software", "gl", "gl-native").
+    const char* rendererName() const { return m_renderer->name(); }
 
     // ---- for the draw slices and tests (not D3D9 API) ----
     // The sampler's view of a texture or volume texture, rebuilt after writes (mips regenerated
@@ -163,7 +170,17 @@ private:
                       DWORD flags, D3DLOCKED_BOX* out);
     HRESULT unlockLevel(const char* call, Resource& r, uint32_t level);
     HRESULT registerShader(const char* call, PixelShaderObject&& shader, Handle* out);
+    // AUTOGENMIPMAP: levels 1.. from level 0, in the front's images.
+    void regenerateMips(Resource& r);
+    // The front wrote a level in its own image.
     void markWritten(Resource& r, uint32_t level);
+    // The renderer wrote a level in its copy (the front's image is stale until syncLevel).
+    void rendererWrote(Resource& r, uint32_t level);
+    // Brings the front's image of a level (or of every level) up to date with the renderer's copy.
+    void syncLevel(Resource& r, uint32_t level);
+    void syncResource(Resource& r);
+    // A level as the renderer sees it (emu/renderer.h SurfaceDesc).
+    SurfaceDesc surfaceDesc(const SurfaceRef& ref, Resource& r);
     HRESULT drawFail(HRESULT hr, const char* code, std::string message);
 
     DrawStats m_lastDraw, m_totalDraw;

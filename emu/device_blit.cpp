@@ -1,12 +1,13 @@
-// Device stage: whole-surface operations outside draws. Clear (viewport ∩ scissor ∩ rects,
-// colour converted to the target's format, depth and stencil), StretchRect (POINT and LINEAR
-// with texel-centre mapping and 8-bit weights in fx profiles, rounded once) and
-// GetRenderTargetData. The exact rules are in docs/device.md.
+// Device front: whole-surface operations outside draws. Clear (viewport ∩ scissor ∩ rects,
+// colour converted to the target's format, depth and stencil) and StretchRect checked and
+// resolved into calls for the renderer (emu/renderer.h; done in the front's images by
+// emu/blit.h when the renderer leaves them), and GetRenderTargetData. docs/device.md.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <vector>
 
+#include "emu/blit.h"
 #include "emu/device.h"
 #include "ps11/precision.h"
 
@@ -28,19 +29,6 @@ struct Box {
         return {std::max(x0, o.x0), std::max(y0, o.y0), std::min(x1, o.x1), std::min(y1, o.y1)};
     }
 };
-
-// floor(n / d) for d > 0.
-int64_t floorDiv(int64_t n, int64_t d) {
-    int64_t q = n / d;
-    if ((n % d) != 0 && n < 0) --q;
-    return q;
-}
-
-uint8_t toUnorm8(double v) {
-    // Nearest 8-bit value, ties to even (docs/precision.md "Outputs").
-    const double x = std::clamp(v, 0.0, 1.0) * 255.0;
-    return uint8_t(std::nearbyint(x));
-}
 
 }  // namespace
 
@@ -67,6 +55,7 @@ HRESULT Device::GetRenderTargetData(Handle renderTarget, Handle destSurface) {
                         s->format->name);
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "GetRenderTargetData: a surface is locked");
+    syncLevel(*src, srcRef.level);  // the read-back of a renderer that keeps copies
     const size_t row = size_t(s->width) * s->format->bytes;
     for (uint32_t y = 0; y < s->height; ++y) std::copy_n(s->texel(0, y), row, d->texel(0, y));
     markWritten(*dst, dstRef.level);
@@ -118,125 +107,22 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
                     "StretchRect: destination rect " + rectText(dr) + " is empty or outside the " + num(d->width) +
                         "x" + num(d->height) + " destination");
 
-    const FormatInfo& sf = *s->format;
-    const FormatInfo& df = *d->format;
-    const int64_t sw = sr.right - sr.left, sh = sr.bottom - sr.top;
-    const int64_t dw = dr.right - dr.left, dh = dr.bottom - dr.top;
-    const bool fx = ps11::isFixedPoint(m_hardware.precision);
-    const bool unormSource = sf.cls == FormatClass::Unorm8;
-    // Channel values in source units: bytes for 8-bit sources (exact sums), values otherwise.
-    auto fetch = [&](int64_t x, int64_t y) {
-        std::array<double, 4> v;
-        const uint8_t* p = s->texel(uint32_t(x), uint32_t(y));
-        if (unormSource) {
-            std::array<uint8_t, 4> b = decodeUnorm8(sf, p);
-            for (size_t c = 0; c < 4; ++c) v[c] = b[c];
-        } else {
-            std::array<float, 4> f = decodeTexel(sf, p, m_hardware.hardware->signedDecode);
-            for (size_t c = 0; c < 4; ++c) v[c] = f[c];
-        }
-        return v;
-    };
-    auto store = [&](int64_t x, int64_t y, const std::array<double, 4>& v) {
-        uint8_t* p = d->texel(uint32_t(x), uint32_t(y));
-        if (df.cls == FormatClass::Unorm8) {
-            std::array<uint8_t, 4> b;
-            for (size_t c = 0; c < 4; ++c)
-                b[c] = unormSource ? uint8_t(std::clamp(std::nearbyint(v[c]), 0.0, 255.0)) : toUnorm8(v[c]);
-            encodeUnorm8(df, b, p);
-        } else {
-            std::array<float, 4> f;
-            for (size_t c = 0; c < 4; ++c) f[c] = float(unormSource ? v[c] / 255.0 : v[c]);
-            encodeFloat(df, f, p);
-        }
-    };
-    // Texel-centre mapping (docs/device.md): destination pixel i of the rect has its centre at
-    // i + 1/2, which maps to source position sr.left + (i + 1/2) * sw / dw. As exact fractions
-    // over 2*dw: POINT takes floor(position) (a tie goes to the higher texel); LINEAR works in
-    // texel space x = position - 1/2 = i0 + f.
-    auto axisPoint = [](int64_t i, int64_t s0, int64_t sn, int64_t dn) {
-        return s0 + floorDiv((2 * i + 1) * sn, 2 * dn);
-    };
-    struct Tap {
-        int64_t i0, i1;
-        double w1;  // weight of i1; i0 gets 1 - w1
-    };
-    auto axisLinear = [fx](int64_t i, int64_t s0, int64_t sn, int64_t dn) {
-        const int64_t num2 = (2 * i + 1) * sn - dn;  // (x - s0) * 2dn
-        const int64_t den = 2 * dn;
-        const int64_t k = floorDiv(num2, den);
-        const int64_t rem = num2 - k * den;  // f = rem / den in [0, 1)
-        // fx profiles: 8 bits of sub-texel weight, round_half_even(f * 256) (docs/precision.md).
-        const double w1 = fx ? double(ps11::roundHalfEven(rem * 256, den)) / 256.0 : double(rem) / double(den);
-        // Taps outside the source rect are clamped to its edge texels.
-        return Tap{std::clamp(s0 + k, s0, s0 + sn - 1), std::clamp(s0 + k + 1, s0, s0 + sn - 1), w1};
-    };
-    const bool linear = filter == D3DTEXF_LINEAR;
-    const bool sameFormat = &sf == &df;
-    // Fast path: an unscaled copy in one format is a row copy with either filter (LINEAR has
-    // f = 0 at every pixel, so it reproduces the texels exactly).
-    if (sameFormat && sw == dw && sh == dh) {
-        const size_t row = size_t(sw) * sf.bytes;
-        for (int64_t j = 0; j < dh; ++j)
-            std::memmove(d->texel(uint32_t(dr.left), uint32_t(dr.top + j)),
-                         s->texel(uint32_t(sr.left), uint32_t(sr.top + j)), row);
-        markWritten(*dst, dstRef.level);
+    StretchCall sc;
+    sc.source = surfaceDesc(srcRef, *src);
+    sc.dest = surfaceDesc(dstRef, *dst);
+    sc.sourceRect = PixelBox{sr.left, sr.top, sr.right, sr.bottom};
+    sc.destRect = PixelBox{dr.left, dr.top, dr.right, dr.bottom};
+    sc.linear = filter == D3DTEXF_LINEAR;
+    sc.fixedPoint = ps11::isFixedPoint(m_hardware.precision);
+    sc.decode = m_hardware.hardware->signedDecode;
+    if (m_renderer->stretchRect(sc)) {
+        rendererWrote(*dst, dstRef.level);
         return D3D_OK;
     }
-    // Fast path: an exact 2:1 LINEAR reduction of A8R8G8B8/X8R8G8B8 has f = 1/2 on both axes
-    // (weight 128/256 in fx profiles, 1/2 exactly otherwise), so each byte is
-    // round_half_even((a + b + c + d) / 4) of a 2x2 block, the general path's result.
-    if (linear && sameFormat && sf.bytes == 4 && sf.cls == FormatClass::Unorm8 && sw == 2 * dw && sh == 2 * dh) {
-        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
-        for (int64_t j = 0; j < dh; ++j) {
-            const uint8_t* r0 = s->texel(uint32_t(sr.left), uint32_t(sr.top + 2 * j));
-            const uint8_t* r1 = r0 + s->rowPitch;
-            uint8_t* out = d->texel(uint32_t(dr.left), uint32_t(dr.top + j));
-            for (int64_t i = 0; i < dw; ++i, r0 += 8, r1 += 8, out += 4)
-                for (int b = 0; b < 4; ++b) {
-                    const int sum = r0[b] + r0[b + 4] + r1[b] + r1[b + 4];
-                    // (sum + 1 + ((sum >> 2) & 1)) >> 2 is round_half_even(sum / 4).
-                    out[b] = uint8_t((sum + 1 + ((sum >> 2) & 1)) >> 2);
-                }
-            if (x8)
-                for (int64_t i = 0; i < dw; ++i) d->texel(uint32_t(dr.left + i), uint32_t(dr.top + j))[3] = 0xFF;
-        }
-        markWritten(*dst, dstRef.level);
-        return D3D_OK;
-    }
-    std::vector<int64_t> pointX, pointY;
-    std::vector<Tap> tapX, tapY;
-    for (int64_t i = 0; i < dw; ++i) {
-        pointX.push_back(axisPoint(i, sr.left, sw, dw));
-        tapX.push_back(axisLinear(i, sr.left, sw, dw));
-    }
-    for (int64_t j = 0; j < dh; ++j) {
-        pointY.push_back(axisPoint(j, sr.top, sh, dh));
-        tapY.push_back(axisLinear(j, sr.top, sh, dh));
-    }
-    for (int64_t j = 0; j < dh; ++j) {
-        for (int64_t i = 0; i < dw; ++i) {
-            const int64_t dx = dr.left + i, dy = dr.top + j;
-            if (!linear) {
-                const int64_t sx = pointX[size_t(i)], sy = pointY[size_t(j)];
-                if (sameFormat)
-                    std::copy_n(s->texel(uint32_t(sx), uint32_t(sy)), sf.bytes, d->texel(uint32_t(dx), uint32_t(dy)));
-                else
-                    store(dx, dy, fetch(sx, sy));
-                continue;
-            }
-            const Tap& tx = tapX[size_t(i)];
-            const Tap& ty = tapY[size_t(j)];
-            const std::array<double, 4> a = fetch(tx.i0, ty.i0), b = fetch(tx.i1, ty.i0);
-            const std::array<double, 4> c = fetch(tx.i0, ty.i1), e = fetch(tx.i1, ty.i1);
-            std::array<double, 4> v;
-            // Exact weighted sum (8-bit weights and 8-bit texels: products of dyadic numbers are
-            // exact in double), rounded once in store().
-            for (size_t k = 0; k < 4; ++k)
-                v[k] = (1 - ty.w1) * ((1 - tx.w1) * a[k] + tx.w1 * b[k]) + ty.w1 * ((1 - tx.w1) * c[k] + tx.w1 * e[k]);
-            store(dx, dy, v);
-        }
-    }
+    // The renderer left it to the front: in the front's images, brought up to date first.
+    syncLevel(*src, srcRef.level);
+    syncLevel(*dst, dstRef.level);
+    stretchImages(sc);
     markWritten(*dst, dstRef.level);
     return D3D_OK;
 }
@@ -296,30 +182,20 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             if (!b.empty()) boxes.push_back(b);  // inverted or outside rects clear nothing
         }
     }
+    ClearCall cc;
+    for (const Box& b : boxes) cc.boxes.push_back(PixelBox{b.x0, b.y0, b.x1, b.y1});
     if (target) {
         const FormatInfo& f = *target->format;
-        uint8_t texel[16] = {};
         const std::array<uint8_t, 4> rgba{uint8_t(color >> 16), uint8_t(color >> 8), uint8_t(color),
                                           uint8_t(color >> 24)};
         if (f.cls == FormatClass::Unorm8) {
-            encodeUnorm8(f, rgba, texel);
+            encodeUnorm8(f, rgba, cc.colorTexel.data());
         } else {
             std::array<float, 4> v;
             for (size_t c = 0; c < 4; ++c) v[c] = float(rgba[c] / 255.0);
-            encodeFloat(f, v, texel);
+            encodeFloat(f, v, cc.colorTexel.data());
         }
-        for (const Box& b : boxes) {
-            const Box c = b.meet(Box{0, 0, target->width, target->height});
-            if (c.empty()) continue;
-            // Fill the first row, then copy it to the others.
-            for (int64_t x = c.x0; x < c.x1; ++x)
-                std::copy_n(texel, f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
-            const size_t row = size_t(c.x1 - c.x0) * f.bytes;
-            for (int64_t y = c.y0 + 1; y < c.y1; ++y)
-                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)),
-                            row);
-        }
-        if (!boxes.empty()) markWritten(*rt, rtRef.level);
+        cc.color = surfaceDesc(rtRef, *rt);
     }
     if (depth) {
         const FormatInfo& f = *depth->format;
@@ -340,18 +216,20 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             }
         }
         if ((flags & D3DCLEAR_STENCIL) && f.stencilBits == 8) keep &= ~0xffu, set = (set & ~0xffu) | (stencil & 0xffu);
-        for (const Box& b : boxes) {
-            const Box c = b.meet(Box{0, 0, depth->width, depth->height});
-            for (int64_t y = c.y0; y < c.y1; ++y) {
-                uint8_t* p = c.x0 < c.x1 ? depth->texel(uint32_t(c.x0), uint32_t(y)) : nullptr;
-                for (int64_t x = c.x0; x < c.x1; ++x, p += f.bytes) {
-                    const uint32_t w = (loadWord(p, f.bytes) & keep) | set;
-                    for (uint32_t k = 0; k < f.bytes; ++k) p[k] = uint8_t(w >> (8 * k));
-                }
-            }
-        }
-        if (!boxes.empty()) markWritten(*ds, dsRef.level);
+        cc.depthKeep = keep, cc.depthSet = set;
+        cc.depth = surfaceDesc(dsRef, *ds);
     }
+    if (boxes.empty()) return D3D_OK;
+    if (m_renderer->clear(cc)) {
+        if (target) rendererWrote(*rt, rtRef.level);
+        if (depth) rendererWrote(*ds, dsRef.level);
+        return D3D_OK;
+    }
+    if (target) syncLevel(*rt, rtRef.level);
+    if (depth) syncLevel(*ds, dsRef.level);
+    clearImages(cc);
+    if (target) markWritten(*rt, rtRef.level);
+    if (depth) markWritten(*ds, dsRef.level);
     return D3D_OK;
 }
 

@@ -108,6 +108,14 @@ size_t hashWords(const std::vector<uint32_t>& w) {
 
 }  // namespace
 
+TransferStats& TransferStats::operator+=(const TransferStats& o) {
+    uploads += o.uploads;
+    uploadBytes += o.uploadBytes;
+    readBacks += o.readBacks;
+    readBackBytes += o.readBackBytes;
+    return *this;
+}
+
 DrawStats& DrawStats::operator+=(const DrawStats& o) {
     draws += o.draws;
     triangles += o.triangles;
@@ -333,6 +341,17 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
                     return drawFail(D3DERR_INVALIDCALL, "E4106",
                                     "texture " + num(uint32_t(tex)) + " on stage " + num(uint32_t(s)) + " is locked");
         }
+        if (m_renderer->keepsCopies() && tr) {
+            // The renderer takes the texture by identity, and the front's view only if it asks.
+            if (tr->autoGenMips() && tr->mipsDirty) regenerateMips(*tr);
+            TextureRef& ref = call.textureRefs[size_t(s)];
+            ref.resource = uint32_t(tex);
+            ref.levels = int(tr->levels.size());
+            ref.volume = tr->kind == ResourceKind::VolumeTexture;
+            ref.format = tr->format;
+            ref.level0 = surfaceDesc(SurfaceRef{tex, 0}, *tr);
+            continue;
+        }
         textures[size_t(s)] = sampledTexture(tex);
         if (!textures[size_t(s)]) {
             const std::string msg = m_error.message;
@@ -389,6 +408,10 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     if (merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
     call.usedAttributes = used;
     call.target = MergeTarget{target, depth};
+    call.colorSurface = surfaceDesc(rtRef, *rt);
+    if (depth) call.depthSurface = surfaceDesc(dsRef, *ds);
+    if (m_renderer->keepsCopies())
+        call.textureView = [this](int stage) { return sampledTexture(m_state.textures[size_t(stage)]); };
     {
         const D3DVIEWPORT9& vp = m_state.viewport;
         int64_t x0 = vp.X, y0 = vp.Y, x1 = int64_t(vp.X) + vp.Width, y1 = int64_t(vp.Y) + vp.Height;
@@ -416,8 +439,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     RendererError rerr;
     if (!m_renderer->draw(call, stats, rerr)) return drawFail(rerr.hr, rerr.code.c_str(), rerr.message);
     if (stats.trianglesDrawn) {
-        markWritten(*rt, rtRef.level);
-        if (depth && merge.depthWrite) markWritten(*ds, dsRef.level);
+        rendererWrote(*rt, rtRef.level);
+        if (depth && merge.depthWrite) rendererWrote(*ds, dsRef.level);
     }
     stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     m_lastDraw = stats;

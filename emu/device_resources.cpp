@@ -237,6 +237,7 @@ HRESULT Device::Release(Handle object) {
     unbind(object);
     m_surfaces.erase(id);
     m_resources.erase(id);
+    m_renderer->release(id);
     return D3D_OK;
 }
 
@@ -323,9 +324,51 @@ HRESULT Device::GetSurfaceLevel(Handle texture, UINT level, Handle* surface) {
     return D3D_OK;
 }
 
+void Device::regenerateMips(Resource& r) {
+    syncResource(r);
+    generateMips(r);
+    for (uint32_t l = 1; l < r.levels.size(); ++l) markWritten(r, l);
+    r.mipsDirty = false;
+}
+
 void Device::markWritten(Resource& r, uint32_t level) {
     ++r.generation;
+    r.levelGeneration.resize(r.levels.size(), 0);
+    r.rendererNewer.resize(r.levels.size(), 0);
+    r.levelGeneration[level] = r.generation;
+    r.rendererNewer[level] = 0;
     if (level == 0 && r.autoGenMips()) r.mipsDirty = true;
+}
+
+void Device::rendererWrote(Resource& r, uint32_t level) {
+    markWritten(r, level);
+    r.rendererNewer[level] = m_renderer->keepsCopies() ? 1 : 0;
+}
+
+SurfaceDesc Device::surfaceDesc(const SurfaceRef& ref, Resource& r) {
+    r.levelGeneration.resize(r.levels.size(), 0);
+    r.rendererNewer.resize(r.levels.size(), 0);
+    SurfaceDesc d;
+    d.resource = uint32_t(ref.owner);
+    d.level = ref.level;
+    d.image = &r.levels[ref.level];
+    d.generation = r.levelGeneration[ref.level];
+    d.writeGeneration = r.generation + 1;  // what markWritten makes it
+    return d;
+}
+
+void Device::syncLevel(Resource& r, uint32_t level) {
+    if (level >= r.rendererNewer.size() || !r.rendererNewer[level]) return;
+    for (const auto& [id, res] : m_resources)
+        if (&res == &r) {
+            m_renderer->readBack(surfaceDesc(SurfaceRef{Handle(id), level}, r));
+            break;
+        }
+    r.rendererNewer[level] = 0;
+}
+
+void Device::syncResource(Resource& r) {
+    for (uint32_t l = 0; l < r.rendererNewer.size(); ++l) syncLevel(r, l);
 }
 
 HRESULT Device::lockLevel(const char* call, Handle owner, Resource& r, uint32_t level, const RECT* rect,
@@ -357,6 +400,7 @@ HRESULT Device::lockLevel(const char* call, Handle owner, Resource& r, uint32_t 
                             "x" + num(im.depth) + " level");
         x0 = box->Left, y0 = box->Top, z0 = box->Front;
     }
+    syncLevel(r, level);  // the locked bytes are the newest contents
     r.locked[level] = 1;
     r.lockedReadOnly[level] = (flags & D3DLOCK_READONLY) ? 1 : 0;
     out->RowPitch = int32_t(im.rowPitch);
@@ -452,10 +496,7 @@ HRESULT Device::GenerateMipSubLevels(Handle texture) {
     if (!r || r->kind == ResourceKind::Surface)
         return fail(D3DERR_INVALIDCALL, "E4102",
                     "GenerateMipSubLevels: handle " + handleText(texture) + " is not a texture");
-    if (r->autoGenMips() && r->mipsDirty) {
-        generateMips(*r);
-        ++r->generation;
-    }
+    if (r->autoGenMips() && r->mipsDirty) regenerateMips(*r);
     return D3D_OK;
 }
 
@@ -467,11 +508,9 @@ std::shared_ptr<const ps11::Texture> Device::sampledTexture(Handle texture) {
         return nullptr;
     }
     // D3D9 regenerates AUTOGENMIPMAP sublevels before the texture is next used.
-    if (r->autoGenMips() && r->mipsDirty) {
-        generateMips(*r);
-        ++r->generation;
-    }
+    if (r->autoGenMips() && r->mipsDirty) regenerateMips(*r);
     if (r->sampled && r->sampledGeneration == r->generation) return r->sampled;
+    syncResource(*r);
     std::string error;
     try {
         r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, error);

@@ -1,8 +1,10 @@
 // The seam between the device front and a renderer (docs/device.md "Front and renderers"): the
 // front (emu/device*.cpp) checks every D3D9 call, translates sampler, stage and render states into
-// the resolved plain values below and processes vertices; a renderer only draws what a DrawCall
-// says. The software renderer (emu/software_renderer.*: rasteriser, executor, aligned passes,
-// output merger, threads) is one implementation.
+// the resolved plain values below and processes vertices; a renderer draws, clears, stretches and
+// reads back what the calls say. The software renderer (emu/software_renderer.*: rasteriser,
+// executor, aligned passes, output merger, threads) works in the front's own images; the GL
+// renderer (emu/gl/gl_renderer.h) keeps its own copy of every surface it has been handed and
+// follows the front's contents by generation.
 #pragma once
 
 #include <array>
@@ -58,6 +60,29 @@ struct DrawProgram {
 // instruction in 1_1–1_3, texld/texcrd source in 1_4) marks its slot.
 uint64_t attributesRead(const ps11::Program& program);
 
+// A surface as a renderer sees it: a level of a texture or a standalone surface, with the
+// front's image (format, size; its bytes are current unless the renderer holds newer contents)
+// and the versions of its contents. A renderer that keeps copies uploads the front's image when
+// its copy's generation differs from `generation`; after writing it, its copy is `writeGeneration`.
+struct SurfaceDesc {
+    uint32_t resource = 0;       // the device's handle of the owning texture or surface (0: none)
+    uint32_t level = 0;
+    Image* image = nullptr;      // the front's copy
+    uint64_t generation = 0;     // the level's contents now
+    uint64_t writeGeneration = 0;  // the level's contents after this call writes it
+    bool valid() const { return resource != 0 && image != nullptr; }
+};
+
+// A texture bound to a stage, for renderers that keep copies: the texture's identity and a way
+// to get the front's sampler view (which first brings back any level the renderer holds newer).
+struct TextureRef {
+    uint32_t resource = 0;  // 0: none bound
+    int levels = 0;         // every level, the hidden ones of AUTOGENMIPMAP included
+    bool volume = false;
+    const FormatInfo* format = nullptr;
+    SurfaceDesc level0;     // level 0 (generation as the front knows it)
+};
+
 // One DrawPrimitiveUP, resolved by the front.
 struct DrawCall {
     ps11::HardwareConfig hardware;  // class, profile, MaxValue, filter weights
@@ -66,8 +91,14 @@ struct DrawCall {
     // stage's sampler state.
     std::array<std::shared_ptr<const ps11::Texture>, kMaxSamplers> textures;
     std::array<ps11::SamplerState, kMaxSamplers> samplers;
+    // For renderers that keep copies (Renderer::keepsCopies): the bound textures by identity,
+    // `textures` left empty; textureView(s) gives the front's sampler view of stage s when the
+    // renderer needs it (null when it cannot be made).
+    std::array<TextureRef, kMaxSamplers> textureRefs;
+    std::function<std::shared_ptr<const ps11::Texture>(int stage)> textureView;
     MergeState merge;
     MergeTarget target;         // colour image and depth image (null: none)
+    SurfaceDesc colorSurface, depthSurface;  // the same surfaces by identity (depth: when bound)
     ClipRect clip;              // viewport ∩ scissor ∩ target, in pixels
     uint64_t usedAttributes = 0;  // what the vertices carry to the pixel stage (program, fog)
     uint32_t primitiveCount = 0;
@@ -83,12 +114,61 @@ struct RendererError {
     std::string message;  // without the code: "the executor refused pixel shader 3"
 };
 
+// A rectangle of pixels, x1 and y1 exclusive.
+struct PixelBox {
+    int64_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+// One Clear, resolved by the front: the boxes (viewport ∩ scissor ∩ rects, inside the surfaces)
+// and what each cleared texel becomes.
+struct ClearCall {
+    SurfaceDesc color;              // not valid: the colour target is not cleared
+    SurfaceDesc depth;              // not valid: neither depth nor stencil is cleared
+    std::vector<PixelBox> boxes;
+    std::array<uint8_t, 16> colorTexel{};  // the colour in the target's format (format->bytes bytes)
+    uint32_t depthKeep = 0, depthSet = 0;  // the stored depth word becomes (old & keep) | set
+};
+
+// One StretchRect, resolved by the front (rects checked, surfaces distinct, formats drawable).
+struct StretchCall {
+    SurfaceDesc source, dest;
+    PixelBox sourceRect, destRect;
+    bool linear = false;             // D3DTEXF_LINEAR (else POINT)
+    bool fixedPoint = false;         // fx profiles: 8-bit sub-texel weights
+    ps11::SignedDecode decode = ps11::SignedDecode::Snorm;
+};
+
+// Counts of what crossed between the front's images and a renderer's copies.
+struct TransferStats {
+    uint64_t uploads = 0, uploadBytes = 0;      // front image → renderer copy
+    uint64_t readBacks = 0, readBackBytes = 0;  // renderer copy → front image
+    TransferStats& operator+=(const TransferStats& o);
+};
+
 class Renderer {
 public:
     virtual ~Renderer() = default;
     // Draws the call into call.target, adding to `stats` (pixels, instructions, texels,
     // triangles drawn). False with `error` set when it cannot (nothing was written then).
     virtual bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) = 0;
+    // Clear and StretchRect. False when this renderer does not do this call: the front then
+    // brings the surfaces back, does it in its own images (emu/blit.h) and the renderer's
+    // copies follow by generation.
+    virtual bool clear(const ClearCall& call) = 0;
+    virtual bool stretchRect(const StretchCall& call) = 0;
+    // Whether the renderer keeps its own copies of surfaces (then the front calls readBack
+    // before it reads or writes a level the renderer wrote, and release when a resource dies).
+    virtual bool keepsCopies() const { return false; }
+    // Writes the renderer's copy of the surface into surface.image.
+    virtual void readBack(const SurfaceDesc& surface) { (void)surface; }
+    // The resource is gone: its copies can go.
+    virtual void release(uint32_t resource) { (void)resource; }
+    // Returns when every call so far has finished (for timings; the software renderer's calls
+    // finish before they return).
+    virtual void finish() {}
+    // Uploads and read-backs so far.
+    virtual TransferStats transfers() const { return {}; }
     // "software" (the name `ps11 test --stats` and the docs use).
     virtual const char* name() const = 0;
 };

@@ -50,6 +50,10 @@ struct Resource {
     std::vector<Handle> surfaces;  // per exposed level: GetSurfaceLevel's handle, Null until asked
     bool mipsDirty = false;        // AUTOGENMIPMAP: level 0 changed since the last generation
     uint64_t generation = 0;       // bumped by every write; the sampler's copy follows it
+    // Per level: the generation of its last write (a renderer's copy follows it), and whether
+    // the renderer holds newer contents than `levels` (its write, not yet read back).
+    std::vector<uint64_t> levelGeneration;
+    std::vector<uint8_t> rendererNewer;
     uint64_t sampledGeneration = ~uint64_t(0);
     std::shared_ptr<const ps11::Texture> sampled;  // the sampler's view (see Device::sampledTexture)
 

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "emu/aligned_pass.h"
+#include "emu/blit.h"
 #include "emu/thread_pool.h"
 #include "ps11/diagnostics.h"
 
@@ -54,6 +55,16 @@ struct SoftwareDrawContext {
 SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_options(options) {}
 
 SoftwareRenderer::~SoftwareRenderer() = default;
+
+bool SoftwareRenderer::clear(const ClearCall& call) {
+    clearImages(call);
+    return true;
+}
+
+bool SoftwareRenderer::stretchRect(const StretchCall& call) {
+    stretchImages(call);
+    return true;
+}
 
 bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& error) {
     if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);

@@ -25,6 +25,9 @@ public:
     explicit SoftwareRenderer(const SoftwareRendererOptions& options);
     ~SoftwareRenderer() override;
     bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) override;
+    // In the front's images (emu/blit.h): the software renderer keeps no copies.
+    bool clear(const ClearCall& call) override;
+    bool stretchRect(const StretchCall& call) override;
     const char* name() const override { return "software"; }
     const SoftwareRendererOptions& options() const { return m_options; }
 

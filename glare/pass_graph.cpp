@@ -181,9 +181,14 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         PassStats s;
         s.pass = p.info.name;
         PassContext ctx{pool.device(), s, error, *this};
+        const emu::TransferStats before = pool.device().transfers();
         const auto start = std::chrono::steady_clock::now();
         const bool ok = p.execute ? p.execute(ctx) : true;
+        pool.device().finish();  // a renderer that queues work (GL) has done this pass's
         s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        const emu::TransferStats after = pool.device().transfers();
+        s.uploads = after.uploads - before.uploads;
+        s.readBacks = after.readBacks - before.readBacks;
         if (!ok) {
             if (error.empty()) error = "pass " + p.info.name + " failed";
             releaseAll();

@@ -55,6 +55,9 @@ struct PassStats {
     std::string pass;
     double milliseconds = 0;
     uint64_t draws = 0, pixels = 0, texels = 0, instructions = 0;
+    // Surfaces that crossed between the device front and a renderer that keeps copies (the GL
+    // renderer): uploaded to it, read back from it.
+    uint64_t uploads = 0, readBacks = 0;
 };
 
 // Device textures by description, kept between frames and runs: a graph takes one when a

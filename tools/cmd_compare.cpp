@@ -425,7 +425,7 @@ int cmdCompare(const std::vector<std::string>& args) {
     if (opts.random < 0 && input.empty()) return usageError("missing SHADER.psh or FILE.ps11test (or --random N)");
     if (opts.random >= 0 && !input.empty()) return usageError("--random takes no input file");
     std::string error;
-    const RendererFactory gl = glRendererFactory(glName, error, opts.glFiltering);
+    const RendererFactory gl = glRendererFactory(glName, error, false, opts.glFiltering);
     if (!gl) {
         std::cerr << "ps11 compare: " << error << "\n";
         return cli::kUserError;

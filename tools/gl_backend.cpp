@@ -22,22 +22,9 @@ Shared& shared() {
     return *s;
 }
 
-// A device's handle on the shared renderer.
-class SharedGlRenderer final : public emu::Renderer {
-public:
-    explicit SharedGlRenderer(std::shared_ptr<emu::gl::GlRenderer> r) : m_renderer(std::move(r)) {}
-    bool draw(const emu::DrawCall& call, emu::DrawStats& stats, emu::RendererError& error) override {
-        return m_renderer->draw(call, stats, error);
-    }
-    const char* name() const override { return "gl"; }
-
-private:
-    std::shared_ptr<emu::gl::GlRenderer> m_renderer;
-};
-
 }  // namespace
 
-RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool hardwareFiltering) {
+RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool native, bool hardwareFiltering) {
     Shared& s = shared();
     if (!s.tried) {
         s.tried = true;
@@ -51,7 +38,8 @@ RendererFactory glRendererFactory(const std::string& kind, std::string& error, b
         return {};
     }
     std::shared_ptr<emu::gl::GlRenderer> r = s.renderer;
-    return [r] { return std::unique_ptr<emu::Renderer>(new SharedGlRenderer(r)); };
+    const emu::gl::GlMode mode = native ? emu::gl::GlMode::Native : emu::gl::GlMode::Exact;
+    return [r, mode] { return emu::gl::GlRenderer::forDevice(r, mode); };
 }
 
 std::string glRendererDescription() {
@@ -61,7 +49,7 @@ std::string glRendererDescription() {
            s.renderer->context().platform() + ")";
 }
 #else
-RendererFactory glRendererFactory(const std::string&, std::string& error, bool) {
+RendererFactory glRendererFactory(const std::string&, std::string& error, bool, bool) {
     error = "no GL renderer: the OpenGL backend is not in this build (configured with PS11_GL=OFF)";
     return {};
 }

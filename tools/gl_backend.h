@@ -17,8 +17,11 @@ using RendererFactory = std::function<std::unique_ptr<emu::Renderer>()>;
 // first call on a context of `kind` ("osmesa", "egl"; "" = the first that works, OSMesa then
 // EGL); an empty function with `error` set when there is none (no context, no OpenGL 4.5, or a
 // build without the GL backend). Later calls return the same renderer whatever kind they name.
-// `hardwareFiltering`: float profiles filter with GL's texture unit (GlRendererOptions).
-RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool hardwareFiltering = false);
+// `native`: the devices draw in the GL renderer's native mode (emu/gl/gl_renderer.h), else exact.
+// `hardwareFiltering` (exact mode): float profiles filter with GL's texture unit
+// (GlRendererOptions); only the first call's value counts.
+RendererFactory glRendererFactory(const std::string& kind, std::string& error, bool native = false,
+                                  bool hardwareFiltering = false);
 
 // The GL renderer's description for reports ("llvmpipe (LLVM 15.0.6, 256 bits), OpenGL 4.5 …"),
 // or "" before glRendererFactory succeeded.

@@ -408,6 +408,7 @@ struct RendererEval::Impl {
     emu::DrawCall call;
     bool writesDepth = false;
     emu::Image color, depth;
+    uint64_t generation = 0;  // of the two surfaces, as a front would count them
 };
 
 RendererEval::~RendererEval() = default;
@@ -481,11 +482,20 @@ std::optional<EvalOutcome> RendererEval::eval(const EvalInputs& in, std::string&
     }
     m.call.assemble = [&tri](uint32_t, uint32_t, std::vector<emu::ScreenTriangle>& out) { out.push_back(tri); };
     std::fill(m.color.bytes.begin(), m.color.bytes.end(), uint8_t(0));
+    // The surfaces as a front hands them to a renderer (emu/renderer.h): cleared here, so newer
+    // than any copy the renderer keeps; read back after the draw.
+    m.generation += 2;
+    m.call.colorSurface = emu::SurfaceDesc{1, 0, &m.color, m.generation, m.generation + 1};
+    if (m.writesDepth) m.call.depthSurface = emu::SurfaceDesc{2, 0, &m.depth, m.generation, m.generation + 1};
     emu::DrawStats stats;
     emu::RendererError rerr;
     if (!m.renderer->draw(m.call, stats, rerr)) {
         error = rerr.code + " " + rerr.message;
         return std::nullopt;
+    }
+    if (m.renderer->keepsCopies()) {
+        m.renderer->readBack(m.call.colorSurface);
+        if (m.writesDepth) m.renderer->readBack(m.call.depthSurface);
     }
     EvalOutcome out;
     out.killed = stats.pixelsWritten == 0;

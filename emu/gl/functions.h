@@ -15,6 +15,9 @@ typedef void(APIENTRYP PFNGLGENTEXTURESPROC)(GLsizei n, GLuint* textures);
 typedef void(APIENTRYP PFNGLDELETETEXTURESPROC)(GLsizei n, const GLuint* textures);
 typedef void(APIENTRYP PFNGLBINDTEXTUREPROC)(GLenum target, GLuint texture);
 typedef void(APIENTRYP PFNGLDRAWARRAYSPROC)(GLenum mode, GLint first, GLsizei count);
+typedef void(APIENTRYP PFNGLTEXSUBIMAGE2DPROC)(GLenum target, GLint level, GLint xoffset, GLint yoffset,
+                                               GLsizei width, GLsizei height, GLenum format, GLenum type,
+                                               const void* pixels);
 
 namespace emu::gl {
 
@@ -87,6 +90,13 @@ using GlProc = void (*)();
     X(PFNGLCLIPCONTROLPROC, ClipControl, "glClipControl") \
     X(PFNGLTEXTUREBARRIERPROC, TextureBarrier, "glTextureBarrier") \
     X(PFNGLGETTEXIMAGEPROC, GetTexImage, "glGetTexImage") \
+    X(PFNGLTEXSTORAGE2DPROC, TexStorage2D, "glTexStorage2D") \
+    X(PFNGLTEXSUBIMAGE2DPROC, TexSubImage2D, "glTexSubImage2D") \
+    X(PFNGLCLEARTEXSUBIMAGEPROC, ClearTexSubImage, "glClearTexSubImage") \
+    X(PFNGLCOPYIMAGESUBDATAPROC, CopyImageSubData, "glCopyImageSubData") \
+    X(PFNGLBLITFRAMEBUFFERPROC, BlitFramebuffer, "glBlitFramebuffer") \
+    X(PFNGLGETTEXTURESUBIMAGEPROC, GetTextureSubImage, "glGetTextureSubImage") \
+    X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray, "glDisableVertexAttribArray") \
     X(PFNGLGENQUERIESPROC, GenQueries, "glGenQueries") \
     X(PFNGLDELETEQUERIESPROC, DeleteQueries, "glDeleteQueries") \
     X(PFNGLBEGINQUERYPROC, BeginQuery, "glBeginQuery") \
@@ -96,7 +106,13 @@ using GlProc = void (*)();
     X(PFNGLDELETESAMPLERSPROC, DeleteSamplers, "glDeleteSamplers") \
     X(PFNGLBINDSAMPLERPROC, BindSampler, "glBindSampler") \
     X(PFNGLSAMPLERPARAMETERIPROC, SamplerParameteri, "glSamplerParameteri") \
-    X(PFNGLSAMPLERPARAMETERFVPROC, SamplerParameterfv, "glSamplerParameterfv")
+    X(PFNGLSAMPLERPARAMETERFVPROC, SamplerParameterfv, "glSamplerParameterfv") \
+    X(PFNGLBLENDFUNCSEPARATEPROC, BlendFuncSeparate, "glBlendFuncSeparate") \
+    X(PFNGLBLENDEQUATIONSEPARATEPROC, BlendEquationSeparate, "glBlendEquationSeparate") \
+    X(PFNGLBLENDCOLORPROC, BlendColor, "glBlendColor") \
+    X(PFNGLCOLORMASKPROC, ColorMask, "glColorMask") \
+    X(PFNGLDEPTHFUNCPROC, DepthFunc, "glDepthFunc") \
+    X(PFNGLDEPTHMASKPROC, DepthMask, "glDepthMask")
 
 // Called as gl.Clear(GL_COLOR_BUFFER_BIT): the GL name without its "gl".
 struct GlFunctions {

@@ -1,44 +1,32 @@
-// Renderer stage: the GL renderer (emu/gl/gl_renderer.h). Per draw: the program decoded as the
-// executor decodes it, the fragment shader generated (emu/gl/glsl.h) and cached by its text,
-// the triangle setups of the software rasteriser written as records (so both renderers shade
-// the same attribute values), textures uploaded as grid integers or float32 and cached per
-// texture object, the target and depth surfaces uploaded as raw words, the triangles drawn in
-// batches that do not overlap (a fragment reads the pixel it writes: ARB_texture_barrier), and
-// the surfaces read back.
+// Renderer stage: the GL renderer's draws (emu/gl/gl_renderer.h), in stages: the program (decoded
+// and translated once per configuration, then found by what determines it), the attributes (exact:
+// the software rasteriser's setups as records, so both renderers shade the same values; native:
+// the vertices as GL attributes), the bindings (resident surfaces and textures, samplers,
+// uniforms) and the draw. Nothing is read back here: the device front asks when it needs to
+// (gl_surfaces.cpp). Exact mode draws triangles in batches that do not overlap (a fragment reads
+// the pixel it writes: ARB_texture_barrier); native mode draws them in one call with GL's blend.
 #include "emu/gl/gl_renderer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <unordered_map>
+#include <type_traits>
 
+#include "emu/gl/gl_internal.h"
 #include "emu/gl/glsl.h"
+#include "emu/gl/native_merge.h"
+#include "emu/vertex.h"
 #include "ps11/diagnostics.h"
 
 namespace emu::gl {
 
 namespace {
 
-constexpr size_t kMaxCachedTextures = 64;
 constexpr size_t kMaxCachedPrograms = 256;
-constexpr int kUnitTri = 8, kUnitDstColor = 9, kUnitDstDepth = 10, kUnitUpload = 11;
-
-struct TextureEntry {
-    std::shared_ptr<const ps11::Texture> texture;  // kept alive: its address is the key
-    bool fx = false;
-    ps11::Precision precision = ps11::Precision::Fx8;
-    bool hardware = false;  // for GL's texture unit: 8-bit textures as GL_RGBA8
-    GLuint name = 0;
-    uint64_t lastUse = 0;
-};
-
-struct ProgramEntry {
-    GLuint program = 0;
-    uint64_t lastUse = 0;
-};
 
 bool hasExtension(const GlFunctions& gl, const char* name) {
     GLint n = 0;
@@ -77,173 +65,87 @@ bool expandTriangle(const double* x, const double* y, double d, double reach, do
     return true;
 }
 
-}  // namespace
 
-struct GlState {
-    const GlFunctions& gl;
-    explicit GlState(const GlFunctions& f) : gl(f) {}
-    GLuint vao = 0, vbo = 0, triBuffer = 0, triTexture = 0, fbo = 0, query = 0;
-    GLuint samplers[8] = {};  // GL sampler objects of hardware filtering
-    GLuint colorTex = 0, depthTex = 0;
-    GLuint vertexShader = 0;
-    std::unordered_map<std::string, ProgramEntry> programs;
-    std::vector<TextureEntry> textures;
-    uint64_t clock = 0;
-
-    ~GlState() {
-        for (auto& [k, p] : programs) gl.DeleteProgram(p.program);
-        for (auto& t : textures) gl.DeleteTextures(1, &t.name);
-        GLuint tex[3] = {triTexture, colorTex, depthTex};
-        gl.DeleteTextures(3, tex);
-        GLuint buf[2] = {vbo, triBuffer};
-        gl.DeleteBuffers(2, buf);
-        gl.DeleteVertexArrays(1, &vao);
-        gl.DeleteFramebuffers(1, &fbo);
-        gl.DeleteQueries(1, &query);
-        gl.DeleteSamplers(8, samplers);
-        if (vertexShader) gl.DeleteShader(vertexShader);
-    }
-
-    GLuint compile(GLenum type, const std::string& src, std::string& log) {
-        GLuint s = gl.CreateShader(type);
-        const char* text = src.c_str();
-        gl.ShaderSource(s, 1, &text, nullptr);
-        gl.CompileShader(s);
-        GLint ok = 0;
-        gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char buf[2048] = {};
-            gl.GetShaderInfoLog(s, sizeof buf - 1, nullptr, buf);
-            log = buf;
-            gl.DeleteShader(s);
-            return 0;
-        }
-        return s;
-    }
-
-    GLuint program(const std::string& fragment, std::string& log) {
-        auto it = programs.find(fragment);
-        if (it != programs.end()) {
-            it->second.lastUse = ++clock;
-            return it->second.program;
-        }
-        if (const char* dir = std::getenv("PS11_GL_DUMP_SHADERS")) {
-            // Every new fragment shader as DIR/ps11_fs_N.frag, for reading and debugging.
-            const std::string path = std::string(dir) + "/ps11_fs_" + std::to_string(programs.size()) + ".frag";
-            if (FILE* f = std::fopen(path.c_str(), "w")) {
-                std::fwrite(fragment.data(), 1, fragment.size(), f);
-                std::fclose(f);
-            }
-        }
-        if (!vertexShader && !(vertexShader = compile(GL_VERTEX_SHADER, vertexSource(), log))) return 0;
-        GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, log);
-        if (!fs) return 0;
-        GLuint p = gl.CreateProgram();
-        gl.AttachShader(p, vertexShader);
-        gl.AttachShader(p, fs);
-        gl.LinkProgram(p);
-        gl.DeleteShader(fs);
-        GLint ok = 0;
-        gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char buf[2048] = {};
-            gl.GetProgramInfoLog(p, sizeof buf - 1, nullptr, buf);
-            log = buf;
-            gl.DeleteProgram(p);
-            return 0;
-        }
-        if (programs.size() >= kMaxCachedPrograms) {
-            auto oldest = std::min_element(programs.begin(), programs.end(), [](const auto& a, const auto& b) {
-                return a.second.lastUse < b.second.lastUse;
-            });
-            gl.DeleteProgram(oldest->second.program);
-            programs.erase(oldest);
-        }
-        programs.emplace(fragment, ProgramEntry{p, ++clock});
-        return p;
-    }
-
-    // The GL texture of a ps11 texture in the profile's terms (grid integers or float32).
-    GLuint texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::Precision precision, bool hardware) {
-        const bool fx = ps11::isFixedPoint(precision);
-        for (TextureEntry& e : textures)
-            if (e.texture == tex && e.fx == fx && e.hardware == hardware && (!fx || e.precision == precision)) {
-                e.lastUse = ++clock;
-                return e.name;
-            }
-        if (textures.size() >= kMaxCachedTextures) {
-            auto oldest = std::min_element(textures.begin(), textures.end(),
-                                           [](const auto& a, const auto& b) { return a.lastUse < b.lastUse; });
-            gl.DeleteTextures(1, &oldest->name);
-            textures.erase(oldest);
-        }
-        GLuint name = 0;
-        gl.GenTextures(1, &name);
-        const GLenum target = tex->isVolume() ? GL_TEXTURE_3D : GL_TEXTURE_2D;
-        gl.ActiveTexture(GL_TEXTURE0 + kUnitUpload);  // not a unit a draw samples
-        gl.BindTexture(target, name);
-        gl.TexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl.TexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        gl.TexParameteri(target, GL_TEXTURE_BASE_LEVEL, 0);
-        gl.TexParameteri(target, GL_TEXTURE_MAX_LEVEL, tex->levelCount() - 1);
-        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        for (int l = 0; l < tex->levelCount(); ++l) {
-            const ps11::TextureLevelInfo& li = tex->level(l);
-            const size_t n = size_t(li.width) * li.height * li.depth;
-            if (hardware && !fx && tex->storage() == ps11::TexelStorage::Unorm8) {
-                // b g r a bytes: GL_BGRA with GL_UNSIGNED_BYTE reads them as they are.
-                const uint8_t* bytes = tex->unorm8() + li.offset * 4;
-                if (tex->isVolume())
-                    gl.TexImage3D(target, l, GL_RGBA8, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
-                                  GL_BGRA, GL_UNSIGNED_BYTE, bytes);
-                else
-                    gl.TexImage2D(target, l, GL_RGBA8, GLsizei(li.width), GLsizei(li.height), 0, GL_BGRA,
-                                  GL_UNSIGNED_BYTE, bytes);
-            } else if (fx && tex->storage() == ps11::TexelStorage::Unorm8) {
-                // The bytes as they are (b g r a: GL_BGRA_INTEGER); the shader scales them to the grid.
-                const uint8_t* bytes = tex->unorm8() + li.offset * 4;
-                if (tex->isVolume())
-                    gl.TexImage3D(target, l, GL_RGBA8UI, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
-                                  GL_BGRA_INTEGER, GL_UNSIGNED_BYTE, bytes);
-                else
-                    gl.TexImage2D(target, l, GL_RGBA8UI, GLsizei(li.width), GLsizei(li.height), 0, GL_BGRA_INTEGER,
-                                  GL_UNSIGNED_BYTE, bytes);
-            } else if (fx) {
-                std::vector<int32_t> data(n * 4);
-                size_t i = 0;
-                for (uint32_t z = 0; z < li.depth; ++z)
-                    for (uint32_t y = 0; y < li.height; ++y)
-                        for (uint32_t x = 0; x < li.width; ++x, ++i) {
-                            const auto g = tex->texelGrid(l, x, y, z, precision);
-                            std::memcpy(&data[i * 4], g.data(), 16);
-                        }
-                if (tex->isVolume())
-                    gl.TexImage3D(target, l, GL_RGBA32I, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
-                                  GL_RGBA_INTEGER, GL_INT, data.data());
-                else
-                    gl.TexImage2D(target, l, GL_RGBA32I, GLsizei(li.width), GLsizei(li.height), 0, GL_RGBA_INTEGER,
-                                  GL_INT, data.data());
-            } else {
-                std::vector<float> data(n * 4);
-                size_t i = 0;
-                for (uint32_t z = 0; z < li.depth; ++z)
-                    for (uint32_t y = 0; y < li.height; ++y)
-                        for (uint32_t x = 0; x < li.width; ++x, ++i) {
-                            const ps11::Vec4 v = tex->texelValue(l, x, y, z);
-                            for (int c = 0; c < 4; ++c) data[i * 4 + size_t(c)] = v[size_t(c)];
-                        }
-                if (tex->isVolume())
-                    gl.TexImage3D(target, l, GL_RGBA32F, GLsizei(li.width), GLsizei(li.height), GLsizei(li.depth), 0,
-                                  GL_RGBA, GL_FLOAT, data.data());
-                else
-                    gl.TexImage2D(target, l, GL_RGBA32F, GLsizei(li.width), GLsizei(li.height), 0, GL_RGBA, GL_FLOAT,
-                                  data.data());
-            }
-        }
-        textures.push_back(TextureEntry{tex, fx, precision, hardware, name, ++clock});
-        return name;
+// FNV-1a over the values that determine a program's GLSL.
+struct KeyHash {
+    uint64_t h = 1469598103934665603ull;
+    template <class T>
+    KeyHash& operator<<(const T& v) {
+        static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+        uint64_t x = 0;
+        std::memcpy(&x, &v, std::min(sizeof v, sizeof x));
+        for (int i = 0; i < 8; ++i) h = (h ^ ((x >> (8 * i)) & 0xff)) * 1099511628211ull;
+        return *this;
     }
 };
+
+// Everything the GLSL writer reads besides the program itself.
+uint64_t programKey(uint64_t space, const DrawProgram& prog, const ps11::HardwareConfig& hw, const FragmentSpec& spec) {
+    KeyHash k;
+    k << space << prog.key << uintptr_t(hw.hardware) << hw.precision << hw.maxValue << spec.weightBits << spec.usedAttributes
+      << spec.shaderDepth << spec.wantZ << spec.hardwareFiltering << spec.native;
+    for (const ps11::StageState& s : prog.stages)
+        k << s.clampLuminance << s.transformFlags << s.coordComponents << s.textureDimensions;
+    for (const StageSpec& s : spec.stages) {
+        k << s.bound << s.volume << s.levels << s.unorm8 << s.packedWords << s.borderInRange << s.state.minFilter << s.state.magFilter
+          << s.state.mipFilter << s.state.addressU << s.state.addressV << s.state.addressW;
+    }
+    const Plan& p = spec.merge;
+    k << p.precision << p.alphaTest << p.depthTest << p.depthWrite << p.fog << p.blend << p.alphaMask << p.depthMask
+      << p.alphaRef << p.channels << p.target << p.depthKind;
+    for (uint8_t b : p.fogByte) k << b;
+    for (uint8_t b : p.bfByte) k << b;
+    for (const ChannelPlan& c : p.ch)
+        k << c.src.slot << c.src.inv << c.dst.slot << c.dst.inv << c.kind << c.cs << c.cd;
+    return k.h;
+}
+
+std::string glErrorText(GLenum e) {
+    char b[32];
+    std::snprintf(b, sizeof b, "OpenGL error 0x%x", unsigned(e));
+    return b;
+}
+
+}  // namespace
+
+const char* glModeName(GlMode mode) { return mode == GlMode::Native ? "native" : "exact"; }
+
+bool parseGlMode(const std::string& text, GlMode& mode) {
+    if (text == "exact") mode = GlMode::Exact;
+    else if (text == "native") mode = GlMode::Native;
+    else return false;
+    return true;
+}
+
+// A device's renderer: its own space of resident surfaces on the shared context.
+class DeviceRenderer final : public Renderer {
+public:
+    DeviceRenderer(std::shared_ptr<GlRenderer> gl, GlMode mode) : m_gl(std::move(gl)) {
+        static std::atomic<uint64_t> serial{0};
+        m_space.mode = mode;
+        m_space.serial = ++serial;
+    }
+    ~DeviceRenderer() override { m_gl->releaseAll(m_space); }
+    bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) override {
+        return m_gl->draw(m_space, call, stats, error);
+    }
+    bool clear(const ClearCall& call) override { return m_gl->clear(m_space, call); }
+    bool stretchRect(const StretchCall& call) override { return m_gl->stretchRect(m_space, call); }
+    bool keepsCopies() const override { return true; }
+    void readBack(const SurfaceDesc& surface) override { m_gl->readBack(m_space, surface); }
+    void release(uint32_t resource) override { m_gl->release(m_space, resource); }
+    TransferStats transfers() const override { return m_space.transfers; }
+    void finish() override { m_gl->finish(); }
+    const char* name() const override { return m_space.mode == GlMode::Native ? "gl-native" : "gl"; }
+
+private:
+    std::shared_ptr<GlRenderer> m_gl;
+    GlSpace m_space;
+};
+
+std::unique_ptr<Renderer> GlRenderer::forDevice(std::shared_ptr<GlRenderer> shared, GlMode mode) {
+    return std::make_unique<DeviceRenderer>(std::move(shared), mode);
+}
 
 std::unique_ptr<GlRenderer> GlRenderer::create(const GlRendererOptions& options, std::string& error) {
     std::unique_ptr<GlRenderer> r(new GlRenderer);
@@ -265,16 +167,19 @@ std::unique_ptr<GlRenderer> GlRenderer::create(const GlRendererOptions& options,
     gl.GenVertexArrays(1, &st.vao);
     gl.GenBuffers(1, &st.vbo);
     gl.GenBuffers(1, &st.triBuffer);
+    gl.GenBuffers(1, &st.tapBuffer);
     gl.GenTextures(1, &st.triTexture);
-    gl.GenTextures(1, &st.colorTex);
-    gl.GenTextures(1, &st.depthTex);
+    gl.GenTextures(1, &st.tapTexture);
     gl.GenFramebuffers(1, &st.fbo);
+    gl.GenFramebuffers(1, &st.readFbo);
     gl.GenQueries(1, &st.query);
     gl.GenSamplers(8, st.samplers);
     r->m_hardwareFiltering = options.hardwareFiltering;
-    // D3D's window convention: y down, pixel rows from the top (the fill rule follows it).
-    gl.ClipControl(GL_UPPER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     return r;
+}
+
+void GlRenderer::finish() {
+    if (m_context->makeCurrent()) m_context->gl().Finish();
 }
 
 GlRenderer::~GlRenderer() {
@@ -282,63 +187,227 @@ GlRenderer::~GlRenderer() {
     m_state.reset();
 }
 
-bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& error) {
-    auto refuse = [&](const std::string& why) {
-        error.hr = D3DERR_INVALIDCALL;
-        error.code = "E4122";
-        error.message = "the GL renderer cannot draw this call: " + why;
+namespace {
+
+// The stage's texture as the shader needs it: a resident surface when the renderer holds one it
+// can sample as it is, else the front's sampler view uploaded (cached by texture object).
+struct Binding {
+    GLuint name = 0;
+    bool volume = false;
+    int levels = 1;
+    bool unorm8 = false;
+    bool packed = false;  // a resident surface's raw words (StageSpec::packedWords)
+};
+
+}  // namespace
+
+bool GlRenderer::draw(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+    if (!m_context->makeCurrent()) {
+        error = RendererError{D3DERR_INVALIDCALL, "E4122", "the GL renderer cannot draw this call: its context could not be made current"};
         return false;
-    };
-    if (!m_context->makeCurrent()) return refuse("its context could not be made current");
-    const GlFunctions& gl = m_context->gl();
-    GlState& st = *m_state;
-    const DrawProgram& prog = call.program;
+    }
+    return space.mode == GlMode::Native ? drawNative(space, call, stats, error) : drawExact(space, call, stats, error);
+}
 
-    // ---- the program, decoded as the executor decodes it ----
-    ps11::Diagnostics diags;
-    ps11::exec::DecodedProgram decoded;
-    if (!ps11::exec::decodeProgram(*prog.program, ps11::executorOptionsFor(call.hardware), diags, decoded))
-        return refuse("the program cannot be run (" +
-                      (diags.all().empty() ? std::string("?") : diags.all()[0].message) + ")");
-    for (int s = 0; s < 8; ++s) decoded.profile.stages[size_t(s)] = prog.stages[size_t(s)];
-    const ps11::Precision precision = call.hardware.precision;
-    const bool fx = ps11::isFixedPoint(precision);
+namespace {
 
-    bool planOk = false;
-    const Plan plan = makePlan(call.merge, call.target, planOk);
-    if (!planOk) return refuse("the render target or depth surface format is not one the merger stores");
-    Image* color = call.target.color;
-    Image* depth = plan.depthTest ? call.target.depth : nullptr;
-    if (!color && !depth) return true;
-
+// The program stage shared by both modes: the stage specs from the bindings, then the program
+// found by its key, or decoded, translated and linked once.
+struct ProgramStage {
     FragmentSpec spec;
-    spec.program = &decoded;
-    spec.precision = precision;
-    spec.weightBits = call.hardware.weightBits;
-    spec.usedAttributes = call.usedAttributes;
-    spec.merge = plan;
-    spec.shaderDepth = decoded.writesDepth;
-    spec.wantZ = call.merge.depthTest || (call.merge.depthWrite && call.target.depth);
-    spec.hardwareFiltering = m_hardwareFiltering && !fx;
+    std::array<Binding, 8> bindings;
+    ProgramEntry* entry = nullptr;
+};
+
+}  // namespace
+
+static bool resolveBindings(GlState& st, GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
+                            std::string& why) {
+    const ps11::Precision precision = call.hardware.precision;
+    const bool fx = ps11::isFixedPoint(precision) && !native;
     for (int s = 0; s < 8; ++s) {
-        if (!((decoded.stagesUsed >> s) & 1)) continue;
-        const auto& tex = call.textures[size_t(s)];
-        StageSpec& ss = spec.stages[size_t(s)];
-        ss.bound = tex && tex->levelCount() > 0;
-        if (!ss.bound) continue;
-        ss.volume = tex->isVolume();
-        ss.levels = tex->levelCount();
+        const TextureRef& ref = call.textureRefs[size_t(s)];
+        Binding& b = ps.bindings[size_t(s)];
+        StageSpec& ss = ps.spec.stages[size_t(s)];
+        if (ref.resource == 0 && !call.textures[size_t(s)]) continue;
+        NativeFormat nf;
+        const bool single = ref.resource != 0 && ref.levels == 1 && !ref.volume;
+        if (single && !native && fx && ref.format->format == D3DFMT_A8R8G8B8) {
+            // The resident words, seen as 8-bit texels: no conversion, no read-back.
+            b.name = st.resident(space, ref.level0).tex;
+            b.unorm8 = b.packed = true;
+        } else if (single && native && nativeFormatOf(*ref.format, nf) && !nf.depth) {
+            b.name = st.resident(space, ref.level0).tex;
+        } else {
+            // A texture given as a sampler view (a caller without a front), or the front's view.
+            const std::shared_ptr<const ps11::Texture> view =
+                ref.resource == 0 ? call.textures[size_t(s)] : call.textureView(s);
+            if (!view) {
+                why = "texture " + std::to_string(ref.resource) + " on stage " + std::to_string(s) +
+                      " has no sampler view";
+                return false;
+            }
+            if (view->levelCount() == 0) continue;
+            b.name = st.texture(view, precision, native || ps.spec.hardwareFiltering);
+            b.volume = view->isVolume();
+            b.levels = view->levelCount();
+            b.unorm8 = fx && view->storage() == ps11::TexelStorage::Unorm8;
+        }
+        if (!b.volume && b.levels == 1 && b.name == 0) continue;
+        ss.bound = true;
+        ss.volume = b.volume;
+        ss.levels = b.levels;
         ss.state = call.samplers[size_t(s)];
-        ss.unorm8 = fx && tex->storage() == ps11::TexelStorage::Unorm8;
+        ss.unorm8 = b.unorm8;
+        ss.packedWords = b.packed;
         ss.borderInRange = true;
         for (int c = 0; c < 4 && fx; ++c) {
             const int32_t g = ps11::toGrid(double(ss.state.border[size_t(c)]), precision);
             ss.borderInRange = ss.borderInRange && g >= 0 && g <= ps11::gridScale(precision);
         }
     }
+    return true;
+}
+
+static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
+                                 std::string& why) {
+    const GlFunctions& gl = st.gl;
+    const DrawProgram& prog = call.program;
+    const uint64_t key = programKey(space.serial, prog, call.hardware, ps.spec);
+    auto it = st.programs.find(key);
+    if (it != st.programs.end()) {
+        it->second.lastUse = ++st.clock;
+        return &it->second;
+    }
+    // Native mode runs the program in float32 with the class's MaxValue clamp, whatever the
+    // emulated card's profile.
+    ps11::HardwareConfig hw = call.hardware;
+    if (native) hw.precision = ps11::Precision::Float;
+    ps11::Diagnostics diags;
+    auto decoded = std::make_unique<ps11::exec::DecodedProgram>();
+    if (!ps11::exec::decodeProgram(*prog.program, ps11::executorOptionsFor(hw), diags, *decoded)) {
+        why = "the program cannot be run (" + (diags.all().empty() ? std::string("?") : diags.all()[0].message) + ")";
+        return nullptr;
+    }
+    for (int s = 0; s < 8; ++s) decoded->profile.stages[size_t(s)] = prog.stages[size_t(s)];
+    ps.spec.program = decoded.get();
+    ps.spec.shaderDepth = decoded->writesDepth;  // r0's depth from texdepth / texm3x2depth
+    const std::string fragment = fragmentSource(ps.spec);
+    if (const char* dir = std::getenv("PS11_GL_DUMP_SHADERS")) {
+        // Every new fragment shader as DIR/ps11_fs_N.frag, for reading and debugging.
+        const std::string path = std::string(dir) + "/ps11_fs_" + std::to_string(st.programs.size()) + ".frag";
+        if (FILE* f = std::fopen(path.c_str(), "w")) {
+            std::fwrite(fragment.data(), 1, fragment.size(), f);
+            std::fclose(f);
+        }
+    }
     std::string log;
-    const GLuint program = st.program(fragmentSource(spec), log);
-    if (!program) return refuse("its shader did not compile: " + log.substr(0, 400));
+    GLuint& vs = native ? st.nativeVertexShader : st.vertexShader;
+    if (!vs && !(vs = st.compile(GL_VERTEX_SHADER, native ? nativeVertexSource() : vertexSource(), log))) {
+        why = "its vertex shader did not compile: " + log.substr(0, 400);
+        return nullptr;
+    }
+    const GLuint program = st.link(vs, fragment, log);
+    if (!program) {
+        why = "its shader did not compile: " + log.substr(0, 400);
+        return nullptr;
+    }
+    if (st.programs.size() >= kMaxCachedPrograms) {
+        auto oldest = std::min_element(st.programs.begin(), st.programs.end(),
+                                       [](const auto& a, const auto& b) { return a.second.lastUse < b.second.lastUse; });
+        gl.DeleteProgram(oldest->second.program);
+        st.programs.erase(oldest);
+    }
+    ProgramEntry e;
+    e.program = program;
+    e.lastUse = ++st.clock;
+    e.decoded = std::move(decoded);
+    auto loc = [&](const char* n) { return gl.GetUniformLocation(program, n); };
+    e.constG = loc("uConstG"), e.constF = loc("uConstF"), e.bump = loc("uBump"), e.lum = loc("uLum");
+    e.borderG = loc("uBorderG"), e.borderF = loc("uBorderF"), e.stride = loc("uStride"), e.tri = loc("uTri");
+    e.dstColor = loc("uDstColor"), e.dstDepth = loc("uDstDepth"), e.xform = loc("uXform");
+    e.primBase = loc("uPrimBase");
+    for (int s = 0; s < 8; ++s) e.tex[s] = loc(("uT" + std::to_string(s)).c_str());
+    return &st.programs.emplace(key, std::move(e)).first->second;
+}
+
+// Textures, samplers and the program's uniforms (constants, bump and luminance, borders).
+static void bindProgram(GlState& st, const DrawCall& call, bool native, const ProgramStage& ps, uint32_t W,
+                        uint32_t H) {
+    const GlFunctions& gl = st.gl;
+    const ProgramEntry& e = *ps.entry;
+    const ps11::exec::DecodedProgram& decoded = *e.decoded;
+    const ps11::Precision precision = native ? ps11::Precision::Float : call.hardware.precision;
+    const bool fx = ps11::isFixedPoint(precision);
+    gl.UseProgram(e.program);
+    for (int s = 0; s < 8; ++s) {
+        const StageSpec& ss = ps.spec.stages[size_t(s)];
+        if (!ss.bound) continue;
+        gl.ActiveTexture(GL_TEXTURE0 + GLenum(s));
+        gl.BindTexture(ss.volume ? GL_TEXTURE_3D : GL_TEXTURE_2D, ps.bindings[size_t(s)].name);
+        if (native || ps.spec.hardwareFiltering)
+            st.bindSampler(s, call.samplers[size_t(s)]);
+        else
+            gl.BindSampler(GLuint(s), 0);
+        if (e.tex[s] >= 0) gl.Uniform1i(e.tex[s], s);
+    }
+    int32_t constG[8][4];
+    float constF[8][4], bump[8][4], lum[8][2], borderF[8][4];
+    int32_t borderG[8][4];
+    for (int i = 0; i < 8; ++i) {
+        const auto& v = (decoded.defMask >> i) & 1 ? decoded.defs[size_t(i)] : call.program.constants[size_t(i)];
+        for (int c = 0; c < 4; ++c) ps11::exec::constantOf(precision, v[size_t(c)], constG[i][c], constF[i][c]);
+        const ps11::StageState& ss = call.program.stages[size_t(i)];
+        for (int c = 0; c < 4; ++c) bump[i][c] = ss.bumpMat[size_t(c)];
+        lum[i][0] = ss.lumScale, lum[i][1] = ss.lumOffset;
+        const ps11::SamplerState& sm = call.samplers[size_t(i)];
+        for (int c = 0; c < 4; ++c) {
+            borderF[i][c] = sm.border[size_t(c)];
+            // The sampler's border on the grid (ps11::TextureSampler::setSamplerState).
+            borderG[i][c] = fx ? std::clamp(ps11::toGrid(double(sm.border[size_t(c)]), precision), -ps11::kMaxTexelGrid,
+                                            ps11::kMaxTexelGrid)
+                               : 0;
+        }
+    }
+    if (e.constG >= 0) gl.Uniform4iv(e.constG, 8, &constG[0][0]);
+    if (e.constF >= 0) gl.Uniform4fv(e.constF, 8, &constF[0][0]);
+    if (e.bump >= 0) gl.Uniform4fv(e.bump, 8, &bump[0][0]);
+    if (e.lum >= 0) gl.Uniform2fv(e.lum, 8, &lum[0][0]);
+    if (e.borderG >= 0) gl.Uniform4iv(e.borderG, 8, &borderG[0][0]);
+    if (e.borderF >= 0) gl.Uniform4fv(e.borderF, 8, &borderF[0][0]);
+    // Window x, y (pixel edges at integers, rows down) to clip space under GL_UPPER_LEFT.
+    if (e.xform >= 0) gl.Uniform4f(e.xform, 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
+}
+
+bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+    auto refuse = [&](const std::string& why) {
+        error.hr = D3DERR_INVALIDCALL;
+        error.code = "E4122";
+        error.message = "the GL renderer cannot draw this call: " + why;
+        return false;
+    };
+    const GlFunctions& gl = m_context->gl();
+    GlState& st = *m_state;
+    bool planOk = false;
+    const Plan plan = makePlan(call.merge, call.target, planOk);
+    if (!planOk) return refuse("the render target or depth surface format is not one the merger stores");
+    Image* color = call.target.color;
+    const bool useDepth = plan.depthTest && call.target.depth && call.depthSurface.valid();
+    if (!color || !call.colorSurface.valid()) return refuse("the draw has no render target");
+
+    // ---- program ----
+    ProgramStage ps;
+    FragmentSpec& spec = ps.spec;
+    spec.precision = call.hardware.precision;
+    spec.weightBits = call.hardware.weightBits;
+    spec.usedAttributes = call.usedAttributes;
+    spec.merge = plan;
+    spec.wantZ = call.merge.depthTest || (call.merge.depthWrite && call.target.depth);
+    spec.hardwareFiltering = m_hardwareFiltering && !ps11::isFixedPoint(spec.precision);
+    std::string why;
+    if (!resolveBindings(st, space, call, false, ps, why)) return refuse(why);
+    ps.entry = findProgram(st, space, call, false, ps, why);
+    if (!ps.entry) return refuse(why);
 
     // ---- triangles: the software rasteriser's setups as records ----
     const uint64_t used = call.usedAttributes;
@@ -392,125 +461,20 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     stats.trianglesDrawn += boxes.size();
     if (boxes.empty()) return true;
 
-    // ---- surfaces as raw words: 1, 2 or 4 32-bit words a pixel (R32UI, RG32UI, RGBA32UI) ----
-    const uint32_t W = color ? color->width : depth->width, H = color ? color->height : depth->height;
-    std::vector<uint32_t> words;
-    auto wordsOf = [](const Image& img) { return (img.format->bytes + 3) / 4; };
-    auto formats = [](uint32_t n, GLenum& internal, GLenum& format) {
-        internal = n == 1 ? GL_R32UI : n == 2 ? GL_RG32UI : GL_RGBA32UI;
-        format = n == 1 ? GL_RED_INTEGER : n == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER;
-    };
-    auto upload = [&](GLuint tex, const Image& img) {
-        const uint32_t n = wordsOf(img), bytes = img.format->bytes;
-        words.assign(size_t(img.width) * img.height * n, 0);
-        for (uint32_t y = 0; y < img.height; ++y) {
-            uint8_t* dst = reinterpret_cast<uint8_t*>(&words[size_t(y) * img.width * n]);
-            if (bytes == 4 * n)
-                std::memcpy(dst, img.texel(0, y), size_t(img.width) * bytes);
-            else
-                for (uint32_t x = 0; x < img.width; ++x) std::memcpy(dst + size_t(x) * 4 * n, img.texel(x, y), bytes);
-        }
-        GLenum internal, format;
-        formats(n, internal, format);
-        gl.BindTexture(GL_TEXTURE_2D, tex);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
-        gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-        gl.TexImage2D(GL_TEXTURE_2D, 0, GLint(internal), GLsizei(img.width), GLsizei(img.height), 0, format,
-                      GL_UNSIGNED_INT, words.data());
-    };
-    // Without a colour target the colour attachment only sizes the framebuffer (never written).
-    emu::Image none;
-    if (!color) {
-        none.format = depth->format;
-        none.width = W, none.height = H;
-        none.rowPitch = W * depth->format->bytes;
-        none.bytes.assign(size_t(none.rowPitch) * H, 0);
-    }
+    // ---- bindings: the resident target and depth words, textures, uniforms, records ----
+    Resident& rc = st.resident(space, call.colorSurface);
+    Resident* rd = useDepth ? &st.resident(space, call.depthSurface) : nullptr;
+    const uint32_t W = rc.width, H = rc.height;
+    bindProgram(st, call, false, ps, W, H);
+    const ProgramEntry& e = *ps.entry;
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstColor);
-    upload(st.colorTex, color ? *color : none);
+    gl.BindTexture(GL_TEXTURE_2D, rc.tex);
     gl.ActiveTexture(GL_TEXTURE0 + kUnitDstDepth);
-    if (depth) upload(st.depthTex, *depth);
-
-    // ---- textures and uniforms ----
-    gl.UseProgram(program);
-    for (int s = 0; s < 8; ++s) {
-        if (!spec.stages[size_t(s)].bound) continue;
-        const GLuint name = st.texture(call.textures[size_t(s)], precision, spec.hardwareFiltering);
-        gl.ActiveTexture(GL_TEXTURE0 + GLenum(s));
-        gl.BindTexture(spec.stages[size_t(s)].volume ? GL_TEXTURE_3D : GL_TEXTURE_2D, name);
-        if (spec.hardwareFiltering) {
-            // D3D's sampler state as GL's (D3DTEXF_NONE as a min/mag filter acts as point).
-            const ps11::SamplerState& sm = call.samplers[size_t(s)];
-            const GLuint so = st.samplers[s];
-            const bool magLin = sm.magFilter == ps11::Filter::Linear, minLin = sm.minFilter == ps11::Filter::Linear;
-            const GLint minf = sm.mipFilter == ps11::Filter::None ? (minLin ? GL_LINEAR : GL_NEAREST)
-                               : sm.mipFilter == ps11::Filter::Point
-                                   ? (minLin ? GL_LINEAR_MIPMAP_NEAREST : GL_NEAREST_MIPMAP_NEAREST)
-                                   : (minLin ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST_MIPMAP_LINEAR);
-            gl.SamplerParameteri(so, GL_TEXTURE_MIN_FILTER, minf);
-            gl.SamplerParameteri(so, GL_TEXTURE_MAG_FILTER, magLin ? GL_LINEAR : GL_NEAREST);
-            const ps11::TextureAddress modes[3] = {sm.addressU, sm.addressV, sm.addressW};
-            const GLenum names[3] = {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R};
-            for (int a = 0; a < 3; ++a) {
-                GLint m = GL_REPEAT;
-                switch (modes[a]) {
-                    case ps11::TextureAddress::Mirror:
-                        m = GL_MIRRORED_REPEAT;
-                        break;
-                    case ps11::TextureAddress::Clamp:
-                        m = GL_CLAMP_TO_EDGE;
-                        break;
-                    case ps11::TextureAddress::Border:
-                        m = GL_CLAMP_TO_BORDER;
-                        break;
-                    case ps11::TextureAddress::MirrorOnce:
-                        m = GL_MIRROR_CLAMP_TO_EDGE;
-                        break;
-                    default:
-                        break;
-                }
-                gl.SamplerParameteri(so, names[a], m);
-            }
-            gl.SamplerParameterfv(so, GL_TEXTURE_BORDER_COLOR, sm.border.data());
-            gl.BindSampler(GLuint(s), so);
-        } else {
-            gl.BindSampler(GLuint(s), 0);
-        }
-        gl.Uniform1i(gl.GetUniformLocation(program, ("uT" + std::to_string(s)).c_str()), s);
-    }
-    int32_t constG[8][4];
-    float constF[8][4], bump[8][4], lum[8][2], borderF[8][4];
-    int32_t borderG[8][4];
-    for (int i = 0; i < 8; ++i) {
-        const auto& v = (decoded.defMask >> i) & 1 ? decoded.defs[size_t(i)] : prog.constants[size_t(i)];
-        for (int c = 0; c < 4; ++c) ps11::exec::constantOf(precision, v[size_t(c)], constG[i][c], constF[i][c]);
-        const ps11::StageState& ss = prog.stages[size_t(i)];
-        for (int c = 0; c < 4; ++c) bump[i][c] = ss.bumpMat[size_t(c)];
-        lum[i][0] = ss.lumScale, lum[i][1] = ss.lumOffset;
-        const ps11::SamplerState& sm = call.samplers[size_t(i)];
-        for (int c = 0; c < 4; ++c) {
-            borderF[i][c] = sm.border[size_t(c)];
-            // The sampler's border on the grid (ps11::TextureSampler::setSamplerState).
-            borderG[i][c] = fx ? std::clamp(ps11::toGrid(double(sm.border[size_t(c)]), precision), -ps11::kMaxTexelGrid,
-                                            ps11::kMaxTexelGrid)
-                               : 0;
-        }
-    }
-    gl.Uniform4iv(gl.GetUniformLocation(program, "uConstG"), 8, &constG[0][0]);
-    gl.Uniform4fv(gl.GetUniformLocation(program, "uConstF"), 8, &constF[0][0]);
-    gl.Uniform4fv(gl.GetUniformLocation(program, "uBump"), 8, &bump[0][0]);
-    gl.Uniform2fv(gl.GetUniformLocation(program, "uLum"), 8, &lum[0][0]);
-    gl.Uniform4iv(gl.GetUniformLocation(program, "uBorderG"), 8, &borderG[0][0]);
-    gl.Uniform4fv(gl.GetUniformLocation(program, "uBorderF"), 8, &borderF[0][0]);
-    gl.Uniform1i(gl.GetUniformLocation(program, "uStride"), stride);
-    gl.Uniform1i(gl.GetUniformLocation(program, "uTri"), kUnitTri);
-    gl.Uniform1i(gl.GetUniformLocation(program, "uDstColor"), kUnitDstColor);
-    gl.Uniform1i(gl.GetUniformLocation(program, "uDstDepth"), kUnitDstDepth);
-    // Window x, y (pixel edges at integers, rows down) to clip space under GL_UPPER_LEFT.
-    gl.Uniform4f(gl.GetUniformLocation(program, "uXform"), 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
-    const GLint primBase = gl.GetUniformLocation(program, "uPrimBase");
+    gl.BindTexture(GL_TEXTURE_2D, rd ? rd->tex : 0);
+    if (e.stride >= 0) gl.Uniform1i(e.stride, stride);
+    if (e.tri >= 0) gl.Uniform1i(e.tri, kUnitTri);
+    if (e.dstColor >= 0) gl.Uniform1i(e.dstColor, kUnitDstColor);
+    if (e.dstDepth >= 0) gl.Uniform1i(e.dstDepth, kUnitDstDepth);
 
     gl.BindBuffer(GL_TEXTURE_BUFFER, st.triBuffer);
     gl.BufferData(GL_TEXTURE_BUFFER, GLsizeiptr(records.size() * 4), records.data(), GL_STREAM_DRAW);
@@ -519,22 +483,27 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.TexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32UI, st.triBuffer);
 
     gl.BindVertexArray(st.vao);
+    for (GLuint a = 1; a < 11; ++a) gl.DisableVertexAttribArray(a);
     gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
     gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(positions.size() * 4), positions.data(), GL_STREAM_DRAW);
     gl.VertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 8, nullptr);
     gl.EnableVertexAttribArray(0);
 
-    // ---- the framebuffer: raw colour words, raw depth words ----
+    // ---- the framebuffer: raw colour words, raw depth words; the merge is in the shader ----
     gl.BindFramebuffer(GL_FRAMEBUFFER, st.fbo);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, st.colorTex, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, depth ? st.depthTex : 0, 0);
-    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, depth ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, rc.tex, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, rd ? rd->tex : 0, 0);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, rd ? GLenum(GL_COLOR_ATTACHMENT1) : GLenum(GL_NONE)};
     gl.DrawBuffers(2, buffers);
     if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         return refuse("its framebuffer is incomplete");
-    const bool writeColor = color && plan.channels != 0;
+    const bool writeColor = plan.channels != 0;
     gl.ColorMaski(0, writeColor, writeColor, writeColor, writeColor);
-    if (depth) gl.ColorMaski(1, plan.depthWrite, plan.depthWrite, plan.depthWrite, plan.depthWrite);
+    if (rd) gl.ColorMaski(1, plan.depthWrite, plan.depthWrite, plan.depthWrite, plan.depthWrite);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_DEPTH_TEST);
+    gl.ClipControl(GL_UPPER_LEFT, GL_NEGATIVE_ONE_TO_ONE);  // D3D's window convention: rows from the top
     gl.Viewport(0, 0, GLsizei(W), GLsizei(H));
     gl.Enable(GL_SCISSOR_TEST);
     gl.Scissor(call.clip.x0, call.clip.y0, call.clip.x1 - call.clip.x0, call.clip.y1 - call.clip.y0);
@@ -557,7 +526,7 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
             if (overlap) break;
             ++end;
         }
-        gl.Uniform1i(primBase, GLint(begin));
+        gl.Uniform1i(e.primBase, GLint(begin));
         gl.DrawArrays(GL_TRIANGLES, GLint(begin * 6), GLsizei((end - begin) * 6));
         gl.TextureBarrier();
         begin = end;
@@ -569,34 +538,110 @@ bool GlRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& err
     gl.GetQueryObjectui64v(st.query, GL_QUERY_RESULT, &passed);
     stats.pixelsWritten += passed;
     gl.Disable(GL_SCISSOR_TEST);
+    // The copies now hold what the front will count as this draw's write (emu/renderer.h).
+    rc.generation = call.colorSurface.writeGeneration;
+    if (call.depthSurface.valid() && call.merge.depthWrite) {
+        auto it = space.surfaces.find(GlSpace::key(call.depthSurface.resource, call.depthSurface.level));
+        if (it != space.surfaces.end()) it->second.generation = call.depthSurface.writeGeneration;
+    }
+    if (GLenum err = gl.GetError(); err != GL_NO_ERROR) return refuse(glErrorText(err));
+    return true;
+}
 
-    // ---- read back ----
-    auto readBack = [&](GLuint tex, Image& img) {
-        const uint32_t n = wordsOf(img), bytes = img.format->bytes;
-        words.assign(size_t(img.width) * img.height * n, 0);
-        GLenum internal, format;
-        formats(n, internal, format);
-        gl.BindTexture(GL_TEXTURE_2D, tex);
-        gl.PixelStorei(GL_PACK_ALIGNMENT, 4);
-        gl.GetTexImage(GL_TEXTURE_2D, 0, format, GL_UNSIGNED_INT, words.data());
-        for (uint32_t y = 0; y < img.height; ++y) {
-            const uint8_t* src = reinterpret_cast<const uint8_t*>(&words[size_t(y) * img.width * n]);
-            if (bytes == 4 * n)
-                std::memcpy(img.texel(0, y), src, size_t(img.width) * bytes);
-            else
-                for (uint32_t x = 0; x < img.width; ++x) std::memcpy(img.texel(x, y), src + size_t(x) * 4 * n, bytes);
-        }
+bool GlRenderer::drawNative(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+    auto refuse = [&](const std::string& why) {
+        error.hr = D3DERR_INVALIDCALL;
+        error.code = "E4122";
+        error.message = "the GL renderer (native mode) cannot draw this call: " + why;
+        return false;
     };
-    gl.ActiveTexture(GL_TEXTURE0 + kUnitDstColor);
-    if (writeColor) readBack(st.colorTex, *color);
-    gl.ActiveTexture(GL_TEXTURE0 + kUnitDstDepth);
-    if (plan.depthWrite) readBack(st.depthTex, *depth);
-    if (GLenum e = gl.GetError(); e != GL_NO_ERROR)
-        return refuse("OpenGL reported error 0x" + [&] {
-            char b[16];
-            std::snprintf(b, sizeof b, "%x", unsigned(e));
-            return std::string(b);
-        }());
+    const GlFunctions& gl = m_context->gl();
+    GlState& st = *m_state;
+    NativeFormat cf, df;
+    if (!call.colorSurface.valid() || !nativeFormatOf(*call.colorSurface.image->format, cf) || cf.depth)
+        return refuse("the render target format is not one it keeps");
+    const bool useDepth = call.depthSurface.valid() && call.merge.depthTest;
+    if (useDepth && (!nativeFormatOf(*call.depthSurface.image->format, df) || !df.depth))
+        return refuse("the depth surface format is not one it keeps");
+    bool planOk = false;
+    const Plan plan = makePlan(call.merge, call.target, planOk);
+    if (!planOk) return refuse("the render target or depth surface format is not one the merger stores");
+
+    // ---- program ----
+    ProgramStage ps;
+    FragmentSpec& spec = ps.spec;
+    spec.native = true;
+    spec.hardwareFiltering = true;
+    spec.precision = ps11::Precision::Float;
+    spec.weightBits = 0;
+    spec.usedAttributes = call.usedAttributes;
+    spec.merge = plan;
+    spec.wantZ = useDepth;
+    std::string why;
+    if (!resolveBindings(st, space, call, true, ps, why)) return refuse(why);
+    ps.entry = findProgram(st, space, call, true, ps, why);
+    if (!ps.entry) return refuse(why);
+
+    // ---- attributes: the vertices as they are; GL interpolates ----
+    constexpr int kFloats = 4 + kAttrCount;
+    std::vector<float> vertices;
+    std::vector<ScreenTriangle> tris;
+    for (uint32_t first = 0; first < call.primitiveCount; first += 1024) {
+        tris.clear();
+        call.assemble(first, std::min<uint32_t>(1024, call.primitiveCount - first), tris);
+        for (const ScreenTriangle& t : tris)
+            for (const ScreenVertex& v : t.v) {
+                vertices.insert(vertices.end(), {float(v.x), float(v.y), v.z, v.rhw});
+                vertices.insert(vertices.end(), v.attr.begin(), v.attr.end());
+            }
+    }
+    const size_t count = vertices.size() / kFloats;
+    stats.trianglesDrawn += count / 3;
+    if (count == 0) return true;
+
+    // ---- bindings ----
+    Resident& rc = st.resident(space, call.colorSurface);
+    Resident* rd = useDepth ? &st.resident(space, call.depthSurface) : nullptr;
+    bindProgram(st, call, true, ps, rc.width, rc.height);
+    gl.BindVertexArray(st.vao);
+    gl.BindBuffer(GL_ARRAY_BUFFER, st.vbo);
+    gl.BufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * 4), vertices.data(), GL_STREAM_DRAW);
+    // location 0: x y z rhw; 1 diffuse; 2 specular; 3..10 the texture-coordinate slots.
+    for (GLuint a = 0; a < 11; ++a) {
+        gl.VertexAttribPointer(a, 4, GL_FLOAT, GL_FALSE, kFloats * 4,
+                               reinterpret_cast<const void*>(uintptr_t(a == 0 ? 0 : 16 + (a - 1) * 16)));
+        gl.EnableVertexAttribArray(a);
+    }
+
+    // ---- the framebuffer in GL's formats; the merge in GL's blend and depth state ----
+    gl.BindFramebuffer(GL_FRAMEBUFFER, st.fbo);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, rc.tex, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
+    if (rd)
+        gl.FramebufferTexture2D(GL_FRAMEBUFFER, df.stencil ? GL_DEPTH_STENCIL_ATTACHMENT : GL_DEPTH_ATTACHMENT,
+                                GL_TEXTURE_2D, rd->tex, 0);
+    const GLenum buffers[1] = {GL_COLOR_ATTACHMENT0};
+    gl.DrawBuffers(1, buffers);
+    if (gl.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return refuse("its framebuffer is incomplete");
+    NativeMerge merge = nativeMergeOf(call.merge, rd != nullptr);
+    // X8R8G8B8 keeps its alpha byte at 0xff (uploaded so): DESTALPHA reads 1, as D3D9 defines.
+    if (call.colorSurface.image->format->format == D3DFMT_X8R8G8B8) merge.colorMask[3] = false;
+    applyNativeMerge(gl, merge);
+    gl.ClipControl(GL_UPPER_LEFT, GL_ZERO_TO_ONE);  // D3D's rows from the top and depth range [0, 1]
+    gl.Viewport(0, 0, GLsizei(rc.width), GLsizei(rc.height));
+    gl.Enable(GL_SCISSOR_TEST);
+    gl.Scissor(call.clip.x0, call.clip.y0, call.clip.x1 - call.clip.x0, call.clip.y1 - call.clip.y0);
+    const auto start = std::chrono::steady_clock::now();
+    gl.DrawArrays(GL_TRIANGLES, 0, GLsizei(count));
+    m_lastDrawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    gl.Disable(GL_SCISSOR_TEST);
+    gl.Disable(GL_BLEND);
+    gl.Disable(GL_DEPTH_TEST);
+    rc.generation = call.colorSurface.writeGeneration;
+    if (rd && call.merge.depthWrite) rd->generation = call.depthSurface.writeGeneration;
+    if (GLenum err = gl.GetError(); err != GL_NO_ERROR) return refuse(glErrorText(err));
     return true;
 }
 

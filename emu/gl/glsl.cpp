@@ -89,7 +89,10 @@ struct Gen {
     std::ostringstream o;
     GlslContext ctx{spec, p, fx, o};
 
-    explicit Gen(const FragmentSpec& s) : spec(s), p(s.program->profile), fx(ps11::isFixedPoint(s.precision)) {}
+    // Native mode is float arithmetic whatever the spec's precision says (the caller decodes
+    // the program with a float profile).
+    explicit Gen(const FragmentSpec& s)
+        : spec(s), p(s.program->profile), fx(!s.native && ps11::isFixedPoint(s.precision)) {}
 
     std::string G() const { return std::to_string(p.g); }
 
@@ -513,6 +516,28 @@ struct Gen {
         }
     }
 
+    // ---- the op list (both modes) ----
+    void ops() {
+        const auto& ops = spec.program->ops;
+        for (size_t i = 0; i < ops.size(); ++i) {
+            const DOp& op = ops[i];
+            if (op.op == Opcode::Phase) continue;
+            if (op.texture)
+                texture(op);
+            else
+                arith(op);
+            if (!op.hold && i > 0 && ops[i - 1].hold) {
+                const DOp& first = ops[i - 1];
+                for (int c = 0; c < 4; ++c)
+                    if ((first.mask >> c) & 1)
+                        o << "    R[" << int(first.dstSlot) << "]." << kComp[c] << " = H." << kComp[c] << ";\n";
+            }
+        }
+    }
+
+    // ---- native mode (FragmentSpec::native) ----
+    std::string runNative();
+
     // ---- the whole shader ----
     std::string run() {
         o << "#version " << kGlslVersion << " core\n#extension GL_ARB_gpu_shader_int64 : require\n";
@@ -603,27 +628,73 @@ struct Gen {
                     o << "    for (int c = 0; c < 4; ++c) { float s = VC[" << v << "][c]; R[" << 12 + v
                       << "][c] = s > 0.0 ? (s < 1.0 ? s : 1.0) : 0.0; }\n";
         }
-        const auto& ops = spec.program->ops;
-        for (size_t i = 0; i < ops.size(); ++i) {
-            const DOp& op = ops[i];
-            if (op.op == Opcode::Phase) continue;
-            if (op.texture)
-                texture(op);
-            else
-                arith(op);
-            if (!op.hold && i > 0 && ops[i - 1].hold) {
-                const DOp& first = ops[i - 1];
-                for (int c = 0; c < 4; ++c)
-                    if ((first.mask >> c) & 1)
-                        o << "    R[" << int(first.dstSlot) << "]." << kComp[c] << " = H." << kComp[c] << ";\n";
-            }
-        }
+        ops();
         o << "    if (killed || !covered) discard;\n";
         writeMerge(ctx);
         o << "}\n";
         return o.str();
     }
 };
+
+
+// Native mode: GL's varyings and texture units, float32 only (no doubles, no 64-bit integers),
+// then only the parts of the merge GL's fixed-function state cannot do: vertex fog and the
+// alpha test (docs/output-merger.md). Blending, the colour mask and the depth test are GL state
+// (emu/gl/native_merge.h).
+std::string Gen::runNative() {
+    const Plan& m = spec.merge;
+    o << "#version " << kGlslVersion << " core\n";
+    o << "uniform vec4 uConstF[8];\nuniform vec4 uBump[8];\nuniform vec2 uLum[8];\n";
+    for (int s = 0; s < 8; ++s) {
+        const StageSpec& st = spec.stages[size_t(s)];
+        if (!st.bound || !((spec.program->stagesUsed >> s) & 1)) continue;
+        o << "uniform sampler" << (st.volume ? "3D" : "2D") << " uT" << s << ";\n";
+    }
+    o << "in vec4 vDiffuse;\nin vec4 vSpecular;\nin vec4 vTex[8];\n";
+    o << "layout(location = 0) out vec4 oColor;\n";
+    // The division of the coordinates (projected texturing, texdepth, texm3x3spec): GL's own.
+    o << "float fdiv(float a, float b) { return a / b; }\n"
+         "float satf(float v) { return v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0; }\n"
+         "bool cmpPass(uint mask, bool less, bool equal, bool greater) {\n"
+         "    uint outcome = less ? 0u : equal ? 1u : greater ? 2u : 3u;\n"
+         "    return ((mask >> outcome) & 1u) != 0u;\n}\n";
+    for (int s = 0; s < 8; ++s)
+        if ((spec.program->stagesUsed >> s) & 1) writeSampler(ctx, s);
+    o << "void main() {\n";
+    o << "    vec4 VC[2] = vec4[2](vDiffuse, vSpecular);\n    vec4 TC[8];\n"
+         "    for (int i = 0; i < 8; ++i) TC[i] = vTex[i];\n";
+    o << "    bool killed = false;\n    float depthOut = 0.0;\n";
+    o << "    float U = 0.0, V = 0.0, W = 0.0, P0 = 0.0, P1 = 0.0;\n    vec4 C4 = vec4(0.0);\n";
+    o << "    vec4 R[14];\n    for (int i = 0; i < 14; ++i) R[i] = vec4(0.0);\n    vec4 H = vec4(0.0);\n";
+    // v0, v1: the interpolated colours clamped to [0, 1] (NaN: 0), as the float profiles load them.
+    for (int v = 0; v < 2; ++v)
+        if ((spec.program->vUsed >> v) & 1)
+            o << "    for (int c = 0; c < 4; ++c) R[" << 12 + v << "][c] = satf(VC[" << v << "][c]);\n";
+    ops();
+    o << "    if (killed) discard;\n";
+    if (spec.shaderDepth) o << "    gl_FragDepth = depthOut;\n";
+    // 8-bit targets (and depth-only draws) see the saturated colour; float targets r0 as is.
+    const bool unorm = m.color == nullptr || m.target == TargetKind::Argb8 || m.target == TargetKind::Xrgb8;
+    o << "    vec4 s = R[0];\n";
+    if (unorm) o << "    for (int c = 0; c < 4; ++c) s[c] = satf(R[0][c]);\n";
+    if (m.fog) {
+        // Vertex fog: rgb = f·rgb + (1 − f)·FOGCOLOR, f the specular alpha clamped to [0, 1].
+        o << "    { float f = satf(VC[1].w);\n      vec3 fogc = vec3(" << flit(float(m.fogByte[0]) / 255.0f) << ", "
+          << flit(float(m.fogByte[1]) / 255.0f) << ", " << flit(float(m.fogByte[2]) / 255.0f) << ");\n"
+          << "      s.rgb = f * s.rgb + (1.0 - f) * fogc; }\n";
+    }
+    if (m.alphaTest) {
+        // 8-bit targets compare the alpha the target stores (round(sat(a)·255)) with ALPHAREF;
+        // float targets the alpha itself with ALPHAREF/255 (docs/output-merger.md "Alpha test").
+        if (unorm)
+            o << "    { float a = roundEven(s.a * 255.0), r = " << m.alphaRef << ".0;\n";
+        else
+            o << "    { float a = s.a, r = " << flit(float(m.alphaRef) / 255.0f) << ";\n";
+        o << "      if (!cmpPass(" << m.alphaMask << "u, a < r, a == r, a > r)) discard; }\n";
+    }
+    o << "    oColor = s;\n}\n";
+    return o.str();
+}
 
 }  // namespace
 
@@ -635,9 +706,30 @@ std::string vertexSource() {
            "void main() { gl_Position = vec4(aPos * uXform.xy + uXform.zw, 0.0, 1.0); }\n";
 }
 
+std::string nativeVertexSource() {
+    std::string s = "#version " + std::to_string(kGlslVersion) +
+                    " core\n"
+                    "layout(location = 0) in vec4 aPos;\n"
+                    "layout(location = 1) in vec4 aDiffuse;\n"
+                    "layout(location = 2) in vec4 aSpecular;\n";
+    for (int i = 0; i < 8; ++i)
+        s += "layout(location = " + std::to_string(3 + i) + ") in vec4 aTex" + std::to_string(i) + ";\n";
+    s += "uniform vec4 uXform;\n"
+         "out vec4 vDiffuse;\nout vec4 vSpecular;\nout vec4 vTex[8];\n"
+         "void main() {\n"
+         "    float rhw = aPos.w > 1e-30 ? aPos.w : 1e-30;\n"
+         "    float w = 1.0 / rhw;\n"
+         "    vec2 ndc = (aPos.xy + 0.5) * uXform.xy + uXform.zw;\n"
+         "    gl_Position = vec4(ndc * w, aPos.z * w, w);\n"
+         "    vDiffuse = aDiffuse;\n    vSpecular = aSpecular;\n";
+    for (int i = 0; i < 8; ++i) s += "    vTex[" + std::to_string(i) + "] = aTex" + std::to_string(i) + ";\n";
+    s += "}\n";
+    return s;
+}
+
 std::string fragmentSource(const FragmentSpec& spec) {
     Gen g(spec);
-    return g.run();
+    return spec.native ? g.runNative() : g.run();
 }
 
 // Texels before the doubles: the header, then the edge functions' a b c (9 int64, two a texel).

@@ -9,6 +9,10 @@
 //   contraction (`precise`), the same filtering formulas in float32.
 // Attributes are not interpolated by GL: each fragment evaluates the rasteriser's planes
 // (emu/raster.h) from a per-triangle record, so both renderers shade the same inputs.
+// A third mode, native (FragmentSpec::native), is what a GPU driver would run for the draw: GL
+// interpolates the attributes (nativeVertexSource), GL's texture unit filters, float32
+// arithmetic with the hardware class's clamps, and the merge left to GL's fixed-function blend
+// and depth state (emu/gl/native_merge.h) except vertex fog and the alpha test.
 #pragma once
 
 #include <array>
@@ -32,6 +36,9 @@ struct StageSpec {
     // fx profiles: 8-bit texels (ps11::TexelStorage::Unorm8), uploaded as GL_RGBA8UI and scaled
     // to the grid in the shader; others are GL_RGBA32I grid integers.
     bool unorm8 = false;
+    // unorm8, sampled from a resident A8R8G8B8 surface's raw words (GL_R32UI) and unpacked in
+    // the shader: no conversion of a texture the renderer drew.
+    bool packedWords = false;
     // The border colour's grid values are within [0, G] (what a D3DCOLOR gives): 32-bit sums
     // suffice for a one-level 2-D bilinear tap.
     bool borderInRange = false;
@@ -57,6 +64,15 @@ struct FragmentSpec {
     // sampler object, 8-bit textures as GL_RGBA8) instead of the emulator's filtering formulas:
     // the experiment that measures a GPU's filtering against the emulator's model.
     bool hardwareFiltering = false;
+    // Native mode (a float profile's program; `fx` never applies): GL's interpolation of the
+    // varyings of nativeVertexSource() for v0, v1 and TC0..7, texture() for every bound stage
+    // (hardwareFiltering implied; an unbound stage samples (0, 0, 0, 1)), float32 registers
+    // clamped to [-maxValue, maxValue] after each write, `discard` for texkill, gl_FragDepth
+    // only when shaderDepth, then vertex fog and the alpha test from `merge` (fog, fogByte,
+    // alphaTest, alphaMask, alphaRef, and the colour target's kind) and r0 out as a vec4.
+    // Blending, the colour mask and the depth test are GL state (nativeMergeOf). No doubles, no
+    // record: usedAttributes, weightBits, wantZ and the stages' border colours are unused.
+    bool native = false;
 };
 
 // The GLSL version and extensions the shaders need (checked by the renderer).
@@ -64,6 +80,17 @@ constexpr int kGlslVersion = 450;
 
 std::string vertexSource();
 std::string fragmentSource(const FragmentSpec& spec);
+
+// The vertex shader of native mode. Attributes: location 0 `vec4 aPos` = (x, y, z, rhw): x, y
+// in D3D screen pixels (pixel centres at integers, rows down), z in [0, 1] after the viewport,
+// rhw = 1/w (1 when not perspective); 1 `vec4 aDiffuse`, 2 `vec4 aSpecular` (alpha: the vertex
+// fog factor); 3..10 `vec4 aTex0` … `aTex7`, the texture-coordinate sets u v w q. Uniform
+// `vec4 uXform` = (2/W, −2/H, −1, 1) maps window x, y (pixel edges at integers) to NDC, for
+// glClipControl(GL_UPPER_LEFT, GL_ZERO_TO_ONE). Position (x + 0.5, y + 0.5) (GL's pixel
+// centres are at +0.5), clip = (ndc·w, z·w, w) with w = 1/rhw (rhw below 1e-30, or NaN, taken
+// as 1e-30), so GL interpolates perspective-correctly as D3D does. Outputs (smooth):
+// vDiffuse, vSpecular, vTex[8].
+std::string nativeVertexSource();
 
 // The triangle record (a usamplerBuffer of RGBA32UI texels): texel 0 = (perspective,
 // constant-mask low, high, top-left bits), texels 1..5 = the edge functions a0 a1 a2 b0 b1 b2 c0

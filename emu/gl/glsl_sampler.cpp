@@ -119,7 +119,7 @@ void writeSampler(GlslContext& cx, int s) {
     const bool vol = st.volume;
     const int axes = vol ? 3 : 2;
     const std::string tex = "uT" + std::to_string(s);
-    if (spec.hardwareFiltering && !fx) {
+    if ((spec.hardwareFiltering || spec.native) && !fx) {
         o << "    return texture(" << tex << ", " << (vol ? "vec3(u, v, w)" : "vec2(u, v)") << ");\n}\n";
         return;
     }
@@ -129,7 +129,10 @@ void writeSampler(GlslContext& cx, int s) {
     const std::string scale = std::to_string(p.g / 255);
     // One texel of level lv as grid integers (8-bit texels scaled to the grid).
     auto texel = [&](const std::string& coord, const std::string& lv) {
-        const std::string f = "texelFetch(" + tex + ", " + coord + ", " + lv + ")";
+        std::string f = "texelFetch(" + tex + ", " + coord + ", " + lv + ")";
+        // A resident A8R8G8B8 surface: its raw words, b | g << 8 | r << 16 | a << 24.
+        if (st.packedWords)
+            f = "(uvec4(" + f + ".x) >> uvec4(16u, 8u, 0u, 24u) & uvec4(255u))";
         return st.unorm8 && fx ? "(ivec4(" + f + ") * " + scale + ")" : f;
     };
     if (fx && st.unorm8 && !vol && lodFree(st) && st.borderInRange) {

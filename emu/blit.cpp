@@ -1,0 +1,188 @@
+// Device stage: Clear and StretchRect carried out in images (emu/blit.h). The front checks the
+// calls and resolves the boxes and texels (emu/device_blit.cpp); the rules are in docs/device.md.
+#include "emu/blit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "ps11/precision.h"
+
+namespace emu {
+
+namespace {
+
+// floor(n / d) for d > 0.
+int64_t floorDiv(int64_t n, int64_t d) {
+    int64_t q = n / d;
+    if ((n % d) != 0 && n < 0) --q;
+    return q;
+}
+
+uint8_t toUnorm8(double v) {
+    // Nearest 8-bit value, ties to even (docs/precision.md "Outputs").
+    const double x = std::clamp(v, 0.0, 1.0) * 255.0;
+    return uint8_t(std::nearbyint(x));
+}
+
+PixelBox meet(const PixelBox& a, const PixelBox& b) {
+    return {std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
+}
+
+}  // namespace
+
+void clearImages(const ClearCall& call) {
+    if (call.color.valid()) {
+        Image* target = call.color.image;
+        const FormatInfo& f = *target->format;
+        for (const PixelBox& b : call.boxes) {
+            const PixelBox c = meet(b, PixelBox{0, 0, target->width, target->height});
+            if (c.empty()) continue;
+            // Fill the first row, then copy it to the others.
+            for (int64_t x = c.x0; x < c.x1; ++x)
+                std::copy_n(call.colorTexel.data(), f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
+            const size_t row = size_t(c.x1 - c.x0) * f.bytes;
+            for (int64_t y = c.y0 + 1; y < c.y1; ++y)
+                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)),
+                            row);
+        }
+    }
+    if (call.depth.valid()) {
+        Image* depth = call.depth.image;
+        const FormatInfo& f = *depth->format;
+        for (const PixelBox& b : call.boxes) {
+            const PixelBox c = meet(b, PixelBox{0, 0, depth->width, depth->height});
+            for (int64_t y = c.y0; y < c.y1; ++y) {
+                uint8_t* p = c.x0 < c.x1 ? depth->texel(uint32_t(c.x0), uint32_t(y)) : nullptr;
+                for (int64_t x = c.x0; x < c.x1; ++x, p += f.bytes) {
+                    const uint32_t w = (loadWord(p, f.bytes) & call.depthKeep) | call.depthSet;
+                    for (uint32_t k = 0; k < f.bytes; ++k) p[k] = uint8_t(w >> (8 * k));
+                }
+            }
+        }
+    }
+}
+
+std::vector<StretchTap> stretchTaps(const StretchCall& call, bool horizontal) {
+    const int64_t s0 = horizontal ? call.sourceRect.x0 : call.sourceRect.y0;
+    const int64_t sn = horizontal ? call.sourceRect.x1 - s0 : call.sourceRect.y1 - s0;
+    const int64_t dn = horizontal ? call.destRect.x1 - call.destRect.x0 : call.destRect.y1 - call.destRect.y0;
+    std::vector<StretchTap> taps(size_t(std::max<int64_t>(dn, 0)));
+    // Texel-centre mapping (docs/device.md): destination pixel i of the rect has its centre at
+    // i + 1/2, which maps to source position s0 + (i + 1/2) * sn / dn. As exact fractions over
+    // 2*dn: POINT takes floor(position) (a tie goes to the higher texel); LINEAR works in texel
+    // space x = position - 1/2 = i0 + f.
+    for (int64_t i = 0; i < dn; ++i) {
+        StretchTap& t = taps[size_t(i)];
+        if (!call.linear) {
+            t.i0 = t.i1 = s0 + floorDiv((2 * i + 1) * sn, 2 * dn);
+            continue;
+        }
+        const int64_t num2 = (2 * i + 1) * sn - dn;  // (x - s0) * 2dn
+        const int64_t den = 2 * dn;
+        const int64_t k = floorDiv(num2, den);
+        const int64_t rem = num2 - k * den;  // f = rem / den in [0, 1)
+        // fx profiles: 8 bits of sub-texel weight, round_half_even(f * 256) (docs/precision.md).
+        t.w1 = call.fixedPoint ? double(ps11::roundHalfEven(rem * 256, den)) / 256.0 : double(rem) / double(den);
+        // Taps outside the source rect are clamped to its edge texels.
+        t.i0 = std::clamp(s0 + k, s0, s0 + sn - 1);
+        t.i1 = std::clamp(s0 + k + 1, s0, s0 + sn - 1);
+    }
+    return taps;
+}
+
+void stretchImages(const StretchCall& call) {
+    const Image* s = call.source.image;
+    Image* d = call.dest.image;
+    const PixelBox& sr = call.sourceRect;
+    const PixelBox& dr = call.destRect;
+    const FormatInfo& sf = *s->format;
+    const FormatInfo& df = *d->format;
+    const int64_t sw = sr.x1 - sr.x0, sh = sr.y1 - sr.y0;
+    const int64_t dw = dr.x1 - dr.x0, dh = dr.y1 - dr.y0;
+    const bool unormSource = sf.cls == FormatClass::Unorm8;
+    // Channel values in source units: bytes for 8-bit sources (exact sums), values otherwise.
+    auto fetch = [&](int64_t x, int64_t y) {
+        std::array<double, 4> v;
+        const uint8_t* p = s->texel(uint32_t(x), uint32_t(y));
+        if (unormSource) {
+            std::array<uint8_t, 4> b = decodeUnorm8(sf, p);
+            for (size_t c = 0; c < 4; ++c) v[c] = b[c];
+        } else {
+            std::array<float, 4> f = decodeTexel(sf, p, call.decode);
+            for (size_t c = 0; c < 4; ++c) v[c] = f[c];
+        }
+        return v;
+    };
+    auto store = [&](int64_t x, int64_t y, const std::array<double, 4>& v) {
+        uint8_t* p = d->texel(uint32_t(x), uint32_t(y));
+        if (df.cls == FormatClass::Unorm8) {
+            std::array<uint8_t, 4> b;
+            for (size_t c = 0; c < 4; ++c)
+                b[c] = unormSource ? uint8_t(std::clamp(std::nearbyint(v[c]), 0.0, 255.0)) : toUnorm8(v[c]);
+            encodeUnorm8(df, b, p);
+        } else {
+            std::array<float, 4> f;
+            for (size_t c = 0; c < 4; ++c) f[c] = float(unormSource ? v[c] / 255.0 : v[c]);
+            encodeFloat(df, f, p);
+        }
+    };
+    const bool linear = call.linear;
+    const bool sameFormat = &sf == &df;
+    // Fast path: an unscaled copy in one format is a row copy with either filter (LINEAR has
+    // f = 0 at every pixel, so it reproduces the texels exactly).
+    if (sameFormat && sw == dw && sh == dh) {
+        const size_t row = size_t(sw) * sf.bytes;
+        for (int64_t j = 0; j < dh; ++j)
+            std::memmove(d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j)), s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j)),
+                         row);
+        return;
+    }
+    // Fast path: an exact 2:1 LINEAR reduction of A8R8G8B8/X8R8G8B8 has f = 1/2 on both axes
+    // (weight 128/256 in fx profiles, 1/2 exactly otherwise), so each byte is
+    // round_half_even((a + b + c + d) / 4) of a 2x2 block, the general path's result.
+    if (linear && sameFormat && sf.bytes == 4 && sf.cls == FormatClass::Unorm8 && sw == 2 * dw && sh == 2 * dh) {
+        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+        for (int64_t j = 0; j < dh; ++j) {
+            const uint8_t* r0 = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + 2 * j));
+            const uint8_t* r1 = r0 + s->rowPitch;
+            uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
+            for (int64_t i = 0; i < dw; ++i, r0 += 8, r1 += 8, out += 4)
+                for (int b = 0; b < 4; ++b) {
+                    const int sum = r0[b] + r0[b + 4] + r1[b] + r1[b + 4];
+                    // (sum + 1 + ((sum >> 2) & 1)) >> 2 is round_half_even(sum / 4).
+                    out[b] = uint8_t((sum + 1 + ((sum >> 2) & 1)) >> 2);
+                }
+            if (x8)
+                for (int64_t i = 0; i < dw; ++i) d->texel(uint32_t(dr.x0 + i), uint32_t(dr.y0 + j))[3] = 0xFF;
+        }
+        return;
+    }
+    const std::vector<StretchTap> tapX = stretchTaps(call, true), tapY = stretchTaps(call, false);
+    for (int64_t j = 0; j < dh; ++j) {
+        for (int64_t i = 0; i < dw; ++i) {
+            const int64_t dx = dr.x0 + i, dy = dr.y0 + j;
+            if (!linear) {
+                const int64_t sx = tapX[size_t(i)].i0, sy = tapY[size_t(j)].i0;
+                if (sameFormat)
+                    std::copy_n(s->texel(uint32_t(sx), uint32_t(sy)), sf.bytes, d->texel(uint32_t(dx), uint32_t(dy)));
+                else
+                    store(dx, dy, fetch(sx, sy));
+                continue;
+            }
+            const StretchTap& tx = tapX[size_t(i)];
+            const StretchTap& ty = tapY[size_t(j)];
+            const std::array<double, 4> a = fetch(tx.i0, ty.i0), b = fetch(tx.i1, ty.i0);
+            const std::array<double, 4> c = fetch(tx.i0, ty.i1), e = fetch(tx.i1, ty.i1);
+            std::array<double, 4> v;
+            // Exact weighted sum (8-bit weights and 8-bit texels: products of dyadic numbers are
+            // exact in double), rounded once in store().
+            for (size_t k = 0; k < 4; ++k)
+                v[k] = (1 - ty.w1) * ((1 - tx.w1) * a[k] + tx.w1 * b[k]) + ty.w1 * ((1 - tx.w1) * c[k] + tx.w1 * e[k]);
+            store(dx, dy, v);
+        }
+    }
+}
+
+}  // namespace emu

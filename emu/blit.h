@@ -1,0 +1,28 @@
+// Clear and StretchRect in the front's images (docs/device.md "Clear", "StretchRect"): what the
+// software renderer does for these calls, and what the front does itself when a renderer that
+// keeps copies leaves a call to it (emu/renderer.h).
+#pragma once
+
+#include <vector>
+
+#include "emu/renderer.h"
+
+namespace emu {
+
+// One destination column (or row) of a StretchRect: POINT reads source texel i0; LINEAR blends
+// i0 and i1 with weight w1 on i1 (8 bits of sub-texel weight in fx profiles), both clamped to the
+// source rect.
+struct StretchTap {
+    int64_t i0 = 0, i1 = 0;
+    double w1 = 0;
+};
+// The taps of every destination column (`horizontal`) or row, by the texel-centre mapping.
+std::vector<StretchTap> stretchTaps(const StretchCall& call, bool horizontal);
+
+// Fills the call's boxes of call.color.image and call.depth.image (when valid).
+void clearImages(const ClearCall& call);
+// Copies call.sourceRect of call.source.image to call.destRect of call.dest.image, scaling with
+// POINT or LINEAR filtering (texel-centre mapping; 8-bit weights in fx profiles, rounded once).
+void stretchImages(const StretchCall& call);
+
+}  // namespace emu
