@@ -28,8 +28,10 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: ps11 compare SHADER.psh|FILE.ps11test [--size WxH] [--seed S] [--hardware H] [--precision P]\n"
-    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-filtering] [-v]\n"
-    "       ps11 compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json] [--gl osmesa|egl]\n";
+    "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-mode exact|native] [--gl-filtering] [-v]\n"
+    "       ps11 compare --random N [--seed S] [--minor 1..4] [--out DIR] [--json] [--gl osmesa|egl]\n"
+    "  --gl-mode native: GL as a GPU driver runs the draws (not bit-exact by design); reports how far it\n"
+    "                    lands from the emulated card and from the ideal profile (exit 1 only on refusals)\n";
 
 int usageError(const std::string& msg) {
     std::cerr << "ps11 compare: " << msg << "\n" << kUsage;
@@ -47,6 +49,7 @@ struct Options {
     int minor = 0;
     std::string outDir = ".";
     bool glFiltering = false;  // float profiles: GL's texture unit filters (GlRendererOptions)
+    bool native = false;       // --gl-mode native: measured against the card and against ideal
     bool verbose = false;      // -v: the first differing pixels of each draw
 };
 
@@ -56,11 +59,13 @@ struct DrawDiff {
     uint64_t pixels = 0, exact = 0, overOne = 0;
     uint64_t distinctEmu = 0, distinctGl = 0;  // distinct colours in each target
     double maxDiff = 0;                        // 8-bit levels, or values on float targets
+    double sumDiff = 0;                        // of every pixel's largest channel difference (mean)
     bool values = false;
 };
 
 struct Report {
     std::vector<DrawDiff> draws;
+    std::vector<DrawDiff> idealDraws;  // --gl-mode native: GL against the ideal profile, per draw
     std::vector<std::pair<uint32_t, std::string>> unsupported;  // line, why the GL renderer refused
     std::string error;                                          // the input itself is wrong
     std::vector<Vec4> emuPixels, glPixels;                      // the last draw's targets
@@ -95,6 +100,7 @@ DrawDiff diffTargets(const std::vector<Vec4>& a, const std::vector<Vec4>& b, boo
         d.exact += m == 0;
         d.overOne += m > (values ? 1e-4 : 1.0);
         d.maxDiff = std::max(d.maxDiff, m);
+        d.sumDiff += std::min(m, 1e30);
     }
     auto distinct = [](std::vector<Vec4> v) {
         std::sort(v.begin(), v.end());
@@ -138,6 +144,16 @@ void compareText(const std::string& text, const std::string& path, const Options
     }
     std::unique_ptr<DrawRunner> glr =
         DrawRunner::create(file, path, program ? &*program : nullptr, hw, error, true, gl);
+    // Native mode: the same draws under `ideal` on the emulator, the other end of the distance.
+    std::unique_ptr<DrawRunner> ideal;
+    if (opts.native) {
+        const HardwareConfig ihw = resolveHardware(named, minor, Precision::Ideal, req.maxValue.value);
+        ideal = DrawRunner::create(file, path, program ? &*program : nullptr, ihw, error);
+        if (!ideal) {
+            report.error = error;
+            return;
+        }
+    }
     if (!glr) {
         report.unsupported.emplace_back(0, error);
         return;
@@ -164,6 +180,16 @@ void compareText(const std::string& text, const std::string& path, const Options
         DrawDiff d = diffTargets(report.glPixels, report.emuPixels, report.values);
         d.line = cmd.line;
         report.draws.push_back(d);
+        if (ideal) {
+            std::vector<Vec4> idealPixels;
+            if (!ideal->draw(cmd, error) || !ideal->targetPixels(idealPixels, error)) {
+                report.error = error;
+                return;
+            }
+            DrawDiff di = diffTargets(report.glPixels, idealPixels, report.values);
+            di.line = cmd.line;
+            report.idealDraws.push_back(di);
+        }
         if (opts.verbose && d.exact < d.pixels) {
             int shown = 0;
             for (size_t i = 0; i < report.emuPixels.size() && shown < 20; ++i) {
@@ -204,9 +230,26 @@ std::string number(double v) {
     return o.str();
 }
 
+// Native mode's distance of GL from one reference over every draw: max and mean |d|, % of pixels
+// more than one level (1e-4 on float targets) apart.
+struct Distance {
+    double max = 0, mean = 0, overOnePct = 0;
+};
+Distance distanceOf(const std::vector<DrawDiff>& draws) {
+    Distance d;
+    uint64_t pixels = 0, over = 0;
+    double sum = 0;
+    for (const DrawDiff& x : draws) pixels += x.pixels, over += x.overOne, sum += x.sumDiff, d.max = std::max(d.max, x.maxDiff);
+    d.mean = pixels ? sum / double(pixels) : 0;
+    d.overOnePct = pixels ? 100.0 * double(over) / double(pixels) : 0;
+    return d;
+}
+
 void printReport(const std::string& path, const Report& r, const Options& opts) {
+    const Distance card = distanceOf(r.draws), ideal = distanceOf(r.idealDraws);
     if (opts.json) {
-        std::cout << "{\"file\": \"" << jsonEscape(path) << "\", \"pixels\": " << r.sum(&DrawDiff::pixels)
+        std::cout << "{\"file\": \"" << jsonEscape(path) << "\", \"gl_mode\": \"" << (opts.native ? "native" : "exact")
+                  << "\", \"pixels\": " << r.sum(&DrawDiff::pixels)
                   << ", \"exact\": " << r.sum(&DrawDiff::exact) << ", \"over_one\": " << r.sum(&DrawDiff::overOne)
                   << ", \"max_diff\": " << number(r.maxDiff()) << ", \"draws\": [";
         for (size_t i = 0; i < r.draws.size(); ++i) {
@@ -220,7 +263,13 @@ void printReport(const std::string& path, const Report& r, const Options& opts) 
         for (size_t i = 0; i < r.unsupported.size(); ++i)
             std::cout << (i ? ", " : "") << "{\"line\": " << r.unsupported[i].first << ", \"why\": \""
                       << jsonEscape(r.unsupported[i].second) << "\"}";
-        std::cout << "], \"gl\": \"" << jsonEscape(glRendererDescription()) << "\"}\n";
+        std::cout << "]";
+        if (opts.native)
+            std::cout << ", \"vs_card\": {\"max\": " << number(card.max) << ", \"mean\": " << number(card.mean)
+                      << ", \"over_one_pct\": " << number(card.overOnePct) << "}, \"vs_ideal\": {\"max\": "
+                      << number(ideal.max) << ", \"mean\": " << number(ideal.mean)
+                      << ", \"over_one_pct\": " << number(ideal.overOnePct) << "}";
+        std::cout << ", \"gl\": \"" << jsonEscape(glRendererDescription()) << "\"}\n";
         return;
     }
     std::cout << "gl: " << glRendererDescription() << "\n";
@@ -235,6 +284,15 @@ void printReport(const std::string& path, const Report& r, const Options& opts) 
     std::cout << "total: " << r.draws.size() << (r.draws.size() == 1 ? " draw, " : " draws, ") << pixels << " pixels, "
               << exact << " exact (" << (pixels ? 100.0 * double(exact) / double(pixels) : 100.0) << " %), "
               << r.sum(&DrawDiff::overOne) << " past the target, max |d| " << number(r.maxDiff()) << "\n";
+    if (opts.native) {
+        const char* unit = r.values ? "" : " levels";
+        std::cout << "gl native against the emulated card: max |d| " << number(card.max) << unit << ", mean "
+                  << number(card.mean) << unit << ", " << number(card.overOnePct) << " % of pixels more than "
+                  << (r.values ? "1e-4" : "one level") << " apart\n"
+                  << "gl native against ideal: max |d| " << number(ideal.max) << unit << ", mean " << number(ideal.mean)
+                  << unit << ", " << number(ideal.overOnePct) << " % of pixels more than "
+                  << (r.values ? "1e-4" : "one level") << " apart\n";
+    }
 }
 
 // The heat map of the last draw: black = equal, blue = one level (or <= 1e-4) apart, red up
@@ -412,10 +470,13 @@ int cmdCompare(const std::vector<std::string>& args) {
         } else if (a == "--gl") {
             if (!value(glName) || (glName != "osmesa" && glName != "egl"))
                 return usageError("--gl takes osmesa or egl");
+        } else if (a == "--gl-mode") {
+            if (!value(v) || (v != "exact" && v != "native")) return usageError("--gl-mode takes exact or native");
+            opts.native = v == "native";
         } else if (!a.empty() && a[0] == '-') {
             return usageError(
                 cli::unknownOption(a, {"--size", "--seed", "--random", "--minor", "--out", "--heatmap", "--hardware",
-                                       "--precision", "--json", "--gl", "--gl-filtering", "--verbose", "--help"}));
+                                       "--precision", "--json", "--gl", "--gl-mode", "--gl-filtering", "--verbose", "--help"}));
         } else if (input.empty()) {
             input = a;
         } else {
@@ -424,8 +485,11 @@ int cmdCompare(const std::vector<std::string>& args) {
     }
     if (opts.random < 0 && input.empty()) return usageError("missing SHADER.psh or FILE.ps11test (or --random N)");
     if (opts.random >= 0 && !input.empty()) return usageError("--random takes no input file");
+    if (opts.random >= 0 && opts.native)
+        return usageError("--random looks for disagreements of the exact mode; --gl-mode native does not apply");
+    if (opts.native && opts.glFiltering) return usageError("--gl-filtering is an exact-mode option; native filters with GL");
     std::string error;
-    const RendererFactory gl = glRendererFactory(glName, error, false, opts.glFiltering);
+    const RendererFactory gl = glRendererFactory(glName, error, opts.native, opts.glFiltering);
     if (!gl) {
         std::cerr << "ps11 compare: " << error << "\n";
         return cli::kUserError;
@@ -447,6 +511,7 @@ int cmdCompare(const std::vector<std::string>& args) {
     }
     printReport(input, r, opts);
     if (!opts.heatmap.empty() && !r.draws.empty() && !writeHeatmap(opts.heatmap, r)) return cli::kUserError;
+    if (opts.native) return r.error.empty() && r.unsupported.empty() ? cli::kOk : cli::kUserError;
     return r.agrees() ? cli::kOk : cli::kUserError;
 }
 

@@ -33,7 +33,7 @@ constexpr const char* kGlareUsage =
     "usage: ps11 glare --list\n"
     "       ps11 glare --report [--json | --markdown]\n"
     "       ps11 glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH]\n"
-    "                  [--backend emu|gl] [--gl osmesa|egl] [--hardware H | --precision P]\n"
+    "                  [--backend emu|gl] [--gl osmesa|egl] [--gl-mode exact|native] [--hardware H | --precision P]\n"
     "                  [--quality low|medium|high|published] [--set name=value]... [--exposure STOPS]\n"
     "                  [--dump-passes DIR] [--graph OUT.dot] [--compare] [--json]\n";
 
@@ -64,6 +64,7 @@ struct GlareOptions {
     uint32_t width = 0, height = 0;
     std::string backend = "emu", glKind;
     bool backendGiven = false;
+    bool glNative = false, glModeGiven = false;  // --gl-mode
     const HardwareClass* hardware = nullptr;
     std::optional<Precision> precision;
     std::string quality = "published";
@@ -232,7 +233,7 @@ int runGlare(const GlareOptions& o) {
         ro.device.hardware = o.hardware;
         ro.device.precision = o.precision;
         if (gl) {
-            ro.device.renderer = glRendererFactory(o.glKind, err);
+            ro.device.renderer = glRendererFactory(o.glKind, err, o.glNative);
             if (!ro.device.renderer) return nullptr;
         }
         return std::make_unique<glare::Runner>(ro);
@@ -243,6 +244,23 @@ int runGlare(const GlareOptions& o) {
     if (!main || (o.compare && !(other = makeRunner(true, err)))) {
         std::cerr << "ps11 glare: the GL renderer is not available: " << err << "\n";
         return cli::kUserError;
+    }
+    // --compare --gl-mode native, end to end: whole frames on GL native (not pass-isolated) and
+    // under `ideal` on the emulator, from the same input as the emulated card's.
+    std::unique_ptr<glare::Runner> ideal, nativeRun;
+    if (o.compare && o.glNative) {
+        glare::RunnerOptions ro;
+        ro.width = width;
+        ro.height = height;
+        ro.device.hardware = o.hardware;
+        ro.device.precision = Precision::Ideal;
+        ideal = std::make_unique<glare::Runner>(ro);
+        nativeRun = makeRunner(true, err);
+        for (glare::Runner* r : {ideal.get(), nativeRun.get()})
+            if (!r || (image && !r->setImage(*image, err))) {
+                std::cerr << "ps11 glare: " << o.in << ": " << err << "\n";
+                return cli::kUserError;
+            }
     }
 
     // --graph without -o: the graph as built, not run.
@@ -277,6 +295,7 @@ int runGlare(const GlareOptions& o) {
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
     std::vector<double> frameMs;
+    emu::TransferStats lastTransfers;  // the last frame's, with its output's read-back
     std::vector<glare::PassAgreement> agreement;
     glare::PassAgreement sceneAgreement{"scene (rendered on both)"};
     for (int f = 0; f < o.frames; ++f) {
@@ -328,8 +347,17 @@ int runGlare(const GlareOptions& o) {
         };
         glare::FrameResult result;
         bool ok;
+        const emu::TransferStats before = main->device().transfers();
         if (other) {
             ok = glare::compareFrame(*main, *other, *technique, *settings, f, o.frames, agreement, result, err, hook);
+            if (ok && ideal) {
+                std::optional<emu::RgbaImage> input = scene ? main->readTexture(main->sceneTexture(), err) : std::nullopt;
+                for (glare::Runner* r : {ideal.get(), nativeRun.get()}) {
+                    glare::FrameResult ir;
+                    ok = ok && (!scene || (input && r->setImage(*input, err))) &&
+                         r->runFrame(*technique, *settings, f, o.frames, ir, err);
+                }
+            }
         } else {
             glare::PassGraph* built = nullptr;
             ok = main->runFrame(
@@ -355,6 +383,9 @@ int runGlare(const GlareOptions& o) {
                 return cli::kUserError;
             }
         }
+        const emu::TransferStats after = main->device().transfers();
+        lastTransfers.uploads = after.uploads - before.uploads;
+        lastTransfers.readBacks = after.readBacks - before.readBacks;
     }
 
     const std::string profile = precisionName(main->device().hardware().precision);
@@ -362,6 +393,24 @@ int runGlare(const GlareOptions& o) {
     if (o.compare) {
         uint64_t over = sceneAgreement.overOne;
         for (const glare::PassAgreement& a : agreement) over += a.overOne;
+        // Native mode, end to end (the last frame's output): GL against the card and against ideal.
+        glare::ImageError vsCard, vsIdeal;
+        if (ideal) {
+            std::optional<emu::RgbaImage> a = main->readOutput(err), g = a ? nativeRun->readOutput(err) : std::nullopt,
+                                          i = g ? ideal->readOutput(err) : std::nullopt;
+            if (!i) {
+                std::cerr << "ps11 glare: " << err << "\n";
+                return cli::kUserError;
+            }
+            vsCard = glare::imageError(*g, *a);
+            vsIdeal = glare::imageError(*g, *i);
+        }
+        auto errorJson = [](const glare::ImageError& e) {
+            char b[160];
+            std::snprintf(b, sizeof b, "{\"max_levels\": %d, \"mean_levels\": %.4f, \"over_one_pct\": %.4f}", e.max, e.mean,
+                          e.overOnePercent);
+            return std::string(b);
+        };
         if (o.json) {
             std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"gl\": \"%s\", \"frames\": %d, "
                         "\"passes\": [\n",
@@ -374,7 +423,11 @@ int runGlare(const GlareOptions& o) {
                 std::printf("  {\"pass\": \"%s\", \"pixels\": %llu, \"exact\": %llu, \"over_one\": %llu, \"max_diff\": %g}%s\n",
                             all[i].pass.c_str(), (unsigned long long)all[i].pixels, (unsigned long long)all[i].exact,
                             (unsigned long long)all[i].overOne, all[i].maxDiff, i + 1 < all.size() ? "," : "");
-            std::printf("]}\n");
+            std::printf("], \"gl_mode\": \"%s\"", o.glNative ? "native" : "exact");
+            if (ideal)
+                std::printf(", \"end_to_end\": {\"vs_card\": %s, \"vs_ideal\": %s}", errorJson(vsCard).c_str(),
+                            errorJson(vsIdeal).c_str());
+            std::printf("}\n");
         } else {
             std::printf("%s on %ux%u, %d frame(s), %s / %s: the emulator against %s, pass-isolated\n",
                         std::string(technique->name()).c_str(), width, height, o.frames, hw.c_str(), profile.c_str(),
@@ -390,8 +443,20 @@ int runGlare(const GlareOptions& o) {
             };
             if (scene) row(sceneAgreement);
             for (const glare::PassAgreement& a : agreement) row(a);
-            std::printf("%s\n", over == 0 ? "agreement: every pass within 1 level" : "DISAGREEMENT: pixels differ by more than 1 level");
+            if (ideal) {
+                std::printf("gl native mode: measured, not checked (a GPU's float arithmetic, filtering and blending)\n");
+                std::printf("end to end, last frame: gl native against the emulated card: max %d levels, mean %.3f, %.3f %% "
+                            "of pixels more than one level apart\n",
+                            vsCard.max, vsCard.mean, vsCard.overOnePercent);
+                std::printf("end to end, last frame: gl native against ideal: max %d levels, mean %.3f, %.3f %% of pixels "
+                            "more than one level apart\n",
+                            vsIdeal.max, vsIdeal.mean, vsIdeal.overOnePercent);
+            } else {
+                std::printf("%s\n", over == 0 ? "agreement: every pass within 1 level"
+                                              : "DISAGREEMENT: pixels differ by more than 1 level");
+            }
         }
+        if (ideal) return cli::kOk;
         return over == 0 ? cli::kOk : cli::kUserError;
     }
     if (o.json) {
@@ -401,22 +466,32 @@ int runGlare(const GlareOptions& o) {
         for (size_t i = 0; i < lastStats.size(); ++i) {
             const glare::PassStats& s = lastStats[i];
             std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
-                        "\"instructions\": %llu}%s\n",
+                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu}%s\n",
                         s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
-                        (unsigned long long)s.texels, (unsigned long long)s.instructions, i + 1 < lastStats.size() ? "," : "");
+                        (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
+                        (unsigned long long)s.readBacks, i + 1 < lastStats.size() ? "," : "");
         }
-        std::printf("]}\n");
+        std::printf("], \"renderer\": \"%s\", \"frame_uploads\": %llu, \"frame_readbacks\": %llu}\n",
+                    main->device().rendererName(), (unsigned long long)lastTransfers.uploads,
+                    (unsigned long long)lastTransfers.readBacks);
         return cli::kOk;
     }
     std::vector<double> sorted = frameMs;
     std::sort(sorted.begin(), sorted.end());
     std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
                 std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
-                hw.c_str(), profile.c_str(), o.backend.c_str(), o.frames, sorted[sorted.size() / 2]);
-    std::printf("%-22s %9s %6s %11s %11s %13s\n", "pass (last frame)", "ms", "draws", "pixels", "texels", "instructions");
+                hw.c_str(), profile.c_str(), main->device().rendererName(), o.frames, sorted[sorted.size() / 2]);
+    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s\n", "pass (last frame)", "ms", "draws", "pixels", "texels",
+                "instructions", "up", "back");
     for (const glare::PassStats& s : lastStats)
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu\n", s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws,
-                    (unsigned long long)s.pixels, (unsigned long long)s.texels, (unsigned long long)s.instructions);
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu\n", s.pass.c_str(), s.milliseconds,
+                    (unsigned long long)s.draws, (unsigned long long)s.pixels, (unsigned long long)s.texels,
+                    (unsigned long long)s.instructions, (unsigned long long)s.uploads, (unsigned long long)s.readBacks);
+    if (o.backend == "gl")
+        std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
+                    "back%s\n",
+                    main->device().rendererName(), (unsigned long long)lastTransfers.uploads,
+                    (unsigned long long)lastTransfers.readBacks, o.out.empty() ? "" : " (the output's read-back included)");
     if (!o.out.empty())
         std::printf("wrote %s\n", o.frames > 1 ? (numbered(o.out, 0, o.frames) + " …").c_str() : o.out.c_str());
     return cli::kOk;
@@ -472,6 +547,10 @@ int cmdGlare(const std::vector<std::string>& args) {
             o.backendGiven = true;
         } else if (a == "--gl") {
             if (!value(o.glKind) || (o.glKind != "osmesa" && o.glKind != "egl")) return glareUsage("--gl takes osmesa or egl");
+        } else if (a == "--gl-mode") {
+            if (!value(v) || (v != "exact" && v != "native")) return glareUsage("--gl-mode takes exact or native");
+            o.glNative = v == "native";
+            o.glModeGiven = true;
         } else if (a == "--hardware") {
             if (!value(v)) return glareUsage("--hardware needs a class");
             o.hardware = findHardware(v);
@@ -494,7 +573,7 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else {
             return glareUsage(cli::unknownOption(
                 a, {"--list", "--report", "--markdown", "--json", "--compare", "--technique", "--scene", "--in", "-o",
-                    "--dump-passes", "--graph", "--frames", "--size", "--backend", "--gl", "--hardware", "--precision",
+                    "--dump-passes", "--graph", "--frames", "--size", "--backend", "--gl", "--gl-mode", "--hardware", "--precision",
                     "--quality", "--set", "--exposure", "--help"}));
         }
     }
@@ -505,6 +584,7 @@ int cmdGlare(const std::vector<std::string>& args) {
     if (!o.in.empty() && o.width) return glareUsage("--size applies to --scene; an --in image keeps its own size");
     if (o.hardware && o.precision) return glareUsage("give --hardware or --precision, not both");
     if (o.compare && o.backendGiven) return glareUsage("--compare runs both renderers; --backend does not apply");
+    if (o.glModeGiven && o.backend != "gl" && !o.compare) return glareUsage("--gl-mode needs --backend gl or --compare");
     if (o.out.empty() && o.graph.empty() && o.dumpDir.empty() && !o.compare)
         return glareUsage("say where the result goes: -o OUT.png (or --dump-passes, --graph, --compare)");
     return runGlare(o);

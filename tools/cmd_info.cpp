@@ -115,7 +115,8 @@ int cmdInfo(const std::vector<std::string>& args) {
             std::cout << "\"kind\": " << jsonString(r.kind) << ", \"platform\": " << jsonString(r.platform)
                       << ", \"GL_RENDERER\": " << jsonString(r.renderer)
                       << ", \"GL_VERSION\": " << jsonString(r.version)
-                      << ", \"GL_SHADING_LANGUAGE_VERSION\": " << jsonString(r.glsl);
+                      << ", \"GL_SHADING_LANGUAGE_VERSION\": " << jsonString(r.glsl)
+                      << ", \"modes\": [\"exact\", \"native\"]";
         } else {
             std::cout << "\"error\": " << jsonString(r.error);
         }
@@ -129,7 +130,10 @@ int cmdInfo(const std::vector<std::string>& args) {
             std::cout << "GL context: " << r.kind << " (" << r.platform << ")\n"
                       << "GL_RENDERER: " << r.renderer << "\n"
                       << "GL_VERSION: " << r.version << "\n"
-                      << "GL_SHADING_LANGUAGE_VERSION: " << r.glsl << "\n";
+                      << "GL_SHADING_LANGUAGE_VERSION: " << r.glsl << "\n"
+                      << "GL renderer modes: exact (bit for bit with the emulator: the cross-check, the default of\n"
+                      << "  --backend gl|both) and native (GL's own interpolation, filtering, float arithmetic and\n"
+                      << "  blending, surfaces resident: the speed peer; --gl-mode native)\n";
         } else {
             std::cout << "GL context: none (" << r.error << ")\n";
         }

@@ -19,7 +19,8 @@ namespace {
 
 constexpr const char* kShadeUsage =
     "usage: ps11 shade SHADER.psh [--texN IMG] [--filterN point|linear] [--cN x,y,z,w] [--size WxH]\n"
-    "                  [--backend emu|gl] [--gl osmesa|egl] [--hardware H | --precision P] [--exposure STOPS]\n"
+    "                  [--backend emu|gl] [--gl osmesa|egl] [--gl-mode exact|native] [--hardware H | --precision P]\n"
+    "                  [--exposure STOPS]\n"
     "                  -o OUT.png\n"
     "  N is a texture stage 0..3 (ps_1_4: 0..5) or a constant 0..7; the output size defaults to texture 0's\n";
 
@@ -38,6 +39,7 @@ int indexed(const std::string& arg, const std::string& prefix, int limit) {
 }  // namespace
 
 int cmdShade(const std::vector<std::string>& args) {
+    bool glNative = false, glModeGiven = false;  // --gl-mode
     std::string shaderPath, out, glKind, backend = "emu";
     std::vector<std::string> textures(6);
     std::vector<emu::D3DTEXTUREFILTERTYPE> filters(6, emu::D3DTEXF_LINEAR);
@@ -83,6 +85,10 @@ int cmdShade(const std::vector<std::string>& args) {
         } else if (a == "--gl") {
             if (!value() || (v != "osmesa" && v != "egl")) return shadeUsage("--gl takes osmesa or egl");
             glKind = v;
+        } else if (a == "--gl-mode") {
+            if (!value() || (v != "exact" && v != "native")) return shadeUsage("--gl-mode takes exact or native");
+            glNative = v == "native";
+            glModeGiven = true;
         } else if (a == "--hardware") {
             if (!value()) return shadeUsage("--hardware needs a class");
             hardware = findHardware(v);
@@ -101,7 +107,7 @@ int cmdShade(const std::vector<std::string>& args) {
             if (!value()) return shadeUsage("-o needs a file name");
             out = v;
         } else if (a.size() > 1 && a[0] == '-') {
-            return shadeUsage(cli::unknownOption(a, {"--tex0", "--filter0", "--c0", "--size", "--backend", "--gl",
+            return shadeUsage(cli::unknownOption(a, {"--tex0", "--filter0", "--c0", "--size", "--backend", "--gl", "--gl-mode",
                                                      "--hardware", "--precision", "--exposure", "-o", "--help"}));
         } else if (shaderPath.empty()) {
             shaderPath = a;
@@ -137,12 +143,13 @@ int cmdShade(const std::vector<std::string>& args) {
         request.textures[s] = glare::ShadeTexture{img->hdr ? emu::exposeUnclamped(img->image, exposure) : img->image,
                                                   filters[s]};
     }
+    if (glModeGiven && backend != "gl") return shadeUsage("--gl-mode needs --backend gl");
     emu::DeviceOptions options;
     options.hardware = hardware;
     options.precision = precision;
     std::string err;
     if (backend == "gl") {
-        options.renderer = glRendererFactory(glKind, err);
+        options.renderer = glRendererFactory(glKind, err, glNative);
         if (!options.renderer) {
             std::cerr << "ps11 shade: the GL renderer is not available: " << err << "\n";
             return cli::kUserError;

@@ -26,11 +26,14 @@ namespace ps11 {
 namespace {
 
 constexpr const char* kUsage =
-    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--gl osmesa|egl] [--hardware H]\n"
-    "                 [--precision fx8|fx12|float|ideal] [--stats] [-v]\n"
+    "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--gl osmesa|egl] [--gl-mode exact|native]\n"
+    "                 [--hardware H] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n"
     "  --backend B    emu (the software renderer), gl (the OpenGL renderer) or both: every draw and eval\n"
     "                 on both renderers, their results compared (disagreements fail the file)\n"
     "  --gl KIND      the OpenGL context: osmesa or egl (default: the first that works)\n"
+    "  --gl-mode M    exact (default: bit for bit with the emulator, checked) or native (GL's own\n"
+    "                 interpolation, filtering, float arithmetic and blending: run and measured against\n"
+    "                 the emulator, its probes and differences counted, not failed)\n"
     "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists\n"
     "                 them); `all` runs the files once per class\n";
 
@@ -46,6 +49,7 @@ struct RunOptions {
     bool verbose = false;
     bool stats = false;  // print executor statistics per file
     RendererFactory glRenderer;  // --backend gl|both
+    bool glNative = false;       // --gl-mode native
 };
 
 enum class Outcome { Passed, Failed, NotRunnable };
@@ -173,6 +177,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
     run.verbose = opts.verbose;
     run.shaderDiags = &shaderDiags;
     run.glRenderer = opts.glRenderer;
+    run.glNative = opts.glNative;
     CommandTally& t = result.tally;
     runCommands(file, path, program ? &*program : nullptr, run, t);
     if (opts.stats && t.evals) {
@@ -206,13 +211,19 @@ int cmdTest(const std::vector<std::string>& args) {
     RunOptions opts;
     bool allHardware = false;
     std::string glKind;
+    bool glModeGiven = false;
     std::vector<std::string> files;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "--backend" || a == "--precision" || a == "--hardware" || a == "--gl") {
+        if (a == "--backend" || a == "--precision" || a == "--hardware" || a == "--gl" || a == "--gl-mode") {
             if (i + 1 >= args.size()) return usageError(a + " needs a value");
             const std::string& v = args[++i];
-            if (a == "--gl") {
+            if (a == "--gl-mode") {
+                if (v != "exact" && v != "native")
+                    return usageError("unknown GL mode " + quote(v) + " (expected exact or native)");
+                opts.glNative = v == "native";
+                glModeGiven = true;
+            } else if (a == "--gl") {
                 if (v != "osmesa" && v != "egl") return usageError("unknown GL context " + quote(v) + " (expected osmesa or egl)");
                 glKind = v;
             } else if (a == "--hardware") {
@@ -248,7 +259,7 @@ int cmdTest(const std::vector<std::string>& args) {
             std::cout << kUsage;
             return cli::kOk;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError(cli::unknownOption(a, {"--backend", "--gl", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
+            return usageError(cli::unknownOption(a, {"--backend", "--gl", "--gl-mode", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
         } else {
             std::error_code ec;
             if (std::filesystem::is_directory(a, ec)) {
@@ -265,9 +276,10 @@ int cmdTest(const std::vector<std::string>& args) {
         }
     }
     if (files.empty()) return usageError("no .ps11test files given");
+    if (glModeGiven && !(opts.backends & kBackendGl)) return usageError("--gl-mode needs --backend gl or both");
     if (opts.backends & kBackendGl) {
         std::string error;
-        opts.glRenderer = glRendererFactory(glKind, error);
+        opts.glRenderer = glRendererFactory(glKind, error, opts.glNative);
         if (!opts.glRenderer) {
             std::cerr << "ps11 test: --backend " << (opts.backends & kBackendEmu ? "both" : "gl") << ": " << error << "\n";
             return cli::kUserError;
@@ -301,6 +313,8 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
         total.overOnePixels += t.overOnePixels;
         total.maxDiff = std::max(total.maxDiff, t.maxDiff);
         total.disagreements += t.disagreements;
+        total.nativeProbesDiffering += t.nativeProbesDiffering;
+        total.nativeDrawsPastTarget += t.nativeDrawsPastTarget;
         if (r.skipped) ++skipped;
         if (r.skippedHardware) {
             ++skippedHardware;
@@ -350,6 +364,12 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
                   << " %), " << total.overOnePixels << " past the target, max |d| " << total.maxDiff << "; "
                   << plural(total.disagreements, "disagreement", "disagreements") << "\n";
     }
+    if (opts.glNative && (opts.backends & kBackendGl))
+        std::cout << (perClass ? std::string(opts.hardware->name) + ": " : std::string())
+                  << "gl native mode, measured against the emulated card: "
+                  << plural(total.nativeProbesDiffering, "probe differs", "probes differ") << " from the expected value, "
+                  << plural(total.nativeDrawsPastTarget, "draw or eval", "draws and evals")
+                  << " past one level of the emulator's result\n";
     return failed ? cli::kUserError : cli::kOk;
 }
 

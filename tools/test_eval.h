@@ -78,6 +78,9 @@ struct CommandTally {
     uint64_t comparedPixels = 0, exactPixels = 0, overOnePixels = 0;
     double maxDiff = 0;           // 8-bit levels (values on float targets)
     size_t disagreements = 0;     // draws past the target, probes passing on one renderer only
+    // --gl-mode native: the gl side is measured, not checked: its probes that would fail, and its
+    // draws and evals past the target, are counted here (no failure, no disagreement).
+    size_t nativeProbesDiffering = 0, nativeDrawsPastTarget = 0;
     bool error = false;         // the executor or the device refused the file's setup or a draw
     ExecutorStats stats;        // executor statistics over every eval
     uint64_t texelsFetched = 0;
@@ -92,6 +95,9 @@ struct CommandRunOptions {
     // places of the executor's E40xx reports.
     const Diagnostics* shaderDiags = nullptr;
     RendererFactory glRenderer;  // the gl backend's renderer (empty: gl commands are not runnable)
+    // The GL renderer runs in native mode (emu/gl/gl_renderer.h): not bit-exact by design, so its
+    // results are measured against the emulator's instead of checked.
+    bool glNative = false;
 };
 
 // Runs (or counts) every command of `file` whose if(...) matches the run. `program` is the
