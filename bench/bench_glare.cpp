@@ -1,14 +1,19 @@
-// BM_Glare: every glare technique (published settings) on a 1920×1080 frame of its scene, on the
-// emulator (software renderer, 2 worker threads unless PS11_THREADS says otherwise) and on its
-// peer, the GL renderer (Mesa llvmpipe through OSMesa, or EGL with PS11_GL=egl), in one process,
-// frames interleaved emu, gl, emu, gl … under the same machine load. Before timing, one frame of
-// each is compared pass by pass (glare/compare.h) and the emulated image against the ideal
-// profile's; the counters report the agreement and the fx8-vs-ideal error. The reported time is
-// the emulator's frame (the passes' own time); `gl_ms` and `gl_over_emu` are the peer's.
-// How to run and read it: bench/README.md "bench_glare".
+// BM_Glare: every glare technique (published settings) on a 1920×1080 frame of its scene, run
+// four ways in one process, frames interleaved under the same machine load: the emulator
+// (software renderer, 2 worker threads unless PS11_THREADS says otherwise) as the 1.1-class card
+// (fx8) and under `ideal`, and the GL renderer (Mesa llvmpipe through OSMesa, or EGL with
+// PS11_GL=egl) in native mode — the peer (PERF.md) — and in exact mode. Before timing, one frame
+// of each technique is compared pass by pass between the emulator and GL exact (glare/compare.h);
+// the counters report that agreement, the fx8-vs-ideal error and the native-vs-fx8 error. A
+// frame's time is its passes' own time (each pass ends when the renderer has finished it); for
+// native mode also with the upload of the scene and the read-back of the result (`native_io_ms`).
+// The benchmark's own time is the emulator's fx8 frame; every mode's median and the ratios to the
+// peer are counters. Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <memory>
@@ -24,84 +29,136 @@ namespace {
 
 constexpr uint32_t kW = 1920, kH = 1080;
 
+enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, kModes };
+const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact"};
+
 int threads() {
     const char* t = std::getenv("PS11_THREADS");
     return t ? std::atoi(t) : 2;
 }
 
-std::unique_ptr<glare::Runner> makeRunner(bool gl, std::optional<ps11::Precision> p, std::string& err) {
+std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err) {
     glare::RunnerOptions ro;
     ro.width = kW;
     ro.height = kH;
-    ro.device.precision = p;
     ro.device.software.threads = threads();
-    if (gl) {
+    if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
+    if (mode == GlNative || mode == GlExact) {
+        setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe reads it when its screen is made
         const char* kind = std::getenv("PS11_GL");
-        ro.device.renderer = ps11::glRendererFactory(kind ? kind : "osmesa", err);
+        ro.device.renderer = ps11::glRendererFactory(kind ? kind : "osmesa", err, mode == GlNative);
         if (!ro.device.renderer) return nullptr;
     }
     return std::make_unique<glare::Runner>(ro);
+}
+
+double median(std::vector<double> v) {
+    if (v.empty()) return 0;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
 }
 
 void BM_Glare(benchmark::State& state, const std::string& name) {
     const glare::Technique& t = *glare::findTechnique(name);
     const glare::Settings s = *glare::presetSettings(t, "published");
     std::string err;
-    auto emuRun = makeRunner(false, std::nullopt, err);
-    auto glRun = makeRunner(true, std::nullopt, err);
-    auto idealRun = makeRunner(false, ps11::Precision::Ideal, err);
-    if (!glRun) {
-        state.SkipWithError(("no GL renderer: " + err).c_str());
-        return;
-    }
+    std::unique_ptr<glare::Runner> run[kModes];
+    for (int m = 0; m < kModes; ++m)
+        if (!(run[m] = makeRunner(Mode(m), err))) {
+            state.SkipWithError(("no GL renderer: " + err).c_str());
+            return;
+        }
     std::unique_ptr<glare::Scene> scene = glare::makeScene(t.scene(), err);
     double ms = 0;
     std::optional<emu::RgbaImage> frame;
-    if (!emuRun->renderScene(*scene, 0, 8, ms, err) || !(frame = emuRun->readTexture(emuRun->sceneTexture(), err)) ||
-        !glRun->setImage(*frame, err) || !idealRun->setImage(*frame, err)) {
+    if (!run[EmuFx8]->renderScene(*scene, 0, 8, ms, err) ||
+        !(frame = run[EmuFx8]->readTexture(run[EmuFx8]->sceneTexture(), err))) {
         state.SkipWithError(err.c_str());
         return;
     }
-    // Agreement, pass-isolated, and the error against ideal (frame 0 each).
+    for (int m = 1; m < kModes; ++m)
+        if (!run[m]->setImage(*frame, err)) {
+            state.SkipWithError(err.c_str());
+            return;
+        }
+    // Agreement of GL exact, pass-isolated, then frame 0 on the others; errors of the outputs.
     std::vector<glare::PassAgreement> agreement;
     glare::FrameResult r;
-    if (!glare::compareFrame(*emuRun, *glRun, t, s, 0, 2, agreement, r, err) || !idealRun->runFrame(t, s, 0, 2, r, err)) {
+    if (!glare::compareFrame(*run[EmuFx8], *run[GlExact], t, s, 0, 2, agreement, r, err) ||
+        !run[EmuIdeal]->runFrame(t, s, 0, 2, r, err) || !run[GlNative]->runFrame(t, s, 0, 2, r, err)) {
         state.SkipWithError(err.c_str());
         return;
     }
     uint64_t pixels = 0, exact = 0;
     for (const glare::PassAgreement& a : agreement) pixels += a.pixels, exact += a.exact;
-    std::optional<emu::RgbaImage> a = emuRun->readOutput(err), b = idealRun->readOutput(err);
-    double maxErr = 0, sumErr = 0;
-    for (size_t i = 0; i < a->rgba.size(); ++i) {
-        if (i % 4 == 3) continue;
-        const double e = std::abs(int(a->rgba[i]) - int(b->rgba[i]));
-        maxErr = std::max(maxErr, e);
-        sumErr += e;
+    std::optional<emu::RgbaImage> fx8 = run[EmuFx8]->readOutput(err), ideal = run[EmuIdeal]->readOutput(err),
+                                  native = run[GlNative]->readOutput(err);
+    if (!fx8 || !ideal || !native) {
+        state.SkipWithError(err.c_str());
+        return;
     }
-    std::vector<double> emuMs, glMs;
+    const glare::ImageError fx8VsIdeal = glare::imageError(*fx8, *ideal), nativeVsFx8 = glare::imageError(*native, *fx8);
+
+    std::vector<double> frameMs[kModes], nativeIoMs;
+    std::map<std::string, std::vector<double>> passMs[kModes];
+    std::vector<std::string> passOrder;
     int f = 1;
     for (auto _ : state) {
-        glare::FrameResult er, gr;
-        if (!emuRun->runFrame(t, s, f, f + 1, er, err) || !glRun->runFrame(t, s, f, f + 1, gr, err)) {
+        for (int m = 0; m < kModes; ++m) {
+            // Native mode with its I/O: the scene handed over and the result read back.
+            const auto t0 = std::chrono::steady_clock::now();
+            if (m == GlNative) {
+                if (!run[m]->setImage(*frame, err)) break;
+                run[m]->device().finish();
+            }
+            const double upMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            glare::FrameResult fr;
+            if (!run[m]->runFrame(t, s, f, f + 1, fr, err)) {
+                state.SkipWithError(err.c_str());
+                return;
+            }
+            if (m == GlNative) {
+                const auto t1 = std::chrono::steady_clock::now();
+                if (!run[m]->readOutput(err)) break;
+                nativeIoMs.push_back(upMs + fr.milliseconds +
+                                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
+            }
+            frameMs[m].push_back(fr.milliseconds);
+            for (const glare::PassStats& p : fr.passes) {
+                if (m == 0 && f == 1) passOrder.push_back(p.pass);
+                passMs[m][p.pass].push_back(p.milliseconds);
+            }
+            if (m == EmuFx8) state.SetIterationTime(fr.milliseconds / 1000);
+        }
+        if (!err.empty()) {
             state.SkipWithError(err.c_str());
             return;
         }
         ++f;
-        emuMs.push_back(er.milliseconds);
-        glMs.push_back(gr.milliseconds);
-        state.SetIterationTime(er.milliseconds / 1000);
     }
-    std::sort(emuMs.begin(), emuMs.end());
-    std::sort(glMs.begin(), glMs.end());
-    const double em = emuMs[emuMs.size() / 2], gm = glMs[glMs.size() / 2];
-    state.counters["emu_ms"] = em;
-    state.counters["gl_ms"] = gm;
-    state.counters["gl_over_emu"] = gm / em;
+    double med[kModes];
+    for (int m = 0; m < kModes; ++m) {
+        med[m] = median(frameMs[m]);
+        state.counters[std::string(kModeNames[m]) + "_ms"] = med[m];
+    }
+    // Ratios to the peer (> 1: faster than GL native).
+    state.counters["fx8_speedup_vs_native"] = med[GlNative] / med[EmuFx8];
+    state.counters["ideal_speedup_vs_native"] = med[GlNative] / med[EmuIdeal];
+    state.counters["exact_over_native"] = med[GlExact] / med[GlNative];
+    state.counters["native_io_ms"] = median(nativeIoMs);
     state.counters["exact_pct"] = pixels ? 100.0 * double(exact) / double(pixels) : 0;
-    state.counters["max_err_vs_ideal"] = maxErr;
-    state.counters["mean_err_vs_ideal"] = sumErr / double(a->rgba.size() / 4 * 3);
+    state.counters["fx8_vs_ideal_max"] = fx8VsIdeal.max;
+    state.counters["fx8_vs_ideal_mean"] = fx8VsIdeal.mean;
+    state.counters["native_vs_fx8_max"] = nativeVsFx8.max;
+    state.counters["native_vs_fx8_mean"] = nativeVsFx8.mean;
     state.SetLabel(ps11::glRendererDescription());
+    std::fprintf(stderr, "%s, per pass (median ms): %-22s %9s %9s %9s %9s\n", name.c_str(), "pass", kModeNames[0],
+                 kModeNames[1], kModeNames[2], kModeNames[3]);
+    for (const std::string& p : passOrder) {
+        std::fprintf(stderr, "%s, per pass (median ms): %-22s", name.c_str(), p.c_str());
+        for (int m = 0; m < kModes; ++m) std::fprintf(stderr, " %9.3f", median(passMs[m][p]));
+        std::fprintf(stderr, "\n");
+    }
 }
 
 }  // namespace
