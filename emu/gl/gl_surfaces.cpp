@@ -276,6 +276,22 @@ Resident& GlState::resident(GlSpace& space, const SurfaceDesc& surface) {
         gl.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     }
     if (r.generation == surface.generation) return r;
+    if (surface.generation == 0) {
+        // Never written since it was made: the front's zero-filled bytes, cleared here instead of
+        // uploaded (zero words in either mode's format).
+        const uint32_t zero[4] = {};
+        NativeFormat zf;
+        GLenum format = 0, type = GL_UNSIGNED_INT;
+        if (native && nativeFormatOf(*img.format, zf)) {
+            format = zf.format, type = zf.type;
+        } else {
+            GLenum internal;
+            wordFormats(wordsOf(*img.format), internal, format);
+        }
+        gl.ClearTexSubImage(r.tex, 0, 0, 0, 0, GLsizei(img.width), GLsizei(img.height), 1, format, type, zero);
+        r.generation = 0;
+        return r;
+    }
     // The front's contents are newer: upload them.
     gl.ActiveTexture(GL_TEXTURE0 + kUnitUpload);
     gl.BindTexture(GL_TEXTURE_2D, r.tex);

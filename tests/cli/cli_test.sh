@@ -360,6 +360,29 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 2 "glare --compare with --backend" "$ps11" glare --technique pyramid --scene sky --compare --backend gl
     expect_rc 0 "glare --compare --json" "$ps11" glare --technique sprites --scene lights --size 64x36 --compare --json
     expect_in "$work/out" '"pass": "draw_sprites", "pixels": 2304, "exact": 2304, "over_one": 0' "glare --compare --json per pass"
+    # The GL renderer's two modes (docs/gl-backend.md "Modes").
+    expect_rc 0 "info lists the GL modes" "$ps11" info
+    expect_in "$work/out" "GL renderer modes: exact" "info names the exact mode"
+    expect_in "$work/out" "native (GL's own interpolation" "info names the native mode"
+    expect_rc 0 "glare --backend gl table" "$ps11" glare --technique pyramid --scene sky --size 64x36 --backend gl -o "$work/pgl.png"
+    expect_in "$work/out" "0 uploaded, 1 read back" "a glare frame on GL reads back once and uploads nothing"
+    expect_rc 0 "glare --gl-mode native" "$ps11" glare --technique glow --scene neon --size 64x36 --backend gl --gl-mode native -o "$work/gn.png"
+    expect_in "$work/out" "gl-native renderer" "glare names the native renderer"
+    expect_rc 0 "glare --compare --gl-mode native" "$ps11" glare --technique quarter --scene neon --size 64x36 --compare --gl-mode native --json
+    expect_in "$work/out" '"gl_mode": "native", "end_to_end": {"vs_card": {"max_levels": ' "glare native distances in JSON"
+    expect_rc 2 "glare --gl-mode without gl" "$ps11" glare --technique glow --scene neon --gl-mode native -o "$work/x.png"
+    expect_in "$work/err" "--gl-mode needs --backend gl or --compare" "glare says what --gl-mode needs"
+    expect_rc 2 "glare --gl-mode bad" "$ps11" glare --technique glow --scene neon --backend gl --gl-mode fast -o "$work/x.png"
+    expect_in "$work/err" "--gl-mode takes exact or native" "glare lists the modes"
+    printf '[render target]\nsize 4 2\nclear 0xff000000\n[pixel shader]\nps_1_1\nmov r0, v0\n[test]\ndraw quad diffuse 0xff0000ff\nprobe all rgba 0xff0000ff\n' >"$work/n.ps11test"
+    expect_rc 0 "test --gl-mode native" "$ps11" test "$work/n.ps11test" --backend both --gl-mode native
+    expect_in "$work/out" "gl native mode, measured against the emulated card: 0 probes differ" "test counts native differences"
+    expect_rc 2 "test --gl-mode without gl" "$ps11" test "$work/d.ps11test" --gl-mode native
+    expect_rc 0 "compare --gl-mode native" "$ps11" compare "$work/n.ps11test" --gl-mode native
+    expect_in "$work/out" "gl native against ideal: max |d| 0 levels" "compare reports the distance from ideal"
+    expect_rc 2 "compare --random --gl-mode native" "$ps11" compare --random 2 --gl-mode native
+    expect_rc 0 "shade --gl-mode native" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --backend gl --gl-mode native -o "$work/sn.png"
+    expect_rc 2 "shade --gl-mode without gl" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --gl-mode native -o "$work/sn.png"
 fi
 
 if [ "$failures" != 0 ]; then
