@@ -719,7 +719,11 @@ std::string nativeVertexSource() {
          "void main() {\n"
          "    float rhw = aPos.w > 1e-30 ? aPos.w : 1e-30;\n"
          "    float w = 1.0 / rhw;\n"
-         "    vec2 ndc = (aPos.xy + 0.5) * uXform.xy + uXform.zw;\n"
+         // D3D9 puts pixel centres on integers, GL at +1/2. A D3D9 driver on GL shifts by 63/128
+         // of a pixel, not 1/2, so an edge through a pixel centre falls the way D3D9's top-left
+         // rule says (wined3d's position fixup with WINED3D_PIXEL_CENTER_INTEGER: 63/64 in clip
+         // units, half a viewport's width per unit); the rasteriser's subpixel grid is 1/256.
+         "    vec2 ndc = (aPos.xy + 0.4921875) * uXform.xy + uXform.zw;\n"
          "    gl_Position = vec4(ndc * w, aPos.z * w, w);\n"
          "    vDiffuse = aDiffuse;\n    vSpecular = aSpecular;\n";
     for (int i = 0; i < 8; ++i) s += "    vTex[" + std::to_string(i) + "] = aTex" + std::to_string(i) + ";\n";
