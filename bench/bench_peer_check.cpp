@@ -64,6 +64,22 @@ void main() {
     gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }
 )";
+// PEER_HAND_QUAD=1 (an attribution knob, not the default): two triangles over the viewport, as
+// the D3D quad the native side draws.
+const char* const kVertexQuad = R"(#version 450 core
+out vec2 uv;
+const vec2 corners[6] = vec2[6](vec2(0, 0), vec2(1, 0), vec2(0, 1), vec2(0, 1), vec2(1, 0), vec2(1, 1));
+void main() {
+    vec2 p = corners[gl_VertexID];
+    uv = p;
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+bool handQuad() {
+    const char* q = std::getenv("PEER_HAND_QUAD");
+    return q && *q == '1';
+}
 
 // The 2x2 luminance level, four point samples at its texel centres, averaged; 4·avg² as the
 // 1.1-class card computes mov_x4/mul_x4 (clamped to 1); luminance; alpha = smoothing.
@@ -218,7 +234,7 @@ public:
             gl.BlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
             gl.BlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
         }
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+        gl.DrawArrays(GL_TRIANGLES, 0, m_vertices);
         gl.Disable(GL_BLEND);
         endPass();
         // Bright pass at W/d x H/d.
@@ -226,7 +242,7 @@ public:
         gl.UseProgram(m_pBright);
         bindTexture(0, m_scene, m_point);
         bindTexture(1, m_adapted, m_point);
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+        gl.DrawArrays(GL_TRIANGLES, 0, m_vertices);
         endPass();
         // Pinwheel blur.
         src = &m_bright;
@@ -238,7 +254,7 @@ public:
             bindTexture(0, *src, m_linear);
             gl.Uniform4f(m_off01, +s * du, +l * dv, -l * du, +s * dv);
             gl.Uniform4f(m_off23, -s * du, -l * dv, +l * du, -s * dv);
-            gl.DrawArrays(GL_TRIANGLES, 0, 3);
+            gl.DrawArrays(GL_TRIANGLES, 0, m_vertices);
             src = &m_blur[size_t(k)];
             endPass();
         }
@@ -247,7 +263,7 @@ public:
         gl.UseProgram(m_pComposite);
         bindTexture(0, m_scene, m_point);
         bindTexture(1, *src, m_linear);
-        gl.DrawArrays(GL_TRIANGLES, 0, 3);
+        gl.DrawArrays(GL_TRIANGLES, 0, m_vertices);
         if (perPass) endPass();
         else gl.Finish();
         return msSince(start);
@@ -311,7 +327,7 @@ private:
             }
             return s;
         };
-        const GLuint vs = compile(GL_VERTEX_SHADER, kVertex), fs = vs ? compile(GL_FRAGMENT_SHADER, fragment) : 0;
+        const GLuint vs = compile(GL_VERTEX_SHADER, handQuad() ? kVertexQuad : kVertex), fs = vs ? compile(GL_FRAGMENT_SHADER, fragment) : 0;
         if (!fs) return 0;
         const GLuint p = gl.CreateProgram();
         gl.AttachShader(p, vs);
@@ -331,6 +347,7 @@ private:
     }
 
     std::unique_ptr<emu::gl::Context> m_ctx;
+    GLsizei m_vertices = handQuad() ? 6 : 3;
     GLuint m_vao = 0, m_point = 0, m_linear = 0;
     GLuint m_pAmount = 0, m_pBright = 0, m_pBlur = 0, m_pComposite = 0;
     GLint m_off01 = -1, m_off23 = -1;
