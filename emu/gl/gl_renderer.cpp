@@ -91,9 +91,11 @@ uint64_t programKey(uint64_t space, const DrawProgram& prog, const ps11::Hardwar
           << s.state.mipFilter << s.state.addressU << s.state.addressV << s.state.addressW;
     }
     const Plan& p = spec.merge;
-    k << p.precision << p.alphaTest << p.depthTest << p.depthWrite << p.fog << p.blend << p.alphaMask << p.depthMask
-      << p.alphaRef << p.channels << p.target << p.depthKind;
+    // Native shaders do only the fog and the alpha test (GL's state does the rest of the merge).
+    k << p.fog << p.alphaTest << p.alphaMask << p.alphaRef << p.target << (p.color != nullptr);
     for (uint8_t b : p.fogByte) k << b;
+    if (spec.native) return k.h;
+    k << p.precision << p.depthTest << p.depthWrite << p.blend << p.depthMask << p.channels << p.depthKind;
     for (uint8_t b : p.bfByte) k << b;
     for (const ChannelPlan& c : p.ch)
         k << c.src.slot << c.src.inv << c.dst.slot << c.dst.inv << c.kind << c.cs << c.cd;
