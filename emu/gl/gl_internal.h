@@ -11,7 +11,7 @@
 
 #include "emu/gl/functions.h"
 #include "emu/gl/gl_renderer.h"
-#include "ps11/executor_internal.h"
+#include "ps11/decoded_program.h"
 
 namespace emu::gl {
 
