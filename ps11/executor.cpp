@@ -15,7 +15,7 @@ namespace ps11 {
 namespace exec {
 
 const float* texcoordLanes(const RunState& st, int set, int comp) {
-    const float* p = (set >= 0 && set < 8) ? st.in->texcoord[set][comp] : nullptr;
+    const float* p = (set >= 0 && set < kMaxTexCoordSets) ? st.in->texcoord[set][comp] : nullptr;
     return p ? p + st.offset : st.zeros;
 }
 
@@ -43,12 +43,12 @@ uint64_t nextConstsId() {
 class ExecutorImpl final : public Executor {
 public:
     ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
-                 std::array<std::array<float, 4>, 8> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
+                 std::array<std::array<float, 4>, kNumConsts> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
                  uint8_t vUsed)
         : m_options(options), m_p(profile), m_ops(std::move(ops)), m_defs(defs), m_defMask(defMask),
           m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
-        for (int i = 0; i < 8; ++i) refreshConstant(i);
+        for (int i = 0; i < kNumConsts; ++i) refreshConstant(i);
         m_constsId = nextConstsId();
         if (options.path != ExecPath::Generic) {
             const FastKernels* k = options.path == ExecPath::FastBaseline ? fastKernelsBaseline() : fastKernelsBest();
@@ -58,14 +58,14 @@ public:
     }
 
     void setConstant(int index, const std::array<float, 4>& value) override {
-        if (index < 0 || index >= 8) return;
+        if (index < 0 || index >= kNumConsts) return;
         m_api[size_t(index)] = value;
         refreshConstant(index);
         m_constsId = nextConstsId();
         if (m_fast.kernels) presampledOps(m_fast, m_p, m_ops, m_presampled);
     }
     void setStageState(int stage, const StageState& state) override {
-        if (stage >= 0 && stage < 8) m_p.stages[size_t(stage)] = state;
+        if (stage >= 0 && stage < kMaxTextureStages) m_p.stages[size_t(stage)] = state;
     }
     bool writesDepth() const override { return m_writesDepth; }
     uint32_t sampledStages() const override { return m_stagesUsed; }
@@ -104,8 +104,8 @@ private:
     ExecutorOptions m_options;
     Profile m_p;
     std::vector<DOp> m_ops;
-    std::array<std::array<float, 4>, 8> m_defs;
-    std::array<std::array<float, 4>, 8> m_api{};
+    std::array<std::array<float, 4>, kNumConsts> m_defs;
+    std::array<std::array<float, 4>, kNumConsts> m_api{};
     uint8_t m_defMask = 0;
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
@@ -119,7 +119,7 @@ void ExecutorImpl::loadColors(RunState& st) const {
     // v# are saturated to [0, 1] and rounded to the grid once per pixel (docs/precision.md "Inputs").
     const bool fx = isFixedPoint(m_p.precision);
     const float g = float(m_p.g);
-    for (int v = 0; v < 2; ++v) {
+    for (int v = 0; v < kNumRegV; ++v) {
         if (!((m_vUsed >> v) & 1)) continue;
         for (int c = 0; c < 4; ++c) {
             const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : st.zeros;
@@ -281,7 +281,7 @@ struct Decoder {
             d.slot = uint8_t(s.index & 7);
         } else if (s.type == RegType::Texture && minor >= 4 && textureOp) {
             d.kind = SrcKind::TexCoord;
-            if (s.index >= 8) fail("E4004", s.loc, "texture coordinate t" + std::to_string(s.index) + " out of range");
+            if (s.index >= kMaxTexCoordSets) fail("E4004", s.loc, "texture coordinate t" + std::to_string(s.index) + " out of range");
             d.slot = uint8_t(s.index & 7);
         } else {
             int slot = slotOf(s.type, s.index, s.loc);
@@ -349,7 +349,7 @@ bool exec::decodeProgram(const Program& program, const ExecutorOptions& options,
     }
 
     std::vector<DOp> ops;
-    std::array<std::array<float, 4>, 8> defs{};
+    std::array<std::array<float, 4>, kNumConsts> defs{};
     uint8_t defMask = 0;
     uint32_t stages = 0;
     bool depth = false;
@@ -363,7 +363,7 @@ bool exec::decodeProgram(const Program& program, const ExecutorOptions& options,
         const Opcode opc = ins.opcode();
         if (opc == Opcode::Def) {
             int i = ins.dst.index;
-            if (i >= 8) {
+            if (i >= kNumConsts) {
                 dec.fail("E4004", ins.dst.loc, "def of c" + std::to_string(i) + " out of range");
                 continue;
             }

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "ps11/caps.h"
 #include "ps11/diagnostics.h"
 #include "ps11/hardware.h"
 #include "ps11/ir.h"
@@ -61,7 +62,7 @@ struct PixelInputs {
     int count = 0;
     bool quads = false;  // lanes 4i..4i+3 are 2x2 quads (see SampleRequest::quads)
     const float* color[2][4] = {};     // v0, v1: r g b a
-    const float* texcoord[8][4] = {};  // TC[0..7]: u v w q
+    const float* texcoord[kMaxTexCoordSets][4] = {};  // TC[0..7]: u v w q
 };
 
 // Results of `count` pixels. color is always filled (r0 as a real value); grid, if given,

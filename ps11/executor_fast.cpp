@@ -121,7 +121,7 @@ struct FastRunState {
 // c0..c7 as lanes, unless this thread's bank already holds them (the same constsId).
 void fillConstants(FastRunState& fs, const FastProgram& fp, const Profile& p, uint64_t constsId) {
     if (constsId != 0 && fs.constsId == constsId) return;
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kNumConsts; ++i)
         if ((fp.constsUsed >> i) & 1)
             for (int c = 0; c < 4; ++c)
                 std::fill_n(fs.bank.reg[kFastConstSlot + i][c], kChunk, int16_t(p.constGrid[size_t(i)][size_t(c)]));
@@ -260,7 +260,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
         const int nv = (n + 15) & ~15;
         std::memset(st.killed, 0, sizeof st.killed);
         // v# saturated and rounded once per pixel (docs/precision.md "Inputs"), as the generic path.
-        for (int v = 0; v < 2; ++v) {
+        for (int v = 0; v < kNumRegV; ++v) {
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c) {
                 const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : st.zeros;
@@ -303,8 +303,8 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
     for (const DOp& op : ops) paired = paired || op.hold;
     if (!paired) {
         std::array<uint8_t, kFastSlots> pos{};
-        pos[kSlotV] = pos[kSlotV + 1] = kMaskAll;
-        for (int i = 0; i < 8; ++i)
+        for (int v = 0; v < kNumRegV; ++v) pos[size_t(kSlotV + v)] = kMaskAll;
+        for (int i = 0; i < kNumConsts; ++i)
             for (int c = 0; c < 4; ++c)
                 if (p.constGrid[size_t(i)][size_t(c)] >= 0) pos[size_t(kFastConstSlot + i)] |= uint8_t(1u << c);
         auto known = [&](const FastSrc& s, int c) { return (pos[s.slot] >> s.sw[size_t(c)]) & 1; };
@@ -353,7 +353,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
         const int nv = (n + 15) & ~15;
-        for (int v = 0; v < 2; ++v) {
+        for (int v = 0; v < kNumRegV; ++v) {
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c)
                 kern.loadColor(inputs.color[v][c] ? inputs.color[v][c] + off : zeros, bank.reg[kSlotV + v][c], n);

@@ -22,9 +22,9 @@ constexpr int32_t kFastMaxGrid = 2040;
 
 enum class FastKind : uint8_t { Mov, Add, Sub, Mul, Mad, Dp3, Dp4, Lrp, Cnd, Cmp };
 
-// Slots of the int16 bank: the register slots of executor_internal.h, then c0..c7 as lanes.
+// Slots of the int16 bank: the register slots (ps11/decoded_program.h), then c0..c7 as lanes.
 constexpr int kFastConstSlot = kNumSlots;
-constexpr int kFastSlots = kNumSlots + 8;
+constexpr int kFastSlots = kNumSlots + kNumConsts;
 
 struct FastSrc {
     uint8_t slot = 0;

@@ -15,7 +15,7 @@
 #include "emu/gl/native_merge.h"
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
-#include "ps11/executor_internal.h"
+#include "ps11/decoded_program.h"
 #include "ps11/validator.h"
 
 using namespace emu;

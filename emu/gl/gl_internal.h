@@ -11,7 +11,7 @@
 
 #include "emu/gl/functions.h"
 #include "emu/gl/gl_renderer.h"
-#include "ps11/executor_internal.h"
+#include "ps11/decoded_program.h"
 
 namespace emu::gl {
 
@@ -51,7 +51,7 @@ struct ProgramEntry {
     // Uniform locations (-1: the program does not use it).
     GLint constG = -1, constF = -1, bump = -1, lum = -1, borderG = -1, borderF = -1, stride = -1, tri = -1,
           dstColor = -1, dstDepth = -1, xform = -1, primBase = -1;
-    GLint tex[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    GLint tex[ps11::kMaxTextureStages] = {-1, -1, -1, -1, -1, -1, -1, -1};
 };
 
 struct TextureEntry {
@@ -68,7 +68,7 @@ struct GlState {
     explicit GlState(const GlFunctions& f) : gl(f) {}
     ~GlState();
     GLuint vao = 0, vbo = 0, triBuffer = 0, triTexture = 0, fbo = 0, readFbo = 0, query = 0;
-    GLuint samplers[8] = {};  // GL sampler objects of GL's own filtering
+    GLuint samplers[ps11::kMaxTextureStages] = {};  // GL sampler objects of GL's own filtering
     GLuint sizingTex = 0;     // exact mode without a colour target: sizes the framebuffer
     GLuint vertexShader = 0, nativeVertexShader = 0, stretchProgram = 0, tapBuffer = 0, tapTexture = 0;
     std::unordered_map<uint64_t, ProgramEntry> programs;  // by what determines the GLSL

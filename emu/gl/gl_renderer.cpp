@@ -175,7 +175,7 @@ std::unique_ptr<GlRenderer> GlRenderer::create(const GlRendererOptions& options,
     gl.GenFramebuffers(1, &st.fbo);
     gl.GenFramebuffers(1, &st.readFbo);
     gl.GenQueries(1, &st.query);
-    gl.GenSamplers(8, st.samplers);
+    gl.GenSamplers(ps11::kMaxTextureStages, st.samplers);
     r->m_hardwareFiltering = options.hardwareFiltering;
     return r;
 }
@@ -217,7 +217,7 @@ namespace {
 // found by its key, or decoded, translated and linked once.
 struct ProgramStage {
     FragmentSpec spec;
-    std::array<Binding, 8> bindings;
+    std::array<Binding, ps11::kMaxTextureStages> bindings;
     ProgramEntry* entry = nullptr;
 };
 
@@ -227,7 +227,7 @@ static bool resolveBindings(GlState& st, GlSpace& space, const DrawCall& call, b
                             std::string& why) {
     const ps11::Precision precision = call.hardware.precision;
     const bool fx = ps11::isFixedPoint(precision) && !native;
-    for (int s = 0; s < 8; ++s) {
+    for (int s = 0; s < ps11::kMaxTextureStages; ++s) {
         const TextureRef& ref = call.textureRefs[size_t(s)];
         Binding& b = ps.bindings[size_t(s)];
         StageSpec& ss = ps.spec.stages[size_t(s)];
@@ -291,7 +291,7 @@ static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCa
         why = "the program cannot be run (" + (diags.all().empty() ? std::string("?") : diags.all()[0].message) + ")";
         return nullptr;
     }
-    for (int s = 0; s < 8; ++s) decoded->profile.stages[size_t(s)] = prog.stages[size_t(s)];
+    for (int s = 0; s < ps11::kMaxTextureStages; ++s) decoded->profile.stages[size_t(s)] = prog.stages[size_t(s)];
     ps.spec.program = decoded.get();
     ps.spec.shaderDepth = decoded->writesDepth;  // r0's depth from texdepth / texm3x2depth
     const std::string fragment = fragmentSource(ps.spec);
@@ -329,7 +329,7 @@ static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCa
     e.borderG = loc("uBorderG"), e.borderF = loc("uBorderF"), e.stride = loc("uStride"), e.tri = loc("uTri");
     e.dstColor = loc("uDstColor"), e.dstDepth = loc("uDstDepth"), e.xform = loc("uXform");
     e.primBase = loc("uPrimBase");
-    for (int s = 0; s < 8; ++s) e.tex[s] = loc(("uT" + std::to_string(s)).c_str());
+    for (int s = 0; s < ps11::kMaxTextureStages; ++s) e.tex[s] = loc(("uT" + std::to_string(s)).c_str());
     return &st.programs.emplace(key, std::move(e)).first->second;
 }
 
@@ -342,7 +342,7 @@ static void bindProgram(GlState& st, const DrawCall& call, bool native, const Pr
     const ps11::Precision precision = native ? ps11::Precision::Float : call.hardware.precision;
     const bool fx = ps11::isFixedPoint(precision);
     gl.UseProgram(e.program);
-    for (int s = 0; s < 8; ++s) {
+    for (int s = 0; s < ps11::kMaxTextureStages; ++s) {
         const StageSpec& ss = ps.spec.stages[size_t(s)];
         if (!ss.bound) continue;
         gl.ActiveTexture(GL_TEXTURE0 + GLenum(s));
@@ -353,12 +353,15 @@ static void bindProgram(GlState& st, const DrawCall& call, bool native, const Pr
             gl.BindSampler(GLuint(s), 0);
         if (e.tex[s] >= 0) gl.Uniform1i(e.tex[s], s);
     }
-    int32_t constG[8][4];
-    float constF[8][4], bump[8][4], lum[8][2], borderF[8][4];
-    int32_t borderG[8][4];
-    for (int i = 0; i < 8; ++i) {
+    constexpr int kConsts = ps11::exec::kNumConsts, kStages = ps11::kMaxTextureStages;
+    int32_t constG[kConsts][4];
+    float constF[kConsts][4], bump[kStages][4], lum[kStages][2], borderF[kStages][4];
+    int32_t borderG[kStages][4];
+    for (int i = 0; i < kConsts; ++i) {
         const auto& v = (decoded.defMask >> i) & 1 ? decoded.defs[size_t(i)] : call.program.constants[size_t(i)];
         for (int c = 0; c < 4; ++c) ps11::exec::constantOf(precision, v[size_t(c)], constG[i][c], constF[i][c]);
+    }
+    for (int i = 0; i < kStages; ++i) {
         const ps11::StageState& ss = call.program.stages[size_t(i)];
         for (int c = 0; c < 4; ++c) bump[i][c] = ss.bumpMat[size_t(c)];
         lum[i][0] = ss.lumScale, lum[i][1] = ss.lumOffset;
@@ -371,12 +374,12 @@ static void bindProgram(GlState& st, const DrawCall& call, bool native, const Pr
                                : 0;
         }
     }
-    if (e.constG >= 0) gl.Uniform4iv(e.constG, 8, &constG[0][0]);
-    if (e.constF >= 0) gl.Uniform4fv(e.constF, 8, &constF[0][0]);
-    if (e.bump >= 0) gl.Uniform4fv(e.bump, 8, &bump[0][0]);
-    if (e.lum >= 0) gl.Uniform2fv(e.lum, 8, &lum[0][0]);
-    if (e.borderG >= 0) gl.Uniform4iv(e.borderG, 8, &borderG[0][0]);
-    if (e.borderF >= 0) gl.Uniform4fv(e.borderF, 8, &borderF[0][0]);
+    if (e.constG >= 0) gl.Uniform4iv(e.constG, kConsts, &constG[0][0]);
+    if (e.constF >= 0) gl.Uniform4fv(e.constF, kConsts, &constF[0][0]);
+    if (e.bump >= 0) gl.Uniform4fv(e.bump, kStages, &bump[0][0]);
+    if (e.lum >= 0) gl.Uniform2fv(e.lum, kStages, &lum[0][0]);
+    if (e.borderG >= 0) gl.Uniform4iv(e.borderG, kStages, &borderG[0][0]);
+    if (e.borderF >= 0) gl.Uniform4fv(e.borderF, kStages, &borderF[0][0]);
     // Window x, y (pixel edges at integers, rows down) to clip space under GL_UPPER_LEFT.
     if (e.xform >= 0) gl.Uniform4f(e.xform, 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
 }

@@ -20,6 +20,12 @@ using ps11::SrcMod;
 using ps11::exec::DOp;
 using ps11::exec::DSrc;
 using ps11::exec::SrcKind;
+using ps11::kMaxTexCoordSets;
+using ps11::kMaxTextureStages;
+using ps11::exec::kNumConsts;
+using ps11::exec::kNumRegV;
+using ps11::exec::kNumSlots;
+using ps11::exec::kSlotV;
 using namespace detail;
 
 namespace detail {
@@ -97,7 +103,7 @@ struct Gen {
     std::string G() const { return std::to_string(p.g); }
 
     // ---- register access ----
-    std::string reg(int slot, int comp) const { return "R[" + std::to_string(slot) + "]." + kComp[comp]; }
+    std::string reg(int slot, int comp) const { return regSlot(slot) + "." + kComp[comp]; }
     // Register component as float (fx: n / G correctly rounded), with _bx2 when given.
     std::string regFloat(int slot, int comp, SrcMod mod) const {
         std::string v = fx ? "fdiv(float(" + reg(slot, comp) + "), " + G() + ".0)" : reg(slot, comp);
@@ -105,7 +111,7 @@ struct Gen {
         return v;
     }
     std::string tc(int set, int comp) const {
-        return set >= 0 && set < 8 ? "TC[" + std::to_string(set) + "]." + kComp[comp] : "0.0";
+        return set >= 0 && set < kMaxTexCoordSets ? "TC[" + std::to_string(set) + "]." + kComp[comp] : "0.0";
     }
     std::string srcFloat(const DSrc& s, int comp) const {
         return s.kind == SrcKind::TexCoord ? tc(s.slot, comp) : regFloat(s.slot, comp, s.mod);
@@ -127,13 +133,13 @@ struct Gen {
         }
     }
     void sampleInto(int stage, const std::string& u, const std::string& v, const std::string& w, int slot) {
-        o << "    R[" << slot << "] = S" << stage << "(" << u << ", " << v << ", " << w << ");\n";
+        const std::string r = regSlot(slot);
+        o << "    " << r << " = S" << stage << "(" << u << ", " << v << ", " << w << ");\n";
         if (fx)
-            o << "    R[" << slot << "] = clamp(R[" << slot << "], ivec4(" << -p.nMax << "), ivec4(" << p.nMax
-              << "));\n";
+            o << "    " << r << " = clamp(" << r << ", ivec4(" << -p.nMax << "), ivec4(" << p.nMax << "));\n";
         else if (p.clampRange)
-            o << "    R[" << slot << "] = clamp(R[" << slot << "], vec4(" << flit(-p.maxValue) << "), vec4("
-              << flit(p.maxValue) << "));\n";
+            o << "    " << r << " = clamp(" << r << ", vec4(" << flit(-p.maxValue) << "), vec4(" << flit(p.maxValue)
+              << "));\n";
     }
 
     // ---- texture-address instructions (ps11/executor_texture.cpp) ----
@@ -205,15 +211,15 @@ struct Gen {
                     o << "    { precise float L = " << b << " * " << l << ".x + " << l << ".y;\n";
                     if (p.stages[size_t(stage)].clampLuminance) o << "      L = L < 0.0 ? 0.0 : (L > 1.0 ? 1.0 : L);\n";
                     if (fx) {
-                        o << "      for (int k = 0; k < 4; ++k) { double x = roundEven(double(R[" << dst
-                          << "][k]) * double(L)); x = x > " << num(-p.nMax) << " ? x : " << num(-p.nMax) << "; x = x < "
-                          << num(p.nMax) << " ? x : " << num(p.nMax) << "; R[" << dst << "][k] = int(x); } }\n";
+                        o << "      for (int k = 0; k < 4; ++k) { double x = roundEven(double(" << regSlot(dst)
+                          << "[k]) * double(L)); x = x > " << num(-p.nMax) << " ? x : " << num(-p.nMax) << "; x = x < "
+                          << num(p.nMax) << " ? x : " << num(p.nMax) << "; " << regSlot(dst) << "[k] = int(x); } }\n";
                     } else {
-                        o << "      for (int k = 0; k < 4; ++k) { precise float x = R[" << dst << "][k] * L;";
+                        o << "      for (int k = 0; k < 4; ++k) { precise float x = " << regSlot(dst) << "[k] * L;";
                         if (p.clampRange)
                             o << " x = x < " << flit(-p.maxValue) << " ? " << flit(-p.maxValue) << " : x; x = x > "
                               << flit(p.maxValue) << " ? " << flit(p.maxValue) << " : x;";
-                        o << " R[" << dst << "][k] = x; } }\n";
+                        o << " " << regSlot(dst) << "[k] = x; } }\n";
                     }
                 }
                 break;
@@ -360,7 +366,7 @@ struct Gen {
         const uint8_t fm = op.op == Opcode::Dp3 ? 7 : op.op == Opcode::Dp4 ? 15 : op.op == Opcode::Bem ? 3 : op.mask;
         const std::string T = fx ? "ivec4" : "vec4";
         o << "    { " << (fx ? "" : "precise ") << T
-          << " t = " << (op.hold ? "H" : "R[" + std::to_string(op.dstSlot) + "]") << ";\n";
+          << " t = " << (op.hold ? "H" : regSlot(op.dstSlot)) << ";\n";
         if (fx)
             arithFx(op, fm);
         else
@@ -370,7 +376,7 @@ struct Gen {
         } else {
             for (int c = 0; c < 4; ++c)
                 if ((op.mask >> c) & 1)
-                    o << "      R[" << int(op.dstSlot) << "]." << kComp[c] << " = t." << kComp[c] << ";\n";
+                    o << "      " << reg(op.dstSlot, c) << " = t." << kComp[c] << ";\n";
             o << "    }\n";
         }
     }
@@ -530,7 +536,7 @@ struct Gen {
                 const DOp& first = ops[i - 1];
                 for (int c = 0; c < 4; ++c)
                     if ((first.mask >> c) & 1)
-                        o << "    R[" << int(first.dstSlot) << "]." << kComp[c] << " = H." << kComp[c] << ";\n";
+                        o << "    " << reg(first.dstSlot, c) << " = H." << kComp[c] << ";\n";
             }
         }
     }
@@ -542,10 +548,12 @@ struct Gen {
     std::string run() {
         o << "#version " << kGlslVersion << " core\n#extension GL_ARB_gpu_shader_int64 : require\n";
         o << "uniform usamplerBuffer uTri;\nuniform int uStride;\nuniform int uPrimBase;\n";
-        o << "uniform ivec4 uConstG[8];\nuniform vec4 uConstF[8];\nuniform vec4 uBump[8];\nuniform vec2 uLum[8];\n";
-        o << "uniform ivec4 uBorderG[8];\nuniform vec4 uBorderF[8];\n";
+        o << "uniform ivec4 uConstG[" << kNumConsts << "];\nuniform vec4 uConstF[" << kNumConsts
+          << "];\nuniform vec4 uBump[" << kMaxTextureStages << "];\nuniform vec2 uLum[" << kMaxTextureStages << "];\n";
+        o << "uniform ivec4 uBorderG[" << kMaxTextureStages << "];\nuniform vec4 uBorderF[" << kMaxTextureStages
+          << "];\n";
         o << "uniform usampler2D uDstColor;\nuniform usampler2D uDstDepth;\n";
-        for (int s = 0; s < 8; ++s) {
+        for (int s = 0; s < kMaxTextureStages; ++s) {
             const StageSpec& st = spec.stages[size_t(s)];
             if (!st.bound) continue;
             o << "uniform " << (fx ? (st.unorm8 ? "usampler" : "isampler") : "sampler") << (st.volume ? "3D" : "2D")
@@ -554,7 +562,7 @@ struct Gen {
         o << "layout(location = 0) out uvec4 oColor;\nlayout(location = 1) out uint oDepth;\n";
         o << kCommon;
         bool samples = false;
-        for (int s = 0; s < 8; ++s)
+        for (int s = 0; s < kMaxTextureStages; ++s)
             samples = samples || (((spec.program->stagesUsed >> s) & 1) && spec.stages[size_t(s)].bound);
         if (samples) o << kSampling;
         o << "int gBase;\n"
@@ -567,7 +575,7 @@ struct Gen {
              "    precise double row = recD(i) + recD(i + 1) * (0.0lf - ox) + recD(i + 2) * (double(p.y) - oy);\n"
              "    precise float r = float(row) + float(recD(i + 1)) * float(p.x);\n"
              "    return r;\n}\n";
-        for (int s = 0; s < 8; ++s)
+        for (int s = 0; s < kMaxTextureStages; ++s)
             if ((spec.program->stagesUsed >> s) & 1) writeSampler(ctx, s);
         writeMergeFunctions(ctx);
         o << "void main() {\n";
@@ -583,7 +591,7 @@ struct Gen {
         // Without derivatives (no stage's level or filter depends on them) an uncovered pixel
         // has nothing to contribute to its quad: it leaves at once.
         bool early = true;
-        for (int s = 0; s < 8; ++s)
+        for (int s = 0; s < kMaxTextureStages; ++s)
             if ((spec.program->stagesUsed >> s) & 1 && spec.stages[size_t(s)].bound &&
                 !lodFree(spec.stages[size_t(s)]) && !(spec.hardwareFiltering && !fx))
                 early = false;
@@ -592,8 +600,8 @@ struct Gen {
         o << "    float inv = 1.0;\n    if (persp) { float r = planeAt(2, P, ox, oy); r = r < 1e-30 ? 1e-30 : r; inv = "
              "fdiv(1.0, r); }\n";
         // Attributes: v0, v1 (diffuse, specular), TC[0..7].
-        o << "    vec4 VC[2] = vec4[2](vec4(0.0), vec4(0.0));\n    vec4 TC[8];\n"
-             "    for (int i = 0; i < 8; ++i) TC[i] = vec4(0.0);\n";
+        o << "    vec4 VC[2] = vec4[2](vec4(0.0), vec4(0.0));\n    vec4 TC[" << kMaxTexCoordSets
+          << "];\n    for (int i = 0; i < " << kMaxTexCoordSets << "; ++i) TC[i] = vec4(0.0);\n";
         int idx = 8;
         for (int a = 0; a < kAttrCount; ++a) {
             if (!((spec.usedAttributes >> a) & 1)) continue;
@@ -613,20 +621,22 @@ struct Gen {
         o << "    float zPlane = " << (spec.wantZ ? "planeAt(5, P, ox, oy)" : "0.0") << ";\n";
         o << "    bool killed = false;\n    float depthOut = 0.0;\n";
         o << "    float U = 0.0, V = 0.0, W = 0.0, P0 = 0.0, P1 = 0.0;\n    vec4 C4 = vec4(0.0);\n";
-        // Registers: r0..r5, t0..t5, v0, v1 (the executor's slots).
+        // Registers: the executor's register file (r0..r5, t0..t5, v0, v1 in its slots).
         if (fx) {
-            o << "    ivec4 R[14];\n    for (int i = 0; i < 14; ++i) R[i] = ivec4(0);\n    ivec4 H = ivec4(0);\n";
-            for (int v = 0; v < 2; ++v)
+            o << "    ivec4 R[" << kNumSlots << "];\n    for (int i = 0; i < " << kNumSlots
+              << "; ++i) R[i] = ivec4(0);\n    ivec4 H = ivec4(0);\n";
+            for (int v = 0; v < kNumRegV; ++v)
                 if ((spec.program->vUsed >> v) & 1)
                     o << "    for (int c = 0; c < 4; ++c) { float s = VC[" << v
                       << "][c]; s = s > 0.0 ? (s < 1.0 ? s : 1.0) : 0.0;"
-                      << " R[" << 12 + v << "][c] = int(roundEven(double(s) * " << num(p.g) << ")); }\n";
+                      << " " << regSlot(kSlotV + v) << "[c] = int(roundEven(double(s) * " << num(p.g) << ")); }\n";
         } else {
-            o << "    vec4 R[14];\n    for (int i = 0; i < 14; ++i) R[i] = vec4(0.0);\n    vec4 H = vec4(0.0);\n";
-            for (int v = 0; v < 2; ++v)
+            o << "    vec4 R[" << kNumSlots << "];\n    for (int i = 0; i < " << kNumSlots
+              << "; ++i) R[i] = vec4(0.0);\n    vec4 H = vec4(0.0);\n";
+            for (int v = 0; v < kNumRegV; ++v)
                 if ((spec.program->vUsed >> v) & 1)
-                    o << "    for (int c = 0; c < 4; ++c) { float s = VC[" << v << "][c]; R[" << 12 + v
-                      << "][c] = s > 0.0 ? (s < 1.0 ? s : 1.0) : 0.0; }\n";
+                    o << "    for (int c = 0; c < 4; ++c) { float s = VC[" << v << "][c]; " << regSlot(kSlotV + v)
+                      << "[c] = s > 0.0 ? (s < 1.0 ? s : 1.0) : 0.0; }\n";
         }
         ops();
         o << "    if (killed || !covered) discard;\n";
@@ -644,13 +654,14 @@ struct Gen {
 std::string Gen::runNative() {
     const Plan& m = spec.merge;
     o << "#version " << kGlslVersion << " core\n";
-    o << "uniform vec4 uConstF[8];\nuniform vec4 uBump[8];\nuniform vec2 uLum[8];\n";
-    for (int s = 0; s < 8; ++s) {
+    o << "uniform vec4 uConstF[" << kNumConsts << "];\nuniform vec4 uBump[" << kMaxTextureStages
+      << "];\nuniform vec2 uLum[" << kMaxTextureStages << "];\n";
+    for (int s = 0; s < kMaxTextureStages; ++s) {
         const StageSpec& st = spec.stages[size_t(s)];
         if (!st.bound || !((spec.program->stagesUsed >> s) & 1)) continue;
         o << "uniform sampler" << (st.volume ? "3D" : "2D") << " uT" << s << ";\n";
     }
-    o << "in vec4 vDiffuse;\nin vec4 vSpecular;\nin vec4 vTex[8];\n";
+    o << "in vec4 vDiffuse;\nin vec4 vSpecular;\nin vec4 vTex[" << kMaxTexCoordSets << "];\n";
     o << "layout(location = 0) out vec4 oColor;\n";
     // The division of the coordinates (projected texturing, texdepth, texm3x3spec): GL's own.
     o << "float fdiv(float a, float b) { return a / b; }\n"
@@ -658,25 +669,26 @@ std::string Gen::runNative() {
          "bool cmpPass(uint mask, bool less, bool equal, bool greater) {\n"
          "    uint outcome = less ? 0u : equal ? 1u : greater ? 2u : 3u;\n"
          "    return ((mask >> outcome) & 1u) != 0u;\n}\n";
-    for (int s = 0; s < 8; ++s)
+    for (int s = 0; s < kMaxTextureStages; ++s)
         if ((spec.program->stagesUsed >> s) & 1) writeSampler(ctx, s);
     o << "void main() {\n";
-    o << "    vec4 VC[2] = vec4[2](vDiffuse, vSpecular);\n    vec4 TC[8];\n"
-         "    for (int i = 0; i < 8; ++i) TC[i] = vTex[i];\n";
+    o << "    vec4 VC[2] = vec4[2](vDiffuse, vSpecular);\n    vec4 TC[" << kMaxTexCoordSets
+      << "];\n    for (int i = 0; i < " << kMaxTexCoordSets << "; ++i) TC[i] = vTex[i];\n";
     o << "    bool killed = false;\n    float depthOut = 0.0;\n";
     o << "    float U = 0.0, V = 0.0, W = 0.0, P0 = 0.0, P1 = 0.0;\n    vec4 C4 = vec4(0.0);\n";
-    o << "    vec4 R[14];\n    for (int i = 0; i < 14; ++i) R[i] = vec4(0.0);\n    vec4 H = vec4(0.0);\n";
+    o << "    vec4 R[" << kNumSlots << "];\n    for (int i = 0; i < " << kNumSlots
+      << "; ++i) R[i] = vec4(0.0);\n    vec4 H = vec4(0.0);\n";
     // v0, v1: the interpolated colours clamped to [0, 1] (NaN: 0), as the float profiles load them.
-    for (int v = 0; v < 2; ++v)
+    for (int v = 0; v < kNumRegV; ++v)
         if ((spec.program->vUsed >> v) & 1)
-            o << "    for (int c = 0; c < 4; ++c) R[" << 12 + v << "][c] = satf(VC[" << v << "][c]);\n";
+            o << "    for (int c = 0; c < 4; ++c) " << regSlot(kSlotV + v) << "[c] = satf(VC[" << v << "][c]);\n";
     ops();
     o << "    if (killed) discard;\n";
     if (spec.shaderDepth) o << "    gl_FragDepth = depthOut;\n";
     // 8-bit targets (and depth-only draws) see the saturated colour; float targets r0 as is.
     const bool unorm = m.color == nullptr || m.target == TargetKind::Argb8 || m.target == TargetKind::Xrgb8;
-    o << "    vec4 s = R[0];\n";
-    if (unorm) o << "    for (int c = 0; c < 4; ++c) s[c] = satf(R[0][c]);\n";
+    o << "    vec4 s = " << regR0() << ";\n";
+    if (unorm) o << "    for (int c = 0; c < 4; ++c) s[c] = satf(" << regR0() << "[c]);\n";
     if (m.fog) {
         // Vertex fog: rgb = f·rgb + (1 − f)·FOGCOLOR, f the specular alpha clamped to [0, 1].
         o << "    { float f = satf(VC[1].w);\n      vec3 fogc = vec3(" << flit(float(m.fogByte[0]) / 255.0f) << ", "
@@ -712,10 +724,10 @@ std::string nativeVertexSource() {
                     "layout(location = 0) in vec4 aPos;\n"
                     "layout(location = 1) in vec4 aDiffuse;\n"
                     "layout(location = 2) in vec4 aSpecular;\n";
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < kMaxTexCoordSets; ++i)
         s += "layout(location = " + std::to_string(3 + i) + ") in vec4 aTex" + std::to_string(i) + ";\n";
     s += "uniform vec4 uXform;\n"
-         "out vec4 vDiffuse;\nout vec4 vSpecular;\nout vec4 vTex[8];\n"
+         "out vec4 vDiffuse;\nout vec4 vSpecular;\nout vec4 vTex[" + std::to_string(kMaxTexCoordSets) + "];\n"
          "void main() {\n"
          "    float rhw = aPos.w > 1e-30 ? aPos.w : 1e-30;\n"
          "    float w = 1.0 / rhw;\n"
@@ -726,7 +738,7 @@ std::string nativeVertexSource() {
          "    vec2 ndc = (aPos.xy + 0.4921875) * uXform.xy + uXform.zw;\n"
          "    gl_Position = vec4(ndc * w, aPos.z * w, w);\n"
          "    vDiffuse = aDiffuse;\n    vSpecular = aSpecular;\n";
-    for (int i = 0; i < 8; ++i) s += "    vTex[" + std::to_string(i) + "] = aTex" + std::to_string(i) + ";\n";
+    for (int i = 0; i < kMaxTexCoordSets; ++i) s += "    vTex[" + std::to_string(i) + "] = aTex" + std::to_string(i) + ";\n";
     s += "}\n";
     return s;
 }

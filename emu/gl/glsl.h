@@ -1,5 +1,5 @@
 // ps_1_x → GLSL for the GL renderer (docs/gl-backend.md "Shaders"). One fragment shader per
-// draw configuration: the decoded program (ps11/executor_internal.h, the op list the executor
+// draw configuration: the decoded program (ps11/decoded_program.h, the op list the executor
 // runs), the precision profile, the sampled stages' texture kinds and sampler states, and the
 // output merger's plan (emu/merge_plan.h). Two modes follow from the profile:
 // - exact (fx8, fx12): registers are grid integers, every instruction forms the executor's exact
@@ -22,7 +22,7 @@
 
 #include "emu/merge_plan.h"
 #include "emu/raster.h"
-#include "ps11/executor_internal.h"
+#include "ps11/decoded_program.h"
 #include "ps11/texture_sampler.h"
 
 namespace emu::gl {
@@ -55,7 +55,7 @@ struct FragmentSpec {
     const ps11::exec::DecodedProgram* program = nullptr;
     ps11::Precision precision = ps11::Precision::Fx8;
     int weightBits = 8;  // float profile: 8-bit sub-texel weights (0: float32 weights)
-    std::array<StageSpec, 8> stages{};
+    std::array<StageSpec, ps11::kMaxTextureStages> stages{};
     uint64_t usedAttributes = 0;  // attributes in the triangle record (emu/vertex.h indices)
     Plan merge;                   // the output merger's plan (colour/depth pointers unused)
     bool shaderDepth = false;     // r0's depth comes from texdepth / texm3x2depth

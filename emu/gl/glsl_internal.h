@@ -19,6 +19,12 @@ struct GlslContext {
     std::ostringstream& o;
 };
 
+// The shader's register array R is the executor's register file (ps11/decoded_program.h):
+// "R[slot]" for a slot of it (r# at kSlotR + #, t# at kSlotT + #, v# at kSlotV + #).
+inline std::string regSlot(int slot) { return "R[" + std::to_string(slot) + "]"; }
+// r0, the colour the merge takes.
+inline std::string regR0() { return regSlot(ps11::exec::kSlotR + 0); }
+
 // A double literal that reads back as `v` (17 significant digits, always with a point or exponent).
 std::string num(double v);
 // A float literal that reads back as exactly `v` (its bits through uintBitsToFloat).
@@ -29,7 +35,7 @@ std::string flit(float v);
 extern const char* const kSampling;
 // `ivec4 S<s>(float u, float v, float w)` (fx) or `vec4 S<s>(…)` (float profiles) for stage s.
 void writeSampler(GlslContext& cx, int s);
-// The merge's helper functions, then the merge at the end of main() (r0 in R[0]).
+// The merge's helper functions, then the merge at the end of main() (r0 in regR0()).
 void writeMergeFunctions(GlslContext& cx);
 void writeMerge(GlslContext& cx);
 

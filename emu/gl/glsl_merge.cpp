@@ -149,7 +149,7 @@ void writeMerge(GlslContext& cx) {
     o << "    oColor = uvec4(0u); oDepth = 0u;\n";
     if (fx && unorm) {
         // mergeFxUnorm8: integers on the grid.
-        o << "    int s[4]; for (int c = 0; c < 4; ++c) s[c] = clamp(R[0][c], 0, " << g << ");\n";
+        o << "    int s[4]; for (int c = 0; c < 4; ++c) s[c] = clamp(" << regR0() << "[c], 0, " << g << ");\n";
         if (m.fog) {
             o << "    { int fq = int(roundEven(double(satf(VC[1].w)) * " << num(g) << "));\n";
             for (int c = 0; c < 3; ++c)
@@ -191,7 +191,7 @@ void writeMerge(GlslContext& cx) {
     // mergeFloat: float32 arithmetic (fx profiles: grid values, exact fog and alpha test).
     o << "    float s[4];\n";
     if (fx) {
-        o << "    int gn[4]; for (int c = 0; c < 4; ++c) gn[c] = R[0][c];\n";
+        o << "    int gn[4]; for (int c = 0; c < 4; ++c) gn[c] = " << regR0() << "[c];\n";
         if (m.fog) {
             o << "    { int fq = int(roundEven(double(satf(VC[1].w)) * " << num(g) << "));\n";
             for (int c = 0; c < 3; ++c)
@@ -204,7 +204,7 @@ void writeMerge(GlslContext& cx) {
             o << "    { int64_t a = int64_t(gn[3]) * 255l, r = int64_t(" << m.alphaRef << ") * " << g << "l;\n"
               << "      if (!cmpPass(" << m.alphaMask << "u, a < r, a == r, a > r)) discard; }\n";
     } else {
-        o << "    for (int c = 0; c < 4; ++c) s[c] = " << (unorm ? "satf(R[0][c])" : "R[0][c]") << ";\n";
+        o << "    for (int c = 0; c < 4; ++c) s[c] = " << (unorm ? "satf(" + regR0() + "[c])" : regR0() + "[c]") << ";\n";
         if (m.fog) {
             o << "    { float f = satf(VC[1].w);\n";
             for (int c = 0; c < 3; ++c)
