@@ -1,7 +1,7 @@
 // BM_EmuVsGl: the emulator's speed against its peer, the GL renderer's native mode on Mesa
 // llvmpipe (PERF.md "The peer"), in one process. Every pass runs on four emu::Devices: the
 // software renderer (2 worker threads) in the 1.1-class card's fx8 and in `ideal`, and the GL
-// renderer (LP_NUM_THREADS=2 unless set) in native mode and in exact mode, registered emu_fx8,
+// renderer (LP_NUM_THREADS=2 unless set; OSMesa, or EGL with PS11_GL=egl) in native mode and in exact mode, registered emu_fx8,
 // emu_ideal, gl_native, gl_exact, … so that --benchmark_enable_random_interleaving mixes their
 // repetitions under the same machine load. Each reports the wall time of DrawPrimitiveUP followed
 // by Device::finish (GL's work done); the GL devices keep their surfaces resident, so nothing is
@@ -125,7 +125,8 @@ void Scene::setup(Pass pass, Kind kind) {
         // llvmpipe reads its thread count when the context's screen is made.
         setenv("LP_NUM_THREADS", "2", 0);
         std::string why;
-        o.renderer = ps11::glRendererFactory("osmesa", why, kind == Kind::GlNative);
+        const char* glKind = std::getenv("PS11_GL");  // "egl" for a GPU driver
+        o.renderer = ps11::glRendererFactory(glKind ? glKind : "osmesa", why, kind == Kind::GlNative);
         if (!o.renderer) {
             error = why;
             if (glError.empty()) glError = error;
