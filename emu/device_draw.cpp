@@ -256,17 +256,9 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         for (const LoweredProgram& entry : dc.ffp[h])
             if (entry.key == key) found = &entry;
         if (!found) {
-            std::string error;
+            CallError error;
             std::optional<LoweredStages> lowered = lowerFixedFunction(m_state, error);
-            if (!lowered) {
-                // The lowering names its own E41xx code first ("E41xx what is wrong").
-                std::string code = error.size() >= 5 && error[0] == 'E' ? error.substr(0, 5) : "E4122";
-                std::string text = error.size() > 6 && error[0] == 'E' ? error.substr(6) : error;
-                m_error.hr = D3DERR_INVALIDCALL;
-                m_error.code = code;
-                m_error.message = code + " DrawPrimitiveUP: " + text;
-                return D3DERR_INVALIDCALL;
-            }
+            if (!lowered) return drawFail(error.hr, error.code.c_str(), error.message);
             if (dc.ffpCount >= kMaxLoweredPrograms) {
                 dc.ffp.clear();
                 dc.ffpCount = 0;
@@ -386,12 +378,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     }
 
     // ---- output merger ----
-    if (std::string e = mergeStateError(m_state, "DrawPrimitiveUP"); !e.empty()) {
-        m_error.hr = D3DERR_INVALIDCALL;
-        m_error.code = e.substr(0, 5);
-        m_error.message = e;
-        return D3DERR_INVALIDCALL;
-    }
+    if (std::optional<CallError> e = mergeStateError(m_state)) return drawFail(e->hr, e->code.c_str(), e->message);
     call.merge = MergeState::from(m_state, depth != nullptr, m_hardware.precision);
     const MergeState& merge = call.merge;
     DrawStats stats;
@@ -436,7 +423,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     call.assemble = [&](uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out) {
         processTriangles(m_state, vs, type, first, count, static_cast<const uint8_t*>(vertexData), stride, out);
     };
-    RendererError rerr;
+    CallError rerr;
     if (!m_renderer->draw(call, stats, rerr)) return drawFail(rerr.hr, rerr.code.c_str(), rerr.message);
     if (stats.trianglesDrawn) {
         rendererWrote(*rt, rtRef.level);
