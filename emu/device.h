@@ -14,6 +14,7 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "emu/call_error.h"
 #include "emu/d3d9types.h"
 #include "emu/resources.h"
 #include "emu/software_renderer.h"
@@ -47,6 +48,7 @@ struct DeviceError {
 };
 
 struct DrawContext;  // emu/device_draw.cpp: the front's lowered fixed-function programs
+struct DrawSetup;    // emu/device_draw.cpp: one DrawPrimitiveUP call as its stages resolve it
 
 class Device {
 public:
@@ -163,6 +165,10 @@ private:
     Resource* findResource(Handle h);
     // The surface's image and owner, or null (with lastError set, naming `call` and `what`).
     Image* surfaceImage(Handle h, const char* call, const char* what, Resource** owner, SurfaceRef* ref);
+    // The same, or null with `error` set (its message names `what`, not the call); lastError untouched.
+    Image* findSurface(Handle h, const char* what, CallError& error, Resource** owner, SurfaceRef* ref);
+    // sampledTexture's work, or null with `error` set ("sampledTexture: …"); lastError untouched.
+    std::shared_ptr<const ps11::Texture> makeSampled(Handle texture, CallError& error);
     HRESULT checkNewSize(const char* call, UINT width, UINT height, UINT depth, uint32_t maxSide);
     HRESULT createResource(const char* call, Resource&& r, UINT width, UINT height, UINT depth, UINT levels,
                            Handle* out);
@@ -181,7 +187,20 @@ private:
     void syncResource(Resource& r);
     // A level as the renderer sees it (emu/renderer.h SurfaceDesc).
     SurfaceDesc surfaceDesc(const SurfaceRef& ref, Resource& r);
-    HRESULT drawFail(HRESULT hr, const char* code, std::string message);
+    // DrawPrimitiveUP's stages (emu/device_draw.cpp), in the order the call runs them: each
+    // resolves its part of `d` (the DrawCall for the renderer) or says why the draw is refused;
+    // submit hands the call to the renderer (which may refuse it too).
+    std::optional<CallError> checkCall(DrawSetup& d) const;      // arguments, FVF, stride
+    std::optional<CallError> resolveTargets(DrawSetup& d);       // render target, depth
+    std::optional<CallError> checkRasterStates() const;          // cull, shade and fill modes
+    std::optional<CallError> resolveProgram(DrawSetup& d);       // shader or lowered fixed function
+    std::optional<CallError> resolveSamplers(DrawSetup& d);      // sampler states, textures
+    std::optional<CallError> resolveStages(DrawSetup& d) const;  // texcoord indices, stage states
+    std::optional<CallError> resolveMerge(DrawSetup& d) const;   // merge state, clip rect
+    void vertices(DrawSetup& d);                                 // vertex processing on demand
+    std::optional<CallError> submit(DrawSetup& d, DrawStats& stats);
+    // Records a refused draw as lastError ("E41xx DrawPrimitiveUP: …") and returns its HRESULT.
+    HRESULT drawFail(const CallError& error);
 
     DrawStats m_lastDraw, m_totalDraw;
     std::shared_ptr<DrawContext> m_draw;  // created by the first draw

@@ -1,9 +1,12 @@
-// Device front: DrawPrimitiveUP. Validation of the call and of the state the draw reads, the
-// pixel program (a shader, or the fixed-function stages lowered by emu/ffp.h), sampler, stage
-// and render states resolved into a DrawCall with vertex processing (emu/vertex.h), handed to the
-// renderer (emu/renderer.h). docs/device.md "Drawing".
+// Device front: DrawPrimitiveUP, in stages. Each checks its part of the call and of the state the
+// draw reads and resolves it into the DrawCall (emu/renderer.h), or refuses with a CallError
+// (emu/call_error.h): the call's arguments, the render target and depth, the raster states, the
+// pixel program (a shader, or the fixed-function stages lowered by emu/ffp.h), sampler states and
+// textures, stage states, the output merger's states and clip rect, and vertex processing
+// (emu/vertex.h) pulled by the renderer. docs/device.md "Drawing".
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <list>
 #include <unordered_map>
@@ -21,6 +24,14 @@ namespace emu {
 namespace {
 
 std::string num(uint64_t v) { return std::to_string(v); }
+
+std::string hexText(unsigned v) {
+    char b[16];
+    std::snprintf(b, sizeof b, "%x", v);
+    return std::string(b);
+}
+
+CallError refuse(HRESULT hr, const char* code, std::string message) { return CallError{hr, code, std::move(message)}; }
 
 // D3DCAPS9 MaxPrimitiveCount of the era's hardware (0xFFFFF) and a stride limit well above
 // any FVF's size (D3DCAPS9 MaxStreamStride was 255–512 on ps 1.x parts).
@@ -81,31 +92,6 @@ std::optional<ps11::Filter> filterOf(DWORD v, bool mip) {
     return std::nullopt;
 }
 
-struct FfpKey {
-    std::vector<uint32_t> words;
-    bool operator==(const FfpKey&) const = default;
-};
-
-// The part of the state the fixed-function lowering reads: stage states, render states and
-// which stages have a texture bound.
-FfpKey ffpKey(const DeviceState& s) {
-    FfpKey k;
-    k.words.reserve(kMaxStages * kStageStateLimit + kRenderStateLimit + 1);
-    for (const auto& st : s.stageStates) k.words.insert(k.words.end(), st.begin(), st.end());
-    k.words.insert(k.words.end(), s.renderStates.begin(), s.renderStates.end());
-    uint32_t bound = 0;
-    for (size_t i = 0; i < s.textures.size(); ++i)
-        if (s.textures[i] != Handle::Null) bound |= 1u << i;
-    k.words.push_back(bound);
-    return k;
-}
-
-size_t hashWords(const std::vector<uint32_t>& w) {
-    uint64_t h = 1469598103934665603ull;
-    for (uint32_t x : w) h = (h ^ x) * 1099511628211ull;
-    return size_t(h);
-}
-
 }  // namespace
 
 TransferStats& TransferStats::operator+=(const TransferStats& o) {
@@ -129,32 +115,47 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
     return *this;
 }
 
-// A lowered fixed-function program, kept while the state the lowering read stays the same.
+// A lowered fixed-function program, kept while the state the lowering reads
+// (DeviceState::FixedFunction) stays the same.
 struct LoweredProgram {
-    FfpKey key;
+    DeviceState state;  // the state it was lowered from; compared over DeviceState::FixedFunction
     LoweredStages lowered;
     uint64_t id = 0;  // DrawProgram::key
     uint64_t attrs = 0;
     bool kills = false;
 };
 
-// What the front keeps between draws: the lowered fixed-function programs by the state words
-// the lowering reads (hash buckets), each with a program identity for the renderer's caches.
+// What the front keeps between draws: the lowered fixed-function programs in buckets by
+// DeviceState::hash(FixedFunction), each with a program identity for the renderer's caches.
 struct DrawContext {
     std::unordered_map<size_t, std::list<LoweredProgram>> ffp;
     size_t ffpCount = 0;
     uint64_t nextId = uint64_t(1) << 32;  // above every shader handle
 };
 
-HRESULT Device::drawFail(HRESULT hr, const char* code, std::string message) {
-    return fail(hr, code, "DrawPrimitiveUP: " + message);
+// One DrawPrimitiveUP call: its arguments, and what the stages resolve, in their order.
+struct DrawSetup {
+    D3DPRIMITIVETYPE type = D3DPT_TRIANGLELIST;
+    UINT primitiveCount = 0;
+    const void* vertexData = nullptr;
+    UINT stride = 0;
+    std::optional<VertexLayout> layout;  // checkCall
+    Resource* rt = nullptr;              // resolveTargets: the render target's owner, level, image
+    SurfaceRef rtRef;
+    Image* target = nullptr;
+    Resource* ds = nullptr;  // and the depth stencil surface's (null: none bound)
+    SurfaceRef dsRef;
+    Image* depth = nullptr;
+    VertexSetup vertexSetup;  // vertices
+    DrawCall call;            // what goes to the renderer
+};
+
+HRESULT Device::drawFail(const CallError& error) {
+    return fail(error.hr, error.code.c_str(), "DrawPrimitiveUP: " + error.message);
 }
 
-HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, const void* vertexData, UINT stride) {
-    const auto t0 = std::chrono::steady_clock::now();
-    ok();
-    // ---- the call's arguments ----
-    switch (type) {
+std::optional<CallError> Device::checkCall(DrawSetup& d) const {
+    switch (d.type) {
         case D3DPT_TRIANGLELIST:
         case D3DPT_TRIANGLESTRIP:
         case D3DPT_TRIANGLEFAN:
@@ -162,111 +163,99 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         case D3DPT_POINTLIST:
         case D3DPT_LINELIST:
         case D3DPT_LINESTRIP:
-            return drawFail(D3DERR_NOTAVAILABLE, "E4114",
-                            "primitive type " + num(DWORD(type)) + " (points and lines) is not drawn by this device");
+            return refuse(D3DERR_NOTAVAILABLE, "E4114",
+                          "primitive type " + num(DWORD(d.type)) + " (points and lines) is not drawn by this device");
         default:
-            return drawFail(D3DERR_INVALIDCALL, "E4113",
-                            "primitive type " + num(DWORD(type)) + " is not a D3DPRIMITIVETYPE");
+            return refuse(D3DERR_INVALIDCALL, "E4113",
+                          "primitive type " + num(DWORD(d.type)) + " is not a D3DPRIMITIVETYPE");
     }
-    if (primitiveCount == 0 || primitiveCount > kMaxPrimitiveCount)
-        return drawFail(D3DERR_INVALIDCALL, "E4115",
-                        "primitive count " + num(primitiveCount) + " outside 1.." + num(kMaxPrimitiveCount));
-    if (!vertexData) return drawFail(D3DERR_INVALIDCALL, "E4103", "vertex data pointer is null");
-    if (m_state.renderTarget == Handle::Null) return drawFail(D3DERR_INVALIDCALL, "E4109", "no render target");
-    if (m_state.fvf == 0) return drawFail(D3DERR_INVALIDCALL, "E4117", "no FVF set (SetFVF)");
+    if (d.primitiveCount == 0 || d.primitiveCount > kMaxPrimitiveCount)
+        return refuse(D3DERR_INVALIDCALL, "E4115",
+                      "primitive count " + num(d.primitiveCount) + " outside 1.." + num(kMaxPrimitiveCount));
+    if (!d.vertexData) return refuse(D3DERR_INVALIDCALL, "E4103", "vertex data pointer is null");
+    // Here, before the FVF: a call with neither reports the missing target (resolveTargets checks
+    // the target itself).
+    if (m_state.renderTarget == Handle::Null) return refuse(D3DERR_INVALIDCALL, "E4109", "no render target");
+    if (m_state.fvf == 0) return refuse(D3DERR_INVALIDCALL, "E4117", "no FVF set (SetFVF)");
     std::string why;
-    const std::optional<VertexLayout> layout = parseFvf(m_state.fvf, why);
-    if (!layout)
-        return drawFail(
-            D3DERR_INVALIDCALL, "E4117", "FVF 0x" + [&] {
-                char b[16];
-                std::snprintf(b, sizeof b, "%x", unsigned(m_state.fvf));
-                return std::string(b);
-            }() + ": " + why);
-    if (stride < layout->size || stride > kMaxStride)
-        return drawFail(D3DERR_INVALIDCALL, "E4116",
-                        "stride " + num(stride) + " outside " + num(layout->size) + ".." + num(kMaxStride) +
-                            " (the FVF's vertex is " + num(layout->size) + " bytes)");
+    d.layout = parseFvf(m_state.fvf, why);
+    if (!d.layout) return refuse(D3DERR_INVALIDCALL, "E4117", "FVF 0x" + hexText(unsigned(m_state.fvf)) + ": " + why);
+    if (d.stride < d.layout->size || d.stride > kMaxStride)
+        return refuse(D3DERR_INVALIDCALL, "E4116",
+                      "stride " + num(d.stride) + " outside " + num(d.layout->size) + ".." + num(kMaxStride) +
+                          " (the FVF's vertex is " + num(d.layout->size) + " bytes)");
+    return std::nullopt;
+}
 
-    // ---- render target and depth ----
-    Resource* rt = nullptr;
-    SurfaceRef rtRef;
-    Image* target = surfaceImage(m_state.renderTarget, "DrawPrimitiveUP", "render target", &rt, &rtRef);
-    if (!target) return m_error.hr;
-    if (!drawableFormat(target->format->format))
-        return drawFail(D3DERR_INVALIDCALL, "E4118",
-                        std::string("render target format ") + target->format->name +
-                            " is not drawn (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
-    if (rt->locked[rtRef.level]) return drawFail(D3DERR_INVALIDCALL, "E4106", "the render target is locked");
-    Resource* ds = nullptr;
-    SurfaceRef dsRef;
-    Image* depth = nullptr;
-    if (m_state.depthStencil != Handle::Null) {
-        depth = surfaceImage(m_state.depthStencil, "DrawPrimitiveUP", "depth stencil surface", &ds, &dsRef);
-        if (!depth) return m_error.hr;
-        if (ds->locked[dsRef.level])
-            return drawFail(D3DERR_INVALIDCALL, "E4106", "the depth stencil surface is locked");
-        if (depth->width < target->width || depth->height < target->height)
-            return drawFail(D3DERR_INVALIDCALL, "E4119",
-                            "depth stencil surface " + num(depth->width) + "x" + num(depth->height) +
-                                " smaller than the render target " + num(target->width) + "x" + num(target->height));
-    }
+std::optional<CallError> Device::resolveTargets(DrawSetup& d) {
+    CallError error;
+    d.target = findSurface(m_state.renderTarget, "render target", error, &d.rt, &d.rtRef);
+    if (!d.target) return error;
+    if (!drawableFormat(d.target->format->format))
+        return refuse(D3DERR_INVALIDCALL, "E4118",
+                      std::string("render target format ") + d.target->format->name +
+                          " is not drawn (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+    if (d.rt->locked[d.rtRef.level]) return refuse(D3DERR_INVALIDCALL, "E4106", "the render target is locked");
+    if (m_state.depthStencil == Handle::Null) return std::nullopt;
+    d.depth = findSurface(m_state.depthStencil, "depth stencil surface", error, &d.ds, &d.dsRef);
+    if (!d.depth) return error;
+    if (d.ds->locked[d.dsRef.level]) return refuse(D3DERR_INVALIDCALL, "E4106", "the depth stencil surface is locked");
+    if (d.depth->width < d.target->width || d.depth->height < d.target->height)
+        return refuse(D3DERR_INVALIDCALL, "E4119",
+                      "depth stencil surface " + num(d.depth->width) + "x" + num(d.depth->height) +
+                          " smaller than the render target " + num(d.target->width) + "x" + num(d.target->height));
+    return std::nullopt;
+}
 
-    // ---- render and stage states the draw reads ----
+std::optional<CallError> Device::checkRasterStates() const {
     const DWORD cull = m_state.renderState(D3DRS_CULLMODE);
     if (cull < D3DCULL_NONE || cull > D3DCULL_CCW)
-        return drawFail(D3DERR_INVALIDCALL, "E4119", "D3DRS_CULLMODE " + num(cull) + " is not a D3DCULL value");
+        return refuse(D3DERR_INVALIDCALL, "E4119", "D3DRS_CULLMODE " + num(cull) + " is not a D3DCULL value");
     const DWORD shade = m_state.renderState(D3DRS_SHADEMODE);
     if (shade < D3DSHADE_FLAT || shade > D3DSHADE_PHONG)
-        return drawFail(D3DERR_INVALIDCALL, "E4119", "D3DRS_SHADEMODE " + num(shade) + " is not a D3DSHADEMODE value");
+        return refuse(D3DERR_INVALIDCALL, "E4119", "D3DRS_SHADEMODE " + num(shade) + " is not a D3DSHADEMODE value");
     const DWORD fill = m_state.renderState(D3DRS_FILLMODE);
     if (fill != 3 /* D3DFILL_SOLID */)
-        return drawFail(
-            D3DERR_NOTAVAILABLE, "E4120",
-            "D3DRS_FILLMODE " + num(fill) + ": only D3DFILL_SOLID (3) is drawn (no point or wireframe fill)");
+        return refuse(D3DERR_NOTAVAILABLE, "E4120",
+                      "D3DRS_FILLMODE " + num(fill) + ": only D3DFILL_SOLID (3) is drawn (no point or wireframe fill)");
+    return std::nullopt;
+}
 
-    // ---- the pixel program ----
-    if (!m_draw) m_draw = std::make_shared<DrawContext>();
-    DrawContext& dc = *m_draw;
-    DrawCall call;
-    call.hardware = m_hardware;
-    DrawProgram& prog = call.program;
+std::optional<CallError> Device::resolveProgram(DrawSetup& d) {
+    DrawProgram& prog = d.call.program;
     if (m_state.pixelShader != Handle::Null) {
         const ps11::Program* program = pixelShaderProgram(m_state.pixelShader);
         if (!program)
-            return drawFail(D3DERR_INVALIDCALL, "E4102",
-                            "pixel shader " + num(uint32_t(m_state.pixelShader)) + " is not a pixel shader");
+            return refuse(D3DERR_INVALIDCALL, "E4102",
+                          "pixel shader " + num(uint32_t(m_state.pixelShader)) + " is not a pixel shader");
         prog.program = program;
         prog.key = uint64_t(uint32_t(m_state.pixelShader));  // handles are never reused
         prog.attributesRead = attributesRead(*program);
         prog.kills = hasTexkill(*program);
         for (int s = 0; s < kMaxStages; ++s) {
             ps11::StageState& st = prog.stages[size_t(s)];
-            st.bumpMat = {m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00),
-                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
-                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10),
-                          m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
+            st.bumpMat = {
+                m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT00), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT01),
+                m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT10), m_state.stageStateFloat(s, D3DTSS_BUMPENVMAT11)};
             st.lumScale = m_state.stageStateFloat(s, D3DTSS_BUMPENVLSCALE);
             st.lumOffset = m_state.stageStateFloat(s, D3DTSS_BUMPENVLOFFSET);
         }
     } else {
-        FfpKey key = ffpKey(m_state);
-        const size_t h = hashWords(key.words);
+        // The lowered program of this fixed-function state, from the cache or lowered now.
+        if (!m_draw) m_draw = std::make_shared<DrawContext>();
+        DrawContext& dc = *m_draw;
+        const size_t h = m_state.hash(DeviceState::FixedFunction);
         const LoweredProgram* found = nullptr;
-        for (const LoweredProgram& entry : dc.ffp[h])
-            if (entry.key == key) found = &entry;
+        if (auto bucket = dc.ffp.find(h); bucket != dc.ffp.end())
+            for (const LoweredProgram& entry : bucket->second)
+                if (entry.state.equal(m_state, DeviceState::FixedFunction)) {
+                    found = &entry;
+                    break;
+                }
         if (!found) {
-            std::string error;
+            CallError error;
             std::optional<LoweredStages> lowered = lowerFixedFunction(m_state, error);
-            if (!lowered) {
-                // The lowering names its own E41xx code first ("E41xx what is wrong").
-                std::string code = error.size() >= 5 && error[0] == 'E' ? error.substr(0, 5) : "E4122";
-                std::string text = error.size() > 6 && error[0] == 'E' ? error.substr(6) : error;
-                m_error.hr = D3DERR_INVALIDCALL;
-                m_error.code = code;
-                m_error.message = code + " DrawPrimitiveUP: " + text;
-                return D3DERR_INVALIDCALL;
-            }
+            if (!lowered) return error;
             if (dc.ffpCount >= kMaxLoweredPrograms) {
                 dc.ffp.clear();
                 dc.ffpCount = 0;
@@ -274,7 +263,7 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             LoweredProgram entry;
             entry.attrs = attributesRead(lowered->program);
             entry.kills = hasTexkill(lowered->program);
-            entry.key = std::move(key);
+            entry.state = m_state;
             entry.lowered = std::move(*lowered);
             entry.id = dc.nextId++;
             auto& bucket = dc.ffp[h];
@@ -291,34 +280,35 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         prog.stages = found->lowered.executorStages;
     }
     for (int i = 0; i < kMaxPsConstants; ++i) prog.constants[size_t(i)] = m_state.psConstants[size_t(i)];
+    return std::nullopt;
+}
 
-    // ---- textures and sampler states of the stages the program samples ----
-    const uint32_t sampled = ps11::sampledStages(*prog.program);
-    std::array<std::shared_ptr<const ps11::Texture>, kMaxSamplers>& textures = call.textures;
-    std::array<ps11::SamplerState, kMaxSamplers>& samplers = call.samplers;
+// Textures and sampler states of the stages the program samples.
+std::optional<CallError> Device::resolveSamplers(DrawSetup& d) {
+    DrawCall& call = d.call;
+    const uint32_t sampled = ps11::sampledStages(*call.program.program);
     for (int s = 0; s < kMaxSamplers; ++s) {
         if (!((sampled >> s) & 1)) continue;
         ps11::SamplerState ss;
         auto filter = [&](D3DSAMPLERSTATETYPE t, bool mip, ps11::Filter& out) -> bool {
-            const DWORD v = m_state.samplerState(s, t);
-            const std::optional<ps11::Filter> f = filterOf(v, mip);
+            const std::optional<ps11::Filter> f = filterOf(m_state.samplerState(s, t), mip);
             if (!f) return false;
             out = *f;
             return true;
         };
         if (!filter(D3DSAMP_MINFILTER, false, ss.minFilter) || !filter(D3DSAMP_MAGFILTER, false, ss.magFilter) ||
             !filter(D3DSAMP_MIPFILTER, true, ss.mipFilter))
-            return drawFail(D3DERR_UNSUPPORTEDTEXTUREFILTER, "E4123",
-                            "sampler " + num(uint32_t(s)) + ": filter (MIN " +
-                                num(m_state.samplerState(s, D3DSAMP_MINFILTER)) + ", MAG " +
-                                num(m_state.samplerState(s, D3DSAMP_MAGFILTER)) + ", MIP " +
-                                num(m_state.samplerState(s, D3DSAMP_MIPFILTER)) + ") is not a filter the device has");
+            return refuse(D3DERR_UNSUPPORTEDTEXTUREFILTER, "E4123",
+                          "sampler " + num(uint32_t(s)) + ": filter (MIN " +
+                              num(m_state.samplerState(s, D3DSAMP_MINFILTER)) + ", MAG " +
+                              num(m_state.samplerState(s, D3DSAMP_MAGFILTER)) + ", MIP " +
+                              num(m_state.samplerState(s, D3DSAMP_MIPFILTER)) + ") is not a filter the device has");
         const D3DSAMPLERSTATETYPE addr[3] = {D3DSAMP_ADDRESSU, D3DSAMP_ADDRESSV, D3DSAMP_ADDRESSW};
         ps11::TextureAddress* out[3] = {&ss.addressU, &ss.addressV, &ss.addressW};
         for (int a = 0; a < 3; ++a) {
             const DWORD v = m_state.samplerState(s, addr[a]);
             if (v < D3DTADDRESS_WRAP || v > D3DTADDRESS_MIRRORONCE)
-                return drawFail(
+                return refuse(
                     D3DERR_INVALIDCALL, "E4123",
                     "sampler " + num(uint32_t(s)) + ": address mode " + num(v) + " is not a D3DTEXTUREADDRESS");
             *out[a] = ps11::TextureAddress(v);
@@ -326,20 +316,18 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         const DWORD border = m_state.samplerState(s, D3DSAMP_BORDERCOLOR);
         ss.border = {float((border >> 16) & 0xff) / 255.0f, float((border >> 8) & 0xff) / 255.0f,
                      float(border & 0xff) / 255.0f, float(border >> 24) / 255.0f};
-        samplers[size_t(s)] = ss;
+        call.samplers[size_t(s)] = ss;
         const Handle tex = m_state.textures[size_t(s)];
         if (tex == Handle::Null) continue;  // samples (0, 0, 0, 1)
+        const std::string where = "texture " + num(uint32_t(tex)) + " on stage " + num(uint32_t(s));
         // A texture that is also the render target (or holds it) would be read while written.
-        if (rt && tex == rtRef.owner && rt->kind != ResourceKind::Surface)
-            return drawFail(D3DERR_INVALIDCALL, "E4124",
-                            "texture " + num(uint32_t(tex)) + " on stage " + num(uint32_t(s)) +
-                                " holds the render target (read and written by one draw)");
+        if (d.rt && tex == d.rtRef.owner && d.rt->kind != ResourceKind::Surface)
+            return refuse(D3DERR_INVALIDCALL, "E4124",
+                          where + " holds the render target (read and written by one draw)");
         Resource* tr = findResource(tex);
         if (tr) {
             for (size_t l = 0; l < tr->locked.size(); ++l)
-                if (tr->locked[l])
-                    return drawFail(D3DERR_INVALIDCALL, "E4106",
-                                    "texture " + num(uint32_t(tex)) + " on stage " + num(uint32_t(s)) + " is locked");
+                if (tr->locked[l]) return refuse(D3DERR_INVALIDCALL, "E4106", where + " is locked");
         }
         if (m_renderer->keepsCopies() && tr) {
             // The renderer takes the texture by identity, and the front's view only if it asks.
@@ -352,95 +340,116 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
             ref.level0 = surfaceDesc(SurfaceRef{tex, 0}, *tr);
             continue;
         }
-        textures[size_t(s)] = sampledTexture(tex);
-        if (!textures[size_t(s)]) {
-            const std::string msg = m_error.message;
-            m_error = DeviceError{};
-            return drawFail(D3DERR_OUTOFVIDEOMEMORY, "E4111",
-                            "texture " + num(uint32_t(tex)) + " on stage " + num(uint32_t(s)) + ": " + msg);
-        }
+        CallError error;
+        call.textures[size_t(s)] = makeSampled(tex, error);
+        if (!call.textures[size_t(s)])
+            return refuse(D3DERR_OUTOFVIDEOMEMORY, "E4111", where + ": " + error.code + " " + error.message);
     }
-    ok();
+    return std::nullopt;
+}
 
-    // ---- stage states: texture coordinates and the executor's per-stage values ----
+// Texture coordinates and the executor's per-stage values.
+std::optional<CallError> Device::resolveStages(DrawSetup& d) const {
+    DrawProgram& prog = d.call.program;
     for (int s = 0; s < kMaxStages; ++s) {
         const DWORD tci = m_state.stageState(s, D3DTSS_TEXCOORDINDEX);
         const bool slotRead = (prog.attributesRead >> attrTex(s, 0)) & 0xF;
         if (slotRead && (tci & 0xFFFF0000u))
-            return drawFail(
-                D3DERR_INVALIDCALL,
-                "E4119", "stage " + num(uint32_t(s)) + ": D3DTSS_TEXCOORDINDEX generation mode 0x" + [&] {
-                    char b[16];
-                    std::snprintf(b, sizeof b, "%x", unsigned(tci >> 16));
-                    return std::string(b);
-                }() + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
+            return refuse(D3DERR_INVALIDCALL, "E4119",
+                          "stage " + num(uint32_t(s)) + ": D3DTSS_TEXCOORDINDEX generation mode 0x" +
+                              hexText(unsigned(tci >> 16)) + " (D3DTSS_TCI_*) is not implemented; only PASSTHRU");
     }
     for (int s = 0; s < kMaxStages; ++s) {
         // D3DTTFF_PROJECTED resolves against the stage's coordinate set in the FVF (any
         // TEXTURETRANSFORMFLAGS value is taken, as D3D9 takes it; ps11::projectionDivisor).
         ps11::StageState& st = prog.stages[size_t(s)];
         const DWORD set = m_state.stageState(s, D3DTSS_TEXCOORDINDEX) & 0xFFFF;
-        st.coordComponents = set < DWORD(layout->texCount) ? layout->texSize[size_t(set)] : 4;
-        st.textureDimensions = textures[size_t(s)] && textures[size_t(s)]->isVolume() ? 3 : 2;
+        st.coordComponents = set < DWORD(d.layout->texCount) ? d.layout->texSize[size_t(set)] : 4;
+        const auto& texture = d.call.textures[size_t(s)];
+        st.textureDimensions = texture && texture->isVolume() ? 3 : 2;
         if (!prog.fixedFunction) st.transformFlags = m_state.stageState(s, D3DTSS_TEXTURETRANSFORMFLAGS);
     }
+    return std::nullopt;
+}
 
-    // ---- output merger ----
-    if (std::string e = mergeStateError(m_state, "DrawPrimitiveUP"); !e.empty()) {
-        m_error.hr = D3DERR_INVALIDCALL;
-        m_error.code = e.substr(0, 5);
-        m_error.message = e;
-        return D3DERR_INVALIDCALL;
+// The output merger's states, and the clip rect: viewport ∩ scissor (when enabled) ∩ target.
+std::optional<CallError> Device::resolveMerge(DrawSetup& d) const {
+    if (std::optional<CallError> error = mergeStateError(m_state)) return error;
+    DrawCall& call = d.call;
+    call.merge = MergeState::from(m_state, d.depth != nullptr, m_hardware.precision);
+    const D3DVIEWPORT9& vp = m_state.viewport;
+    int64_t x0 = vp.X, y0 = vp.Y, x1 = int64_t(vp.X) + vp.Width, y1 = int64_t(vp.Y) + vp.Height;
+    if (m_state.renderState(D3DRS_SCISSORTESTENABLE)) {
+        const RECT& sc = m_state.scissor;
+        x0 = std::max<int64_t>(x0, sc.left);
+        y0 = std::max<int64_t>(y0, sc.top);
+        x1 = std::min<int64_t>(x1, sc.right);
+        y1 = std::min<int64_t>(y1, sc.bottom);
     }
-    call.merge = MergeState::from(m_state, depth != nullptr, m_hardware.precision);
-    const MergeState& merge = call.merge;
+    call.clip.x0 = int(std::clamp<int64_t>(x0, 0, d.target->width));
+    call.clip.y0 = int(std::clamp<int64_t>(y0, 0, d.target->height));
+    call.clip.x1 = int(std::clamp<int64_t>(x1, 0, d.target->width));
+    call.clip.y1 = int(std::clamp<int64_t>(y1, 0, d.target->height));
+    return std::nullopt;
+}
+
+// Vertices → screen triangles, pulled by the renderer chunk by chunk: only the attributes the
+// program reads (and the specular alpha for fog) are carried.
+void Device::vertices(DrawSetup& d) {
+    DrawCall& call = d.call;
+    uint64_t used = call.program.attributesRead;
+    if (call.merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
+    call.usedAttributes = used;
+    d.vertexSetup.layout = &*d.layout;
+    d.vertexSetup.usedAttrs = used;
+    call.primitiveCount = d.primitiveCount;
+    call.assemble = [this, &d](uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out) {
+        processTriangles(m_state, d.vertexSetup, d.type, first, count, static_cast<const uint8_t*>(d.vertexData),
+                         d.stride, out);
+    };
+}
+
+// The surfaces by identity, and the call to the renderer; the levels it drew into are marked.
+std::optional<CallError> Device::submit(DrawSetup& d, DrawStats& stats) {
+    DrawCall& call = d.call;
+    call.target = MergeTarget{d.target, d.depth};
+    call.colorSurface = surfaceDesc(d.rtRef, *d.rt);
+    if (d.depth) call.depthSurface = surfaceDesc(d.dsRef, *d.ds);
+    if (m_renderer->keepsCopies())
+        call.textureView = [this](int stage) { return sampledTexture(m_state.textures[size_t(stage)]); };
+    CallError error;
+    if (!m_renderer->draw(call, stats, error)) return error;
+    if (stats.trianglesDrawn) {
+        rendererWrote(*d.rt, d.rtRef.level);
+        if (d.depth && call.merge.depthWrite) rendererWrote(*d.ds, d.dsRef.level);
+    }
+    return std::nullopt;
+}
+
+HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, const void* vertexData, UINT stride) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ok();
+    DrawSetup d;
+    d.type = type;
+    d.primitiveCount = primitiveCount;
+    d.vertexData = vertexData;
+    d.stride = stride;
+    d.call.hardware = m_hardware;
+    if (std::optional<CallError> e = checkCall(d)) return drawFail(*e);
+    if (std::optional<CallError> e = resolveTargets(d)) return drawFail(*e);
+    if (std::optional<CallError> e = checkRasterStates()) return drawFail(*e);
+    if (std::optional<CallError> e = resolveProgram(d)) return drawFail(*e);
+    if (std::optional<CallError> e = resolveSamplers(d)) return drawFail(*e);
+    if (std::optional<CallError> e = resolveStages(d)) return drawFail(*e);
+    if (std::optional<CallError> e = resolveMerge(d)) return drawFail(*e);
+
     DrawStats stats;
     stats.draws = 1;
     stats.triangles = primitiveCount;
-    if (merge.writesNothing()) {
-        // Nothing can change: skipped without shading (never changes an output pixel).
-        stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-        m_lastDraw = stats;
-        m_totalDraw += stats;
-        return D3D_OK;
-    }
-    uint64_t used = prog.attributesRead;
-    if (merge.fog) used |= uint64_t(1) << (kAttrSpecular + 3);
-    call.usedAttributes = used;
-    call.target = MergeTarget{target, depth};
-    call.colorSurface = surfaceDesc(rtRef, *rt);
-    if (depth) call.depthSurface = surfaceDesc(dsRef, *ds);
-    if (m_renderer->keepsCopies())
-        call.textureView = [this](int stage) { return sampledTexture(m_state.textures[size_t(stage)]); };
-    {
-        const D3DVIEWPORT9& vp = m_state.viewport;
-        int64_t x0 = vp.X, y0 = vp.Y, x1 = int64_t(vp.X) + vp.Width, y1 = int64_t(vp.Y) + vp.Height;
-        if (m_state.renderState(D3DRS_SCISSORTESTENABLE)) {
-            const RECT& sc = m_state.scissor;
-            x0 = std::max<int64_t>(x0, sc.left);
-            y0 = std::max<int64_t>(y0, sc.top);
-            x1 = std::min<int64_t>(x1, sc.right);
-            y1 = std::min<int64_t>(y1, sc.bottom);
-        }
-        call.clip.x0 = int(std::clamp<int64_t>(x0, 0, target->width));
-        call.clip.y0 = int(std::clamp<int64_t>(y0, 0, target->height));
-        call.clip.x1 = int(std::clamp<int64_t>(x1, 0, target->width));
-        call.clip.y1 = int(std::clamp<int64_t>(y1, 0, target->height));
-    }
-
-    // ---- vertices → screen triangles, pulled by the renderer chunk by chunk ----
-    VertexSetup vs;
-    vs.layout = &*layout;
-    vs.usedAttrs = used;
-    call.primitiveCount = primitiveCount;
-    call.assemble = [&](uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out) {
-        processTriangles(m_state, vs, type, first, count, static_cast<const uint8_t*>(vertexData), stride, out);
-    };
-    RendererError rerr;
-    if (!m_renderer->draw(call, stats, rerr)) return drawFail(rerr.hr, rerr.code.c_str(), rerr.message);
-    if (stats.trianglesDrawn) {
-        rendererWrote(*rt, rtRef.level);
-        if (depth && merge.depthWrite) rendererWrote(*ds, dsRef.level);
+    // A merge state that writes nothing is skipped without shading (never changes an output pixel).
+    if (!d.call.merge.writesNothing()) {
+        vertices(d);
+        if (std::optional<CallError> e = submit(d, stats)) return drawFail(*e);
     }
     stats.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     m_lastDraw = stats;

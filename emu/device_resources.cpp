@@ -241,24 +241,31 @@ HRESULT Device::Release(Handle object) {
     return D3D_OK;
 }
 
-Image* Device::surfaceImage(Handle h, const char* call, const char* what, Resource** owner, SurfaceRef* ref) {
+Image* Device::findSurface(Handle h, const char* what, CallError& error, Resource** owner, SurfaceRef* ref) {
     auto it = m_surfaces.find(uint32_t(h));
     if (it == m_surfaces.end()) {
         const bool other = m_resources.count(uint32_t(h)) || m_shaders.count(uint32_t(h));
-        fail(D3DERR_INVALIDCALL, "E4102",
-             std::string(call) + ": " + what + " " + handleText(h) +
-                 (other ? " is not a surface (use GetSurfaceLevel for a texture level)"
-                        : " is not an object of this device"));
+        error = CallError{D3DERR_INVALIDCALL, "E4102",
+                          std::string(what) + " " + handleText(h) +
+                              (other ? " is not a surface (use GetSurfaceLevel for a texture level)"
+                                     : " is not an object of this device")};
         return nullptr;
     }
     Resource* r = findResource(it->second.owner);
     if (!r) {
-        fail(D3DERR_INVALIDCALL, "E4102", std::string(call) + ": " + what + " " + handleText(h) + " was released");
+        error = CallError{D3DERR_INVALIDCALL, "E4102", std::string(what) + " " + handleText(h) + " was released"};
         return nullptr;
     }
     if (owner) *owner = r;
     if (ref) *ref = it->second;
     return &r->levels[it->second.level];
+}
+
+Image* Device::surfaceImage(Handle h, const char* call, const char* what, Resource** owner, SurfaceRef* ref) {
+    CallError error;
+    Image* image = findSurface(h, what, error, owner, ref);
+    if (!image) fail(error.hr, error.code.c_str(), std::string(call) + ": " + error.message);
+    return image;
 }
 
 DWORD Device::GetLevelCount(Handle texture) {
@@ -500,30 +507,39 @@ HRESULT Device::GenerateMipSubLevels(Handle texture) {
     return D3D_OK;
 }
 
-std::shared_ptr<const ps11::Texture> Device::sampledTexture(Handle texture) {
-    ok();
+std::shared_ptr<const ps11::Texture> Device::makeSampled(Handle texture, CallError& error) {
     Resource* r = findResource(texture);
     if (!r || r->kind == ResourceKind::Surface) {
-        fail(D3DERR_INVALIDCALL, "E4102", "sampledTexture: handle " + handleText(texture) + " is not a texture");
+        error = CallError{D3DERR_INVALIDCALL, "E4102",
+                          "sampledTexture: handle " + handleText(texture) + " is not a texture"};
         return nullptr;
     }
     // D3D9 regenerates AUTOGENMIPMAP sublevels before the texture is next used.
     if (r->autoGenMips() && r->mipsDirty) regenerateMips(*r);
     if (r->sampled && r->sampledGeneration == r->generation) return r->sampled;
     syncResource(*r);
-    std::string error;
+    std::string why;
     try {
-        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, error);
+        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, why);
     } catch (const std::bad_alloc&) {
         r->sampled = nullptr;
-        error = "out of memory";
+        why = "out of memory";
     }
     if (!r->sampled) {
-        fail(D3DERR_OUTOFVIDEOMEMORY, "E4111", "sampledTexture: texture " + handleText(texture) + ": " + error);
+        error =
+            CallError{D3DERR_OUTOFVIDEOMEMORY, "E4111", "sampledTexture: texture " + handleText(texture) + ": " + why};
         return nullptr;
     }
     r->sampledGeneration = r->generation;
     return r->sampled;
+}
+
+std::shared_ptr<const ps11::Texture> Device::sampledTexture(Handle texture) {
+    ok();
+    CallError error;
+    std::shared_ptr<const ps11::Texture> t = makeSampled(texture, error);
+    if (!t) fail(error.hr, error.code.c_str(), error.message);
+    return t;
 }
 
 }  // namespace emu

@@ -71,14 +71,14 @@ std::array<float, 4> colorFloats(DWORD argb) {
 
 class Lowering {
 public:
-    Lowering(const DeviceState& state, std::string& error) : m_state(state), m_error(error) {}
+    Lowering(const DeviceState& state, CallError& error) : m_state(state), m_error(error) {}
 
     std::optional<LoweredStages> run();
 
 private:
     DWORD tss(int stage, D3DTEXTURESTAGESTATETYPE s) const { return m_state.stageState(stage, s); }
     bool fail(const char* code, int stage, const char* stateName, const std::string& what) {
-        m_error = std::string(code) + " stage " + std::to_string(stage) + " " + stateName + ": " + what;
+        m_error = CallError{D3DERR_INVALIDCALL, code, "stage " + std::to_string(stage) + " " + stateName + ": " + what};
         return false;
     }
 
@@ -104,7 +104,7 @@ private:
     void emit(const char* mnemonic, const Dst& dst, std::initializer_list<Src> srcs, Instruction& out) const;
 
     const DeviceState& m_state;
-    std::string& m_error;
+    CallError& m_error;
     std::vector<std::array<float, 4>> m_consts;  // c0, c1, … in order of first use
     bool m_constOverflow = false;
     bool m_r0Written = false, m_r1Written = false;
@@ -499,8 +499,8 @@ std::optional<LoweredStages> Lowering::run() {
 
 }  // namespace
 
-std::optional<LoweredStages> lowerFixedFunction(const DeviceState& state, std::string& error) {
-    error.clear();
+std::optional<LoweredStages> lowerFixedFunction(const DeviceState& state, CallError& error) {
+    error = CallError{};
     Lowering lowering(state, error);
     return lowering.run();
 }

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "emu/call_error.h"
 #include "emu/state.h"
 #include "ps11/executor.h"
 #include "ps11/ir.h"
@@ -33,10 +34,11 @@ struct LoweredStages {
 };
 
 // Lowers the texture stage states and the render states the combiner reads (TEXTUREFACTOR,
-// SPECULARENABLE) of `state`. Deterministic: equal inputs give equal programs, so the draw may
-// cache by state. For a setup the device cannot run (D3DERR_UNSUPPORTEDCOLOROPERATION and
-// friends in D3D9's ValidateDevice) returns nullopt and sets `error` to "E41xx <what is wrong,
-// naming the stage and the state>".
-std::optional<LoweredStages> lowerFixedFunction(const DeviceState& state, std::string& error);
+// SPECULARENABLE) of `state`; the texture bindings only as DeviceState::StateWords::FixedFunction
+// names them. Deterministic: equal inputs give equal programs, so the draw may cache by state.
+// For a setup the device cannot run (D3DERR_UNSUPPORTEDCOLOROPERATION and friends in D3D9's
+// ValidateDevice) returns nullopt and sets `error` to D3DERR_INVALIDCALL, its E41xx code and
+// "stage 2 D3DTSS_COLOROP: <what is wrong>"; `error` is reset (hr D3D_OK) on success.
+std::optional<LoweredStages> lowerFixedFunction(const DeviceState& state, CallError& error);
 
 }  // namespace emu

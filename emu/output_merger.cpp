@@ -870,11 +870,11 @@ bool MergeState::writesNothing() const {
     return p.channels == 0;
 }
 
-std::string mergeStateError(const DeviceState& st, const char* call) {
+std::optional<CallError> mergeStateError(const DeviceState& st) {
     const auto rs = [&](D3DRENDERSTATETYPE s) { return st.renderState(s); };
     const auto bad = [&](const char* state, DWORD value, const char* what) {
-        return std::string("E4160 ") + call + ": " + state + " " + std::to_string(value) + " is not a " + what +
-               " value";
+        return CallError{D3DERR_INVALIDCALL, "E4160",
+                         std::string(state) + " " + std::to_string(value) + " is not a " + what + " value"};
     };
     if (rs(D3DRS_ALPHATESTENABLE) && !knownCmp(rs(D3DRS_ALPHAFUNC)))
         return bad("D3DRS_ALPHAFUNC", rs(D3DRS_ALPHAFUNC), "D3DCMPFUNC");
@@ -893,7 +893,7 @@ std::string mergeStateError(const DeviceState& st, const char* call) {
                 return bad("D3DRS_BLENDOPALPHA", rs(D3DRS_BLENDOPALPHA), "D3DBLENDOP");
         }
     }
-    return {};
+    return std::nullopt;
 }
 
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats) {

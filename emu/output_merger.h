@@ -5,8 +5,10 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
+#include "emu/call_error.h"
 #include "emu/d3d9types.h"
 #include "emu/resources.h"
 #include "emu/state.h"
@@ -72,10 +74,11 @@ struct MergeStats {
 // caller's programming errors: asserted (debug), and skipped in release builds.
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats);
 
-// Draw-time check of the states the merger reads (ValidateDevice-style): "" when they are
-// usable, else "E4160 <call>: D3DRS_SRCBLEND 99 is not a D3DBLEND value" for an unknown
-// D3DBLEND / D3DBLENDOP / D3DCMPFUNC value in a state that is in use. (MergeState::from never
-// fails: unknown values act as the state's D3D9 default.)
-std::string mergeStateError(const DeviceState& state, const char* call);
+// Draw-time check of the states the merger reads (ValidateDevice-style): nullopt when they are
+// usable, else D3DERR_INVALIDCALL, E4160, "D3DRS_SRCBLEND 99 is not a D3DBLEND value" for an
+// unknown D3DBLEND / D3DBLENDOP / D3DCMPFUNC value in a state that is in use (the caller
+// prefixes its call's name). (MergeState::from never fails: unknown values act as the state's
+// D3D9 default.)
+std::optional<CallError> mergeStateError(const DeviceState& state);
 
 }  // namespace emu

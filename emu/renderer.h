@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "emu/call_error.h"
 #include "emu/output_merger.h"
 #include "emu/raster.h"
 #include "emu/resources.h"
@@ -107,13 +108,6 @@ struct DrawCall {
     std::function<void(uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out)> assemble;
 };
 
-// What a renderer reports when it cannot draw a call the front accepted.
-struct RendererError {
-    HRESULT hr = D3D_OK;
-    std::string code;     // "E4121"
-    std::string message;  // without the code: "the executor refused pixel shader 3"
-};
-
 // A rectangle of pixels, x1 and y1 exclusive.
 struct PixelBox {
     int64_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
@@ -150,8 +144,9 @@ class Renderer {
 public:
     virtual ~Renderer() = default;
     // Draws the call into call.target, adding to `stats` (pixels, instructions, texels,
-    // triangles drawn). False with `error` set when it cannot (nothing was written then).
-    virtual bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) = 0;
+    // triangles drawn). False with `error` set when it cannot (nothing was written then): the
+    // same CallError the front's own draw stages report (emu/call_error.h).
+    virtual bool draw(const DrawCall& call, DrawStats& stats, CallError& error) = 0;
     // Clear and StretchRect. False when this renderer does not do this call: the front then
     // brings the surfaces back, does it in its own images (emu/blit.h) and the renderer's
     // copies follow by generation.

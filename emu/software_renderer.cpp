@@ -66,7 +66,7 @@ bool SoftwareRenderer::stretchRect(const StretchCall& call) {
     return true;
 }
 
-bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, RendererError& error) {
+bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& error) {
     if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
     SoftwareDrawContext& dc = *m_context;
     const DrawProgram& prog = call.program;

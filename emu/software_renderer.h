@@ -24,7 +24,7 @@ class SoftwareRenderer final : public Renderer {
 public:
     explicit SoftwareRenderer(const SoftwareRendererOptions& options);
     ~SoftwareRenderer() override;
-    bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) override;
+    bool draw(const DrawCall& call, DrawStats& stats, CallError& error) override;
     // In the front's images (emu/blit.h): the software renderer keeps no copies.
     bool clear(const ClearCall& call) override;
     bool stretchRect(const StretchCall& call) override;

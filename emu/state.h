@@ -53,13 +53,35 @@ struct DeviceState {
     float renderStateFloat(D3DRENDERSTATETYPE s) const;
     float stageStateFloat(int stage, D3DTEXTURESTAGESTATETYPE s) const;
 
+    // Parts of the state as 32-bit words, for hashing and comparing all of it or a part.
+    enum StateWords : uint32_t {
+        RenderStates = 1u << 0,
+        StageStates = 1u << 1,
+        SamplerStates = 1u << 2,
+        Textures = 1u << 3,    // the texture handles of the stages
+        Bindings = 1u << 4,    // render target, depth stencil surface, pixel shader
+        Transforms = 1u << 5,  // world, view, projection, texture 0..7
+        ViewportScissor = 1u << 6,
+        PsConstants = 1u << 7,
+        Fvf = 1u << 8,
+        AllFields = (1u << 9) - 1,
+        // One word, bit i: stage i has a texture bound (derived from Textures; not in AllFields).
+        BoundTextures = 1u << 9,
+        // What the fixed-function lowering reads (emu/ffp.h): the draw caches lowered programs by it.
+        FixedFunction = RenderStates | StageStates | BoundTextures,
+    };
+
     // Hash and equality over every field, floats compared by bit pattern (so -0 != 0 and a NaN
     // equals itself, consistent with the hash).
-    size_t hash() const;
-    bool operator==(const DeviceState& other) const;
+    size_t hash() const { return hash(AllFields); }
+    bool operator==(const DeviceState& other) const { return equal(other, AllFields); }
+    // The same over the parts named in `parts` (StateWords bits).
+    size_t hash(uint32_t parts) const;
+    bool equal(const DeviceState& other, uint32_t parts) const;
 
-    // Calls f(uint32_t) for every 32-bit word of the state in a fixed order (hash and == use it).
-    void forEachWord(const std::function<void(uint32_t)>& f) const;
+    // Calls f(uint32_t) for every 32-bit word of the named parts in a fixed order (hash and
+    // equal use it; the order of the parts is that of StateWords).
+    void forEachWord(const std::function<void(uint32_t)>& f, uint32_t parts = AllFields) const;
 };
 
 // True for a D3DRENDERSTATETYPE value d3d9types.h defines.

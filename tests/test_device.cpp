@@ -227,6 +227,43 @@ TEST_CASE("device: DeviceState hash and equality", "[device]") {
     CHECK_FALSE(a == b);
 }
 
+TEST_CASE("device: DeviceState hash and equality over a part", "[device]") {
+    const uint32_t ffp = DeviceState::FixedFunction;
+    DeviceState a, b;
+    CHECK(a.equal(b, ffp));
+    CHECK(a.hash(ffp) == b.hash(ffp));
+    CHECK(a.hash(DeviceState::AllFields) == a.hash());
+    CHECK(a.hash(ffp) != a.hash());
+    // Outside the part: sampler states, constants, the FVF, which texture is bound.
+    b.samplerStates[2][D3DSAMP_MINFILTER] = D3DTEXF_LINEAR;
+    b.psConstants[1][2] = 0.5f;
+    b.fvf = 0x104;
+    b.textures[0] = Handle(5);
+    a.textures[0] = Handle(6);
+    CHECK_FALSE(a == b);
+    CHECK(a.equal(b, ffp));
+    CHECK(a.hash(ffp) == b.hash(ffp));
+    // Inside: stage states, render states, whether a stage has a texture.
+    b = a;
+    b.stageStates[1][D3DTSS_COLOROP] = D3DTOP_ADD;
+    CHECK_FALSE(a.equal(b, ffp));
+    CHECK(a.hash(ffp) != b.hash(ffp));
+    b = a;
+    b.renderStates[D3DRS_TEXTUREFACTOR] = 0x80808080u;
+    CHECK_FALSE(a.equal(b, ffp));
+    CHECK(a.hash(ffp) != b.hash(ffp));
+    b = a;
+    b.textures[3] = Handle(9);
+    CHECK_FALSE(a.equal(b, ffp));
+    CHECK(a.hash(ffp) != b.hash(ffp));
+    CHECK(a.equal(b, DeviceState::RenderStates | DeviceState::StageStates));
+    // Each part on its own.
+    b = a;
+    b.viewport.MaxZ = 0.5f;
+    CHECK_FALSE(a.equal(b, DeviceState::ViewportScissor));
+    CHECK(a.equal(b, DeviceState::AllFields & ~uint32_t(DeviceState::ViewportScissor)));
+}
+
 TEST_CASE("device: state setters, getters and their errors", "[device]") {
     Device dev;
     const DeviceState before = dev.state();

@@ -499,6 +499,57 @@ TEST_CASE("draw: fixed function MODULATE (no pixel shader) multiplies texture an
     CHECK(dev.lastDrawStats().pixelsWritten == W * H);
 }
 
+TEST_CASE("draw: refusals of the lowering and the merger keep their codes and messages", "[draw]") {
+    Device dev;
+    const UINT W = 8, H = 8;
+    target(dev, W, H);
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xff808080);
+    auto draw = [&] { return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)); };
+    REQUIRE(dev.SetTextureStageState(1, D3DTSS_COLOROP, 27) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG2) == D3D_OK);
+    CHECK(draw() == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().hr == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4140");
+    CHECK(dev.lastError().message ==
+          "E4140 DrawPrimitiveUP: stage 1 D3DTSS_COLOROP: unknown texture operation 27 (D3DTOP_* is 1..26)");
+    REQUIRE(dev.SetTextureStageState(1, D3DTSS_COLOROP, D3DTOP_DISABLE) == D3D_OK);
+    CHECK(draw() == D3D_OK);
+    CHECK(dev.lastError().code.empty());
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, 99) == D3D_OK);
+    CHECK(draw() == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4160");
+    CHECK(dev.lastError().message == "E4160 DrawPrimitiveUP: D3DRS_DESTBLEND 99 is not a D3DBLEND value");
+}
+
+TEST_CASE("draw: the fixed-function program cache follows the state the lowering reads", "[draw]") {
+    // More distinct stage setups than the cache keeps (64), each drawn twice, interleaved with a
+    // setup drawn between them: every draw gives the colour of its own setup.
+    Device dev;
+    const UINT W = 4, H = 4;
+    Handle rt = target(dev, W, H);
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xff000000);
+    auto drawFactor = [&](DWORD factor) {
+        REQUIRE(dev.SetRenderState(D3DRS_TEXTUREFACTOR, factor) == D3D_OK);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        return readTarget(dev, rt, W, H)[5];
+    };
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_TFACTOR) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1) == D3D_OK);
+    REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAARG1, D3DTA_TFACTOR) == D3D_OK);
+    int bad = 0;
+    for (DWORD i = 0; i < 80; ++i) {
+        const DWORD factor = 0xff000000u | (i * 3) << 16 | (255 - i) << 8 | (i * 7 & 0xff);
+        bad += drawFactor(factor) != factor;
+        bad += drawFactor(0xff102030u) != 0xff102030u;
+        bad += drawFactor(factor) != factor;
+    }
+    CHECK(bad == 0);
+}
+
 TEST_CASE("draw: 2x2 quads give the sampler its mip level", "[draw]") {
     // A 64×64 texture with a full chain drawn onto 16×16 pixels: the texture coordinates change by
     // 4 texels per pixel, so the LOD is log2(4) = 2 and point mip filtering reads level 2 only.

@@ -58,11 +58,13 @@ struct Outputs {
 };
 
 LoweredStages lower(const DeviceState& s) {
-    std::string error;
+    CallError error;
     std::optional<LoweredStages> l = lowerFixedFunction(s, error);
-    INFO(error);
+    INFO(error.code + " " + error.message);
     REQUIRE(l);
-    CHECK(error.empty());
+    CHECK(error.hr == D3D_OK);
+    CHECK(error.code.empty());
+    CHECK(error.message.empty());
     return *l;
 }
 
@@ -822,36 +824,38 @@ TEST_CASE("ffp: program shape", "[ffp]") {
 }
 
 TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
-    auto fails = [](const DeviceState& s, const std::string& prefix) {
-        std::string error;
+    auto fails = [](const DeviceState& s, const std::string& code, const std::string& prefix) {
+        CallError error;
         CHECK_FALSE(lowerFixedFunction(s, error));
-        INFO(error);
-        CHECK(error.rfind(prefix, 0) == 0);
+        INFO(error.code + " " + error.message);
+        CHECK(error.hr == D3DERR_INVALIDCALL);
+        CHECK(error.code == code);
+        CHECK(error.message.rfind(prefix, 0) == 0);
     };
     DeviceState s;
     s.stageStates[0][D3DTSS_COLOROP] = 27;
-    fails(s, "E4140 stage 0 D3DTSS_COLOROP: unknown texture operation 27");
+    fails(s, "E4140", "stage 0 D3DTSS_COLOROP: unknown texture operation 27");
     s = DeviceState();
     s.stageStates[0][D3DTSS_COLOROP] = 0;
-    fails(s, "E4140 stage 0 D3DTSS_COLOROP:");
+    fails(s, "E4140", "stage 0 D3DTSS_COLOROP:");
     s = DeviceState();
     s.stageStates[0][D3DTSS_ALPHAOP] = 0x7fffffff;
-    fails(s, "E4140 stage 0 D3DTSS_ALPHAOP:");
+    fails(s, "E4140", "stage 0 D3DTSS_ALPHAOP:");
 
     s = DeviceState();
     s.stageStates[0][D3DTSS_COLORARG2] = 7;
-    fails(s, "E4141 stage 0 D3DTSS_COLORARG2: unknown texture argument 0x00000007");
+    fails(s, "E4141", "stage 0 D3DTSS_COLORARG2: unknown texture argument 0x00000007");
     s = DeviceState();
     s.stageStates[0][D3DTSS_ALPHAARG1] = D3DTA_TEXTURE | 0x40;
-    fails(s, "E4141 stage 0 D3DTSS_ALPHAARG1:");
+    fails(s, "E4141", "stage 0 D3DTSS_ALPHAARG1:");
     s = DeviceState();
     setStage(s, 0, D3DTOP_LERP, D3DTA_TEXTURE, D3DTA_DIFFUSE, D3DTOP_SELECTARG1, D3DTA_TEXTURE, 0);
     s.stageStates[0][D3DTSS_COLORARG0] = 9;
-    fails(s, "E4141 stage 0 D3DTSS_COLORARG0:");
+    fails(s, "E4141", "stage 0 D3DTSS_COLORARG0:");
     // An argument the operation does not read is not checked.
     s = DeviceState();
     setStage(s, 0, D3DTOP_SELECTARG1, D3DTA_TEXTURE, 9, D3DTOP_SELECTARG2, 9, D3DTA_DIFFUSE);
-    std::string error;
+    CallError error;
     CHECK(lowerFixedFunction(s, error));
 
     // Texture reads beyond the sampled-stage limit.
@@ -860,28 +864,28 @@ TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
         setStage(s, i, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
     CHECK(lowerFixedFunction(s, error));
     setStage(s, 4, D3DTOP_MODULATE, D3DTA_CURRENT, D3DTA_TEXTURE, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
-    fails(s, "E4142 stage 4 D3DTSS_COLORARG2:");
+    fails(s, "E4142", "stage 4 D3DTSS_COLORARG2:");
     setStage(s, 4, D3DTOP_BLENDTEXTUREALPHA, D3DTA_CURRENT, D3DTA_DIFFUSE, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
-    fails(s, "E4142 stage 4 D3DTSS_COLOROP:");
+    fails(s, "E4142", "stage 4 D3DTSS_COLOROP:");
     setStage(s, 4, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_TEXTURE, 0);
-    fails(s, "E4142 stage 4 D3DTSS_ALPHAARG1:");
+    fails(s, "E4142", "stage 4 D3DTSS_ALPHAARG1:");
     setStage(s, 4, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
     setStage(s, 3, D3DTOP_BUMPENVMAP, D3DTA_TEXTURE, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
-    fails(s, "E4142 stage 3 D3DTSS_COLOROP: D3DTOP_BUMPENVMAP looks up stage 4's texture");
+    fails(s, "E4142", "stage 3 D3DTSS_COLOROP: D3DTOP_BUMPENVMAP looks up stage 4's texture");
 
     // BUMPENVMAP in the last enabled stage.
     s = DeviceState();
     s.stageStates[0][D3DTSS_COLOROP] = D3DTOP_BUMPENVMAP;
-    fails(s, "E4143 stage 0 D3DTSS_COLOROP:");
+    fails(s, "E4143", "stage 0 D3DTSS_COLOROP:");
     s.stageStates[0][D3DTSS_COLOROP] = D3DTOP_BUMPENVMAPLUMINANCE;
-    fails(s, "E4143 stage 0 D3DTSS_COLOROP:");
+    fails(s, "E4143", "stage 0 D3DTSS_COLOROP:");
 
     // Colour-only operations as ALPHAOP.
     for (DWORD op : {D3DTOP_MODULATEALPHA_ADDCOLOR, D3DTOP_MODULATECOLOR_ADDALPHA, D3DTOP_MODULATEINVALPHA_ADDCOLOR,
                      D3DTOP_MODULATEINVCOLOR_ADDALPHA, D3DTOP_BUMPENVMAP, D3DTOP_BUMPENVMAPLUMINANCE}) {
         s = DeviceState();
         s.stageStates[0][D3DTSS_ALPHAOP] = op;
-        fails(s, "E4144 stage 0 D3DTSS_ALPHAOP:");
+        fails(s, "E4144", "stage 0 D3DTSS_ALPHAOP:");
     }
 
     // PREMODULATE in stage 3 needs stage 4's texture.
@@ -890,15 +894,15 @@ TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
         setStage(s, i, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0, D3DTOP_SELECTARG1, D3DTA_CURRENT, 0);
     CHECK(lowerFixedFunction(s, error));
     s.stageStates[3][D3DTSS_ALPHAOP] = D3DTOP_PREMODULATE;
-    fails(s, "E4142 stage 3 D3DTSS_ALPHAOP: D3DTOP_PREMODULATE modulates with stage 4's texture");
+    fails(s, "E4142", "stage 3 D3DTSS_ALPHAOP: D3DTOP_PREMODULATE modulates with stage 4's texture");
     s.stageStates[3][D3DTSS_COLOROP] = D3DTOP_PREMODULATE;
-    fails(s, "E4142 stage 3 D3DTSS_COLOROP: D3DTOP_PREMODULATE");
+    fails(s, "E4142", "stage 3 D3DTSS_COLOROP: D3DTOP_PREMODULATE");
 
     s = DeviceState();
     s.stageStates[0][D3DTSS_RESULTARG] = D3DTA_TEXTURE;
-    fails(s, "E4146 stage 0 D3DTSS_RESULTARG:");
+    fails(s, "E4146", "stage 0 D3DTSS_RESULTARG:");
     s.stageStates[0][D3DTSS_RESULTARG] = D3DTA_CURRENT | D3DTA_COMPLEMENT;
-    fails(s, "E4146 stage 0 D3DTSS_RESULTARG:");
+    fails(s, "E4146", "stage 0 D3DTSS_RESULTARG:");
 
     // Nine distinct constants: TFACTOR and eight per-stage CONSTANTs.
     s = DeviceState();
@@ -908,5 +912,5 @@ TEST_CASE("ffp: errors name the stage and the state", "[ffp]") {
     }
     CHECK(lowerFixedFunction(s, error));
     s.stageStates[0][D3DTSS_COLORARG1] = D3DTA_TFACTOR;
-    fails(s, "E4147 stage 7 D3DTSS_COLORARG2:");
+    fails(s, "E4147", "stage 7 D3DTSS_COLORARG2:");
 }

@@ -1073,7 +1073,7 @@ TEST_CASE("merger: MergeState::from reads the render states", "[merger]") {
     ds.renderStates[D3DRS_FOGTABLEMODE] = D3DFOG_LINEAR;
     CHECK_FALSE(MergeState::from(ds, true, Precision::Fx8).fog);
     // Unknown values act as the state's default and are reported by mergeStateError.
-    CHECK(mergeStateError(ds, "DrawPrimitiveUP").empty());
+    CHECK_FALSE(mergeStateError(ds));
     ds.renderStates[D3DRS_SRCBLEND] = 99;
     ds.renderStates[D3DRS_BLENDOP] = 0;
     ds.renderStates[D3DRS_ALPHAFUNC] = 9;
@@ -1081,10 +1081,14 @@ TEST_CASE("merger: MergeState::from reads the render states", "[merger]") {
     CHECK(m.srcBlend == D3DBLEND_ONE);
     CHECK(m.blendOp == D3DBLENDOP_ADD);
     CHECK(m.alphaFunc == D3DCMP_ALWAYS);
-    const std::string e = mergeStateError(ds, "DrawPrimitiveUP");
-    CHECK(e.rfind("E4160 DrawPrimitiveUP: D3DRS_ALPHAFUNC 9", 0) == 0);
+    const std::optional<CallError> e = mergeStateError(ds);
+    REQUIRE(e);
+    CHECK(e->hr == D3DERR_INVALIDCALL);
+    CHECK(e->code == "E4160");
+    CHECK(e->message == "D3DRS_ALPHAFUNC 9 is not a D3DCMPFUNC value");
     ds.renderStates[D3DRS_ALPHAFUNC] = D3DCMP_LESS;
-    CHECK(mergeStateError(ds, "DrawPrimitiveUP").find("D3DRS_SRCBLEND 99") != std::string::npos);
+    REQUIRE(mergeStateError(ds));
+    CHECK(mergeStateError(ds)->message == "D3DRS_SRCBLEND 99 is not a D3DBLEND value");
 }
 
 TEST_CASE("merger: writesNothing only when no pixel can change the target", "[merger]") {

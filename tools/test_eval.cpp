@@ -507,7 +507,7 @@ std::optional<EvalOutcome> RendererEval::eval(const EvalInputs& in, std::string&
     m.call.colorSurface = emu::SurfaceDesc{1, 0, &m.color, m.generation, m.generation + 1};
     if (m.writesDepth) m.call.depthSurface = emu::SurfaceDesc{2, 0, &m.depth, m.generation, m.generation + 1};
     emu::DrawStats stats;
-    emu::RendererError rerr;
+    emu::CallError rerr;
     if (!m.renderer->draw(m.call, stats, rerr)) {
         error = rerr.code + " " + rerr.message;
         return std::nullopt;

@@ -128,7 +128,7 @@ public:
         m_space.serial = ++serial;
     }
     ~DeviceRenderer() override { m_gl->releaseAll(m_space); }
-    bool draw(const DrawCall& call, DrawStats& stats, RendererError& error) override {
+    bool draw(const DrawCall& call, DrawStats& stats, CallError& error) override {
         return m_gl->draw(m_space, call, stats, error);
     }
     bool clear(const ClearCall& call) override { return m_gl->clear(m_space, call); }
@@ -203,9 +203,9 @@ struct Binding {
 
 }  // namespace
 
-bool GlRenderer::draw(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+bool GlRenderer::draw(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error) {
     if (!m_context->makeCurrent()) {
-        error = RendererError{D3DERR_INVALIDCALL, "E4122", "the GL renderer cannot draw this call: its context could not be made current"};
+        error = CallError{D3DERR_INVALIDCALL, "E4122", "the GL renderer cannot draw this call: its context could not be made current"};
         return false;
     }
     return space.mode == GlMode::Native ? drawNative(space, call, stats, error) : drawExact(space, call, stats, error);
@@ -384,7 +384,7 @@ static void bindProgram(GlState& st, const DrawCall& call, bool native, const Pr
     if (e.xform >= 0) gl.Uniform4f(e.xform, 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
 }
 
-bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error) {
     auto refuse = [&](const std::string& why) {
         error.hr = D3DERR_INVALIDCALL;
         error.code = "E4122";
@@ -553,7 +553,7 @@ bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stat
     return true;
 }
 
-bool GlRenderer::drawNative(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error) {
+bool GlRenderer::drawNative(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error) {
     auto refuse = [&](const std::string& why) {
         error.hr = D3DERR_INVALIDCALL;
         error.code = "E4122";

@@ -53,7 +53,7 @@ public:
     double lastDrawMilliseconds() const { return m_lastDrawMs; }
 
     // The operations of a device renderer, on that device's space.
-    bool draw(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error);
+    bool draw(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error);
     bool clear(GlSpace& space, const ClearCall& call);
     bool stretchRect(GlSpace& space, const StretchCall& call);
     void readBack(GlSpace& space, const SurfaceDesc& surface);
@@ -64,8 +64,8 @@ public:
 
 private:
     GlRenderer() = default;
-    bool drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error);
-    bool drawNative(GlSpace& space, const DrawCall& call, DrawStats& stats, RendererError& error);
+    bool drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error);
+    bool drawNative(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error);
     std::unique_ptr<Context> m_context;
     std::unique_ptr<GlState> m_state;
     bool m_hardwareFiltering = false;
