@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -515,7 +514,6 @@ bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stat
 
     // Batches of triangles whose pixel boxes do not overlap: a fragment that reads its pixel
     // (blending, depth, write masks) must see every earlier triangle's write.
-    const auto start = std::chrono::steady_clock::now();
     gl.BeginQuery(GL_SAMPLES_PASSED, st.query);
     size_t begin = 0;
     const size_t n = boxes.size();
@@ -537,8 +535,6 @@ bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stat
         begin = end;
     }
     gl.EndQuery(GL_SAMPLES_PASSED);
-    gl.Finish();
-    m_lastDrawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     GLuint64 passed = 0;
     gl.GetQueryObjectui64v(st.query, GL_QUERY_RESULT, &passed);
     stats.pixelsWritten += passed;
@@ -638,9 +634,7 @@ bool GlRenderer::drawNative(GlSpace& space, const DrawCall& call, DrawStats& sta
     gl.Viewport(0, 0, GLsizei(rc.width), GLsizei(rc.height));
     gl.Enable(GL_SCISSOR_TEST);
     gl.Scissor(call.clip.x0, call.clip.y0, call.clip.x1 - call.clip.x0, call.clip.y1 - call.clip.y0);
-    const auto start = std::chrono::steady_clock::now();
     gl.DrawArrays(GL_TRIANGLES, 0, GLsizei(count));
-    m_lastDrawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     gl.Disable(GL_SCISSOR_TEST);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_DEPTH_TEST);

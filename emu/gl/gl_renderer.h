@@ -48,9 +48,6 @@ public:
     static std::unique_ptr<Renderer> forDevice(std::shared_ptr<GlRenderer> shared, GlMode mode);
 
     const Context& context() const { return *m_context; }
-    // Wall time of the last draw's GL work alone (from the first GL draw call to glFinish),
-    // without uploads and read-backs: what benchmarks compare.
-    double lastDrawMilliseconds() const { return m_lastDrawMs; }
 
     // The operations of a device renderer, on that device's space.
     bool draw(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error);
@@ -69,7 +66,6 @@ private:
     std::unique_ptr<Context> m_context;
     std::unique_ptr<GlState> m_state;
     bool m_hardwareFiltering = false;
-    double m_lastDrawMs = 0;
 };
 
 }  // namespace emu::gl
