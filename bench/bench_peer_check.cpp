@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "emu/gl/context.h"
+#include "emu/gl/shader_program.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
 #include "tools/gl_backend.h"
@@ -312,35 +313,12 @@ private:
     }
     GLuint program(const char* fragment, std::string& err) {
         const auto& gl = m_ctx->gl();
-        auto compile = [&](GLenum type, const char* text) -> GLuint {
-            GLuint s = gl.CreateShader(type);
-            gl.ShaderSource(s, 1, &text, nullptr);
-            gl.CompileShader(s);
-            GLint ok = 0;
-            gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-            if (!ok) {
-                char log[2048] = {};
-                gl.GetShaderInfoLog(s, sizeof log, nullptr, log);
-                err = std::string("shader: ") + log;
-                gl.DeleteShader(s);
-                return 0;
-            }
-            return s;
-        };
-        const GLuint vs = compile(GL_VERTEX_SHADER, handQuad() ? kVertexQuad : kVertex), fs = vs ? compile(GL_FRAGMENT_SHADER, fragment) : 0;
-        if (!fs) return 0;
-        const GLuint p = gl.CreateProgram();
-        gl.AttachShader(p, vs);
-        gl.AttachShader(p, fs);
-        gl.LinkProgram(p);
-        gl.DeleteShader(vs);
-        gl.DeleteShader(fs);
-        GLint ok = 0;
-        gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[2048] = {};
-            gl.GetProgramInfoLog(p, sizeof log, nullptr, log);
-            err = std::string("link: ") + log;
+        std::string log;
+        const GLuint vs = emu::gl::compileShader(gl, GL_VERTEX_SHADER, handQuad() ? kVertexQuad : kVertex, log);
+        const GLuint p = vs ? emu::gl::linkProgram(gl, vs, fragment, log) : 0;
+        if (vs) gl.DeleteShader(vs);
+        if (!p) {
+            err = "shader: " + log;
             return 0;
         }
         return p;

@@ -13,6 +13,7 @@
 #include "emu/gl/context.h"
 #include "emu/gl/glsl.h"
 #include "emu/gl/native_merge.h"
+#include "emu/gl/shader_program.h"
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
 #include "ps11/decoded_program.h"
@@ -51,43 +52,12 @@ const char* const kSmall = "ps_1_1\ntex t0\nmad r0, t0, v0, v0_bias\n";
 const char* const kTexkillBem = "ps_1_1\ntex t0\ntexbem t1, t0\ntexkill t2\nmul_sat r0, t1, v1\n";
 const char* const kDepth = "ps_1_3\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2depth t2, t0_bx2\nmov r0, v0\n";
 
-GLuint compile(const GlFunctions& gl, GLenum type, const std::string& src, std::string& log) {
-    const GLuint sh = gl.CreateShader(type);
-    const char* text = src.c_str();
-    gl.ShaderSource(sh, 1, &text, nullptr);
-    gl.CompileShader(sh);
-    GLint ok = 0;
-    gl.GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[4096] = {};
-        gl.GetShaderInfoLog(sh, sizeof buf, nullptr, buf);
-        log += buf;
-        gl.DeleteShader(sh);
-        return 0;
-    }
-    return sh;
-}
-
 // Compiles and links the native vertex shader with `fragment`; 0 and the logs on failure.
 GLuint link(const GlFunctions& gl, const std::string& fragment, std::string& log) {
-    const GLuint vs = compile(gl, GL_VERTEX_SHADER, nativeVertexSource(), log);
-    const GLuint fs = compile(gl, GL_FRAGMENT_SHADER, fragment, log);
-    if (!vs || !fs) return 0;
-    const GLuint prog = gl.CreateProgram();
-    gl.AttachShader(prog, vs);
-    gl.AttachShader(prog, fs);
-    gl.LinkProgram(prog);
+    const GLuint vs = compileShader(gl, GL_VERTEX_SHADER, nativeVertexSource(), log);
+    if (!vs) return 0;
+    const GLuint prog = linkProgram(gl, vs, fragment, log);
     gl.DeleteShader(vs);
-    gl.DeleteShader(fs);
-    GLint ok = 0;
-    gl.GetProgramiv(prog, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char buf[4096] = {};
-        gl.GetProgramInfoLog(prog, sizeof buf, nullptr, buf);
-        log += buf;
-        gl.DeleteProgram(prog);
-        return 0;
-    }
     return prog;
 }
 

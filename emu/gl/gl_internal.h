@@ -75,9 +75,6 @@ struct GlState {
     std::vector<TextureEntry> textures;
     uint64_t clock = 0;
 
-    GLuint compile(GLenum type, const std::string& src, std::string& log);
-    // A program of `vertex` and `fragment`, 0 with `log` on failure.
-    GLuint link(GLuint vertex, const std::string& fragment, std::string& log);
     // The GL texture of a ps11 texture in the profile's terms (grid integers or float32, or
     // GL_RGBA8 for GL's own filtering).
     GLuint texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::Precision precision, bool hardware);

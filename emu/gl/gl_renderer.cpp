@@ -18,6 +18,7 @@
 #include "emu/gl/gl_internal.h"
 #include "emu/gl/glsl.h"
 #include "emu/gl/native_merge.h"
+#include "emu/gl/shader_program.h"
 #include "emu/vertex.h"
 #include "ps11/diagnostics.h"
 
@@ -304,11 +305,11 @@ static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCa
     }
     std::string log;
     GLuint& vs = native ? st.nativeVertexShader : st.vertexShader;
-    if (!vs && !(vs = st.compile(GL_VERTEX_SHADER, native ? nativeVertexSource() : vertexSource(), log))) {
+    if (!vs && !(vs = compileShader(gl, GL_VERTEX_SHADER, native ? nativeVertexSource() : vertexSource(), log))) {
         why = "its vertex shader did not compile: " + log.substr(0, 400);
         return nullptr;
     }
-    const GLuint program = st.link(vs, fragment, log);
+    const GLuint program = linkProgram(gl, vs, fragment, log);
     if (!program) {
         why = "its shader did not compile: " + log.substr(0, 400);
         return nullptr;

@@ -9,6 +9,7 @@
 #include "emu/blit.h"
 #include "emu/gl/gl_internal.h"
 #include "emu/gl/glsl.h"
+#include "emu/gl/shader_program.h"
 
 namespace emu::gl {
 
@@ -21,6 +22,19 @@ uint32_t wordsOf(const FormatInfo& f) { return (f.bytes + 3) / 4; }
 void wordFormats(uint32_t n, GLenum& internal, GLenum& format) {
     internal = n == 1 ? GL_R32UI : n == 2 ? GL_RG32UI : GL_RGBA32UI;
     format = n == 1 ? GL_RED_INTEGER : n == 2 ? GL_RG_INTEGER : GL_RGBA_INTEGER;
+}
+
+// The client format and type of a surface's texels: GL's own (native mode, true) or raw words.
+bool clientFormatOf(bool native, const FormatInfo& f, GLenum& format, GLenum& type) {
+    NativeFormat nf;
+    if (native && nativeFormatOf(f, nf)) {
+        format = nf.format, type = nf.type;
+        return true;
+    }
+    GLenum internal;
+    wordFormats(wordsOf(f), internal, format);
+    type = GL_UNSIGNED_INT;
+    return false;
 }
 
 const char* kStretchFragment = R"(#version 450 core
@@ -105,43 +119,6 @@ GlState::~GlState() {
     if (stretchProgram) gl.DeleteProgram(stretchProgram);
     if (vertexShader) gl.DeleteShader(vertexShader);
     if (nativeVertexShader) gl.DeleteShader(nativeVertexShader);
-}
-
-GLuint GlState::compile(GLenum type, const std::string& src, std::string& log) {
-    GLuint s = gl.CreateShader(type);
-    const char* text = src.c_str();
-    gl.ShaderSource(s, 1, &text, nullptr);
-    gl.CompileShader(s);
-    GLint ok = 0;
-    gl.GetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[2048] = {};
-        gl.GetShaderInfoLog(s, sizeof buf - 1, nullptr, buf);
-        log = buf;
-        gl.DeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
-GLuint GlState::link(GLuint vertex, const std::string& fragment, std::string& log) {
-    GLuint fs = compile(GL_FRAGMENT_SHADER, fragment, log);
-    if (!fs) return 0;
-    GLuint p = gl.CreateProgram();
-    gl.AttachShader(p, vertex);
-    gl.AttachShader(p, fs);
-    gl.LinkProgram(p);
-    gl.DeleteShader(fs);
-    GLint ok = 0;
-    gl.GetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char buf[2048] = {};
-        gl.GetProgramInfoLog(p, sizeof buf - 1, nullptr, buf);
-        log = buf;
-        gl.DeleteProgram(p);
-        return 0;
-    }
-    return p;
 }
 
 GLuint GlState::texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::Precision precision, bool hardware) {
@@ -280,14 +257,8 @@ Resident& GlState::resident(GlSpace& space, const SurfaceDesc& surface) {
         // Never written since it was made: the front's zero-filled bytes, cleared here instead of
         // uploaded (zero words in either mode's format).
         const uint32_t zero[4] = {};
-        NativeFormat zf;
-        GLenum format = 0, type = GL_UNSIGNED_INT;
-        if (native && nativeFormatOf(*img.format, zf)) {
-            format = zf.format, type = zf.type;
-        } else {
-            GLenum internal;
-            wordFormats(wordsOf(*img.format), internal, format);
-        }
+        GLenum format = 0, type = 0;
+        clientFormatOf(native, *img.format, format, type);
         gl.ClearTexSubImage(r.tex, 0, 0, 0, 0, GLsizei(img.width), GLsizei(img.height), 1, format, type, zero);
         r.generation = 0;
         return r;
@@ -387,14 +358,10 @@ bool GlRenderer::clear(GlSpace& space, const ClearCall& call) {
     const bool native = space.mode == GlMode::Native;
     auto fill = [&](const SurfaceDesc& s, const uint8_t* texel) {
         Resident& r = st.resident(space, s);
-        NativeFormat nf;
+        GLenum format = 0, type = 0;
         uint32_t words[4] = {};
-        GLenum format = 0, type = GL_UNSIGNED_INT;
-        if (native && nativeFormatOf(*s.image->format, nf)) {
-            format = nf.format, type = nf.type;
-        } else {
-            GLenum internal;
-            wordFormats(wordsOf(*s.image->format), internal, format);
+        if (!clientFormatOf(native, *s.image->format, format, type)) {
+            // Raw words: the texel's bytes, the last word padded with zeros.
             std::memcpy(words, texel, s.image->format->bytes);
             texel = reinterpret_cast<const uint8_t*>(words);
         }
@@ -460,8 +427,8 @@ bool GlRenderer::stretchRect(GlSpace& space, const StretchCall& call) {
     if (sf.format != D3DFMT_A8R8G8B8 || df.format != D3DFMT_A8R8G8B8) return false;
     std::string log;
     if (!st.stretchProgram) {
-        if (!st.vertexShader && !(st.vertexShader = st.compile(GL_VERTEX_SHADER, vertexSource(), log))) return false;
-        if (!(st.stretchProgram = st.link(st.vertexShader, kStretchFragment, log))) return false;
+        if (!st.vertexShader && !(st.vertexShader = compileShader(gl, GL_VERTEX_SHADER, vertexSource(), log))) return false;
+        if (!(st.stretchProgram = linkProgram(gl, st.vertexShader, kStretchFragment, log))) return false;
     }
     // The taps of the columns, then of the rows (emu/blit.h: one definition for both renderers).
     std::vector<uint32_t> taps;
