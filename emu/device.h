@@ -1,5 +1,5 @@
 // The emulated Direct3D 9-style device (docs/device.md): D3D9 names and return codes at the
-// edge, plain C++ inside. This slice has resources (textures, volume textures, render targets,
+// edge, plain C++ inside. It has resources (textures, volume textures, render targets,
 // depth surfaces, offscreen plain surfaces; Lock/Unlock in D3D's memory layout, mip generation,
 // GetRenderTargetData), every state setter, pixel shaders, Clear, StretchRect and DrawPrimitiveUP
 // (vertex processing, rasteriser, executor, output merger; docs/device.md "Drawing").
@@ -151,7 +151,7 @@ public:
     // The renderer's name ("software", "gl", "gl-native").
     const char* rendererName() const { return m_renderer->name(); }
 
-    // ---- for the draw slices and tests (not D3D9 API) ----
+    // ---- for the renderers, the glare layer and tests (not D3D9 API) ----
     // The sampler's view of a texture or volume texture, rebuilt after writes (mips regenerated
     // first for AUTOGENMIPMAP); nullptr with lastError() set on failure.
     std::shared_ptr<const ps11::Texture> sampledTexture(Handle texture);

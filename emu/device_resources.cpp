@@ -42,6 +42,7 @@ HRESULT Device::createResource(const char* call, Resource&& r, UINT width, UINT 
         allocateLevels(r, width, height, depth, levels);
         if (r.kind != ResourceKind::Surface) r.surfaces.assign(r.exposedLevels, Handle::Null);
         const Handle h = newHandle();
+        r.handle = h;
         if (r.kind == ResourceKind::Surface) m_surfaces.emplace(uint32_t(h), SurfaceRef{h, 0});
         m_resources.emplace(uint32_t(h), std::move(r));
         *out = h;
@@ -366,11 +367,7 @@ SurfaceDesc Device::surfaceDesc(const SurfaceRef& ref, Resource& r) {
 
 void Device::syncLevel(Resource& r, uint32_t level) {
     if (level >= r.rendererNewer.size() || !r.rendererNewer[level]) return;
-    for (const auto& [id, res] : m_resources)
-        if (&res == &r) {
-            m_renderer->readBack(surfaceDesc(SurfaceRef{Handle(id), level}, r));
-            break;
-        }
+    m_renderer->readBack(surfaceDesc(SurfaceRef{r.handle, level}, r));
     r.rendererNewer[level] = 0;
 }
 

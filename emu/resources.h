@@ -37,6 +37,7 @@ enum class ResourceKind : uint8_t { Texture, VolumeTexture, Surface };
 // A texture, volume texture or standalone surface (render target, depth stencil, offscreen
 // plain surface).
 struct Resource {
+    Handle handle = Handle::Null;  // its own handle (what renderers know it by)
     ResourceKind kind = ResourceKind::Texture;
     const FormatInfo* format = nullptr;
     DWORD usage = 0;
