@@ -221,9 +221,7 @@ struct ProgramStage {
     ProgramEntry* entry = nullptr;
 };
 
-}  // namespace
-
-static bool resolveBindings(GlState& st, GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
+bool resolveBindings(GlState& st, GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
                             std::string& why) {
     const ps11::Precision precision = call.hardware.precision;
     const bool fx = ps11::isFixedPoint(precision) && !native;
@@ -271,7 +269,7 @@ static bool resolveBindings(GlState& st, GlSpace& space, const DrawCall& call, b
     return true;
 }
 
-static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
+ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCall& call, bool native, ProgramStage& ps,
                                  std::string& why) {
     const GlFunctions& gl = st.gl;
     const DrawProgram& prog = call.program;
@@ -334,7 +332,7 @@ static ProgramEntry* findProgram(GlState& st, const GlSpace& space, const DrawCa
 }
 
 // Textures, samplers and the program's uniforms (constants, bump and luminance, borders).
-static void bindProgram(GlState& st, const DrawCall& call, bool native, const ProgramStage& ps, uint32_t W,
+void bindProgram(GlState& st, const DrawCall& call, bool native, const ProgramStage& ps, uint32_t W,
                         uint32_t H) {
     const GlFunctions& gl = st.gl;
     const ProgramEntry& e = *ps.entry;
@@ -383,6 +381,8 @@ static void bindProgram(GlState& st, const DrawCall& call, bool native, const Pr
     // Window x, y (pixel edges at integers, rows down) to clip space under GL_UPPER_LEFT.
     if (e.xform >= 0) gl.Uniform4f(e.xform, 2.0f / float(W), -2.0f / float(H), -1.0f, 1.0f);
 }
+
+}  // namespace
 
 bool GlRenderer::drawExact(GlSpace& space, const DrawCall& call, DrawStats& stats, CallError& error) {
     auto refuse = [&](const std::string& why) {
