@@ -202,12 +202,14 @@ void Validator::dataflowReads(size_t i) {
         return;
     }
     // ps_1_4.
-    // ps_1_4: texld/texcrd read their source through its selector; texkill and texdepth read the
-    // register their destination token names (dstReads).
+    // ps_1_4: texkill and texdepth read the register their destination token names (dstReads);
+    // texld reads its source through its selector; texcrd's source is a t# coordinate set (P2032
+    // otherwise), whose components the read set names.
     if (in.info->dstReads) {
         readAccess(in, in.dst.type, in.dst.index, in.info->dstReads, in.dst.loc);
     } else if (in.info->numSrc >= 1) {
-        const uint8_t comps = swizzled(in.src[0], 0);
+        const uint8_t comps =
+            op == Opcode::Tex ? swizzled(in.src[0], 0) : componentsRead(*in.info, 0, in.dst.mask);
         readAccess(in, in.src[0].type, in.src[0].index, comps, in.src[0].loc);
         if (op == Opcode::Tex && m_phaseOf[i] == 2 && in.src[0].type == RegType::Temp &&
             inRange(RegType::Temp, in.src[0].index) && (m_writtenPhase2[in.src[0].index] & comps))
