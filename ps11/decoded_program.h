@@ -49,6 +49,7 @@ struct DSrc {
 
 struct DOp {
     Opcode op = Opcode::Nop;
+    const OpcodeInfo* info = nullptr;  // the opcode-table row (components read, writes its destination)
     bool texture = false;   // texture-address instruction
     bool hold = false;      // first member of a co-issued pair: result held until the partner has read
     uint8_t dstSlot = 0;

@@ -380,6 +380,7 @@ bool exec::decodeProgram(const Program& program, const ExecutorOptions& options,
         }
         DOp d;
         d.op = opc;
+        d.info = ins.info;
         if (opc == Opcode::Phase) {
             ops.push_back(d);
             continue;

@@ -16,15 +16,9 @@
 namespace ps11::exec {
 namespace {
 
-// Components of each source an op reads, as a mask of output channels.
-uint8_t fetchMask(const DOp& op) {
-    switch (op.op) {
-        case Opcode::Dp3: return kMaskRGB;
-        case Opcode::Dp4: return kMaskAll;
-        case Opcode::Bem: return kMaskR | kMaskG;
-        default: return op.mask;
-    }
-}
+// Channels of source s an op reads, as a mask of output channels (the opcode table's
+// componentsRead: the write mask, or dp3 .rgb, dp4 .rgba, bem .rg).
+inline uint8_t fetchMask(const DOp& op, int s) { return componentsRead(*op.info, s, op.mask); }
 
 // Source modifier as k = a·n + b (k/(2G) is the exact value, docs/precision.md table) and,
 // for float, x' = a·x + b, which rounds exactly like the written formulas (negation is exact).
@@ -47,9 +41,9 @@ Affine modAffine(SrcMod m, int32_t g) {
 }
 
 void fetchFx(const Profile& p, const DOp& op, RunState& st) {
-    const uint8_t fm = fetchMask(op);
     const int n = st.n;
     for (int s = 0; s < op.numSrc; ++s) {
+        const uint8_t fm = fetchMask(op, s);
         const DSrc& src = op.src[size_t(s)];
         const Affine af = modAffine(src.mod, p.g);
         for (int c = 0; c < 4; ++c) {
@@ -185,9 +179,9 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
 // Float profiles ------------------------------------------------------------------------------
 
 [[gnu::always_inline]] inline void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
-    const uint8_t fm = fetchMask(op);
     const int n = st.n;
     for (int s = 0; s < op.numSrc; ++s) {
+        const uint8_t fm = fetchMask(op, s);
         const DSrc& src = op.src[size_t(s)];
         // The written formulas (docs/precision.md "float and ideal"), signed zeros included.
         auto apply = [m = src.mod](float x) {

@@ -84,27 +84,6 @@ bool fastKind(Opcode op, FastKind& k) {
     }
 }
 
-// Source components an op reads, as a mask of output channels (as executor_arith.cpp).
-uint8_t readMask(const FastOp& op) {
-    if (op.kind == FastKind::Dp3) return kMaskRGB;
-    if (op.kind == FastKind::Dp4) return kMaskAll;
-    return op.mask;
-}
-
-// Texture ops that write their destination register (the others write pad/depth/killed only).
-bool textureWritesDst(const DOp& op) {
-    switch (op.op) {
-        case Opcode::TexKill:
-        case Opcode::TexM3x2Pad:
-        case Opcode::TexM3x3Pad:
-        case Opcode::TexM3x2Depth:
-        case Opcode::TexDepth:
-            return false;
-        default:
-            return true;
-    }
-}
-
 // Texture ops that write all four components of their destination for every lane, so the
 // int32 copy of the destination need not be brought up to date first.
 bool textureWritesAll(const DOp& op, int minor) {
@@ -181,7 +160,7 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
     for (size_t i = 0; i < ops.size(); ++i) {
         const DOp& d = ops[i];
         if (d.texture) fp.syncDstBefore[i] = !textureWritesAll(d, p.minor);
-        if (d.dstSlot == kSlotR && d.op != Opcode::Phase && (!d.texture || textureWritesDst(d)))
+        if (d.dstSlot == kSlotR && d.info->writesDst)
             fp.r0Written = uint8_t(fp.r0Written | d.mask);
         if (d.texture || d.op == Opcode::Phase) continue;
         FastOp& f = fp.ops[i];
@@ -223,8 +202,8 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
         // Component c of the destination is written before component c' > c is read: a source
         // that is the destination itself and reads other components must see the old values.
         if (!f.hold && f.kind != FastKind::Dp3 && f.kind != FastKind::Dp4) {
-            const uint8_t rm = readMask(f);
             for (int s = 0; s < f.numSrc; ++s) {
+                const uint8_t rm = componentsRead(*d.info, s, d.mask);  // channels source s reads
                 const FastSrc& fs = f.src[size_t(s)];
                 if (fs.slot != f.dst) continue;
                 for (int c = 0; c < 4; ++c)
@@ -277,7 +256,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
                 st.deferTexelClamp = op.op == Opcode::Tex;
                 execTexture(p, op, st);
                 st.deferTexelClamp = false;
-                if (textureWritesDst(op)) syncTo16(*fs, op.dstSlot, kern, p.nMax);
+                if (op.info->writesDst) syncTo16(*fs, op.dstSlot, kern, p.nMax);
             } else {
                 arithStep(kern, fp.ops[idx], bank, nv);
             }

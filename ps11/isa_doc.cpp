@@ -29,13 +29,35 @@ const char* className(OpClass c) {
     return "?";
 }
 
+// ".rgb" for a component mask (rgba order), "write mask" for kReadsWriteMask.
+std::string readSet(uint8_t m) {
+    if (m == kReadsWriteMask) return "write mask";
+    std::string out = ".";
+    for (int c = 0; c < 4; ++c)
+        if (m & (1u << c)) out += "rgba"[c];
+    return out;
+}
+
+// Components read: one set when every source reads the same, else per source; the destination's
+// register for texkill/texdepth.
+std::string readsColumn(const OpcodeInfo& row) {
+    std::string out;
+    bool same = true;
+    for (int s = 1; s < row.numSrc; ++s) same = same && row.srcReads[size_t(s)] == row.srcReads[0];
+    if (row.numSrc > 0 && same) out = readSet(row.srcReads[0]);
+    for (int s = 0; s < row.numSrc && !same; ++s)
+        out += (s ? ", src" : "src") + std::to_string(s) + " " + readSet(row.srcReads[size_t(s)]);
+    if (row.dstReads) out += (out.empty() ? "dst " : ", dst ") + readSet(row.dstReads);
+    return out.empty() ? "–" : out;
+}
+
 }  // namespace
 
 std::string isaMarkdownTable() {
     std::string out =
         "| mnemonic | opcode | class | versions | operands | tex slots | arith slots 1_1–1_3 | arith slots 1_4 | "
-        "co-issue | max per shader | meaning |\n"
-        "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        "co-issue | max per shader | components read | writes dst | meaning |\n"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const OpcodeInfo& row : opcodeTable()) {
         char opcode[16];
         std::snprintf(opcode, sizeof opcode, "0x%02X", unsigned(row.opcode));
@@ -48,6 +70,7 @@ std::string isaMarkdownTable() {
                std::to_string(row.arithSlots13) + " | " + std::to_string(row.arithSlots14) + " | " +
                (row.coissuable ? "yes" : "no") + " | " +
                (row.maxPerShader ? std::to_string(row.maxPerShader) : std::string("–")) + " | " +
+               readsColumn(row) + " | " + (!row.hasDst ? "–" : row.writesDst ? "yes" : "no") + " | " +
                std::string(row.summary) + " |\n";
     }
     return out;

@@ -1,8 +1,10 @@
 // The opcode table: one row per mnemonic (and per operand layout across versions).
-// Lexer, parser, encoder, decoder, disassembler, validator and docs all read this
-// table; no other file lists opcode facts. Facts from ps1x-spec.md §2.1 and §4.1.
+// Lexer, parser, encoder, decoder, disassembler, validator, executor, the GLSL writer and docs
+// all read this table; no other file lists opcode facts (components read, whether the
+// destination is written included). Facts from ps1x-spec.md §2.1-2.4 and §4.1.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -59,6 +61,12 @@ enum class OpClass : uint8_t {
 enum VersionBits : uint8_t { kV11 = 1, kV12 = 2, kV13 = 4, kV14 = 8, kV11to13 = 7, kVAll = 15, kV12to13 = 6 };
 constexpr uint8_t versionBit(int minor) { return minor >= 1 && minor <= 4 ? uint8_t(1u << (minor - 1)) : 0; }
 
+// A source's read set (OpcodeInfo::srcReads): the channels of the result a source feeds, as a
+// mask r = 1, g = 2, b = 4, a = 8 (a source's swizzle maps each channel to the component read),
+// or kReadsWriteMask for a per-component instruction, whose sources feed exactly the channels
+// its write mask enables.
+constexpr uint8_t kReadsWriteMask = 0x10;
+
 struct OpcodeInfo {
     std::string_view mnemonic;
     Opcode opcode;
@@ -72,8 +80,30 @@ struct OpcodeInfo {
     uint8_t arithSlots14;  // arithmetic slots used in 1_4
     bool coissuable;       // may be a member of a co-issued pair
     uint8_t maxPerShader;  // 0 = unlimited (dp4: 4, cmp: 3 in 1_2/1_3; bem: 1)
+    // Components each source reads (see kReadsWriteMask; unused entries 0; use componentsRead()).
+    std::array<uint8_t, 3> srcReads;
+    uint8_t dstReads;      // components of the register the destination token names that are read (1_4
+                           // texkill .rgb, texdepth r5.rg); 0 for every other row
+    bool writesDst;        // running it writes its destination register (false: nop, def, phase,
+                           // texkill, the pads, texm3x2depth and texdepth)
     std::string_view summary;  // one line for docs and --help
 };
+
+// Components of source `src` that the row reads, as a mask of result channels: its fixed set
+// (dp3 .rgb, dp4 .rgba, bem .rg, texture-address sources), or the channels of `writeMask` for a
+// per-component instruction (mov add sub mul mad lrp cnd cmp); 0 for a source the row lacks.
+// Channel c of a source reads its register component swizzle[c].
+constexpr uint8_t componentsRead(const OpcodeInfo& row, int src, uint8_t writeMask) {
+    if (src < 0 || src >= row.numSrc) return 0;
+    const uint8_t r = row.srcReads[size_t(src)];
+    return r == kReadsWriteMask ? uint8_t(writeMask & 0xF) : r;
+}
+// The union over the row's sources (what an op must fetch).
+constexpr uint8_t componentsReadAny(const OpcodeInfo& row, uint8_t writeMask) {
+    uint8_t m = 0;
+    for (int s = 0; s < row.numSrc; ++s) m = uint8_t(m | componentsRead(row, s, writeMask));
+    return m;
+}
 
 // All rows, in opcode order.
 std::span<const OpcodeInfo> opcodeTable();

@@ -170,24 +170,26 @@ void Validator::readAccess(const Instruction& in, RegType type, int index, uint8
 void Validator::dataflowReads(size_t i) {
     const Instruction& in = inst(i);
     const Opcode op = in.opcode();
+    // Register components a source reads: the row's read set (opcode table), through the swizzle.
+    auto swizzled = [&](const Src& src, int s) {
+        const uint8_t channels = componentsRead(*in.info, s, in.dst.mask);
+        uint8_t comps = 0;
+        for (int c = 0; c < 4; ++c)
+            if (channels & (1u << c)) comps |= uint8_t(1u << swizzleComponent(src.swizzle, c));
+        return comps;
+    };
     if (isArith(in)) {
-        uint8_t channels = in.dst.mask & kMaskAll;
-        if (op == Opcode::Dp3) channels = kMaskRGB;
-        if (op == Opcode::Dp4) channels = kMaskAll;
-        if (op == Opcode::Bem) channels = kMaskR | kMaskG;
-        for (size_t s = 0; s < in.info->numSrc; ++s) {
-            const Src& src = in.src[s];
-            uint8_t comps = 0;
-            for (int c = 0; c < 4; ++c)
-                if (channels & (1u << c)) comps |= uint8_t(1u << swizzleComponent(src.swizzle, c));
-            readAccess(in, src.type, src.index, comps, src.loc);
-        }
+        for (size_t s = 0; s < in.info->numSrc; ++s)
+            readAccess(in, in.src[s].type, in.src[s].index, swizzled(in.src[s], int(s)), in.src[s].loc);
         return;
     }
     if (!isTexture(in)) return;
     if (!is14()) {
+        // 1_1-1_3 texture sources take no selector (checked by the operand rules): the read set names
+        // the register components. texkill's destination t(m) names coordinate set m, not the
+        // register (spec §7.9): nothing of the register is read.
         for (size_t s = 0; s < in.info->numSrc; ++s)
-            readAccess(in, in.src[s].type, in.src[s].index, s == 0 ? texSourceComponents(op) : uint8_t(kMaskRGB),
+            readAccess(in, in.src[s].type, in.src[s].index, componentsRead(*in.info, int(s), in.dst.mask),
                        in.src[s].loc);
         if ((op == Opcode::TexBem || op == Opcode::TexBemL) && in.src[0].type == RegType::Texture &&
             inRange(RegType::Texture, in.src[0].index))
@@ -200,21 +202,23 @@ void Validator::dataflowReads(size_t i) {
         return;
     }
     // ps_1_4.
-    if (op == Opcode::Tex && in.src[0].type == RegType::Temp && inRange(RegType::Temp, in.src[0].index)) {
-        uint8_t comps = 0;
-        for (int c = 0; c < 3; ++c) comps |= uint8_t(1u << swizzleComponent(in.src[0].swizzle, c));
-        readAccess(in, RegType::Temp, in.src[0].index, comps, in.src[0].loc);
-        if (m_phaseOf[i] == 2 && (m_writtenPhase2[in.src[0].index] & comps))
+    // ps_1_4: texkill and texdepth read the register their destination token names (dstReads);
+    // texld reads its source through its selector; texcrd's source is a t# coordinate set (P2032
+    // otherwise), whose components the read set names.
+    if (in.info->dstReads) {
+        readAccess(in, in.dst.type, in.dst.index, in.info->dstReads, in.dst.loc);
+    } else if (in.info->numSrc >= 1) {
+        const uint8_t comps =
+            op == Opcode::Tex ? swizzled(in.src[0], 0) : componentsRead(*in.info, 0, in.dst.mask);
+        readAccess(in, in.src[0].type, in.src[0].index, comps, in.src[0].loc);
+        if (op == Opcode::Tex && m_phaseOf[i] == 2 && in.src[0].type == RegType::Temp &&
+            inRange(RegType::Temp, in.src[0].index) && (m_writtenPhase2[in.src[0].index] & comps))
             error(kDependentRead, in.src[0].loc,
                   "texld reads " + regName(RegType::Temp, in.src[0].index) +
                       " written in phase 2; a dependent read uses r# values computed in phase 1");
-    } else if (op == Opcode::TexKill || op == Opcode::TexDepth) {
-        readAccess(in, in.dst.type, in.dst.index, op == Opcode::TexKill ? uint8_t(kMaskRGB) : uint8_t(kMaskR | kMaskG),
-                   in.dst.loc);
-    } else if (in.info->numSrc >= 1) {
-        readAccess(in, in.src[0].type, in.src[0].index, kMaskRGB, in.src[0].loc);
     }
-    if (op != Opcode::TexKill && op != Opcode::TexDepth && inRange(in.dst.type, in.dst.index) &&
+    // A destination that is read was checked above; a written one may not be a dead register.
+    if (!in.info->dstReads && inRange(in.dst.type, in.dst.index) &&
         !m_unusable[size_t(in.dst.type)][in.dst.index].empty())
         error(kUnusableRegister, in.dst.loc,
               regName(in.dst.type, in.dst.index) +
@@ -254,7 +258,7 @@ void Validator::dataflowWrites(size_t i) {
     }
     const std::string at = mn(in) + " at " + lineRef(in.loc);
     if (!is14()) {
-        if (texWritesDst(op)) {
+        if (in.info->writesDst) {
             writeAccess(d.type, d.index, kMaskAll, phase);
             return;
         }

@@ -180,27 +180,6 @@ inline bool endsM3x3(Opcode op) {
     return op == Opcode::TexM3x3Tex || op == Opcode::TexM3x3 || op == Opcode::TexM3x3Spec || op == Opcode::TexM3x3VSpec;
 }
 
-// Components of a t(n) source that a 1_1-1_3 texture-address instruction reads (spec §2.3 formulas).
-inline uint8_t texSourceComponents(Opcode op) {
-    switch (op) {
-        case Opcode::TexBem:
-            return kMaskR | kMaskG;
-        case Opcode::TexBemL:
-            return kMaskRGB;
-        case Opcode::TexReg2AR:
-            return kMaskA | kMaskR;
-        case Opcode::TexReg2GB:
-            return kMaskG | kMaskB;
-        default:
-            return kMaskRGB;
-    }
-}
-
-// 1_1-1_3 texture-address instructions that leave their destination unwritten.
-inline bool texWritesDst(Opcode op) {
-    return op != Opcode::TexKill && op != Opcode::TexM3x2Pad && op != Opcode::TexM3x3Pad && op != Opcode::TexM3x2Depth;
-}
-
 enum class Pipe { Color, Alpha, Both, None };
 
 // The pipe a write mask routes an arithmetic instruction to (spec §3.5).

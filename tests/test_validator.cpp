@@ -522,6 +522,43 @@ TEST_CASE("validator: tests/shaders/validate corpus", "[validator][corpus]") {
     CHECK(fails >= 80);
 }
 
+TEST_CASE("opcode table: components read and destination writes", "[validator][opcodes]") {
+    auto row = [](const char* mnemonic, int minor) { return *findOpcode(mnemonic, minor); };
+    // Per-component instructions read the write mask's channels; dp3/dp4/bem a fixed set.
+    CHECK(componentsRead(row("mad", 1), 2, kMaskG | kMaskA) == (kMaskG | kMaskA));
+    CHECK(componentsRead(row("cmp", 4), 0, kMaskB) == kMaskB);
+    CHECK(componentsRead(row("dp3", 4), 1, kMaskA) == kMaskRGB);
+    CHECK(componentsRead(row("dp4", 2), 0, kMaskR) == kMaskAll);
+    CHECK(componentsRead(row("bem", 4), 1, kMaskR | kMaskG) == (kMaskR | kMaskG));
+    CHECK(componentsRead(row("add", 1), 2, kMaskAll) == 0);  // no third source
+    // Texture-address sources (spec §2.3 formulas).
+    CHECK(componentsRead(row("texbem", 1), 0, kMaskAll) == (kMaskR | kMaskG));
+    CHECK(componentsRead(row("texbeml", 1), 0, kMaskAll) == kMaskRGB);
+    CHECK(componentsRead(row("texreg2ar", 1), 0, kMaskAll) == (kMaskA | kMaskR));
+    CHECK(componentsRead(row("texreg2gb", 1), 0, kMaskAll) == (kMaskG | kMaskB));
+    CHECK(componentsRead(row("texm3x3spec", 1), 1, kMaskAll) == kMaskRGB);
+    CHECK(componentsRead(row("texld", 4), 0, kMaskAll) == kMaskRGB);
+    CHECK(componentsReadAny(row("lrp", 1), kMaskRGB) == kMaskRGB);
+    // texkill and texdepth read the register their destination token names.
+    CHECK(row("texkill", 4).dstReads == kMaskRGB);
+    CHECK(row("texdepth", 4).dstReads == (kMaskR | kMaskG));
+    // Destinations written: texdepth writes depth only (r5 is read, then unusable).
+    for (const char* m : {"texkill", "texm3x2pad", "texm3x3pad", "texm3x2depth", "texdepth", "nop", "phase", "def"})
+        CHECK_FALSE(row(m, 4).writesDst);
+    for (const char* m : {"mov", "bem", "texcoord", "texcrd", "tex", "texld", "texm3x3", "texdp3", "texm3x3vspec"})
+        CHECK(row(m, 4).writesDst);
+    for (const OpcodeInfo& r : opcodeTable()) {
+        INFO(r.mnemonic);
+        if (r.writesDst) CHECK(r.hasDst);
+        for (int s = 0; s < 3; ++s) {
+            if (s >= r.numSrc) CHECK(r.srcReads[size_t(s)] == 0);
+            else CHECK(r.srcReads[size_t(s)] != 0);
+            // Only arithmetic instructions read per write mask.
+            if (r.srcReads[size_t(s)] == kReadsWriteMask) CHECK(r.cls == OpClass::Arith);
+        }
+    }
+}
+
 TEST_CASE("validator: random programs never crash", "[validator]") {
     // Any well-typed IR (the decoder can produce any row, register number and modifier) must be
     // validated without crashing; run under the sanitizer build for the real check.

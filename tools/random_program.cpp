@@ -258,7 +258,7 @@ void Generator::record(const Instruction& in) {
         if (op == Opcode::TexBem || op == Opcode::TexBemL) m_bemSources |= bit(in.src[0].index);
         if (op == Opcode::TexM3x2Depth)
             m_unusable[size_t(d.type)] |= bit(d.index);
-        else if (op != Opcode::TexKill && shapeOf(op) != Shape::Pad)
+        else if (in.info->writesDst)
             write(d.type, d.index, ps11::kMaskAll);
         return;
     }

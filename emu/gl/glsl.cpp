@@ -363,14 +363,13 @@ struct Gen {
         }
     }
     void arith(const DOp& op) {
-        const uint8_t fm = op.op == Opcode::Dp3 ? 7 : op.op == Opcode::Dp4 ? 15 : op.op == Opcode::Bem ? 3 : op.mask;
         const std::string T = fx ? "ivec4" : "vec4";
         o << "    { " << (fx ? "" : "precise ") << T
           << " t = " << (op.hold ? "H" : regSlot(op.dstSlot)) << ";\n";
         if (fx)
-            arithFx(op, fm);
+            arithFx(op);
         else
-            arithFloat(op, fm);
+            arithFloat(op);
         if (op.hold) {
             o << "      H = t; }\n";
         } else {
@@ -380,7 +379,7 @@ struct Gen {
             o << "    }\n";
         }
     }
-    void arithFx(const DOp& op, uint8_t) {
+    void arithFx(const DOp& op) {
         const int g = p.g;
         const int lo = op.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
         const int hi = op.sat ? std::min(g, p.nMax) : p.nMax;
@@ -399,9 +398,11 @@ struct Gen {
         const int64_t kLin = 2, kProd = 4 * int64_t(g);
         auto K = [&](int s, int c) { return W + k(op, s, c); };
         if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
+            // The sum over the components both sources read (dp3 .rgb, dp4 .rgba: the opcode table).
+            const uint8_t rd = ps11::componentsRead(*op.info, 0, op.mask) & ps11::componentsRead(*op.info, 1, op.mask);
             std::string sum;
-            for (int c = 0; c < (op.op == Opcode::Dp3 ? 3 : 4); ++c)
-                sum += (c ? " + " : "") + K(0, c) + " * " + K(1, c);
+            for (int c = 0; c < 4; ++c)
+                if ((rd >> c) & 1) sum += (sum.empty() ? "" : " + ") + K(0, c) + " * " + K(1, c);
             o << "      int d = " << finish(sum, kProd) << ";\n";
             for (int c = 0; c < 4; ++c)
                 if ((op.mask >> c) & 1) o << "      t." << kComp[c] << " = d;\n";
@@ -459,7 +460,7 @@ struct Gen {
             o << "      t." << kComp[c] << " = " << e << ";\n";
         }
     }
-    void arithFloat(const DOp& op, uint8_t) {
+    void arithFloat(const DOp& op) {
         const float scale = std::ldexp(1.0f, op.shift);
         auto finish = [&](const std::string& e) {
             std::string s = "{ precise float v = (" + e + ") * " + flit(scale) + ";";
@@ -470,9 +471,16 @@ struct Gen {
             return s;
         };
         if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
-            std::string e = "(" + x(op, 0, 0) + " * " + x(op, 1, 0) + " + " + x(op, 0, 1) + " * " + x(op, 1, 1) +
-                            ") + " + x(op, 0, 2) + " * " + x(op, 1, 2);
-            if (op.op == Opcode::Dp4) e = "(" + e + ") + " + x(op, 0, 3) + " * " + x(op, 1, 3);
+            // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a) over the components read, as the executor.
+            const uint8_t rd = ps11::componentsRead(*op.info, 0, op.mask) & ps11::componentsRead(*op.info, 1, op.mask);
+            std::string e;
+            int terms = 0;
+            for (int c = 0; c < 4; ++c) {
+                if (!((rd >> c) & 1)) continue;
+                const std::string t = x(op, 0, c) + " * " + x(op, 1, c);
+                e = terms == 0 ? t : (terms == 1 ? e : "(" + e + ")") + " + " + t;  // left to right
+                ++terms;
+            }
             o << "      " << finish(e) << " t = vec4(v); }\n";
             return;
         }
