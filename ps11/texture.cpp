@@ -267,10 +267,10 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode dec
         error = "texture has no size";
         return std::nullopt;
     }
-    if (desc.width > kMaxSurfaceSize || desc.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+    if (desc.width > kMaxTextureSide || desc.height > kMaxTextureSide || depth > kMaxVolumeSide) {
         error = "texture size " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
                 (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
-                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+                std::to_string(kMaxTextureSide) + " per side, depth " + std::to_string(kMaxVolumeSide) + ")";
         return std::nullopt;
     }
     const uint32_t possible = fullMipCount(desc.width, desc.height, depth);
@@ -445,10 +445,10 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         error = "texture has no size";
         return std::nullopt;
     }
-    if (l0.width > kMaxSurfaceSize || l0.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+    if (l0.width > kMaxTextureSide || l0.height > kMaxTextureSide || depth > kMaxVolumeSide) {
         error = "texture size " + std::to_string(l0.width) + "x" + std::to_string(l0.height) +
                 (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
-                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+                std::to_string(kMaxTextureSide) + " per side, depth " + std::to_string(kMaxVolumeSide) + ")";
         return std::nullopt;
     }
     const uint32_t possible = fullMipCount(l0.width, l0.height, depth);
