@@ -28,7 +28,9 @@ using TF = TexFormat;
 // A16B16G16R16F = halves R G B A; A32B32G32R32F = floats R G B A. The sampler's view
 // (docs/textures.md, ps1x-spec §6.4): missing channels read 1, except A8's rgb which read 0;
 // bump formats map r = U, g = V, b = L or W, a = Q.
-// D3DFORMAT values as in d3d9types.h (emu/d3d9types.h checks them against these rows).
+// D3DFORMAT values as in d3d9types.h (the SDK header emu/d3d9types.h mirrors).
+// One row per line:
+// clang-format off
 constexpr FormatRow kFormatRows[19] = {
     // d3d, name, bytes, class, r g b a, pad, texture, render target, lockable depth, depth, stencil, TexFormat
     {21, "A8R8G8B8", 4, FC::Unorm8, {U(16, 8), U(8, 8), U(0, 8), U(24, 8)}, kNoPad, true, true, false, 0, 0, TF::A8R8G8B8},
@@ -51,6 +53,7 @@ constexpr FormatRow kFormatRows[19] = {
     {71, "D32", 4, FC::Depth, {}, kNoPad, false, false, false, 32, 0},
     {82, "D32F_LOCKABLE", 4, FC::Depth, {}, kNoPad, false, false, true, 32, 0},
 };
+// clang-format on
 
 namespace {
 
@@ -67,19 +70,15 @@ static_assert(texturesInEnumOrder(), "kFormatRows: the texture formats first, ro
 
 const FormatRow& formatRow(TexFormat f) { return kFormatRows[size_t(f)]; }
 
-const FormatRow* formatRowOf(uint32_t d3d) {
-    for (const FormatRow& r : kFormatRows)
-        if (r.d3d == d3d) return &r;
-    return nullptr;
-}
+namespace {
+constexpr NameEntry<TexFormat> nameOf(size_t i) { return {kFormatRows[i].name, TexFormat(i)}; }
+}  // namespace
 
 const NameEntry<TexFormat> kTexFormatNames[kTexFormatCount] = {
-#define PS11_ROW_NAME(i) {kFormatRows[i].name, TexFormat(i)}
-    PS11_ROW_NAME(0), PS11_ROW_NAME(1), PS11_ROW_NAME(2),  PS11_ROW_NAME(3),  PS11_ROW_NAME(4),
-    PS11_ROW_NAME(5), PS11_ROW_NAME(6), PS11_ROW_NAME(7),  PS11_ROW_NAME(8),  PS11_ROW_NAME(9),
-    PS11_ROW_NAME(10), PS11_ROW_NAME(11), PS11_ROW_NAME(12),
-#undef PS11_ROW_NAME
+    nameOf(0), nameOf(1), nameOf(2), nameOf(3),  nameOf(4),  nameOf(5),  nameOf(6),
+    nameOf(7), nameOf(8), nameOf(9), nameOf(10), nameOf(11), nameOf(12),
 };
+static_assert(kTexFormatCount == 13, "kTexFormatNames names every texture row");
 
 const char* texFormatName(TexFormat f) { return size_t(f) < kTexFormatCount ? formatRow(f).name : "?"; }
 

@@ -46,12 +46,12 @@ enum class FormatClass : uint8_t {
 
 // Where one channel of the sampler's view (r g b a) comes from.
 enum class ChannelKind : uint8_t {
-    Zero,    // the constant 0 (A8's rgb, ps1x-spec §6.4)
-    One,     // the constant 1 (a channel the format lacks)
-    Unorm,   // an unsigned field, value = field / (2^bits - 1)
-    Snorm,   // a signed (bump) field, decoded by the hardware class's SignedDecode
-    Half,    // an IEEE half at bit `shift` of the texel
-    Float,   // an IEEE float at bit `shift` of the texel
+    Zero,   // the constant 0 (A8's rgb, ps1x-spec §6.4)
+    One,    // the constant 1 (a channel the format lacks)
+    Unorm,  // an unsigned field, value = field / (2^bits - 1)
+    Snorm,  // a signed (bump) field, decoded by the hardware class's SignedDecode
+    Half,   // an IEEE half at bit `shift` of the texel
+    Float,  // an IEEE float at bit `shift` of the texel
 };
 
 // One channel: its kind and the bit field of the texel (little endian, bit 0 = first byte's
@@ -64,9 +64,9 @@ struct Channel {
 // Everything about one D3DFORMAT, stated once: the device, the textures, the sampler and the
 // .ps11test model derive their facts from these rows (docs/device.md "Formats").
 struct FormatRow {
-    uint32_t d3d = 0;    // its D3DFORMAT value (d3d9types.h)
+    uint32_t d3d = 0;       // its D3DFORMAT value (d3d9types.h)
     const char* name = "";  // D3DFMT_ name without the prefix
-    uint32_t bytes = 0;  // per texel in D3D9's memory layout
+    uint32_t bytes = 0;     // per texel in D3D9's memory layout
     FormatClass cls = FormatClass::Unorm8;
     std::array<Channel, 4> rgba{};  // the sampler's view: r g b a (texture formats)
     Channel pad{};                  // stored bits no channel reads (the X of X8*): written 1s, mip-averaged
@@ -82,8 +82,6 @@ struct FormatRow {
 extern const FormatRow kFormatRows[19];
 // The row of a texture format.
 const FormatRow& formatRow(TexFormat f);
-// The row of a D3DFORMAT value; nullptr for a format the project does not know.
-const FormatRow* formatRowOf(uint32_t d3d);
 
 // Every texture format with its name, in enum order (from kFormatRows).
 extern const NameEntry<TexFormat> kTexFormatNames[kTexFormatCount];

@@ -55,7 +55,7 @@ std::array<uint8_t, 4> decodeUnorm8(const FormatRow& row, uint32_t w) {
     if (row.cls != FormatClass::Unorm8) return out;
     for (size_t c = 0; c < 4; ++c) {
         const Channel& ch = row.rgba[c];
-        out[size_t(kUnorm8Byte[c])] = ch.kind == ChannelKind::Unorm ? uint8_t(fieldOf(ch, w))
+        out[size_t(kUnorm8Byte[c])] = ch.kind == ChannelKind::Unorm  ? uint8_t(fieldOf(ch, w))
                                       : ch.kind == ChannelKind::Zero ? 0
                                                                      : 255;
     }
@@ -84,7 +84,10 @@ Vec4 decodeFloat(const FormatRow& row, const Texel& t) {
     Vec4 v = t.value;
     for (size_t c = 0; c < 4; ++c) {
         const ChannelKind k = row.rgba[c].kind;
-        v[c] = k == ChannelKind::Half ? roundToHalf(v[c]) : k == ChannelKind::Float ? v[c] : k == ChannelKind::Zero ? 0.0f : 1.0f;
+        v[c] = k == ChannelKind::Half    ? roundToHalf(v[c])
+               : k == ChannelKind::Float ? v[c]
+               : k == ChannelKind::Zero  ? 0.0f
+                                         : 1.0f;
     }
     return v;
 }
@@ -412,7 +415,7 @@ inline float loadF32(const uint8_t* p) {
 // One row of an Unorm8 format into b g r a words: a copy where the format's layout is the stored
 // one (A8R8G8B8), else each stored byte from the texel byte that holds its channel, or a constant.
 void unorm8Row(const FormatRow& row, const uint8_t* src, uint32_t width, uint8_t* dst) {
-    std::array<int, 4> from{};     // per stored byte: the texel byte it copies, or -1
+    std::array<int, 4> from{};      // per stored byte: the texel byte it copies, or -1
     std::array<uint8_t, 4> fill{};  // the constant of a byte no texel byte gives
     bool copy = row.bytes == 4;
     for (size_t c = 0; c < 4; ++c) {
