@@ -40,11 +40,6 @@ constexpr uint32_t kMaxStride = 2048;
 // Lowered fixed-function programs kept per device (cleared when full).
 constexpr size_t kMaxLoweredPrograms = 64;
 
-bool drawableFormat(D3DFORMAT f) {
-    return f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8 || f == D3DFMT_R32F || f == D3DFMT_A16B16G16R16F ||
-           f == D3DFMT_A32B32G32R32F;
-}
-
 }  // namespace
 
 uint64_t attributesRead(const ps11::Program& program) {
@@ -191,7 +186,7 @@ std::optional<CallError> Device::resolveTargets(DrawSetup& d) {
     CallError error;
     d.target = findSurface(m_state.renderTarget, "render target", error, &d.rt, &d.rtRef);
     if (!d.target) return error;
-    if (!drawableFormat(d.target->format->format))
+    if (!d.target->format->renderTarget)
         return refuse(D3DERR_INVALIDCALL, "E4118",
                       std::string("render target format ") + d.target->format->name +
                           " is not drawn (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");

@@ -1,35 +1,25 @@
-// Surface formats of the device: bytes per texel in D3D9's memory layout, which uses each
-// format allows, and the conversions between a texel's bytes and its channel values
-// (docs/device.md "Formats").
+// Surface formats of the device: the rows of ps11/formats.h (bytes per texel in D3D9's memory
+// layout, which uses each format allows) and the conversions between a texel's bytes and its
+// channel values, driven by the rows' channels (docs/device.md "Formats").
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 #include "emu/d3d9types.h"
+#include "ps11/formats.h"
 #include "ps11/hardware.h"
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
 
 namespace emu {
 
-enum class FormatClass : uint8_t {
-    Unorm8,  // 8-bit unsigned channels (A8R8G8B8, X8R8G8B8, A8, L8, A8L8)
-    Signed,  // bump formats with signed channels (V8U8, L6V5U5, X8L8V8U8, Q8W8V8U8, V16U16)
-    Float,   // R32F, A16B16G16R16F, A32B32G32R32F
-    Depth,   // D16, D24S8, D24X8, D32, D16_LOCKABLE, D32F_LOCKABLE
-};
+using ps11::FormatClass;
 
-struct FormatInfo {
+// A row of ps11/formats.h's table (the one place each format is described) with its D3DFORMAT
+// typed for the device.
+struct FormatInfo : ps11::FormatRow {
     D3DFORMAT format = D3DFMT_UNKNOWN;
-    const char* name = "UNKNOWN";
-    uint32_t bytes = 0;  // per texel
-    FormatClass cls = FormatClass::Unorm8;
-    bool texture = false;        // CreateTexture / CreateVolumeTexture take it
-    bool renderTarget = false;   // D3DUSAGE_RENDERTARGET / CreateRenderTarget / StretchRect
-    bool lockableDepth = false;  // a depth format LockRect may lock (the _LOCKABLE ones)
-    uint32_t depthBits = 0, stencilBits = 0;
-    ps11::TexFormat texFormat = ps11::TexFormat::A8R8G8B8;  // the sampler's name for it
 };
 
 // Facts about a format; nullptr for a format the device does not know.

@@ -813,19 +813,7 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
     n.written += written;
 }
 
-[[maybe_unused]] bool supportedColor(const Image* img) {
-    if (!img || !img->format) return false;
-    switch (img->format->format) {
-        case D3DFMT_A8R8G8B8:
-        case D3DFMT_X8R8G8B8:
-        case D3DFMT_A16B16G16R16F:
-        case D3DFMT_A32B32G32R32F:
-        case D3DFMT_R32F:
-            return true;
-        default:
-            return false;
-    }
-}
+[[maybe_unused]] bool supportedColor(const Image* img) { return img && img->format && img->format->renderTarget; }
 
 }  // namespace
 

@@ -21,26 +21,19 @@ struct Field {
     bool isSigned;
 };
 
-int fieldsOf(D3DFORMAT f, Field* out) {
-    switch (f) {
-        case D3DFMT_V8U8:
-            out[0] = {0, 8, true}, out[1] = {8, 8, true};
-            return 2;
-        case D3DFMT_L6V5U5:
-            out[0] = {0, 5, true}, out[1] = {5, 5, true}, out[2] = {10, 6, false};
-            return 3;
-        case D3DFMT_X8L8V8U8:
-            out[0] = {0, 8, true}, out[1] = {8, 8, true}, out[2] = {16, 8, false}, out[3] = {24, 8, false};
-            return 4;
-        case D3DFMT_Q8W8V8U8:
-            for (int i = 0; i < 4; ++i) out[i] = {8 * i, 8, true};
-            return 4;
-        case D3DFMT_V16U16:
-            out[0] = {0, 16, true}, out[1] = {16, 16, true};
-            return 2;
-        default:
-            return 0;
-    }
+// The stored fields of a signed (bump) format, from its row: its channels' fields and the pad (X).
+int fieldsOf(const FormatInfo& f, Field* out) {
+    if (f.cls != FormatClass::Signed) return 0;
+    int n = 0;
+    auto add = [&](const ps11::Channel& ch) {
+        if (ch.kind != ps11::ChannelKind::Snorm && ch.kind != ps11::ChannelKind::Unorm) return;
+        for (int i = 0; i < n; ++i)
+            if (out[i].shift == ch.shift) return;
+        out[n++] = {ch.shift, ch.bits, ch.kind == ps11::ChannelKind::Snorm};
+    };
+    for (const ps11::Channel& ch : f.rgba) add(ch);
+    if (f.pad.bits) add({ps11::ChannelKind::Unorm, f.pad.shift, f.pad.bits});
+    return n;
 }
 
 int64_t fieldValue(uint32_t w, const Field& f) {
@@ -62,7 +55,7 @@ void boxLevel(const Image& src, Image& dst, bool volume) {
     const FormatInfo& f = *src.format;
     const int n = volume ? 8 : 4;
     Field fields[4];
-    const int nFields = fieldsOf(f.format, fields);
+    const int nFields = fieldsOf(f, fields);
     for (uint32_t z = 0; z < dst.depth; ++z)
         for (uint32_t y = 0; y < dst.height; ++y)
             for (uint32_t x = 0; x < dst.width; ++x) {

@@ -40,7 +40,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     if (!ok) return 0;
     for (const ps11::TextureDesc& t : file.textures) {
-        check(t.width >= 1 && t.width <= ps11::kMaxSurfaceSize && t.height >= 1 && t.height <= ps11::kMaxSurfaceSize);
+        check(t.width >= 1 && t.width <= ps11::kMaxTextureSide && t.height >= 1 && t.height <= ps11::kMaxTextureSide);
         check(!t.data.empty());
         for (const ps11::TextureLevel& l : t.data) {
             if (!l.hasFill) check(l.texels.size() == size_t(l.width) * l.height * l.depth);

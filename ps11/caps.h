@@ -11,6 +11,8 @@ constexpr int kMaxTextureStages = 8;          // MaxTextureBlendStages; samplers
 constexpr int kMaxTexCoordSets = 8;           // D3DFVF_TEX8: texture coordinate sets of a vertex
 constexpr uint32_t kMaxTextureSide = 16384;   // MaxTextureWidth / MaxTextureHeight
 constexpr uint32_t kMaxVolumeSide = 2048;     // MaxVolumeExtent
-constexpr uint64_t kMaxResourceBytes = uint64_t(1) << 30;  // one resource's memory, checked before allocating
+// One resource's memory, checked before allocating: a device resource in D3D9's layout (all
+// levels) and a ps11::Texture with its decoded copies.
+constexpr uint64_t kMaxResourceBytes = uint64_t(1) << 30;
 
 }  // namespace ps11

@@ -394,8 +394,8 @@ void Parser::renderTargetLine(Args& a, std::string_view kw) {
     RenderTargetDesc& rt = m_file.renderTarget;
     uint32_t line = a.line();
     if (iequals(kw, "size")) {
-        std::optional<int64_t> w = a.integer("render target width", 1, kMaxSurfaceSize);
-        std::optional<int64_t> h = a.integer("render target height", 1, kMaxSurfaceSize);
+        std::optional<int64_t> w = a.integer("render target width", 1, kMaxTextureSide);
+        std::optional<int64_t> h = a.integer("render target height", 1, kMaxTextureSide);
         if (w && h) rt.size = {{uint32_t(*w), uint32_t(*h)}, line};
     } else if (iequals(kw, "format")) {
         assign(rt.format, a.name(kTargetFormats, "render target format"), line);
@@ -459,10 +459,10 @@ void Parser::textureLine(Args& a, std::string_view kw) {
     };
     if (iequals(kw, "size")) {
         if (!beforeData("size")) return;
-        std::optional<int64_t> w = a.integer("texture width", 1, kMaxSurfaceSize);
-        std::optional<int64_t> h = a.integer("texture height", 1, kMaxSurfaceSize);
+        std::optional<int64_t> w = a.integer("texture width", 1, kMaxTextureSide);
+        std::optional<int64_t> h = a.integer("texture height", 1, kMaxTextureSide);
         std::optional<int64_t> d = std::optional<int64_t>(0);
-        if (!a.atEnd()) d = a.integer("volume texture depth", 1, kMaxVolumeDepth);
+        if (!a.atEnd()) d = a.integer("volume texture depth", 1, kMaxVolumeSide);
         if (w && h && d) {
             uint64_t texels = uint64_t(*w) * uint64_t(*h) * uint64_t(std::max<int64_t>(*d, 1));
             if (texels > kMaxTexels) {
@@ -853,10 +853,10 @@ void Parser::transformLine(Args& a, std::string_view kw) {
         if (a.floats(m.data(), 16, std::string(kw) + " matrix (16 floats)")) *target = {m, line};
     } else if (iequals(kw, "viewport")) {
         Viewport vp;
-        std::optional<int64_t> x = a.integer("viewport x", 0, kMaxSurfaceSize);
-        std::optional<int64_t> y = a.integer("viewport y", 0, kMaxSurfaceSize);
-        std::optional<int64_t> w = a.integer("viewport width", 1, kMaxSurfaceSize);
-        std::optional<int64_t> h = a.integer("viewport height", 1, kMaxSurfaceSize);
+        std::optional<int64_t> x = a.integer("viewport x", 0, kMaxTextureSide);
+        std::optional<int64_t> y = a.integer("viewport y", 0, kMaxTextureSide);
+        std::optional<int64_t> w = a.integer("viewport width", 1, kMaxTextureSide);
+        std::optional<int64_t> h = a.integer("viewport height", 1, kMaxTextureSide);
         if (!x || !y || !w || !h) return;
         vp.x = uint32_t(*x);
         vp.y = uint32_t(*y);

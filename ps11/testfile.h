@@ -210,7 +210,7 @@ struct Viewport {
 struct TransformDesc {
     uint32_t line = 0;
     Setting<Matrix4> world, view, projection;  // identity unless set
-    std::array<Setting<Matrix4>, 8> texture;   // D3DTS_TEXTURE0..7
+    std::array<Setting<Matrix4>, kMaxTextureStages> texture;  // D3DTS_TEXTURE0..7
     Setting<Viewport> viewport;
 };
 Matrix4 identityMatrix();
@@ -254,7 +254,7 @@ struct Condition {
 struct DrawQuad {
     Color diffuse = Color::fromArgb(0xffffffff);
     Color specular = Color::fromArgb(0);
-    std::array<Vec4, 8> texRect;  // u0 v0 u1 v1 per coordinate set, (0,0)-(1,1) by default
+    std::array<Vec4, kMaxTexCoordSets> texRect;  // u0 v0 u1 v1 per coordinate set, (0,0)-(1,1) by default
     bool hasRect = false;
     std::array<uint32_t, 4> rect{};  // x0 y0 x1 y1 in pixels (x1, y1 exclusive)
     DrawQuad();
@@ -279,7 +279,7 @@ struct DrawPrimitives {
 
 struct Eval {
     std::array<Setting<Vec4>, 2> color;    // v0, v1 (missing ones are 0)
-    std::array<Setting<Vec4>, 8> texture;  // t0 ... (missing ones are 0)
+    std::array<Setting<Vec4>, kMaxTexCoordSets> texture;  // t0 ... (missing ones are 0)
 };
 
 enum class ProbeKind : uint8_t { Pixel, Rect, All, Eval, EvalKilled, EvalDepth };
@@ -337,8 +337,7 @@ bool parseTestFile(std::string_view text, const std::string& fileName, TestFile&
 std::string formatTestFileError(const std::string& fileName, const TestFileError& error);
 
 // Limits that keep hostile input from asking for absurd allocations.
-constexpr uint32_t kMaxSurfaceSize = kMaxTextureSide;  // ps11/caps.h
-constexpr uint32_t kMaxVolumeDepth = kMaxVolumeSide;
+// (Sides: kMaxTextureSide and kMaxVolumeSide of ps11/caps.h.)
 constexpr uint64_t kMaxTexels = uint64_t(kMaxTextureSide) * kMaxTextureSide;
 
 }  // namespace ps11

@@ -114,7 +114,7 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
     std::string_view prim = a.next();
     if (iequals(prim, "quad")) {
         DrawQuad q;
-        std::array<bool, 8> seenSet{};
+        std::array<bool, kMaxTexCoordSets> seenSet{};
         bool seenDiffuse = false, seenSpecular = false;
         while (!a.atEnd()) {
             std::string_view opt = a.next();
@@ -126,7 +126,7 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
                 std::optional<Color> c = a.color(std::string(opt) + " colour");
                 if (!c) return false;
                 (iequals(opt, "diffuse") ? q.diffuse : q.specular) = *c;
-            } else if (set && *set <= 7) {
+            } else if (set && *set < kMaxTexCoordSets) {
                 if (seenSet[size_t(*set)]) a.error(quote(opt) + " given twice");
                 seenSet[size_t(*set)] = true;
                 Vec4& r = q.texRect[size_t(*set)];
@@ -135,7 +135,7 @@ bool Parser::drawCommand(Args& a, TestCommand& cmd) {
                 if (q.hasRect) a.error("'rect' given twice");
                 for (int i = 0; i < 4; ++i) {
                     static const char* names[] = {"rect x0", "rect y0", "rect x1", "rect y1"};
-                    std::optional<int64_t> v = a.integer(names[i], 0, kMaxSurfaceSize);
+                    std::optional<int64_t> v = a.integer(names[i], 0, kMaxTextureSide);
                     if (!v) return false;
                     q.rect[size_t(i)] = uint32_t(*v);
                 }
@@ -287,7 +287,7 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
         p.kind = ProbeKind::Rect;
         static const char* names[] = {"probe rect x0", "probe rect y0", "probe rect x1", "probe rect y1"};
         for (int i = 0; i < 4; ++i) {
-            std::optional<int64_t> v = a.integer(names[i], 0, kMaxSurfaceSize);
+            std::optional<int64_t> v = a.integer(names[i], 0, kMaxTextureSide);
             if (!v) return false;
             p.rect[size_t(i)] = uint32_t(*v);
         }
@@ -296,8 +296,8 @@ bool Parser::probeCommand(Args& a, TestCommand& cmd) {
             return false;
         }
     } else if (a.peekNumeric()) {
-        std::optional<int64_t> x = a.integer("probe x", 0, kMaxSurfaceSize - 1);
-        std::optional<int64_t> y = a.integer("probe y", 0, kMaxSurfaceSize - 1);
+        std::optional<int64_t> x = a.integer("probe x", 0, kMaxTextureSide - 1);
+        std::optional<int64_t> y = a.integer("probe y", 0, kMaxTextureSide - 1);
         if (!x || !y) return false;
         p.rect = {uint32_t(*x), uint32_t(*y), uint32_t(*x + 1), uint32_t(*y + 1)};
     } else {

@@ -12,9 +12,10 @@ namespace ps11 {
 
 namespace {
 
-// Per format: how channels are stored and, for integer formats stored Decoded, each channel's
-// signed width (bump channels, decoded by the hardware class's SignedDecode) or, for the other
-// channels, the denominator (value = raw / den: unsigned L, and the constant 1 of missing ones).
+// Per format, from its row (ps11/formats.h): how channels are stored and, for integer formats
+// stored Decoded, each channel's signed width (bump channels, decoded by the hardware class's
+// SignedDecode) or, for the other channels, the denominator (value = raw / den: unsigned L, and
+// the constant 1 of missing ones).
 struct FormatInfo {
     TexelStorage storage = TexelStorage::Unorm8;
     bool floats = false;  // float32/float16 channels
@@ -24,46 +25,15 @@ struct FormatInfo {
 };
 
 FormatInfo formatInfo(TexFormat f) {
+    const FormatRow& row = formatRow(f);
     FormatInfo i;
-    switch (f) {
-        case TexFormat::A8R8G8B8:
-        case TexFormat::X8R8G8B8:
-        case TexFormat::A8:
-        case TexFormat::L8:
-        case TexFormat::A8L8:
-            break;
-        case TexFormat::V8U8:
-            i.storage = TexelStorage::Decoded;
-            i.signedBits = {8, 8, 0, 0};
-            break;
-        case TexFormat::Q8W8V8U8:
-            i.storage = TexelStorage::Decoded;
-            i.signedBits = {8, 8, 8, 8};
-            break;
-        case TexFormat::L6V5U5:
-            i.storage = TexelStorage::Decoded;
-            i.signedBits = {5, 5, 0, 0};
-            i.den = {1, 1, 63, 1};
-            break;
-        case TexFormat::X8L8V8U8:
-            i.storage = TexelStorage::Decoded;
-            i.signedBits = {8, 8, 0, 0};
-            i.den = {1, 1, 255, 1};
-            break;
-        case TexFormat::V16U16:
-            i.storage = TexelStorage::Decoded;
-            i.signedBits = {16, 16, 0, 0};
-            break;
-        case TexFormat::A16B16G16R16F:
-            i.storage = TexelStorage::Decoded;
-            i.floats = true;
-            i.half = true;
-            break;
-        case TexFormat::A32B32G32R32F:
-        case TexFormat::R32F:
-            i.storage = TexelStorage::Decoded;
-            i.floats = true;
-            break;
+    i.storage = row.cls == FormatClass::Unorm8 ? TexelStorage::Unorm8 : TexelStorage::Decoded;
+    i.floats = row.cls == FormatClass::Float;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        i.half = i.half || ch.kind == ChannelKind::Half;
+        if (ch.kind == ChannelKind::Snorm) i.signedBits[c] = int8_t(ch.bits);
+        if (ch.kind == ChannelKind::Unorm) i.den[c] = int32_t((uint32_t(1) << ch.bits) - 1);
     }
     return i;
 }
@@ -74,51 +44,51 @@ int32_t signExtend(uint32_t v, int bits) {
     return int32_t(v ^ m) - int32_t(m);
 }
 
+uint32_t fieldOf(const Channel& ch, uint32_t w) {
+    return ch.bits >= 32 ? w >> ch.shift : (w >> ch.shift) & ((uint32_t(1) << ch.bits) - 1);
+}
+
 // A packed word of an Unorm8 format -> the stored bytes b g r a (spec §6.4: missing channels
 // read 1, except A8 whose rgb read 0). A8R8G8B8 keeps D3D's byte order, so its hand-over is a copy.
-std::array<uint8_t, 4> decodeUnorm8(TexFormat f, uint32_t w) {
-    auto b = [w](int shift) { return uint8_t((w >> shift) & 0xff); };
-    switch (f) {
-        case TexFormat::A8R8G8B8:
-            return {b(0), b(8), b(16), b(24)};
-        case TexFormat::X8R8G8B8:
-            return {b(0), b(8), b(16), 255};
-        case TexFormat::A8:
-            return {0, 0, 0, b(0)};
-        case TexFormat::L8:
-            return {b(0), b(0), b(0), 255};
-        case TexFormat::A8L8:
-            return {b(0), b(0), b(0), b(8)};
-        default:
-            return {0, 0, 0, 255};
+std::array<uint8_t, 4> decodeUnorm8(const FormatRow& row, uint32_t w) {
+    std::array<uint8_t, 4> out{0, 0, 0, 255};
+    if (row.cls != FormatClass::Unorm8) return out;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        out[size_t(kUnorm8Byte[c])] = ch.kind == ChannelKind::Unorm  ? uint8_t(fieldOf(ch, w))
+                                      : ch.kind == ChannelKind::Zero ? 0
+                                                                     : 255;
     }
+    return out;
 }
 
 // A packed word of a signed (bump) format -> raw channel integers: signed codes where
-// FormatInfo::signedBits says so, else over FormatInfo::den.
-// Mapping (docs/textures.md): r = U, g = V, b = L or W (else 1), a = Q (else 1).
-std::array<int32_t, 4> decodeSigned(TexFormat f, uint32_t w) {
-    switch (f) {
-        case TexFormat::V8U8:
-            return {signExtend(w, 8), signExtend(w >> 8, 8), 1, 1};
-        case TexFormat::L6V5U5:
-            return {signExtend(w, 5), signExtend(w >> 5, 5), int32_t((w >> 10) & 63), 1};
-        case TexFormat::X8L8V8U8:
-            return {signExtend(w, 8), signExtend(w >> 8, 8), int32_t((w >> 16) & 0xff), 1};
-        case TexFormat::Q8W8V8U8:
-            return {signExtend(w, 8), signExtend(w >> 8, 8), signExtend(w >> 16, 8), signExtend(w >> 24, 8)};
-        case TexFormat::V16U16:
-            return {signExtend(w, 16), signExtend(w >> 16, 16), 1, 1};
-        default:
-            return {0, 0, 0, 1};
+// FormatInfo::signedBits says so, else over FormatInfo::den (the row's channels:
+// r = U, g = V, b = L or W (else 1), a = Q (else 1); docs/textures.md).
+std::array<int32_t, 4> decodeSigned(const FormatRow& row, uint32_t w) {
+    std::array<int32_t, 4> out{0, 0, 0, 1};
+    if (row.cls != FormatClass::Signed) return out;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        out[c] = ch.kind == ChannelKind::Snorm   ? signExtend(w >> ch.shift, ch.bits)
+                 : ch.kind == ChannelKind::Unorm ? int32_t(fieldOf(ch, w))
+                 : ch.kind == ChannelKind::Zero  ? 0
+                                                 : 1;
     }
+    return out;
 }
 
-Vec4 decodeFloat(TexFormat f, const Texel& t) {
-    Vec4 v = t.value;  // components not written are 0 0 0 1 (testfile.h)
-    if (f == TexFormat::R32F) return {v[0], 1.0f, 1.0f, 1.0f};
-    if (f == TexFormat::A16B16G16R16F)
-        for (float& c : v) c = roundToHalf(c);
+// Float texels of the .ps11test model (components not written are 0 0 0 1, testfile.h): the
+// channels the format has, half-rounded where it stores halves; the others 1.
+Vec4 decodeFloat(const FormatRow& row, const Texel& t) {
+    Vec4 v = t.value;
+    for (size_t c = 0; c < 4; ++c) {
+        const ChannelKind k = row.rgba[c].kind;
+        v[c] = k == ChannelKind::Half    ? roundToHalf(v[c])
+               : k == ChannelKind::Float ? v[c]
+               : k == ChannelKind::Zero  ? 0.0f
+                                         : 1.0f;
+    }
     return v;
 }
 
@@ -242,10 +212,10 @@ bool Texture::layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height
     m_texelCount = total;
     // Unorm8: 4 bytes; Decoded: 16 (float) + 32 (two grids) + 16 (raw while building).
     const uint64_t bytesPerTexel = info.storage == TexelStorage::Unorm8 ? 4 : 64;
-    if (uint64_t(total) * bytesPerTexel > kMaxTextureBytes) {
+    if (uint64_t(total) * bytesPerTexel > kMaxResourceBytes) {
         error = "texture needs " + std::to_string(uint64_t(total) * bytesPerTexel) + " bytes (" +
                 std::to_string(total) + " texels of " + texFormatName(fmt) + "), more than the limit of " +
-                std::to_string(kMaxTextureBytes);
+                std::to_string(kMaxResourceBytes);
         return false;
     }
     return true;
@@ -280,7 +250,7 @@ void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<f
 
 Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
     const FormatInfo info = formatInfo(f);
-    const std::array<int32_t, 4> raw = decodeSigned(f, word);
+    const std::array<int32_t, 4> raw = decodeSigned(formatRow(f), word);
     Vec4 v{0, 0, 0, 1};
     for (size_t c = 0; c < 4; ++c) {
         const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[c], info.signedBits[c])
@@ -293,16 +263,17 @@ Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
 std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error) {
     const TexFormat fmt = desc.format.value;
     const FormatInfo info = formatInfo(fmt);
+    const FormatRow& row = formatRow(fmt);
     const bool volume = desc.isVolume();
     const uint32_t depth = volume ? desc.depth : 1;
     if (desc.width == 0 || desc.height == 0) {
         error = "texture has no size";
         return std::nullopt;
     }
-    if (desc.width > kMaxSurfaceSize || desc.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+    if (desc.width > kMaxTextureSide || desc.height > kMaxTextureSide || depth > kMaxVolumeSide) {
         error = "texture size " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
                 (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
-                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+                std::to_string(kMaxTextureSide) + " per side, depth " + std::to_string(kMaxVolumeSide) + ")";
         return std::nullopt;
     }
     const uint32_t possible = fullMipCount(desc.width, desc.height, depth);
@@ -369,13 +340,13 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode dec
 
     auto store = [&](size_t index, const Texel& x) {
         if (info.storage == TexelStorage::Unorm8) {
-            std::array<uint8_t, 4> b = decodeUnorm8(fmt, x.bits);
+            std::array<uint8_t, 4> b = decodeUnorm8(row, x.bits);
             std::copy(b.begin(), b.end(), t.m_u8.begin() + ptrdiff_t(index * 4));
         } else if (info.floats) {
-            Vec4 v = decodeFloat(fmt, x);
+            Vec4 v = decodeFloat(row, x);
             std::copy(v.begin(), v.end(), rawf.begin() + ptrdiff_t(index * 4));
         } else {
-            std::array<int32_t, 4> r = decodeSigned(fmt, x.bits);
+            std::array<int32_t, 4> r = decodeSigned(row, x.bits);
             std::copy(r.begin(), r.end(), raw.begin() + ptrdiff_t(index * 4));
         }
     };
@@ -425,18 +396,7 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode dec
     return t;
 }
 
-uint32_t bytesPerTexel(TexFormat f) {
-    switch (f) {
-        case TexFormat::A16B16G16R16F:
-            return 8;
-        case TexFormat::A32B32G32R32F:
-            return 16;
-        case TexFormat::R32F:
-            return 4;
-        default:
-            return uint32_t(formatBits(f) / 8);
-    }
-}
+uint32_t bytesPerTexel(TexFormat f) { return formatRow(f).bytes; }
 
 namespace {
 
@@ -452,41 +412,25 @@ inline float loadF32(const uint8_t* p) {
     return f;
 }
 
-// One row of an Unorm8 format into b g r a words (little-endian host: word = 0xAARRGGBB).
-void unorm8Row(TexFormat f, const uint8_t* src, uint32_t width, uint8_t* dst) {
-    switch (f) {
-        case TexFormat::A8R8G8B8:
-            std::memcpy(dst, src, size_t(width) * 4);  // D3D's byte order is the stored order
-            return;
-        case TexFormat::X8R8G8B8:
-            for (uint32_t x = 0; x < width; ++x) {
-                uint32_t w;
-                std::memcpy(&w, src + 4 * x, 4);
-                w |= 0xff000000u;  // X reads 1
-                std::memcpy(dst + 4 * x, &w, 4);
-            }
-            return;
-        case TexFormat::A8:
-            for (uint32_t x = 0; x < width; ++x) {
-                const uint32_t w = uint32_t(src[x]) << 24;
-                std::memcpy(dst + 4 * x, &w, 4);
-            }
-            return;
-        case TexFormat::L8:
-            for (uint32_t x = 0; x < width; ++x) {
-                const uint32_t w = uint32_t(src[x]) * 0x010101u | 0xff000000u;
-                std::memcpy(dst + 4 * x, &w, 4);
-            }
-            return;
-        case TexFormat::A8L8:
-            for (uint32_t x = 0; x < width; ++x) {
-                const uint32_t w = uint32_t(src[2 * x]) * 0x010101u | uint32_t(src[2 * x + 1]) << 24;
-                std::memcpy(dst + 4 * x, &w, 4);
-            }
-            return;
-        default:
-            return;
+// One row of an Unorm8 format into b g r a words: a copy where the format's layout is the stored
+// one (A8R8G8B8), else each stored byte from the texel byte that holds its channel, or a constant.
+void unorm8Row(const FormatRow& row, const uint8_t* src, uint32_t width, uint8_t* dst) {
+    std::array<int, 4> from{};      // per stored byte: the texel byte it copies, or -1
+    std::array<uint8_t, 4> fill{};  // the constant of a byte no texel byte gives
+    bool copy = row.bytes == 4;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        const size_t b = size_t(kUnorm8Byte[c]);
+        from[b] = ch.kind == ChannelKind::Unorm ? ch.shift / 8 : -1;
+        fill[b] = ch.kind == ChannelKind::Zero ? 0 : 255;
+        copy = copy && from[b] == int(b);
     }
+    if (copy) {
+        std::memcpy(dst, src, size_t(width) * 4);  // D3D's byte order is the stored order
+        return;
+    }
+    for (uint32_t x = 0; x < width; ++x, src += row.bytes, dst += 4)
+        for (size_t b = 0; b < 4; ++b) dst[b] = from[b] >= 0 ? src[from[b]] : fill[b];
 }
 
 }  // namespace
@@ -504,10 +448,10 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         error = "texture has no size";
         return std::nullopt;
     }
-    if (l0.width > kMaxSurfaceSize || l0.height > kMaxSurfaceSize || depth > kMaxVolumeDepth) {
+    if (l0.width > kMaxTextureSide || l0.height > kMaxTextureSide || depth > kMaxVolumeSide) {
         error = "texture size " + std::to_string(l0.width) + "x" + std::to_string(l0.height) +
                 (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
-                std::to_string(kMaxSurfaceSize) + " per side, depth " + std::to_string(kMaxVolumeDepth) + ")";
+                std::to_string(kMaxTextureSide) + " per side, depth " + std::to_string(kMaxVolumeSide) + ")";
         return std::nullopt;
     }
     const uint32_t possible = fullMipCount(l0.width, l0.height, depth);
@@ -536,6 +480,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
     }
 
     const FormatInfo info = formatInfo(fmt);
+    const FormatRow& row = formatRow(fmt);
     const size_t total = t.m_texelCount;
     auto forEachRow = [&](auto&& row) {
         for (size_t k = 0; k < levelCount; ++k) {
@@ -550,7 +495,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
     if (info.storage == TexelStorage::Unorm8) {
         t.m_u8.resize(total * 4);
         forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
-            unorm8Row(fmt, src, width, t.m_u8.data() + first * 4);
+            unorm8Row(row, src, width, t.m_u8.data() + first * 4);
         });
         return t;
     }
@@ -562,12 +507,13 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
             float* d = rawf.data() + first * 4;
             for (uint32_t x = 0; x < width; ++x, d += 4) {
                 const uint8_t* p = src + size_t(x) * bpt;
-                if (fmt == TexFormat::R32F) {
-                    d[0] = loadF32(p), d[1] = d[2] = d[3] = 1.0f;
-                } else if (fmt == TexFormat::A16B16G16R16F) {
-                    for (int c = 0; c < 4; ++c) d[c] = halfToFloat(uint16_t(loadLE(p + 2 * c, 2)));
-                } else {
-                    for (int c = 0; c < 4; ++c) d[c] = loadF32(p + 4 * c);
+                for (size_t c = 0; c < 4; ++c) {
+                    const Channel& ch = row.rgba[c];
+                    const uint8_t* q = p + ch.shift / 8;
+                    d[c] = ch.kind == ChannelKind::Float  ? loadF32(q)
+                           : ch.kind == ChannelKind::Half ? halfToFloat(uint16_t(loadLE(q, 2)))
+                           : ch.kind == ChannelKind::Zero ? 0.0f
+                                                          : 1.0f;
                 }
             }
         });
@@ -576,7 +522,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
             int32_t* d = raw.data() + first * 4;
             for (uint32_t x = 0; x < width; ++x, d += 4) {
-                const std::array<int32_t, 4> r = decodeSigned(fmt, loadLE(src + size_t(x) * bpt, bpt));
+                const std::array<int32_t, 4> r = decodeSigned(row, loadLE(src + size_t(x) * bpt, bpt));
                 std::copy(r.begin(), r.end(), d);
             }
         });

@@ -12,21 +12,23 @@
 #include <string>
 #include <vector>
 
+#include "ps11/caps.h"
+#include "ps11/formats.h"
 #include "ps11/hardware.h"
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
 
 namespace ps11 {
 
-// Largest number of bytes one texture may occupy (all levels, all decoded copies). A full
-// 16384 x 16384 A8R8G8B8 level fits; larger requests are refused with an error, never allocated.
-constexpr uint64_t kMaxTextureBytes = uint64_t(1) << 30;
-
 // Grid values of float texels are clamped to +-kMaxTexelGrid (about +-4112 in fx8, far beyond any
 // MaxValue) so that the exact integer sums of the sampler cannot overflow.
 constexpr int32_t kMaxTexelGrid = 1 << 20;
 
-// How a texture keeps its texels.
+// One texture may occupy at most kMaxResourceBytes (ps11/caps.h: all levels, all decoded
+// copies). A full 16384 x 16384 A8R8G8B8 level fits; larger requests are refused with an error,
+// never allocated.
+
+// How a texture keeps its texels (from its format's class, ps11/formats.h).
 enum class TexelStorage : uint8_t {
     Unorm8,   // 4 bytes b g r a per texel (D3D's A8R8G8B8 order), value = byte / 255
               // (A8R8G8B8, X8R8G8B8, A8, L8, A8L8)
@@ -81,7 +83,7 @@ public:
     // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
     // (level k has the extents of level 0 halved k times). The result is the one
     // textureFromDesc gives for the same texels; A8R8G8B8 levels are copied row by row.
-    // On failure returns nullopt and sets `error`; never allocates more than kMaxTextureBytes.
+    // On failure returns nullopt and sets `error`; never allocates more than kMaxResourceBytes.
     // Signed channels decode as `decode` says (the hardware class's rule).
     static std::optional<Texture> fromLevels(TexFormat format, bool volume, const TextureLevelBytes* levels,
                                              size_t levelCount, SignedDecode decode, std::string& error);
@@ -91,7 +93,7 @@ public:
 private:
     friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
     size_t texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const;
-    // Sets format and level extents; false (with `error`) beyond kMaxTextureBytes.
+    // Sets format and level extents; false (with `error`) beyond kMaxResourceBytes.
     bool layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
                 std::string& error);
     // Signed formats: raw channel integers -> values and grids; float formats: the floats -> grids.
@@ -111,7 +113,7 @@ private:
 // Builds a texture from a parsed [texture N] section: texel words in the format's natural
 // packing (docs/test-format.md) or float tuples, `fill`, and `levels 0` (generate the whole chain
 // from level 0). On failure returns nullopt and sets `error`; never allocates more than
-// kMaxTextureBytes. Signed channels decode as `decode` says (the hardware class's rule).
+// kMaxResourceBytes. Signed channels decode as `decode` says (the hardware class's rule).
 std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
 
 // The value of one texel word of a signed (bump) format (V8U8, L6V5U5, X8L8V8U8, Q8W8V8U8,

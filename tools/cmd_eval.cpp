@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "ps11/assembler.h"
+#include "ps11/decoded_program.h"
 #include "ps11/diagnostics.h"
 #include "ps11/executor.h"
 #include "ps11/testfile.h"
@@ -96,10 +97,10 @@ std::string num(double v) {
 struct EvalArgs {
     std::string shader;
     std::array<std::optional<Vec4>, 2> color;
-    std::array<std::optional<Vec4>, 8> texcoord;
-    std::array<std::optional<Vec4>, 8> constant;
-    std::array<std::optional<uint32_t>, 8> texture;  // 1x1 texel word per stage
-    std::array<TexFormat, 8> textureFormat{};        // its format (A8R8G8B8 unless FORMAT: given)
+    std::array<std::optional<Vec4>, kMaxTexCoordSets> texcoord;
+    std::array<std::optional<Vec4>, exec::kNumConsts> constant;
+    std::array<std::optional<uint32_t>, kMaxTextureStages> texture;  // 1x1 texel word per stage
+    std::array<TexFormat, kMaxTextureStages> textureFormat{};        // its format (A8R8G8B8 unless FORMAT: given)
     const HardwareClass* hardware = nullptr;         // null = the default class of the version
     std::optional<Precision> precision;              // overrides the class's profile
     float maxValue = 0;                              // overrides the class's MaxValue (0 = none)
@@ -204,12 +205,12 @@ int cmdEval(const std::vector<std::string>& args) {
     std::unique_ptr<Executor> executor = Executor::create(*program, eo, execDiags);
     std::cerr << execDiags.formatAll();
     if (!executor) return cli::kUserError;
-    for (int c = 0; c < 8; ++c)
+    for (int c = 0; c < exec::kNumConsts; ++c)
         if (ea.constant[c]) executor->setConstant(c, *ea.constant[c]);
 
     TextureSampler sampler;
     sampler.setWeightBits(hw.weightBits);
-    for (int stage = 0; stage < 8; ++stage) {
+    for (int stage = 0; stage < kMaxTextureStages; ++stage) {
         if (!ea.texture[stage]) continue;
         TextureDesc desc;
         desc.stage = stage;
@@ -226,7 +227,7 @@ int cmdEval(const std::vector<std::string>& args) {
         sampler.bind(stage, std::make_shared<const Texture>(std::move(*texture)));
     }
     uint32_t sampled = executor->sampledStages();
-    for (int stage = 0; stage < 8; ++stage)
+    for (int stage = 0; stage < kMaxTextureStages; ++stage)
         if ((sampled & (1u << stage)) && !ea.texture[stage])
             std::cerr << "ps11: eval: note: the shader samples stage " << stage << ", which has no --tex" << stage
                       << "; D3D returns (0, 0, 0, 1) there\n";

@@ -655,11 +655,16 @@ constexpr int kVolumePercent = 30;           // a sampled stage's texture is a v
 constexpr int kMipPercent = 45;              // a mip chain (levels 0 = generated, 2D only; or 2..all given)
 
 using ps11::TexFormat;
-const std::vector<TexFormat> kUnsignedFormats = {TexFormat::A8R8G8B8, TexFormat::X8R8G8B8, TexFormat::A8, TexFormat::L8,
-                                                 TexFormat::A8L8};
-const std::vector<TexFormat> kSignedFormats = {TexFormat::V8U8, TexFormat::L6V5U5, TexFormat::X8L8V8U8,
-                                               TexFormat::Q8W8V8U8, TexFormat::V16U16};
-const std::vector<TexFormat> kFloatFormats = {TexFormat::A16B16G16R16F, TexFormat::A32B32G32R32F, TexFormat::R32F};
+// The texture formats of one class, in ps11::kFormatRows' order.
+std::vector<TexFormat> formatsOf(ps11::FormatClass cls) {
+    std::vector<TexFormat> out;
+    for (size_t i = 0; i < ps11::kTexFormatCount; ++i)
+        if (ps11::kFormatRows[i].cls == cls) out.push_back(TexFormat(i));
+    return out;
+}
+const std::vector<TexFormat> kUnsignedFormats = formatsOf(ps11::FormatClass::Unorm8);
+const std::vector<TexFormat> kSignedFormats = formatsOf(ps11::FormatClass::Signed);
+const std::vector<TexFormat> kFloatFormats = formatsOf(ps11::FormatClass::Float);
 
 const std::vector<std::string> kCompareFuncs = {"never",   "less",     "equal",        "lessequal",
                                                 "greater", "notequal", "greaterequal", "always"};

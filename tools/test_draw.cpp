@@ -205,7 +205,7 @@ bool setUpTransforms(Device& d, const TestFile& file, const std::string& path, s
         return false;
     };
     if (!set(D3DTS_WORLD, t.world) || !set(D3DTS_VIEW, t.view) || !set(D3DTS_PROJECTION, t.projection)) return false;
-    for (int i = 0; i < 8; ++i)
+    for (int i = 0; i < ps11::kMaxTextureStages; ++i)
         if (!set(D3DTRANSFORMSTATETYPE(D3DTS_TEXTURE0 + i), t.texture[size_t(i)])) return false;
     if (t.viewport.isSet()) {
         const Viewport& v = t.viewport.value;

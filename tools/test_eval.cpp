@@ -112,7 +112,7 @@ bool prepare(const TestFile& file, const std::string& path, const Program& progr
     }
     if (opts.verbose) {
         uint32_t sampled = state.executor->sampledStages();
-        for (int stage = 0; stage < 8; ++stage)
+        for (int stage = 0; stage < kMaxTextureStages; ++stage)
             if ((sampled & (1u << stage)) && !file.texture(stage))
                 std::cout << where(path, file.pixelShader.line) << ": note: the shader samples stage " << stage
                           << ", which has no [texture " << stage << "]; D3D returns (0, 0, 0, 1) there\n";
@@ -149,7 +149,7 @@ EvalOutcome evalOnePixel(const Executor& executor, Sampler& sampler, const EvalI
     inputs.quads = false;
     for (int r = 0; r < 2; ++r)
         for (int c = 0; c < 4; ++c) inputs.color[r][c] = in.color[r] ? &(*in.color[r])[c] : nullptr;
-    for (int r = 0; r < 8; ++r)
+    for (int r = 0; r < kMaxTexCoordSets; ++r)
         for (int c = 0; c < 4; ++c) inputs.texcoord[r][c] = in.texture[r] ? &(*in.texture[r])[c] : nullptr;
     EvalOutcome out;
     float depth = 0;
@@ -369,7 +369,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 EvalInputs in;
                 for (int r = 0; r < 2; ++r)
                     if (eval->color[r].isSet()) in.color[r] = &eval->color[r].value;
-                for (int r = 0; r < 8; ++r)
+                for (int r = 0; r < kMaxTexCoordSets; ++r)
                     if (eval->texture[r].isSet()) in.texture[r] = &eval->texture[r].value;
                 if (gl) {
                     if (!glEval) {
@@ -495,7 +495,7 @@ std::optional<EvalOutcome> RendererEval::eval(const EvalInputs& in, std::string&
         for (int r = 0; r < 2; ++r)
             for (int c = 0; c < 4; ++c)
                 sv.attr[size_t((r ? emu::kAttrSpecular : emu::kAttrDiffuse) + c)] = in.color[size_t(r)] ? (*in.color[size_t(r)])[size_t(c)] : 0.0f;
-        for (int t = 0; t < 8; ++t)
+        for (int t = 0; t < kMaxTexCoordSets; ++t)
             for (int c = 0; c < 4; ++c)
                 sv.attr[size_t(emu::attrTex(t, c))] = in.texture[size_t(t)] ? (*in.texture[size_t(t)])[size_t(c)] : 0.0f;
     }

@@ -29,7 +29,7 @@ struct EvalOutcome {
 // Interpolants of one pixel; a null pointer reads as 0.
 struct EvalInputs {
     std::array<const Vec4*, 2> color{};    // v0, v1
-    std::array<const Vec4*, 8> texture{};  // TC[0..7]
+    std::array<const Vec4*, kMaxTexCoordSets> texture{};  // TC[0..7]
 };
 
 // Runs the program for one pixel (one lane, quads = false).
