@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <memory>
+#include <thread>
 
 #include "emu/format.h"
 #include "emu/fullscreen.h"
@@ -17,24 +19,41 @@ float luminance(const uint8_t* p) { return (0.30f * p[0] + 0.59f * p[1] + 0.11f 
 }  // namespace
 
 std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t height, const SensorSettings& s) {
-    std::vector<Sprite> out;
     const uint32_t n = uint32_t(std::max(s.group, 1));
+    const size_t pixels = size_t(width) * height;
+    // Workers: row bands of groups (at least 64 rows each), results joined in order, so the
+    // sprites and every sum are those of one pass in raster order.
+    const uint32_t groupRows = (height + n - 1) / n;
+    const unsigned threads =
+        std::max(1u, std::min({std::thread::hardware_concurrency(), 8u, groupRows * n / 64 + 1, groupRows}));
+    auto inBands = [&](uint32_t rows, const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
+        std::vector<std::thread> pool;
+        for (unsigned t = 1; t < threads; ++t)
+            pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads), t);
+        work(0, uint32_t(uint64_t(rows) / threads), 0);
+        for (std::thread& th : pool) th.join();
+    };
+    // Whether each pixel's sensor fires (its luminance is taken again only where it does).
+    std::vector<uint8_t> fires(pixels);
+    inBands(height, [&](uint32_t y0, uint32_t y1, unsigned) {
+        for (size_t i = size_t(y0) * width; i < size_t(y1) * width; ++i) fires[i] = luminance(&rgba[i * 4]) >= s.threshold;
+    });
     // Cluster blocks first: 8x8 blocks at least 90 % bright.
     const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;
     std::vector<uint8_t> clustered(size_t(cw) * ch, 0);
-    auto addSprite = [&](uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, bool cluster) {
+    auto sprite = [&](uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, bool cluster, std::vector<Sprite>& out) {
         double sl = 0, sx = 0, sy = 0, e[3] = {0, 0, 0};
         for (uint32_t y = y0; y < y1; ++y)
             for (uint32_t x = x0; x < x1; ++x) {
+                const size_t i = size_t(y) * width + x;
+                if (!fires[i]) continue;
                 // A group's pixels inside a cluster block belong to the cluster sprite only.
                 if (!cluster && s.clusters && clustered[size_t(y / 8) * cw + x / 8]) continue;
-                const uint8_t* p = &rgba[(size_t(y) * width + x) * 4];
-                const float l = luminance(p);
-                if (l < s.threshold) continue;
+                const float l = luminance(&rgba[i * 4]);
                 sl += l;
                 sx += double(l) * x;
                 sy += double(l) * y;
-                for (int c = 0; c < 3; ++c) e[c] += p[c] / 255.0;
+                for (int c = 0; c < 3; ++c) e[c] += rgba[i * 4 + size_t(c)] / 255.0;
             }
         if (sl <= 0) return;
         Sprite sp;
@@ -45,23 +64,31 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
         sp.cluster = cluster;
         out.push_back(sp);
     };
+    std::vector<Sprite> out;
     if (s.clusters)
         for (uint32_t by = 0; by < ch; ++by)
             for (uint32_t bx = 0; bx < cw; ++bx) {
                 const uint32_t x0 = bx * 8, y0 = by * 8, x1 = std::min(x0 + 8, width), y1 = std::min(y0 + 8, height);
                 uint32_t bright = 0;
                 for (uint32_t y = y0; y < y1; ++y)
-                    for (uint32_t x = x0; x < x1; ++x) bright += luminance(&rgba[(size_t(y) * width + x) * 4]) >= s.threshold;
+                    for (uint32_t x = x0; x < x1; ++x) bright += fires[size_t(y) * width + x];
                 if (bright * 10 >= 9 * (x1 - x0) * (y1 - y0)) {
                     clustered[size_t(by) * cw + bx] = 1;
-                    addSprite(x0, y0, x1, y1, true);
+                    sprite(x0, y0, x1, y1, true, out);
                 }
             }
-    for (uint32_t y0 = 0; y0 < height; y0 += n)
-        for (uint32_t x0 = 0; x0 < width; x0 += n) {
-            const uint32_t x1 = std::min(x0 + n, width), y1 = std::min(y0 + n, height);
-            addSprite(x0, y0, x1, y1, false);
-        }
+    std::vector<std::vector<Sprite>> bands(threads);
+    inBands(groupRows, [&](uint32_t g0, uint32_t g1, unsigned t) {
+        for (uint32_t y0 = g0 * n; y0 < std::min(g1 * n, height); y0 += n)
+            for (uint32_t x0 = 0; x0 < width; x0 += n) {
+                const uint32_t x1 = std::min(x0 + n, width), y1 = std::min(y0 + n, height);
+                bool any = false;  // most groups of a frame are dark: one look at their mask
+                for (uint32_t y = y0; y < y1 && !any; ++y)
+                    for (uint32_t x = x0; x < x1 && !any; ++x) any = fires[size_t(y) * width + x];
+                if (any) sprite(x0, y0, x1, y1, false, bands[t]);
+            }
+    });
+    for (const std::vector<Sprite>& b : bands) out.insert(out.end(), b.begin(), b.end());
     return out;
 }
 

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <fstream>
 #include <numeric>
+#include <random>
 #include <sstream>
 
 #include "emu/fullscreen.h"
@@ -423,6 +424,86 @@ TEST_CASE("sprites: grouping keeps the total glare energy", "[glare]") {
     noClusters.clusters = false;
     const auto e0 = energy(senseSprites(img.data(), w, h, noClusters));
     for (int c = 0; c < 3; ++c) CHECK(e0[size_t(c)] == Approx(e1[size_t(c)]).epsilon(1e-5));
+}
+
+namespace {
+
+// The sensor step as one pass in raster order, written plainly: what the threaded senseSprites
+// must reproduce sprite for sprite, bit for bit.
+std::vector<Sprite> senseSpritesReference(const uint8_t* rgba, uint32_t width, uint32_t height,
+                                          const SensorSettings& s) {
+    auto luminance = [](const uint8_t* p) { return (0.30f * p[0] + 0.59f * p[1] + 0.11f * p[2]) / 255.0f; };
+    std::vector<Sprite> out;
+    const uint32_t n = uint32_t(std::max(s.group, 1));
+    const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;
+    std::vector<uint8_t> clustered(size_t(cw) * ch, 0);
+    auto addSprite = [&](uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1, bool cluster) {
+        double sl = 0, sx = 0, sy = 0, e[3] = {0, 0, 0};
+        for (uint32_t y = y0; y < y1; ++y)
+            for (uint32_t x = x0; x < x1; ++x) {
+                if (!cluster && s.clusters && clustered[size_t(y / 8) * cw + x / 8]) continue;
+                const uint8_t* p = &rgba[(size_t(y) * width + x) * 4];
+                const float l = luminance(p);
+                if (l < s.threshold) continue;
+                sl += l;
+                sx += double(l) * x;
+                sy += double(l) * y;
+                for (int c = 0; c < 3; ++c) e[c] += p[c] / 255.0;
+            }
+        if (sl <= 0) return;
+        Sprite sp;
+        sp.x = float(sx / sl);
+        sp.y = float(sy / sl);
+        for (int c = 0; c < 3; ++c) sp.energy[c] = float(e[c] * s.strength);
+        sp.radius = cluster ? 2 * s.radius : s.radius;
+        sp.cluster = cluster;
+        out.push_back(sp);
+    };
+    if (s.clusters)
+        for (uint32_t by = 0; by < ch; ++by)
+            for (uint32_t bx = 0; bx < cw; ++bx) {
+                const uint32_t x0 = bx * 8, y0 = by * 8, x1 = std::min(x0 + 8, width), y1 = std::min(y0 + 8, height);
+                uint32_t bright = 0;
+                for (uint32_t y = y0; y < y1; ++y)
+                    for (uint32_t x = x0; x < x1; ++x) bright += luminance(&rgba[(size_t(y) * width + x) * 4]) >= s.threshold;
+                if (bright * 10 >= 9 * (x1 - x0) * (y1 - y0)) {
+                    clustered[size_t(by) * cw + bx] = 1;
+                    addSprite(x0, y0, x1, y1, true);
+                }
+            }
+    for (uint32_t y0 = 0; y0 < height; y0 += n)
+        for (uint32_t x0 = 0; x0 < width; x0 += n) addSprite(x0, y0, std::min(x0 + n, width), std::min(y0 + n, height), false);
+    return out;
+}
+
+}  // namespace
+
+TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites exactly", "[glare]") {
+    std::mt19937 rng(7);
+    for (int round = 0; round < 24; ++round) {
+        const uint32_t w = 1 + rng() % 300, h = 1 + rng() % 260;
+        std::vector<uint8_t> img(size_t(w) * h * 4);
+        const unsigned bright = rng() % 60;  // % of bright pixels, some in 8x8 blocks
+        for (size_t i = 0; i < img.size(); ++i) img[i] = rng() % 100 < bright ? uint8_t(200 + rng() % 56) : uint8_t(rng() % 256);
+        for (int b = 0; b < 4 && w >= 16 && h >= 16; ++b) {
+            const uint32_t bx = rng() % (w - 8), by = rng() % (h - 8);
+            for (uint32_t y = by; y < by + 8; ++y)
+                for (uint32_t x = bx; x < bx + 8; ++x) std::memset(&img[(size_t(y) * w + x) * 4], 255, 4);
+        }
+        SensorSettings s;
+        s.group = 1 + int(rng() % 6);
+        s.clusters = rng() % 3 != 0;
+        s.threshold = 0.3f + float(rng() % 60) / 100.0f;
+        INFO(w << "x" << h << ", group " << s.group << ", clusters " << s.clusters << ", threshold " << s.threshold);
+        const std::vector<Sprite> fast = senseSprites(img.data(), w, h, s), ref = senseSpritesReference(img.data(), w, h, s);
+        REQUIRE(fast.size() == ref.size());
+        for (size_t i = 0; i < ref.size(); ++i) {
+            CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
+            CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
+            CHECK(fast[i].radius == ref[i].radius);
+            CHECK(fast[i].cluster == ref[i].cluster);
+        }
+    }
 }
 
 TEST_CASE("sprites: the drawn glare buffer keeps its energy when pixels are grouped", "[glare]") {
