@@ -128,7 +128,8 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
             const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
             const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
                                            row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
-            alignedVerticalAvx2(hKindOf(cols.w[size_t(x - colBase)]), h0, h1, row.wy, e - x, x - first, out);
+            const HKind kind = run.tabulated ? HKind::H : hKindOf(cols.w[size_t(x - colBase)]);
+            alignedVerticalAvx2(kind, h0, h1, row.wy, e - x, x - first, out);
             x = e;
             continue;
 #endif
@@ -141,6 +142,15 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
     }
 }
 
+// Whether a tabulated slot was built from the same column table as `key` (the slot keeps a copy:
+// the tables it was built from may since have been refilled for another chunk of the draw).
+bool sameTable(const HRowCache::Slot& sl, const HConfig& key) {
+    const size_t n = size_t(key.jhi - key.jlo);
+    if (sl.table.size() != 3 * n) return false;
+    return std::memcmp(sl.table.data(), key.off0, 4 * n) == 0 && std::memcmp(sl.table.data() + n, key.off1, 4 * n) == 0 &&
+           std::memcmp(sl.table.data() + 2 * n, key.w, 4 * n) == 0;
+}
+
 // Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
 // the current pixel row (so every pointer handed out for a row stays valid until the next row),
 // or a new one. `fresh` tells whether it must be filled.
@@ -150,7 +160,7 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
         HRowCache::Slot& sl = *sp;
         const HConfig& k = sl.config;
         if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-            k.jlo == key.jlo && k.jhi == key.jhi) {
+            k.jlo == key.jlo && k.jhi == key.jhi && k.hash == key.hash && (key.wx != -2 || sameTable(sl, key))) {
             sl.stamp = cache.stamp;
             fresh = false;
             return sl;
@@ -182,6 +192,24 @@ void slotPlanes(HRowCache::Slot& sl, int n, int pad, uint16_t* out[4]) {
 void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::array<const uint16_t*, 4>& planes) {
 #if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
     bool fresh = false;
+    if (config.wx == -2) {  // tabulated: straight from the texel row, per column
+        HRowCache::Slot& h = slotFor(cache, row, config, fresh);
+        if (fresh) {
+            const int n = config.jhi - config.jlo;
+            uint16_t* out[4];
+            slotPlanes(h, n, kHRowPad, out);
+            alignedBuildTabulatedAvx2(row, config.off0, config.off1, config.w, n, out);
+            h.table.resize(3 * size_t(n));
+            std::memcpy(h.table.data(), config.off0, 4 * size_t(n));
+            std::memcpy(h.table.data() + n, config.off1, 4 * size_t(n));
+            std::memcpy(h.table.data() + 2 * size_t(n), config.w, 4 * size_t(n));
+            ++cache.built;
+        } else {
+            ++cache.hits;
+        }
+        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        return;
+    }
     const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
     HRowCache::Slot& staged = slotFor(cache, row, stageKey, fresh);
     const int first = config.step * config.jlo + config.phase - config.stageLo;  // staged element of jlo
@@ -348,20 +376,66 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
             }
             x = e;
         }
-        // Texel indices to byte offsets within a row (−1 stays the border).
+        // Tabulated runs over the columns left (a magnified tap: step 0, a weight per column):
+        // at least kMinAlignedRun columns with both texels off the border (or weight 0), filtered
+        // from H rows built per column from the table; one configuration per tap.
+        auto tabOk = [&](int x) {
+            return cols.run[size_t(x)] < 0 && cols.off0[size_t(x)] >= 0 &&
+                   (cols.w[size_t(x)] == 0 || cols.off1[size_t(x)] >= 0);
+        };
+        int tabSlot = -1, tabConfig = -1;
+        for (int x = 0; hasAvx2() && x < n;) {
+            if (!tabOk(x)) {
+                ++x;
+                continue;
+            }
+            int e = x + 1;
+            while (e < n && tabOk(e)) ++e;
+            if (e - x >= kMinAlignedRun && tabSlot < 0 && cols.configCount < kMaxTapConfigs) {
+                HConfig h{tap.texels, -2, 0, 0, out.x0 + x, out.x0 + e, 0, 0};
+                out.configs.push_back(h);
+                tabConfig = int(out.configs.size()) - 1;
+                tabSlot = cols.configCount++;
+                cols.configs[size_t(tabSlot)] = tabConfig;
+            }
+            if (e - x >= kMinAlignedRun && tabSlot >= 0) {
+                HConfig& h = out.configs[size_t(tabConfig)];
+                h.jlo = std::min(h.jlo, out.x0 + x);
+                h.jhi = std::max(h.jhi, out.x0 + e);
+                cols.runs.push_back(AlignedTriangle::Run{out.x0 + x, out.x0 + e, out.x0 + x, tabSlot, true});
+                std::fill(cols.run.begin() + x, cols.run.begin() + e, int32_t(cols.runs.size() - 1));
+            }
+            x = e;
+        }
+        // Texel indices to byte offsets within a row (−1 stays the border). Weight 0 reads only
+        // the first texel: its second becomes the first (the same sum, and tabulated H rows read
+        // both).
         for (int x = 0; x < n; ++x) {
             if (cols.off0[size_t(x)] >= 0) cols.off0[size_t(x)] *= 4;
             if (cols.off1[size_t(x)] >= 0) cols.off1[size_t(x)] *= 4;
+            if (cols.w[size_t(x)] == 0 && cols.off0[size_t(x)] >= 0) cols.off1[size_t(x)] = cols.off0[size_t(x)];
+        }
+        if (tabConfig >= 0) {
+            HConfig& h = out.configs[size_t(tabConfig)];
+            const size_t at = size_t(h.jlo - out.x0), len = size_t(h.jhi - h.jlo);
+            h.off0 = cols.off0.data() + at;
+            h.off1 = cols.off1.data() + at;
+            h.w = cols.w.data() + at;
+            uint64_t hash = 1469598103934665603ull;
+            for (size_t k = 0; k < len; ++k)
+                for (const int32_t v : {h.off0[k], h.off1[k], h.w[k]}) hash = (hash ^ uint32_t(v)) * 1099511628211ull;
+            h.hash = hash;
         }
     }
     // Each texture's staged range: the texels every configuration on it reads.
     for (HConfig& h : out.configs) {
+        if (h.wx == -2) continue;  // tabulated: read straight from the texel rows
         h.stageLo = h.step * h.jlo + h.phase;
         h.stageHi = h.step * (h.jhi - 1) + h.phase + 1 + (h.wx != 0);
     }
     for (HConfig& h : out.configs)
         for (const HConfig& o : out.configs)
-            if (o.texels == h.texels)
+            if (o.texels == h.texels && h.wx != -2 && o.wx != -2)
                 h.stageLo = std::min(h.stageLo, o.stageLo), h.stageHi = std::max(h.stageHi, o.stageHi);
     // Run starts relative to their H row's first element, now that the ranges are final.
     for (int i = 0; i < draw.plan.count; ++i) {

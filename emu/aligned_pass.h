@@ -68,6 +68,15 @@ struct HConfig {
     // Texels [stageLo, stageHi) of the row: what every configuration on this texture reads,
     // deinterleaved once per texel row and shared by them.
     int32_t stageLo = 0, stageHi = 0;
+    // Tabulated configuration (step = 0, wx = −2): element j is absolute column jlo + j of one
+    // tap's column table, H = (256 − w)·T[off0] + w·T[off1] with that column's pair and weight
+    // (a magnified tap: consecutive columns share texels and weights change every column).
+    // off0/off1/w point at column jlo of the tap's tables (byte offsets); `hash` is of their
+    // contents over [jlo, jhi): slots compare contents, so triangles with equal tables share rows.
+    const int32_t* off0 = nullptr;
+    const int32_t* off1 = nullptr;
+    const int32_t* w = nullptr;
+    uint64_t hash = 0;
 };
 
 struct AlignedTriangle {
@@ -76,6 +85,7 @@ struct AlignedTriangle {
         int32_t x0 = 0, x1 = 0;  // absolute columns [x0, x1)
         int32_t j0 = 0;          // element of column x0 in the config's H row (from jlo)
         int32_t config = 0;      // index into the tap's configs
+        bool tabulated = false;  // a tabulated configuration's run (H rows of kind H whatever the weight)
     };
     struct Columns {
         std::vector<int32_t> off0, off1, w;
@@ -107,6 +117,7 @@ struct HRowCache {
         uint64_t stamp = 0;            // the pixel row that last used it (slots in use are never evicted)
         int32_t stride = 0;            // elements per plane
         std::vector<uint16_t> data;
+        std::vector<int32_t> table;  // tabulated configuration: its off0, off1, w over [jlo, jhi)
     };
     std::vector<std::unique_ptr<Slot>> slots;
     uint64_t serial = 0;  // the draw the slots belong to

@@ -121,6 +121,49 @@ void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx,
         }
 }
 
+void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
+                               uint16_t* const out[4]) {
+    static constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a within a b g r a word
+    // Per channel: byte of a to bits 0-7 of each dword, byte of b to bits 16-23 (pmaddwd pairs).
+    __m256i selA[4], selB[4];
+    for (int c = 0; c < 4; ++c) {
+        alignas(32) int8_t ma[32], mb[32];
+        for (int i = 0; i < 32; ++i) {
+            const int k = i & ~3, pos = i & 3;
+            ma[i] = pos == 0 ? int8_t(k % 16 + kByte[c]) : int8_t(-128);
+            mb[i] = pos == 2 ? int8_t(k % 16 + kByte[c]) : int8_t(-128);
+        }
+        selA[c] = loadu(ma);
+        selB[c] = loadu(mb);
+    }
+    const __m256i zero = _mm256_setzero_si256(), w256 = _mm256_set1_epi32(256);
+    const int* base = reinterpret_cast<const int*>(row);
+    int j = 0;
+    for (; j + 16 <= n; j += 16) {
+        __m256i m[2][4];
+        for (int h = 0; h < 2; ++h) {
+            const int k = j + 8 * h;
+            const __m256i i0 = _mm256_max_epi32(loadu(off0 + k), zero), i1 = _mm256_max_epi32(loadu(off1 + k), zero);
+            const __m256i a = _mm256_i32gather_epi32(base, i0, 1), b = _mm256_i32gather_epi32(base, i1, 1);
+            const __m256i wv = loadu(w + k);
+            const __m256i wp = _mm256_or_si256(_mm256_sub_epi32(w256, wv), _mm256_slli_epi32(wv, 16));
+            for (int c = 0; c < 4; ++c)
+                m[h][c] = _mm256_madd_epi16(
+                    _mm256_or_si256(_mm256_shuffle_epi8(a, selA[c]), _mm256_shuffle_epi8(b, selB[c])), wp);
+        }
+        for (int c = 0; c < 4; ++c)
+            storeu(out[c] + j, _mm256_permute4x64_epi64(_mm256_packus_epi32(m[0][c], m[1][c]), 0xD8));
+    }
+    for (; j < n; ++j) {
+        uint32_t a, b;
+        std::memcpy(&a, row + std::max(off0[j], 0), 4);
+        std::memcpy(&b, row + std::max(off1[j], 0), 4);
+        for (int c = 0; c < 4; ++c)
+            out[c][j] = uint16_t(((a >> (8 * kByte[c])) & 0xffu) * uint32_t(256 - w[j]) +
+                                 ((b >> (8 * kByte[c])) & 0xffu) * uint32_t(w[j]));
+    }
+}
+
 namespace {
 
 // One group of 16 lanes of every channel: f(c, k) gives the vector of channel c at element k.

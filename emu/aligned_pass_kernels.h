@@ -37,6 +37,12 @@ void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[
 // last one read.
 void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
 
+// Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b the
+// channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets; negative
+// offsets read texel 0: such elements are never used).
+void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
+                               uint16_t* const out[4]);
+
 // Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of kind
 // `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
 void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
