@@ -144,11 +144,16 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
 
 // Whether a tabulated slot was built from the same column table as `key` (the slot keeps a copy:
 // the tables it was built from may since have been refilled for another chunk of the draw).
-bool sameTable(const HRowCache::Slot& sl, const HConfig& key) {
+bool sameTable(HRowCache::Slot& sl, const HConfig& key) {
+    for (const uint64_t id : sl.tables)
+        if (id == key.tableId) return true;
     const size_t n = size_t(key.jhi - key.jlo);
     if (sl.table.size() != 3 * n) return false;
-    return std::memcmp(sl.table.data(), key.off0, 4 * n) == 0 && std::memcmp(sl.table.data() + n, key.off1, 4 * n) == 0 &&
-           std::memcmp(sl.table.data() + 2 * n, key.w, 4 * n) == 0;
+    const bool same = std::memcmp(sl.table.data(), key.off0, 4 * n) == 0 &&
+                      std::memcmp(sl.table.data() + n, key.off1, 4 * n) == 0 &&
+                      std::memcmp(sl.table.data() + 2 * n, key.w, 4 * n) == 0;
+    if (same) sl.tables[sl.nextTable++ % sl.tables.size()] = key.tableId;  // compared once per table
+    return same;
 }
 
 // Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
@@ -157,7 +162,7 @@ bool sameTable(const HRowCache::Slot& sl, const HConfig& key) {
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, bool& fresh) {
     HRowCache::Slot* victim = nullptr;
     for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
-        HRowCache::Slot& sl = *sp;
+        HRowCache::Slot& sl = *sp;  // (sameTable may note a table id)
         const HConfig& k = sl.config;
         if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
             k.jlo == key.jlo && k.jhi == key.jhi && k.hash == key.hash && (key.wx != -2 || sameTable(sl, key))) {
@@ -203,6 +208,8 @@ void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::arra
             std::memcpy(h.table.data(), config.off0, 4 * size_t(n));
             std::memcpy(h.table.data() + n, config.off1, 4 * size_t(n));
             std::memcpy(h.table.data() + 2 * size_t(n), config.w, 4 * size_t(n));
+            h.tables = {config.tableId, 0, 0, 0};
+            h.nextTable = 1;
             ++cache.built;
         } else {
             ++cache.hits;
@@ -425,6 +432,8 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
             for (size_t k = 0; k < len; ++k)
                 for (const int32_t v : {h.off0[k], h.off1[k], h.w[k]}) hash = (hash ^ uint32_t(v)) * 1099511628211ull;
             h.hash = hash;
+            static std::atomic<uint64_t> tableIds{0};
+            h.tableId = ++tableIds;
         }
     }
     // Each texture's staged range: the texels every configuration on it reads.

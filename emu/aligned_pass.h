@@ -77,6 +77,7 @@ struct HConfig {
     const int32_t* off1 = nullptr;
     const int32_t* w = nullptr;
     uint64_t hash = 0;
+    uint64_t tableId = 0;  // unique per prepared table (a slot that checked it needs no second look)
 };
 
 struct AlignedTriangle {
@@ -118,6 +119,8 @@ struct HRowCache {
         int32_t stride = 0;            // elements per plane
         std::vector<uint16_t> data;
         std::vector<int32_t> table;  // tabulated configuration: its off0, off1, w over [jlo, jhi)
+        std::array<uint64_t, 4> tables{};  // tableIds known equal to `table` (round robin)
+        uint32_t nextTable = 0;
     };
     std::vector<std::unique_ptr<Slot>> slots;
     uint64_t serial = 0;  // the draw the slots belong to
