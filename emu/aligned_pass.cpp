@@ -142,30 +142,16 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
     }
 }
 
-// Whether a tabulated slot was built from the same column table as `key` (the slot keeps a copy:
-// the tables it was built from may since have been refilled for another chunk of the draw).
-bool sameTable(HRowCache::Slot& sl, const HConfig& key) {
-    for (const uint64_t id : sl.tables)
-        if (id == key.tableId) return true;
-    const size_t n = size_t(key.jhi - key.jlo);
-    if (sl.table.size() != 3 * n) return false;
-    const bool same = std::memcmp(sl.table.data(), key.off0, 4 * n) == 0 &&
-                      std::memcmp(sl.table.data() + n, key.off1, 4 * n) == 0 &&
-                      std::memcmp(sl.table.data() + 2 * n, key.w, 4 * n) == 0;
-    if (same) sl.tables[sl.nextTable++ % sl.tables.size()] = key.tableId;  // compared once per table
-    return same;
-}
-
 // Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
 // the current pixel row (so every pointer handed out for a row stays valid until the next row),
 // or a new one. `fresh` tells whether it must be filled.
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, bool& fresh) {
     HRowCache::Slot* victim = nullptr;
     for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
-        HRowCache::Slot& sl = *sp;  // (sameTable may note a table id)
+        HRowCache::Slot& sl = *sp;
         const HConfig& k = sl.config;
         if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-            k.jlo == key.jlo && k.jhi == key.jhi && k.hash == key.hash && (key.wx != -2 || sameTable(sl, key))) {
+            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == key.tableId) {
             sl.stamp = cache.stamp;
             fresh = false;
             return sl;
@@ -204,12 +190,6 @@ void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::arra
             uint16_t* out[4];
             slotPlanes(h, n, kHRowPad, out);
             alignedBuildTabulatedAvx2(row, config.off0, config.off1, config.w, n, out);
-            h.table.resize(3 * size_t(n));
-            std::memcpy(h.table.data(), config.off0, 4 * size_t(n));
-            std::memcpy(h.table.data() + n, config.off1, 4 * size_t(n));
-            std::memcpy(h.table.data() + 2 * size_t(n), config.w, 4 * size_t(n));
-            h.tables = {config.tableId, 0, 0, 0};
-            h.nextTable = 1;
             ++cache.built;
         } else {
             ++cache.hits;
@@ -489,6 +469,30 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         cache.serial = draw.serial;
     }
     std::array<const uint16_t*, 4> planes{};
+    // Tabulated configurations: a triangle whose table equals an earlier one's over the same
+    // columns takes that one's id, so their H rows are shared (a full-screen quad's two halves).
+    std::array<std::array<uint64_t, 8 * kMaxTapConfigs>, kMaxAlignedTriangles> tabIds{};
+    for (size_t ti = 0; ti < count && ti < kMaxAlignedTriangles; ++ti) {
+        const std::vector<HConfig>& cs = tris[ti]->configs;
+        for (size_t c = 0; c < cs.size() && c < tabIds[ti].size(); ++c) {
+            const HConfig& h = cs[c];
+            tabIds[ti][c] = h.tableId;
+            if (h.wx != -2) continue;
+            const size_t n = size_t(h.jhi - h.jlo);
+            for (size_t tj = 0; tj < ti && tabIds[ti][c] == h.tableId; ++tj) {
+                const std::vector<HConfig>& os = tris[tj]->configs;
+                for (size_t oc = 0; oc < os.size() && oc < tabIds[tj].size(); ++oc) {
+                    const HConfig& o = os[oc];
+                    if (o.wx == -2 && o.texels == h.texels && o.jlo == h.jlo && o.jhi == h.jhi && o.hash == h.hash &&
+                        std::memcmp(o.off0, h.off0, 4 * n) == 0 && std::memcmp(o.off1, h.off1, 4 * n) == 0 &&
+                        std::memcmp(o.w, h.w, 4 * n) == 0) {
+                        tabIds[ti][c] = tabIds[tj][oc];
+                        break;
+                    }
+                }
+            }
+        }
+    }
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them).
     for (int y = y0; y < y1; ++y) {
@@ -511,7 +515,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 for (int c = 0; c < cols.configCount; ++c) {
                     r.ready[size_t(c)] = rowsOk;
                     if (!rowsOk) continue;
-                    const HConfig& h = tri.configs[size_t(cols.configs[size_t(c)])];
+                    const size_t ci = size_t(cols.configs[size_t(c)]);
+                    HConfig h = tri.configs[ci];
+                    if (ti < kMaxAlignedTriangles && ci < tabIds[ti].size()) h.tableId = tabIds[ti][ci];
                     hRow(cache, r.row0, h, planes);
                     for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
                     if (r.wy != 0) {

@@ -72,7 +72,8 @@ struct HConfig {
     // tap's column table, H = (256 − w)·T[off0] + w·T[off1] with that column's pair and weight
     // (a magnified tap: consecutive columns share texels and weights change every column).
     // off0/off1/w point at column jlo of the tap's tables (byte offsets); `hash` is of their
-    // contents over [jlo, jhi): slots compare contents, so triangles with equal tables share rows.
+    // contents over [jlo, jhi). Slots match by tableId; drawAlignedRows gives triangles whose
+    // tables are equal the id of the first (they share rows).
     const int32_t* off0 = nullptr;
     const int32_t* off1 = nullptr;
     const int32_t* w = nullptr;
@@ -118,9 +119,6 @@ struct HRowCache {
         uint64_t stamp = 0;            // the pixel row that last used it (slots in use are never evicted)
         int32_t stride = 0;            // elements per plane
         std::vector<uint16_t> data;
-        std::vector<int32_t> table;  // tabulated configuration: its off0, off1, w over [jlo, jhi)
-        std::array<uint64_t, 4> tables{};  // tableIds known equal to `table` (round robin)
-        uint32_t nextTable = 0;
     };
     std::vector<std::unique_ptr<Slot>> slots;
     uint64_t serial = 0;  // the draw the slots belong to
