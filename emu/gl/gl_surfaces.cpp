@@ -37,6 +37,17 @@ bool clientFormatOf(bool native, const FormatInfo& f, GLenum& format, GLenum& ty
     return false;
 }
 
+// `fbo` bound for drawing with `tex` as its only colour target, every channel written.
+void drawInto(const GlFunctions& gl, GLuint fbo, GLuint tex) {
+    gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, fbo);
+    gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
+    gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
+    const GLenum buffers[1] = {GL_COLOR_ATTACHMENT0};
+    gl.DrawBuffers(1, buffers);
+    gl.ColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
 const char* kStretchFragment = R"(#version 450 core
 // Exact StretchRect of A8R8G8B8: the taps of emu/blit.h, bytes summed in double in its order and
 // rounded once (ties to even).
@@ -399,13 +410,7 @@ bool GlRenderer::stretchRect(GlSpace& space, const StretchCall& call) {
         Resident& d = st.resident(space, call.dest);
         gl.BindFramebuffer(GL_READ_FRAMEBUFFER, st.readFbo);
         gl.FramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, s.tex, 0);
-        gl.BindFramebuffer(GL_DRAW_FRAMEBUFFER, st.fbo);
-        gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d.tex, 0);
-        gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
-        gl.FramebufferTexture2D(GL_DRAW_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
-        const GLenum buffers[1] = {GL_COLOR_ATTACHMENT0};
-        gl.DrawBuffers(1, buffers);
-        gl.ColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        drawInto(gl, st.fbo, d.tex);
         gl.Disable(GL_SCISSOR_TEST);
         gl.BlitFramebuffer(GLint(sr.x0), GLint(sr.y0), GLint(sr.x1), GLint(sr.y1), GLint(dr.x0), GLint(dr.y0),
                            GLint(dr.x1), GLint(dr.y1), GL_COLOR_BUFFER_BIT,
@@ -455,13 +460,7 @@ bool GlRenderer::stretchRect(GlSpace& space, const StretchCall& call) {
     gl.Uniform1i(gl.GetUniformLocation(st.stretchProgram, "uLinear"), call.linear ? 1 : 0);
     gl.Uniform4f(gl.GetUniformLocation(st.stretchProgram, "uXform"), 2.0f / float(d.width), -2.0f / float(d.height),
                  -1.0f, 1.0f);
-    gl.BindFramebuffer(GL_FRAMEBUFFER, st.fbo);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, d.tex, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, 0, 0);
-    gl.FramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_TEXTURE_2D, 0, 0);
-    const GLenum buffers[1] = {GL_COLOR_ATTACHMENT0};
-    gl.DrawBuffers(1, buffers);
-    gl.ColorMaski(0, GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    drawInto(gl, st.fbo, d.tex);
     gl.Disable(GL_BLEND);
     gl.Disable(GL_DEPTH_TEST);
     gl.ClipControl(GL_UPPER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
