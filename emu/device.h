@@ -182,6 +182,9 @@ private:
     void markWritten(Resource& r, uint32_t level);
     // The renderer wrote a level in its copy (the front's image is stale until syncLevel).
     void rendererWrote(Resource& r, uint32_t level);
+    // Called before anything writes a resource's levels (the front, a renderer, a lock): drops
+    // the sampler's view and gives the levels a copy if a texture still reads them in place.
+    void prepareWrite(Resource& r);
     // Brings the front's image of a level (or of every level) up to date with the renderer's copy.
     void syncLevel(Resource& r, uint32_t level);
     void syncResource(Resource& r);

@@ -56,6 +56,7 @@ HRESULT Device::GetRenderTargetData(Handle renderTarget, Handle destSurface) {
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "GetRenderTargetData: a surface is locked");
     syncLevel(*src, srcRef.level);  // the read-back of a renderer that keeps copies
+    prepareWrite(*dst);
     const size_t row = size_t(s->width) * s->format->bytes;
     for (uint32_t y = 0; y < s->height; ++y) std::copy_n(s->texel(0, y), row, d->texel(0, y));
     markWritten(*dst, dstRef.level);
@@ -115,6 +116,7 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     sc.linear = filter == D3DTEXF_LINEAR;
     sc.fixedPoint = ps11::isFixedPoint(m_hardware.precision);
     sc.decode = m_hardware.hardware->signedDecode;
+    prepareWrite(*dst);
     if (m_renderer->stretchRect(sc)) {
         rendererWrote(*dst, dstRef.level);
         return D3D_OK;
@@ -220,6 +222,8 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
         cc.depth = surfaceDesc(dsRef, *ds);
     }
     if (boxes.empty()) return D3D_OK;
+    if (target) prepareWrite(*rt);
+    if (depth) prepareWrite(*ds);
     if (m_renderer->clear(cc)) {
         if (target) rendererWrote(*rt, rtRef.level);
         if (depth) rendererWrote(*ds, dsRef.level);

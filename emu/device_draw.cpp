@@ -412,6 +412,8 @@ std::optional<CallError> Device::submit(DrawSetup& d, DrawStats& stats) {
     if (d.depth) call.depthSurface = surfaceDesc(d.dsRef, *d.ds);
     if (m_renderer->keepsCopies())
         call.textureView = [this](int stage) { return sampledTexture(m_state.textures[size_t(stage)]); };
+    prepareWrite(*d.rt);
+    if (d.depth) prepareWrite(*d.ds);
     CallError error;
     if (!m_renderer->draw(call, stats, error)) return error;
     if (stats.trianglesDrawn) {

@@ -334,6 +334,7 @@ HRESULT Device::GetSurfaceLevel(Handle texture, UINT level, Handle* surface) {
 
 void Device::regenerateMips(Resource& r) {
     syncResource(r);
+    prepareWrite(r);
     generateMips(r);
     for (uint32_t l = 1; l < r.levels.size(); ++l) markWritten(r, l);
     r.mipsDirty = false;
@@ -365,8 +366,16 @@ SurfaceDesc Device::surfaceDesc(const SurfaceRef& ref, Resource& r) {
     return d;
 }
 
+void Device::prepareWrite(Resource& r) {
+    // The sampler's view is stale once the write lands. A texture reading the levels in place
+    // that is still held elsewhere keeps the bytes it was made from: the levels move to a copy.
+    if (r.sampled && r.sampled->readsInPlace()) r.sampled.reset();
+    if (r.storeShared()) detachStore(r);
+}
+
 void Device::syncLevel(Resource& r, uint32_t level) {
     if (level >= r.rendererNewer.size() || !r.rendererNewer[level]) return;
+    prepareWrite(r);
     m_renderer->readBack(surfaceDesc(SurfaceRef{r.handle, level}, r));
     r.rendererNewer[level] = 0;
 }
@@ -405,6 +414,8 @@ HRESULT Device::lockLevel(const char* call, Handle owner, Resource& r, uint32_t 
         x0 = box->Left, y0 = box->Top, z0 = box->Front;
     }
     syncLevel(r, level);  // the locked bytes are the newest contents
+    // Even a read-only lock: no buffer may move while a pointer into it is handed out.
+    prepareWrite(r);
     r.locked[level] = 1;
     r.lockedReadOnly[level] = (flags & D3DLOCK_READONLY) ? 1 : 0;
     out->RowPitch = int32_t(im.rowPitch);
@@ -516,8 +527,10 @@ std::shared_ptr<const ps11::Texture> Device::makeSampled(Handle texture, CallErr
     if (r->sampled && r->sampledGeneration == r->generation) return r->sampled;
     syncResource(*r);
     std::string why;
+    // A locked level's bytes may change under the texture: it gets a copy then.
+    const bool locked = std::find(r->locked.begin(), r->locked.end(), 1) != r->locked.end();
     try {
-        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, why);
+        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, locked, why);
     } catch (const std::bad_alloc&) {
         r->sampled = nullptr;
         why = "out of memory";

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
@@ -115,8 +116,22 @@ uint64_t resourceBytes(const FormatInfo& f, uint32_t width, uint32_t height, uin
     return total;
 }
 
+void ImageBytes::assign(size_t n, uint8_t v) {
+    view(std::make_shared<uint8_t[]>(n, v), 0, n);
+}
+
+void ImageBytes::copyFrom(const ImageBytes& o) {
+    if (!o.m_data) {
+        *this = ImageBytes{};
+        return;
+    }
+    assign(o.m_size, 0);
+    std::memcpy(m_data, o.m_data, m_size);
+}
+
 void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels) {
     r.levels.resize(levels);
+    size_t total = 0;
     for (uint32_t k = 0; k < levels; ++k) {
         Image& im = r.levels[k];
         im.format = r.format;
@@ -125,7 +140,14 @@ void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth
         im.depth = extentAt(depth, k);
         im.rowPitch = rowPitchOf(*r.format, im.width);
         im.slicePitch = uint64_t(im.rowPitch) * im.height;
-        im.bytes.assign(size_t(im.slicePitch * im.depth), 0);
+        total += size_t(im.slicePitch * im.depth);
+    }
+    std::shared_ptr<uint8_t[]> store = std::make_shared<uint8_t[]>(total);
+    size_t offset = 0;
+    for (Image& im : r.levels) {
+        const size_t n = size_t(im.slicePitch * im.depth);
+        im.bytes.view(store, offset, n);
+        offset += n;
     }
     r.locked.assign(levels, 0);
     r.lockedReadOnly.assign(levels, 0);
@@ -137,17 +159,28 @@ void generateMips(Resource& r) {
     r.mipsDirty = false;
 }
 
-std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode,
+void detachStore(Resource& r) {
+    if (r.levels.empty()) return;
+    const std::shared_ptr<uint8_t[]> old = r.store();
+    size_t total = 0;
+    for (const Image& im : r.levels) total += im.bytes.size();
+    std::shared_ptr<uint8_t[]> store(new uint8_t[total]);  // every byte copied below
+    std::memcpy(store.get(), old.get(), total);
+    for (Image& im : r.levels) im.bytes.view(store, size_t(im.bytes.data() - old.get()), im.bytes.size());
+}
+
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode, bool copy,
                                                        std::string& error) {
-    // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): a row copy
-    // for A8R8G8B8, a per-texel expansion for the other formats. No transient per-texel model.
+    // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): read in
+    // place for A8R8G8B8, a per-texel expansion for the other formats. No transient per-texel model.
     std::vector<ps11::TextureLevelBytes> levels(r.levels.size());
     for (size_t k = 0; k < r.levels.size(); ++k) {
         const Image& im = r.levels[k];
         levels[k] = {im.width, im.height, im.depth, im.bytes.data(), im.rowPitch, size_t(im.slicePitch)};
     }
     std::optional<ps11::Texture> t = ps11::Texture::fromLevels(
-        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), decode, error);
+        r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), decode, error,
+        copy || r.levels.empty() ? std::shared_ptr<const void>{} : std::shared_ptr<const void>(r.store()));
     if (!t) return nullptr;
     return std::make_shared<const ps11::Texture>(std::move(*t));
 }

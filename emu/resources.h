@@ -15,6 +15,51 @@
 
 namespace emu {
 
+// The bytes of one image. A standalone image owns them (assign; a copy is a deep copy); a
+// resource's levels are views into the resource's one buffer (allocateLevels), which a sampled
+// texture may share (makeSampledTexture reads A8R8G8B8 levels in place).
+class ImageBytes {
+public:
+    ImageBytes() = default;
+    ImageBytes(const ImageBytes& o) { copyFrom(o); }
+    ImageBytes& operator=(const ImageBytes& o) {
+        if (this != &o) copyFrom(o);
+        return *this;
+    }
+    ImageBytes(ImageBytes&& o) noexcept { *this = std::move(o); }
+    ImageBytes& operator=(ImageBytes&& o) noexcept {
+        m_store = std::move(o.m_store);
+        m_data = o.m_data, m_size = o.m_size;
+        o.m_data = nullptr, o.m_size = 0;
+        return *this;
+    }
+
+    // Owns n fresh bytes of value v.
+    void assign(size_t n, uint8_t v);
+    // Views n bytes at `offset` of a shared buffer.
+    void view(std::shared_ptr<uint8_t[]> store, size_t offset, size_t n) {
+        m_store = std::move(store);
+        m_data = m_store.get() + offset, m_size = n;
+    }
+    const std::shared_ptr<uint8_t[]>& store() const { return m_store; }
+
+    uint8_t* data() { return m_data; }
+    const uint8_t* data() const { return m_data; }
+    size_t size() const { return m_size; }
+    uint8_t* begin() { return m_data; }
+    uint8_t* end() { return m_data + m_size; }
+    const uint8_t* begin() const { return m_data; }
+    const uint8_t* end() const { return m_data + m_size; }
+    uint8_t& operator[](size_t i) { return m_data[i]; }
+    const uint8_t& operator[](size_t i) const { return m_data[i]; }
+
+private:
+    void copyFrom(const ImageBytes& o);
+    std::shared_ptr<uint8_t[]> m_store;
+    uint8_t* m_data = nullptr;
+    size_t m_size = 0;
+};
+
 // One mip level or one standalone surface: texels in the format's D3D layout, rows `rowPitch`
 // bytes apart, slices `slicePitch` bytes apart.
 struct Image {
@@ -22,7 +67,7 @@ struct Image {
     uint32_t width = 0, height = 0, depth = 1;
     uint32_t rowPitch = 0;
     uint64_t slicePitch = 0;
-    std::vector<uint8_t> bytes;
+    ImageBytes bytes;
 
     uint8_t* texel(uint32_t x, uint32_t y, uint32_t z = 0) {
         return bytes.data() + z * slicePitch + size_t(y) * rowPitch + size_t(x) * format->bytes;
@@ -58,6 +103,11 @@ struct Resource {
     uint64_t sampledGeneration = ~uint64_t(0);
     std::shared_ptr<const ps11::Texture> sampled;  // the sampler's view (see Device::sampledTexture)
 
+    // The one buffer all levels view (allocateLevels).
+    const std::shared_ptr<uint8_t[]>& store() const { return levels.front().bytes.store(); }
+    // Whether something besides the levels holds the buffer (a texture reading it in place).
+    bool storeShared() const { return !levels.empty() && store().use_count() > long(levels.size()); }
+
     bool autoGenMips() const { return (usage & D3DUSAGE_AUTOGENMIPMAP) != 0; }
     bool isRenderTarget() const { return (usage & D3DUSAGE_RENDERTARGET) != 0; }
     bool isDepthStencil() const { return (usage & D3DUSAGE_DEPTHSTENCIL) != 0; }
@@ -85,13 +135,16 @@ using ps11::kMaxVolumeSide;
 uint32_t rowPitchOf(const FormatInfo& f, uint32_t width);
 // Bytes of a whole resource (all levels) without allocating anything.
 uint64_t resourceBytes(const FormatInfo& f, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels);
-// Allocates the levels (zero-filled). May throw std::bad_alloc.
+// Allocates the levels (zero-filled), one buffer viewed by every level. May throw std::bad_alloc.
 void allocateLevels(Resource& r, uint32_t width, uint32_t height, uint32_t depth, uint32_t levels);
 // Regenerates levels 1.. from level 0 with a 2x2 (2x2x2) box filter rounded half-even in the
 // stored representation, the rule ps11/texture.cpp uses for generated chains.
 void generateMips(Resource& r);
+// Gives the levels a private copy of their buffer (before a write while a texture reads it).
+void detachStore(Resource& r);
 // Builds the sampler's immutable texture from the stored levels; nullptr and `error` on failure.
-std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode,
+// A8R8G8B8 textures read the levels in place, sharing the buffer (unless `copy`).
+std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode, bool copy,
                                                        std::string& error);
 
 }  // namespace emu

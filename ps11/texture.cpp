@@ -179,7 +179,7 @@ Vec4 Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
     size_t i = texelIndex(level, x, y, z) * 4;
     Vec4 v;
     for (size_t c = 0; c < 4; ++c)
-        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[m_u8[i + size_t(kUnorm8Byte[c])]] : m_value[i + c];
+        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[unorm8()[i + size_t(kUnorm8Byte[c])]] : m_value[i + c];
     return v;
 }
 
@@ -188,7 +188,7 @@ std::array<int32_t, 4> Texture::texelGrid(int level, uint32_t x, uint32_t y, uin
     std::array<int32_t, 4> g{};
     int32_t scale = gridScale(p) / 255;
     for (size_t c = 0; c < 4; ++c)
-        g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(m_u8[i + size_t(kUnorm8Byte[c])]) * scale : grid(p)[i + c];
+        g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(unorm8()[i + size_t(kUnorm8Byte[c])]) * scale : grid(p)[i + c];
     return g;
 }
 
@@ -436,7 +436,8 @@ void unorm8Row(const FormatRow& row, const uint8_t* src, uint32_t width, uint8_t
 }  // namespace
 
 std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const TextureLevelBytes* levels,
-                                           size_t levelCount, SignedDecode decode, std::string& error) {
+                                           size_t levelCount, SignedDecode decode, std::string& error,
+                                           std::shared_ptr<const void> owner) {
     static_assert(std::endian::native == std::endian::little, "Unorm8 words are stored little endian");
     if (levelCount == 0 || !levels) {
         error = "texture has no levels";
@@ -493,6 +494,19 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         }
     };
     if (info.storage == TexelStorage::Unorm8) {
+        // In place: D3D's A8R8G8B8 word is the stored b g r a order, and the levels follow each
+        // other exactly at the texture's own texel offsets.
+        bool inPlace = owner && fmt == TexFormat::A8R8G8B8;
+        for (size_t k = 0; inPlace && k < levelCount; ++k) {
+            const TextureLevelInfo& li = t.m_levels[k];
+            const TextureLevelBytes& lb = levels[k];
+            inPlace = lb.data == levels[0].data + li.offset * 4 && lb.rowPitch == size_t(li.width) * 4 &&
+                      (li.depth == 1 || lb.slicePitch == lb.rowPitch * li.height);
+        }
+        if (inPlace) {
+            t.m_u8view = std::shared_ptr<const uint8_t>(std::move(owner), levels[0].data);
+            return t;
+        }
         t.m_u8.resize(total * 4);
         forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
             unorm8Row(row, src, width, t.m_u8.data() + first * 4);

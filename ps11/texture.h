@@ -2,12 +2,14 @@
 // decoded per channel so that every precision profile reads exact values (8-bit channels as
 // bytes, signed and float formats as per-profile grid integers and float32). Built from the
 // .ps11test model by textureFromDesc() or from levels in D3D's memory layout by
-// Texture::fromLevels() (the device's hand-over); immutable afterwards, shared by samplers.
+// Texture::fromLevels() (the device's hand-over, which samples A8R8G8B8 levels where they are);
+// immutable afterwards, shared by samplers.
 #pragma once
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -71,7 +73,7 @@ public:
 
     // Raw arrays for the sampler, 4 entries per texel, indexed by level offset + texel: Unorm8 as
     // b g r a bytes (kUnorm8Byte), Decoded as r g b a.
-    const uint8_t* unorm8() const { return m_u8.data(); }   // Unorm8
+    const uint8_t* unorm8() const { return m_u8view ? m_u8view.get() : m_u8.data(); }  // Unorm8
     const float* values() const { return m_value.data(); }  // Decoded
     const int32_t* grid(Precision p) const {                // Decoded, fx
         return p == Precision::Fx12 ? m_grid12.data() : m_grid8.data();
@@ -81,12 +83,20 @@ public:
 
     // Builds a texture from every level of a mip chain in D3D's memory layout (the device's
     // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
-    // (level k has the extents of level 0 halved k times). The result is the one
-    // textureFromDesc gives for the same texels; A8R8G8B8 levels are copied row by row.
+    // (level k has the extents of level 0 halved k times). The result reads as the one
+    // textureFromDesc gives for the same texels.
+    // A8R8G8B8 levels laid out exactly as the texture keeps them (one buffer, rows of width * 4
+    // bytes, level after level with no gap) are not copied when `owner` is given: the texture
+    // reads them where they are and keeps `owner` alive; the caller must not change those bytes
+    // while the texture is in use (emu's device copies them first: Device::prepareWrite). Other
+    // levels are copied (A8R8G8B8 row by row) or decoded.
     // On failure returns nullopt and sets `error`; never allocates more than kMaxResourceBytes.
     // Signed channels decode as `decode` says (the hardware class's rule).
     static std::optional<Texture> fromLevels(TexFormat format, bool volume, const TextureLevelBytes* levels,
-                                             size_t levelCount, SignedDecode decode, std::string& error);
+                                             size_t levelCount, SignedDecode decode, std::string& error,
+                                             std::shared_ptr<const void> owner = {});
+    // Whether the texels are read where fromLevels found them (no copy).
+    bool readsInPlace() const { return m_u8view != nullptr; }
     // The rule the signed channels were decoded with (Snorm for textures without them).
     SignedDecode signedDecode() const { return m_signedDecode; }
 
@@ -106,6 +116,7 @@ private:
     std::vector<TextureLevelInfo> m_levels;
     size_t m_texelCount = 0;
     std::vector<uint8_t> m_u8;
+    std::shared_ptr<const uint8_t> m_u8view;  // fromLevels' levels, read in place (owner kept)
     std::vector<float> m_value;
     std::vector<int32_t> m_grid8, m_grid12;
 };

@@ -1195,3 +1195,91 @@ TEST_CASE("device: every E41xx code in emu/ is documented", "[device][docs]") {
     INFO("undocumented codes: " << list);
     CHECK(missing.empty());
 }
+
+TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never changes", "[device]") {
+    Device dev;
+    auto fill = [&](Handle tex, UINT level, uint32_t word) {
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(tex, level, &lr, nullptr, 0) == D3D_OK);
+        D3DSURFACE_DESC desc{};
+        REQUIRE(dev.GetLevelDesc(tex, level, &desc) == D3D_OK);
+        for (UINT y = 0; y < desc.Height; ++y)
+            for (UINT x = 0; x < desc.Width; ++x)
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + x * 4, &word, 4);
+        REQUIRE(dev.UnlockRect(tex, level) == D3D_OK);
+    };
+    auto red = [](const std::shared_ptr<const ps11::Texture>& t, int level) {
+        return int(std::lround(t->texelValue(level, 0, 0)[0] * 255.0f));
+    };
+
+    SECTION("a mip chain is read where it is; X8R8G8B8 and A8 are copied") {
+        Handle tex{}, x8{}, a8{};
+        REQUIRE(dev.CreateTexture(8, 4, 0, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+        for (UINT l = 0; l < 4; ++l) fill(tex, l, 0xFF000000u | ((10u + l) << 16));
+        auto t = dev.sampledTexture(tex);
+        REQUIRE(t);
+        CHECK(t->readsInPlace());
+        for (int l = 0; l < 4; ++l) CHECK(red(t, l) == 10 + l);
+        REQUIRE(dev.CreateTexture(4, 4, 1, 0, D3DFMT_X8R8G8B8, D3DPOOL_MANAGED, &x8) == D3D_OK);
+        fill(x8, 0, 0x00FF0000u);  // alpha byte 0: the sampler must read 1
+        auto tx = dev.sampledTexture(x8);
+        REQUIRE(tx);
+        CHECK_FALSE(tx->readsInPlace());
+        CHECK(tx->texelValue(0, 0, 0)[3] == 1.0f);
+        REQUIRE(dev.CreateTexture(4, 4, 1, 0, D3DFMT_A8, D3DPOOL_MANAGED, &a8) == D3D_OK);
+        CHECK_FALSE(dev.sampledTexture(a8)->readsInPlace());
+    }
+
+    SECTION("every write leaves a view someone holds as it was") {
+        Handle tex{}, level{}, src{};
+        REQUIRE(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &tex) == D3D_OK);
+        REQUIRE(dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK);
+        src = makeTarget(dev, 4, 4, [](UINT, UINT) { return 0xFF330000u; });
+        REQUIRE(dev.SetRenderTarget(0, level) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xFF010000u, 1.0f, 0) == D3D_OK);
+        auto v1 = dev.sampledTexture(tex);
+        REQUIRE(v1);
+        CHECK(v1->readsInPlace());
+        CHECK(red(v1, 0) == 1);
+        // Clear, StretchRect and a lock each write the level while v1 is held.
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xFF020000u, 1.0f, 0) == D3D_OK);
+        CHECK(red(v1, 0) == 1);
+        auto v2 = dev.sampledTexture(tex);
+        CHECK(red(v2, 0) == 2);
+        REQUIRE(dev.StretchRect(src, nullptr, level, nullptr, D3DTEXF_POINT) == D3D_OK);
+        CHECK(red(v1, 0) == 1);
+        CHECK(red(v2, 0) == 2);
+        auto v3 = dev.sampledTexture(tex);
+        CHECK(red(v3, 0) == 0x33);
+        // A draw into the level (a clear-coloured quad through the fixed function's diffuse).
+        struct V { float x, y, z, rhw; DWORD c; };
+        const V quad[4] = {{-0.5f, -0.5f, 0, 1, 0xFF440000u}, {3.5f, -0.5f, 0, 1, 0xFF440000u},
+                           {-0.5f, 3.5f, 0, 1, 0xFF440000u}, {3.5f, 3.5f, 0, 1, 0xFF440000u}};
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+        CHECK(red(v3, 0) == 0x33);
+        CHECK(red(dev.sampledTexture(tex), 0) == 0x44);
+    }
+
+    SECTION("a lock after the view was made, then a write to another level") {
+        Handle tex{};
+        REQUIRE(dev.CreateTexture(4, 4, 2, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+        fill(tex, 0, 0xFF050000u);
+        fill(tex, 1, 0xFF060000u);
+        auto v = dev.sampledTexture(tex);
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(tex, 1, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+        fill(tex, 0, 0xFF070000u);  // level 0 written while level 1 stays locked
+        CHECK(static_cast<const uint8_t*>(lr.pBits)[2] == 6);
+        REQUIRE(dev.UnlockRect(tex, 1) == D3D_OK);
+        CHECK(red(v, 0) == 5);
+        auto w = dev.sampledTexture(tex);
+        CHECK(red(w, 0) == 7);
+        CHECK(red(w, 1) == 6);
+        // Released while held: the view keeps its bytes alive.
+        REQUIRE(dev.Release(tex) == D3D_OK);
+        CHECK(red(w, 0) == 7);
+    }
+}

@@ -1123,11 +1123,11 @@ TEST_CASE("merger: writesNothing only when no pixel can change the target", "[me
     Image img = makeImage(D3DFMT_A32B32G32R32F, 16, 1);
     const float d[4] = {-0.0f, INFINITY, 0.5f, -3.0f};
     std::memcpy(img.texel(0, 0), d, 16);
-    const std::vector<uint8_t> before = img.bytes;
+    const std::vector<uint8_t> before(img.bytes.begin(), img.bytes.end());
     Span span(1);
     span.setColor(0, {INFINITY, NAN, -INFINITY, 1.0f});
     run(st, span, &img);
-    CHECK(img.bytes == before);
+    CHECK(std::vector<uint8_t>(img.bytes.begin(), img.bytes.end()) == before);
 }
 
 TEST_CASE("merger: null live means every lane; null z reads 0", "[merger]") {
