@@ -63,6 +63,17 @@ public:
     emu::Handle outputTexture() const { return m_output; }
     std::optional<emu::RgbaImage> readOutput(std::string& error);
     std::optional<emu::RgbaImage> readTexture(emu::Handle texture, std::string& error);
+    // Level 0 of a render-target texture as the application sees it: GetRenderTargetData into a
+    // SYSTEMMEM surface the runner keeps (one per size and format), locked read-only while `use`
+    // looks at it (D3D's layout, `pitch` bytes a row). False with `error` if a call fails or `use`
+    // returns false.
+    struct Pixels {
+        const uint8_t* data = nullptr;
+        uint32_t width = 0, height = 0;
+        size_t pitch = 0;
+        D3DFORMAT format = D3DFMT_UNKNOWN;
+    };
+    bool readPixels(emu::Handle texture, const std::function<bool(const Pixels&)>& use, std::string& error);
 
     // A pixel shader of glare/shaders by file name, assembled and validated on first use.
     emu::Handle shader(const std::string& file, std::string& error);
@@ -79,6 +90,8 @@ private:
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
     std::string m_persistentError;
+    emu::Handle m_readBack{};  // readPixels' SYSTEMMEM surface
+    D3DSURFACE_DESC m_readBackDesc{};
     std::string m_lastGraphviz;
 };
 

@@ -1,10 +1,16 @@
 #include "glare/sprites.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <functional>
 #include <memory>
 #include <thread>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "emu/format.h"
 #include "emu/fullscreen.h"
@@ -15,28 +21,71 @@ namespace glare {
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-float luminance(const uint8_t* p) { return (0.30f * p[0] + 0.59f * p[1] + 0.11f * p[2]) / 255.0f; }
+// A pixel's luminance from its r, g, b bytes; the sensors fire where it reaches the threshold.
+float luminance(uint32_t r, uint32_t g, uint32_t b) { return (0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b)) / 255.0f; }
+
+// The number of bits set in each byte value (no POPCNT on the baseline x86-64).
+constexpr auto kBitsSet = [] {
+    std::array<uint8_t, 256> t{};
+    for (int i = 0; i < 256; ++i) t[size_t(i)] = uint8_t(std::popcount(unsigned(i)));
+    return t;
+}();
+
+// Sets bit x of `fires` where luminance(pixel x of the row) >= threshold, over one row of `width`
+// pixels, each a 32-bit word whose bytes at bit shifts rs, 8 and bs are r, g and b. The same float
+// operations in the same order as luminance(), four pixels at a time where SSE2 is there (every
+// x86-64). `fires` holds (width + 63) / 64 words, zero on entry.
+void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float threshold, uint64_t* fires) {
+    uint32_t x = 0;
+#if defined(__SSE2__)
+    const __m128i m = _mm_set1_epi32(0xff);
+    const __m128 kr = _mm_set1_ps(0.30f), kg = _mm_set1_ps(0.59f), kb = _mm_set1_ps(0.11f);
+    const __m128 k255 = _mm_set1_ps(255.0f), t = _mm_set1_ps(threshold);
+    const __m128i sr = _mm_cvtsi32_si128(rs), sb = _mm_cvtsi32_si128(bs);
+    for (; x + 4 <= width; x += 4) {
+        const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + size_t(x) * 4));
+        const __m128 r = _mm_cvtepi32_ps(_mm_and_si128(_mm_srl_epi32(w, sr), m));
+        const __m128 g = _mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, 8), m));
+        const __m128 b = _mm_cvtepi32_ps(_mm_and_si128(_mm_srl_epi32(w, sb), m));
+        const __m128 l = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(kr, r), _mm_mul_ps(kg, g)), _mm_mul_ps(kb, b)), k255);
+        fires[x / 64] |= uint64_t(_mm_movemask_ps(_mm_cmpge_ps(l, t))) << (x % 64);
+    }
+#endif
+    for (; x < width; ++x) {
+        const uint8_t* p = row + size_t(x) * 4;
+        if (luminance(p[rs / 8], p[1], p[bs / 8]) >= threshold) fires[x / 64] |= uint64_t(1) << (x % 64);
+    }
+}
 }  // namespace
 
 std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t height, const SensorSettings& s) {
+    return senseSprites(SensorFrame{rgba, width, height, size_t(width) * 4, false}, s);
+}
+
+std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) {
+    const uint32_t width = f.width, height = f.height;
     const uint32_t n = uint32_t(std::max(s.group, 1));
-    const size_t pixels = size_t(width) * height;
-    // Workers: row bands of groups (at least 64 rows each), results joined in order, so the
-    // sprites and every sum are those of one pass in raster order.
-    const uint32_t groupRows = (height + n - 1) / n;
-    const unsigned threads =
-        std::max(1u, std::min({std::thread::hardware_concurrency(), 8u, groupRows * n / 64 + 1, groupRows}));
-    auto inBands = [&](uint32_t rows, const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
+    const int rs = f.bgra ? 16 : 0, bs = f.bgra ? 0 : 16;  // bit shifts of r and b in a pixel's word
+    auto pixel = [&](uint32_t x, uint32_t y) { return f.data + size_t(y) * f.pitch + size_t(x) * 4; };
+    auto lum = [&](const uint8_t* p) { return luminance(p[rs / 8], p[1], p[bs / 8]); };
+    // Workers: row bands (at least 64 rows each), results joined in order, so the sprites and
+    // every sum are those of one pass in raster order.
+    auto inBands = [&](uint32_t rows, uint32_t rowsPerItem, const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
+        const unsigned threads =
+            std::max(1u, std::min({std::thread::hardware_concurrency(), 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
         std::vector<std::thread> pool;
         for (unsigned t = 1; t < threads; ++t)
             pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads), t);
         work(0, uint32_t(uint64_t(rows) / threads), 0);
         for (std::thread& th : pool) th.join();
     };
-    // Whether each pixel's sensor fires (its luminance is taken again only where it does).
-    std::vector<uint8_t> fires(pixels);
-    inBands(height, [&](uint32_t y0, uint32_t y1, unsigned) {
-        for (size_t i = size_t(y0) * width; i < size_t(y1) * width; ++i) fires[i] = luminance(&rgba[i * 4]) >= s.threshold;
+    // Whether each pixel's sensor fires, one bit a pixel (its luminance is taken again only where
+    // it does): dark stretches of a frame are skipped 64 pixels at a time.
+    const size_t wpr = (size_t(width) + 63) / 64;
+    std::vector<uint64_t> fires(wpr * height, 0);
+    auto fired = [&](uint32_t x, uint32_t y) { return (fires[size_t(y) * wpr + x / 64] >> (x % 64)) & 1; };
+    inBands(height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
+        for (uint32_t y = y0; y < y1; ++y) fireRow(pixel(0, y), width, rs, bs, s.threshold, &fires[size_t(y) * wpr]);
     });
     // Cluster blocks first: 8x8 blocks at least 90 % bright.
     const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;
@@ -45,15 +94,16 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
         double sl = 0, sx = 0, sy = 0, e[3] = {0, 0, 0};
         for (uint32_t y = y0; y < y1; ++y)
             for (uint32_t x = x0; x < x1; ++x) {
-                const size_t i = size_t(y) * width + x;
-                if (!fires[i]) continue;
+                if (!fired(x, y)) continue;
                 // A group's pixels inside a cluster block belong to the cluster sprite only.
                 if (!cluster && s.clusters && clustered[size_t(y / 8) * cw + x / 8]) continue;
-                const float l = luminance(&rgba[i * 4]);
+                const uint8_t* p = pixel(x, y);
+                const float l = lum(p);
                 sl += l;
                 sx += double(l) * x;
                 sy += double(l) * y;
-                for (int c = 0; c < 3; ++c) e[c] += rgba[i * 4 + size_t(c)] / 255.0;
+                const uint8_t rgb[3] = {p[rs / 8], p[1], p[bs / 8]};
+                for (int c = 0; c < 3; ++c) e[c] += rgb[c] / 255.0;
             }
         if (sl <= 0) return;
         Sprite sp;
@@ -65,30 +115,52 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
         out.push_back(sp);
     };
     std::vector<Sprite> out;
-    if (s.clusters)
-        for (uint32_t by = 0; by < ch; ++by)
-            for (uint32_t bx = 0; bx < cw; ++bx) {
-                const uint32_t x0 = bx * 8, y0 = by * 8, x1 = std::min(x0 + 8, width), y1 = std::min(y0 + 8, height);
-                uint32_t bright = 0;
-                for (uint32_t y = y0; y < y1; ++y)
-                    for (uint32_t x = x0; x < x1; ++x) bright += fires[size_t(y) * width + x];
-                if (bright * 10 >= 9 * (x1 - x0) * (y1 - y0)) {
-                    clustered[size_t(by) * cw + bx] = 1;
-                    sprite(x0, y0, x1, y1, true, out);
+    std::vector<std::vector<Sprite>> bands(8);
+    auto join = [&] {
+        for (std::vector<Sprite>& b : bands) {
+            out.insert(out.end(), b.begin(), b.end());
+            b.clear();
+        }
+    };
+    if (s.clusters) {
+        inBands(ch, 8, [&](uint32_t b0, uint32_t b1, unsigned t) {
+            for (uint32_t by = b0; by < b1; ++by) {
+                const uint32_t y0 = by * 8, y1 = std::min(y0 + 8, height);
+                for (uint32_t bx = 0; bx < cw; ++bx) {
+                    const uint32_t x0 = bx * 8, x1 = std::min(x0 + 8, width);
+                    uint32_t bright = 0;  // bits past the row's end are never set
+                    for (uint32_t y = y0; y < y1; ++y)
+                        bright += kBitsSet[(fires[size_t(y) * wpr + x0 / 64] >> (x0 % 64)) & 0xffu];
+                    if (bright * 10 >= 9 * (x1 - x0) * (y1 - y0)) {
+                        clustered[size_t(by) * cw + bx] = 1;
+                        sprite(x0, y0, x1, y1, true, bands[t]);
+                    }
                 }
             }
-    std::vector<std::vector<Sprite>> bands(threads);
-    inBands(groupRows, [&](uint32_t g0, uint32_t g1, unsigned t) {
-        for (uint32_t y0 = g0 * n; y0 < std::min(g1 * n, height); y0 += n)
-            for (uint32_t x0 = 0; x0 < width; x0 += n) {
-                const uint32_t x1 = std::min(x0 + n, width), y1 = std::min(y0 + n, height);
-                bool any = false;  // most groups of a frame are dark: one look at their mask
-                for (uint32_t y = y0; y < y1 && !any; ++y)
-                    for (uint32_t x = x0; x < x1 && !any; ++x) any = fires[size_t(y) * width + x];
-                if (any) sprite(x0, y0, x1, y1, false, bands[t]);
+        });
+        join();
+    }
+    // Groups in raster order: per band of n rows, the groups holding a set bit of the rows' OR.
+    const uint32_t groupRows = (height + n - 1) / n;
+    inBands(groupRows, n, [&](uint32_t g0, uint32_t g1, unsigned t) {
+        for (uint32_t y0 = g0 * n; y0 < std::min(g1 * n, height); y0 += n) {
+            const uint32_t y1 = std::min(y0 + n, height);
+            uint32_t next = 0;  // the first column of the next group not yet taken
+            for (size_t k = 0; k < wpr; ++k) {
+                uint64_t any = 0;
+                for (uint32_t y = y0; y < y1; ++y) any |= fires[size_t(y) * wpr + k];
+                while (any) {
+                    const uint32_t x = uint32_t(k * 64) + uint32_t(std::countr_zero(any));
+                    any &= any - 1;
+                    if (x < next) continue;
+                    const uint32_t x0 = x / n * n;
+                    next = x0 + n;
+                    sprite(x0, y0, std::min(next, width), y1, false, bands[t]);
+                }
             }
+        }
     });
-    for (const std::vector<Sprite>& b : bands) out.insert(out.end(), b.begin(), b.end());
+    join();
     return out;
 }
 
@@ -193,6 +265,19 @@ public:
                       b.write(list);
                   },
                   [=](PassContext& c) {
+                      // 8-bit frames are sensed where the read-back left them; float frames
+                      // (ideal) through the runner's 8-bit conversion.
+                      D3DSURFACE_DESC desc{};
+                      if (!c.check(c.device.GetLevelDesc(c.texture(scene), 0, &desc))) return false;
+                      if (desc.Format == D3DFMT_A8R8G8B8 || desc.Format == D3DFMT_X8R8G8B8)
+                          return runner->readPixels(
+                              c.texture(scene),
+                              [&](const Runner::Pixels& px) {
+                                  *sprites = senseSprites(SensorFrame{px.data, px.width, px.height, px.pitch, true}, ss);
+                                  c.stats.pixels += uint64_t(px.width) * px.height;
+                                  return true;
+                              },
+                              c.error);
                       std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
                       if (!img) return false;
                       *sprites = senseSprites(img->rgba.data(), img->width, img->height, ss);

@@ -3,6 +3,7 @@
 // runs on the device side; its grouping is exposed here for tests.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -23,10 +24,21 @@ struct SensorSettings {
     float radius = 32;       // sprite radius in pixels (cluster sprites: twice)
 };
 
-// The sprites of an RGBA8 frame (rows top to bottom, rgba bytes). Grouping: a group's sprite sits
+// A frame of 8-bit pixels for the sensors: rows top to bottom, `pitch` bytes apart, 4 bytes a
+// pixel in r g b a order, or b g r a (D3D's A8R8G8B8 and X8R8G8B8 as they sit in memory).
+struct SensorFrame {
+    const uint8_t* data = nullptr;
+    uint32_t width = 0, height = 0;
+    size_t pitch = 0;
+    bool bgra = false;
+};
+
+// The sprites of a frame. Grouping: a group's sprite sits
 // at the luminance-weighted centre of its firing pixels, Σ L_i p_i / Σ L_i, and carries the sum of
 // their colours, so its energy equals that of the N² single-pixel sprites it replaces. A cluster
 // sprite has twice the radius (four times the area) and carries the same sum.
+std::vector<Sprite> senseSprites(const SensorFrame& frame, const SensorSettings& s);
+// The same over tight rgba rows.
 std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t height, const SensorSettings& s);
 
 // The glare image (size x size, values in [0, 1], peak 1 at the centre): radial streaks plus a halo.
