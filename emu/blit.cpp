@@ -3,6 +3,7 @@
 #include "emu/blit.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -21,9 +22,12 @@ int64_t floorDiv(int64_t n, int64_t d) {
 }
 
 uint8_t toUnorm8(double v) {
-    // Nearest 8-bit value, ties to even (docs/precision.md "Outputs").
+    // Nearest 8-bit value, ties to even (docs/precision.md "Outputs"); NaN stores 0.
+    if (std::isnan(v)) return 0;
+    // x in [0, 255]: adding and subtracting 1.5 * 2^52 rounds it to an integer, ties to even, in
+    // the default rounding mode (what nearbyint does, without the library call).
     const double x = std::clamp(v, 0.0, 1.0) * 255.0;
-    return uint8_t(std::nearbyint(x));
+    return uint8_t((x + 6755399441055744.0) - 6755399441055744.0);
 }
 
 PixelBox meet(const PixelBox& a, const PixelBox& b) {
@@ -137,6 +141,41 @@ void stretchImages(const StretchCall& call) {
         for (int64_t j = 0; j < dh; ++j)
             std::memmove(d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j)), s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j)),
                          row);
+        return;
+    }
+    // Fast path: an unscaled copy of 8-bit b g r a words into A32B32G32R32F (the ideal profile's
+    // float targets) stores each byte's value float(b / 255), what store() makes of it.
+    if (sw == dw && sh == dh && unormSource && sf.bytes == 4 && df.format == D3DFMT_A32B32G32R32F) {
+        static const std::array<float, 256> value = [] {
+            std::array<float, 256> t{};
+            for (size_t b = 0; b < 256; ++b) t[b] = float(double(b) / 255.0);
+            return t;
+        }();
+        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+        for (int64_t j = 0; j < dh; ++j) {
+            const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
+            uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
+            for (int64_t i = 0; i < dw; ++i, in += 4, out += 16) {
+                const float v[4] = {value[in[2]], value[in[1]], value[in[0]], x8 ? 1.0f : value[in[3]]};
+                std::memcpy(out, v, 16);
+            }
+        }
+        return;
+    }
+    // Fast path: an unscaled copy of A32B32G32R32F into 8-bit b g r a words (the ideal
+    // profile's float frame into an 8-bit output): store()'s rounding, channel by channel.
+    if (sw == dw && sh == dh && sf.format == D3DFMT_A32B32G32R32F && df.cls == FormatClass::Unorm8 && df.bytes == 4) {
+        const bool x8 = df.format == D3DFMT_X8R8G8B8;
+        for (int64_t j = 0; j < dh; ++j) {
+            const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
+            uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
+            for (int64_t i = 0; i < dw; ++i, in += 16, out += 4) {
+                float v[4];
+                std::memcpy(v, in, 16);
+                out[0] = toUnorm8(v[2]), out[1] = toUnorm8(v[1]), out[2] = toUnorm8(v[0]);
+                out[3] = x8 ? 0xFF : toUnorm8(v[3]);
+            }
+        }
         return;
     }
     // Fast path: an exact 2:1 LINEAR reduction of A8R8G8B8/X8R8G8B8 has f = 1/2 on both axes

@@ -219,6 +219,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 }
                 flush();
             }
+            // The draw's textures are not kept alive past it: a texture read in place would
+            // otherwise be copied on its next write (Device::prepareWrite).
+            for (int s = 0; s < kMaxSamplers; ++s) sampler.bind(s, nullptr);
             ws.pixelsCovered += as.pixels;
             ws.pixelsShaded = es.pixels + as.exec.pixels;
             ws.instructions = es.instructions + as.exec.instructions;

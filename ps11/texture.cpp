@@ -179,7 +179,7 @@ Vec4 Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
     size_t i = texelIndex(level, x, y, z) * 4;
     Vec4 v;
     for (size_t c = 0; c < 4; ++c)
-        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[unorm8()[i + size_t(kUnorm8Byte[c])]] : m_value[i + c];
+        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[unorm8()[i + size_t(kUnorm8Byte[c])]] : values()[i + c];
     return v;
 }
 
@@ -221,31 +221,43 @@ bool Texture::layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height
     return true;
 }
 
-void Texture::finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf, SignedDecode decode) {
+void Texture::finishDecoded(const std::vector<int32_t>& raw, std::vector<float>&& rawf, SignedDecode decode) {
     m_signedDecode = decode;
     const FormatInfo info = formatInfo(m_format);
+    if (info.floats) {
+        m_value = std::move(rawf);  // the grids follow on first use (grid())
+        return;
+    }
     const size_t n = m_texelCount * 4;
     m_value.resize(n);
-    m_grid8.resize(n);
-    m_grid12.resize(n);
+    Grids& g = *m_grids;
+    g.g8.resize(n);
+    g.g12.resize(n);
     for (size_t i = 0; i < n; ++i) {
         const size_t c = i & 3;
-        if (info.floats) {
-            float v = rawf[i];
-            m_value[i] = v;
-            auto g = [v](Precision p) { return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid); };
-            m_grid8[i] = g(Precision::Fx8);
-            m_grid12[i] = g(Precision::Fx12);
-        } else {
-            // docs/precision.md "Signed texels": the class's rational num/den; fx grids
-            // round_half_even(num*G/den), exact.
-            const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[i], info.signedBits[c])
-                                                      : SignedValue{raw[i], info.den[c]};
-            m_value[i] = float(double(sv.num) / double(sv.den));
-            m_grid8[i] = int32_t(roundHalfEven(sv.num * 255, sv.den));
-            m_grid12[i] = int32_t(roundHalfEven(sv.num * 4080, sv.den));
-        }
+        // docs/precision.md "Signed texels": the class's rational num/den; fx grids
+        // round_half_even(num*G/den), exact.
+        const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[i], info.signedBits[c])
+                                                  : SignedValue{raw[i], info.den[c]};
+        m_value[i] = float(double(sv.num) / double(sv.den));
+        g.g8[i] = int32_t(roundHalfEven(sv.num * 255, sv.den));
+        g.g12[i] = int32_t(roundHalfEven(sv.num * 4080, sv.den));
     }
+}
+
+const int32_t* Texture::grid(Precision p) const {
+    Grids& g = *m_grids;
+    const bool fx12 = p == Precision::Fx12;
+    std::vector<int32_t>& out = fx12 ? g.g12 : g.g8;
+    if (formatInfo(m_format).floats)
+        std::call_once(fx12 ? g.once12 : g.once8, [&] {
+            const Precision q = fx12 ? Precision::Fx12 : Precision::Fx8;
+            const float* v = values();
+            out.resize(m_texelCount * 4);
+            for (size_t i = 0; i < out.size(); ++i)
+                out[i] = std::clamp(toGrid(double(v[i]), q), -kMaxTexelGrid, kMaxTexelGrid);
+        });
+    return out.data();
 }
 
 Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
@@ -392,7 +404,7 @@ std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode dec
         }
     }
 
-    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, rawf, decode);
+    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, std::move(rawf), decode);
     return t;
 }
 
@@ -493,20 +505,27 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
                         li.offset + (size_t(z) * li.height + y) * li.width);
         }
     };
+    // In place: D3D's A8R8G8B8 word is the stored b g r a order and A32B32G32R32F's four floats
+    // the stored r g b a values, when the levels follow each other exactly at the texture's own
+    // texel offsets.
+    const size_t inPlaceBytes = fmt == TexFormat::A8R8G8B8 ? 4 : fmt == TexFormat::A32B32G32R32F ? 16 : 0;
+    bool inPlace = owner && inPlaceBytes && (inPlaceBytes == 4 || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
+    for (size_t k = 0; inPlace && k < levelCount; ++k) {
+        const TextureLevelInfo& li = t.m_levels[k];
+        const TextureLevelBytes& lb = levels[k];
+        inPlace = lb.data == levels[0].data + li.offset * inPlaceBytes && lb.rowPitch == size_t(li.width) * inPlaceBytes &&
+                  (li.depth == 1 || lb.slicePitch == lb.rowPitch * li.height);
+    }
+    if (inPlace && inPlaceBytes == 4) {
+        t.m_u8view = std::shared_ptr<const uint8_t>(std::move(owner), levels[0].data);
+        return t;
+    }
+    if (inPlace) {
+        t.m_signedDecode = decode;
+        t.m_valueView = std::shared_ptr<const float>(std::move(owner), reinterpret_cast<const float*>(levels[0].data));
+        return t;
+    }
     if (info.storage == TexelStorage::Unorm8) {
-        // In place: D3D's A8R8G8B8 word is the stored b g r a order, and the levels follow each
-        // other exactly at the texture's own texel offsets.
-        bool inPlace = owner && fmt == TexFormat::A8R8G8B8;
-        for (size_t k = 0; inPlace && k < levelCount; ++k) {
-            const TextureLevelInfo& li = t.m_levels[k];
-            const TextureLevelBytes& lb = levels[k];
-            inPlace = lb.data == levels[0].data + li.offset * 4 && lb.rowPitch == size_t(li.width) * 4 &&
-                      (li.depth == 1 || lb.slicePitch == lb.rowPitch * li.height);
-        }
-        if (inPlace) {
-            t.m_u8view = std::shared_ptr<const uint8_t>(std::move(owner), levels[0].data);
-            return t;
-        }
         t.m_u8.resize(total * 4);
         forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
             unorm8Row(row, src, width, t.m_u8.data() + first * 4);
@@ -541,7 +560,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
             }
         });
     }
-    t.finishDecoded(raw, rawf, decode);
+    t.finishDecoded(raw, std::move(rawf), decode);
     return t;
 }
 

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,10 +75,10 @@ public:
     // Raw arrays for the sampler, 4 entries per texel, indexed by level offset + texel: Unorm8 as
     // b g r a bytes (kUnorm8Byte), Decoded as r g b a.
     const uint8_t* unorm8() const { return m_u8view ? m_u8view.get() : m_u8.data(); }  // Unorm8
-    const float* values() const { return m_value.data(); }  // Decoded
-    const int32_t* grid(Precision p) const {                // Decoded, fx
-        return p == Precision::Fx12 ? m_grid12.data() : m_grid8.data();
-    }
+    const float* values() const { return m_valueView ? m_valueView.get() : m_value.data(); }  // Decoded
+    // Decoded, fx. Float formats compute a profile's grid from the values on its first use (a
+    // float texture sampled only by float profiles never needs one); thread-safe.
+    const int32_t* grid(Precision p) const;
     // Float32 of byte b (b / 255), shared by all Unorm8 textures.
     static const float* unorm8Values();
 
@@ -85,8 +86,9 @@ public:
     // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
     // (level k has the extents of level 0 halved k times). The result reads as the one
     // textureFromDesc gives for the same texels.
-    // A8R8G8B8 levels laid out exactly as the texture keeps them (one buffer, rows of width * 4
-    // bytes, level after level with no gap) are not copied when `owner` is given: the texture
+    // A8R8G8B8 and A32B32G32R32F levels laid out exactly as the texture keeps them (one buffer,
+    // rows of width * 4 bytes or width * 4 floats, level after level with no gap) are not copied
+    // when `owner` is given: the texture
     // reads them where they are and keeps `owner` alive; the caller must not change those bytes
     // while the texture is in use (emu's device copies them first: Device::prepareWrite). Other
     // levels are copied (A8R8G8B8 row by row) or decoded.
@@ -96,7 +98,7 @@ public:
                                              size_t levelCount, SignedDecode decode, std::string& error,
                                              std::shared_ptr<const void> owner = {});
     // Whether the texels are read where fromLevels found them (no copy).
-    bool readsInPlace() const { return m_u8view != nullptr; }
+    bool readsInPlace() const { return m_u8view != nullptr || m_valueView != nullptr; }
     // The rule the signed channels were decoded with (Snorm for textures without them).
     SignedDecode signedDecode() const { return m_signedDecode; }
 
@@ -107,7 +109,7 @@ private:
     bool layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
                 std::string& error);
     // Signed formats: raw channel integers -> values and grids; float formats: the floats -> grids.
-    void finishDecoded(const std::vector<int32_t>& raw, const std::vector<float>& rawf, SignedDecode decode);
+    void finishDecoded(const std::vector<int32_t>& raw, std::vector<float>&& rawf, SignedDecode decode);
 
     TexFormat m_format = TexFormat::A8R8G8B8;
     bool m_volume = false;
@@ -118,7 +120,12 @@ private:
     std::vector<uint8_t> m_u8;
     std::shared_ptr<const uint8_t> m_u8view;  // fromLevels' levels, read in place (owner kept)
     std::vector<float> m_value;
-    std::vector<int32_t> m_grid8, m_grid12;
+    std::shared_ptr<const float> m_valueView;  // fromLevels' A32B32G32R32F levels, read in place
+    struct Grids {
+        std::once_flag once8, once12;  // float formats: filled on first use
+        std::vector<int32_t> g8, g12;
+    };
+    std::shared_ptr<Grids> m_grids = std::make_shared<Grids>();
 };
 
 // Builds a texture from a parsed [texture N] section: texel words in the format's natural

@@ -935,6 +935,48 @@ TEST_CASE("device: StretchRect point and linear", "[device]") {
         CHECK(readFloat(dev, dst, 0, 0) == float(76.5 / 255.0));
         REQUIRE(dev.StretchRect(src, nullptr, dst, nullptr, D3DTEXF_POINT) == D3D_OK);
         CHECK(readFloat(dev, dst, 0, 0) == float(153.0 / 255.0));  // point picks (1, 1)
+        // Unscaled into A32B32G32R32F (a fast path): every byte value, each channel, X8's alpha 1.
+        for (D3DFORMAT from : {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8}) {
+            Handle bytes = makeTarget(
+                dev, 16, 16, [](UINT x, UINT y) { const uint32_t b = y * 16 + x; return (b << 24) | ((255 - b) << 16) | (b << 8) | (b ^ 0x5a); },
+                from);
+            Handle f32{};
+            REQUIRE(dev.CreateRenderTarget(16, 16, D3DFMT_A32B32G32R32F, 1, &f32) == D3D_OK);
+            REQUIRE(dev.StretchRect(bytes, nullptr, f32, nullptr, D3DTEXF_LINEAR) == D3D_OK);
+            int wrong = 0;
+            for (UINT y = 0; y < 16; ++y)
+                for (UINT x = 0; x < 16; ++x) {
+                    const uint32_t b = y * 16 + x;
+                    const double want[4] = {double(255 - b), double(b), double(b ^ 0x5a), from == D3DFMT_X8R8G8B8 ? 255.0 : double(b)};
+                    for (UINT c = 0; c < 4; ++c) wrong += readFloat(dev, f32, x, y, c) != float(want[c] / 255.0);
+                }
+            CHECK(wrong == 0);
+        }
+        // And back (another fast path): nearest byte, ties to even, clamped, NaN 0.
+        const float values[] = {0.0f, 1.0f, -0.5f, 2.0f, 0.5f / 255, 1.5f / 255, 2.5f / 255, 254.5f / 255,
+                                 0.3f, 0.7f, float(NAN), float(INFINITY), -float(INFINITY), 1e-30f, 0.999f, 0.0019607f};
+        const size_t nv = sizeof values / sizeof values[0];
+        for (D3DFORMAT to : {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8}) {
+            Handle f32{}, bytes{};
+            REQUIRE(dev.CreateRenderTarget(UINT(nv), 1, D3DFMT_A32B32G32R32F, 1, &f32) == D3D_OK);
+            REQUIRE(dev.CreateRenderTarget(UINT(nv), 1, to, 1, &bytes) == D3D_OK);
+            D3DLOCKED_RECT lr{};
+            REQUIRE(dev.LockRect(f32, &lr, nullptr, 0) == D3D_OK);
+            for (size_t i = 0; i < nv; ++i) {
+                const float px[4] = {values[i], values[(i + 1) % nv], values[(i + 2) % nv], values[(i + 3) % nv]};
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + i * 16, px, 16);
+            }
+            REQUIRE(dev.UnlockRect(f32) == D3D_OK);
+            REQUIRE(dev.StretchRect(f32, nullptr, bytes, nullptr, D3DTEXF_POINT) == D3D_OK);
+            auto byteOf = [](float v) {
+                return std::isnan(v) ? 0u : uint32_t(std::nearbyint(std::clamp(double(v), 0.0, 1.0) * 255.0));
+            };
+            for (size_t i = 0; i < nv; ++i) {
+                const uint32_t a = to == D3DFMT_X8R8G8B8 ? 255u : byteOf(values[(i + 3) % nv]);
+                const uint32_t want = a << 24 | byteOf(values[i]) << 16 | byteOf(values[(i + 1) % nv]) << 8 | byteOf(values[(i + 2) % nv]);
+                CHECK(readPixel(dev, bytes, UINT(i), 0) == want);
+            }
+        }
     }
 
     SECTION("into a render-target texture, which its sampler view then shows") {
@@ -1261,6 +1303,29 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
         CHECK(red(v3, 0) == 0x33);
         CHECK(red(dev.sampledTexture(tex), 0) == 0x44);
+    }
+
+    SECTION("a texture a draw sampled is written in place afterwards (nothing keeps the view)") {
+        Handle tex{}, level{}, out{};
+        REQUIRE(dev.CreateTexture(8, 8, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &tex) == D3D_OK);
+        REQUIRE(dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK);
+        out = makeTarget(dev, 8, 8, [](UINT, UINT) { return 0u; });
+        struct V { float x, y, z, rhw, u, v; };
+        const V quad[4] = {{-0.5f, -0.5f, 0, 1, 0, 0}, {7.5f, -0.5f, 0, 1, 1, 0}, {-0.5f, 7.5f, 0, 1, 0, 1}, {7.5f, 7.5f, 0, 1, 1, 1}};
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX1) == D3D_OK);
+        auto drawFrom = [&] {
+            REQUIRE(dev.SetRenderTarget(0, out) == D3D_OK);
+            REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+            REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+            REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
+            REQUIRE(dev.SetRenderTarget(0, level) == D3D_OK);
+            REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xFF102030u, 1.0f, 0) == D3D_OK);
+        };
+        drawFrom();
+        const void* before = dev.sampledTexture(tex)->unorm8();
+        drawFrom();
+        CHECK(dev.sampledTexture(tex)->unorm8() == before);  // the clear wrote the same buffer
+        CHECK(red(dev.sampledTexture(tex), 0) == 0x10);
     }
 
     SECTION("a lock after the view was made, then a write to another level") {
