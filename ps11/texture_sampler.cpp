@@ -199,8 +199,11 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     const int levels = tex.levelCount();
     const int axes = tex.isVolume() ? 3 : 2;
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
-    if (!req.quads) {
-        for (int i = 0; i < count; ++i) L.level[0][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0;
+    // Without quads, or when every LOD gives level 0 with one filter (one level or no mip
+    // filter, and MIN = MAG), no LOD is computed.
+    if (!req.quads || ((levels == 1 || st.mipFilter == Filter::None) && magLinear == minLinear)) {
+        for (int i = 0; i < count; ++i)
+            L.level[0][i] = L.level[1][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0, L.mipF[i] = 0.0f;
         return;
     }
     for (int q = 0; q < count; q += 4) {
