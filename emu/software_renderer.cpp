@@ -112,6 +112,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                                            used, aligned);
     std::vector<AlignedTriangle> alignedTris;
     std::vector<uint8_t> isAligned;
+    std::vector<uint32_t> bandStart, bandFill, bandTris;
     for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
         const uint32_t chunk = std::min(kChunkTriangles, call.primitiveCount - first);
         tris.clear();
@@ -138,6 +139,20 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         const int firstBand = (yLo & ~1) / kBandRows;
         const int lastBand = (yHi + kBandRows - 1) / kBandRows;
         const int bands = lastBand - firstBand;
+        // Each band's triangles in primitive order (a draw of many small triangles, such as
+        // sprites, visits each triangle only in the bands it touches).
+        bandStart.assign(size_t(bands) + 1, 0);
+        for (const TriangleSetup& t : setups)
+            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+                ++bandStart[size_t(b) + 1];
+        for (int b = 0; b < bands; ++b) bandStart[size_t(b) + 1] += bandStart[size_t(b)];
+        bandTris.resize(bandStart[size_t(bands)]);
+        bandFill.assign(bandStart.begin(), bandStart.end() - 1);
+        for (uint32_t i = 0; i < setups.size(); ++i) {
+            const TriangleSetup& t = setups[i];
+            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+                bandTris[bandFill[size_t(b)]++] = i;
+        }
         std::atomic<int> next{0};
         const int workers = std::min(dc.pool.size(), bands);
         std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
@@ -206,9 +221,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
                     grouped = 0;
                 };
-                for (size_t i = 0; i < setups.size(); ++i) {
+                for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
+                    const uint32_t i = bandTris[k];
                     const TriangleSetup& s = setups[i];
-                    if (s.yMax <= by0 || s.yMin >= by1) continue;
                     if (isAligned[i]) {
                         group[grouped] = &alignedTris[i];
                         groupSetups[grouped++] = &s;
