@@ -495,13 +495,25 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
         s.clusters = rng() % 3 != 0;
         s.threshold = 0.3f + float(rng() % 60) / 100.0f;
         INFO(w << "x" << h << ", group " << s.group << ", clusters " << s.clusters << ", threshold " << s.threshold);
-        const std::vector<Sprite> fast = senseSprites(img.data(), w, h, s), ref = senseSpritesReference(img.data(), w, h, s);
-        REQUIRE(fast.size() == ref.size());
-        for (size_t i = 0; i < ref.size(); ++i) {
-            CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
-            CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
-            CHECK(fast[i].radius == ref[i].radius);
-            CHECK(fast[i].cluster == ref[i].cluster);
+        const std::vector<Sprite> ref = senseSpritesReference(img.data(), w, h, s);
+        // The same frame as D3D's b g r a words in rows with padding (what the read-back hands over).
+        const size_t pitch = size_t(w) * 4 + 4 * (rng() % 5);
+        std::vector<uint8_t> bgra(pitch * h, 0xEE);
+        for (uint32_t y = 0; y < h; ++y)
+            for (uint32_t x = 0; x < w; ++x) {
+                const uint8_t* p = &img[(size_t(y) * w + x) * 4];
+                uint8_t* q = &bgra[y * pitch + size_t(x) * 4];
+                q[0] = p[2], q[1] = p[1], q[2] = p[0], q[3] = p[3];
+            }
+        for (const std::vector<Sprite>& fast :
+             {senseSprites(img.data(), w, h, s), senseSprites(SensorFrame{bgra.data(), w, h, pitch, true}, s)}) {
+            REQUIRE(fast.size() == ref.size());
+            for (size_t i = 0; i < ref.size(); ++i) {
+                CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
+                CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
+                CHECK(fast[i].radius == ref[i].radius);
+                CHECK(fast[i].cluster == ref[i].cluster);
+            }
         }
     }
 }
