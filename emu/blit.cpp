@@ -96,7 +96,7 @@ std::vector<StretchTap> stretchTaps(const StretchCall& call, bool horizontal) {
     return taps;
 }
 
-void stretchImages(const StretchCall& call) {
+void stretchImages(const StretchCall& call, RowRange rows) {
     const Image* s = call.source.image;
     Image* d = call.dest.image;
     const PixelBox& sr = call.sourceRect;
@@ -104,7 +104,11 @@ void stretchImages(const StretchCall& call) {
     const FormatInfo& sf = *s->format;
     const FormatInfo& df = *d->format;
     const int64_t sw = sr.x1 - sr.x0, sh = sr.y1 - sr.y0;
-    const int64_t dw = dr.x1 - dr.x0, dh = dr.y1 - dr.y0;
+    const int64_t dw = dr.x1 - dr.x0;
+    // Destination rows [j0, dh) of the rect.
+    const int64_t j0 = std::clamp<int64_t>(rows.first, 0, dr.y1 - dr.y0);
+    const int64_t dh = std::clamp<int64_t>(rows.last, j0, dr.y1 - dr.y0);
+    const int64_t fullHeight = dr.y1 - dr.y0;
     const bool unormSource = sf.cls == FormatClass::Unorm8;
     // Channel values in source units: bytes for 8-bit sources (exact sums), values otherwise.
     auto fetch = [&](int64_t x, int64_t y) {
@@ -136,23 +140,23 @@ void stretchImages(const StretchCall& call) {
     const bool sameFormat = &sf == &df;
     // Fast path: an unscaled copy in one format is a row copy with either filter (LINEAR has
     // f = 0 at every pixel, so it reproduces the texels exactly).
-    if (sameFormat && sw == dw && sh == dh) {
+    if (sameFormat && sw == dw && sh == fullHeight) {
         const size_t row = size_t(sw) * sf.bytes;
-        for (int64_t j = 0; j < dh; ++j)
+        for (int64_t j = j0; j < dh; ++j)
             std::memmove(d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j)), s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j)),
                          row);
         return;
     }
     // Fast path: an unscaled copy of 8-bit b g r a words into A32B32G32R32F (the ideal profile's
     // float targets) stores each byte's value float(b / 255), what store() makes of it.
-    if (sw == dw && sh == dh && unormSource && sf.bytes == 4 && df.format == D3DFMT_A32B32G32R32F) {
+    if (sw == dw && sh == fullHeight && unormSource && sf.bytes == 4 && df.format == D3DFMT_A32B32G32R32F) {
         static const std::array<float, 256> value = [] {
             std::array<float, 256> t{};
             for (size_t b = 0; b < 256; ++b) t[b] = float(double(b) / 255.0);
             return t;
         }();
         const bool x8 = sf.format == D3DFMT_X8R8G8B8;
-        for (int64_t j = 0; j < dh; ++j) {
+        for (int64_t j = j0; j < dh; ++j) {
             const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
             for (int64_t i = 0; i < dw; ++i, in += 4, out += 16) {
@@ -164,9 +168,9 @@ void stretchImages(const StretchCall& call) {
     }
     // Fast path: an unscaled copy of A32B32G32R32F into 8-bit b g r a words (the ideal
     // profile's float frame into an 8-bit output): store()'s rounding, channel by channel.
-    if (sw == dw && sh == dh && sf.format == D3DFMT_A32B32G32R32F && df.cls == FormatClass::Unorm8 && df.bytes == 4) {
+    if (sw == dw && sh == fullHeight && sf.format == D3DFMT_A32B32G32R32F && df.cls == FormatClass::Unorm8 && df.bytes == 4) {
         const bool x8 = df.format == D3DFMT_X8R8G8B8;
-        for (int64_t j = 0; j < dh; ++j) {
+        for (int64_t j = j0; j < dh; ++j) {
             const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
             for (int64_t i = 0; i < dw; ++i, in += 16, out += 4) {
@@ -181,9 +185,9 @@ void stretchImages(const StretchCall& call) {
     // Fast path: an exact 2:1 LINEAR reduction of A8R8G8B8/X8R8G8B8 has f = 1/2 on both axes
     // (weight 128/256 in fx profiles, 1/2 exactly otherwise), so each byte is
     // round_half_even((a + b + c + d) / 4) of a 2x2 block, the general path's result.
-    if (linear && sameFormat && sf.bytes == 4 && sf.cls == FormatClass::Unorm8 && sw == 2 * dw && sh == 2 * dh) {
+    if (linear && sameFormat && sf.bytes == 4 && sf.cls == FormatClass::Unorm8 && sw == 2 * dw && sh == 2 * fullHeight) {
         const bool x8 = sf.format == D3DFMT_X8R8G8B8;
-        for (int64_t j = 0; j < dh; ++j) {
+        for (int64_t j = j0; j < dh; ++j) {
             const uint8_t* r0 = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + 2 * j));
             const uint8_t* r1 = r0 + s->rowPitch;
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
@@ -199,7 +203,36 @@ void stretchImages(const StretchCall& call) {
         return;
     }
     const std::vector<StretchTap> tapX = stretchTaps(call, true), tapY = stretchTaps(call, false);
-    for (int64_t j = 0; j < dh; ++j) {
+    // Fast path: LINEAR between 8-bit b g r a words of one format in an fx profile. The weights
+    // are k/256, so the general path's double sum is exactly S / 65536 with the integer
+    // S = (256-ky)((256-kx)a + kx b) + ky((256-kx)c + kx e), and its rounding round_half_even(S / 65536).
+    if (linear && sameFormat && call.fixedPoint && sf.bytes == 4 && sf.cls == FormatClass::Unorm8) {
+        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+        std::vector<int32_t> kx(static_cast<size_t>(dw)), x0(static_cast<size_t>(dw)), x1(static_cast<size_t>(dw));
+        for (int64_t i = 0; i < dw; ++i) {
+            const StretchTap& t = tapX[size_t(i)];
+            kx[size_t(i)] = int32_t(t.w1 * 256.0);
+            x0[size_t(i)] = int32_t(t.i0) * 4, x1[size_t(i)] = int32_t(t.i1) * 4;
+        }
+        for (int64_t j = j0; j < dh; ++j) {
+            const StretchTap& ty = tapY[size_t(j)];
+            const int64_t ky = int64_t(ty.w1 * 256.0);
+            const uint8_t* r0 = s->texel(0, uint32_t(ty.i0));
+            const uint8_t* r1 = s->texel(0, uint32_t(ty.i1));
+            uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
+            for (int64_t i = 0; i < dw; ++i, out += 4) {
+                const int64_t wx = kx[size_t(i)];
+                const uint8_t *a = r0 + x0[size_t(i)], *b = r0 + x1[size_t(i)], *c = r1 + x0[size_t(i)], *e = r1 + x1[size_t(i)];
+                for (int k = 0; k < (x8 ? 3 : 4); ++k) {
+                    const int64_t top = (256 - wx) * a[k] + wx * b[k], bottom = (256 - wx) * c[k] + wx * e[k];
+                    out[k] = uint8_t(ps11::roundHalfEven((256 - ky) * top + ky * bottom, 65536));
+                }
+                if (x8) out[3] = 0xFF;
+            }
+        }
+        return;
+    }
+    for (int64_t j = j0; j < dh; ++j) {
         for (int64_t i = 0; i < dw; ++i) {
             const int64_t dx = dr.x0 + i, dy = dr.y0 + j;
             if (!linear) {

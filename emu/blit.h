@@ -3,6 +3,7 @@
 // keeps copies leaves a call to it (emu/renderer.h).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "emu/renderer.h"
@@ -23,6 +24,11 @@ std::vector<StretchTap> stretchTaps(const StretchCall& call, bool horizontal);
 void clearImages(const ClearCall& call);
 // Copies call.sourceRect of call.source.image to call.destRect of call.dest.image, scaling with
 // POINT or LINEAR filtering (texel-centre mapping; 8-bit weights in fx profiles, rounded once).
-void stretchImages(const StretchCall& call);
+// `rows` limits the work to destination rows [first, last) of the rect (relative to its top), so
+// that workers can share one call; the default is every row.
+struct RowRange {
+    int64_t first = 0, last = INT64_MAX;
+};
+void stretchImages(const StretchCall& call, RowRange rows = {});
 
 }  // namespace emu

@@ -18,6 +18,8 @@ namespace {
 
 // Rows per band handed to a worker: even (quads) and small enough to balance two threads.
 constexpr int kBandRows = 16;
+// A StretchRect shares its rows among the workers from this many destination pixels per worker.
+constexpr int64_t kMinStretchPixelsPerWorker = 16384;
 // Executors kept per renderer (cleared when full).
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
@@ -62,7 +64,14 @@ bool SoftwareRenderer::clear(const ClearCall& call) {
 }
 
 bool SoftwareRenderer::stretchRect(const StretchCall& call) {
-    stretchImages(call);
+    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+    // Destination rows in bands over the workers (each row is written by one of them).
+    const int64_t rows = call.destRect.y1 - call.destRect.y0;
+    const int64_t pixels = rows * (call.destRect.x1 - call.destRect.x0);
+    const int workers = int(std::clamp<int64_t>(pixels / kMinStretchPixelsPerWorker, 1, m_context->pool.size()));
+    m_context->pool.run(workers, [&](int w) {
+        stretchImages(call, RowRange{rows * w / workers, rows * (w + 1) / workers});
+    });
     return true;
 }
 
