@@ -1,12 +1,22 @@
-// The one SIMD dispatch (ps11/simd_dispatch.h): the level names, PS11_SIMD's rule and the
-// override.
+// The one SIMD dispatch (ps11/simd_dispatch.h): the level names, PS11_SIMD's rule, the override,
+// and the float arithmetic (generic executor, float and ideal profiles) run at every level this
+// CPU runs and compared bit for bit. The executor's fx8 kernels are compared across levels by
+// test_executor_fast.cpp.
 #include <catch2/catch.hpp>
 
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "executor_random_programs.h"
 #include "ps11/cpu_features.h"
+#include "ps11/executor.h"
 #include "ps11/simd_dispatch.h"
+#include "simd_levels.h"
 
 using ps11::SimdLevel;
 
@@ -87,4 +97,143 @@ TEST_CASE("simd dispatch: the best level follows the CPU query; the override fal
     CHECK(ps11::simdLevel() == SimdLevel::Baseline);
     ps11::clearSimdLevel();
     CHECK(ps11::simdLevel() == before);
+}
+
+namespace {
+
+// Runs a float-profile program over `count` pixels (one span) at the level in force; returns
+// the output colours' bits and the killed flags.
+std::vector<uint32_t> runFloat(const ps11::Executor& e, const std::vector<float> (&tc)[8][4],
+                               const std::vector<float> (&col)[2][4], int count) {
+    ps11::PixelInputs in;
+    in.count = count;
+    for (int v = 0; v < 2; ++v)
+        for (int c = 0; c < 4; ++c) in.color[v][c] = col[v][c].data();
+    for (int t = 0; t < 8; ++t)
+        for (int c = 0; c < 4; ++c) in.texcoord[t][c] = tc[t][c].data();
+    std::vector<float> color[4];
+    std::vector<uint8_t> killed(size_t(count), 9);
+    ps11::PixelOutputs out;
+    for (int c = 0; c < 4; ++c) color[c].assign(size_t(count), -7.0f), out.color[c] = color[c].data();
+    out.killed = killed.data();
+    ps11::NullSampler sampler;
+    e.run(in, sampler, out);
+    std::vector<uint32_t> bits;
+    for (int c = 0; c < 4; ++c)
+        for (float f : color[c]) {
+            uint32_t b;
+            std::memcpy(&b, &f, 4);
+            bits.push_back(b);
+        }
+    for (uint8_t k : killed) bits.push_back(k);
+    return bits;
+}
+
+std::unique_ptr<ps11::Executor> makeFloat(const ps11::Program& program, ps11::Precision precision) {
+    ps11::Diagnostics diags;
+    ps11::ExecutorOptions opt;
+    opt.precision = precision;
+    std::unique_ptr<ps11::Executor> e = ps11::Executor::create(program, opt, diags);
+    REQUIRE(e);
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("simd dispatch: float arithmetic gives the same bits at every level (float, ideal)", "[simd][executor]") {
+    using namespace ps11test;
+    Gen g(0x51d0f10u);
+    int valid = 0, generated = 0, compared = 0;
+    int64_t bad = 0;
+    while (valid < 300 && generated < 30000) {
+        const int minor = 1 + generated++ % 4;
+        const Prog p = g.program(minor);
+        std::string err;
+        const std::optional<ps11::Program> program = assemble(progText(p), err);
+        if (!program) continue;
+        ++valid;
+        const int count = g.uni(1, ps11::kMaxSpan);
+        std::vector<float> tc[8][4], col[2][4];
+        for (auto& t : tc)
+            for (auto& c : t) c.resize(size_t(count));
+        for (auto& v : col)
+            for (auto& c : v) c.resize(size_t(count));
+        for (int i = 0; i < count; ++i) {
+            const Inputs in = g.inputs();
+            for (int t = 0; t < 8; ++t)
+                for (int c = 0; c < 4; ++c) tc[t][c][size_t(i)] = in.tc[t][c];
+            for (int v = 0; v < 2; ++v)
+                for (int c = 0; c < 4; ++c) col[v][c][size_t(i)] = in.color[v][c];
+        }
+        const Inputs consts = g.inputs();
+        for (ps11::Precision precision : {ps11::Precision::Float, ps11::Precision::Ideal}) {
+            std::unique_ptr<ps11::Executor> e = makeFloat(*program, precision);
+            for (int i = 0; i < 8; ++i) e->setConstant(i, consts.consts[i]);
+            std::vector<uint32_t> first;
+            testutil::forEachSimdLevel([&](SimdLevel level) {
+                const std::vector<uint32_t> got = runFloat(*e, tc, col, count);
+                if (level == SimdLevel::Baseline) {
+                    first = got;
+                    return;
+                }
+                ++compared;
+                if (got != first && bad++ < 3) FAIL_CHECK(ps11::precisionName(precision) << "\n" << progText(p));
+            });
+        }
+    }
+    CHECK(valid >= 300);
+    CHECK(bad == 0);
+    if (ps11::simdLevelRuns(SimdLevel::Avx2)) CHECK(compared == 2 * valid);
+}
+
+TEST_CASE("simd dispatch: float mad, lrp and dp3 round each product at every level (no FMA)", "[simd][executor]") {
+    // a·b + c rounded twice, as written: an FMA would round once and differ for most operands.
+    ps11::Diagnostics diags;
+    const char* text =
+        "ps_1_4\ntexcrd r0.xyz, t0\ntexcrd r1.xyz, t1\ntexcrd r2.xyz, t2\n"
+        "mad r3.rgb, r0, r1, r2\nlrp r4.rgb, r0, r1, r2\ndp3 r5.rgb, r0, r1\n"
+        "mov r0.r, r3.r\nmov r0.g, r4.g\nmov r0.b, r5.b\n";
+    const std::optional<ps11::Program> program = ps11::parseAssembly(text, "fma.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    std::unique_ptr<ps11::Executor> e = makeFloat(*program, ps11::Precision::Ideal);
+    const int count = ps11::kMaxSpan;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<float> tc[8][4], col[2][4];
+    for (auto& t : tc)
+        for (auto& c : t) c.assign(size_t(count), 0.0f);
+    for (auto& v : col)
+        for (auto& c : v) c.assign(size_t(count), 0.0f);
+    for (int t = 0; t < 3; ++t)
+        for (int c = 0; c < 3; ++c)
+            for (float& f : tc[t][c]) f = u(rng);
+    auto asFloat = [](uint32_t b) {
+        float f;
+        std::memcpy(&f, &b, 4);
+        return f;
+    };
+    testutil::forEachSimdLevel([&](SimdLevel) {
+        const std::vector<uint32_t> got = runFloat(*e, tc, col, count);
+        int wrong = 0;
+        for (int i = 0; i < count; ++i) {
+            const size_t k = size_t(i);
+            const float a0 = tc[0][0][k], b0 = tc[1][0][k], c0 = tc[2][0][k];
+            const float a1 = tc[0][1][k], b1 = tc[1][1][k], c1 = tc[2][1][k];
+            const float prod = a0 * b0;
+            const float mad = prod + c0;
+            const float diff = b1 - c1;
+            const float scaled = a1 * diff;
+            const float lrp = c1 + scaled;
+            float dp = tc[0][0][k] * tc[1][0][k];
+            const float p1 = tc[0][1][k] * tc[1][1][k];
+            dp = dp + p1;
+            const float p2 = tc[0][2][k] * tc[1][2][k];
+            dp = dp + p2;
+            wrong += asFloat(got[k]) != mad;
+            wrong += asFloat(got[size_t(count) + k]) != lrp;
+            wrong += asFloat(got[2 * size_t(count) + k]) != dp;
+        }
+        CHECK(wrong == 0);
+    });
 }

@@ -10,6 +10,7 @@
 #include "ps11/cpu_features.h"
 #include "ps11/executor_fast.h"
 #include "ps11/hardware.h"
+#include "ps11/simd_dispatch.h"
 #include "ps11/suggest.h"
 #include "ps11/version.h"
 #include "tools/cli_util.h"
@@ -98,7 +99,7 @@ int cmdInfo(const std::vector<std::string>& args) {
         }
     }
     const HardwareClass& hw = defaultHardware(1);
-    const exec::FastKernels* kernels = exec::fastKernelsBest();
+    const exec::FastKernels* kernels = exec::fastKernels(simdLevel());
     const char* kernelName = kernels ? kernels->name : "none";
     const CpuFeatures& cpu = cpuFeatures();
     std::string cpuText;
