@@ -1,7 +1,10 @@
-// The one SIMD dispatch (ps11/simd_dispatch.h): the level names, PS11_SIMD's rule, the override,
-// and the float arithmetic (generic executor, float and ideal profiles) run at every level this
-// CPU runs and compared bit for bit. The executor's fx8 kernels are compared across levels by
-// test_executor_fast.cpp.
+// The one SIMD dispatch (ps11/simd_dispatch.h): PS11_SIMD's rule, the override, each family's
+// tables per level, and the families without a cross-level test of their own, each run at every
+// level this CPU runs and compared bit for bit: the float arithmetic (generic executor, float
+// and ideal profiles) and the output merger's half store. The executor's fx8 kernels, the fast
+// sampler and the aligned-pass path are compared across levels by test_executor_fast.cpp,
+// test_sampler_fast.cpp and test_aligned_pass.cpp (and the half store once more by
+// test_output_merger.cpp, against format.cpp).
 #include <catch2/catch.hpp>
 
 #include <array>
@@ -12,10 +15,18 @@
 #include <string>
 #include <vector>
 
+#include "emu/aligned_pass_kernels.h"
+#include "emu/format.h"
+#include "emu/output_merger.h"
+#include "emu/output_merger_kernels.h"
+#include "emu/resources.h"
 #include "executor_random_programs.h"
 #include "ps11/cpu_features.h"
 #include "ps11/executor.h"
+#include "ps11/executor_fast.h"
+#include "ps11/executor_internal.h"
 #include "ps11/simd_dispatch.h"
+#include "ps11/texture_sampler_fast.h"
 #include "simd_levels.h"
 
 using ps11::SimdLevel;
@@ -236,4 +247,101 @@ TEST_CASE("simd dispatch: float mad, lrp and dp3 round each product at every lev
         }
         CHECK(wrong == 0);
     });
+}
+
+TEST_CASE("simd dispatch: every family has its tables, distinct per level where the build has Avx2", "[simd]") {
+    using namespace ps11;
+    const exec::FastKernels* fastB = exec::fastKernels(SimdLevel::Baseline);
+    const exec::FastKernels* fastA = exec::fastKernels(SimdLevel::Avx2);
+#ifdef PS11_HAVE_AVX2
+    REQUIRE(fastB);
+    REQUIRE(fastA);
+    CHECK(std::string(fastB->name) == "fast-sse2");
+    CHECK(std::string(fastA->name) == "fast-avx2");
+    CHECK(&exec::floatArithKernels(SimdLevel::Baseline) != &exec::floatArithKernels(SimdLevel::Avx2));
+    CHECK(&fastpath::samplerKernels(SimdLevel::Baseline) != &fastpath::samplerKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx2) != nullptr);
+    CHECK(&emu::mergerKernels(SimdLevel::Baseline) != &emu::mergerKernels(SimdLevel::Avx2));
+#else
+    // No x86 kernels: the generic path runs every program; every other family has only Baseline.
+    CHECK(fastB == nullptr);
+    CHECK(fastA == nullptr);
+    CHECK(&exec::floatArithKernels(SimdLevel::Baseline) == &exec::floatArithKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx2) == nullptr);
+#endif
+    // The aligned-pass path has no vector kernels at Baseline (every pixel on its own).
+    CHECK(emu::alignedKernels(SimdLevel::Baseline) == nullptr);
+}
+
+TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at every level", "[simd][merger]") {
+    // Every half pattern as a float, then floats between halves (ties, the overflow boundary,
+    // subnormals), in spans whose lengths are not multiples of 8; NaNs stay NaNs.
+    std::vector<float> values;
+    for (uint32_t h = 0; h < 65536; ++h) values.push_back(emu::halfToFloat(uint16_t(h)));
+    std::mt19937 rng(3);
+    for (int i = 0; i < 65536; ++i) {
+        uint32_t bits = rng();
+        if (i % 3 == 0) bits = (bits & 0x80000000u) | (0x33000000u + (bits % 0x14800000u));
+        if (i % 3 == 1) bits = (bits & 0xffffe000u) | 0x1000u;
+        float f;
+        std::memcpy(&f, &bits, 4);
+        values.push_back(f);
+    }
+    const emu::MergerKernels& base = emu::mergerKernels(SimdLevel::Baseline);
+    int64_t bad = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::MergerKernels& k = emu::mergerKernels(level);
+        for (size_t at = 0; at + 4 * 256 <= values.size(); at += 4 * 256) {
+            const int count = 1 + int((at / 1024) % 256);
+            const float* f[4] = {&values[at], &values[at + 256], &values[at + 512], &values[at + 768]};
+            std::vector<uint16_t> want(size_t(4 * count)), got(size_t(4 * count));
+            base.halves(f, count, want.data());
+            k.halves(f, count, got.data());
+            for (size_t j = 0; j < got.size(); ++j) {
+                const bool nanWant = (want[j] & 0x7c00) == 0x7c00 && (want[j] & 0x3ff);
+                const bool nanGot = (got[j] & 0x7c00) == 0x7c00 && (got[j] & 0x3ff);
+                bad += nanWant ? !nanGot : got[j] != want[j];
+            }
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+}
+
+TEST_CASE("simd dispatch: mergePixels stores the same A16B16G16R16F bytes at every level", "[simd][merger]") {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(-70000.0f, 70000.0f), small(-1.0f, 1.0f);
+    const int count = 200;  // not a multiple of 8
+    std::vector<int32_t> x(count), y(count);
+    std::vector<uint8_t> live(count);
+    std::vector<float> color[4];
+    for (int i = 0; i < count; ++i) x[size_t(i)] = i % 16, y[size_t(i)] = i / 16, live[size_t(i)] = i % 7 != 3;
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < count; ++i) color[c].push_back(i % 2 ? u(rng) : small(rng));
+    emu::MergeInputs in;
+    in.count = count;
+    in.x = x.data(), in.y = y.data(), in.live = live.data();
+    for (int c = 0; c < 4; ++c) in.color[c] = color[c].data();
+    for (uint32_t mask : {0xfu, 0x5u, 0x8u}) {
+        std::vector<uint8_t> first;
+        testutil::forEachSimdLevel([&](SimdLevel level) {
+            emu::Image img;
+            img.format = emu::formatInfo(emu::D3DFMT_A16B16G16R16F);
+            REQUIRE(img.format);
+            img.width = 16, img.height = 16;
+            img.rowPitch = emu::rowPitchOf(*img.format, 16);
+            img.slicePitch = uint64_t(img.rowPitch) * 16;
+            img.bytes.assign(size_t(img.slicePitch), 0x5a);
+            emu::MergeState st;
+            st.precision = ps11::Precision::Float;
+            st.colorWrite = mask;
+            emu::MergeStats stats;
+            emu::mergePixels(st, in, emu::MergeTarget{&img, nullptr}, &stats);
+            CHECK(stats.written == uint64_t(count - (count + 3) / 7));
+            if (level == SimdLevel::Baseline)
+                first = img.bytes;
+            else
+                CHECK(img.bytes == first);
+        });
+    }
 }
