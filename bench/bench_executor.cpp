@@ -20,6 +20,7 @@
 #include "ps11/diagnostics.h"
 #include "ps11/executor.h"
 #include "ps11/sampler.h"
+#include "ps11/simd_dispatch.h"
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
@@ -224,20 +225,19 @@ double timeRows(const Executor& executor, Sampler& sampler, const SpanInputs& sp
 
 // One benchmark per program × profile × sampler. Each iteration runs the 16 rows with the default
 // path (Auto: the fast path where it applies) and, where the fast path applies, the same rows with
-// the generic path and with the fast path's SSE2 kernels, alternating the order (A B C, C B A, …)
-// so drift of the shared VM hits all alike.
+// the generic path and with the default path at the Baseline SIMD level (ps11::ScopedSimdLevel:
+// what a CPU without AVX2 runs, sampler included) when the level in force is above it,
+// alternating the order (A B C, C B A, …) so drift of the shared VM hits all alike.
 // Thread CPU time, like the CPU column: on a shared VM wall time also counts other tenants.
 void runProgram(benchmark::State& state, const BenchProgram& prog, Precision precision, bool textured) {
     std::unique_ptr<Executor> fast = makeExecutor(prog.text, precision, ExecPath::Auto);
     std::unique_ptr<Executor> generic = makeExecutor(prog.text, precision, ExecPath::Generic);
-    std::unique_ptr<Executor> sse2 = makeExecutor(prog.text, precision, ExecPath::FastBaseline);
-    if (!fast || !generic || !sse2) {
+    if (!fast || !generic) {
         state.SkipWithError("cannot prepare the program");
         return;
     }
     const bool compare = std::string(fast->pathName()) != "generic";
-    // The SSE2 kernels too, when the default path runs the AVX2 ones.
-    const bool compareSse2 = compare && std::string(fast->pathName()) != sse2->pathName();
+    const bool compareBaseline = compare && simdLevel() != SimdLevel::Baseline;
     std::unique_ptr<Sampler> sampler = makeSampler(textured);
     static const SpanInputs spans;
     SpanOutputs out(precision);
@@ -247,13 +247,17 @@ void runProgram(benchmark::State& state, const BenchProgram& prog, Precision pre
     fast->run(spans.inputs[0], *sampler, out.outputs, &stats);
     const double perPixel = stats.pixels ? double(stats.instructions) / double(stats.pixels) : 0.0;
 
-    double tFast = 0, tGeneric = 0, tSse2 = 0;
+    auto timeBaseline = [&] {
+        const ScopedSimdLevel baseline(SimdLevel::Baseline);
+        return timeRows(*fast, *sampler, spans, out);
+    };
+    double tFast = 0, tGeneric = 0, tBaseline = 0;
     bool fastFirst = true;
     for (auto _ : state) {
         if (compare && !fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
-        if (compareSse2 && !fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
+        if (compareBaseline && !fastFirst) tBaseline += timeBaseline();
         tFast += timeRows(*fast, *sampler, spans, out);
-        if (compareSse2 && fastFirst) tSse2 += timeRows(*sse2, *sampler, spans, out);
+        if (compareBaseline && fastFirst) tBaseline += timeBaseline();
         if (compare && fastFirst) tGeneric += timeRows(*generic, *sampler, spans, out);
         fastFirst = !fastFirst;
     }
@@ -266,7 +270,7 @@ void runProgram(benchmark::State& state, const BenchProgram& prog, Precision pre
         if (perPixel > 0) state.counters["generic_ns/pixel/instr"] = tGeneric / (pixels * perPixel);
         state.counters["speedup"] = tFast > 0 ? tGeneric / tFast : 0.0;
     }
-    if (compareSse2) state.counters["sse2_ns/pixel"] = tSse2 / pixels;
+    if (compareBaseline) state.counters["baseline_ns/pixel"] = tBaseline / pixels;
     state.SetItemsProcessed(int64_t(pixels));
     state.SetLabel(fast->pathName());
 }

@@ -19,7 +19,7 @@
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
-#include "ps11/texture_sampler_fast.h"
+#include "ps11/simd_dispatch.h"
 
 namespace {
 
@@ -123,7 +123,7 @@ double pass(TextureSampler& s, const Coords& c, std::array<std::vector<int32_t>,
 }
 
 // fast vs reference on one pattern, interleaved; counters are ns per lookup and their ratio.
-void BM_Lookup(benchmark::State& state, Pattern pattern, Filter filter, TextureAddress mode, bool generic) {
+void BM_Lookup(benchmark::State& state, Pattern pattern, Filter filter, TextureAddress mode, bool baseline) {
     const Coords c = makeCoords(pattern, 8);
     TextureSampler fast(true), ref(false);
     SamplerState st;
@@ -135,13 +135,14 @@ void BM_Lookup(benchmark::State& state, Pattern pattern, Filter filter, TextureA
     }
     std::array<std::vector<int32_t>, 4> out;
     for (auto& o : out) o.assign(kMaxSpan, 0);
-    fastpath::setForceGeneric(generic);
     double fastNs = 0, refNs = 0;
+    std::optional<ScopedSimdLevel> level;
+    if (baseline) level.emplace(SimdLevel::Baseline);
     for (auto _ : state) {
         fastNs += pass(fast, c, out, pattern == Pattern::HalfTexelQuads);
         refNs += pass(ref, c, out, pattern == Pattern::HalfTexelQuads);
     }
-    fastpath::setForceGeneric(false);
+    level.reset();
     const double lookups = double(c.u.size()) * double(state.iterations());
     state.counters["fast_ns"] = fastNs / lookups;
     state.counters["ref_ns"] = refNs / lookups;
@@ -203,7 +204,7 @@ BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_wrap, Pattern::HalfTexelTaps, Fi
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_quads_clamp, Pattern::HalfTexelQuads, Filter::Linear,
                   TextureAddress::Clamp, false)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_clamp_generic, Pattern::HalfTexelTaps, Filter::Linear,
+BENCHMARK_CAPTURE(BM_Lookup, bilinear_halftexel_clamp_baseline, Pattern::HalfTexelTaps, Filter::Linear,
                   TextureAddress::Clamp, true)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Lookup, bilinear_downsample2x_clamp, Pattern::Downsample2x, Filter::Linear, TextureAddress::Clamp,

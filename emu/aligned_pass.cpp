@@ -1,7 +1,7 @@
 // Device stage: the aligned-pass path of DrawPrimitiveUP (emu/aligned_pass.h). Eligibility,
 // per-triangle column tables and runs, the per-worker H-row cache, per-row filtering of each tap
-// into int16 lanes (scalar for any footprint, AVX2 for runs of columns that step a fixed number
-// of texels with a fixed weight), the pre-sampled
+// into int16 lanes (scalar for any footprint, the SIMD level's vector kernels for runs of columns
+// that step a fixed number of texels with a fixed weight), the pre-sampled
 // executor run, and the stores. Exactness: the tables hold the very texel pairs and weights the
 // TextureSampler's kernels compute for the same coordinates (ps11::fastpath::axisTable), and the
 // coordinates are the rasteriser's own formula (emu/raster.h planeValue); the blend is the
@@ -13,7 +13,6 @@
 #include <cstring>
 
 #include "emu/aligned_pass_kernels.h"
-#include "ps11/cpu_features.h"
 #include "ps11/texture_sampler_fast.h"
 
 namespace emu {
@@ -35,8 +34,8 @@ inline uint32_t load32(const uint8_t* p) {
 }
 
 // One row of one tap: the two texel rows (null = border), the vertical weight, and per config of
-// the tap the H-row planes of both texel rows (null: the tap's runs are filtered per pixel on
-// this row: a border row, or no AVX2).
+// the tap the H-row planes of both texel rows (not ready: the tap's runs are filtered per pixel
+// on this row, a border row).
 struct TapRow {
     const uint8_t* row0 = nullptr;
     const uint8_t* row1 = nullptr;
@@ -66,12 +65,6 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
         }
     }
 }
-
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-bool hasAvx2() { return ps11::cpuFeatures().avx2Fma(); }
-#else
-bool hasAvx2() { return false; }
-#endif
 
 template <bool Additive>
 void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
@@ -103,9 +96,10 @@ TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
     return r;
 }
 
-// Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count).
-void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase, int first,
-               int count, int16_t* const out[4]) {
+// Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count); vector runs
+// (only where the draw has kernels) with `kernels`.
+void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
+               const TapRow& row, int colBase, int first, int count, int16_t* const out[4]) {
     if (!tap.bound) {
         for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? 255 : 0));
         return;
@@ -119,7 +113,6 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
     while (x < end) {
         const int r = vectorRun(x);
         if (r >= 0) {
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
             const AlignedTriangle::Run& run = cols.runs[size_t(r)];
             const int e = std::min(end, int(run.x1));
             const int j = run.j0 + (x - run.x0);
@@ -129,12 +122,12 @@ void filterTap(const AlignedTap& tap, const AlignedTriangle::Columns& cols, cons
             const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
                                            row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
             const HKind kind = run.tabulated ? HKind::H : hKindOf(cols.w[size_t(x - colBase)]);
-            alignedVerticalAvx2(kind, h0, h1, row.wy, e - x, x - first, out);
+            kernels->vertical(kind, h0, h1, row.wy, e - x, x - first, out);
             x = e;
             continue;
-#endif
         }
-        // Border texels, short runs, or no AVX2: one pixel at a time up to the next vector run.
+        // Border texels, short runs, or no vector kernels: one pixel at a time up to the next
+        // vector run.
         int e = x + 1;
         while (e < end && vectorRun(e) < 0) ++e;
         filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
@@ -180,8 +173,8 @@ void slotPlanes(HRowCache::Slot& sl, int n, int pad, uint16_t* out[4]) {
 // Texel rows are first deinterleaved once per draw (a "staged" slot over the triangle's texel
 // range of that texture), then combined per configuration; weight 0 at step 1 is the staged row
 // itself.
-void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::array<const uint16_t*, 4>& planes) {
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
+void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, const HConfig& config,
+          std::array<const uint16_t*, 4>& planes) {
     bool fresh = false;
     if (config.wx == -2) {  // tabulated: straight from the texel row, per column
         HRowCache::Slot& h = slotFor(cache, row, config, fresh);
@@ -189,7 +182,7 @@ void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::arra
             const int n = config.jhi - config.jlo;
             uint16_t* out[4];
             slotPlanes(h, n, kHRowPad, out);
-            alignedBuildTabulatedAvx2(row, config.off0, config.off1, config.w, n, out);
+            kernels.buildTabulated(row, config.off0, config.off1, config.w, n, out);
             ++cache.built;
         } else {
             ++cache.hits;
@@ -203,7 +196,7 @@ void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::arra
     if (fresh) {
         uint16_t* out[4];
         slotPlanes(staged, config.stageHi - config.stageLo, kStagePad, out);
-        alignedDeinterleaveAvx2(row + size_t(config.stageLo) * 4, config.stageHi - config.stageLo, out);
+        kernels.deinterleave(row + size_t(config.stageLo) * 4, config.stageHi - config.stageLo, out);
         ++cache.staged;
     }
     if (config.step == 1 && config.wx == 0) {
@@ -219,18 +212,24 @@ void hRow(HRowCache& cache, const uint8_t* row, const HConfig& config, std::arra
                                       staged.data.data() + size_t(staged.stride) + size_t(first),
                                       staged.data.data() + 2 * size_t(staged.stride) + size_t(first),
                                       staged.data.data() + 3 * size_t(staged.stride) + size_t(first)};
-        alignedCombineAvx2(t, config.jhi - config.jlo, config.step, config.wx, out);
+        kernels.combine(t, config.jhi - config.jlo, config.step, config.wx, out);
         ++cache.built;
     } else {
         ++cache.hits;
     }
     for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
-#else
-    (void)cache, (void)row, (void)config, (void)planes;
-#endif
 }
 
 }  // namespace
+
+const AlignedKernels* alignedKernels(ps11::SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return ps11::simdTable<AlignedKernels>(level, nullptr, &avx2::kAligned);
+#else
+    (void)level;
+    return nullptr;
+#endif
+}
 
 bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
@@ -242,6 +241,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     static std::atomic<uint64_t> serials{0};
     d.serial = ++serials;
     d.executor = &executor;
+    d.kernels = alignedKernels(ps11::simdLevel());
     for (int i = 0; i < d.plan.count; ++i) {
         const int stage = d.plan.stage[size_t(i)];
         AlignedTap& tap = d.taps[size_t(i)];
@@ -315,7 +315,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
         cols.w.resize(size_t(n));
         ps11::fastpath::axisTable(tap.addressU, tap.linear, n, u.data(), tap.width, cols.off0.data(), cols.off1.data(),
                                   cols.w.data());
-        // Long runs (vector kernels, AVX2 only): at least kMinAlignedRun columns whose first texel
+        // Long runs (vector kernels only): at least kMinAlignedRun columns whose first texel
         // i0 steps by a fixed 1..kMaxAlignedStep texels with one weight, none on the border, and
         // i1 = i0 + 1 when the weight is not 0 (the H rows read texels i0 and i0 + 1).
         cols.run.assign(size_t(n), -1);
@@ -323,7 +323,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
             const int32_t i0 = cols.off0[size_t(x)], w = cols.w[size_t(x)];
             return i0 >= 0 && (w == 0 || cols.off1[size_t(x)] == i0 + 1);
         };
-        for (int x = 0; hasAvx2() && x < n;) {
+        for (int x = 0; draw.kernels && x < n;) {
             int e = x + 1;
             const int32_t step = x + 1 < n ? cols.off0[size_t(x + 1)] - cols.off0[size_t(x)] : 0;
             if (ok(x) && step >= 1 && step <= kMaxAlignedStep)
@@ -371,7 +371,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
                    (cols.w[size_t(x)] == 0 || cols.off1[size_t(x)] >= 0);
         };
         int tabSlot = -1, tabConfig = -1;
-        for (int x = 0; hasAvx2() && x < n;) {
+        for (int x = 0; draw.kernels && x < n;) {
             if (!tabOk(x)) {
                 ++x;
                 continue;
@@ -459,7 +459,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     } ctx{&draw, nullptr, &rows, 0};
     const ps11::Executor::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
-        filterTap(f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
+        filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
                   count, dst);
     };
     HRowCache& cache = sc.hrows;
@@ -518,10 +518,10 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     HConfig h = tri.configs[ci];
                     if (ti < kMaxAlignedTriangles && ci < tabIds[ti].size()) h.tableId = tabIds[ti][ci];
-                    hRow(cache, r.row0, h, planes);
+                    hRow(*draw.kernels, cache, r.row0, h, planes);
                     for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
                     if (r.wy != 0) {
-                        hRow(cache, r.row1, h, planes);
+                        hRow(*draw.kernels, cache, r.row1, h, planes);
                         for (int ch = 0; ch < 4; ++ch) r.h1[size_t(c)].p[ch] = planes[size_t(ch)];
                     }
                 }
@@ -550,9 +550,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
                 if (draw.directStore || draw.directAdd) {
                     int done = 0;
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-                    if (hasAvx2()) done = alignedStoreRowAvx2(draw.directAdd, r0c, n, orMask, row);
-#endif
+                    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r0c, n, orMask, row);
                     const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
                     if (draw.directAdd)
                         storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);

@@ -20,6 +20,8 @@
 
 namespace emu {
 
+struct AlignedKernels;
+
 // One texture read of the program, resolved against the draw's textures and sampler states.
 struct AlignedTap {
     bool bound = false;               // no texture: every lookup is (0, 0, 0, 1)
@@ -35,6 +37,9 @@ struct AlignedTap {
 struct AlignedDraw {
     uint64_t serial = 0;  // unique per draw: H rows cached by workers are valid within one draw only
     const ps11::Executor* executor = nullptr;
+    // The vector kernels of the SIMD level in force when the draw was prepared
+    // (emu/aligned_pass_kernels.h); null: every pixel filtered and stored one at a time.
+    const AlignedKernels* kernels = nullptr;
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
@@ -54,7 +59,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
 // Per-triangle column tables of every tap: texel byte offsets of the pair (−1 = border) and the
 // 8-bit weight per column; and the long runs: at least kMinAlignedRun columns whose first texel
 // steps by a fixed 1..kMaxAlignedStep texels with one weight, filtered with vector kernels from
-// shared H rows (emu/aligned_pass_kernels.h) when the CPU has AVX2.
+// shared H rows where the draw has them (AlignedDraw::kernels).
 constexpr int kMinAlignedRun = 16;
 constexpr int kMaxAlignedStep = 8;
 constexpr int kMaxTapConfigs = 4;  // H-row configurations per tap (runs past these are filtered per pixel)

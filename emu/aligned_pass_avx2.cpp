@@ -1,5 +1,9 @@
-// The AVX2 kernels of the aligned-pass path (emu/aligned_pass_kernels.h), compiled with -mavx2
-// (CMakeLists.txt) and called only when the CPU has AVX2.
+// The aligned-pass kernels at the Avx2 level (emu/aligned_pass_kernels.h): CMakeLists.txt builds
+// this file with -mavx2 -mfma -mf16c on x86-64 only; alignedKernels() hands the table out only
+// where the CPU runs that level.
+#if !defined(__AVX2__)
+#error "aligned_pass_avx2.cpp needs the Avx2 level's flags (CMakeLists.txt)"
+#endif
 #include <immintrin.h>
 
 #include <algorithm>
@@ -43,8 +47,6 @@ inline __m256i roundShift(__m256i v) {
     const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(v, S), _mm256_set1_epi16(1));
     return _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(v, _mm256_set1_epi16((1 << (S - 1)) - 1)), odd), S);
 }
-
-}  // namespace
 
 void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]) {
     int k = 0;
@@ -164,8 +166,6 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const in
     }
 }
 
-namespace {
-
 // One group of 16 lanes of every channel: f(c, k) gives the vector of channel c at element k.
 template <typename F>
 inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
@@ -180,8 +180,6 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
         }
     }
 }
-
-}  // namespace
 
 void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                          int lane, int16_t* const out[4]) {
@@ -232,8 +230,6 @@ void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t
     });
 }
 
-namespace {
-
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
@@ -263,10 +259,13 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
     return i;
 }
 
-}  // namespace
-
 int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
 }
+
+}  // namespace
+
+const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2, &alignedCombineAvx2, &alignedBuildTabulatedAvx2,
+                                    &alignedVerticalAvx2, &alignedStoreRowAvx2};
 
 }  // namespace emu

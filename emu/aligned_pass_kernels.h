@@ -1,9 +1,11 @@
-// The vector kernels of the aligned-pass path (emu/aligned_pass.h), built for AVX2 in
-// aligned_pass_avx2.cpp; callers check the CPU first. Internal to emu/aligned_pass*.cpp.
+// The vector kernels of the aligned-pass path (emu/aligned_pass.h): a table per SIMD level
+// (ps11/simd_dispatch.h), fetched once per draw (AlignedDraw::kernels). Only the Avx2 level has
+// one (aligned_pass_avx2.cpp); at Baseline there is none and every pixel is filtered and stored
+// one at a time. Internal to emu/aligned_pass*.cpp.
 //
 // Filtering is split in two passes (docs/device.md "Aligned passes"): a horizontal pass turns a
-// texel row into an "H row" once (alignedBuildHRowAvx2), and each tap of each pixel row combines
-// two H rows vertically (alignedVerticalAvx2). An H row of weight wx holds, per output j, planar
+// texel row into an "H row" once (combine, or buildTabulated), and each tap of each pixel row
+// combines two H rows vertically (vertical). An H row of weight wx holds, per output j, planar
 // (r, g, b, a) uint16 values in one of three forms, all exact:
 //   kind A (wx = 0):   a           (h = 256·a)
 //   kind S (wx = 128): a + b       (h = 128·(a + b))
@@ -13,6 +15,8 @@
 #pragma once
 
 #include <cstdint>
+
+#include "ps11/simd_dispatch.h"
 
 namespace emu {
 
@@ -26,31 +30,40 @@ inline HKind hKindOf(int32_t wx) { return wx == 0 ? HKind::A : (wx == 128 ? HKin
 constexpr int kHRowPad = 32;
 constexpr int kStagePad = 16 * 8 + 32;
 
-// Texels [0, count) of a b g r a row as r g b a uint16 planes out[c][0 .. count) (and up to the
-// next multiple of 16: whatever the row holds there, or 0 past the row's end; never read past
-// row + 4·count).
-void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]);
+struct AlignedKernels {
+    // Texels [0, count) of a b g r a row as r g b a uint16 planes out[c][0 .. count) (and up to
+    // the next multiple of 16: whatever the row holds there, or 0 past the row's end; never read
+    // past row + 4·count).
+    void (*deinterleave)(const uint8_t* row, int count, uint16_t* const out[4]);
 
-// H row j in [0, n) from staged planes t (t[c][k] = channel c of texel i_first + k): texels
-// k = step·j and k + 1 with weight wx, in the form of hKindOf(wx). Steps 1, 2 and 4 are
-// vectorised, others run one element at a time. t's planes must hold kStagePad elements past the
-// last one read.
-void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
+    // H row j in [0, n) from staged planes t (t[c][k] = channel c of texel i_first + k): texels
+    // k = step·j and k + 1 with weight wx, in the form of hKindOf(wx). Steps 1, 2 and 4 are
+    // vectorised, others run one element at a time. t's planes must hold kStagePad elements past
+    // the last one read.
+    void (*combine)(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
 
-// Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b the
-// channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets; negative
-// offsets read texel 0: such elements are never used).
-void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
-                               uint16_t* const out[4]);
+    // Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b
+    // the channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets;
+    // negative offsets read texel 0: such elements are never used).
+    void (*buildTabulated)(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
+                           uint16_t* const out[4]);
 
-// Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of kind
-// `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
-void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
-                         int lane, int16_t* const out[4]);
+    // Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of
+    // kind `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
+    void (*vertical)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                     int lane, int16_t* const out[4]);
 
-// Stores the first pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
-// dst, or-ing orMask (additive: a saturating byte add onto what dst holds), in whole groups of
-// 16; returns how many it stored (the caller stores the rest).
-int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+    // Stores the first pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words
+    // at dst, or-ing orMask (additive: a saturating byte add onto what dst holds), in whole
+    // groups of 16; returns how many it stored (the caller stores the rest).
+    int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+};
+
+// The table of a level, or null (no vector kernels at that level).
+const AlignedKernels* alignedKernels(ps11::SimdLevel level);
+// The Avx2 table (x86-64 builds only); use alignedKernels().
+namespace avx2 {
+extern const AlignedKernels kAligned;
+}
 
 }  // namespace emu

@@ -5,6 +5,7 @@
 #include "emu/output_merger.h"
 
 #include "emu/merge_plan.h"
+#include "emu/output_merger_kernels.h"
 
 #include <algorithm>
 #include <bit>
@@ -12,12 +13,7 @@
 #include <cstring>
 #include <string>
 
-#include "ps11/cpu_features.h"
 #include "ps11/sampler.h"
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
 
 namespace emu {
 
@@ -742,35 +738,11 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     }
 }
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-// A16B16G16R16F stores with the F16C conversion (VCVTPS2PH, round to nearest even: the same
-// halves as halfOf for every non-NaN value; a NaN stays a NaN), chosen at run time.
-// CPUID: F16C, AVX and OSXSAVE, and XCR0 saying the OS keeps the AVX state (VCVTPS2PH is
-// VEX-encoded): ps11::cpuFeatures.
-bool hasF16c() { return ps11::cpuFeatures().f16c; }
-__attribute__((target("f16c"))) uint64_t storeHalfF16c(const Surf& cs, const Lanes& lanes, const MergeInputs& in,
-                                                       const float* const f[4], uint32_t channels) {
-    const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
-    const uint8_t* live = in.live;
-    uint64_t written = 0;
-    for (int i = 0; i < in.count; ++i) {
-        uint32_t x, y;
-        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
-        uint8_t* q = cs.at(x, y);
-        ++written;
-        const __m128i h = _mm_cvtps_ph(_mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), _MM_FROUND_TO_NEAREST_INT);
-        uint16_t v[8];
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(v), h);
-        if (channels == 0xfu) {
-            std::memcpy(q, v, 8);
-        } else {
-            for (int c = 0; c < 4; ++c)
-                if (channels >> c & 1u) std::memcpy(q + 2 * c, &v[c], 2);
-        }
-    }
-    return written;
+// The Baseline level's half conversion (emu/output_merger_kernels.h).
+void halvesBaseline(const float* const f[4], int count, uint16_t* out) {
+    for (int i = 0; i < count; ++i)
+        for (int c = 0; c < 4; ++c) out[4 * i + c] = halfOf(f[c][i]);
 }
-#endif
 
 // Float targets without fog, tests or blending: convert and store the live lanes' channels.
 void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
@@ -780,12 +752,8 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
     const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
     const uint8_t* live = in.live;
     const bool half = p.target == TargetKind::Rgba16F;
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-    if (half && hasF16c()) {
-        n.written += storeHalfF16c(cs, lanes, in, f, channels);
-        return;
-    }
-#endif
+    alignas(16) uint16_t halves[4 * ps11::kMaxSpan];
+    if (half) mergerKernels(ps11::simdLevel()).halves(f, in.count, halves);
     uint64_t written = 0;
     for (int i = 0; i < in.count; ++i) {
         uint32_t x, y;
@@ -793,7 +761,7 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
         uint8_t* q = cs.at(x, y);
         ++written;
         if (half) {
-            const uint16_t h[4] = {halfOf(f0[i]), halfOf(f1[i]), halfOf(f2[i]), halfOf(f3[i])};
+            const uint16_t* h = halves + 4 * i;
             if (channels == 0xfu) {
                 std::memcpy(q, h, 8);
             } else {
@@ -816,6 +784,17 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
 [[maybe_unused]] bool supportedColor(const Image* img) { return img && img->format && img->format->renderTarget; }
 
 }  // namespace
+
+const MergerKernels baseline::kMerger{&halvesBaseline};
+
+const MergerKernels& mergerKernels(ps11::SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return *ps11::simdTable(level, &baseline::kMerger, &avx2::kMerger);
+#else
+    (void)level;
+    return baseline::kMerger;
+#endif
+}
 
 // ---------------------------------------------------------------------------------------------
 

@@ -1,5 +1,6 @@
 // What this CPU and operating system can run, queried once for the whole program (CPUID and
-// XGETBV on x86-64). Every SIMD path chooses its kernels from here.
+// XGETBV on x86-64). The SIMD dispatch (ps11/simd_dispatch.h) chooses every kernel level from
+// here; nothing else asks it to pick code paths.
 #pragma once
 
 namespace ps11 {

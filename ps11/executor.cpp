@@ -51,8 +51,7 @@ public:
         for (int i = 0; i < kNumConsts; ++i) refreshConstant(i);
         m_constsId = nextConstsId();
         if (options.path != ExecPath::Generic) {
-            const FastKernels* k = options.path == ExecPath::FastBaseline ? fastKernelsBaseline() : fastKernelsBest();
-            buildFastProgram(m_p, m_ops, k, m_fast);
+            buildFastProgram(m_p, m_ops, m_fast);
             presampledOps(m_fast, m_p, m_ops, m_presampled);
         }
     }
@@ -62,7 +61,7 @@ public:
         m_api[size_t(index)] = value;
         refreshConstant(index);
         m_constsId = nextConstsId();
-        if (m_fast.kernels) presampledOps(m_fast, m_p, m_ops, m_presampled);
+        if (m_fast.ready) presampledOps(m_fast, m_p, m_ops, m_presampled);
     }
     void setStageState(int stage, const StageState& state) override {
         if (stage >= 0 && stage < kMaxTextureStages) m_p.stages[size_t(stage)] = state;
@@ -71,8 +70,7 @@ public:
     uint32_t sampledStages() const override { return m_stagesUsed; }
     const ExecutorOptions& options() const override { return m_options; }
     const char* pathName() const override {
-        if (!m_fast.kernels) return "generic";
-        return m_fast.kernels == fastKernelsAvx2() ? "fast-avx2" : "fast-sse2";
+        return m_fast.ready ? fastKernels(simdLevel())->name : "generic";
     }
 
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
@@ -99,7 +97,7 @@ private:
         stats->instructions += executed * uint64_t(count);
     }
     void loadColors(RunState& st) const;
-    void runChunk(RunState& st) const;
+    void runChunk(RunState& st, const FloatArithKernels& floatArith) const;
 
     ExecutorOptions m_options;
     Profile m_p;
@@ -110,7 +108,7 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
-    FastProgram m_fast;                // kernels == null: the generic path runs
+    FastProgram m_fast;                // not ready: the generic path runs
     std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
     uint64_t m_constsId = 0;           // names the constants (a thread's fast bank keeps them)
 };
@@ -137,7 +135,7 @@ void ExecutorImpl::loadColors(RunState& st) const {
     }
 }
 
-void ExecutorImpl::runChunk(RunState& st) const {
+void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith) const {
     const bool fx = isFixedPoint(m_p.precision);
     std::memset(st.killed, 0, sizeof st.killed);
     loadColors(st);
@@ -148,7 +146,7 @@ void ExecutorImpl::runChunk(RunState& st) const {
         } else if (fx) {
             execArithFx(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
         } else {
-            execArithFloat(m_p, op, st, op.hold ? st.bf.hold : st.bf.reg[op.dstSlot]);
+            floatArith.arith(m_p, op, st, op.hold ? st.bf.hold : st.bf.reg[op.dstSlot]);
         }
         if (!op.hold && (&op != m_ops.data()) && (&op - 1)->hold) {
             // Co-issued pair: the second member has read and written; now the first writes
@@ -167,7 +165,7 @@ void ExecutorImpl::runChunk(RunState& st) const {
 
 bool ExecutorImpl::tapPlan(TapPlan& plan) const {
     plan = TapPlan{};
-    if (!m_fast.kernels) return false;
+    if (!m_fast.ready) return false;
     for (const DOp& op : m_ops) {
         if (!op.texture) continue;
         if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
@@ -196,7 +194,7 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* 
 void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
                        ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    if (m_fast.kernels) {
+    if (m_fast.ready) {
         runFast(m_fast, m_p, m_constsId, m_ops, m_vUsed, m_writesDepth, inputs, sampler, outputs);
     } else {
         runGeneric(inputs, sampler, outputs);
@@ -215,11 +213,12 @@ void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, Pixel
     std::memset(st->bi.reg[kSlotR], 0, sizeof st->bi.reg[kSlotR]);
     std::memset(st->bf.reg[kSlotR], 0, sizeof st->bf.reg[kSlotR]);
     const float g = float(m_p.g);
+    const FloatArithKernels& floatArith = floatArithKernels(simdLevel());
     for (int off = 0; off < count; off += kChunk) {
         st->offset = off;
         st->n = std::min(kChunk, count - off);
         st->depthWritten = false;
-        runChunk(*st);
+        runChunk(*st, floatArith);
         for (int c = 0; c < 4; ++c) {
             if (fx) {
                 const int32_t* r = st->bi.reg[kSlotR][c];

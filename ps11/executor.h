@@ -16,11 +16,12 @@
 
 namespace ps11 {
 
-// Which implementation runs a program. Results are bit-identical; tests and benchmarks compare
-// them in one process. Auto: the fx8 fast path (int16 lanes, AVX2 when the CPU has it) where it
-// applies (fx8, round(M·G) <= 2040, no bem), the generic path otherwise. Generic: always the
-// generic path (the reference). FastBaseline: as Auto but with the fast path's SSE2 kernels.
-enum class ExecPath : uint8_t { Auto, Generic, FastBaseline };
+// Which interpreter runs a program (not a SIMD level: both run their kernels at
+// ps11::simdLevel(), ps11/simd_dispatch.h). Results are bit-identical; tests and benchmarks
+// compare them in one process. Auto: the fx8 fast path (int16 lanes) where it applies (fx8,
+// round(M·G) <= 2040, no bem, an x86-64 build), the generic path otherwise. Generic: always the
+// generic path (the reference).
+enum class ExecPath : uint8_t { Auto, Generic };
 
 struct ExecutorOptions {
     Precision precision = Precision::Fx8;
@@ -105,7 +106,8 @@ public:
     // Stages the program samples (bit per stage).
     virtual uint32_t sampledStages() const = 0;
     virtual const ExecutorOptions& options() const = 0;
-    // The implementation run() uses: "generic", "fast-avx2" or "fast-sse2".
+    // The implementation run() uses now: "generic", or the fast path's kernels at the current
+    // SIMD level, "fast-sse2" or "fast-avx2".
     virtual const char* pathName() const = 0;
 
     // Runs the program for inputs.count pixels (<= kMaxSpan). Thread-safe for distinct

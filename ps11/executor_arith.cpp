@@ -1,24 +1,15 @@
 // The executor, arithmetic stage: fetch (selector, then modifier) → op → write step (shift,
 // round once, _sat, range clamp) for mov add sub mul mad dp3 dp4 lrp cnd cmp bem, over a chunk
-// of lanes, exactly as docs/precision.md says. fx profiles keep int32 grid integers and form
-// each result as an exact integer numerator (int32 or int64 lanes); float profiles use float32.
+// of lanes, exactly as docs/precision.md says, for the fx profiles: int32 grid integers, each
+// result formed as an exact integer numerator (int32 or int64 lanes). The float profiles'
+// float32 stage is executor_arith_float.inc.
 #include <cmath>
 #include <cstring>
 
 #include "ps11/executor_internal.h"
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
-#define PS11_AVX2_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define PS11_AVX2_CLONES
-#endif
-
 namespace ps11::exec {
 namespace {
-
-// Channels of source s an op reads, as a mask of output channels (the opcode table's
-// componentsRead: the write mask, or dp3 .rgb, dp4 .rgba, bem .rg).
-inline uint8_t fetchMask(const DOp& op, int s) { return componentsRead(*op.info, s, op.mask); }
 
 // Source modifier as k = a·n + b (k/(2G) is the exact value, docs/precision.md table) and,
 // for float, x' = a·x + b, which rounds exactly like the written formulas (negation is exact).
@@ -176,70 +167,6 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
     }
 }
 
-// Float profiles ------------------------------------------------------------------------------
-
-[[gnu::always_inline]] inline void fetchFloat(const Profile& p, const DOp& op, RunState& st) {
-    const int n = st.n;
-    for (int s = 0; s < op.numSrc; ++s) {
-        const uint8_t fm = fetchMask(op, s);
-        const DSrc& src = op.src[size_t(s)];
-        // The written formulas (docs/precision.md "float and ideal"), signed zeros included.
-        auto apply = [m = src.mod](float x) {
-            switch (m) {
-                case SrcMod::Neg: return -x;
-                case SrcMod::Bias: return x - 0.5f;
-                case SrcMod::BiasNeg: return -(x - 0.5f);
-                case SrcMod::Sign: return 2.0f * x - 1.0f;
-                case SrcMod::SignNeg: return -(2.0f * x - 1.0f);
-                case SrcMod::Comp: return 1.0f - x;
-                case SrcMod::X2: return 2.0f * x;
-                case SrcMod::X2Neg: return -(2.0f * x);
-                default: return x;
-            }
-        };
-        for (int c = 0; c < 4; ++c) {
-            if (!((fm >> c) & 1)) continue;
-            float* x = st.x[s][c];
-            if (src.kind == SrcKind::Const) {
-                const float v = apply(p.constF[src.slot][src.sw[size_t(c)]]);
-                for (int i = 0; i < n; ++i) x[i] = v;
-                continue;
-            }
-            const float* r = st.bf.reg[src.slot][src.sw[size_t(c)]];
-            switch (src.mod) {
-                case SrcMod::Neg: for (int i = 0; i < n; ++i) x[i] = -r[i]; break;
-                case SrcMod::Bias: for (int i = 0; i < n; ++i) x[i] = r[i] - 0.5f; break;
-                case SrcMod::BiasNeg: for (int i = 0; i < n; ++i) x[i] = -(r[i] - 0.5f); break;
-                case SrcMod::Sign: for (int i = 0; i < n; ++i) x[i] = 2.0f * r[i] - 1.0f; break;
-                case SrcMod::SignNeg: for (int i = 0; i < n; ++i) x[i] = -(2.0f * r[i] - 1.0f); break;
-                case SrcMod::Comp: for (int i = 0; i < n; ++i) x[i] = 1.0f - r[i]; break;
-                case SrcMod::X2: for (int i = 0; i < n; ++i) x[i] = 2.0f * r[i]; break;
-                case SrcMod::X2Neg: for (int i = 0; i < n; ++i) x[i] = -(2.0f * r[i]); break;
-                default: std::memcpy(x, r, sizeof(float) * size_t(n)); break;
-            }
-        }
-    }
-}
-
-template <class F>
-[[gnu::always_inline]] inline void finishFloat(int n, float* __restrict out, const F& f, float scale, bool sat, float lo, float hi) {
-    if (sat) {
-        for (int i = 0; i < n; ++i) {
-            float v = f(i) * scale;
-            v = v > 0.0f ? v : 0.0f;  // NaN -> 0
-            v = v < 1.0f ? v : 1.0f;
-            v = v < lo ? lo : v;
-            out[i] = v > hi ? hi : v;
-        }
-    } else {
-        for (int i = 0; i < n; ++i) {
-            float v = f(i) * scale;
-            v = v < lo ? lo : v;
-            out[i] = v > hi ? hi : v;
-        }
-    }
-}
-
 }  // namespace
 
 void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]) {
@@ -252,76 +179,6 @@ void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[k
         arithFx<int64_t, 4080>(p, op, st, out);
     } else {
         arithFx<int32_t, 4080>(p, op, st, out);
-    }
-}
-
-// Compiled for AVX2 and for the baseline, picked at load time (ifunc); the float formulas are
-// the same in both (-ffp-contract=off for this file: no FMA contraction).
-PS11_AVX2_CLONES void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]) {
-    fetchFloat(p, op, st);
-    const int n = st.n;
-    const float scale = std::ldexp(1.0f, op.shift);  // exact power of two
-    const float inf = INFINITY;
-    const float lo = p.clampRange ? -p.maxValue : -inf;
-    const float hi = p.clampRange ? p.maxValue : inf;
-    const bool sat = op.sat;
-    auto& x = st.x;
-    if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
-        const float *a0 = x[0][0], *a1 = x[0][1], *a2 = x[0][2], *a3 = x[0][3];
-        const float *b0 = x[1][0], *b1 = x[1][1], *b2 = x[1][2], *b3 = x[1][3];
-        int first = -1;
-        for (int c = 0; c < 4; ++c) {
-            if (!((op.mask >> c) & 1)) continue;
-            if (first >= 0) {
-                std::memcpy(out[c], out[first], sizeof(float) * size_t(n));
-                continue;
-            }
-            first = c;
-            // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a), evaluated as written.
-            if (op.op == Opcode::Dp3)
-                finishFloat(n, out[c], [=](int i) { return (a0[i] * b0[i] + a1[i] * b1[i]) + a2[i] * b2[i]; }, scale,
-                            sat, lo, hi);
-            else
-                finishFloat(n, out[c], [=](int i) {
-                    return ((a0[i] * b0[i] + a1[i] * b1[i]) + a2[i] * b2[i]) + a3[i] * b3[i];
-                }, scale, sat, lo, hi);
-        }
-        return;
-    }
-    if (op.op == Opcode::Bem) {
-        const StageState& ss = p.stages[op.stage];
-        for (int c = 0; c < 2; ++c) {
-            if (!((op.mask >> c) & 1)) continue;
-            const float mr = c == 0 ? ss.bumpMat[0] : ss.bumpMat[1], mg = c == 0 ? ss.bumpMat[2] : ss.bumpMat[3];
-            const float *a = x[0][c], *br = x[1][0], *bg = x[1][1];
-            // a + (Mr·b.r + Mg·b.g), as the spec's formula is written.
-            finishFloat(n, out[c], [=](int i) { return a[i] + (mr * br[i] + mg * bg[i]); }, scale, sat, lo, hi);
-        }
-        return;
-    }
-    for (int c = 0; c < 4; ++c) {
-        if (!((op.mask >> c) & 1)) continue;
-        const float *s0 = x[0][c], *s1 = x[1][c], *s2 = x[2][c];
-        float* o = out[c];
-        switch (op.op) {
-            case Opcode::Mov: finishFloat(n, o, [=](int i) { return s0[i]; }, scale, sat, lo, hi); break;
-            case Opcode::Add: finishFloat(n, o, [=](int i) { return s0[i] + s1[i]; }, scale, sat, lo, hi); break;
-            case Opcode::Sub: finishFloat(n, o, [=](int i) { return s0[i] - s1[i]; }, scale, sat, lo, hi); break;
-            case Opcode::Mul: finishFloat(n, o, [=](int i) { return s0[i] * s1[i]; }, scale, sat, lo, hi); break;
-            case Opcode::Mad:
-                finishFloat(n, o, [=](int i) { return s0[i] * s1[i] + s2[i]; }, scale, sat, lo, hi);
-                break;
-            case Opcode::Lrp:
-                finishFloat(n, o, [=](int i) { return s2[i] + s0[i] * (s1[i] - s2[i]); }, scale, sat, lo, hi);
-                break;
-            case Opcode::Cnd:
-                finishFloat(n, o, [=](int i) { return s0[i] > 0.5f ? s1[i] : s2[i]; }, scale, sat, lo, hi);
-                break;
-            case Opcode::Cmp:
-                finishFloat(n, o, [=](int i) { return s0[i] >= 0.0f ? s1[i] : s2[i]; }, scale, sat, lo, hi);
-                break;
-            default: break;
-        }
     }
 }
 

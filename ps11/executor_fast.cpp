@@ -152,9 +152,18 @@ struct ThreadState {
 
 }  // namespace
 
-bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp) {
+const FastKernels* fastKernels(SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return simdTable(level, &sse2::kKernels, &avx2::kKernels);
+#else
+    (void)level;
+    return nullptr;
+#endif
+}
+
+bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram& fp) {
     fp = FastProgram{};
-    if (!kernels || p.precision != Precision::Fx8 || p.g != 255 || p.nMax > kFastMaxGrid || p.nMax < 1) return false;
+    if (!fastKernels(SimdLevel::Baseline) || p.precision != Precision::Fx8 || p.g != 255 || p.nMax > kFastMaxGrid || p.nMax < 1) return false;
     fp.ops.resize(ops.size());
     fp.syncDstBefore.assign(ops.size(), 0);
     for (size_t i = 0; i < ops.size(); ++i) {
@@ -211,7 +220,7 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastK
             }
         }
     }
-    fp.kernels = kernels;
+    fp.ready = true;
     return true;
 }
 
@@ -230,7 +239,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
     // SIMD arithmetic, so whatever those lanes hold is harmless.
     std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
     fillConstants(*fs, fp, p, constsId);
-    const FastKernels& kern = *fp.kernels;
+    const FastKernels& kern = *fastKernels(simdLevel());
     for (int off = 0; off < count; off += kChunk) {
         st.offset = off;
         st.n = std::min(kChunk, count - off);
@@ -273,7 +282,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
 
 void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out) {
     out = fp.ops;
-    if (!fp.kernels) return;
+    if (!fp.ready) return;
     // Sign analysis for productSmall: channels known >= 0 per slot (bit c). Taps are 8-bit texels
     // (>= 0), v# are in [0, 1], constants as they are; a mov or small mul/mad of known
     // non-negative sources with positive modifiers, or a _sat result, is >= 0. Programs with
@@ -327,7 +336,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     for (int c = 0; c < 4; ++c)
         if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
     fillConstants(*fs, fp, p, constsId);
-    const FastKernels& kern = *fp.kernels;
+    const FastKernels& kern = *fastKernels(simdLevel());
     const int16_t m = int16_t(p.nMax);
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);

@@ -4,14 +4,15 @@
 // operations whose exactness is proven over the whole input range (tests/test_executor_fast.cpp).
 // It gives results bit-identical to the generic int32/int64 path (executor_arith.cpp), which
 // stays the reference and runs whatever the fast path does not cover. The kernels are compiled
-// twice (executor_fast_avx2.cpp with -mavx2 -mfma, executor_fast_sse2.cpp for any x86-64) and
-// picked once at run time. Not part of the public API.
+// twice (executor_fast_sse2.cpp for any x86-64, executor_fast_avx2.cpp for the Avx2 level) and
+// fetched per run from fastKernels(simdLevel()) (ps11/simd_dispatch.h). Not part of the public API.
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 #include "ps11/executor_internal.h"
+#include "ps11/simd_dispatch.h"
 
 namespace ps11::exec {
 
@@ -71,7 +72,7 @@ using FastNarrowFn = void (*)(const int32_t* src, int16_t* dst, int n, int16_t m
 using FastStoreFn = void (*)(const int16_t* r, float* color, int32_t* grid, int n);
 
 struct FastKernels {
-    const char* name;  // "avx2" or "sse2"
+    const char* name;  // what Executor::pathName() says: "fast-sse2" or "fast-avx2"
     FastArithFn arith;
     FastLoadColorFn loadColor;
     FastStoreFn store;
@@ -80,13 +81,10 @@ struct FastKernels {
     FastRoundLinearFn roundLinear;
 };
 
-// Kernel sets: the baseline (SSE2, every x86-64) and AVX2 (null if the CPU lacks AVX2 or the
-// build has no x86 kernels). fastKernelsBaseline() is null on non-x86 builds.
-const FastKernels* fastKernelsBaseline();
-const FastKernels* fastKernelsAvx2();
-// The best set for this CPU (AVX2 when available), chosen once.
-const FastKernels* fastKernelsBest();
-
+// The kernels of a SIMD level: SSE2 at Baseline, AVX2 + FMA at Avx2. Null off x86-64 (no
+// kernels at any level: the generic path runs every program).
+const FastKernels* fastKernels(SimdLevel level);
+// The two tables (x86-64 builds), defined by executor_fast_kernels.inc; use fastKernels().
 namespace sse2 {
 extern const FastKernels kKernels;
 }
@@ -100,24 +98,25 @@ namespace ps11::exec {
 
 // A program prepared for the fast path: one FastOp per DOp (unused for texture ops and phase).
 struct FastProgram {
-    const FastKernels* kernels = nullptr;
+    bool ready = false;  // the fast path applies (buildFastProgram); false: the generic path runs
     std::vector<FastOp> ops;
     uint8_t constsUsed = 0;              // constants the arithmetic ops read (bit per c#)
     uint8_t r0Written = 0;               // r0 channels some op writes (the others stay 0)
     std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
 };
 
-// Fills fp for ops if the fast path applies (fx8, round(M·G) <= kFastMaxGrid, no bem) and
-// kernels is not null; returns false otherwise (the generic path then runs the program).
-bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, const FastKernels* kernels, FastProgram& fp);
+// Fills fp for ops if the fast path applies (fx8, round(M·G) <= kFastMaxGrid, no bem) and this
+// build has the kernels; returns false otherwise (the generic path then runs the program).
+bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram& fp);
 
-// run() of the fast path: same inputs, outputs and semantics as the generic run.
+// run() of the fast path, with the kernels of simdLevel(): same inputs, outputs and semantics as
+// the generic run.
 // constsId names p's constants (a process-wide unique number per executor and constant change;
 // 0 = unnamed): a thread's bank keeps them between runs with the same id.
 void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops, uint8_t vUsed,
              bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
-// Executor::runPresampled on the fast path: texture instructions (plain reads, Executor::tapPlan)
+// Executor::runPresampled on the fast path (the kernels of simdLevel()): texture instructions (plain reads, Executor::tapPlan)
 // have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
 // sampled texels are) instead of sampling; r0's int16 lanes are the output.
 // `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.

@@ -1,5 +1,5 @@
 // Executor internals shared by its stages: the per-run register file in structure-of-arrays
-// lanes and the kernels of each family (executor_arith.cpp, executor_texture.cpp). The decoded op
+// lanes and the kernels of each family (executor_arith*.cpp, executor_texture.cpp). The decoded op
 // list, the profile and the register slot layout they run over are public
 // (ps11/decoded_program.h). Not part of the public API.
 #pragma once
@@ -9,6 +9,7 @@
 
 #include "ps11/decoded_program.h"
 #include "ps11/executor.h"
+#include "ps11/simd_dispatch.h"
 
 namespace ps11::exec {
 
@@ -42,9 +43,26 @@ struct RunState {
     bool deferTexelClamp = false;
 };
 
-// Arithmetic instruction (mov … bem, not nop) into out (the destination or the hold buffer).
+// Channels of source s an op reads, as a mask of output channels (the opcode table's
+// componentsRead: the write mask, or dp3 .rgb, dp4 .rgba, bem .rg).
+inline uint8_t fetchMask(const DOp& op, int s) { return componentsRead(*op.info, s, op.mask); }
+
+// Arithmetic instruction (mov … bem, not nop) into out (the destination or the hold buffer):
+// fx profiles (executor_arith.cpp), float profiles (executor_arith_float.inc, a table per SIMD
+// level that runGeneric fetches once per run).
 void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]);
-void execArithFloat(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]);
+using FloatArithFn = void (*)(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]);
+struct FloatArithKernels {
+    FloatArithFn arith;
+};
+const FloatArithKernels& floatArithKernels(SimdLevel level);
+// The tables (the Avx2 one in x86-64 builds only); use floatArithKernels().
+namespace baseline {
+extern const FloatArithKernels kFloatArith;
+}
+namespace avx2 {
+extern const FloatArithKernels kFloatArith;
+}
 // Texture-address instruction.
 void execTexture(const Profile& p, const DOp& op, RunState& st);
 

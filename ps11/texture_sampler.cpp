@@ -423,7 +423,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
         run.scale = gridScale(req.precision) / 255;
         const bool border = ss.addressU == TextureAddress::Border || ss.addressV == TextureAddress::Border;
         if (!border || borderAsWord(borderGrid, run.scale, run.borderWord)) {
-            const fastpath::Unorm8Kernel kernel = fastpath::unorm8Kernel();
+            const fastpath::Unorm8Kernel kernel = fastpath::samplerKernels(simdLevel()).unorm8;
             auto fastRun = [&](int first, int n, int level, bool linear) {
                 const TextureLevelInfo& li = tex.level(level);
                 run.texels = tex.unorm8() + li.offset * 4;

@@ -1,33 +1,19 @@
-// The fast Unorm8 kernels for any x86-64 (or other) CPU, and the runtime choice between them
-// and the AVX2 build (texture_sampler_fast_avx2.cpp).
-#define PS11_FAST_KERNEL sampleUnorm8Generic
-#include "ps11/cpu_features.h"
+// The fast Unorm8 kernels at the Baseline level (any x86-64, or other, CPU), the choice of a
+// level's table, and axisTable.
+#define PS11_SAMPLER_LEVEL baseline
 #include "ps11/texture_sampler_fast_impl.h"
 
-#include <atomic>
 #include <type_traits>
 
 namespace ps11::fastpath {
 
-namespace {
-std::atomic<bool> g_forceGeneric{false};
-}
-
-bool hasAvx2Kernel() {
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-    return cpuFeatures().avx2Fma();
+const SamplerKernels& samplerKernels(SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return *simdTable(level, &baseline::kSampler, &avx2::kSampler);
 #else
-    return false;
+    (void)level;
+    return baseline::kSampler;
 #endif
-}
-
-void setForceGeneric(bool generic) { g_forceGeneric.store(generic, std::memory_order_relaxed); }
-
-Unorm8Kernel unorm8Kernel() {
-#if defined(__x86_64__) && defined(PS11_HAVE_AVX2_KERNEL)
-    if (hasAvx2Kernel() && !g_forceGeneric.load(std::memory_order_relaxed)) return &sampleUnorm8Avx2;
-#endif
-    return &sampleUnorm8Generic;
 }
 
 void axisTable(TextureAddress mode, bool linear, int count, const float* c, uint32_t n, int32_t* i0, int32_t* i1,

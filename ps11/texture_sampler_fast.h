@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "ps11/simd_dispatch.h"
 #include "ps11/texture_sampler.h"
 
 namespace ps11::fastpath {
@@ -22,16 +23,19 @@ struct Unorm8Run {
 
 using Unorm8Kernel = void (*)(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
 
-// Portable build (baseline x86-64 / any CPU).
-void sampleUnorm8Generic(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
-// Built with AVX2 + FMA; call only when the CPU has both.
-void sampleUnorm8Avx2(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
-// The best kernel this CPU runs (chosen once, by ps11::cpuFeatures), or the generic one
-// while setForceGeneric(true) (tests compare both builds on a CPU that has AVX2).
-Unorm8Kernel unorm8Kernel();
-void setForceGeneric(bool generic);
-// True when this process would pick the AVX2 build.
-bool hasAvx2Kernel();
+// The kernels of a SIMD level (ps11/simd_dispatch.h), one source (texture_sampler_fast_impl.h)
+// built per level; TextureSampler fetches the table once per span.
+struct SamplerKernels {
+    Unorm8Kernel unorm8;
+};
+const SamplerKernels& samplerKernels(SimdLevel level);
+// The tables (the Avx2 one in x86-64 builds only); use samplerKernels().
+namespace baseline {
+extern const SamplerKernels kSampler;
+}
+namespace avx2 {
+extern const SamplerKernels kSampler;
+}
 
 // One axis of the kernels above on its own, for callers that tabulate it (the device's
 // aligned-pass path): per coordinate c[i] of an axis with n texels, the texel pair i0/i1 (-1 =

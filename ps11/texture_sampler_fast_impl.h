@@ -1,6 +1,7 @@
-// The body of the fast Unorm8 kernels, included by texture_sampler_fast.cpp (baseline ISA) and
-// texture_sampler_fast_avx2.cpp (AVX2 + FMA) with PS11_FAST_KERNEL naming the exported function.
-// Everything else has internal linkage so the two builds never mix at link time.
+// The body of the fast Unorm8 kernels, included by texture_sampler_fast.cpp (Baseline level) and
+// texture_sampler_fast_avx2.cpp (Avx2 level) with PS11_SAMPLER_LEVEL naming the level's namespace
+// (baseline or avx2), whose table kSampler it defines. Everything else has internal linkage so
+// the two builds never mix at link time.
 //
 // Exactness (docs/precision.md "Sampling"): per axis R = round_half_even((u*n - 0.5)*256) gives
 // the first texel R >> 8 and the 8-bit weight R & 255 of the second; when f*256 rounds up to 256
@@ -18,8 +19,8 @@
 #include "ps11/texture_sampler_fast.h"
 #include "ps11/texture_sampler_internal.h"
 
-#ifndef PS11_FAST_KERNEL
-#error "define PS11_FAST_KERNEL before including texture_sampler_fast_impl.h"
+#ifndef PS11_SAMPLER_LEVEL
+#error "define PS11_SAMPLER_LEVEL before including texture_sampler_fast_impl.h"
 #endif
 
 namespace ps11::fastpath {
@@ -328,9 +329,7 @@ void pointOut(int count, const Unorm8Run& run, const Scratch& s, int32_t* __rest
     }
 }
 
-}  // namespace
-
-void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst) {
+void sampleUnorm8(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst) {
     static thread_local Scratch s;
     if (run.linear) {
         axisPass<true>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
@@ -356,5 +355,9 @@ void PS11_FAST_KERNEL(const Unorm8Run& run, int count, const float* u, const flo
         pointOut(count, run, s, dst[0], dst[1], dst[2], dst[3]);
     }
 }
+
+}  // namespace
+
+const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8};
 
 }  // namespace ps11::fastpath

@@ -2,8 +2,9 @@
 // screen-aligned draws (target and texture sizes, texel formats, filters, every address mode,
 // border colours, 1:1 / offset / scaled / downsampling coordinates, colour gradients, programs of
 // ps_1_1–1_4, blending, alpha test, write masks, scissor) drawn by two devices, one with
-// DeviceOptions::alignedPasses off; the render targets must be identical byte for byte, and the
-// aligned device must really have taken the row path (no helper lanes shaded).
+// DeviceOptions::alignedPasses off, the aligned one at every SIMD level this CPU runs; the render
+// targets must be identical byte for byte, and the aligned device must really have taken the row
+// path (no helper lanes shaded).
 #include <catch2/catch.hpp>
 
 #include <cstring>
@@ -12,10 +13,12 @@
 #include <vector>
 
 #include "emu/aligned_pass.h"
+#include "emu/aligned_pass_kernels.h"
 #include "emu/device.h"
 #include "emu/format.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
+#include "simd_levels.h"
 
 using namespace emu;
 
@@ -237,19 +240,22 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
         }
-        Device quadDev(quadOpt), rowDev(rowOpt);
-        DrawStats qs, rs;
+        Device quadDev(quadOpt);
+        DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
         INFO("case " << i << ": " << c.w << "x" << c.h << " program:\n" << c.program);
-        REQUIRE(got == expected);
-        CHECK(rs.pixelsCovered == qs.pixelsCovered);
-        CHECK(rs.pixelsWritten == qs.pixelsWritten);
-        if (qs.pixelsCovered == 0) continue;
-        ++cases;
-        // The row path shades exactly the covered pixels; the quad path adds helper lanes.
-        if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
-        CHECK(rs.instructions * qs.pixelsShaded == qs.instructions * rs.pixelsShaded);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsCovered == qs.pixelsCovered);
+            CHECK(rs.pixelsWritten == qs.pixelsWritten);
+            if (qs.pixelsCovered == 0) return;
+            ++cases;
+            // The row path shades exactly the covered pixels; the quad path adds helper lanes.
+            if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
+            CHECK(rs.instructions * qs.pixelsShaded == qs.instructions * rs.pixelsShaded);
+        });
     }
     // Every case qualifies (fx8, plain texture reads, screen-aligned): all must take the row path,
     // save those whose quads happened to be all covered.
@@ -460,8 +466,9 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
         INFO("draw " << draw);
         CHECK(wrong == 0);
     }
-    // The vector path really served the second draw from rows it built itself.
-    if (__builtin_cpu_supports("avx2")) CHECK(scratch->hrows.built == uint64_t(h + 1));
+    // The vector path (where the level has one) really served the second draw from rows it built
+    // itself.
+    if (alignedKernels(ps11::simdLevel())) CHECK(scratch->hrows.built == uint64_t(h + 1));
     delete scratch;
 }
 
@@ -529,24 +536,29 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
         }
-        Device quadDev(quadOpt), rowDev(rowOpt);
-        DrawStats qs, rs;
+        Device quadDev(quadOpt);
+        DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
         INFO("case " << i << ": " << c.w << "x" << c.h << " scale " << scale << " program:\n" << c.program);
-        REQUIRE(got == expected);
-        if (qs.pixelsCovered == 0) continue;
-        ++cases;
-        if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            if (qs.pixelsCovered == 0) return;
+            ++cases;
+            if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
+        });
     }
     INFO(aligned << " of " << cases << " cases took the row path");
     CHECK(aligned * 10 >= cases * 9);
 }
 
 TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][aligned]") {
-    // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with AVX2, all columns but a few at the
-    // edges (clamped pairs) belong to runs of the tabulated configuration (weight per column).
-    if (!__builtin_cpu_supports("avx2")) return;
+    // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with vector kernels (the Avx2 level), all
+    // columns but a few at the edges (clamped pairs) belong to runs of the tabulated configuration
+    // (weight per column).
+    const ps11::ScopedSimdLevel level(ps11::SimdLevel::Avx2);
+    if (!alignedKernels(level.level())) return;
     ps11::Diagnostics diags;
     std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
     REQUIRE(program);

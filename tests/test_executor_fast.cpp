@@ -1,9 +1,10 @@
 // The fx8 fast path (ps11/executor_fast.h) against the generic path, which is the reference
-// (test_executor_reference.cpp checks it against docs/precision.md). The rounding steps of both
-// kernel sets (SSE2, AVX2) are checked exhaustively over every input that does not saturate, and
-// sampled beyond; then whole programs are compared pixel by pixel: every arithmetic op over all
-// operand pairs with each modifier, shift and _sat, random valid programs (co-issue, masks,
-// selectors, 1_4 ranges) over spans of 1..256 pixels, and textured programs.
+// (test_executor_reference.cpp checks it against docs/precision.md). The rounding steps of the
+// kernel set of every SIMD level this CPU runs (SSE2, AVX2) are checked exhaustively over every
+// input that does not saturate, and sampled beyond; then whole programs are compared pixel by
+// pixel at every level: every arithmetic op over all operand pairs with each modifier, shift and
+// _sat, random valid programs (co-issue, masks, selectors, 1_4 ranges) over spans of 1..256
+// pixels, and textured programs.
 #include <algorithm>
 #include <array>
 #include <catch2/catch.hpp>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "executor_random_programs.h"
+#include "simd_levels.h"
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
 #include "ps11/executor_fast.h"
@@ -36,10 +38,11 @@ int64_t rhe(int64_t num, int64_t den) {
     return q;
 }
 
+// The kernel sets of the SIMD levels this CPU runs (none off x86-64).
 std::vector<const ps11::exec::FastKernels*> kernelSets() {
     std::vector<const ps11::exec::FastKernels*> k;
-    if (ps11::exec::fastKernelsBaseline()) k.push_back(ps11::exec::fastKernelsBaseline());
-    if (ps11::exec::fastKernelsAvx2()) k.push_back(ps11::exec::fastKernelsAvx2());
+    for (ps11::SimdLevel level : ps11::runnableSimdLevels())
+        if (ps11::exec::fastKernels(level)) k.push_back(ps11::exec::fastKernels(level));
     return k;
 }
 
@@ -256,8 +259,8 @@ int64_t compare(const Out& a, const Out& b, int count, const std::string& what) 
     return bad;
 }
 
-// Runs text with the generic path and both fast kernel sets over the lanes; checks the fast
-// executors really take the fast path; returns mismatches.
+// Runs text with the generic path, then with the fast path at every SIMD level this CPU runs,
+// over the lanes; checks the fast path really runs with that level's kernels; returns mismatches.
 int64_t diffPaths(const std::string& text, float maxValue, const Lanes& l, int span, ps11::Sampler& s,
                   const std::array<std::array<float, 4>, 8>* consts = nullptr, bool expectFast = true) {
     auto gen = make(text, Precision::Fx8, maxValue, ExecPath::Generic);
@@ -270,23 +273,19 @@ int64_t diffPaths(const std::string& text, float maxValue, const Lanes& l, int s
     Out want(l.count);
     runAll(*gen, l, want, s, span);
     int64_t bad = 0;
-    for (ExecPath path : {ExecPath::Auto, ExecPath::FastBaseline}) {
-        auto fast = make(text, Precision::Fx8, maxValue, path);
+    auto fast = make(text, Precision::Fx8, maxValue, ExecPath::Auto);
+    set(*fast);
+    testutil::forEachSimdLevel([&](ps11::SimdLevel level) {
         const std::string name = fast->pathName();
-        if (!ps11::exec::fastKernelsBaseline()) {
-            CHECK(name == "generic");  // a build without x86 kernels: the generic path everywhere
-        } else if (expectFast) {
-            CHECK(name != "generic");
-            if (path == ExecPath::FastBaseline) CHECK(name == "fast-sse2");
-            if (path == ExecPath::Auto && ps11::exec::fastKernelsAvx2()) CHECK(name == "fast-avx2");
-        } else {
-            CHECK(name == "generic");
-        }
-        set(*fast);
+        const ps11::exec::FastKernels* kernels = ps11::exec::fastKernels(level);
+        if (kernels && expectFast)
+            CHECK(name == kernels->name);
+        else
+            CHECK(name == "generic");  // or a build without x86 kernels: the generic path everywhere
         Out got(l.count);
         runAll(*fast, l, got, s, span);
         bad += compare(got, want, l.count, name + " span " + std::to_string(span) + "\n" + text);
-    }
+    });
     return bad;
 }
 
@@ -480,7 +479,7 @@ TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem
 }
 
 TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
-    if (!ps11::exec::fastKernelsBaseline()) return;  // no x86 kernels in this build
+    if (!ps11::exec::fastKernels(ps11::SimdLevel::Baseline)) return;  // no x86 kernels in this build
     const std::string text = "ps_1_4\ntexcrd r0.rgb, t0\nmul r0.rgb, r0, r0\n";
     CHECK(std::string(make(text, Precision::Fx8, 0, ExecPath::Auto)->pathName()) != "generic");
     CHECK(std::string(make(text, Precision::Fx8, 8, ExecPath::Auto)->pathName()) != "generic");

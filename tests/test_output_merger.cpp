@@ -13,6 +13,7 @@
 #include "emu/format.h"
 #include "emu/output_merger.h"
 #include "emu/resources.h"
+#include "ps11/simd_dispatch.h"
 
 using namespace emu;
 using ps11::Precision;
@@ -963,57 +964,61 @@ TEST_CASE("merger: float targets blend in float32 without clamping", "[merger]")
 TEST_CASE("merger: half conversion matches format.cpp for every half and a float sweep", "[merger]") {
     // Every half pattern decoded by format.cpp, stored through the merger, must come back bit
     // for bit (NaNs: still NaN).
-    // Twice: the plain store (F16C where the CPU has it) and the general loop (software
-    // conversion; an ALWAYS alpha test routes the pixels there).
-    for (bool general : {false, true}) {
-        MergeState st;
-        st.precision = Precision::Float;
-        st.alphaTest = general, st.alphaFunc = D3DCMP_ALWAYS;
-        Image img = makeImage(D3DFMT_A16B16G16R16F, 16, 16);
-        for (uint32_t base = 0; base < 65536; base += 1024) {
-            Span span(256);
-            for (int i = 0; i < 256; ++i) {
-                std::array<float, 4> v;
-                for (int c = 0; c < 4; ++c) v[size_t(c)] = halfToFloat(uint16_t(base + uint32_t(i) * 4 + uint32_t(c)));
-                span.setColor(i, v);
+    // At every SIMD level this CPU runs (the plain store converts with F16C at Avx2, by bit
+    // manipulation at Baseline), and through the general loop (software conversion; an ALWAYS
+    // alpha test routes the pixels there).
+    for (ps11::SimdLevel level : ps11::runnableSimdLevels())
+        for (bool general : {false, true}) {
+            const ps11::ScopedSimdLevel scoped(level);
+            INFO("SIMD level " << ps11::simdLevelName(level) << (general ? ", general loop" : ", plain store"));
+            MergeState st;
+            st.precision = Precision::Float;
+            st.alphaTest = general, st.alphaFunc = D3DCMP_ALWAYS;
+            Image img = makeImage(D3DFMT_A16B16G16R16F, 16, 16);
+            for (uint32_t base = 0; base < 65536; base += 1024) {
+                Span span(256);
+                for (int i = 0; i < 256; ++i) {
+                    std::array<float, 4> v;
+                    for (int c = 0; c < 4; ++c) v[size_t(c)] = halfToFloat(uint16_t(base + uint32_t(i) * 4 + uint32_t(c)));
+                    span.setColor(i, v);
+                }
+                run(st, span, &img);
+                for (int i = 0; i < 256; ++i)
+                    for (int c = 0; c < 4; ++c) {
+                        const uint16_t h = uint16_t(base + uint32_t(i) * 4 + uint32_t(c));
+                        const uint16_t got = halfAt(img, uint32_t(i % 16), uint32_t(i / 16), c);
+                        if ((h & 0x7c00) == 0x7c00 && (h & 0x3ff))
+                            CHECK(((got & 0x7c00) == 0x7c00 && (got & 0x3ff)));
+                        else
+                            CHECK(got == h);
+                    }
             }
-            run(st, span, &img);
-            for (int i = 0; i < 256; ++i)
-                for (int c = 0; c < 4; ++c) {
-                    const uint16_t h = uint16_t(base + uint32_t(i) * 4 + uint32_t(c));
-                    const uint16_t got = halfAt(img, uint32_t(i % 16), uint32_t(i / 16), c);
-                    if ((h & 0x7c00) == 0x7c00 && (h & 0x3ff))
-                        CHECK(((got & 0x7c00) == 0x7c00 && (got & 0x3ff)));
-                    else
-                        CHECK(got == h);
+            // Floats between halves, including exact ties and the overflow boundary.
+            std::mt19937 rng(5);
+            for (int round = 0; round < 64; ++round) {
+                Span span(256);
+                for (int i = 0; i < 256; ++i) {
+                    std::array<float, 4> v;
+                    for (int c = 0; c < 4; ++c) {
+                        uint32_t bits = rng();
+                        if (c == 0) bits = (bits & 0x80000000u) | (0x33000000u + (bits % 0x14800000u));  // 2^-25 .. 65536+
+                        if (c == 1) bits = (bits & 0xffffe000u) | 0x1000u;                               // exact half-way
+                        float f;
+                        std::memcpy(&f, &bits, 4);
+                        v[size_t(c)] = f;
+                    }
+                    if (i == 0) v = {65519.996f, 65520.0f, -65504.0f, 5.9604645e-8f * 0.5f};
+                    span.setColor(i, v);
                 }
-        }
-        // Floats between halves, including exact ties and the overflow boundary.
-        std::mt19937 rng(5);
-        for (int round = 0; round < 64; ++round) {
-            Span span(256);
-            for (int i = 0; i < 256; ++i) {
-                std::array<float, 4> v;
-                for (int c = 0; c < 4; ++c) {
-                    uint32_t bits = rng();
-                    if (c == 0) bits = (bits & 0x80000000u) | (0x33000000u + (bits % 0x14800000u));  // 2^-25 .. 65536+
-                    if (c == 1) bits = (bits & 0xffffe000u) | 0x1000u;                               // exact half-way
-                    float f;
-                    std::memcpy(&f, &bits, 4);
-                    v[size_t(c)] = f;
-                }
-                if (i == 0) v = {65519.996f, 65520.0f, -65504.0f, 5.9604645e-8f * 0.5f};
-                span.setColor(i, v);
+                run(st, span, &img);
+                for (int i = 0; i < 256; ++i)
+                    for (int c = 0; c < 4; ++c) {
+                        const float f = span.color[c][size_t(i)];
+                        if (std::isnan(f)) continue;
+                        CHECK(halfAt(img, uint32_t(i % 16), uint32_t(i / 16), c) == floatToHalf(f));
+                    }
             }
-            run(st, span, &img);
-            for (int i = 0; i < 256; ++i)
-                for (int c = 0; c < 4; ++c) {
-                    const float f = span.color[c][size_t(i)];
-                    if (std::isnan(f)) continue;
-                    CHECK(halfAt(img, uint32_t(i % 16), uint32_t(i / 16), c) == floatToHalf(f));
-                }
         }
-    }
 }
 
 // ---- states -----------------------------------------------------------------------------------

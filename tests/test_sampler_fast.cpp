@@ -1,8 +1,8 @@
 // The fast sampler kernels and the direct texture hand-over against their references:
 // - Texture::fromLevels (D3D memory layout) builds the same texture as textureFromDesc from the
 //   same texel words / floats, for every format, texel by texel;
-// - TextureSampler with the fast path (dispatched AVX2 build, and the generic build) answers
-//   bit-identically to TextureSampler(false), the reference path, over random and adversarial
+// - TextureSampler with the fast path, at every SIMD level this CPU runs (ps11/simd_dispatch.h),
+//   answers bit-identically to TextureSampler(false), the reference path, over random and adversarial
 //   coordinates, every address mode pair, border colours, filters, mips with quads and span
 //   lengths 1..256. The reference's own values are checked by hand in test_texture_sampler.cpp.
 #include <catch2/catch.hpp>
@@ -20,7 +20,7 @@
 #include "ps11/testfile.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
-#include "ps11/texture_sampler_fast.h"
+#include "simd_levels.h"
 
 using namespace ps11;
 
@@ -256,16 +256,6 @@ std::shared_ptr<const Texture> randomTexture(std::mt19937& rng, TexFormat f, uin
     return std::make_shared<const Texture>(std::move(*t));
 }
 
-// Runs `body` once with the dispatched kernel and once with the generic build forced.
-template <class F>
-void forEachKernel(F&& body) {
-    for (bool generic : {false, true}) {
-        fastpath::setForceGeneric(generic);
-        body();
-    }
-    fastpath::setForceGeneric(false);
-}
-
 }  // namespace
 
 TEST_CASE("texture: fromLevels equals textureFromDesc for every format", "[sampler][fast]") {
@@ -399,7 +389,7 @@ TEST_CASE("sampler fast: equals the reference, every format, address mode pair a
     const Filter filters[] = {Filter::Point, Filter::Linear};
     uint64_t fastLanes = 0;
     int bad = 0;
-    forEachKernel([&] {
+    testutil::forEachSimdLevel([&](SimdLevel) {
         for (TexFormat f : kAllFormats)
             for (const auto& sz : sizes) {
                 auto tex = randomTexture(rng, f, sz[0], sz[1], 1);
@@ -430,7 +420,7 @@ TEST_CASE("sampler fast: equals the reference, every format, address mode pair a
 TEST_CASE("sampler fast: every span length 1..256 and every border colour kind", "[sampler][fast]") {
     std::mt19937 rng(99);
     int bad = 0;
-    forEachKernel([&] {
+    testutil::forEachSimdLevel([&](SimdLevel) {
         for (TexFormat f : kUnorm8Formats) {
             auto tex = randomTexture(rng, f, 1920 / 64, 1080 / 60, 1);  // 30 x 18
             for (int count = 1; count <= kMaxSpan; ++count) {
@@ -458,7 +448,7 @@ TEST_CASE("sampler fast: mip levels chosen per quad equal the reference", "[samp
     std::mt19937 rng(4242);
     int bad = 0;
     uint64_t fastLanes = 0;
-    forEachKernel([&] {
+    testutil::forEachSimdLevel([&](SimdLevel) {
         for (TexFormat f : {TexFormat::A8R8G8B8, TexFormat::L8, TexFormat::V8U8}) {
             const uint32_t w = 64, h = 24;
             auto tex = randomTexture(rng, f, w, h, fullMipCount(w, h, 1));
@@ -497,7 +487,7 @@ TEST_CASE("sampler fast: screen-aligned taps on a 1080p-shaped texture", "[sampl
     std::mt19937 rng(5);
     auto tex = randomTexture(rng, TexFormat::A8R8G8B8, 1920, 1080, 1);
     int bad = 0;
-    forEachKernel([&] {
+    testutil::forEachSimdLevel([&](SimdLevel) {
         for (TextureAddress mode : {TextureAddress::Clamp, TextureAddress::Wrap, TextureAddress::Mirror})
             for (float offset : {0.0f, 0.5f, -0.5f, 0.25f, 1.0f})
                 for (float step : {1.0f, 2.0f, 0.5f})

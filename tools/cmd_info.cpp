@@ -1,5 +1,6 @@
 // `ps11 info`: reports the build and the machine — the ps11 version, the default hardware class,
-// the fx8 executor kernels this CPU runs, and the GL backend's context (kind, GL_RENDERER,
+// the CPU features, the SIMD level in use and the fx8 executor kernels it gives, and the GL
+// backend's context (kind, GL_RENDERER,
 // GL_VERSION, GL_SHADING_LANGUAGE_VERSION) or why none could be made (docs/gl-backend.md).
 #include "tools/cmd_info.h"
 
@@ -10,6 +11,7 @@
 #include "ps11/cpu_features.h"
 #include "ps11/executor_fast.h"
 #include "ps11/hardware.h"
+#include "ps11/simd_dispatch.h"
 #include "ps11/suggest.h"
 #include "ps11/version.h"
 #include "tools/cli_util.h"
@@ -98,8 +100,12 @@ int cmdInfo(const std::vector<std::string>& args) {
         }
     }
     const HardwareClass& hw = defaultHardware(1);
-    const exec::FastKernels* kernels = exec::fastKernelsBest();
+    const SimdLevel level = simdLevel();
+    const exec::FastKernels* kernels = exec::fastKernels(level);
     const char* kernelName = kernels ? kernels->name : "none";
+    std::string levelText = simdLevelName(level);
+    if (level != bestSimdLevel())
+        levelText += std::string(" (forced; this CPU runs ") + simdLevelName(bestSimdLevel()) + ")";
     const CpuFeatures& cpu = cpuFeatures();
     std::string cpuText;
     for (auto [name, has] : {std::pair{"avx2", cpu.avx2}, std::pair{"fma", cpu.fma}, std::pair{"f16c", cpu.f16c}})
@@ -108,6 +114,7 @@ int cmdInfo(const std::vector<std::string>& args) {
     GlReport r = probeGl(gl);
     if (json) {
         std::cout << "{\"version\": " << jsonString(versionString()) << ", \"hardware\": " << jsonString(hw.name)
+                  << ", \"simd_level\": " << jsonString(simdLevelName(level))
                   << ", \"executor_kernels\": " << jsonString(kernelName) << ", \"cpu\": {\"avx2\": "
                   << (cpu.avx2 ? "true" : "false") << ", \"fma\": " << (cpu.fma ? "true" : "false")
                   << ", \"f16c\": " << (cpu.f16c ? "true" : "false") << "}, \"gl\": {";
@@ -125,6 +132,7 @@ int cmdInfo(const std::vector<std::string>& args) {
         std::cout << "ps11 " << versionString() << "\n"
                   << "default hardware: " << hw.name << " (" << hw.kind << ")\n"
                   << "cpu features: " << cpuText << "\n"
+                  << "simd level: " << levelText << "\n"
                   << "executor kernels: " << kernelName << "\n";
         if (r.ok) {
             std::cout << "GL context: " << r.kind << " (" << r.platform << ")\n"

@@ -234,6 +234,14 @@ expect_rc 0 "info" "$ps11" info
 expect_in "$work/out" "$(cat "$work/version1")" "info prints the version"
 expect_in "$work/out" "default hardware: geforce4" "info names the default hardware class"
 expect_in "$work/out" "executor kernels: " "info names the executor kernels"
+expect_in "$work/out" "simd level: " "info names the SIMD level"
+# PS11_SIMD forces a SIMD level (docs/architecture.md "SIMD dispatch"); a value it does not know
+# is named on stderr and the best level is used.
+expect_rc 0 "info at the baseline level" env PS11_SIMD=baseline "$ps11" info
+expect_in "$work/out" "simd level: baseline" "PS11_SIMD=baseline is the level in use"
+expect_rc 0 "info with an unknown PS11_SIMD" env PS11_SIMD=bogus "$ps11" info
+expect_in "$work/err" "ps11: PS11_SIMD=bogus: unknown SIMD level" "an unknown PS11_SIMD is reported"
+expect_in "$work/out" "simd level: " "an unknown PS11_SIMD still gives a level"
 expect_rc 0 "info --json" "$ps11" info --json
 expect_in "$work/out" '"hardware": "geforce4"' "info --json"
 if grep -q "PS11_GL=OFF" "$work/out"; then

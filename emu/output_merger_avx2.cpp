@@ -1,0 +1,43 @@
+// The output merger's kernels at the Avx2 level (emu/output_merger_kernels.h): CMakeLists.txt
+// builds this file with -mavx2 -mfma -mf16c on x86-64 only; mergerKernels() hands the table out
+// only where the CPU runs that level (CPUID F16C, AVX and OSXSAVE, and XCR0 keeping the AVX
+// state: ps11::cpuFeatures).
+#if !defined(__AVX2__) || !defined(__F16C__)
+#error "output_merger_avx2.cpp needs the Avx2 level's flags (CMakeLists.txt)"
+#endif
+#include <immintrin.h>
+
+#include "emu/output_merger_kernels.h"
+
+namespace emu {
+
+namespace {
+
+// VCVTPS2PH rounds to nearest even, as the Baseline conversion does.
+void halvesF16c(const float* const f[4], int count, uint16_t* out) {
+    constexpr int kRound = _MM_FROUND_TO_NEAREST_INT;
+    int i = 0;
+    for (; i + 8 <= count; i += 8) {
+        const __m128i r = _mm256_cvtps_ph(_mm256_loadu_ps(f[0] + i), kRound);
+        const __m128i g = _mm256_cvtps_ph(_mm256_loadu_ps(f[1] + i), kRound);
+        const __m128i b = _mm256_cvtps_ph(_mm256_loadu_ps(f[2] + i), kRound);
+        const __m128i a = _mm256_cvtps_ph(_mm256_loadu_ps(f[3] + i), kRound);
+        const __m128i rgLo = _mm_unpacklo_epi16(r, g), rgHi = _mm_unpackhi_epi16(r, g);  // r0 g0 r1 g1 …
+        const __m128i baLo = _mm_unpacklo_epi16(b, a), baHi = _mm_unpackhi_epi16(b, a);
+        __m128i* d = reinterpret_cast<__m128i*>(out + 4 * i);
+        _mm_storeu_si128(d + 0, _mm_unpacklo_epi32(rgLo, baLo));  // pixels 0, 1
+        _mm_storeu_si128(d + 1, _mm_unpackhi_epi32(rgLo, baLo));  // 2, 3
+        _mm_storeu_si128(d + 2, _mm_unpacklo_epi32(rgHi, baHi));  // 4, 5
+        _mm_storeu_si128(d + 3, _mm_unpackhi_epi32(rgHi, baHi));  // 6, 7
+    }
+    for (; i < count; ++i) {
+        const __m128i h = _mm_cvtps_ph(_mm_setr_ps(f[0][i], f[1][i], f[2][i], f[3][i]), kRound);
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 4 * i), h);
+    }
+}
+
+}  // namespace
+
+const MergerKernels avx2::kMerger{&halvesF16c};
+
+}  // namespace emu

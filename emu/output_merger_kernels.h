@@ -1,0 +1,27 @@
+// The output merger's kernels, a table per SIMD level (ps11/simd_dispatch.h) that mergePixels
+// fetches once per call. Internal to emu/output_merger*.cpp (and their tests).
+#pragma once
+
+#include <cstdint>
+
+#include "ps11/simd_dispatch.h"
+
+namespace emu {
+
+struct MergerKernels {
+    // The IEEE halves (round to nearest even) of `count` lanes of r g b a, interleaved:
+    // out[4·i + c] = half(f[c][i]). Baseline: by bit manipulation; Avx2: F16C (VCVTPS2PH). The
+    // same half for every non-NaN value; a NaN stays a NaN (its payload may differ).
+    void (*halves)(const float* const f[4], int count, uint16_t* out);
+};
+
+const MergerKernels& mergerKernels(ps11::SimdLevel level);
+// The tables (the Avx2 one in x86-64 builds only); use mergerKernels().
+namespace baseline {
+extern const MergerKernels kMerger;
+}
+namespace avx2 {
+extern const MergerKernels kMerger;
+}
+
+}  // namespace emu

@@ -1,0 +1,347 @@
+// The one SIMD dispatch (ps11/simd_dispatch.h): PS11_SIMD's rule, the override, each family's
+// tables per level, and the families without a cross-level test of their own, each run at every
+// level this CPU runs and compared bit for bit: the float arithmetic (generic executor, float
+// and ideal profiles) and the output merger's half store. The executor's fx8 kernels, the fast
+// sampler and the aligned-pass path are compared across levels by test_executor_fast.cpp,
+// test_sampler_fast.cpp and test_aligned_pass.cpp (and the half store once more by
+// test_output_merger.cpp, against format.cpp).
+#include <catch2/catch.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/aligned_pass_kernels.h"
+#include "emu/format.h"
+#include "emu/output_merger.h"
+#include "emu/output_merger_kernels.h"
+#include "emu/resources.h"
+#include "executor_random_programs.h"
+#include "ps11/cpu_features.h"
+#include "ps11/executor.h"
+#include "ps11/executor_fast.h"
+#include "ps11/executor_internal.h"
+#include "ps11/simd_dispatch.h"
+#include "ps11/texture_sampler_fast.h"
+#include "simd_levels.h"
+
+using ps11::SimdLevel;
+
+namespace {
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("simd dispatch: level names", "[simd]") {
+    CHECK(std::string(ps11::simdLevelName(SimdLevel::Baseline)) == "baseline");
+    CHECK(std::string(ps11::simdLevelName(SimdLevel::Avx2)) == "avx2");
+    CHECK(ps11::parseSimdLevel("baseline") == SimdLevel::Baseline);
+    CHECK(ps11::parseSimdLevel("avx2") == SimdLevel::Avx2);
+    CHECK_FALSE(ps11::parseSimdLevel("AVX2"));
+    CHECK_FALSE(ps11::parseSimdLevel("sse2"));
+    CHECK_FALSE(ps11::parseSimdLevel(""));
+}
+
+TEST_CASE("simd dispatch: PS11_SIMD's rule, bad values and levels the CPU cannot run", "[simd]") {
+    std::string error = "stale";
+    // Unset or empty: the best level, silently.
+    CHECK(ps11::simdLevelFromEnv(nullptr, SimdLevel::Avx2, error) == SimdLevel::Avx2);
+    CHECK(error.empty());
+    CHECK(ps11::simdLevelFromEnv("", SimdLevel::Baseline, error) == SimdLevel::Baseline);
+    CHECK(error.empty());
+    // A level the CPU runs.
+    CHECK(ps11::simdLevelFromEnv("baseline", SimdLevel::Avx2, error) == SimdLevel::Baseline);
+    CHECK(error.empty());
+    CHECK(ps11::simdLevelFromEnv("avx2", SimdLevel::Avx2, error) == SimdLevel::Avx2);
+    CHECK(error.empty());
+    // An unknown value: the best level, and a message naming the variable and the value.
+    CHECK(ps11::simdLevelFromEnv("avx512", SimdLevel::Avx2, error) == SimdLevel::Avx2);
+    INFO(error);
+    CHECK(contains(error, "PS11_SIMD=avx512"));
+    CHECK(contains(error, "unknown SIMD level"));
+    CHECK(contains(error, "using avx2"));
+    CHECK(ps11::simdLevelFromEnv("Baseline", SimdLevel::Baseline, error) == SimdLevel::Baseline);
+    CHECK(contains(error, "PS11_SIMD=Baseline"));
+    // Avx2 on a CPU without it: Baseline, and a message.
+    CHECK(ps11::simdLevelFromEnv("avx2", SimdLevel::Baseline, error) == SimdLevel::Baseline);
+    CHECK(contains(error, "PS11_SIMD=avx2"));
+    CHECK(contains(error, "cannot run avx2"));
+    CHECK(contains(error, "using baseline"));
+}
+
+TEST_CASE("simd dispatch: the best level follows the CPU query; the override falls back to it", "[simd]") {
+#ifdef PS11_HAVE_AVX2
+    const ps11::CpuFeatures& f = ps11::cpuFeatures();
+    const bool avx2 = f.avx2Fma() && f.f16c;
+#else
+    const bool avx2 = false;
+#endif
+    CHECK(ps11::simdLevelRuns(SimdLevel::Baseline));
+    CHECK(ps11::simdLevelRuns(SimdLevel::Avx2) == avx2);
+    CHECK(ps11::bestSimdLevel() == (avx2 ? SimdLevel::Avx2 : SimdLevel::Baseline));
+    const std::vector<SimdLevel> levels = ps11::runnableSimdLevels();
+    REQUIRE(!levels.empty());
+    CHECK(levels.front() == SimdLevel::Baseline);
+    CHECK(levels.back() == ps11::bestSimdLevel());
+
+    const SimdLevel before = ps11::simdLevel();
+    {
+        const ps11::ScopedSimdLevel outer(SimdLevel::Baseline);
+        CHECK(outer.level() == SimdLevel::Baseline);
+        CHECK(ps11::simdLevel() == SimdLevel::Baseline);
+        {
+            // Avx2 where the CPU runs it, else Baseline.
+            const ps11::ScopedSimdLevel inner(SimdLevel::Avx2);
+            CHECK(inner.level() == ps11::bestSimdLevel());
+            CHECK(ps11::simdLevel() == inner.level());
+        }
+        CHECK(ps11::simdLevel() == SimdLevel::Baseline);
+    }
+    CHECK(ps11::simdLevel() == before);
+    CHECK(ps11::setSimdLevel(SimdLevel::Avx2) == ps11::bestSimdLevel());
+    CHECK(ps11::setSimdLevel(SimdLevel::Baseline) == SimdLevel::Baseline);
+    CHECK(ps11::simdLevel() == SimdLevel::Baseline);
+    ps11::clearSimdLevel();
+    CHECK(ps11::simdLevel() == before);
+}
+
+namespace {
+
+// Runs a float-profile program over `count` pixels (one span) at the level in force; returns
+// the output colours' bits and the killed flags.
+std::vector<uint32_t> runFloat(const ps11::Executor& e, const std::vector<float> (&tc)[8][4],
+                               const std::vector<float> (&col)[2][4], int count) {
+    ps11::PixelInputs in;
+    in.count = count;
+    for (int v = 0; v < 2; ++v)
+        for (int c = 0; c < 4; ++c) in.color[v][c] = col[v][c].data();
+    for (int t = 0; t < 8; ++t)
+        for (int c = 0; c < 4; ++c) in.texcoord[t][c] = tc[t][c].data();
+    std::vector<float> color[4];
+    std::vector<uint8_t> killed(size_t(count), 9);
+    ps11::PixelOutputs out;
+    for (int c = 0; c < 4; ++c) color[c].assign(size_t(count), -7.0f), out.color[c] = color[c].data();
+    out.killed = killed.data();
+    ps11::NullSampler sampler;
+    e.run(in, sampler, out);
+    std::vector<uint32_t> bits;
+    for (int c = 0; c < 4; ++c)
+        for (float f : color[c]) {
+            uint32_t b;
+            std::memcpy(&b, &f, 4);
+            bits.push_back(b);
+        }
+    for (uint8_t k : killed) bits.push_back(k);
+    return bits;
+}
+
+std::unique_ptr<ps11::Executor> makeFloat(const ps11::Program& program, ps11::Precision precision) {
+    ps11::Diagnostics diags;
+    ps11::ExecutorOptions opt;
+    opt.precision = precision;
+    std::unique_ptr<ps11::Executor> e = ps11::Executor::create(program, opt, diags);
+    REQUIRE(e);
+    return e;
+}
+
+}  // namespace
+
+TEST_CASE("simd dispatch: float arithmetic gives the same bits at every level (float, ideal)", "[simd][executor]") {
+    using namespace ps11test;
+    Gen g(0x51d0f10u);
+    int valid = 0, generated = 0, compared = 0;
+    int64_t bad = 0;
+    while (valid < 300 && generated < 30000) {
+        const int minor = 1 + generated++ % 4;
+        const Prog p = g.program(minor);
+        std::string err;
+        const std::optional<ps11::Program> program = assemble(progText(p), err);
+        if (!program) continue;
+        ++valid;
+        const int count = g.uni(1, ps11::kMaxSpan);
+        std::vector<float> tc[8][4], col[2][4];
+        for (auto& t : tc)
+            for (auto& c : t) c.resize(size_t(count));
+        for (auto& v : col)
+            for (auto& c : v) c.resize(size_t(count));
+        for (int i = 0; i < count; ++i) {
+            const Inputs in = g.inputs();
+            for (int t = 0; t < 8; ++t)
+                for (int c = 0; c < 4; ++c) tc[t][c][size_t(i)] = in.tc[t][c];
+            for (int v = 0; v < 2; ++v)
+                for (int c = 0; c < 4; ++c) col[v][c][size_t(i)] = in.color[v][c];
+        }
+        const Inputs consts = g.inputs();
+        for (ps11::Precision precision : {ps11::Precision::Float, ps11::Precision::Ideal}) {
+            std::unique_ptr<ps11::Executor> e = makeFloat(*program, precision);
+            for (int i = 0; i < 8; ++i) e->setConstant(i, consts.consts[i]);
+            std::vector<uint32_t> first;
+            testutil::forEachSimdLevel([&](SimdLevel level) {
+                const std::vector<uint32_t> got = runFloat(*e, tc, col, count);
+                if (level == SimdLevel::Baseline) {
+                    first = got;
+                    return;
+                }
+                ++compared;
+                if (got != first && bad++ < 3) FAIL_CHECK(ps11::precisionName(precision) << "\n" << progText(p));
+            });
+        }
+    }
+    CHECK(valid >= 300);
+    CHECK(bad == 0);
+    if (ps11::simdLevelRuns(SimdLevel::Avx2)) CHECK(compared == 2 * valid);
+}
+
+TEST_CASE("simd dispatch: float mad, lrp and dp3 round each product at every level (no FMA)", "[simd][executor]") {
+    // a·b + c rounded twice, as written: an FMA would round once and differ for most operands.
+    ps11::Diagnostics diags;
+    const char* text =
+        "ps_1_4\ntexcrd r0.xyz, t0\ntexcrd r1.xyz, t1\ntexcrd r2.xyz, t2\n"
+        "mad r3.rgb, r0, r1, r2\nlrp r4.rgb, r0, r1, r2\ndp3 r5.rgb, r0, r1\n"
+        "mov r0.r, r3.r\nmov r0.g, r4.g\nmov r0.b, r5.b\n";
+    const std::optional<ps11::Program> program = ps11::parseAssembly(text, "fma.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    std::unique_ptr<ps11::Executor> e = makeFloat(*program, ps11::Precision::Ideal);
+    const int count = ps11::kMaxSpan;
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<float> tc[8][4], col[2][4];
+    for (auto& t : tc)
+        for (auto& c : t) c.assign(size_t(count), 0.0f);
+    for (auto& v : col)
+        for (auto& c : v) c.assign(size_t(count), 0.0f);
+    for (int t = 0; t < 3; ++t)
+        for (int c = 0; c < 3; ++c)
+            for (float& f : tc[t][c]) f = u(rng);
+    auto asFloat = [](uint32_t b) {
+        float f;
+        std::memcpy(&f, &b, 4);
+        return f;
+    };
+    testutil::forEachSimdLevel([&](SimdLevel) {
+        const std::vector<uint32_t> got = runFloat(*e, tc, col, count);
+        int wrong = 0;
+        for (int i = 0; i < count; ++i) {
+            const size_t k = size_t(i);
+            const float a0 = tc[0][0][k], b0 = tc[1][0][k], c0 = tc[2][0][k];
+            const float a1 = tc[0][1][k], b1 = tc[1][1][k], c1 = tc[2][1][k];
+            const float prod = a0 * b0;
+            const float mad = prod + c0;
+            const float diff = b1 - c1;
+            const float scaled = a1 * diff;
+            const float lrp = c1 + scaled;
+            float dp = tc[0][0][k] * tc[1][0][k];
+            const float p1 = tc[0][1][k] * tc[1][1][k];
+            dp = dp + p1;
+            const float p2 = tc[0][2][k] * tc[1][2][k];
+            dp = dp + p2;
+            wrong += asFloat(got[k]) != mad;
+            wrong += asFloat(got[size_t(count) + k]) != lrp;
+            wrong += asFloat(got[2 * size_t(count) + k]) != dp;
+        }
+        CHECK(wrong == 0);
+    });
+}
+
+TEST_CASE("simd dispatch: every family has its tables, distinct per level where the build has Avx2", "[simd]") {
+    using namespace ps11;
+    const exec::FastKernels* fastB = exec::fastKernels(SimdLevel::Baseline);
+    const exec::FastKernels* fastA = exec::fastKernels(SimdLevel::Avx2);
+#ifdef PS11_HAVE_AVX2
+    REQUIRE(fastB);
+    REQUIRE(fastA);
+    CHECK(std::string(fastB->name) == "fast-sse2");
+    CHECK(std::string(fastA->name) == "fast-avx2");
+    CHECK(&exec::floatArithKernels(SimdLevel::Baseline) != &exec::floatArithKernels(SimdLevel::Avx2));
+    CHECK(&fastpath::samplerKernels(SimdLevel::Baseline) != &fastpath::samplerKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx2) != nullptr);
+    CHECK(&emu::mergerKernels(SimdLevel::Baseline) != &emu::mergerKernels(SimdLevel::Avx2));
+#else
+    // No x86 kernels: the generic path runs every program; every other family has only Baseline.
+    CHECK(fastB == nullptr);
+    CHECK(fastA == nullptr);
+    CHECK(&exec::floatArithKernels(SimdLevel::Baseline) == &exec::floatArithKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx2) == nullptr);
+#endif
+    // The aligned-pass path has no vector kernels at Baseline (every pixel on its own).
+    CHECK(emu::alignedKernels(SimdLevel::Baseline) == nullptr);
+}
+
+TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at every level", "[simd][merger]") {
+    // Every half pattern as a float, then floats between halves (ties, the overflow boundary,
+    // subnormals), in spans whose lengths are not multiples of 8; NaNs stay NaNs.
+    std::vector<float> values;
+    for (uint32_t h = 0; h < 65536; ++h) values.push_back(emu::halfToFloat(uint16_t(h)));
+    std::mt19937 rng(3);
+    for (int i = 0; i < 65536; ++i) {
+        uint32_t bits = rng();
+        if (i % 3 == 0) bits = (bits & 0x80000000u) | (0x33000000u + (bits % 0x14800000u));
+        if (i % 3 == 1) bits = (bits & 0xffffe000u) | 0x1000u;
+        float f;
+        std::memcpy(&f, &bits, 4);
+        values.push_back(f);
+    }
+    const emu::MergerKernels& base = emu::mergerKernels(SimdLevel::Baseline);
+    int64_t bad = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::MergerKernels& k = emu::mergerKernels(level);
+        for (size_t at = 0; at + 4 * 256 <= values.size(); at += 4 * 256) {
+            const int count = 1 + int((at / 1024) % 256);
+            const float* f[4] = {&values[at], &values[at + 256], &values[at + 512], &values[at + 768]};
+            std::vector<uint16_t> want(size_t(4 * count)), got(size_t(4 * count));
+            base.halves(f, count, want.data());
+            k.halves(f, count, got.data());
+            for (size_t j = 0; j < got.size(); ++j) {
+                const bool nanWant = (want[j] & 0x7c00) == 0x7c00 && (want[j] & 0x3ff);
+                const bool nanGot = (got[j] & 0x7c00) == 0x7c00 && (got[j] & 0x3ff);
+                bad += nanWant ? !nanGot : got[j] != want[j];
+            }
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+}
+
+TEST_CASE("simd dispatch: mergePixels stores the same A16B16G16R16F bytes at every level", "[simd][merger]") {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(-70000.0f, 70000.0f), small(-1.0f, 1.0f);
+    const int count = 200;  // not a multiple of 8
+    std::vector<int32_t> x(count), y(count);
+    std::vector<uint8_t> live(count);
+    std::vector<float> color[4];
+    for (int i = 0; i < count; ++i) x[size_t(i)] = i % 16, y[size_t(i)] = i / 16, live[size_t(i)] = i % 7 != 3;
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < count; ++i) color[c].push_back(i % 2 ? u(rng) : small(rng));
+    emu::MergeInputs in;
+    in.count = count;
+    in.x = x.data(), in.y = y.data(), in.live = live.data();
+    for (int c = 0; c < 4; ++c) in.color[c] = color[c].data();
+    for (uint32_t mask : {0xfu, 0x5u, 0x8u}) {
+        std::vector<uint8_t> first;
+        testutil::forEachSimdLevel([&](SimdLevel level) {
+            emu::Image img;
+            img.format = emu::formatInfo(emu::D3DFMT_A16B16G16R16F);
+            REQUIRE(img.format);
+            img.width = 16, img.height = 16;
+            img.rowPitch = emu::rowPitchOf(*img.format, 16);
+            img.slicePitch = uint64_t(img.rowPitch) * 16;
+            img.bytes.assign(size_t(img.slicePitch), 0x5a);
+            emu::MergeState st;
+            st.precision = ps11::Precision::Float;
+            st.colorWrite = mask;
+            emu::MergeStats stats;
+            emu::mergePixels(st, in, emu::MergeTarget{&img, nullptr}, &stats);
+            CHECK(stats.written == uint64_t(count - (count + 3) / 7));
+            if (level == SimdLevel::Baseline)
+                first = img.bytes;
+            else
+                CHECK(img.bytes == first);
+        });
+    }
+}
