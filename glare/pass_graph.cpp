@@ -187,6 +187,16 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         pool.device().finish();  // a renderer that queues work (GL) has done this pass's
         s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const emu::TransferStats after = pool.device().transfers();
+        for (const std::vector<TextureId>* list : {&p.reads, &p.writes})
+            for (TextureId id : *list) {
+                const TextureNode& t = m_textures[id.index];
+                if (t.data) continue;
+                const emu::FormatInfo* f = emu::formatInfo(t.desc.format);
+                const uint64_t texel = f ? f->bytes : 4, whole = uint64_t(t.desc.width) * t.desc.height * texel;
+                // A device-side step counts the pixels it looks at, not texels.
+                const uint64_t touched = list == &p.reads ? (s.texels ? s.texels : s.pixels) : s.pixels;
+                s.bytes += std::min(whole, touched * texel);
+            }
         s.uploads = after.uploads - before.uploads;
         s.readBacks = after.readBacks - before.readBacks;
         if (!ok) {

@@ -58,6 +58,10 @@ struct PassStats {
     // Surfaces that crossed between the device front and a renderer that keeps copies (the GL
     // renderer): uploaded to it, read back from it.
     uint64_t uploads = 0, readBacks = 0;
+    // The memory traffic the pass cannot avoid: each texture it reads, once (no more than its
+    // texels fetched), and each texture it writes, once (no more than its pixels). Time over
+    // this shows a pass far above its share.
+    uint64_t bytes = 0;
 };
 
 // Device textures by description, kept between frames and runs: a graph takes one when a

@@ -171,6 +171,9 @@ TEST_CASE("pass graph: a technique's transient textures share device textures wh
     CHECK(r.passes.size() == live.size());
     // Two textures of the glow buffer's size serve three transient textures.
     CHECK(run.pool().created() == 2);
+    // The traffic floor: copy_scene reads and writes one 96x64 A8R8G8B8 frame.
+    for (const PassStats& p : r.passes)
+        if (p.pass == "copy_scene") CHECK(p.bytes == 2u * 96 * 64 * 4);
 }
 
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {

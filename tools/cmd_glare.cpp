@@ -466,10 +466,10 @@ int runGlare(const GlareOptions& o) {
         for (size_t i = 0; i < lastStats.size(); ++i) {
             const glare::PassStats& s = lastStats[i];
             std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
-                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu}%s\n",
+                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu}%s\n",
                         s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                         (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
-                        (unsigned long long)s.readBacks, i + 1 < lastStats.size() ? "," : "");
+                        (unsigned long long)s.readBacks, (unsigned long long)s.bytes, i + 1 < lastStats.size() ? "," : "");
         }
         std::printf("], \"renderer\": \"%s\", \"frame_uploads\": %llu, \"frame_readbacks\": %llu}\n",
                     main->device().rendererName(), (unsigned long long)lastTransfers.uploads,
@@ -481,12 +481,14 @@ int runGlare(const GlareOptions& o) {
     std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
                 std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
                 hw.c_str(), profile.c_str(), main->device().rendererName(), o.frames, sorted[sorted.size() / 2]);
-    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s\n", "pass (last frame)", "ms", "draws", "pixels", "texels",
-                "instructions", "up", "back");
+    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s\n", "pass (last frame)", "ms", "draws", "pixels", "texels",
+                "instructions", "up", "back", "MB", "GB/s");
     for (const glare::PassStats& s : lastStats)
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu\n", s.pass.c_str(), s.milliseconds,
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f\n", s.pass.c_str(), s.milliseconds,
                     (unsigned long long)s.draws, (unsigned long long)s.pixels, (unsigned long long)s.texels,
-                    (unsigned long long)s.instructions, (unsigned long long)s.uploads, (unsigned long long)s.readBacks);
+                    (unsigned long long)s.instructions, (unsigned long long)s.uploads, (unsigned long long)s.readBacks,
+                    double(s.bytes) / 1e6, s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0);
+    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
