@@ -83,6 +83,25 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 }
 
 // The texel rows and vertical weight of a tap on pixel row y.
+}  // namespace
+
+void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]) {
+    for (int k = 0; k < 8; ++k) {
+        const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
+        if (!((colorAttrs >> attr) & 1)) continue;
+        float* dst = color[k];
+        if ((s.constMask >> attr) & 1) {
+            std::fill_n(dst, n, s.constValue[size_t(attr)]);
+        } else {
+            const Plane& p = s.attr[size_t(attr)];
+            const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
+            for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+        }
+    }
+}
+
+namespace {
+
 TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
     TapRow r;
     const int k = attrTex(tap.coordSet, 1);
@@ -532,18 +551,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     stats.texels +=
                         uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
                 ctx.x = x;
-                for (int k = 0; k < 8; ++k) {
-                    const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
-                    if (!((draw.colorAttrs >> attr) & 1)) continue;
-                    float* dst = sc.color[k];
-                    if ((s.constMask >> attr) & 1) {
-                        std::fill_n(dst, n, s.constValue[size_t(attr)]);
-                    } else {
-                        const Plane& p = s.attr[size_t(attr)];
-                        const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
-                        for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
-                    }
-                }
+                fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                 in.count = n;
                 exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
                 stats.pixels += uint64_t(n);

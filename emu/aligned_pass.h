@@ -141,6 +141,11 @@ struct AlignedScratch {
     HRowCache hrows;
 };
 
+// The diffuse (color[0..3]) and specular (color[4..7]) lanes of pixels x .. x + n − 1 of row y
+// that `colorAttrs` names, as the quad path interpolates them (constant or affine, no
+// perspective).
+void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]);
+
 struct AlignedStats {
     uint64_t pixels = 0, written = 0, texels = 0;
     ps11::ExecutorStats exec;

@@ -9,6 +9,7 @@
 
 #include "emu/aligned_pass.h"
 #include "emu/blit.h"
+#include "emu/aligned_float.h"
 #include "emu/thread_pool.h"
 #include "ps11/diagnostics.h"
 
@@ -40,6 +41,7 @@ struct WorkerScratch {
     Lanes lanes;
     ps11::TextureSampler sampler;
     AlignedScratch aligned;
+    FloatRowScratch floatRows;
 };
 
 }  // namespace
@@ -120,6 +122,12 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                                            call.samplers, merge, mtarget, wantZ,
                                                                            used, aligned);
     std::vector<AlignedTriangle> alignedTris;
+    // The float profiles' row path (emu/aligned_float.h), the same per-triangle decision.
+    FloatRowDraw floatRows;
+    const bool floatDraw = m_options.alignedPasses && !alignedDraw &&
+                           prepareFloatRowDraw(executor, precision, call.hardware.weightBits, kills, call.textures,
+                                               call.samplers, merge, mtarget, wantZ, used, floatRows);
+    std::vector<FloatRowTriangle> floatTris;
     std::vector<uint8_t> isAligned;
     std::vector<uint32_t> bandStart, bandFill, bandTris;
     for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
@@ -141,6 +149,12 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             alignedTris.resize(setups.size());
             for (size_t i = 0; i < setups.size(); ++i)
                 isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
+        }
+        if (floatDraw && setups.size() <= kMaxAlignedTriangles) {
+            floatTris.resize(setups.size());
+            for (size_t i = 0; i < setups.size(); ++i)
+                isAligned[i] = prepareFloatRowTriangle(floatRows, setups[i], floatTris[i]);
+            shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
         }
         if (setups.empty()) continue;
 
@@ -233,6 +247,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
                     const uint32_t i = bandTris[k];
                     const TriangleSetup& s = setups[i];
+                    if (isAligned[i] && floatDraw) {
+                        drawFloatRows(floatRows, floatTris[i], s, by0, by1, ws0.floatRows, as);
+                        continue;
+                    }
                     if (isAligned[i]) {
                         group[grouped] = &alignedTris[i];
                         groupSetups[grouped++] = &s;

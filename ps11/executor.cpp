@@ -76,6 +76,7 @@ public:
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
              ExecutorStats* stats) const override;
     bool tapPlan(TapPlan& plan) const override;
+    bool plainTaps(TapPlan& plan) const override;
     void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
                        ExecutorStats* stats) const override;
 
@@ -165,7 +166,11 @@ void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith) c
 
 bool ExecutorImpl::tapPlan(TapPlan& plan) const {
     plan = TapPlan{};
-    if (!m_fast.ready) return false;
+    return m_fast.ready && plainTaps(plan);
+}
+
+bool ExecutorImpl::plainTaps(TapPlan& plan) const {
+    plan = TapPlan{};
     for (const DOp& op : m_ops) {
         if (!op.texture) continue;
         if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;

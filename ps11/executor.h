@@ -121,6 +121,10 @@ public:
     // without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw,
     // .xy as written). Fills `plan` and returns true, else false.
     virtual bool tapPlan(TapPlan& plan) const = 0;
+    // The same plan in any profile, without the fx8 fast path: true when every texture
+    // instruction is a plain read as above (the float row path, emu/aligned_float.h, samples
+    // them for run() with a sampler of its own).
+    virtual bool plainTaps(TapPlan& plan) const = 0;
     // Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from
     // `fill` instead of a sampler: fill(ctx, i, first, n, dst) writes the fx8 grid integers of
     // tap i for lanes [first, first + n) into dst[c][0 .. n) (c = r g b a): 8-bit texels, values

@@ -381,6 +381,26 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
 
 }  // namespace
 
+void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, const float* coord, uint32_t extent,
+                   int32_t* i0, int32_t* i1, float* f) {
+    // axisPass over lanes of one level and one filter, then the weights as sampleReference
+    // turns them into float weights.
+    static thread_local AxisTaps taps;
+    static thread_local uint8_t level[kMaxSpan], lin[kMaxSpan];
+    const uint32_t extents[1] = {extent};
+    std::fill_n(level, kMaxSpan, uint8_t(0));
+    std::fill_n(lin, kMaxSpan, uint8_t(linear));
+    for (int first = 0; first < count; first += kMaxSpan) {
+        const int n = std::min(kMaxSpan, count - first);
+        axisPass(mode, n, coord + first, extents, level, lin, taps);
+        for (int i = 0; i < n; ++i) {
+            i0[first + i] = taps.i0[i];
+            i1[first + i] = taps.i1[i];
+            f[first + i] = weights8 ? float(taps.w[i]) / 256.0f : taps.f[i];
+        }
+    }
+}
+
 void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
     const int count = std::clamp(req.count, 0, kMaxSpan);
     const bool fixed = isFixedPoint(req.precision);

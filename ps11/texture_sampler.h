@@ -1,7 +1,7 @@
 // The software sampler: textures bound to stages 0..7 with D3D9 sampler state (filters,
 // address modes, border colour), answering the executor's span requests exactly as
-// docs/precision.md "Sampling" and docs/textures.md say. Used by the executor's test runs now
-// and by the emu device later.
+// docs/precision.md "Sampling" and docs/textures.md say. Used by the executor's test runs and
+// by the emu device.
 #pragma once
 
 #include <array>
@@ -72,5 +72,13 @@ private:
     bool m_fastPath = true;
     int m_weightBits = 0;
 };
+
+// One axis of the reference sampler's float-profile addressing, for row paths that tabulate it
+// per column or row (emu/aligned_float.cpp): for each coordinate, the texel pair after the
+// address mode (-1 = border) and the weight of i1 as float/ideal lerp with it (w/256 of the
+// 8-bit weight when `weights8`, the class's weights in the float profile; 0 for point). The same
+// values sample() computes per lane for a 2-D level of `extent` texels.
+void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, const float* coord, uint32_t extent,
+                   int32_t* i0, int32_t* i1, float* f);
 
 }  // namespace ps11

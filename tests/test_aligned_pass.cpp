@@ -48,9 +48,18 @@ const char* const kPrograms[] = {
 };
 
 const D3DFORMAT kTexFormats[] = {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8, D3DFMT_L8, D3DFMT_A8, D3DFMT_A8L8};
+// The float row path also reads decoded textures: float, half and signed formats.
+const D3DFORMAT kFloatTexFormats[] = {D3DFMT_A8R8G8B8,      D3DFMT_L8,   D3DFMT_A32B32G32R32F,
+                                      D3DFMT_A16B16G16R16F, D3DFMT_R32F, D3DFMT_V8U8};
 
 uint32_t texelBytes(D3DFORMAT f) {
     switch (f) {
+        case D3DFMT_A32B32G32R32F:
+            return 16;
+        case D3DFMT_A16B16G16R16F:
+            return 8;
+        case D3DFMT_V8U8:
+            return 2;
         case D3DFMT_L8:
         case D3DFMT_A8:
             return 1;
@@ -85,7 +94,7 @@ struct Case {
     RECT scissorRect{};
 };
 
-Case randomCase(std::mt19937& rng) {
+Case randomCase(std::mt19937& rng, bool floatFormats = false) {
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
     Case c;
@@ -98,7 +107,7 @@ Case randomCase(std::mt19937& rng) {
     for (Case::Tex& t : c.tex) {
         t.w = UINT(uni(0, 2) ? uni(1, 320) : c.w);
         t.h = UINT(uni(0, 2) ? uni(1, 40) : c.h);
-        t.format = kTexFormats[uni(0, 4)];
+        t.format = floatFormats ? kFloatTexFormats[uni(0, 5)] : kTexFormats[uni(0, 4)];
         t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
         for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : (uni(0, 1) ? 0 : 255));
         t.filter = uni(0, 2) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
@@ -261,6 +270,44 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     // save those whose quads happened to be all covered.
     INFO(aligned << " of " << cases << " cases took the row path");
     CHECK(aligned * 10 >= cases * 9);
+}
+
+TEST_CASE("float row path: random screen-aligned draws in float and ideal equal the quad path byte for byte",
+          "[draw][aligned]") {
+    std::mt19937 rng(20261127);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 300; ++i) {
+        // Float, half and signed textures with random bits (NaN and infinities included).
+        const Case c = randomCase(rng, true);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+        quadOpt.precision = rowOpt.precision = (i / 2) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", program:\n"
+                     << c.program);
+        const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
+        size_t firstDiff = 0;
+        while (firstDiff < got.size() && got[firstDiff] == expected[firstDiff]) ++firstDiff;
+        INFO("first difference at byte " << firstDiff << " (pixel " << firstDiff / 4 % c.w << ", " << firstDiff / 4 / c.w
+                                         << "), tex0 format " << c.tex[0].format << " filter " << c.tex[0].filter
+                                         << " got " << (firstDiff < got.size() ? int(got[firstDiff]) : -1) << " want "
+                                         << (firstDiff < got.size() ? int(expected[firstDiff]) : -1) << " tex " << c.tex[0].w
+                                         << "x" << c.tex[0].h << " addr " << c.tex[0].addressU << "," << c.tex[0].addressV
+                                         << " bound " << c.tex[0].bound << " blend " << c.blend << " mask " << c.writeMask
+                                         << " alphatest " << c.alphaTest << " scissor " << c.scissor);
+        REQUIRE(firstDiff == got.size());
+        CHECK(rs.pixelsCovered == qs.pixelsCovered);
+        CHECK(rs.pixelsWritten == qs.pixelsWritten);
+        if (qs.pixelsCovered == 0) continue;
+        ++cases;
+        if (rs.pixelsShaded == rs.pixelsCovered) ++rowPath;
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 9);
 }
 
 TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path", "[draw][aligned]") {

@@ -1,0 +1,289 @@
+// The float profiles' row path (emu/aligned_float.h): tabulated addressing, H rows of lerps, the
+// executor over rows with a sampler that serves them, the output merger over rows.
+#include "emu/aligned_float.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+
+#include "emu/vertex.h"
+
+namespace emu {
+
+namespace {
+
+bool linearFilter(ps11::Filter f) { return f == ps11::Filter::Linear; }
+
+// The reference sampler's lerp (texture_sampler.cpp combineFloat), in the same order.
+inline float lerpf(float a, float b, float f) { return (1.0f - f) * a + f * b; }
+
+// Texel (ix, iy) of level 0 as float r g b a, or the border colour when an index is −1.
+inline void texel(const FloatRowTap& tap, int32_t ix, int32_t iy, float t[4]) {
+    if ((ix | iy) < 0) {
+        for (int c = 0; c < 4; ++c) t[c] = tap.border[size_t(c)];
+        return;
+    }
+    const size_t i = (size_t(iy) * tap.width + size_t(ix)) * 4;
+    if (tap.unorm8) {
+        const float* table = ps11::Texture::unorm8Values();
+        for (int c = 0; c < 4; ++c) t[c] = table[tap.bytes[i + size_t(ps11::kUnorm8Byte[c])]];
+    } else {
+        for (int c = 0; c < 4; ++c) t[c] = tap.values[i + size_t(c)];
+    }
+}
+
+// One tap's texel rows for the pixel row being drawn.
+struct RowTaps {
+    int32_t j0 = 0, j1 = 0;
+    float fy = 0;
+    const float* h0 = nullptr;  // linear taps: H rows of j0 and j1 (planar, `width` columns)
+    const float* h1 = nullptr;
+};
+
+// The H row of texel row j for a linear tap: per column, the horizontal lerp of its texel pair
+// (the first step of combineFloat), over every column of the triangle. Kept per worker: two
+// rows per tap, so a magnified tap builds each texel row once for all the pixel rows it serves.
+const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, int32_t j, int32_t keep,
+                  FloatRowScratch& sc) {
+    std::array<FloatRowScratch::HRow, 2>& slots = sc.hrows[size_t(t)];
+    const uint64_t id = tri.taps[size_t(t)].tableId;
+    for (FloatRowScratch::HRow& h : slots)
+        if (h.serial == draw.serial && h.tableId == id && h.row == j) {
+            h.stamp = ++sc.stamp;
+            return h.h.data();
+        }
+    // Replace the slot not holding `keep` (the other row this pixel row needs), else the older.
+    auto holds = [&](const FloatRowScratch::HRow& h) { return h.serial == draw.serial && h.tableId == id && h.row == keep; };
+    FloatRowScratch::HRow& h = holds(slots[0]) ? slots[1] : holds(slots[1]) ? slots[0]
+                               : slots[0].stamp <= slots[1].stamp       ? slots[0]
+                                                                        : slots[1];
+    const FloatRowTap& tap = draw.taps[size_t(t)];
+    const FloatRowTriangle::Columns& cols = tri.taps[size_t(t)];
+    const size_t w = size_t(tri.x1 - tri.x0);
+    h.h.resize(4 * w);
+    float a[4], b[4];
+    for (size_t x = 0; x < w; ++x) {
+        texel(tap, cols.i0[x], j, a);
+        texel(tap, cols.i1[x], j, b);
+        for (size_t c = 0; c < 4; ++c) h.h[c * w + x] = lerpf(a[c], b[c], cols.f[x]);
+    }
+    h.serial = draw.serial;
+    h.tableId = id;
+    h.row = j;
+    h.stamp = ++sc.stamp;
+    return h.h.data();
+}
+
+// Lane indices as floats: every texture-coordinate set's u on the row path, so a request's u
+// says which lanes of the row it covers (the executor works through a row in chunks).
+const auto kLaneIndex = [] {
+    std::array<float, ps11::kMaxSpan> t{};
+    for (int i = 0; i < ps11::kMaxSpan; ++i) t[size_t(i)] = float(i);
+    return t;
+}();
+
+// The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
+// each stage read by one tap (prepareFloatRowDraw checks it).
+class RowSampler final : public ps11::Sampler {
+public:
+    RowSampler(const FloatRowDraw& draw, const FloatRowTriangle& tri, const std::array<RowTaps, 8>& rows)
+        : m_draw(draw), m_tri(tri), m_rows(rows) {
+        m_tapOf.fill(-1);
+        for (int t = 0; t < draw.plan.count; ++t) m_tapOf[draw.plan.stage[size_t(t)]] = int8_t(t);
+    }
+    void setX(int x) { m_x = x; }
+
+    void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
+        const int n = req.count;
+        const int t = req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
+        const FloatRowTap* tap = t >= 0 ? &m_draw.taps[size_t(t)] : nullptr;
+        if (!tap || !tap->bound) {
+            for (int c = 0; c < 4; ++c) std::fill_n(out.value[c], n, c == 3 ? 1.0f : 0.0f);
+            return;
+        }
+        const RowTaps& r = m_rows[size_t(t)];
+        const size_t first = size_t(m_x - m_tri.x0) + size_t(req.u[0]);  // lanes are consecutive
+        if (tap->linear) {
+            const size_t w = size_t(m_tri.x1 - m_tri.x0);
+            for (int c = 0; c < 4; ++c) {
+                const float* a = r.h0 + size_t(c) * w + first;
+                const float* b = r.h1 + size_t(c) * w + first;
+                float* o = out.value[c];
+                for (int i = 0; i < n; ++i) o[i] = lerpf(a[i], b[i], r.fy);
+            }
+            m_fetched += uint64_t(n) * 4;
+            return;
+        }
+        const int32_t* i0 = m_tri.taps[size_t(t)].i0.data() + first;
+        float v[4];
+        for (int i = 0; i < n; ++i) {
+            texel(*tap, i0[i], r.j0, v);
+            for (int c = 0; c < 4; ++c) out.value[c][i] = v[c];
+        }
+        m_fetched += uint64_t(n);
+    }
+    bool hasTexture(int stage) const override {
+        const int t = stage >= 0 && stage < 8 ? m_tapOf[size_t(stage)] : -1;
+        return t >= 0 && m_draw.taps[size_t(t)].bound;
+    }
+    uint64_t texelsFetched() const override { return m_fetched; }
+
+private:
+    const FloatRowDraw& m_draw;
+    const FloatRowTriangle& m_tri;
+    const std::array<RowTaps, 8>& m_rows;
+    std::array<int8_t, 8> m_tapOf{};
+    int m_x = 0;
+    uint64_t m_fetched = 0;
+};
+
+}  // namespace
+
+bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
+                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
+                         const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
+                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out) {
+    if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
+    if (kills || wantZ || merge.fog || !target.color || executor.writesDepth()) return false;
+    FloatRowDraw d;
+    if (!executor.plainTaps(d.plan)) return false;
+    static std::atomic<uint64_t> serials{0};
+    d.serial = ++serials;
+    d.executor = &executor;
+    d.weights8 = weightBits == 8 && precision == ps11::Precision::Float;
+    uint32_t stagesSeen = 0;
+    for (int i = 0; i < d.plan.count; ++i) {
+        const int stage = d.plan.stage[size_t(i)];
+        if ((stagesSeen >> stage) & 1) return false;  // the row sampler tells taps apart by stage
+        stagesSeen |= 1u << stage;
+        FloatRowTap& tap = d.taps[size_t(i)];
+        tap.stage = stage;
+        tap.coordSet = d.plan.coordSet[size_t(i)];
+        const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
+        if (!tex) continue;  // (0, 0, 0, 1)
+        const ps11::SamplerState& ss = samplers[size_t(stage)];
+        // One level and one filter for every pixel, as the sampler decides (docs/textures.md).
+        if (tex->isVolume()) return false;
+        if (linearFilter(ss.minFilter) != linearFilter(ss.magFilter)) return false;
+        if (tex->levelCount() != 1 && ss.mipFilter != ps11::Filter::None) return false;
+        const ps11::TextureLevelInfo& li = tex->level(0);
+        tap.bound = true;
+        tap.unorm8 = tex->storage() == ps11::TexelStorage::Unorm8;
+        if (tap.unorm8)
+            tap.bytes = tex->unorm8() + li.offset * 4;
+        else
+            tap.values = tex->values() + li.offset * 4;
+        tap.width = li.width;
+        tap.height = li.height;
+        tap.linear = linearFilter(ss.magFilter);
+        tap.addressU = ss.addressU;
+        tap.addressV = ss.addressV;
+        tap.border = ss.border;
+    }
+    d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
+    d.merge = merge;
+    d.target = target;
+    out = d;
+    return true;
+}
+
+bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
+    if (s.perspective) return false;
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const int ku = attrTex(draw.taps[size_t(i)].coordSet, 0), kv = ku + 1;
+        if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
+        if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
+    }
+    out.x0 = s.clip.x0;
+    out.x1 = s.clip.x1;
+    const int n = std::max(out.x1 - out.x0, 0);
+    std::vector<float> u(static_cast<size_t>(n));
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const FloatRowTap& tap = draw.taps[size_t(i)];
+        FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
+        if (!tap.bound) continue;
+        const int k = attrTex(tap.coordSet, 0);
+        for (int x = 0; x < n; ++x)
+            u[size_t(x)] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
+                                                  : planeValue(s.attr[size_t(k)], s.ox, s.oy, out.x0 + x, s.yMin);
+        cols.i0.resize(size_t(n));
+        cols.i1.resize(size_t(n));
+        cols.f.resize(size_t(n));
+        ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u.data(), tap.width, cols.i0.data(),
+                            cols.i1.data(), cols.f.data());
+    }
+    return true;
+}
+
+void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count) {
+    static std::atomic<uint64_t> ids{0};
+    for (size_t i = 0; i < count; ++i) {
+        if (!prepared[i]) continue;
+        for (int t = 0; t < draw.plan.count; ++t) {
+            FloatRowTriangle::Columns& c = tris[i].taps[size_t(t)];
+            c.tableId = 0;
+            for (size_t j = 0; j < i && !c.tableId; ++j) {
+                const FloatRowTriangle::Columns& o = tris[j].taps[size_t(t)];
+                if (prepared[j] && tris[j].x0 == tris[i].x0 && tris[j].x1 == tris[i].x1 && o.i0 == c.i0 &&
+                    o.i1 == c.i1 && std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0)
+                    c.tableId = o.tableId;
+            }
+            if (!c.tableId) c.tableId = ++ids;
+        }
+    }
+}
+
+void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
+                   FloatRowScratch& sc, AlignedStats& stats) {
+    const ps11::Executor& exec = *draw.executor;
+    const int taps = draw.plan.count;
+    std::array<RowTaps, 8> rows{};
+    RowSampler sampler(draw, tri, rows);
+    ps11::PixelInputs in;
+    for (int c = 0; c < 4; ++c) {
+        if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
+        if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
+    }
+    for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) in.texcoord[set][0] = kLaneIndex.data();
+    ps11::PixelOutputs outp;
+    for (int c = 0; c < 4; ++c) outp.color[c] = sc.out[c];
+    uint64_t texelsPerPixel = 0;
+    for (int t = 0; t < taps; ++t)
+        texelsPerPixel += draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0;
+    for (int y = std::max(y0, s.yMin); y < std::min(y1, s.yMax); ++y) {
+        int xl = 0, xr = 0;
+        if (!rowCoverage(s, y, xl, xr)) continue;
+        for (int t = 0; t < taps; ++t) {
+            const FloatRowTap& tap = draw.taps[size_t(t)];
+            if (!tap.bound) continue;
+            const int k = attrTex(tap.coordSet, 1);
+            const float v = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+            RowTaps& r = rows[size_t(t)];
+            ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
+            if (tap.linear) {
+                r.h0 = hRow(draw, tri, t, r.j0, r.j1, sc);
+                r.h1 = hRow(draw, tri, t, r.j1, r.j0, sc);
+            }
+        }
+        for (int x = xl; x < xr; x += ps11::kMaxSpan) {
+            const int n = std::min(ps11::kMaxSpan, xr - x);
+            fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+            in.count = n;
+            sampler.setX(x);
+            exec.run(in, sampler, outp, &stats.exec);
+            MergeInputs mi;
+            mi.count = n;
+            for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+            mi.x = sc.x;
+            mi.y = sc.y;
+            for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
+            MergeStats ms;
+            mergePixels(draw.merge, mi, draw.target, &ms);
+            stats.written += ms.written;
+            stats.pixels += uint64_t(n);
+            stats.texels += uint64_t(n) * texelsPerPixel;
+        }
+    }
+}
+
+}  // namespace emu

@@ -1,0 +1,102 @@
+// The row path of the float profiles (docs/device.md "Aligned passes"): the float and ideal
+// counterpart of emu/aligned_pass.h. Triangles whose texture coordinates are screen-aligned (u
+// depends on x only, v on y only, no perspective) are drawn row by row without quads: each tap's
+// addressing (texel pair and weight, ps11::floatAxisTaps) is tabulated once per column and once
+// per row instead of per lane; a linear tap's horizontal lerps are made once per texel row ("H
+// rows", kept while the rows that need them are drawn) and each pixel takes one vertical lerp;
+// the executor runs its float program over the row with a sampler that hands out these values,
+// and the output merger merges the row. The arithmetic is the reference sampler's, operation for
+// operation, so results are bit-identical to the quad path.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "emu/aligned_pass.h"
+#include "emu/output_merger.h"
+#include "emu/raster.h"
+#include "ps11/executor.h"
+#include "ps11/texture.h"
+#include "ps11/texture_sampler.h"
+
+namespace emu {
+
+// One texture read of the program, resolved against the draw's textures and sampler states.
+struct FloatRowTap {
+    bool bound = false;  // no texture: every lookup is (0, 0, 0, 1)
+    int stage = 0, coordSet = 0;
+    bool unorm8 = false;               // texels as b g r a bytes (else float r g b a values)
+    const uint8_t* bytes = nullptr;    // level 0 (Unorm8)
+    const float* values = nullptr;     // level 0 (Decoded)
+    uint32_t width = 1, height = 1;
+    bool linear = false;
+    ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;
+    std::array<float, 4> border{};
+};
+
+// What one draw needs, shared read-only by the workers.
+struct FloatRowDraw {
+    uint64_t serial = 0;  // unique per draw: H rows kept by workers are valid within one draw only
+    const ps11::Executor* executor = nullptr;
+    ps11::TapPlan plan;
+    std::array<FloatRowTap, 8> taps{};
+    bool weights8 = false;  // the float profile on a class with 8-bit filter weights
+    uint64_t colorAttrs = 0;
+    MergeState merge;
+    MergeTarget target;
+};
+
+// Decides whether a draw can take the float row path (float or ideal precision, a program whose
+// texture reads are plain and on distinct stages, 2-D textures each read at level 0 with one
+// filter, no depth, fog or texkill) and fills `out`.
+bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
+                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
+                         const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
+                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out);
+
+// Per triangle: every tap's column table over the clip rect's columns.
+struct FloatRowTriangle {
+    int x0 = 0, x1 = 0;
+    struct Columns {
+        std::vector<int32_t> i0, i1;
+        std::vector<float> f;
+        // Equal tables of one draw share their H rows (a full-screen quad's two triangles):
+        // shareFloatRowTables gives them the id of the first.
+        uint64_t tableId = 0;
+    };
+    std::array<Columns, 8> taps;
+};
+
+// Gives each tap's table of tris[0 .. count) an id, equal tables (same columns, texel pairs and
+// weights) the same, so drawFloatRows builds their H rows once.
+void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count);
+
+// True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
+// colours constant or affine), and then fills its tables.
+bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out);
+
+// Per-worker buffers, allocated once and kept by the worker.
+struct FloatRowScratch {
+    alignas(32) float color[8][ps11::kMaxSpan];
+    alignas(32) float out[4][ps11::kMaxSpan];
+    alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
+    // H rows: per tap, two texel rows filtered horizontally over the triangle's columns, planar
+    // r g b a (4 × columns floats each), keyed by draw, column table and texel row.
+    struct HRow {
+        uint64_t serial = 0;
+        uint64_t tableId = 0;
+        int32_t row = 0;
+        uint64_t stamp = 0;
+        std::vector<float> h;
+    };
+    std::array<std::array<HRow, 2>, 8> hrows;
+    uint64_t stamp = 0;
+};
+
+// Draws rows [y0, y1) of one prepared triangle.
+void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
+                   FloatRowScratch& sc, AlignedStats& stats);
+
+}  // namespace emu
