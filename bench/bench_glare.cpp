@@ -30,8 +30,8 @@ namespace {
 
 constexpr uint32_t kW = 1920, kH = 1080;
 
-enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, kModes };
-const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact"};
+enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, EmuFloat, kModes };
+const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact", "emu_float"};
 
 int threads() {
     const char* t = std::getenv("PS11_THREADS");
@@ -44,6 +44,7 @@ std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err) {
     ro.height = kH;
     ro.device.software.threads = threads();
     if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
+    if (mode == EmuFloat) ro.device.precision = ps11::Precision::Float;
     if (mode == GlNative || mode == GlExact) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe reads it when its screen is made
         const char* kind = std::getenv("PS11_GL");
@@ -86,7 +87,8 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     std::vector<glare::PassAgreement> agreement;
     glare::FrameResult r;
     if (!glare::compareFrame(*run[EmuFx8], *run[GlExact], t, s, 0, 2, agreement, r, err) ||
-        !run[EmuIdeal]->runFrame(t, s, 0, 2, r, err) || !run[GlNative]->runFrame(t, s, 0, 2, r, err)) {
+        !run[EmuIdeal]->runFrame(t, s, 0, 2, r, err) || !run[EmuFloat]->runFrame(t, s, 0, 2, r, err) ||
+        !run[GlNative]->runFrame(t, s, 0, 2, r, err)) {
         state.SkipWithError(err.c_str());
         return;
     }
@@ -180,6 +182,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     // Ratios to the peer (> 1: faster than GL native).
     state.counters["fx8_speedup_vs_native"] = med[GlNative] / med[EmuFx8];
     state.counters["ideal_speedup_vs_native"] = med[GlNative] / med[EmuIdeal];
+    state.counters["float_speedup_vs_native"] = med[GlNative] / med[EmuFloat];
     state.counters["exact_over_native"] = med[GlExact] / med[GlNative];
     state.counters["emu_fx8_moving_ms"] = median(movingMs[0]);
     state.counters["gl_native_moving_ms"] = median(movingMs[1]);
@@ -191,8 +194,8 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["native_vs_fx8_max"] = nativeVsFx8.max;
     state.counters["native_vs_fx8_mean"] = nativeVsFx8.mean;
     state.SetLabel(ps11::glRendererDescription());
-    std::fprintf(stderr, "%s, per pass (median ms): %-22s %9s %9s %9s %9s\n", name.c_str(), "pass", kModeNames[0],
-                 kModeNames[1], kModeNames[2], kModeNames[3]);
+    std::fprintf(stderr, "%s, per pass (median ms): %-22s %9s %9s %9s %9s %9s\n", name.c_str(), "pass", kModeNames[0],
+                 kModeNames[1], kModeNames[2], kModeNames[3], kModeNames[4]);
     for (const std::string& p : passOrder) {
         std::fprintf(stderr, "%s, per pass (median ms): %-22s", name.c_str(), p.c_str());
         for (int m = 0; m < kModes; ++m) std::fprintf(stderr, " %9.3f", median(passMs[m][p]));
