@@ -8,6 +8,7 @@
 #include "emu/output_merger_kernels.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cstring>
@@ -41,6 +42,14 @@ inline int32_t divRoundEven(int64_t num) {
 
 // Saturate to [0, 1]; NaN becomes 0.
 inline float sat(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
+
+// float(b) / 255.0f for every byte b (a destination byte as the float blend reads it), without a
+// division per channel.
+const std::array<float, 256> kUnitOfByte = [] {
+    std::array<float, 256> t{};
+    for (uint32_t b = 0; b < 256; ++b) t[b] = float(b) / 255.0f;
+    return t;
+}();
 
 // The 8-bit value of a saturated float (precision.md "Outputs": round_half_even(x * 255); x * 255
 // is exact in double).
@@ -694,10 +703,10 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
                 for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(s[c]));
             } else {
                 const uint32_t old = load32(q);
-                v[kDst + 0] = float((old >> 16) & 0xffu) / 255.0f;
-                v[kDst + 1] = float((old >> 8) & 0xffu) / 255.0f;
-                v[kDst + 2] = float(old & 0xffu) / 255.0f;
-                v[kDst + 3] = x8 ? 1.0f : float(old >> 24) / 255.0f;
+                v[kDst + 0] = kUnitOfByte[(old >> 16) & 0xffu];
+                v[kDst + 1] = kUnitOfByte[(old >> 8) & 0xffu];
+                v[kDst + 2] = kUnitOfByte[old & 0xffu];
+                v[kDst + 3] = x8 ? 1.0f : kUnitOfByte[old >> 24];
                 for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c];
                 v[kSat] = std::min(s[3], 1.0f - v[kDst + 3]);
                 for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(blendFloat(ch[c], v, s[c], v[kDst + c])));
@@ -775,6 +784,53 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
             } else {
                 for (int c = 0; c < 4; ++c)
                     if (channels >> c & 1u) std::memcpy(q + 4 * c, &v[c], 4);  // R32F: only red is enabled
+            }
+        }
+    }
+    n.written += written;
+}
+
+// Float targets with blending and no fog or tests: mergeFloat's float-target steps (the same
+// blendFloat per channel, the same reads and stores) without its per-pixel branches.
+void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
+    const Lanes lanes(in, p);
+    const Surf cs = p.colorSurf;
+    ChannelPlan ch[4];
+    std::copy_n(p.ch, 4, ch);
+    float v[kSlots];
+    v[kZero] = 0.0f, v[kOne] = 1.0f;
+    for (int c = 0; c < 4; ++c) v[kBf + c] = float(p.bfByte[c]) / 255.0f;
+    const uint8_t* live = in.live;
+    uint64_t written = 0;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        ++written;
+        uint8_t* q = cs.at(x, y);
+        float s[4] = {f[0][i], f[1][i], f[2][i], f[3][i]};
+        float d[4] = {0, 0, 0, 1};
+        if (p.target == TargetKind::Rgba16F) {
+            for (int c = 0; c < 4; ++c) {
+                uint16_t h;
+                std::memcpy(&h, q + 2 * c, 2);
+                d[c] = floatOfHalf(h);
+            }
+        } else if (p.target == TargetKind::Rgba32F) {
+            std::memcpy(d, q, 16);
+        } else {
+            std::memcpy(d, q, 4);  // R32F: g b a read 1
+            d[1] = d[2] = d[3] = 1.0f;
+        }
+        for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
+        v[kSat] = std::min(s[3], 1.0f - d[3]);
+        for (int c = 0; c < 4; ++c) s[c] = blendFloat(ch[c], v, s[c], d[c]);
+        for (int c = 0; c < 4; ++c) {
+            if (!(p.channels >> c & 1u)) continue;
+            if (p.target == TargetKind::Rgba16F) {
+                const uint16_t h = halfOf(s[c]);
+                std::memcpy(q + 2 * c, &h, 2);
+            } else {
+                std::memcpy(q + 4 * c, &s[c], 4);  // R32F: only c = 0 is enabled
             }
         }
     }
@@ -919,6 +975,8 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
         }
     } else if (!p.fog && !p.alphaTest && !p.depthTest && !p.blend) {
         storeFloatPlain(p, lanes, color, n);
+    } else if (!fx && p.color && !p.fog && !p.alphaTest && !p.depthTest) {
+        blendFloatTarget(p, lanes, color, n);
     } else {
         mergeFloat(p, lanes, FloatSource{color, grid, G}, n);
     }
