@@ -144,10 +144,7 @@ std::optional<emu::RgbaImage> Runner::readTexture(Handle texture, std::string& e
             std::memcpy(&img.rgba[i * 4], rgba.data(), 4);
         } else {
             const auto v = emu::decodeTexel(info, p, ps11::SignedDecode{});
-            for (int c = 0; c < 4; ++c) {
-                const float x = v[size_t(c)] < 0 ? 0 : v[size_t(c)] > 1 ? 1 : v[size_t(c)];
-                img.rgba[i * 4 + size_t(c)] = uint8_t(x * 255.0f + 0.5f);
-            }
+            for (int c = 0; c < 4; ++c) img.rgba[i * 4 + size_t(c)] = frameByte(v[size_t(c)]);
         }
     }
     return img;

@@ -30,6 +30,14 @@ struct FrameResult {
     double sceneMilliseconds = 0;
 };
 
+// The 8-bit value a float frame's channel reads back as (Runner::readTexture): clamped to
+// [0, 1], x·255 rounded half up; NaN reads 0.
+inline uint8_t frameByte(float v) {
+    if (!(v == v)) return 0;
+    const float x = v < 0 ? 0 : v > 1 ? 1 : v;
+    return uint8_t(x * 255.0f + 0.5f);
+}
+
 class Runner {
 public:
     explicit Runner(const RunnerOptions& options);

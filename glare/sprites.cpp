@@ -278,6 +278,25 @@ public:
                                   return true;
                               },
                               c.error);
+                      if (desc.Format == D3DFMT_A32B32G32R32F)
+                          return runner->readPixels(
+                              c.texture(scene),
+                              [&](const Runner::Pixels& px) {
+                                  // The 8-bit frame readTexture would give, converted row by row
+                                  // into a buffer the thread keeps (no fresh 8 MB every frame).
+                                  static thread_local std::vector<uint8_t> frame8buf;
+                                  std::vector<uint8_t>* frame8 = &frame8buf;
+                                  frame8->resize(size_t(px.width) * px.height * 4);
+                                  for (uint32_t y = 0; y < px.height; ++y) {
+                                      const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
+                                      uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
+                                      for (size_t i = 0; i < size_t(px.width) * 4; ++i) out[i] = frameByte(in[i]);
+                                  }
+                                  *sprites = senseSprites(frame8->data(), px.width, px.height, ss);
+                                  c.stats.pixels += uint64_t(px.width) * px.height;
+                                  return true;
+                              },
+                              c.error);
                       std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
                       if (!img) return false;
                       *sprites = senseSprites(img->rgba.data(), img->width, img->height, ss);
