@@ -790,6 +790,33 @@ void storeFloatPlain(const Plan& p, const MergeInputs& in, const float* const f[
     n.written += written;
 }
 
+// Float profiles' ONE/ONE ADD into an 8-bit target, no fog or tests: mergeFloat's result. With
+// both factors ONE, blendFloat's 1·(s·1) + 1·(d·1) is s + d exactly (s is saturated, d a byte's
+// value: both finite), saturated and rounded as mergeFloat does.
+void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
+    const Lanes lanes(in, p);
+    const Surf cs = p.colorSurf;
+    const bool x8 = p.target == TargetKind::Xrgb8;
+    const uint32_t mask = wordMask(p);
+    const uint8_t* live = in.live;
+    uint64_t written = 0;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        ++written;
+        uint8_t* q = cs.at(x, y);
+        const uint32_t old = load32(q);
+        const float d[4] = {kUnitOfByte[(old >> 16) & 0xffu], kUnitOfByte[(old >> 8) & 0xffu], kUnitOfByte[old & 0xffu],
+                            x8 ? 1.0f : kUnitOfByte[old >> 24]};
+        uint32_t out[4];
+        for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(sat(f[c][i]) + d[c]));
+        uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
+        if (mask != 0xffffffffu) w = (w & mask) | (old & ~mask);
+        store32(q, w);
+    }
+    n.written += written;
+}
+
 // Float targets with blending and no fog or tests: mergeFloat's float-target steps (the same
 // blendFloat per channel, the same reads and stores) without its per-pixel branches.
 void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
@@ -950,11 +977,12 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
 
     Counts n;
     const bool unorm = p.color && (p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8);
-    // fx8 ONE/ONE ADD on every channel (additive passes).
-    bool additive = p.blend && state.precision == Precision::Fx8;
+    // ONE/ONE ADD on every channel (additive passes); fx8's has an exact byte path.
+    bool oneOneAdd = p.blend;
     for (const ChannelPlan& cp : p.ch)
-        additive = additive && cp.kind == OpKind::Linear && cp.cs == 1 && cp.cd == 1 && cp.src.slot == kOne &&
-                   !cp.src.inv && cp.dst.slot == kOne && !cp.dst.inv;
+        oneOneAdd = oneOneAdd && cp.kind == OpKind::Linear && cp.cs == 1 && cp.cd == 1 && cp.src.slot == kOne &&
+                    !cp.src.inv && cp.dst.slot == kOne && !cp.dst.inv;
+    const bool additive = oneOneAdd && state.precision == Precision::Fx8;
     if (unorm && !p.fog && !p.alphaTest && !p.depthTest && (!p.blend || additive) && p.channels) {
         if (additive)
             storeUnorm8Plain<true>(p, lanes, grid, color, n);
@@ -965,6 +993,8 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
             blendFxUnorm8Simple<255>(p, lanes, grid, n);
         else
             blendFxUnorm8Simple<4080>(p, lanes, grid, n);
+    } else if (unorm && !fx && oneOneAdd && !p.fog && !p.alphaTest && !p.depthTest) {
+        addUnorm8Float(p, lanes, color, n);
     } else if (!p.color || unorm) {
         if (state.precision == Precision::Fx8) {
             mergeFxUnorm8<255>(p, lanes, grid, n);

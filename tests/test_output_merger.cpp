@@ -1267,3 +1267,33 @@ TEST_CASE("merger: random states through the whole pipeline match a per-pixel mo
         CHECK(stats.depthRejected == zRej);
     }
 }
+
+TEST_CASE("merger: float-profile ONE/ONE ADD into 8-bit targets equals the general blend", "[merger]") {
+    // The additive path (no fog) against the same blend through the general path (fog on, with
+    // fog factor 1: the colour is unchanged), for random colours (NaN, infinities, negatives,
+    // values above 1), destination bytes, X8 targets and write masks.
+    std::mt19937 rng(42);
+    const float specials[] = {NAN, INFINITY, -INFINITY, -0.0f, 0.0f, 1.0f, 2.5f, -1.0f, 0.5f / 255, 1e-30f};
+    for (int round = 0; round < 40; ++round) {
+        const D3DFORMAT fmt = round % 3 ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        const Precision p = round % 2 ? Precision::Float : Precision::Ideal;
+        MergeState st = blendState(D3DBLEND_ONE, D3DBLEND_ONE, D3DBLENDOP_ADD, p);
+        st.colorWrite = round % 5 == 0 ? DWORD(rng() % 16) : 0xfu;
+        Span span(64);
+        for (int i = 0; i < 64; ++i) {
+            std::array<float, 4> v;
+            for (float& f : v) f = rng() % 4 == 0 ? specials[rng() % 10] : float(int(rng() % 3000) - 500) / 1000.0f;
+            span.setColor(i, v);
+            span.live[size_t(i)] = rng() % 8 != 0;
+        }
+        Image fast = makeImage(fmt, 16, 4), general = makeImage(fmt, 16, 4);
+        for (size_t b = 0; b < fast.bytes.size(); ++b) fast.bytes[b] = general.bytes[b] = uint8_t(rng());
+        const MergeStats a = run(st, span, &fast);
+        st.fog = true;
+        st.fogColor = 0x00808080u;
+        const MergeStats b = run(st, span, &general);
+        CHECK(a.written == b.written);
+        CHECK(std::vector<uint8_t>(fast.bytes.begin(), fast.bytes.end()) ==
+              std::vector<uint8_t>(general.bytes.begin(), general.bytes.end()));
+    }
+}
