@@ -8,6 +8,10 @@
 #include <cstring>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "ps11/precision.h"
 
 namespace emu {
@@ -173,7 +177,23 @@ void stretchImages(const StretchCall& call, RowRange rows) {
         for (int64_t j = j0; j < dh; ++j) {
             const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
-            for (int64_t i = 0; i < dw; ++i, in += 16, out += 4) {
+            int64_t i = 0;
+#if defined(__SSE2__)
+            // toUnorm8 two channels at a time: max(v, 0) gives 0 for NaN (MAXPD returns its second
+            // operand), the conversion rounds to nearest even (the default MXCSR mode).
+            const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), k255 = _mm_set1_pd(255.0);
+            for (; i < dw; ++i, in += 16, out += 4) {
+                const __m128 v = _mm_loadu_ps(reinterpret_cast<const float*>(in));
+                const __m128d rg = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(v), zero), one), k255);
+                const __m128d ba = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), zero), one), k255);
+                const __m128i irg = _mm_cvtpd_epi32(rg), iba = _mm_cvtpd_epi32(ba);
+                out[0] = uint8_t(_mm_cvtsi128_si32(iba));
+                out[1] = uint8_t(_mm_cvtsi128_si32(_mm_srli_si128(irg, 4)));
+                out[2] = uint8_t(_mm_cvtsi128_si32(irg));
+                out[3] = x8 ? 0xFF : uint8_t(_mm_cvtsi128_si32(_mm_srli_si128(iba, 4)));
+            }
+#endif
+            for (; i < dw; ++i, in += 16, out += 4) {
                 float v[4];
                 std::memcpy(v, in, 16);
                 out[0] = toUnorm8(v[2]), out[1] = toUnorm8(v[1]), out[2] = toUnorm8(v[0]);
