@@ -162,10 +162,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        // One level and one filter for every pixel, as the sampler decides (docs/textures.md).
-        if (tex->isVolume()) return false;
-        if (linearFilter(ss.minFilter) != linearFilter(ss.magFilter)) return false;
-        if (tex->levelCount() != 1 && ss.mipFilter != ps11::Filter::None) return false;
+        if (!levelZeroOnly(*tex, ss)) return false;
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
         tap.unorm8 = tex->storage() == ps11::TexelStorage::Unorm8;
@@ -188,12 +185,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
 }
 
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
-    if (s.perspective) return false;
-    for (int i = 0; i < draw.plan.count; ++i) {
-        const int ku = attrTex(draw.taps[size_t(i)].coordSet, 0), kv = ku + 1;
-        if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
-        if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
-    }
+    if (!screenAligned(draw.plan, s)) return false;
     out.x0 = s.clip.x0;
     out.x1 = s.clip.x1;
     const int n = std::max(out.x1 - out.x0, 0);
@@ -202,10 +194,7 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
         const FloatRowTap& tap = draw.taps[size_t(i)];
         FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
         if (!tap.bound) continue;
-        const int k = attrTex(tap.coordSet, 0);
-        for (int x = 0; x < n; ++x)
-            u[size_t(x)] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
-                                                  : planeValue(s.attr[size_t(k)], s.ox, s.oy, out.x0 + x, s.yMin);
+        columnU(s, tap.coordSet, out.x0, n, u.data());
         cols.i0.resize(size_t(n));
         cols.i1.resize(size_t(n));
         cols.f.resize(size_t(n));
@@ -256,8 +245,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
         for (int t = 0; t < taps; ++t) {
             const FloatRowTap& tap = draw.taps[size_t(t)];
             if (!tap.bound) continue;
-            const int k = attrTex(tap.coordSet, 1);
-            const float v = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+            const float v = rowV(s, tap.coordSet, y);
             RowTaps& r = rows[size_t(t)];
             ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
             if (tap.linear) {

@@ -104,8 +104,7 @@ namespace {
 
 TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
     TapRow r;
-    const int k = attrTex(tap.coordSet, 1);
-    const float v = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+    const float v = rowV(s, tap.coordSet, y);
     int32_t j0 = 0, j1 = 0, w = 0;
     ps11::fastpath::axisTable(tap.addressV, tap.linear, 1, &v, tap.height, &j0, &j1, &w);
     const size_t pitch = size_t(tap.width) * 4;
@@ -268,10 +267,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        // One level and one filter for every pixel, as the sampler decides (docs/textures.md).
-        if (tex->isVolume() || tex->storage() != ps11::TexelStorage::Unorm8) return false;
-        if (effectiveLinear(ss.minFilter) != effectiveLinear(ss.magFilter)) return false;
-        if (tex->levelCount() != 1 && ss.mipFilter != ps11::Filter::None) return false;
+        if (!levelZeroOnly(*tex, ss) || tex->storage() != ps11::TexelStorage::Unorm8) return false;
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
         tap.texels = tex->unorm8() + li.offset * 4;
@@ -306,14 +302,35 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     return true;
 }
 
-bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss) {
+    return !tex.isVolume() && effectiveLinear(ss.minFilter) == effectiveLinear(ss.magFilter) &&
+           (tex.levelCount() == 1 || ss.mipFilter == ps11::Filter::None);
+}
+
+bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {
     if (s.perspective) return false;
-    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
-    for (int i = 0; i < draw.plan.count; ++i) {
-        const int ku = attrTex(draw.taps[size_t(i)].coordSet, 0), kv = ku + 1;
+    for (int i = 0; i < plan.count; ++i) {
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
         if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
         if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
     }
+    return true;
+}
+
+void columnU(const TriangleSetup& s, int set, int x0, int n, float* u) {
+    const int k = attrTex(set, 0);
+    for (int x = 0; x < n; ++x)
+        u[x] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, x0 + x, s.yMin);
+}
+
+float rowV(const TriangleSetup& s, int set, int y) {
+    const int k = attrTex(set, 1);
+    return (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+}
+
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
+    if (!screenAligned(draw.plan, s)) return false;
     out.x0 = s.clip.x0;
     out.x1 = s.clip.x1;
     out.configs.clear();
@@ -325,10 +342,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
         cols.runs.clear();
         cols.configCount = 0;
         if (!tap.bound) continue;
-        const int k = attrTex(tap.coordSet, 0);
-        for (int x = 0; x < n; ++x)
-            u[size_t(x)] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
-                                                  : planeValue(s.attr[size_t(k)], s.ox, s.oy, out.x0 + x, s.yMin);
+        columnU(s, tap.coordSet, out.x0, n, u.data());
         cols.off0.resize(size_t(n));
         cols.off1.resize(size_t(n));
         cols.w.resize(size_t(n));

@@ -141,6 +141,20 @@ struct AlignedScratch {
     HRowCache hrows;
 };
 
+// Whether the sampler reads level 0 with one filter at every level of detail (a 2-D texture, the
+// same filter for minification and magnification, one level or MIP filter NONE): the row
+// paths' per-texture condition (docs/textures.md "Level of detail").
+bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss);
+
+// Whether every texture-coordinate set of `plan` is screen-aligned on the triangle (u constant or
+// a plane with dy = 0, v constant or a plane with dx = 0) and the triangle has no perspective:
+// the row paths' per-triangle condition (colours are then constant or affine).
+bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s);
+// The quad path's u of coordinate set `set` at columns x0 .. x0 + n − 1 (any row), and its v at
+// row y (any column), on a screen-aligned triangle.
+void columnU(const TriangleSetup& s, int set, int x0, int n, float* u);
+float rowV(const TriangleSetup& s, int set, int y);
+
 // The diffuse (color[0..3]) and specular (color[4..7]) lanes of pixels x .. x + n − 1 of row y
 // that `colorAttrs` names, as the quad path interpolates them (constant or affine, no
 // perspective).

@@ -637,6 +637,39 @@ struct FloatSource {
     int32_t G;
 };
 
+// One pixel of a float target (R32F, A16B16G16R16F, A32B32G32R32F): blended with what it holds
+// when the plan blends (blendFloat per channel; v holds the plan's constant slots), then the
+// enabled channels stored.
+inline void blendIntoFloatTarget(const Plan& p, const ChannelPlan* ch, float* v, float s[4], uint8_t* q) {
+    float d[4] = {0, 0, 0, 1};
+    if (p.blend) {
+        if (p.target == TargetKind::Rgba16F) {
+            for (int c = 0; c < 4; ++c) {
+                uint16_t h;
+                std::memcpy(&h, q + 2 * c, 2);
+                d[c] = floatOfHalf(h);
+            }
+        } else if (p.target == TargetKind::Rgba32F) {
+            std::memcpy(d, q, 16);
+        } else {
+            std::memcpy(d, q, 4);  // R32F: g b a read 1
+            d[1] = d[2] = d[3] = 1.0f;
+        }
+        for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
+        v[kSat] = std::min(s[3], 1.0f - d[3]);
+        for (int c = 0; c < 4; ++c) s[c] = blendFloat(ch[c], v, s[c], d[c]);
+    }
+    for (int c = 0; c < 4; ++c) {
+        if (!(p.channels >> c & 1u)) continue;
+        if (p.target == TargetKind::Rgba16F) {
+            const uint16_t h = halfOf(s[c]);
+            std::memcpy(q + 2 * c, &h, 2);
+        } else {
+            std::memcpy(q + 4 * c, &s[c], 4);  // R32F: only c = 0 is enabled
+        }
+    }
+}
+
 void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Counts& n) {
     const bool fx = ps11::isFixedPoint(p.precision);
     // Without a colour target (depth only) the alpha test uses the 8-bit rule.
@@ -716,34 +749,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
             store32(q, w);
             continue;
         }
-        // Float targets.
-        float d[4] = {0, 0, 0, 1};
-        if (p.blend) {
-            if (p.target == TargetKind::Rgba16F) {
-                for (int c = 0; c < 4; ++c) {
-                    uint16_t h;
-                    std::memcpy(&h, q + 2 * c, 2);
-                    d[c] = floatOfHalf(h);
-                }
-            } else if (p.target == TargetKind::Rgba32F) {
-                std::memcpy(d, q, 16);
-            } else {
-                std::memcpy(d, q, 4);  // R32F: g b a read 1
-                d[1] = d[2] = d[3] = 1.0f;
-            }
-            for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
-            v[kSat] = std::min(s[3], 1.0f - d[3]);
-            for (int c = 0; c < 4; ++c) s[c] = blendFloat(ch[c], v, s[c], d[c]);
-        }
-        for (int c = 0; c < 4; ++c) {
-            if (!(p.channels >> c & 1u)) continue;
-            if (p.target == TargetKind::Rgba16F) {
-                const uint16_t h = halfOf(s[c]);
-                std::memcpy(q + 2 * c, &h, 2);
-            } else {
-                std::memcpy(q + 4 * c, &s[c], 4);  // R32F: only c = 0 is enabled
-            }
-        }
+        blendIntoFloatTarget(p, ch, v, s, q);
     }
 }
 
@@ -817,8 +823,8 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     n.written += written;
 }
 
-// Float targets with blending and no fog or tests: mergeFloat's float-target steps (the same
-// blendFloat per channel, the same reads and stores) without its per-pixel branches.
+// Float targets with blending and no fog or tests: mergeFloat's float-target step
+// (blendIntoFloatTarget) without its per-pixel branches.
 void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f[4], Counts& n) {
     const Lanes lanes(in, p);
     const Surf cs = p.colorSurf;
@@ -835,31 +841,7 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
         ++written;
         uint8_t* q = cs.at(x, y);
         float s[4] = {f[0][i], f[1][i], f[2][i], f[3][i]};
-        float d[4] = {0, 0, 0, 1};
-        if (p.target == TargetKind::Rgba16F) {
-            for (int c = 0; c < 4; ++c) {
-                uint16_t h;
-                std::memcpy(&h, q + 2 * c, 2);
-                d[c] = floatOfHalf(h);
-            }
-        } else if (p.target == TargetKind::Rgba32F) {
-            std::memcpy(d, q, 16);
-        } else {
-            std::memcpy(d, q, 4);  // R32F: g b a read 1
-            d[1] = d[2] = d[3] = 1.0f;
-        }
-        for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c], v[kDst + c] = d[c];
-        v[kSat] = std::min(s[3], 1.0f - d[3]);
-        for (int c = 0; c < 4; ++c) s[c] = blendFloat(ch[c], v, s[c], d[c]);
-        for (int c = 0; c < 4; ++c) {
-            if (!(p.channels >> c & 1u)) continue;
-            if (p.target == TargetKind::Rgba16F) {
-                const uint16_t h = halfOf(s[c]);
-                std::memcpy(q + 2 * c, &h, 2);
-            } else {
-                std::memcpy(q + 4 * c, &s[c], 4);  // R32F: only c = 0 is enabled
-            }
-        }
+        blendIntoFloatTarget(p, ch, v, s, q);
     }
     n.written += written;
 }
