@@ -213,8 +213,10 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
             c.tableId = 0;
             for (size_t j = 0; j < i && !c.tableId; ++j) {
                 const FloatRowTriangle::Columns& o = tris[j].taps[size_t(t)];
+                // Weights compared by bits (an unbound tap's table is empty).
                 if (prepared[j] && tris[j].x0 == tris[i].x0 && tris[j].x1 == tris[i].x1 && o.i0 == c.i0 &&
-                    o.i1 == c.i1 && std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0)
+                    o.i1 == c.i1 && o.f.size() == c.f.size() &&
+                    (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0))
                     c.tableId = o.tableId;
             }
             if (!c.tableId) c.tableId = ++ids;
