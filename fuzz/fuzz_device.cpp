@@ -2,9 +2,10 @@
 // files the reader accepts are set up on emu::Device and their draws and pixel probes run. The
 // device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
 // format can express; a refused call must carry a message. Sizes are capped so each input
-// stays fast (the limits themselves are tested elsewhere). In fx8 every file is also drawn with
-// the aligned-pass path off: after every draw both render targets must be identical bit for bit
-// (docs/device.md "Aligned passes").
+// stays fast (the limits themselves are tested elsewhere). In fx8, float and ideal every file is
+// also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path): after
+// every draw both render targets must be identical bit for bit (docs/device.md "Aligned
+// passes").
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -57,7 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (program) ps11::validate(*program, diags);
         if (!program || diags.hasErrors()) return 0;
     }
-    for (ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Float}) {
+    for (ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal}) {
         std::string error;
         const ps11::HardwareConfig hw = ps11::resolveHardware(file.require.hardware.value, program ? program->version.minor : 1,
                                                               p, file.require.maxValue.value);
@@ -66,12 +67,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             check(!error.empty());
             continue;
         }
-        std::unique_ptr<ps11::DrawRunner> quads;
-        if (p == ps11::Precision::Fx8) {
-            std::string quadError;
-            quads = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
-            check(quads != nullptr);
-        }
+        std::string quadError;
+        std::unique_ptr<ps11::DrawRunner> quads =
+            ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
+        check(quads != nullptr);
         for (const ps11::TestCommand& cmd : file.commands) {
             if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;
             error.clear();
