@@ -6,6 +6,10 @@
 #include <atomic>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 #include "emu/vertex.h"
 
 namespace emu {
@@ -17,6 +21,9 @@ bool linearFilter(ps11::Filter f) { return f == ps11::Filter::Linear; }
 // The reference sampler's lerp (texture_sampler.cpp combineFloat), in the same order.
 inline float lerpf(float a, float b, float f) { return (1.0f - f) * a + f * b; }
 
+// ps11::Texture::unorm8Values(), fetched once.
+const float* const kUnorm8 = ps11::Texture::unorm8Values();
+
 // Texel (ix, iy) of level 0 as float r g b a, or the border colour when an index is −1.
 inline void texel(const FloatRowTap& tap, int32_t ix, int32_t iy, float t[4]) {
     if ((ix | iy) < 0) {
@@ -25,8 +32,7 @@ inline void texel(const FloatRowTap& tap, int32_t ix, int32_t iy, float t[4]) {
     }
     const size_t i = (size_t(iy) * tap.width + size_t(ix)) * 4;
     if (tap.unorm8) {
-        const float* table = ps11::Texture::unorm8Values();
-        for (int c = 0; c < 4; ++c) t[c] = table[tap.bytes[i + size_t(ps11::kUnorm8Byte[c])]];
+        for (int c = 0; c < 4; ++c) t[c] = kUnorm8[tap.bytes[i + size_t(ps11::kUnorm8Byte[c])]];
     } else {
         for (int c = 0; c < 4; ++c) t[c] = tap.values[i + size_t(c)];
     }
@@ -61,8 +67,52 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     const FloatRowTriangle::Columns& cols = tri.taps[size_t(t)];
     const size_t w = size_t(tri.x1 - tri.x0);
     h.h.resize(4 * w);
+    size_t x = 0;
+    if (tap.unorm8 && j >= 0) {
+        // The texel row decoded once into planar floats, then lerped in blocks of four columns
+        // whose pairs are consecutive texels (i0 = k, k+1, k+2, k+3 and i1 = i0 + 1: every
+        // column of a 1:1 or minified-by-one mapping, away from clamped edges) with vector
+        // loads; the same operations in the same order as lerpf.
+        const size_t tw = tap.width;
+        sc.decoded.resize(4 * tw);
+        float* dec = sc.decoded.data();
+        const uint8_t* row = tap.bytes + size_t(j) * tw * 4;
+        const float* table = kUnorm8;
+        for (size_t i = 0; i < tw; ++i)
+            for (size_t c = 0; c < 4; ++c) dec[c * tw + i] = table[row[i * 4 + size_t(ps11::kUnorm8Byte[c])]];
+        const int32_t* i0 = cols.i0.data();
+        const int32_t* i1 = cols.i1.data();
+        const float* f = cols.f.data();
+        float* out = h.h.data();
+        for (; x < w; ++x) {
+            const int32_t k = i0[x];
+            if (x + 4 <= w && k >= 0 && i0[x + 3] == k + 3 && i1[x] == k + 1 && i1[x + 3] == k + 4 &&
+                i0[x + 1] == k + 1 && i0[x + 2] == k + 2 && i1[x + 1] == k + 2 && i1[x + 2] == k + 3) {
+#if defined(__SSE2__)
+                const __m128 fv = _mm_loadu_ps(f + x), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
+                for (size_t c = 0; c < 4; ++c) {
+                    const float* d = dec + c * tw + size_t(k);
+                    _mm_storeu_ps(out + c * w + x,
+                                  _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(d)), _mm_mul_ps(fv, _mm_loadu_ps(d + 1))));
+                }
+#else
+                for (size_t c = 0; c < 4; ++c)
+                    for (size_t q = 0; q < 4; ++q)
+                        out[c * w + x + q] = lerpf(dec[c * tw + size_t(k) + q], dec[c * tw + size_t(k) + q + 1], f[x + q]);
+#endif
+                x += 3;
+                continue;
+            }
+            const int32_t k1 = i1[x];
+            for (size_t c = 0; c < 4; ++c) {
+                const float a = k >= 0 ? dec[c * tw + size_t(k)] : tap.border[c];
+                const float b = k1 >= 0 ? dec[c * tw + size_t(k1)] : tap.border[c];
+                out[c * w + x] = lerpf(a, b, f[x]);
+            }
+        }
+    }
     float a[4], b[4];
-    for (size_t x = 0; x < w; ++x) {
+    for (; x < w; ++x) {
         texel(tap, cols.i0[x], j, a);
         texel(tap, cols.i1[x], j, b);
         for (size_t c = 0; c < 4; ++c) h.h[c * w + x] = lerpf(a[c], b[c], cols.f[x]);
@@ -109,7 +159,13 @@ public:
                 const float* a = r.h0 + size_t(c) * w + first;
                 const float* b = r.h1 + size_t(c) * w + first;
                 float* o = out.value[c];
-                for (int i = 0; i < n; ++i) o[i] = lerpf(a[i], b[i], r.fy);
+                int i = 0;
+#if defined(__SSE2__)
+                const __m128 fv = _mm_set1_ps(r.fy), gv = _mm_set1_ps(1.0f - r.fy);
+                for (; i + 4 <= n; i += 4)
+                    _mm_storeu_ps(o + i, _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + i)), _mm_mul_ps(fv, _mm_loadu_ps(b + i))));
+#endif
+                for (; i < n; ++i) o[i] = lerpf(a[i], b[i], r.fy);
             }
             m_fetched += uint64_t(n) * 4;
             return;

@@ -93,6 +93,7 @@ struct FloatRowScratch {
     };
     std::array<std::array<HRow, 2>, 8> hrows;
     uint64_t stamp = 0;
+    std::vector<float> decoded;  // an 8-bit texel row as planar r g b a floats, while its H row is built
 };
 
 // Draws rows [y0, y1) of one prepared triangle.

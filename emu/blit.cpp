@@ -25,15 +25,6 @@ int64_t floorDiv(int64_t n, int64_t d) {
     return q;
 }
 
-uint8_t toUnorm8(double v) {
-    // Nearest 8-bit value, ties to even (docs/precision.md "Outputs"); NaN stores 0.
-    if (std::isnan(v)) return 0;
-    // x in [0, 255]: adding and subtracting 1.5 * 2^52 rounds it to an integer, ties to even, in
-    // the default rounding mode (what nearbyint does, without the library call).
-    const double x = std::clamp(v, 0.0, 1.0) * 255.0;
-    return uint8_t((x + 6755399441055744.0) - 6755399441055744.0);
-}
-
 PixelBox meet(const PixelBox& a, const PixelBox& b) {
     return {std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1), std::min(a.y1, b.y1)};
 }
@@ -132,7 +123,7 @@ void stretchImages(const StretchCall& call, RowRange rows) {
         if (df.cls == FormatClass::Unorm8) {
             std::array<uint8_t, 4> b;
             for (size_t c = 0; c < 4; ++c)
-                b[c] = unormSource ? uint8_t(std::clamp(std::nearbyint(v[c]), 0.0, 255.0)) : toUnorm8(v[c]);
+                b[c] = unormSource ? uint8_t(std::clamp(std::nearbyint(v[c]), 0.0, 255.0)) : ps11::unorm8OfFloat(v[c]);
             encodeUnorm8(df, b, p);
         } else {
             std::array<float, 4> f;
@@ -179,7 +170,7 @@ void stretchImages(const StretchCall& call, RowRange rows) {
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
             int64_t i = 0;
 #if defined(__SSE2__)
-            // toUnorm8 two channels at a time: max(v, 0) gives 0 for NaN (MAXPD returns its second
+            // ps11::unorm8OfFloat two channels at a time: max(v, 0) gives 0 for NaN (MAXPD returns its second
             // operand), the conversion rounds to nearest even (the default MXCSR mode).
             const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), k255 = _mm_set1_pd(255.0);
             for (; i < dw; ++i, in += 16, out += 4) {
@@ -196,8 +187,8 @@ void stretchImages(const StretchCall& call, RowRange rows) {
             for (; i < dw; ++i, in += 16, out += 4) {
                 float v[4];
                 std::memcpy(v, in, 16);
-                out[0] = toUnorm8(v[2]), out[1] = toUnorm8(v[1]), out[2] = toUnorm8(v[0]);
-                out[3] = x8 ? 0xFF : toUnorm8(v[3]);
+                out[0] = ps11::unorm8OfFloat(v[2]), out[1] = ps11::unorm8OfFloat(v[1]), out[2] = ps11::unorm8OfFloat(v[0]);
+                out[3] = x8 ? 0xFF : ps11::unorm8OfFloat(v[3]);
             }
         }
         return;

@@ -14,6 +14,10 @@
 #include <cstring>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "ps11/sampler.h"
 
 namespace emu {
@@ -24,14 +28,6 @@ using ps11::Precision;
 
 // ---------------------------------------------------------------------------------------------
 // Small exact helpers.
-
-// round_half_even(x) for 0 <= x < 2^51 under the default rounding mode: adding 1.5 * 2^52 leaves
-// no fraction bits, so the addition itself rounds to the nearest integer, ties to even. This is
-// the rounding std::nearbyint does (Clear uses it), without a libm call per pixel.
-inline double rintEven(double x) {
-    constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
-    return (x + kMagic) - kMagic;                  // not folded: without -ffast-math the compiler keeps IEEE rounding
-}
 
 // round_half_even(num / den) for num >= 0, den > 0 a compile-time constant.
 template <int64_t Den>
@@ -51,9 +47,8 @@ const std::array<float, 256> kUnitOfByte = [] {
     return t;
 }();
 
-// The 8-bit value of a saturated float (precision.md "Outputs": round_half_even(x * 255); x * 255
-// is exact in double).
-inline uint32_t byteOfUnit(float v) { return uint32_t(rintEven(double(v) * 255.0)); }
+// round_half_even(v * 255) of a float already in [0, 1] (ps11::unorm8OfFloat without the clamp).
+inline uint32_t byteOfUnit(float v) { return uint32_t(ps11::roundEvenSmall(double(v) * 255.0)); }
 
 template <typename T>
 inline bool cmpPass(uint32_t mask, T a, T b) {
@@ -269,11 +264,11 @@ namespace {
 inline uint32_t depthCode(DepthKind k, float z) {
     switch (k) {
         case DepthKind::D16:
-            return uint32_t(rintEven(double(z) * 65535.0));
+            return uint32_t(ps11::roundEvenSmall(double(z) * 65535.0));
         case DepthKind::D24:
-            return uint32_t(rintEven(double(z) * 16777215.0));
+            return uint32_t(ps11::roundEvenSmall(double(z) * 16777215.0));
         case DepthKind::D32:
-            return uint32_t(rintEven(double(z) * 4294967295.0));
+            return uint32_t(ps11::roundEvenSmall(double(z) * 4294967295.0));
         default:
             return std::bit_cast<uint32_t>(z);
     }
@@ -409,7 +404,7 @@ struct Fx {
         }
     }
     // The fog factor on the grid: round_half_even(f * G) (f * G is exact in double).
-    static int32_t fogGrid(float f) { return int32_t(rintEven(double(f) * G)); }
+    static int32_t fogGrid(float f) { return int32_t(ps11::roundEvenSmall(double(f) * G)); }
 };
 
 // Bytewise min(a + b, 255) of two words (SWAR): the sum of the low 7 bits, the top bits added
@@ -442,9 +437,7 @@ void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const
         const auto b = [](int32_t v) { return Fx<4080>::byteOf(v < 0 ? 0 : v > 4080 ? 4080 : v); };
         for (int i = 0; i < count; ++i) words[i] = packArgb(b(g0[i]), b(g1[i]), b(g2[i]), b(g3[i])) | alphaFill;
     } else {
-        const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
-        const auto b = [](float v) { return byteOfUnit(sat(v)); };
-        for (int i = 0; i < count; ++i) words[i] = packArgb(b(f0[i]), b(f1[i]), b(f2[i]), b(f3[i])) | alphaFill;
+        mergerKernels(ps11::simdLevel()).unorm8Words(f, count, alphaFill, words);
     }
     const Surf cs = p.colorSurf;
     const Lanes lanes(in, p);
@@ -701,7 +694,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
             int32_t gn[4];
             for (int c = 0; c < 4; ++c) gn[c] = unorm ? std::clamp(src.grid[c][i], 0, G) : src.grid[c][i];
             if (p.fog) {
-                const int32_t fq = int32_t(rintEven(double(lanes.fog(i)) * G));
+                const int32_t fq = int32_t(ps11::roundEvenSmall(double(lanes.fog(i)) * G));
                 for (int c = 0; c < 3; ++c) {
                     const int64_t num = int64_t(fq) * gn[c] + int64_t(G - fq) * fogG[c];
                     gn[c] = int32_t(ps11::roundHalfEven(num, G));
@@ -733,7 +726,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
         if (unorm) {
             uint32_t out[4];
             if (!p.blend) {
-                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(s[c]));
+                for (int c = 0; c < 4; ++c) out[c] = ps11::unorm8OfFloat(s[c]);
             } else {
                 const uint32_t old = load32(q);
                 v[kDst + 0] = kUnitOfByte[(old >> 16) & 0xffu];
@@ -742,7 +735,7 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
                 v[kDst + 3] = x8 ? 1.0f : kUnitOfByte[old >> 24];
                 for (int c = 0; c < 4; ++c) v[kSrc + c] = s[c];
                 v[kSat] = std::min(s[3], 1.0f - v[kDst + 3]);
-                for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(blendFloat(ch[c], v, s[c], v[kDst + c])));
+                for (int c = 0; c < 4; ++c) out[c] = ps11::unorm8OfFloat(blendFloat(ch[c], v, s[c], v[kDst + c]));
             }
             uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
             if (mask != 0xffffffffu) w = (w & mask) | (load32(q) & ~mask);
@@ -754,6 +747,32 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
 }
 
 // The Baseline level's half conversion (emu/output_merger_kernels.h).
+void unorm8WordsBaseline(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
+    int i = 0;
+#if defined(__SSE2__)
+    // Two lanes of a channel per step in double: max(v, 0) is 0 for NaN (MAXPD returns its second
+    // operand), the product is exact, CVTPD2DQ rounds to nearest even (the default MXCSR mode).
+    const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), k255 = _mm_set1_pd(255.0);
+    const auto bytes4 = [&](const float* p) {
+        const __m128 v = _mm_loadu_ps(p);
+        const __m128d lo = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(v), zero), one), k255);
+        const __m128d hi = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), zero), one), k255);
+        return _mm_unpacklo_epi64(_mm_cvtpd_epi32(lo), _mm_cvtpd_epi32(hi));
+    };
+    const __m128i fill = _mm_set1_epi32(int32_t(alphaFill));
+    for (; i + 4 <= count; i += 4) {
+        const __m128i w = _mm_or_si128(
+            _mm_or_si128(_mm_slli_epi32(bytes4(f[3] + i), 24), _mm_slli_epi32(bytes4(f[0] + i), 16)),
+            _mm_or_si128(_mm_slli_epi32(bytes4(f[1] + i), 8), bytes4(f[2] + i)));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + i), _mm_or_si128(w, fill));
+    }
+#endif
+    for (; i < count; ++i)
+        words[i] = packArgb(ps11::unorm8OfFloat(f[0][i]), ps11::unorm8OfFloat(f[1][i]), ps11::unorm8OfFloat(f[2][i]),
+                            ps11::unorm8OfFloat(f[3][i])) |
+                   alphaFill;
+}
+
 void halvesBaseline(const float* const f[4], int count, uint16_t* out) {
     for (int i = 0; i < count; ++i)
         for (int c = 0; c < 4; ++c) out[4 * i + c] = halfOf(f[c][i]);
@@ -815,7 +834,7 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
         const float d[4] = {kUnitOfByte[(old >> 16) & 0xffu], kUnitOfByte[(old >> 8) & 0xffu], kUnitOfByte[old & 0xffu],
                             x8 ? 1.0f : kUnitOfByte[old >> 24]};
         uint32_t out[4];
-        for (int c = 0; c < 4; ++c) out[c] = byteOfUnit(sat(sat(f[c][i]) + d[c]));
+        for (int c = 0; c < 4; ++c) out[c] = ps11::unorm8OfFloat(sat(f[c][i]) + d[c]);
         uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
         if (mask != 0xffffffffu) w = (w & mask) | (old & ~mask);
         store32(q, w);
@@ -850,7 +869,7 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
 
 }  // namespace
 
-const MergerKernels baseline::kMerger{&halvesBaseline};
+const MergerKernels baseline::kMerger{&halvesBaseline, &unorm8WordsBaseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #ifdef PS11_HAVE_AVX2

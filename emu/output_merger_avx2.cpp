@@ -36,8 +36,33 @@ void halvesF16c(const float* const f[4], int count, uint16_t* out) {
     }
 }
 
+// Four lanes of a channel per step in double, as the Baseline kernel does two: the same clamp
+// (MAXPD gives 0 for NaN), exact product and nearest-even conversion.
+void unorm8WordsAvx2(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
+    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), k255 = _mm256_set1_pd(255.0);
+    const auto bytes8 = [&](const float* p) {
+        const __m128i lo = _mm256_cvtpd_epi32(
+            _mm256_mul_pd(_mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(_mm_loadu_ps(p)), zero), one), k255));
+        const __m128i hi = _mm256_cvtpd_epi32(
+            _mm256_mul_pd(_mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(_mm_loadu_ps(p + 4)), zero), one), k255));
+        return _mm256_setr_m128i(lo, hi);
+    };
+    const __m256i fill = _mm256_set1_epi32(int32_t(alphaFill));
+    int i = 0;
+    for (; i + 8 <= count; i += 8) {
+        const __m256i w = _mm256_or_si256(
+            _mm256_or_si256(_mm256_slli_epi32(bytes8(f[3] + i), 24), _mm256_slli_epi32(bytes8(f[0] + i), 16)),
+            _mm256_or_si256(_mm256_slli_epi32(bytes8(f[1] + i), 8), bytes8(f[2] + i)));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + i), _mm256_or_si256(w, fill));
+    }
+    if (i < count) {
+        const float* const rest[4] = {f[0] + i, f[1] + i, f[2] + i, f[3] + i};
+        baseline::kMerger.unorm8Words(rest, count - i, alphaFill, words + i);
+    }
+}
+
 }  // namespace
 
-const MergerKernels avx2::kMerger{&halvesF16c};
+const MergerKernels avx2::kMerger{&halvesF16c, &unorm8WordsAvx2};
 
 }  // namespace emu

@@ -13,6 +13,9 @@ struct MergerKernels {
     // out[4·i + c] = half(f[c][i]). Baseline: by bit manipulation; Avx2: F16C (VCVTPS2PH). The
     // same half for every non-NaN value; a NaN stays a NaN (its payload may differ).
     void (*halves)(const float* const f[4], int count, uint16_t* out);
+    // The A8R8G8B8 words of `count` lanes of float r g b a: each channel ps11::unorm8OfFloat
+    // (clamped to [0, 1], NaN 0, round_half_even(v * 255) in double), ORed with `alphaFill`.
+    void (*unorm8Words)(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words);
 };
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level);

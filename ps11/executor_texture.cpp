@@ -5,6 +5,10 @@
 #include <cmath>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 #include "ps11/executor_internal.h"
 
 namespace ps11::exec {
@@ -101,7 +105,19 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
             const float m = p.maxValue;
             for (int c = 0; c < 4; ++c) {
                 float* d = st.bf.reg[slot][c];
-                for (int i = 0; i < n; ++i) d[i] = d[i] < -m ? -m : (d[i] > m ? m : d[i]);
+                int i = 0;
+#if defined(__SSE2__)
+                // Compare and select, so a NaN stays a NaN as in the scalar loop (MINPS/MAXPS
+                // would replace it).
+                const __m128 hi = _mm_set1_ps(m), lo = _mm_set1_ps(-m);
+                for (; i + 4 <= n; i += 4) {
+                    const __m128 v = _mm_loadu_ps(d + i);
+                    const __m128 below = _mm_cmplt_ps(v, lo), above = _mm_cmpgt_ps(v, hi);
+                    const __m128 inside = _mm_andnot_ps(_mm_or_ps(below, above), v);
+                    _mm_storeu_ps(d + i, _mm_or_ps(inside, _mm_or_ps(_mm_and_ps(below, lo), _mm_and_ps(above, hi))));
+                }
+#endif
+                for (; i < n; ++i) d[i] = d[i] < -m ? -m : (d[i] > m ? m : d[i]);
             }
         }
     }

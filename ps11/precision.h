@@ -37,4 +37,17 @@ constexpr int64_t roundHalfEven(int64_t num, int64_t den) {
 // round_half_even(v * G) for a double v (exact for float inputs: 24 + 13 bits < 53).
 int32_t toGrid(double v, Precision p);
 
+// round_half_even(x) for |x| < 2^51 in the default rounding mode, without a library call: adding
+// and removing 1.5 * 2^52 leaves no fraction bits, so the addition itself rounds (what
+// std::nearbyint does). Not folded: without -ffast-math the compiler keeps IEEE rounding.
+constexpr double kRoundMagic = 6755399441055744.0;
+inline double roundEvenSmall(double x) { return (x + kRoundMagic) - kRoundMagic; }
+
+// The 8-bit value a float stores into an 8-bit target or surface (docs/precision.md "Outputs"):
+// round_half_even(clamp(v, 0, 1) * 255), NaN stores 0 (x * 255 is exact in double).
+inline uint8_t unorm8OfFloat(double v) {
+    const double c = v > 0.0 ? (v < 1.0 ? v : 1.0) : 0.0;
+    return uint8_t(roundEvenSmall(c * 255.0));
+}
+
 }  // namespace ps11

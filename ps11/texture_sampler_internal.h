@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "ps11/precision.h"
 #include "ps11/texture_sampler.h"
 
 namespace ps11 {
@@ -48,10 +49,6 @@ inline void addressPair(double fl, int64_t n, int32_t& i0, int32_t& i1) {
     }
 }
 
-// round_half_even(x) for |x| < 2^51 in the default rounding mode, without a library call
-// (adding and removing 1.5 * 2^52 leaves no fraction bits; the compiler may not fold it).
-constexpr double kRoundMagic = 6755399441055744.0;
-inline double roundEvenSmall(double x) { return (x + kRoundMagic) - kRoundMagic; }
 constexpr double kSmall = 1099511627776.0;  // 2^40: beyond it positions take the slow path
 
 // Texel-space position of one coordinate: x = u*n - 0.5 for linear (texel centres, spec §6.2),

@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -25,6 +26,7 @@
 #include "ps11/executor.h"
 #include "ps11/executor_fast.h"
 #include "ps11/executor_internal.h"
+#include "ps11/precision.h"
 #include "ps11/simd_dispatch.h"
 #include "ps11/texture_sampler_fast.h"
 #include "simd_levels.h"
@@ -306,6 +308,56 @@ TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at 
         INFO("SIMD level " << ps11::simdLevelName(level));
         CHECK(bad == 0);
     }
+}
+
+TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at every level", "[simd][merger]") {
+    // Every tie k + 1/2 over 255 and its float neighbours, the ends of [0, 1], values outside it,
+    // ±0, ±Inf and NaN, then random bits; spans of every length 0..40 at every offset mod 8.
+    std::vector<float> values;
+    for (int k = 0; k < 256; ++k) {
+        const float tie = float((k + 0.5) / 255.0);
+        values.insert(values.end(), {tie, std::nextafter(tie, 0.0f), std::nextafter(tie, 2.0f), float(k / 255.0)});
+    }
+    const float inf = std::numeric_limits<float>::infinity();
+    values.insert(values.end(), {0.0f, -0.0f, 1.0f, std::nextafter(1.0f, 2.0f), -1e-30f, 7.5f, -3.0f, inf, -inf,
+                                 std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN()});
+    std::mt19937 rng(11);
+    for (int i = 0; i < 4096; ++i) {
+        uint32_t bits = rng();
+        float f;
+        std::memcpy(&f, &bits, 4);
+        values.push_back(i % 2 ? f : float(rng() % 100000) / 90000.0f);
+    }
+    int64_t bad = 0, checked = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::MergerKernels& k = emu::mergerKernels(level);
+        for (size_t at = 0; at + 4 * 48 <= values.size(); at += 37) {
+            const int count = int(at % 41);
+            const float* f[4] = {&values[at], &values[at + 48], &values[at + 96], &values[at + 144]};
+            for (uint32_t fill : {0u, 0xff000000u}) {
+                std::vector<uint32_t> got(size_t(count) + 1, 0xdeadbeefu);
+                k.unorm8Words(f, count, fill, got.data());
+                for (int i = 0; i < count; ++i) {
+                    const uint32_t want = (uint32_t(ps11::unorm8OfFloat(f[3][i])) << 24 |
+                                           uint32_t(ps11::unorm8OfFloat(f[0][i])) << 16 |
+                                           uint32_t(ps11::unorm8OfFloat(f[1][i])) << 8 | ps11::unorm8OfFloat(f[2][i])) |
+                                          fill;
+                    bad += got[size_t(i)] != want;
+                    ++checked;
+                }
+                bad += got[size_t(count)] != 0xdeadbeefu;  // nothing past the span
+            }
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+    CHECK(checked > 10000);
+    // The rule itself (docs/precision.md "Outputs"): ties to even, clamped, NaN 0.
+    CHECK(ps11::unorm8OfFloat(0.5) == 128);  // 127.5: the even neighbour
+    CHECK(ps11::unorm8OfFloat(1.0) == 255);
+    CHECK(ps11::unorm8OfFloat(std::numeric_limits<double>::quiet_NaN()) == 0);
+    CHECK(ps11::unorm8OfFloat(-2.0) == 0);
+    CHECK(ps11::unorm8OfFloat(2.0) == 255);
 }
 
 TEST_CASE("simd dispatch: mergePixels stores the same A16B16G16R16F bytes at every level", "[simd][merger]") {
