@@ -46,40 +46,56 @@ struct RowTaps {
     const float* h1 = nullptr;
 };
 
+// Texel row j of an 8-bit tap as planar r g b a floats (kUnorm8 values), decoded once per
+// worker while it stays among the last few rows used.
+const float* decodedRow(const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
+    const uint8_t* row = tap.bytes + size_t(j) * tap.width * 4;
+    FloatRowScratch::DecodedRow* slot = &sc.decoded[0];
+    for (FloatRowScratch::DecodedRow& d : sc.decoded) {
+        if (d.row == row && d.width == tap.width) {
+            d.stamp = ++sc.stamp;
+            return d.v.data();
+        }
+        if (d.stamp < slot->stamp) slot = &d;
+    }
+    const size_t tw = tap.width;
+    slot->v.resize(4 * tw);
+    float* dec = slot->v.data();
+    for (size_t i = 0; i < tw; ++i)
+        for (size_t c = 0; c < 4; ++c) dec[c * tw + i] = kUnorm8[row[i * 4 + size_t(ps11::kUnorm8Byte[c])]];
+    slot->row = row;
+    slot->width = tap.width;
+    slot->stamp = ++sc.stamp;
+    return dec;
+}
+
 // The H row of texel row j for a linear tap: per column, the horizontal lerp of its texel pair
-// (the first step of combineFloat), over every column of the triangle. Kept per worker: two
-// rows per tap, so a magnified tap builds each texel row once for all the pixel rows it serves.
-const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, int32_t j, int32_t keep,
-                  FloatRowScratch& sc) {
-    std::array<FloatRowScratch::HRow, 2>& slots = sc.hrows[size_t(t)];
+// (the first step of combineFloat), over every column of the triangle. Kept per worker and
+// shared by the taps whose column tables are equal, so a magnified tap builds each texel row
+// once for all the pixel rows it serves and a vertical blur one row per pixel row.
+const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, int32_t j, FloatRowScratch& sc) {
     const uint64_t id = tri.taps[size_t(t)].tableId;
-    for (FloatRowScratch::HRow& h : slots)
+    FloatRowScratch::HRow* victim = nullptr;
+    for (FloatRowScratch::HRow& h : sc.hrows) {
         if (h.serial == draw.serial && h.tableId == id && h.row == j) {
             h.stamp = ++sc.stamp;
             return h.h.data();
         }
-    // Replace the slot not holding `keep` (the other row this pixel row needs), else the older.
-    auto holds = [&](const FloatRowScratch::HRow& h) { return h.serial == draw.serial && h.tableId == id && h.row == keep; };
-    FloatRowScratch::HRow& h = holds(slots[0]) ? slots[1] : holds(slots[1]) ? slots[0]
-                               : slots[0].stamp <= slots[1].stamp       ? slots[0]
-                                                                        : slots[1];
+        if (h.stamp <= sc.rowStart && (!victim || h.stamp < victim->stamp)) victim = &h;
+    }
+    if (!victim) victim = &sc.hrows.emplace_back();  // every slot serves this pixel row
+    FloatRowScratch::HRow& h = *victim;
     const FloatRowTap& tap = draw.taps[size_t(t)];
     const FloatRowTriangle::Columns& cols = tri.taps[size_t(t)];
     const size_t w = size_t(tri.x1 - tri.x0);
     h.h.resize(4 * w);
     size_t x = 0;
     if (tap.unorm8 && j >= 0) {
-        // The texel row decoded once into planar floats, then lerped in blocks of four columns
-        // whose pairs are consecutive texels (i0 = k, k+1, k+2, k+3 and i1 = i0 + 1: every
-        // column of a 1:1 or minified-by-one mapping, away from clamped edges) with vector
-        // loads; the same operations in the same order as lerpf.
+        // Blocks of four columns whose pairs are consecutive texels (i0 = k .. k+3 and i1 = i0 +
+        // 1: every column of a 1:1 mapping away from clamped edges) take vector loads; the same
+        // operations in the same order as lerpf.
         const size_t tw = tap.width;
-        sc.decoded.resize(4 * tw);
-        float* dec = sc.decoded.data();
-        const uint8_t* row = tap.bytes + size_t(j) * tw * 4;
-        const float* table = kUnorm8;
-        for (size_t i = 0; i < tw; ++i)
-            for (size_t c = 0; c < 4; ++c) dec[c * tw + i] = table[row[i * 4 + size_t(ps11::kUnorm8Byte[c])]];
+        const float* dec = decodedRow(tap, j, sc);
         const int32_t* i0 = cols.i0.data();
         const int32_t* i1 = cols.i1.data();
         const float* f = cols.f.data();
@@ -262,19 +278,24 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
 
 void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count) {
     static std::atomic<uint64_t> ids{0};
+    // Two taps' H rows are equal when they filter the same texels (texture, border) with the same
+    // columns, texel pairs and weights (compared by bits; an unbound tap's table is empty).
+    auto sameRows = [&](size_t i, int t, size_t j, int u) {
+        const FloatRowTap &a = draw.taps[size_t(t)], &b = draw.taps[size_t(u)];
+        const FloatRowTriangle::Columns &c = tris[i].taps[size_t(t)], &o = tris[j].taps[size_t(u)];
+        return a.bound == b.bound && a.unorm8 == b.unorm8 && a.bytes == b.bytes && a.values == b.values &&
+               a.width == b.width && a.border == b.border && tris[j].x0 == tris[i].x0 && tris[j].x1 == tris[i].x1 &&
+               o.i0 == c.i0 && o.i1 == c.i1 && o.f.size() == c.f.size() &&
+               (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0);
+    };
     for (size_t i = 0; i < count; ++i) {
         if (!prepared[i]) continue;
         for (int t = 0; t < draw.plan.count; ++t) {
             FloatRowTriangle::Columns& c = tris[i].taps[size_t(t)];
             c.tableId = 0;
-            for (size_t j = 0; j < i && !c.tableId; ++j) {
-                const FloatRowTriangle::Columns& o = tris[j].taps[size_t(t)];
-                // Weights compared by bits (an unbound tap's table is empty).
-                if (prepared[j] && tris[j].x0 == tris[i].x0 && tris[j].x1 == tris[i].x1 && o.i0 == c.i0 &&
-                    o.i1 == c.i1 && o.f.size() == c.f.size() &&
-                    (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0))
-                    c.tableId = o.tableId;
-            }
+            for (size_t j = 0; j <= i && !c.tableId; ++j)
+                for (int u = 0; u < (j < i ? draw.plan.count : t) && !c.tableId; ++u)
+                    if (prepared[j] && sameRows(i, t, j, u)) c.tableId = tris[j].taps[size_t(u)].tableId;
             if (!c.tableId) c.tableId = ++ids;
         }
     }
@@ -300,6 +321,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
     for (int y = std::max(y0, s.yMin); y < std::min(y1, s.yMax); ++y) {
         int xl = 0, xr = 0;
         if (!rowCoverage(s, y, xl, xr)) continue;
+        sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
         for (int t = 0; t < taps; ++t) {
             const FloatRowTap& tap = draw.taps[size_t(t)];
             if (!tap.bound) continue;
@@ -307,8 +329,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
             RowTaps& r = rows[size_t(t)];
             ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
             if (tap.linear) {
-                r.h0 = hRow(draw, tri, t, r.j0, r.j1, sc);
-                r.h1 = hRow(draw, tri, t, r.j1, r.j0, sc);
+                r.h0 = hRow(draw, tri, t, r.j0, sc);
+                r.h1 = hRow(draw, tri, t, r.j1, sc);
             }
         }
         for (int x = xl; x < xr; x += ps11::kMaxSpan) {

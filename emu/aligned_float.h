@@ -62,15 +62,16 @@ struct FloatRowTriangle {
     struct Columns {
         std::vector<int32_t> i0, i1;
         std::vector<float> f;
-        // Equal tables of one draw share their H rows (a full-screen quad's two triangles):
-        // shareFloatRowTables gives them the id of the first.
+        // Equal tables of one draw share their H rows (a full-screen quad's two triangles, the
+        // taps of a vertical blur): shareFloatRowTables gives them the id of the first.
         uint64_t tableId = 0;
     };
     std::array<Columns, 8> taps;
 };
 
-// Gives each tap's table of tris[0 .. count) an id, equal tables (same columns, texel pairs and
-// weights) the same, so drawFloatRows builds their H rows once.
+// Gives each tap's table of tris[0 .. count) an id, the same to taps of any triangle whose H
+// rows are equal (same texels, border, columns, texel pairs and weights), so drawFloatRows
+// builds their H rows once.
 void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count);
 
 // True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
@@ -82,8 +83,10 @@ struct FloatRowScratch {
     alignas(32) float color[8][ps11::kMaxSpan];
     alignas(32) float out[4][ps11::kMaxSpan];
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
-    // H rows: per tap, two texel rows filtered horizontally over the triangle's columns, planar
-    // r g b a (4 × columns floats each), keyed by draw, column table and texel row.
+    // H rows: texel rows filtered horizontally over the triangle's columns, planar r g b a (4 ×
+    // columns floats each), keyed by draw, column table and texel row, shared by every tap with
+    // that table (a vertical blur's taps read each other's rows). Slots used by the pixel row
+    // being drawn (stamp > rowStart) are never replaced; the pool grows to what a row needs.
     struct HRow {
         uint64_t serial = 0;
         uint64_t tableId = 0;
@@ -91,9 +94,17 @@ struct FloatRowScratch {
         uint64_t stamp = 0;
         std::vector<float> h;
     };
-    std::array<std::array<HRow, 2>, 8> hrows;
-    uint64_t stamp = 0;
-    std::vector<float> decoded;  // an 8-bit texel row as planar r g b a floats, while its H row is built
+    std::vector<HRow> hrows;
+    // 8-bit texel rows decoded into planar r g b a floats (the taps of a horizontal blur read
+    // one row), keyed by the row's first byte and its width; replaced least recently used.
+    struct DecodedRow {
+        const uint8_t* row = nullptr;
+        uint32_t width = 0;
+        uint64_t stamp = 0;
+        std::vector<float> v;
+    };
+    std::array<DecodedRow, 4> decoded;
+    uint64_t stamp = 0, rowStart = 0;
 };
 
 // Draws rows [y0, y1) of one prepared triangle.

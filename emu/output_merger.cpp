@@ -824,20 +824,48 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     const bool x8 = p.target == TargetKind::Xrgb8;
     const uint32_t mask = wordMask(p);
     const uint8_t* live = in.live;
-    uint64_t written = 0;
-    for (int i = 0; i < in.count; ++i) {
+    const int count = in.count;
+    // The destination words of the lanes that store (0 for the others), then per channel
+    // sat(s) + d in float, then the words (the merger's 8-bit words kernel), then the stores.
+    alignas(32) uint32_t old[ps11::kMaxSpan];
+    alignas(32) uint8_t stores[ps11::kMaxSpan];
+    for (int i = 0; i < count; ++i) {
         uint32_t x, y;
-        if ((live && !live[i]) || !lanes.inside(i, x, y)) continue;
+        stores[i] = uint8_t((!live || live[i]) && lanes.inside(i, x, y));
+        old[i] = stores[i] ? load32(cs.at(x, y)) : 0u;
+    }
+    alignas(32) float sum[4][ps11::kMaxSpan];
+    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+    for (int c = 0; c < 4; ++c) {
+        const float* src = f[c];
+        float* out = sum[c];
+        int i = 0;
+#if defined(__SSE2__)
+        // sat: v > 0 selects min(v, 1), else 0 (NaN included); d = float(byte) / 255, as kUnitOfByte.
+        const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f);
+        const __m128i byte = _mm_set1_epi32(0xff);
+        for (; i + 4 <= count; i += 4) {
+            const __m128 v = _mm_loadu_ps(src + i);
+            const __m128 sv = _mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_min_ps(v, one));
+            const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(old + i));
+            const __m128 d = _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, kShift[c]), byte)), k255);
+            _mm_store_ps(out + i, _mm_add_ps(sv, d));
+        }
+#endif
+        for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(old[i] >> kShift[c]) & 0xffu];
+    }
+    alignas(32) uint32_t words[ps11::kMaxSpan];
+    const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
+    // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both.
+    mergerKernels(ps11::simdLevel()).unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
+    uint64_t written = 0;
+    for (int i = 0; i < count; ++i) {
+        if (!stores[i]) continue;
         ++written;
-        uint8_t* q = cs.at(x, y);
-        const uint32_t old = load32(q);
-        const float d[4] = {kUnitOfByte[(old >> 16) & 0xffu], kUnitOfByte[(old >> 8) & 0xffu], kUnitOfByte[old & 0xffu],
-                            x8 ? 1.0f : kUnitOfByte[old >> 24]};
-        uint32_t out[4];
-        for (int c = 0; c < 4; ++c) out[c] = ps11::unorm8OfFloat(sat(f[c][i]) + d[c]);
-        uint32_t w = packArgb(out[0], out[1], out[2], x8 ? 0xffu : out[3]);
-        if (mask != 0xffffffffu) w = (w & mask) | (old & ~mask);
-        store32(q, w);
+        const uint32_t x = uint32_t(in.x[i]), y = uint32_t(in.y[i]);
+        uint32_t w = words[i];
+        if (mask != 0xffffffffu) w = (w & mask) | (old[i] & ~mask);
+        store32(cs.at(x, y), w);
     }
     n.written += written;
 }

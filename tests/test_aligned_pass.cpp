@@ -83,6 +83,9 @@ struct Case {
         bool bound = true;
     };
     std::vector<Tex> tex;  // 4 stages
+    // Every stage reads stage 0's texture (each with its own sampler states and coordinates):
+    // a blur's taps, whose row paths share texel rows between taps.
+    bool oneTexture = false;
     std::string program;
     float consts[4][4] = {};
     std::vector<Vtx> verts;
@@ -136,6 +139,18 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
             for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : (uni(0, 1) ? 0 : 255));
         }
     }
+    // One texture on every stage, or (as often) textures that differ only in their texels: the
+    // row paths must share rows between the taps of the first and never of the second.
+    c.oneTexture = uni(0, 3) == 0;
+    const bool sameShape = !c.oneTexture && uni(0, 2) == 0;
+    if (c.oneTexture || sameShape)
+        for (size_t s = 1; s < 4; ++s) {
+            const Case::Tex own = c.tex[s];
+            c.tex[s] = c.tex[0];
+            if (uni(0, 2) == 0) c.tex[s].filter = own.filter, c.tex[s].addressV = own.addressV;
+            if (sameShape)
+                for (uint8_t& b : c.tex[s].bytes) b = uint8_t(rng());
+        }
     float u[4][2], v[4][2];
     for (int s = 0; s < 4; ++s) {
         const Case::Tex& t = c.tex[size_t(s)];
@@ -150,6 +165,8 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
             u[s][0] = real(-1.5f, 1.5f), u[s][1] = real(-1.5f, 2.5f), v[s][0] = real(-1.5f, 1.5f),
             v[s][1] = real(-1.5f, 2.5f);
         }
+        // Mostly stage 0's columns with other rows (a vertical blur).
+        if ((c.oneTexture || sameShape) && s > 0 && uni(0, 3) != 0) u[s][0] = u[0][0], u[s][1] = u[0][1];
     }
     DWORD dif[4];
     const bool gradient = uni(0, 1);
@@ -187,6 +204,7 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     for (UINT y = 0; y < c.h; ++y)
         std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &c.rtInit[size_t(y) * c.w * 4], 4 * c.w);
     REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+    Handle first{};
     for (DWORD s = 0; s < 4; ++s) {
         const Case::Tex& t = c.tex[s];
         Handle tex{};
@@ -196,7 +214,8 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
         for (UINT y = 0; y < t.h; ++y)
             std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &t.bytes[y * row], row);
         REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
-        REQUIRE(dev.SetTexture(s, t.bound ? tex : Handle::Null) == D3D_OK);
+        if (s == 0) first = tex;
+        REQUIRE(dev.SetTexture(s, !t.bound ? Handle::Null : c.oneTexture ? first : tex) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, t.filter) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, t.filter) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, t.addressU) == D3D_OK);
