@@ -589,3 +589,14 @@ TEST_CASE("sampler: the 8-bit fast path equals the general path", "[sampler]") {
                 }
     }
 }
+
+TEST_CASE("texture: an 8-bit texel's float is float(b) / 255 rounded once", "[texture]") {
+    // The row paths decode 8-bit texel rows with a float division per channel instead of the
+    // table (emu/aligned_float.cpp, the output merger's blends): both must give the same floats.
+    const float* table = ps11::Texture::unorm8Values();
+    for (int b = 0; b < 256; ++b) {
+        volatile float divided = float(b) / 255.0f;
+        INFO("byte " << b);
+        CHECK(table[b] == divided);
+    }
+}
