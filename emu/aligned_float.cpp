@@ -44,20 +44,22 @@ struct RowTaps {
     float fy = 0;
     const float* h0 = nullptr;  // linear taps: H rows of j0 and j1 (planar, `width` columns)
     const float* h1 = nullptr;
+    const float* dec = nullptr;  // point taps of 8-bit textures: texel row j0 decoded (planar)
 };
 
-// Texel row j of an 8-bit tap as planar r g b a floats (kUnorm8 values), decoded once per
-// worker while it stays among the last few rows used.
+// Texel row j (in the texture) of an 8-bit tap as planar r g b a floats (kUnorm8 values),
+// decoded once per worker and kept while recent; valid until the next pixel row.
 const float* decodedRow(const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
     const uint8_t* row = tap.bytes + size_t(j) * tap.width * 4;
-    FloatRowScratch::DecodedRow* slot = &sc.decoded[0];
+    FloatRowScratch::DecodedRow* slot = nullptr;
     for (FloatRowScratch::DecodedRow& d : sc.decoded) {
         if (d.row == row && d.width == tap.width) {
             d.stamp = ++sc.stamp;
             return d.v.data();
         }
-        if (d.stamp < slot->stamp) slot = &d;
+        if (d.stamp <= sc.rowStart && (!slot || d.stamp < slot->stamp)) slot = &d;
     }
+    if (!slot) slot = &sc.decoded.emplace_back();  // every row serves this pixel row
     const size_t tw = tap.width;
     slot->v.resize(4 * tw);
     float* dec = slot->v.data();
@@ -216,6 +218,23 @@ public:
             return;
         }
         const int32_t* i0 = m_tri.taps[size_t(t)].i0.data() + first;
+        if (r.dec) {
+            // Columns of a decoded row: runs of consecutive texels copied four at a time.
+            const size_t tw = tap->width;
+            int i = 0;
+            while (i < n) {
+                const int32_t k = i0[i];
+                if (i + 4 <= n && k >= 0 && i0[i + 3] == k + 3 && i0[i + 1] == k + 1 && i0[i + 2] == k + 2) {
+                    for (int c = 0; c < 4; ++c) std::memcpy(out.value[c] + i, r.dec + size_t(c) * tw + size_t(k), 16);
+                    i += 4;
+                    continue;
+                }
+                for (int c = 0; c < 4; ++c) out.value[c][i] = k >= 0 ? r.dec[size_t(c) * tw + size_t(k)] : tap->border[size_t(c)];
+                ++i;
+            }
+            m_fetched += uint64_t(n);
+            return;
+        }
         float v[4];
         for (int i = 0; i < n; ++i) {
             texel(*tap, i0[i], r.j0, v);
@@ -360,6 +379,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
             if (tap.linear) {
                 r.h0 = hRow(draw, tri, t, r.j0, sc);
                 r.h1 = hRow(draw, tri, t, r.j1, sc);
+            } else {
+                r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(tap, r.j0, sc) : nullptr;
             }
         }
         for (int x = xl; x < xr; x += ps11::kMaxSpan) {

@@ -96,14 +96,14 @@ struct FloatRowScratch {
     };
     std::vector<HRow> hrows;
     // 8-bit texel rows decoded into planar r g b a floats (the taps of a horizontal blur read
-    // one row), keyed by the row's first byte and its width; replaced least recently used.
+    // one row), keyed by the row's first byte and its width; kept like the H rows.
     struct DecodedRow {
         const uint8_t* row = nullptr;
         uint32_t width = 0;
         uint64_t stamp = 0;
         std::vector<float> v;
     };
-    std::array<DecodedRow, 4> decoded;
+    std::vector<DecodedRow> decoded;
     uint64_t stamp = 0, rowStart = 0;
 };
 
