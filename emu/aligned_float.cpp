@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>
@@ -202,6 +204,13 @@ public:
         const size_t first = size_t(m_x - m_tri.x0) + size_t(req.u[0]);  // lanes are consecutive
         if (tap->linear) {
             const size_t w = size_t(m_tri.x1 - m_tri.x0);
+            if (r.fy == 0.0f && tap->nonNegative) {
+                // (1 − 0)·a + 0·b is a: 8-bit texels, the border colour and their lerps are
+                // finite and not negative (a 1:1 row under 8-bit weights).
+                for (int c = 0; c < 4; ++c) std::memcpy(out.value[c], r.h0 + size_t(c) * w + first, sizeof(float) * size_t(n));
+                m_fetched += uint64_t(n) * 4;
+                return;
+            }
             for (int c = 0; c < 4; ++c) {
                 const float* a = r.h0 + size_t(c) * w + first;
                 const float* b = r.h1 + size_t(c) * w + first;
@@ -296,6 +305,9 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         tap.addressU = ss.addressU;
         tap.addressV = ss.addressV;
         tap.border = ss.border;
+        tap.nonNegative = tap.unorm8 && std::all_of(tap.border.begin(), tap.border.end(), [](float b) {
+                              return b >= 0.0f && b <= std::numeric_limits<float>::max() && !std::signbit(b);
+                          });
     }
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;

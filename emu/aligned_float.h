@@ -34,6 +34,9 @@ struct FloatRowTap {
     bool linear = false;
     ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;
     std::array<float, 4> border{};
+    // Every value the tap returns is finite and not negative (8-bit texels, such a border): then
+    // a lerp with weight 0 is its first operand exactly.
+    bool nonNegative = false;
 };
 
 // What one draw needs, shared read-only by the workers.
