@@ -5,6 +5,10 @@
 #include <cstdlib>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "emu/format.h"
 #include "emu/fullscreen.h"
 #include "glare/scene.h"
@@ -262,6 +266,25 @@ ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b) {
     e.mean = px ? double(sum) / double(px * 3) : 0;
     e.overOnePercent = px ? 100.0 * double(over) / double(px) : 0;
     return e;
+}
+
+void frameBytes(const float* in, size_t n, uint8_t* out) {
+    size_t i = 0;
+#if defined(__SSE2__)
+    // max(v, 0) is 0 for NaN (MAXPS returns its second operand); the product and the sum round
+    // as frameByte's float operations do, and the conversion truncates as its cast does.
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f), half = _mm_set1_ps(0.5f);
+    auto ints = [&](const float* p) {
+        const __m128 x = _mm_min_ps(_mm_max_ps(_mm_loadu_ps(p), zero), one);
+        return _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(x, k255), half));
+    };
+    for (; i + 16 <= n; i += 16) {
+        const __m128i lo = _mm_packs_epi32(ints(in + i), ints(in + i + 4));
+        const __m128i hi = _mm_packs_epi32(ints(in + i + 8), ints(in + i + 12));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_packus_epi16(lo, hi));
+    }
+#endif
+    for (; i < n; ++i) out[i] = frameByte(in[i]);
 }
 
 }  // namespace glare

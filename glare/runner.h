@@ -37,6 +37,8 @@ inline uint8_t frameByte(float v) {
     const float x = v < 0 ? 0 : v > 1 ? 1 : v;
     return uint8_t(x * 255.0f + 0.5f);
 }
+// frameByte of n floats (vector blocks, the same float operations).
+void frameBytes(const float* in, size_t n, uint8_t* out);
 
 class Runner {
 public:

@@ -290,7 +290,7 @@ public:
                                   for (uint32_t y = 0; y < px.height; ++y) {
                                       const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
                                       uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
-                                      for (size_t i = 0; i < size_t(px.width) * 4; ++i) out[i] = frameByte(in[i]);
+                                      frameBytes(in, size_t(px.width) * 4, out);
                                   }
                                   *sprites = senseSprites(frame8->data(), px.width, px.height, ss);
                                   c.stats.pixels += uint64_t(px.width) * px.height;

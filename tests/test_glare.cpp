@@ -386,6 +386,32 @@ TEST_CASE("glow: feedback decays by k per frame, and 8-bit rounding leaves a res
     }
 }
 
+TEST_CASE("frameBytes is frameByte for every float", "[glare]") {
+    // Specials, the ends of [0, 1], every value near a rounding boundary, random bits; lengths
+    // around the vector block.
+    std::vector<float> v = {NAN, -NAN, INFINITY, -INFINITY, 0.0f, -0.0f, 1.0f, 1.0001f, -1e-30f, 1e30f};
+    for (int k = 0; k < 256; ++k) {
+        const float b = (float(k) + 0.5f) / 255.0f;
+        v.insert(v.end(), {b, std::nextafter(b, 0.0f), std::nextafter(b, 1.0f)});
+    }
+    std::mt19937 rng(5);
+    for (int i = 0; i < 3000; ++i) {
+        uint32_t bits = rng();
+        float f;
+        std::memcpy(&f, &bits, 4);
+        v.push_back(i % 2 ? f : float(rng() % 70000) / 65536.0f);
+    }
+    for (size_t n : {size_t(0), size_t(5), size_t(16), size_t(17), size_t(31), v.size()}) {
+        std::vector<uint8_t> got(n + 1, 0xAB);
+        glare::frameBytes(v.data(), n, got.data());
+        size_t bad = 0;
+        for (size_t i = 0; i < n; ++i) bad += got[i] != glare::frameByte(v[i]);
+        INFO("length " << n);
+        CHECK(bad == 0);
+        CHECK(got[n] == 0xAB);
+    }
+}
+
 TEST_CASE("sprites: grouping keeps the total glare energy", "[glare]") {
     // Scattered bright pixels (some adjacent) on black.
     const uint32_t w = 64, h = 48;
