@@ -1,3 +1,6 @@
+// The pass graph (glare/pass_graph.h): building (declared reads and writes), compile (culling,
+// lifetimes), run (pooled textures, the device state put back before every pass, statistics),
+// and Graphviz.
 #include "glare/pass_graph.h"
 
 #include <algorithm>
@@ -148,17 +151,30 @@ std::vector<std::string> PassGraph::livePassNames() const {
 
 bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook) {
     if (!m_compiled) compile();
+    emu::Device& device = pool.device();
+    // Every pass starts from this state, and run() leaves it behind (emu::Device::applyState).
+    const emu::DeviceState initial = device.state();
+    auto putBack = [&](const std::string& when) {
+        if (device.applyState(initial) == D3D_OK) return true;
+        error = when + ": " + device.lastError().message;
+        return false;
+    };
     std::map<uint32_t, int> physicalOf;  // device handle → small id, for the aliasing report
     for (TextureNode& t : m_textures) {
         t.device = t.imported ? t.importedTexture : Handle::Null;
         t.physical = -1;
     }
-    auto releaseAll = [&]() {
+    // Gives every transient texture back and the device its state; the first error is kept.
+    auto finish = [&](bool ok) {
         for (TextureNode& t : m_textures)
             if (!t.imported && t.device != Handle::Null) {
                 pool.release(t.device);
                 t.device = Handle::Null;
             }
+        const std::string first = error;
+        const bool restored = putBack("after the passes");
+        if (!ok) error = first;
+        return ok && restored;
     };
     for (size_t i = 0; i < m_passes.size(); ++i) {
         PassNode& p = m_passes[i];
@@ -168,25 +184,22 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
                 t.device = pool.acquire(t.desc, error);
                 if (t.device == Handle::Null) {
                     error = "pass " + p.info.name + ": texture " + t.name + ": " + error;
-                    releaseAll();
-                    return false;
+                    return finish(false);
                 }
                 auto [it, inserted] = physicalOf.emplace(uint32_t(t.device), int(physicalOf.size()));
                 t.physical = it->second;
             }
-        if (hook && !hook(uint32_t(i), false, error)) {
-            releaseAll();
-            return false;
-        }
+        if (hook && !hook(uint32_t(i), false, error)) return finish(false);
+        if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
         PassStats s;
         s.pass = p.info.name;
-        PassContext ctx{pool.device(), s, error, *this};
-        const emu::TransferStats before = pool.device().transfers();
+        PassContext ctx{device, s, error, *this};
+        const emu::TransferStats before = device.transfers();
         const auto start = std::chrono::steady_clock::now();
         const bool ok = p.execute ? p.execute(ctx) : true;
-        pool.device().finish();  // a renderer that queues work (GL) has done this pass's
+        device.finish();  // a renderer that queues work (GL) has done this pass's
         s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        const emu::TransferStats after = pool.device().transfers();
+        const emu::TransferStats after = device.transfers();
         for (const std::vector<TextureId>* list : {&p.reads, &p.writes})
             for (TextureId id : *list) {
                 const TextureNode& t = m_textures[id.index];
@@ -201,21 +214,17 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         s.readBacks = after.readBacks - before.readBacks;
         if (!ok) {
             if (error.empty()) error = "pass " + p.info.name + " failed";
-            releaseAll();
-            return false;
+            return finish(false);
         }
         stats.push_back(s);
-        if (hook && !hook(uint32_t(i), true, error)) {
-            releaseAll();
-            return false;
-        }
+        if (hook && !hook(uint32_t(i), true, error)) return finish(false);
         for (TextureNode& t : m_textures)
             if (!t.imported && t.lastUse == int(i)) {
                 pool.release(t.device);
                 t.device = Handle::Null;
             }
     }
-    return true;
+    return finish(true);
 }
 
 Handle PassContext::texture(TextureId id) const { return graph.texture(id).device; }

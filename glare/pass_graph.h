@@ -4,7 +4,8 @@
 // compile() culls the passes whose output nobody reads and gives every transient texture a
 // lifetime (first to last use); run() takes device textures from a TexturePool when a texture's
 // life starts and gives them back when it ends, so textures of the same description that are
-// never alive together share one device texture (aliasing).
+// never alive together share one device texture (aliasing). Every pass starts from the device
+// state run() found.
 #pragma once
 
 #include <cstdint>
@@ -111,7 +112,8 @@ struct PassInfo {
     std::string note;    // what the pass does, or why it is not 1.1
 };
 
-// What a pass's execute step sees.
+// What a pass's execute step sees. It starts from the device state run() found: every pass sets
+// the states it relies on.
 struct PassContext {
     emu::Device& device;
     PassStats& stats;
@@ -149,9 +151,11 @@ public:
 
     // Culls and computes lifetimes. Must be called before run(); may be called again after adding.
     void compile();
-    // Runs the live passes in order on the pool's device. Before and after each pass `hook` (when
-    // set) is called with the pass index, to let a comparison capture or replace textures. False
-    // with `error` set at the first failure. `stats` gets one entry per live pass.
+    // Runs the live passes in order on the pool's device. Each pass starts from the device state
+    // run() found (Device::applyState before each), and run() leaves that state behind, failed or
+    // not. Before and after each pass `hook` (when set) is called with the pass index, to let a
+    // comparison capture or replace textures. False with `error` set at the first failure.
+    // `stats` gets one entry per live pass.
     using Hook = std::function<bool(uint32_t pass, bool after, std::string& error)>;
     bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {});
 

@@ -176,6 +176,114 @@ TEST_CASE("pass graph: a technique's transient textures share device textures wh
         if (p.pass == "copy_scene") CHECK(p.bytes == 2u * 96 * 64 * 4);
 }
 
+namespace {
+
+// A pass graph over a device with one imported 8x8 output, for the self-containment tests.
+struct SmallGraph {
+    emu::Device device;
+    TexturePool pool{device};
+    emu::Handle out{};
+    PassGraph graph;
+    TextureId output;
+    SmallGraph() {
+        REQUIRE(device.CreateTexture(8, 8, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &out) == D3D_OK);
+        output = graph.import("output", {8, 8}, out, true);
+    }
+    bool run(std::string& error) {
+        std::vector<PassStats> stats;
+        return graph.run(pool, stats, error);
+    }
+    uint32_t pixel() {
+        emu::Handle s{};
+        REQUIRE(device.GetSurfaceLevel(out, 0, &s) == D3D_OK);
+        std::string err;
+        std::optional<emu::SurfacePixels> px = emu::readSurface(device, s, err);
+        REQUIRE(px);
+        uint32_t v = 0;
+        std::memcpy(&v, px->bytes.data(), 4);
+        return v;
+    }
+};
+
+// Fixed function: the vertex colour, as it is (stage 0 selects the diffuse colour and alpha).
+bool drawDiffuse(PassContext& c, D3DCOLOR colour) {
+    emu::Device& d = c.device;
+    return c.check(d.SetPixelShader(emu::Handle::Null)) &&
+           c.check(d.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1)) &&
+           c.check(d.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE)) &&
+           c.check(d.SetTextureStageState(0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1)) &&
+           c.check(d.SetTextureStageState(0, D3DTSS_ALPHAARG1, D3DTA_DIFFUSE)) && c.drawQuad({}, colour);
+}
+
+}  // namespace
+
+TEST_CASE("pass graph: every pass starts from the state run() found, and run() leaves it behind", "[glare][graph]") {
+    SmallGraph g;
+    emu::Handle tex{};
+    REQUIRE(g.device.CreateTexture(4, 4, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    // The caller's state: not D3D9's defaults everywhere.
+    REQUIRE(g.device.SetRenderState(D3DRS_TEXTUREFACTOR, 0x12345678) == D3D_OK);
+    REQUIRE(g.device.SetTextureStageState(3, D3DTSS_COLOROP, D3DTOP_ADD) == D3D_OK);
+    const emu::DeviceState initial = g.device.state();
+    const TextureId scratch = g.graph.create("scratch", {8, 8});
+    std::vector<emu::DeviceState> seen;
+    // The first pass turns additive blending on and binds a texture, and does not turn them off.
+    g.graph.addPass(
+        PassInfo{"leaky", PassKind::FixedFunction, "", ""}, [&](PassBuilder& b) { b.write(scratch); },
+        [&](PassContext& c) {
+            seen.push_back(c.device.state());
+            emu::Device& d = c.device;
+            return c.clear(scratch, 0xff000000) && c.check(d.SetRenderState(D3DRS_ALPHABLENDENABLE, 1)) &&
+                   c.check(d.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE)) &&
+                   c.check(d.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE)) && c.check(d.SetTexture(1, tex)) &&
+                   drawDiffuse(c, 0xff101010);
+        });
+    // The second clears the output to 0x40 grey and draws 0x20 grey over it: 0x20 when blending
+    // is off, 0x60 had the first pass's blending leaked into it.
+    g.graph.addPass(
+        PassInfo{"after", PassKind::FixedFunction, "", ""},
+        [&](PassBuilder& b) {
+            b.read(scratch);
+            b.write(g.output);
+        },
+        [&](PassContext& c) {
+            seen.push_back(c.device.state());
+            return c.clear(g.output, 0xff404040) && drawDiffuse(c, 0xff202020);
+        });
+    std::string err;
+    REQUIRE(g.run(err));
+    REQUIRE(seen.size() == 2);
+    CHECK(seen[0] == initial);
+    CHECK(seen[1] == initial);
+    CHECK(g.pixel() == 0xff202020u);
+    CHECK(g.device.state() == initial);
+
+    // After a failing pass too.
+    g.graph.addPass(
+        PassInfo{"fails", PassKind::FixedFunction, "", ""}, [&](PassBuilder& b) { b.readWrite(g.output); },
+        [&](PassContext& c) {
+            c.device.SetRenderState(D3DRS_ZENABLE, D3DZB_TRUE);
+            c.device.SetTexture(0, tex);
+            c.error = "pass fails: on purpose";
+            return false;
+        });
+    CHECK_FALSE(g.run(err));
+    CHECK(err == "pass fails: on purpose");
+    CHECK(g.device.state() == initial);
+
+    // A state that can no longer be put back (a texture released in a pass) fails the run, naming it.
+    PassGraph released;
+    const TextureId out = released.import("output", {8, 8}, g.out, true);
+    released.addPass(
+        PassInfo{"release", PassKind::Clear, "", ""}, [&](PassBuilder& b) { b.write(out); },
+        [&](PassContext& c) { return c.check(c.device.Release(tex)) && c.clear(out, 0); });
+    REQUIRE(g.device.SetTexture(2, tex) == D3D_OK);
+    std::vector<PassStats> stats;
+    CHECK_FALSE(released.run(g.pool, stats, err));
+    CHECK(err == "after the passes: E4102 applyState: SetTexture: handle " + std::to_string(uint32_t(tex)) +
+                     " is not an object of this device (the block's texture of stage 2)");
+}
+
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
     std::string error;
     const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
