@@ -1,6 +1,6 @@
 // The pass graph (glare/pass_graph.h): building (declared reads and writes), compile (culling,
 // lifetimes), run (pooled textures, the device state put back before every pass, statistics),
-// and Graphviz.
+// the declared-texture checks of PassContext, and Graphviz.
 #include "glare/pass_graph.h"
 
 #include <algorithm>
@@ -193,10 +193,14 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
         PassStats s;
         s.pass = p.info.name;
-        PassContext ctx{device, s, error, *this};
+        PassContext ctx{device, s, error, *this, uint32_t(i), {}};
         const emu::TransferStats before = device.transfers();
         const auto start = std::chrono::steady_clock::now();
-        const bool ok = p.execute ? p.execute(ctx) : true;
+        bool ok = p.execute ? p.execute(ctx) : true;
+        if (!ctx.refusal.empty()) {
+            error = ctx.refusal;
+            ok = false;
+        }
         device.finish();  // a renderer that queues work (GL) has done this pass's
         s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const emu::TransferStats after = device.transfers();
@@ -227,15 +231,46 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
     return finish(true);
 }
 
-Handle PassContext::texture(TextureId id) const { return graph.texture(id).device; }
+bool PassContext::declared(TextureId id, Access access) const {
+    const std::string& name = graph.passes()[pass].info.name;
+    auto refuse = [&](const std::string& why) {
+        if (refusal.empty()) refusal = "pass " + name + ": " + why;
+        error = refusal;
+        return false;
+    };
+    if (id.index >= graph.textures().size())
+        return refuse("texture " + (id.valid() ? "#" + std::to_string(id.index) : std::string("(invalid id)")) +
+                      " is not a texture of this graph");
+    const PassGraph::PassNode& p = graph.passes()[pass];
+    const bool reads = std::find(p.reads.begin(), p.reads.end(), id) != p.reads.end();
+    const bool writes = std::find(p.writes.begin(), p.writes.end(), id) != p.writes.end();
+    const std::string& tex = graph.texture(id).name;
+    if (!reads && !writes)
+        return refuse("texture " + tex + " was not declared by the pass (declare it with read() or write() in setup)");
+    if (access == Access::Write && !writes)
+        return refuse("texture " + tex +
+                      " is written but was declared read only (declare it with write() or readWrite() in setup)");
+    if (access == Access::Read && !reads)
+        return refuse("texture " + tex +
+                      " is read but was declared write only (declare it with read() or readWrite() in setup)");
+    return true;
+}
+
+Handle PassContext::texture(TextureId id) const {
+    return declared(id, Access::Any) ? graph.texture(id).device : Handle::Null;
+}
 
 Handle PassContext::surface(TextureId id) const {
+    if (!declared(id, Access::Any)) return Handle::Null;
     Handle s{};
-    device.GetSurfaceLevel(texture(id), 0, &s);
+    device.GetSurfaceLevel(graph.texture(id).device, 0, &s);
     return s;
 }
 
-const TextureDesc& PassContext::desc(TextureId id) const { return graph.texture(id).desc; }
+const TextureDesc& PassContext::desc(TextureId id) const {
+    static const TextureDesc kNone{0, 0, D3DFMT_UNKNOWN};
+    return declared(id, Access::Any) ? graph.texture(id).desc : kNone;
+}
 
 bool PassContext::check(HRESULT hr) {
     if (hr == D3D_OK) return true;
@@ -243,7 +278,9 @@ bool PassContext::check(HRESULT hr) {
     return false;
 }
 
-bool PassContext::setTarget(TextureId target) { return check(device.SetRenderTarget(0, surface(target))); }
+bool PassContext::setTarget(TextureId target) {
+    return declared(target, Access::Write) && check(device.SetRenderTarget(0, surface(target)));
+}
 
 bool PassContext::clear(TextureId target, D3DCOLOR colour) {
     if (!setTarget(target) || !check(device.Clear(0, nullptr, D3DCLEAR_TARGET, colour, 1, 0))) return false;
@@ -252,7 +289,9 @@ bool PassContext::clear(TextureId target, D3DCOLOR colour) {
 }
 
 bool PassContext::stretch(TextureId source, TextureId dest, D3DTEXTUREFILTERTYPE filter) {
-    if (!check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter))) return false;
+    if (!declared(source, Access::Read) || !declared(dest, Access::Write) ||
+        !check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter)))
+        return false;
     const uint64_t px = uint64_t(desc(dest).width) * desc(dest).height;
     stats.pixels += px;
     stats.texels += px * (filter == D3DTEXF_LINEAR ? 4 : 1);

@@ -4,8 +4,8 @@
 // compile() culls the passes whose output nobody reads and gives every transient texture a
 // lifetime (first to last use); run() takes device textures from a TexturePool when a texture's
 // life starts and gives them back when it ends, so textures of the same description that are
-// never alive together share one device texture (aliasing). Every pass starts from the device
-// state run() found.
+// never alive together share one device texture (aliasing). Passes are self-contained: each
+// starts from the device state run() found and reaches only the textures it declared.
 #pragma once
 
 #include <cstdint>
@@ -112,19 +112,24 @@ struct PassInfo {
     std::string note;    // what the pass does, or why it is not 1.1
 };
 
-// What a pass's execute step sees. It starts from the device state run() found: every pass sets
-// the states it relies on.
+// What a pass's execute step sees. It starts from the device state run() found (every pass
+// sets the states it relies on) and reaches only the textures its setup declared.
 struct PassContext {
     emu::Device& device;
     PassStats& stats;
     std::string& error;
     const PassGraph& graph;
-    // The device texture and its level-0 surface behind a virtual texture (valid while it lives).
+    uint32_t pass;  // the pass's index in the graph
+    // The device texture and its level-0 surface behind a virtual texture (valid while it lives),
+    // and its description. A texture the pass did not declare (read or write) gives Null and
+    // (for desc) an empty description, sets `error` and fails the pass.
     emu::Handle texture(TextureId id) const;
     emu::Handle surface(TextureId id) const;
     const TextureDesc& desc(TextureId id) const;
 
     // Device calls that also count into `stats` and set `error` ("pass NAME: message") on failure.
+    // A target (setTarget, clear, the destination of stretch) must be declared written, the
+    // source of stretch declared read.
     bool check(HRESULT hr);
     bool setTarget(TextureId target);  // render target = the texture's surface, viewport = all of it
     bool clear(TextureId target, D3DCOLOR colour);
@@ -133,6 +138,15 @@ struct PassContext {
     bool drawQuad(const std::array<emu::QuadCoords, 4>& coords = {}, DWORD diffuse = 0xffffffff);
     // DrawPrimitiveUP, counted.
     bool draw(D3DPRIMITIVETYPE type, UINT count, const void* vertices, UINT stride);
+
+    // The first refusal of a texture the pass did not declare (also put in `error`): run() fails
+    // the pass with it even if its execute step goes on and returns true or fails otherwise.
+    mutable std::string refusal;
+
+private:
+    enum class Access : uint8_t { Any, Read, Write };
+    // True when the pass declared the texture for `access`; else false with `error` set.
+    bool declared(TextureId id, Access access) const;
 };
 
 class PassGraph {

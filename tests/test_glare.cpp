@@ -284,6 +284,85 @@ TEST_CASE("pass graph: every pass starts from the state run() found, and run() l
                      " is not an object of this device (the block's texture of stage 2)");
 }
 
+TEST_CASE("pass graph: a pass reaches only the textures it declared", "[glare][graph]") {
+    SmallGraph g;
+    const TextureId other = g.graph.create("other", {8, 8});
+    g.graph.addPass(
+        PassInfo{"make_other", PassKind::Clear, "", ""}, [&](PassBuilder& b) { b.write(other); },
+        [&](PassContext& c) { return c.clear(other, 0); });
+    // What the pass's execute does with `other`, which it does not declare.
+    std::function<bool(PassContext&)> peek;
+    g.graph.addPass(
+        PassInfo{"peek", PassKind::Clear, "", ""}, [&](PassBuilder& b) { b.readWrite(g.output); },
+        [&](PassContext& c) { return peek(c); });
+    const std::string undeclared =
+        "pass peek: texture other was not declared by the pass (declare it with read() or write() in setup)";
+    auto fails = [&](const std::function<bool(PassContext&)>& f, const std::string& message) {
+        peek = f;
+        std::string err;
+        CHECK_FALSE(g.run(err));
+        CHECK(err == message);
+        CHECK(g.device.state() == emu::DeviceState{});
+    };
+    emu::Handle seenTexture{emu::Handle(1234)}, seenSurface{emu::Handle(1234)};
+    TextureDesc seenDesc;
+    // Even an execute step that goes on and reports success fails the pass.
+    fails(
+        [&](PassContext& c) {
+            seenTexture = c.texture(other);
+            seenSurface = c.surface(other);
+            seenDesc = c.desc(other);
+            return true;
+        },
+        undeclared);
+    CHECK(seenTexture == emu::Handle::Null);
+    CHECK(seenSurface == emu::Handle::Null);
+    CHECK(seenDesc.width == 0);
+    CHECK(seenDesc.format == D3DFMT_UNKNOWN);
+    fails([&](PassContext& c) { return c.setTarget(other); }, undeclared);
+    fails([&](PassContext& c) { return c.clear(other, 0); }, undeclared);
+    fails([&](PassContext& c) { return c.stretch(other, g.output, D3DTEXF_POINT); }, undeclared);
+    fails([&](PassContext& c) { return c.stretch(g.output, other, D3DTEXF_POINT); }, undeclared);
+    fails([&](PassContext& c) { return c.texture(TextureId{99}) != emu::Handle::Null; },
+          "pass peek: texture #99 is not a texture of this graph");
+    fails([&](PassContext& c) { return c.texture(TextureId{}) != emu::Handle::Null; },
+          "pass peek: texture (invalid id) is not a texture of this graph");
+    // The declared texture is there.
+    peek = [&](PassContext& c) { return c.texture(g.output) == g.out && c.desc(g.output).width == 8; };
+    std::string err;
+    CHECK(g.run(err));
+
+    // A target must be declared written, a StretchRect source read.
+    PassGraph h;
+    const TextureId out = h.import("output", {8, 8}, g.out, true);
+    const TextureId in = h.create("in", {8, 8});
+    h.addPass(
+        PassInfo{"make_in", PassKind::Clear, "", ""}, [&](PassBuilder& b) { b.write(in); },
+        [&](PassContext& c) { return c.clear(in, 0xff00ff00); });
+    h.addPass(
+        PassInfo{"copy", PassKind::StretchRect, "", ""},
+        [&](PassBuilder& b) {
+            b.read(in);
+            b.write(out);
+        },
+        [&](PassContext& c) { return peek(c); });
+    std::vector<PassStats> stats;
+    auto hFails = [&](const std::function<bool(PassContext&)>& f, const std::string& message) {
+        peek = f;
+        CHECK_FALSE(h.run(g.pool, stats, err));
+        CHECK(err == message);
+    };
+    hFails([&](PassContext& c) { return c.setTarget(in); },
+           "pass copy: texture in is written but was declared read only (declare it with write() or readWrite() in "
+           "setup)");
+    hFails([&](PassContext& c) { return c.stretch(out, in, D3DTEXF_POINT); },
+           "pass copy: texture output is read but was declared write only (declare it with read() or readWrite() in "
+           "setup)");
+    peek = [&](PassContext& c) { return c.stretch(in, out, D3DTEXF_POINT); };
+    REQUIRE(h.run(g.pool, stats, err));
+    CHECK(g.pixel() == 0xff00ff00u);
+}
+
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
     std::string error;
     const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
