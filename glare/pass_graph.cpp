@@ -1,6 +1,6 @@
 // The pass graph (glare/pass_graph.h): building (declared reads and writes), compile (culling,
-// lifetimes), run (pooled textures, the device state put back before every pass, statistics),
-// the declared-texture checks of PassContext, and Graphviz.
+// lifetimes, the read-before-write check), run (pooled textures, the device state put back
+// before every pass, statistics), the declared-texture checks of PassContext, and Graphviz.
 #include "glare/pass_graph.h"
 
 #include <algorithm>
@@ -66,15 +66,27 @@ TextureId PassGraph::create(const std::string& name, const TextureDesc& desc) {
 }
 
 TextureId PassBuilder::read(TextureId texture) {
+    if (!m_graph.declarable(m_pass, texture)) return texture;
     auto& reads = m_graph.m_passes[m_pass].reads;
     if (std::find(reads.begin(), reads.end(), texture) == reads.end()) reads.push_back(texture);
     return texture;
 }
 
 TextureId PassBuilder::write(TextureId texture) {
+    if (!m_graph.declarable(m_pass, texture)) return texture;
     auto& writes = m_graph.m_passes[m_pass].writes;
     if (std::find(writes.begin(), writes.end(), texture) == writes.end()) writes.push_back(texture);
     return texture;
+}
+
+bool PassGraph::declarable(uint32_t pass, TextureId texture) {
+    if (texture.index < m_textures.size()) return true;
+    if (m_setupError.empty())
+        m_setupError = "pass " + m_passes[pass].info.name + ": setup declares texture " +
+                       (texture.valid() ? "#" + std::to_string(texture.index) : std::string("(invalid id)")) +
+                       ", which is not a texture of this graph";
+    m_compiled = false;
+    return false;
 }
 
 TextureId PassGraph::createData(const std::string& name) {
@@ -112,7 +124,10 @@ void PassGraph::addPass(const PassInfo& info, const std::function<void(PassBuild
 // Culling walks the passes backwards with the set of textures whose current content someone still
 // needs: the outputs at the end. A pass is live when it writes a needed texture; then what it reads
 // becomes needed, and what it writes without reading is no longer needed before it (it overwrote it).
-void PassGraph::compile() {
+// Then the live passes are walked forwards: a transient texture (or CPU data) must be written by
+// an earlier live pass before a pass reads it — a pass's own write does not count, as a pass that
+// declares a texture read and written keeps (blends onto) what was there.
+bool PassGraph::compile() {
     std::set<uint32_t> needed;
     for (uint32_t t = 0; t < m_textures.size(); ++t)
         if (m_textures[t].output) needed.insert(t);
@@ -137,7 +152,27 @@ void PassGraph::compile() {
         for (TextureId r : m_passes[i].reads) touch(r);
         for (TextureId w : m_passes[i].writes) touch(w);
     }
+    m_compileError = m_setupError;
+    std::vector<bool> written(m_textures.size(), false);
+    for (const PassNode& p : m_passes) {
+        if (!p.live || !m_compileError.empty()) continue;
+        for (TextureId r : p.reads) {
+            const TextureNode& t = m_textures[r.index];
+            if (t.imported || written[r.index]) continue;
+            const bool alsoWrites = std::find(p.writes.begin(), p.writes.end(), r) != p.writes.end();
+            const std::string what = (t.data ? "CPU data " : "transient texture ") + t.name;
+            m_compileError = alsoWrites
+                                 ? "pass " + p.info.name + " reads and writes " + what +
+                                       ", which no earlier live pass wrote: it would keep or blend onto undefined "
+                                       "contents (a pass that clears it first declares it write() only)"
+                                 : "pass " + p.info.name + " reads " + what +
+                                       ", which no earlier live pass wrote: its contents are undefined";
+            break;
+        }
+        for (TextureId w : p.writes) written[w.index] = true;
+    }
     m_compiled = true;
+    return m_compileError.empty();
 }
 
 std::vector<std::string> PassGraph::livePassNames() const {
@@ -151,6 +186,10 @@ std::vector<std::string> PassGraph::livePassNames() const {
 
 bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook) {
     if (!m_compiled) compile();
+    if (!m_compileError.empty()) {
+        error = m_compileError;
+        return false;
+    }
     emu::Device& device = pool.device();
     // Every pass starts from this state, and run() leaves it behind (emu::Device::applyState).
     const emu::DeviceState initial = device.state();

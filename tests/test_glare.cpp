@@ -363,6 +363,81 @@ TEST_CASE("pass graph: a pass reaches only the textures it declared", "[glare][g
     CHECK(g.pixel() == 0xff00ff00u);
 }
 
+TEST_CASE("pass graph: a transient texture read before any live pass wrote it is an error", "[glare][graph]") {
+    auto clearPass = [](PassGraph& graph, const char* name, std::vector<TextureId> reads, std::vector<TextureId> writes,
+                        bool* ran = nullptr) {
+        graph.addPass(
+            PassInfo{name, PassKind::Clear, "", ""},
+            [&](PassBuilder& b) {
+                for (TextureId r : reads) b.read(r);
+                for (TextureId w : writes) b.write(w);
+            },
+            [ran, target = writes.front()](PassContext& c) {
+                if (ran) *ran = true;
+                return c.clear(target, 0);
+            });
+    };
+    std::string err;
+    {
+        SmallGraph g;
+        const TextureId a = g.graph.create("a", {8, 8});
+        bool ran = false;
+        clearPass(g.graph, "use_a", {a}, {g.output}, &ran);
+        const std::string message =
+            "pass use_a reads transient texture a, which no earlier live pass wrote: its contents are undefined";
+        CHECK_FALSE(g.graph.compile());
+        CHECK(g.graph.compileError() == message);
+        CHECK_FALSE(g.run(err));
+        CHECK(err == message);
+        CHECK_FALSE(ran);
+        // A writer after the reader does not help (and is culled).
+        clearPass(g.graph, "make_a_late", {}, {a});
+        CHECK_FALSE(g.graph.compile());
+        CHECK(g.graph.compileError() == message);
+    }
+    {
+        // Blending onto a fresh texture reads undefined contents: a pass's own write does not count.
+        SmallGraph g;
+        const TextureId a = g.graph.create("a", {8, 8});
+        clearPass(g.graph, "blend_onto_a", {a}, {a});
+        clearPass(g.graph, "use_a", {a}, {g.output});
+        CHECK_FALSE(g.run(err));
+        CHECK(err ==
+              "pass blend_onto_a reads and writes transient texture a, which no earlier live pass wrote: it would "
+              "keep or blend onto undefined contents (a pass that clears it first declares it write() only)");
+    }
+    {
+        // CPU data too.
+        SmallGraph g;
+        const TextureId list = g.graph.createData("list");
+        clearPass(g.graph, "use_list", {list}, {g.output});
+        CHECK_FALSE(g.run(err));
+        CHECK(err == "pass use_list reads CPU data list, which no earlier live pass wrote: its contents are undefined");
+    }
+    {
+        // What is fine: blending onto an import, onto a texture an earlier pass wrote, and a pass
+        // that clears a fresh texture and then blends onto it (declared written only).
+        SmallGraph g;
+        const TextureId a = g.graph.create("a", {8, 8}), b = g.graph.create("b", {8, 8});
+        clearPass(g.graph, "clear_then_blend_a", {}, {a});
+        clearPass(g.graph, "blend_onto_a", {a}, {a});
+        clearPass(g.graph, "a_to_b", {a}, {b});
+        clearPass(g.graph, "blend_b_onto_output", {b}, {g.output});
+        clearPass(g.graph, "blend_onto_output", {g.output}, {g.output});
+        CHECK(g.graph.compile());
+        CHECK(g.graph.compileError().empty());
+        CHECK(g.run(err));
+    }
+    {
+        // A TextureId that is no texture of the graph, declared in a setup.
+        SmallGraph g;
+        clearPass(g.graph, "stray", {TextureId{42}}, {g.output});
+        CHECK_FALSE(g.graph.compile());
+        CHECK(g.graph.compileError() == "pass stray: setup declares texture #42, which is not a texture of this graph");
+        CHECK_FALSE(g.run(err));
+    }
+}
+
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
     std::string error;
     const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
