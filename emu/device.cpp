@@ -1,6 +1,6 @@
 // Device stage: the API edge for state and shaders. Error reporting (E41xx codes, D3D9 return
-// values), handles, every Set*/Get* state call, pixel shader creation through ps11's decoder,
-// assembler and validator, and the draw entry point of later slices.
+// values), handles, every Set*/Get* state call, state blocks (applyState), pixel shader creation
+// through ps11's decoder, assembler and validator.
 #include "emu/device.h"
 
 #include <cmath>
@@ -284,6 +284,65 @@ HRESULT Device::SetFVF(DWORD fvf) {
     ok();
     m_state.fvf = fvf;
     return D3D_OK;
+}
+
+// ---- state blocks ----
+
+// Every field goes through its Set* call, so a block is checked exactly as the calls are; the
+// arrays of states only where they differ from the device's (a slot with no D3D9 state then
+// reaches its Set* call, which refuses it). The render target comes first: SetRenderTarget
+// resets the viewport and scissor rect, which follow.
+HRESULT Device::applyState(const DeviceState& s) {
+    const DeviceState before = m_state;
+    std::string field;  // which field of the block the refused call was setting
+    auto refused = [&](HRESULT hr, std::string what) {
+        if (hr == D3D_OK) return false;
+        field = std::move(what);
+        return true;
+    };
+    bool failed = false;
+    if (s.renderTarget != Handle::Null) {
+        failed = refused(SetRenderTarget(0, s.renderTarget), "render target") ||
+                 refused(SetViewport(&s.viewport), "viewport");
+    } else {
+        // A fresh device's NULL render target (SetRenderTarget refuses NULL); with no target to
+        // check it against, the viewport is kept as given.
+        m_state.renderTarget = Handle::Null;
+        m_state.viewport = s.viewport;
+    }
+    failed = failed || refused(SetScissorRect(&s.scissor), "scissor rect") ||
+             refused(SetDepthStencilSurface(s.depthStencil), "depth stencil surface") ||
+             refused(SetPixelShader(s.pixelShader), "pixel shader");
+    for (DWORD stage = 0; !failed && stage < DWORD(kMaxSamplers); ++stage)
+        failed = refused(SetTexture(stage, s.textures[stage]), "texture of stage " + num(stage));
+    for (DWORD i = 0; !failed && i < DWORD(kRenderStateLimit); ++i)
+        if (s.renderStates[i] != m_state.renderStates[i])
+            failed = refused(SetRenderState(D3DRENDERSTATETYPE(i), s.renderStates[i]), "");
+    for (DWORD stage = 0; !failed && stage < DWORD(kMaxStages); ++stage)
+        for (DWORD i = 0; !failed && i < DWORD(kStageStateLimit); ++i)
+            if (s.stageStates[stage][i] != m_state.stageStates[stage][i])
+                failed = refused(SetTextureStageState(stage, D3DTEXTURESTAGESTATETYPE(i), s.stageStates[stage][i]),
+                                 "stage " + num(stage));
+    for (DWORD sampler = 0; !failed && sampler < DWORD(kMaxSamplers); ++sampler)
+        for (DWORD i = 0; !failed && i < DWORD(kSamplerStateLimit); ++i)
+            if (s.samplerStates[sampler][i] != m_state.samplerStates[sampler][i])
+                failed = refused(SetSamplerState(sampler, D3DSAMPLERSTATETYPE(i), s.samplerStates[sampler][i]),
+                                 "sampler " + num(sampler));
+    const std::pair<D3DTRANSFORMSTATETYPE, const D3DMATRIX*> transforms[] = {
+        {D3DTS_WORLD, &s.world}, {D3DTS_VIEW, &s.view}, {D3DTS_PROJECTION, &s.projection}};
+    for (const auto& [type, matrix] : transforms) failed = failed || refused(SetTransform(type, matrix), "");
+    for (DWORD t = 0; !failed && t < DWORD(s.texture.size()); ++t)
+        failed = refused(SetTransform(D3DTRANSFORMSTATETYPE(D3DTS_TEXTURE0 + t), &s.texture[t]), "");
+    for (UINT c = 0; !failed && c < UINT(kMaxPsConstants); ++c)
+        failed = refused(SetPixelShaderConstantF(c, s.psConstants[c].data(), 1), "");
+    failed = failed || refused(SetFVF(s.fvf), "");
+    if (!failed) return ok();
+    // Atomic, as every call is: a refused block changes nothing.
+    const DeviceError error = m_error;
+    m_state = before;
+    return fail(error.hr, error.code.c_str(),
+                "applyState: " + error.message.substr(error.code.size() + 1) +
+                    (field.empty() ? "" : " (the block's " + field + ")"));
 }
 
 // ---- pixel shaders ----

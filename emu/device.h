@@ -1,8 +1,9 @@
 // The emulated Direct3D 9-style device (docs/device.md): D3D9 names and return codes at the
 // edge, plain C++ inside. It has resources (textures, volume textures, render targets,
 // depth surfaces, offscreen plain surfaces; Lock/Unlock in D3D's memory layout, mip generation,
-// GetRenderTargetData), every state setter, pixel shaders, Clear, StretchRect and DrawPrimitiveUP
-// (vertex processing, rasteriser, executor, output merger; docs/device.md "Drawing").
+// GetRenderTargetData), every state setter, state blocks, pixel shaders, Clear, StretchRect and
+// DrawPrimitiveUP (vertex processing, rasteriser, executor, output merger; docs/device.md
+// "Drawing").
 #pragma once
 
 #include <cstdint>
@@ -60,6 +61,7 @@ public:
     const DeviceOptions& options() const { return m_options; }
     // The class, profile and MaxValue every draw uses (DeviceOptions resolved).
     const ps11::HardwareConfig& hardware() const { return m_hardware; }
+    // Everything the Set* calls have set; a copy is a captured state block (applyState).
     const DeviceState& state() const { return m_state; }
     const DeviceError& lastError() const { return m_error; }
 
@@ -125,6 +127,11 @@ public:
     HRESULT SetScissorRect(const RECT* rect);
     HRESULT GetScissorRect(RECT* rect);
     HRESULT SetFVF(DWORD fvf);
+    // Not D3D9 API: a state block of D3DSBT_ALL as a value (docs/device.md "State blocks").
+    // state() captures; applyState sets every field of `state` through its Set* call, with that
+    // call's checks. A refused field (a handle released since the capture, a state slot no Set*
+    // call takes) changes nothing and names the Set* call and the field in lastError().
+    HRESULT applyState(const DeviceState& state);
 
     // ---- pixel shaders ----
     // Tokens up to and including the end token (D3D9 has no length: the stream is scanned).

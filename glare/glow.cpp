@@ -158,12 +158,7 @@ public:
                     !tss(1, D3DTSS_ALPHAOP, second ? D3DTOP_SELECTARG1 : D3DTOP_DISABLE) ||
                     !tss(1, D3DTSS_ALPHAARG1, D3DTA_CURRENT) || !tss(2, D3DTSS_COLOROP, D3DTOP_DISABLE))
                     return false;
-                const bool ok = c.drawQuad(coords, diffuse);
-                // Back to D3D9's defaults for the stages touched.
-                return ok && tss(0, D3DTSS_ALPHAARG1, D3DTA_TEXTURE) && tss(0, D3DTSS_COLORARG2, D3DTA_CURRENT) &&
-                       tss(1, D3DTSS_COLOROP, D3DTOP_DISABLE) && tss(1, D3DTSS_ALPHAOP, D3DTOP_DISABLE) &&
-                       tss(1, D3DTSS_COLORARG1, D3DTA_TEXTURE) && tss(1, D3DTSS_COLORARG2, D3DTA_CURRENT) &&
-                       tss(1, D3DTSS_ALPHAARG1, D3DTA_TEXTURE) && setBlend(c, Blend::None);
+                return c.drawQuad(coords, diffuse);
             });
     }
 

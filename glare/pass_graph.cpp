@@ -1,3 +1,6 @@
+// The pass graph (glare/pass_graph.h): building (declared reads and writes), compile (culling,
+// lifetimes, the read-before-write check), run (pooled textures, the device state put back
+// before every pass, statistics), the declared-texture checks of PassContext, and Graphviz.
 #include "glare/pass_graph.h"
 
 #include <algorithm>
@@ -63,15 +66,27 @@ TextureId PassGraph::create(const std::string& name, const TextureDesc& desc) {
 }
 
 TextureId PassBuilder::read(TextureId texture) {
+    if (!m_graph.declarable(m_pass, texture)) return texture;
     auto& reads = m_graph.m_passes[m_pass].reads;
     if (std::find(reads.begin(), reads.end(), texture) == reads.end()) reads.push_back(texture);
     return texture;
 }
 
 TextureId PassBuilder::write(TextureId texture) {
+    if (!m_graph.declarable(m_pass, texture)) return texture;
     auto& writes = m_graph.m_passes[m_pass].writes;
     if (std::find(writes.begin(), writes.end(), texture) == writes.end()) writes.push_back(texture);
     return texture;
+}
+
+bool PassGraph::declarable(uint32_t pass, TextureId texture) {
+    if (texture.index < m_textures.size()) return true;
+    if (m_setupError.empty())
+        m_setupError = "pass " + m_passes[pass].info.name + ": setup declares texture " +
+                       (texture.valid() ? "#" + std::to_string(texture.index) : std::string("(invalid id)")) +
+                       ", which is not a texture of this graph";
+    m_compiled = false;
+    return false;
 }
 
 TextureId PassGraph::createData(const std::string& name) {
@@ -109,7 +124,10 @@ void PassGraph::addPass(const PassInfo& info, const std::function<void(PassBuild
 // Culling walks the passes backwards with the set of textures whose current content someone still
 // needs: the outputs at the end. A pass is live when it writes a needed texture; then what it reads
 // becomes needed, and what it writes without reading is no longer needed before it (it overwrote it).
-void PassGraph::compile() {
+// Then the live passes are walked forwards: a transient texture (or CPU data) must be written by
+// an earlier live pass before a pass reads it — a pass's own write does not count, as a pass that
+// declares a texture read and written keeps (blends onto) what was there.
+bool PassGraph::compile() {
     std::set<uint32_t> needed;
     for (uint32_t t = 0; t < m_textures.size(); ++t)
         if (m_textures[t].output) needed.insert(t);
@@ -134,7 +152,27 @@ void PassGraph::compile() {
         for (TextureId r : m_passes[i].reads) touch(r);
         for (TextureId w : m_passes[i].writes) touch(w);
     }
+    m_compileError = m_setupError;
+    std::vector<bool> written(m_textures.size(), false);
+    for (const PassNode& p : m_passes) {
+        if (!p.live || !m_compileError.empty()) continue;
+        for (TextureId r : p.reads) {
+            const TextureNode& t = m_textures[r.index];
+            if (t.imported || written[r.index]) continue;
+            const bool alsoWrites = std::find(p.writes.begin(), p.writes.end(), r) != p.writes.end();
+            const std::string what = (t.data ? "CPU data " : "transient texture ") + t.name;
+            m_compileError = alsoWrites
+                                 ? "pass " + p.info.name + " reads and writes " + what +
+                                       ", which no earlier live pass wrote: it would keep or blend onto undefined "
+                                       "contents (a pass that clears it first declares it write() only)"
+                                 : "pass " + p.info.name + " reads " + what +
+                                       ", which no earlier live pass wrote: its contents are undefined";
+            break;
+        }
+        for (TextureId w : p.writes) written[w.index] = true;
+    }
     m_compiled = true;
+    return m_compileError.empty();
 }
 
 std::vector<std::string> PassGraph::livePassNames() const {
@@ -148,17 +186,34 @@ std::vector<std::string> PassGraph::livePassNames() const {
 
 bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook) {
     if (!m_compiled) compile();
+    if (!m_compileError.empty()) {
+        error = m_compileError;
+        return false;
+    }
+    emu::Device& device = pool.device();
+    // Every pass starts from this state, and run() leaves it behind (emu::Device::applyState).
+    const emu::DeviceState initial = device.state();
+    auto putBack = [&](const std::string& when) {
+        if (device.applyState(initial) == D3D_OK) return true;
+        error = when + ": " + device.lastError().message;
+        return false;
+    };
     std::map<uint32_t, int> physicalOf;  // device handle → small id, for the aliasing report
     for (TextureNode& t : m_textures) {
         t.device = t.imported ? t.importedTexture : Handle::Null;
         t.physical = -1;
     }
-    auto releaseAll = [&]() {
+    // Gives every transient texture back and the device its state; the first error is kept.
+    auto finish = [&](bool ok) {
         for (TextureNode& t : m_textures)
             if (!t.imported && t.device != Handle::Null) {
                 pool.release(t.device);
                 t.device = Handle::Null;
             }
+        const std::string first = error;
+        const bool restored = putBack("after the passes");
+        if (!ok) error = first;
+        return ok && restored;
     };
     for (size_t i = 0; i < m_passes.size(); ++i) {
         PassNode& p = m_passes[i];
@@ -168,25 +223,26 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
                 t.device = pool.acquire(t.desc, error);
                 if (t.device == Handle::Null) {
                     error = "pass " + p.info.name + ": texture " + t.name + ": " + error;
-                    releaseAll();
-                    return false;
+                    return finish(false);
                 }
                 auto [it, inserted] = physicalOf.emplace(uint32_t(t.device), int(physicalOf.size()));
                 t.physical = it->second;
             }
-        if (hook && !hook(uint32_t(i), false, error)) {
-            releaseAll();
-            return false;
-        }
+        if (hook && !hook(uint32_t(i), false, error)) return finish(false);
+        if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
         PassStats s;
         s.pass = p.info.name;
-        PassContext ctx{pool.device(), s, error, *this};
-        const emu::TransferStats before = pool.device().transfers();
+        PassContext ctx{device, s, error, *this, uint32_t(i), {}};
+        const emu::TransferStats before = device.transfers();
         const auto start = std::chrono::steady_clock::now();
-        const bool ok = p.execute ? p.execute(ctx) : true;
-        pool.device().finish();  // a renderer that queues work (GL) has done this pass's
+        bool ok = p.execute ? p.execute(ctx) : true;
+        if (!ctx.refusal.empty()) {
+            error = ctx.refusal;
+            ok = false;
+        }
+        device.finish();  // a renderer that queues work (GL) has done this pass's
         s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        const emu::TransferStats after = pool.device().transfers();
+        const emu::TransferStats after = device.transfers();
         for (const std::vector<TextureId>* list : {&p.reads, &p.writes})
             for (TextureId id : *list) {
                 const TextureNode& t = m_textures[id.index];
@@ -201,32 +257,59 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         s.readBacks = after.readBacks - before.readBacks;
         if (!ok) {
             if (error.empty()) error = "pass " + p.info.name + " failed";
-            releaseAll();
-            return false;
+            return finish(false);
         }
         stats.push_back(s);
-        if (hook && !hook(uint32_t(i), true, error)) {
-            releaseAll();
-            return false;
-        }
+        if (hook && !hook(uint32_t(i), true, error)) return finish(false);
         for (TextureNode& t : m_textures)
             if (!t.imported && t.lastUse == int(i)) {
                 pool.release(t.device);
                 t.device = Handle::Null;
             }
     }
+    return finish(true);
+}
+
+bool PassContext::declared(TextureId id, Access access) const {
+    const std::string& name = graph.passes()[pass].info.name;
+    auto refuse = [&](const std::string& why) {
+        if (refusal.empty()) refusal = "pass " + name + ": " + why;
+        error = refusal;
+        return false;
+    };
+    if (id.index >= graph.textures().size())
+        return refuse("texture " + (id.valid() ? "#" + std::to_string(id.index) : std::string("(invalid id)")) +
+                      " is not a texture of this graph");
+    const PassGraph::PassNode& p = graph.passes()[pass];
+    const bool reads = std::find(p.reads.begin(), p.reads.end(), id) != p.reads.end();
+    const bool writes = std::find(p.writes.begin(), p.writes.end(), id) != p.writes.end();
+    const std::string& tex = graph.texture(id).name;
+    if (!reads && !writes)
+        return refuse("texture " + tex + " was not declared by the pass (declare it with read() or write() in setup)");
+    if (access == Access::Write && !writes)
+        return refuse("texture " + tex +
+                      " is written but was declared read only (declare it with write() or readWrite() in setup)");
+    if (access == Access::Read && !reads)
+        return refuse("texture " + tex +
+                      " is read but was declared write only (declare it with read() or readWrite() in setup)");
     return true;
 }
 
-Handle PassContext::texture(TextureId id) const { return graph.texture(id).device; }
+Handle PassContext::texture(TextureId id) const {
+    return declared(id, Access::Any) ? graph.texture(id).device : Handle::Null;
+}
 
 Handle PassContext::surface(TextureId id) const {
+    if (!declared(id, Access::Any)) return Handle::Null;
     Handle s{};
-    device.GetSurfaceLevel(texture(id), 0, &s);
+    device.GetSurfaceLevel(graph.texture(id).device, 0, &s);
     return s;
 }
 
-const TextureDesc& PassContext::desc(TextureId id) const { return graph.texture(id).desc; }
+const TextureDesc& PassContext::desc(TextureId id) const {
+    static const TextureDesc kNone{0, 0, D3DFMT_UNKNOWN};
+    return declared(id, Access::Any) ? graph.texture(id).desc : kNone;
+}
 
 bool PassContext::check(HRESULT hr) {
     if (hr == D3D_OK) return true;
@@ -234,7 +317,9 @@ bool PassContext::check(HRESULT hr) {
     return false;
 }
 
-bool PassContext::setTarget(TextureId target) { return check(device.SetRenderTarget(0, surface(target))); }
+bool PassContext::setTarget(TextureId target) {
+    return declared(target, Access::Write) && check(device.SetRenderTarget(0, surface(target)));
+}
 
 bool PassContext::clear(TextureId target, D3DCOLOR colour) {
     if (!setTarget(target) || !check(device.Clear(0, nullptr, D3DCLEAR_TARGET, colour, 1, 0))) return false;
@@ -243,7 +328,9 @@ bool PassContext::clear(TextureId target, D3DCOLOR colour) {
 }
 
 bool PassContext::stretch(TextureId source, TextureId dest, D3DTEXTUREFILTERTYPE filter) {
-    if (!check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter))) return false;
+    if (!declared(source, Access::Read) || !declared(dest, Access::Write) ||
+        !check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter)))
+        return false;
     const uint64_t px = uint64_t(desc(dest).width) * desc(dest).height;
     stats.pixels += px;
     stats.texels += px * (filter == D3DTEXF_LINEAR ? 4 : 1);

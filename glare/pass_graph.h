@@ -1,10 +1,12 @@
 // The pass graph (docs/glare/README.md "Pass graph"), in the style of Filament's FrameGraph: a
 // pass is a name, a setup that declares the textures it reads and writes, and an execute step
 // that draws through emu::Device only, so one graph runs on the software and the GL renderer.
-// compile() culls the passes whose output nobody reads and gives every transient texture a
-// lifetime (first to last use); run() takes device textures from a TexturePool when a texture's
-// life starts and gives them back when it ends, so textures of the same description that are
-// never alive together share one device texture (aliasing).
+// compile() culls the passes whose output nobody reads, gives every transient texture a
+// lifetime (first to last use) and refuses a read of a transient texture nothing wrote; run()
+// takes device textures from a TexturePool when a texture's life starts and gives them back when
+// it ends, so textures of the same description that are never alive together share one device
+// texture (aliasing). Passes are self-contained: each starts from the device state run() found
+// and reaches only the textures it declared.
 #pragma once
 
 #include <cstdint>
@@ -88,13 +90,16 @@ private:
 class PassGraph;
 struct PassContext;
 
-// Declares a pass's reads and writes during setup.
+// Declares a pass's reads and writes during setup. A pass that needs a texture's earlier
+// contents reads it; one that overwrites it all (a clear first, then blending onto it, included)
+// only writes it.
 class PassBuilder {
 public:
     TextureId create(const std::string& name, const TextureDesc& desc);  // a transient texture
     TextureId read(TextureId texture);
     TextureId write(TextureId texture);
-    // Reads and writes (blending onto it, or drawing only part of it).
+    // Reads and writes (blending onto it, or drawing only part of it): the texture must hold
+    // contents an earlier live pass wrote (or be imported).
     TextureId readWrite(TextureId texture) { return write(read(texture)); }
 
 private:
@@ -111,18 +116,24 @@ struct PassInfo {
     std::string note;    // what the pass does, or why it is not 1.1
 };
 
-// What a pass's execute step sees.
+// What a pass's execute step sees. It starts from the device state run() found (every pass
+// sets the states it relies on) and reaches only the textures its setup declared.
 struct PassContext {
     emu::Device& device;
     PassStats& stats;
     std::string& error;
     const PassGraph& graph;
-    // The device texture and its level-0 surface behind a virtual texture (valid while it lives).
+    uint32_t pass;  // the pass's index in the graph
+    // The device texture and its level-0 surface behind a virtual texture (valid while it lives),
+    // and its description. A texture the pass did not declare (read or write) gives Null and
+    // (for desc) an empty description, sets `error` and fails the pass.
     emu::Handle texture(TextureId id) const;
     emu::Handle surface(TextureId id) const;
     const TextureDesc& desc(TextureId id) const;
 
     // Device calls that also count into `stats` and set `error` ("pass NAME: message") on failure.
+    // A target (setTarget, clear, the destination of stretch) must be declared written, the
+    // source of stretch declared read.
     bool check(HRESULT hr);
     bool setTarget(TextureId target);  // render target = the texture's surface, viewport = all of it
     bool clear(TextureId target, D3DCOLOR colour);
@@ -131,6 +142,15 @@ struct PassContext {
     bool drawQuad(const std::array<emu::QuadCoords, 4>& coords = {}, DWORD diffuse = 0xffffffff);
     // DrawPrimitiveUP, counted.
     bool draw(D3DPRIMITIVETYPE type, UINT count, const void* vertices, UINT stride);
+
+    // The first refusal of a texture the pass did not declare (also put in `error`): run() fails
+    // the pass with it even if its execute step goes on and returns true or fails otherwise.
+    mutable std::string refusal;
+
+private:
+    enum class Access : uint8_t { Any, Read, Write };
+    // True when the pass declared the texture for `access`; else false with `error` set.
+    bool declared(TextureId id, Access access) const;
 };
 
 class PassGraph {
@@ -147,11 +167,17 @@ public:
     // Adds a pass; `setup` declares its textures now, `execute` draws when the graph runs.
     void addPass(const PassInfo& info, const std::function<void(PassBuilder&)>& setup, Execute execute);
 
-    // Culls and computes lifetimes. Must be called before run(); may be called again after adding.
-    void compile();
-    // Runs the live passes in order on the pool's device. Before and after each pass `hook` (when
-    // set) is called with the pass index, to let a comparison capture or replace textures. False
-    // with `error` set at the first failure. `stats` gets one entry per live pass.
+    // Culls, computes lifetimes and checks the declarations: false (compileError() says why)
+    // when a setup declared a TextureId of no texture of this graph, or a live pass reads a
+    // transient texture (or CPU data) that no earlier live pass wrote. run() compiles when needed
+    // and fails with the same error; compile() may be called again after adding.
+    bool compile();
+    const std::string& compileError() const { return m_compileError; }
+    // Runs the live passes in order on the pool's device. Each pass starts from the device state
+    // run() found (Device::applyState before each), and run() leaves that state behind, failed or
+    // not. Before and after each pass `hook` (when set) is called with the pass index, to let a
+    // comparison capture or replace textures. False with `error` set at the first failure.
+    // `stats` gets one entry per live pass.
     using Hook = std::function<bool(uint32_t pass, bool after, std::string& error)>;
     bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {});
 
@@ -183,9 +209,13 @@ public:
 private:
     friend class PassBuilder;
     friend struct PassContext;
+    // True when `texture` is a texture of this graph; else records the setup error (PassBuilder).
+    bool declarable(uint32_t pass, TextureId texture);
     std::vector<PassNode> m_passes;
     std::vector<TextureNode> m_textures;
     bool m_compiled = false;
+    std::string m_setupError;    // the first TextureId a setup declared that is no texture here
+    std::string m_compileError;  // compile()'s verdict
 };
 
 }  // namespace glare

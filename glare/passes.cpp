@@ -81,8 +81,7 @@ bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q) {
     }
     for (const auto& [reg, value] : q.constants)
         if (!c.check(d.SetPixelShaderConstantF(UINT(reg), value.data(), 1))) return false;
-    const bool ok = c.drawQuad(coords);
-    return ok && setBlend(c, Blend::None);
+    return c.drawQuad(coords);
 }
 
 void addQuadPass(FrameBuild& fb, const std::string& name, const std::string& note, const QuadPass& q) {

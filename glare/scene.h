@@ -31,8 +31,8 @@ public:
     // surface). RGB is the scene; alpha is the glow mask: 255 on emissive surfaces (lights, neon
     // strips, bright objects, the sun), 0 elsewhere. Device resources (a D24S8 depth surface of
     // the target's size) are made on first use and reused; a target of another size gets a new
-    // one. The device state the scene changes (render target, viewport, scissor, depth surface,
-    // render and stage states, transforms, FVF, pixel shader) is put back as it was afterwards.
+    // one. The whole device state is put back as it was afterwards, failed or not
+    // (emu::Device::applyState).
     // A Scene serves one device at a time (its depth surface belongs to that device).
     // False with `error` set ("scene box: Device::DrawPrimitiveUP failed: <device message>",
     // "scene box: frame 7 out of range 0..3", …) on failure.

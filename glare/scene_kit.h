@@ -1,7 +1,8 @@
 // The toolkit of the built-in scenes (glare/scene.cpp): vertices and colours, deterministic
-// noise, per-vertex lighting on the CPU, world-space meshes, and SceneBase, which saves and
-// restores the device state, sets up the frame and draws meshes as painter's layers (clipped and
-// projected here, drawn as XYZRHW triangles) or through the device's transforms with depth.
+// noise, per-vertex lighting on the CPU, world-space meshes, and SceneBase, which sets up the
+// frame, draws meshes as painter's layers (clipped and projected here, drawn as XYZRHW
+// triangles) or through the device's transforms with depth, and puts the caller's device state
+// back (emu::Device::applyState).
 #pragma once
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -300,22 +302,7 @@ inline D3DMATRIX toD3D(const glm::mat4& m) {
     return d;
 }
 
-// ---- the frame: device setup, state save and restore, drawing helpers ----
-
-constexpr D3DRENDERSTATETYPE kRenderStates[] = {
-    D3DRS_ZENABLE,          D3DRS_ZWRITEENABLE,    D3DRS_ZFUNC,          D3DRS_CULLMODE,
-    D3DRS_FILLMODE,         D3DRS_SHADEMODE,       D3DRS_ALPHABLENDENABLE, D3DRS_ALPHATESTENABLE,
-    D3DRS_FOGENABLE,        D3DRS_SCISSORTESTENABLE, D3DRS_COLORWRITEENABLE, D3DRS_SPECULARENABLE,
-};
-struct StageStateRef {
-    DWORD stage;
-    D3DTEXTURESTAGESTATETYPE type;
-};
-constexpr StageStateRef kStageStates[] = {
-    {0, D3DTSS_COLOROP}, {0, D3DTSS_COLORARG1}, {0, D3DTSS_ALPHAOP},
-    {0, D3DTSS_ALPHAARG1}, {0, D3DTSS_RESULTARG}, {1, D3DTSS_COLOROP},
-    {1, D3DTSS_ALPHAOP},
-};
+// ---- the frame: device setup, the caller's state put back, drawing helpers ----
 
 class SceneBase : public Scene {
 public:
@@ -339,9 +326,9 @@ public:
         m_width = desc.Width;
         m_height = desc.Height;
         bool ok = setUp(target) && draw(frame, frameCount);
-        // Put back what the frame changed, even after a failure (the first failure is reported).
+        // Put back the caller's state, even after a failure (the first failure is reported).
         std::string drawError = error;
-        const bool restored = restore(saved, target);
+        const bool restored = check(device.applyState(saved), "applyState");
         if (!ok) error = drawError;
         return ok && restored;
     }
@@ -627,36 +614,15 @@ private:
         };
         for (const auto& [s, v] : states)
             if (!check(d.SetRenderState(s, v), "SetRenderState")) return false;
-        const std::pair<StageStateRef, DWORD> stages[] = {
-            {{0, D3DTSS_COLOROP}, D3DTOP_SELECTARG1}, {{0, D3DTSS_COLORARG1}, D3DTA_DIFFUSE},
-            {{0, D3DTSS_ALPHAOP}, D3DTOP_SELECTARG1}, {{0, D3DTSS_ALPHAARG1}, D3DTA_DIFFUSE},
-            {{0, D3DTSS_RESULTARG}, D3DTA_CURRENT},   {{1, D3DTSS_COLOROP}, D3DTOP_DISABLE},
-            {{1, D3DTSS_ALPHAOP}, D3DTOP_DISABLE},
+        const std::tuple<DWORD, D3DTEXTURESTAGESTATETYPE, DWORD> stages[] = {
+            {0, D3DTSS_COLOROP, D3DTOP_SELECTARG1}, {0, D3DTSS_COLORARG1, D3DTA_DIFFUSE},
+            {0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1}, {0, D3DTSS_ALPHAARG1, D3DTA_DIFFUSE},
+            {0, D3DTSS_RESULTARG, D3DTA_CURRENT},   {1, D3DTSS_COLOROP, D3DTOP_DISABLE},
+            {1, D3DTSS_ALPHAOP, D3DTOP_DISABLE},
         };
-        for (const auto& [s, v] : stages)
-            if (!check(d.SetTextureStageState(s.stage, s.type, v), "SetTextureStageState")) return false;
+        for (const auto& [stage, type, v] : stages)
+            if (!check(d.SetTextureStageState(stage, type, v), "SetTextureStageState")) return false;
         return check(d.Clear(0, nullptr, D3DCLEAR_TARGET, clearColor(), 1.0f, 0), "Clear");
-    }
-
-    bool restore(const DeviceState& s, Handle target) {
-        Device& d = *m_device;
-        bool ok = true;
-        auto keep = [&](HRESULT hr, const char* call) { ok = check(hr, call) && ok; };
-        if (s.renderTarget != Handle::Null) {
-            if (s.renderTarget != target) keep(d.SetRenderTarget(0, s.renderTarget), "SetRenderTarget");
-            keep(d.SetViewport(&s.viewport), "SetViewport");
-            keep(d.SetScissorRect(&s.scissor), "SetScissorRect");
-        }
-        keep(d.SetDepthStencilSurface(s.depthStencil), "SetDepthStencilSurface");
-        keep(d.SetPixelShader(s.pixelShader), "SetPixelShader");
-        for (D3DRENDERSTATETYPE rs : kRenderStates) keep(d.SetRenderState(rs, s.renderStates[rs]), "SetRenderState");
-        for (const StageStateRef& ts : kStageStates)
-            keep(d.SetTextureStageState(ts.stage, ts.type, s.stageStates[ts.stage][ts.type]), "SetTextureStageState");
-        keep(d.SetTransform(D3DTS_WORLD, &s.world), "SetTransform");
-        keep(d.SetTransform(D3DTS_VIEW, &s.view), "SetTransform");
-        keep(d.SetTransform(D3DTS_PROJECTION, &s.projection), "SetTransform");
-        keep(d.SetFVF(s.fvf), "SetFVF");
-        return ok;
     }
 
     std::string_view m_name;

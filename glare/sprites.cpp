@@ -373,8 +373,7 @@ public:
                           const size_t count = std::min<size_t>(v.size() - first, 6 * 4096);
                           ok = c.draw(D3DPT_TRIANGLELIST, UINT(count / 3), &v[first], sizeof(emu::QuadVertex));
                       }
-                      return ok && c.check(d.SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_CURRENT)) &&
-                             setBlend(c, Blend::None);
+                      return ok;
                   });
         addStretchPass(fb, "copy_scene", fb.scene, fb.output, D3DTEXF_POINT);
         addQuadPass(fb, "composite", "additive blend (ONE, ONE) of the glare buffer",

@@ -1,7 +1,8 @@
 // The GL renderer against the software renderer under the same device front: overlapping
 // blended and depth-tested triangles (the batches and texture barriers of emu/gl/gl_renderer.cpp),
-// every render-target and depth format, and random valid programs (tools/random_program.h),
-// each compared byte for byte (docs/gl-backend.md).
+// every render-target and depth format, random valid programs (tools/random_program.h), and a
+// draw after a state block was applied (Device::applyState), each compared byte for byte
+// (docs/gl-backend.md).
 #include <catch2/catch.hpp>
 
 #include <cstring>
@@ -164,4 +165,110 @@ TEST_CASE("gl renderer: random valid programs draw the emulator's images bit for
         }
     }
     CHECK(compared == 60);
+}
+
+namespace {
+
+// The objects of the state-block test, created in one order so two devices get the same handles.
+struct BlockObjects {
+    Handle target{}, otherTarget{}, depth{}, texture{}, otherTexture{}, shader{};
+};
+
+BlockObjects blockObjects(Device& dev) {
+    BlockObjects o;
+    REQUIRE(dev.CreateRenderTarget(24, 16, D3DFMT_A8R8G8B8, 1, &o.target) == D3D_OK);
+    REQUIRE(dev.CreateRenderTarget(24, 16, D3DFMT_A8R8G8B8, 1, &o.otherTarget) == D3D_OK);
+    REQUIRE(dev.CreateDepthStencilSurface(24, 16, D3DFMT_D16_LOCKABLE, &o.depth) == D3D_OK);
+    for (Handle* t : {&o.texture, &o.otherTexture}) {
+        REQUIRE(dev.CreateTexture(4, 4, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, t) == D3D_OK);
+        D3DLOCKED_RECT lr;
+        REQUIRE(dev.LockRect(*t, 0, &lr, nullptr, 0) == D3D_OK);
+        for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 4; ++x) {
+                const uint32_t c = 0x80000000u + uint32_t(x * 0x3f0000 + y * 0x3f00) + (t == &o.texture ? 0x20 : 0xc0);
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch + 4 * x, &c, 4);
+            }
+        REQUIRE(dev.UnlockRect(*t, 0) == D3D_OK);
+    }
+    REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ntex t0\nmad r0, t0, v0, c2\n", &o.shader) == D3D_OK);
+    return o;
+}
+
+// The state of the draw that is compared: a shader with a constant, a linear-filtered texture,
+// blending, a depth test and a viewport smaller than the target.
+void setDrawState(Device& dev, const BlockObjects& o) {
+    REQUIRE(dev.SetRenderTarget(0, o.target) == D3D_OK);
+    const D3DVIEWPORT9 vp{2, 1, 20, 14, 0.0f, 1.0f};
+    REQUIRE(dev.SetViewport(&vp) == D3D_OK);
+    REQUIRE(dev.SetDepthStencilSurface(o.depth) == D3D_OK);
+    REQUIRE(dev.SetPixelShader(o.shader) == D3D_OK);
+    const float c2[4] = {0.1f, -0.2f, 0.3f, 0.0f};
+    REQUIRE(dev.SetPixelShaderConstantF(2, c2, 1) == D3D_OK);
+    REQUIRE(dev.SetTexture(0, o.texture) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+    REQUIRE(dev.SetSamplerState(0, D3DSAMP_ADDRESSU, D3DTADDRESS_MIRROR) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_ZENABLE, 1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_ZFUNC, D3DCMP_LESS) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_SRCALPHA) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_INVSRCALPHA) == D3D_OK);
+    REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
+}
+
+// Clears the viewport (and the depth surface when one is bound) and draws overlapping triangles
+// under whatever state the device holds.
+void drawTriangles(Device& dev) {
+    Handle depth{};
+    const DWORD clear = D3DCLEAR_TARGET | (dev.GetDepthStencilSurface(&depth) == D3D_OK ? D3DCLEAR_ZBUFFER : 0);
+    REQUIRE(dev.Clear(0, nullptr, clear, 0xff204060, 0.5f, 0) == D3D_OK);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> px(-4.0f, 28.0f), z(0.0f, 1.0f), uv(-1.0f, 2.0f);
+    std::vector<Vertex> v;
+    for (int i = 0; i < 3 * 40; ++i)
+        v.push_back(Vertex{px(rng), px(rng), z(rng), 1.0f, DWORD(rng()), uv(rng), uv(rng)});
+    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 40, v.data(), sizeof(Vertex)) == D3D_OK);
+}
+
+}  // namespace
+
+TEST_CASE("gl renderer: a draw after applyState equals the draw after the Set* calls, on both renderers", "[gl]") {
+    std::vector<uint8_t> softwareColour;
+    for (bool gl : {false, true}) {
+        INFO((gl ? "GL renderer" : "software renderer"));
+        DeviceOptions options;
+        if (gl) options.renderer = glRenderer;
+        // The state set by its Set* calls.
+        Device direct(options);
+        const BlockObjects o = blockObjects(direct);
+        setDrawState(direct, o);
+        drawTriangles(direct);
+        const std::vector<uint8_t> colour = surfaceBytes(direct, o.target, 24, 16, 4);
+        const std::vector<uint8_t> depth = surfaceBytes(direct, o.depth, 24, 16, 2);
+        // The same state captured, then changed everywhere by a draw of another kind, then applied.
+        Device restored(options);
+        REQUIRE(blockObjects(restored).shader == o.shader);  // the same handles
+        setDrawState(restored, o);
+        const DeviceState captured = restored.state();
+        REQUIRE(restored.SetRenderTarget(0, o.otherTarget) == D3D_OK);
+        REQUIRE(restored.SetDepthStencilSurface(Handle::Null) == D3D_OK);
+        REQUIRE(restored.SetPixelShader(Handle::Null) == D3D_OK);
+        REQUIRE(restored.SetTexture(0, o.otherTexture) == D3D_OK);
+        REQUIRE(restored.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_ADD) == D3D_OK);
+        REQUIRE(restored.SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(restored.SetSamplerState(0, D3DSAMP_MINFILTER, D3DTEXF_POINT) == D3D_OK);
+        REQUIRE(restored.SetRenderState(D3DRS_ALPHABLENDENABLE, 0) == D3D_OK);
+        REQUIRE(restored.SetRenderState(D3DRS_COLORWRITEENABLE, 0x5) == D3D_OK);
+        drawTriangles(restored);
+        // The draw depends on the state: under the other one the same triangles gave other bytes.
+        CHECK(surfaceBytes(restored, o.otherTarget, 24, 16, 4) != colour);
+        REQUIRE(restored.applyState(captured) == D3D_OK);
+        REQUIRE(restored.state() == captured);
+        drawTriangles(restored);
+        CHECK(surfaceBytes(restored, o.target, 24, 16, 4) == colour);
+        CHECK(surfaceBytes(restored, o.depth, 24, 16, 2) == depth);
+        if (gl) CHECK(colour == softwareColour);
+        softwareColour = colour;
+    }
 }
