@@ -158,6 +158,28 @@ public:
     // The renderer's name ("software", "gl", "gl-native").
     const char* rendererName() const { return m_renderer->name(); }
 
+    // ---- fingerprints (not D3D9 API; docs/device.md "Fingerprints") ----
+    // Between beginFingerprint and endFingerprint the calls that write resources (Clear,
+    // StretchRect, DrawPrimitiveUP) are checked but not run: each appends to the fingerprint
+    // everything its result depends on — the call and its arguments, the whole state, the
+    // vertices, and the contents (handle and generation) of every resource it reads whose
+    // contents the fingerprint's earlier calls do not determine. Two fingerprints with equal
+    // words, taken where those generations are equal, stand for calls that write the same
+    // bytes. A call that hands contents back (locks, GetRenderTargetData, GenerateMipSubLevels)
+    // cannot wait: it fails with E4125 and the fingerprint is incomplete. Set* and Create*
+    // calls run as always.
+    struct Fingerprint {
+        bool complete = false;
+        std::vector<uint32_t> words;
+        std::vector<Handle> writes;  // resources the calls write (owners: a texture, not its level's surface)
+    };
+    void beginFingerprint();
+    Fingerprint endFingerprint();
+    bool fingerprinting() const { return m_fingerprint.active; }
+    // The version of a resource's contents (a texture's, or a surface's owner's): it changes
+    // with every write that changes a byte (docs/device.md "Generations"); 0 for a bad handle.
+    uint64_t contentGeneration(Handle resourceOrSurface) const;
+
     // ---- for the renderers, the glare layer and tests (not D3D9 API) ----
     // The sampler's view of a texture or volume texture, rebuilt after writes (mips regenerated
     // first for AUTOGENMIPMAP); nullptr with lastError() set on failure.
@@ -211,6 +233,18 @@ private:
     std::optional<CallError> submit(DrawSetup& d, DrawStats& stats);
     // Records a refused draw as lastError ("E41xx DrawPrimitiveUP: …") and returns its HRESULT.
     HRESULT drawFail(const CallError& error);
+
+    // Fingerprints: the owner of a surface handle (or the resource itself); the calls' parts.
+    Handle ownerOf(Handle resourceOrSurface) const;
+    void fingerprintWords(const void* data, size_t bytes);
+    void fingerprintRead(Handle owner);                   // contents not determined yet: handle, generation
+    void fingerprintWrite(Handle owner, bool wholeImage);  // wholeImage: the contents are determined from here on
+    HRESULT fingerprintRefuse(const char* call);
+    struct FingerprintState {
+        bool active = false;
+        Fingerprint print;
+        std::vector<Handle> determined;
+    } m_fingerprint;
 
     DrawStats m_lastDraw, m_totalDraw;
     std::shared_ptr<DrawContext> m_draw;  // created by the first draw

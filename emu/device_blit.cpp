@@ -34,6 +34,7 @@ struct Box {
 
 HRESULT Device::GetRenderTargetData(Handle renderTarget, Handle destSurface) {
     ok();
+    if (m_fingerprint.active) return fingerprintRefuse("GetRenderTargetData");
     Resource* src = nullptr;
     Resource* dst = nullptr;
     SurfaceRef srcRef, dstRef;
@@ -108,6 +109,19 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
                     "StretchRect: destination rect " + rectText(dr) + " is empty or outside the " + num(d->width) +
                         "x" + num(d->height) + " destination");
 
+    if (m_fingerprint.active) {
+        const uint32_t words[] = {0x53545245u,  // "STRE"
+                                  uint32_t(srcRef.owner), srcRef.level, uint32_t(sr.left), uint32_t(sr.top),
+                                  uint32_t(sr.right), uint32_t(sr.bottom), uint32_t(dstRef.owner), dstRef.level,
+                                  uint32_t(dr.left), uint32_t(dr.top), uint32_t(dr.right), uint32_t(dr.bottom),
+                                  uint32_t(filter)};
+        fingerprintWords(words, sizeof words);
+        fingerprintRead(srcRef.owner);
+        const bool whole = dst->levels.size() == 1 && dr.left == 0 && dr.top == 0 && uint32_t(dr.right) == d->width &&
+                           uint32_t(dr.bottom) == d->height;
+        fingerprintWrite(dstRef.owner, whole);
+        return D3D_OK;
+    }
     StretchCall sc;
     sc.source = surfaceDesc(srcRef, *src);
     sc.dest = surfaceDesc(dstRef, *dst);
@@ -183,6 +197,27 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             const Box b = region.meet(Box{rects[i].x1, rects[i].y1, rects[i].x2, rects[i].y2});
             if (!b.empty()) boxes.push_back(b);  // inverted or outside rects clear nothing
         }
+    }
+    if (m_fingerprint.active) {
+        uint32_t zBits;
+        std::memcpy(&zBits, &z, 4);
+        const uint32_t words[] = {0x434c4541u, flags, color, zBits, stencil, uint32_t(boxes.size())};  // "CLEA"
+        fingerprintWords(words, sizeof words);
+        for (const Box& b : boxes) {
+            const int64_t box[4] = {b.x0, b.y0, b.x1, b.y1};
+            fingerprintWords(box, sizeof box);
+        }
+        auto whole = [&](const Resource* r, const Image* im) {
+            return r->levels.size() == 1 && boxes.size() == 1 && boxes[0].x0 <= 0 && boxes[0].y0 <= 0 &&
+                   boxes[0].x1 >= int64_t(im->width) && boxes[0].y1 >= int64_t(im->height);
+        };
+        // A depth surface cleared of depth but not of its stencil keeps the stencil bits.
+        const bool depthWhole = depth && (flags & D3DCLEAR_ZBUFFER) &&
+                                ((flags & D3DCLEAR_STENCIL) || depth->format->stencilBits == 0) && whole(ds, depth);
+        if (depth && !depthWhole) fingerprintRead(dsRef.owner);
+        if (target) fingerprintWrite(rtRef.owner, whole(rt, target));
+        if (depth) fingerprintWrite(dsRef.owner, depthWhole);
+        return D3D_OK;
     }
     ClearCall cc;
     for (const Box& b : boxes) cc.boxes.push_back(PixelBox{b.x0, b.y0, b.x1, b.y1});

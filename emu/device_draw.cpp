@@ -434,6 +434,22 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
     d.call.hardware = m_hardware;
     if (std::optional<CallError> e = checkCall(d)) return drawFail(*e);
     if (std::optional<CallError> e = resolveTargets(d)) return drawFail(*e);
+    if (m_fingerprint.active) {
+        // The call, its vertices and the whole state; the textures it may sample, the depth
+        // surface it tests against and the target it blends onto, by contents.
+        const uint64_t vertexCount = type == D3DPT_TRIANGLELIST ? 3ull * primitiveCount : uint64_t(primitiveCount) + 2;
+        const uint32_t words[] = {0x44524157u, uint32_t(type), primitiveCount, stride};  // "DRAW"
+        fingerprintWords(words, sizeof words);
+        fingerprintWords(vertexData, size_t(vertexCount) * stride);
+        m_state.forEachWord([this](uint32_t w) { m_fingerprint.print.words.push_back(w); });
+        for (Handle t : m_state.textures) fingerprintRead(ownerOf(t));
+        const bool depthTest = d.ds && m_state.renderStates[D3DRS_ZENABLE];
+        if (depthTest) fingerprintRead(d.dsRef.owner);
+        if (m_state.renderStates[D3DRS_ALPHABLENDENABLE]) fingerprintRead(d.rtRef.owner);
+        fingerprintWrite(d.rtRef.owner, false);
+        if (depthTest && m_state.renderStates[D3DRS_ZWRITEENABLE]) fingerprintWrite(d.dsRef.owner, false);
+        return D3D_OK;
+    }
     if (std::optional<CallError> e = checkRasterStates()) return drawFail(*e);
     if (std::optional<CallError> e = resolveProgram(d)) return drawFail(*e);
     if (std::optional<CallError> e = resolveSamplers(d)) return drawFail(*e);

@@ -3,6 +3,7 @@
 // rules, sizes refused before allocating, surfaces of levels, LockRect/LockBox in D3D's memory
 // layout, automatic mip generation and the sampler's view of a texture.
 #include <algorithm>
+#include <cstring>
 #include <new>
 
 #include "emu/device.h"
@@ -340,10 +341,31 @@ void Device::regenerateMips(Resource& r) {
     r.mipsDirty = false;
 }
 
+namespace {
+
+// Resources of at most this many bytes keep their generation through a write that changes no
+// byte (a 1×1 adaptation state that has converged); larger ones are not compared.
+constexpr size_t kComparedResourceBytes = 4096;
+
+size_t levelBytes(const Image& im) { return size_t(im.slicePitch) * im.depth; }
+
+}  // namespace
+
 void Device::markWritten(Resource& r, uint32_t level) {
-    ++r.generation;
     r.levelGeneration.resize(r.levels.size(), 0);
     r.rendererNewer.resize(r.levels.size(), 0);
+    if (!r.bytesBefore.empty()) {
+        bool same = true;
+        size_t at = 0;
+        for (const Image& im : r.levels) {
+            const size_t n = levelBytes(im);
+            same = same && std::memcmp(r.bytesBefore.data() + at, im.bytes.data(), n) == 0;
+            at += n;
+        }
+        r.bytesBefore.clear();
+        if (same) return;  // nothing changed: the generation, the mips and the renderer's copy stand
+    }
+    ++r.generation;
     r.levelGeneration[level] = r.generation;
     r.rendererNewer[level] = 0;
     if (level == 0 && r.autoGenMips()) r.mipsDirty = true;
@@ -371,6 +393,16 @@ void Device::prepareWrite(Resource& r) {
     // that is still held elsewhere keeps the bytes it was made from: the levels move to a copy.
     if (r.sampled && r.sampled->readsInPlace()) r.sampled.reset();
     if (r.storeShared()) detachStore(r);
+    // A small resource whose bytes the front holds: kept, to tell an unchanging write.
+    r.bytesBefore.clear();
+    size_t total = 0;
+    for (const Image& im : r.levels) total += levelBytes(im);
+    if (total <= kComparedResourceBytes && !m_renderer->keepsCopies() &&
+        std::none_of(r.rendererNewer.begin(), r.rendererNewer.end(), [](uint8_t b) { return b != 0; })) {
+        r.bytesBefore.reserve(total);
+        for (const Image& im : r.levels)
+            r.bytesBefore.insert(r.bytesBefore.end(), im.bytes.data(), im.bytes.data() + levelBytes(im));
+    }
 }
 
 void Device::syncLevel(Resource& r, uint32_t level) {
@@ -434,6 +466,7 @@ HRESULT Device::unlockLevel(const char* call, Resource& r, uint32_t level) {
 
 HRESULT Device::LockRect(Handle texture, UINT level, D3DLOCKED_RECT* locked, const RECT* rect, DWORD flags) {
     ok();
+    if (m_fingerprint.active) return fingerprintRefuse("LockRect");
     if (!locked) return fail(D3DERR_INVALIDCALL, "E4103", "LockRect: locked-rect pointer is null");
     Resource* r = findResource(texture);
     if (!r || r->kind != ResourceKind::Texture)
@@ -461,6 +494,7 @@ HRESULT Device::UnlockRect(Handle texture, UINT level) {
 
 HRESULT Device::LockRect(Handle surface, D3DLOCKED_RECT* locked, const RECT* rect, DWORD flags) {
     ok();
+    if (m_fingerprint.active) return fingerprintRefuse("LockRect");
     if (!locked) return fail(D3DERR_INVALIDCALL, "E4103", "LockRect: locked-rect pointer is null");
     Resource* r = nullptr;
     SurfaceRef ref;
@@ -482,6 +516,7 @@ HRESULT Device::UnlockRect(Handle surface) {
 
 HRESULT Device::LockBox(Handle volumeTexture, UINT level, D3DLOCKED_BOX* locked, const D3DBOX* box, DWORD flags) {
     ok();
+    if (m_fingerprint.active) return fingerprintRefuse("LockBox");
     if (!locked) return fail(D3DERR_INVALIDCALL, "E4103", "LockBox: locked-box pointer is null");
     Resource* r = findResource(volumeTexture);
     if (!r || r->kind != ResourceKind::VolumeTexture)
@@ -507,6 +542,7 @@ HRESULT Device::UnlockBox(Handle volumeTexture, UINT level) {
 
 HRESULT Device::GenerateMipSubLevels(Handle texture) {
     ok();
+    if (m_fingerprint.active) return fingerprintRefuse("GenerateMipSubLevels");
     Resource* r = findResource(texture);
     if (!r || r->kind == ResourceKind::Surface)
         return fail(D3DERR_INVALIDCALL, "E4102",

@@ -95,7 +95,10 @@ struct Resource {
     std::vector<uint8_t> lockedReadOnly;
     std::vector<Handle> surfaces;  // per exposed level: GetSurfaceLevel's handle, Null until asked
     bool mipsDirty = false;        // AUTOGENMIPMAP: level 0 changed since the last generation
-    uint64_t generation = 0;       // bumped by every write; the sampler's copy follows it
+    uint64_t generation = 0;       // bumped by every write that changes a byte; the sampler's copy follows it
+    // A small resource's bytes before the write under way (Device::prepareWrite): a write that
+    // leaves them equal keeps the generation (docs/device.md "Generations").
+    std::vector<uint8_t> bytesBefore;
     // Per level: the generation of its last write (a renderer's copy follows it), and whether
     // the renderer holds newer contents than `levels` (its write, not yet read back).
     std::vector<uint64_t> levelGeneration;
