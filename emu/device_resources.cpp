@@ -344,8 +344,9 @@ void Device::regenerateMips(Resource& r) {
 namespace {
 
 // Resources of at most this many bytes keep their generation through a write that changes no
-// byte (a 1×1 adaptation state that has converged); larger ones are not compared.
-constexpr size_t kComparedResourceBytes = 4096;
+// byte (a 1×1 adaptation state that has converged, a glare sprite image uploaded every frame);
+// larger ones are not compared (a copy and a compare per write).
+constexpr size_t kComparedResourceBytes = 65536;
 
 size_t levelBytes(const Image& im) { return size_t(im.slicePitch) * im.depth; }
 

@@ -184,7 +184,14 @@ std::vector<std::string> PassGraph::livePassNames() const {
 
 // ---- running ----
 
-bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook) {
+void PassMemo::clear(TexturePool& pool) {
+    for (const auto& [key, handle] : m_textures) pool.release(handle);
+    m_textures.clear();
+    m_entries.clear();
+}
+
+bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook,
+                    PassMemo* memo) {
     if (!m_compiled) compile();
     if (!m_compileError.empty()) {
         error = m_compileError;
@@ -207,7 +214,7 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
     auto finish = [&](bool ok) {
         for (TextureNode& t : m_textures)
             if (!t.imported && t.device != Handle::Null) {
-                pool.release(t.device);
+                if (!memo) pool.release(t.device);  // a memo's textures stay with it
                 t.device = Handle::Null;
             }
         const std::string first = error;
@@ -220,7 +227,13 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         if (!p.live) continue;
         for (TextureNode& t : m_textures)
             if (!t.imported && !t.data && t.firstUse == int(i)) {
-                t.device = pool.acquire(t.desc, error);
+                if (memo) {
+                    Handle& kept = memo->m_textures[{t.name, t.desc}];
+                    if (kept == Handle::Null) kept = pool.acquire(t.desc, error);
+                    t.device = kept;
+                } else {
+                    t.device = pool.acquire(t.desc, error);
+                }
                 if (t.device == Handle::Null) {
                     error = "pass " + p.info.name + ": texture " + t.name + ": " + error;
                     return finish(false);
@@ -232,9 +245,34 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
         PassStats s;
         s.pass = p.info.name;
+        const auto start = std::chrono::steady_clock::now();
+        // Reuse: the pass's calls as a dry run, compared with last frame's.
+        emu::Device::Fingerprint print;
+        bool writesData = false;
+        for (TextureId id : p.writes) writesData = writesData || m_textures[id.index].data;
+        if (memo && p.execute && !writesData) {
+            if (memo->m_entries.size() < m_passes.size()) memo->m_entries.resize(m_passes.size());
+            PassMemo::Entry& e = memo->m_entries[i];
+            PassStats dryStats;
+            std::string dryError;
+            PassContext dry{device, dryStats, dryError, *this, uint32_t(i), {}};
+            device.beginFingerprint();
+            const bool dryOk = p.execute(dry) && dry.refusal.empty();
+            print = device.endFingerprint();
+            print.complete = print.complete && dryOk;
+            bool same = print.complete && e.valid && e.name == p.info.name && e.words == print.words;
+            for (const auto& [handle, generation] : e.outputs)
+                same = same && device.contentGeneration(handle) == generation;
+            if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
+            if (same) {
+                s.reused = true;
+                s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+                stats.push_back(s);
+                continue;
+            }
+        }
         PassContext ctx{device, s, error, *this, uint32_t(i), {}};
         const emu::TransferStats before = device.transfers();
-        const auto start = std::chrono::steady_clock::now();
         bool ok = p.execute ? p.execute(ctx) : true;
         if (!ctx.refusal.empty()) {
             error = ctx.refusal;
@@ -260,10 +298,20 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
             return finish(false);
         }
         stats.push_back(s);
+        if (memo && i < memo->m_entries.size()) {
+            // What the pass wrote, at the generations it left: next frame's dry run is compared
+            // with this one only while they stand.
+            PassMemo::Entry& e = memo->m_entries[i];
+            e.name = p.info.name;
+            e.valid = print.complete;
+            e.words = std::move(print.words);
+            e.outputs.clear();
+            for (Handle h : print.writes) e.outputs.emplace_back(h, device.contentGeneration(h));
+        }
         if (hook && !hook(uint32_t(i), true, error)) return finish(false);
         for (TextureNode& t : m_textures)
             if (!t.imported && t.lastUse == int(i)) {
-                pool.release(t.device);
+                if (!memo) pool.release(t.device);
                 t.device = Handle::Null;
             }
     }

@@ -64,6 +64,9 @@ struct PassStats {
     // texels fetched), and each texture it writes, once (no more than its pixels). Time over
     // this shows a pass far above its share.
     uint64_t bytes = 0;
+    // Run with a PassMemo: the pass's fingerprint and outputs were last frame's, so its outputs
+    // were kept and nothing ran (milliseconds is the dry run's).
+    bool reused = false;
 };
 
 // Device textures by description, kept between frames and runs: a graph takes one when a
@@ -85,6 +88,33 @@ private:
     emu::Device& m_device;
     std::multimap<TextureDesc, emu::Handle> m_free;
     std::map<uint32_t, TextureDesc> m_all;
+};
+
+// What PassGraph::run keeps from frame to frame to run a pass only when something it depends on
+// changed (docs/glare/README.md "Reuse"): per pass, its device fingerprint (emu::Device::
+// beginFingerprint: the calls it makes, with every state, constant and vertex, and the
+// generations of what it reads) and the generations its outputs had when it ran; and a device
+// texture of its own for every transient texture, kept between frames (no aliasing: a pass's
+// outputs stay as it left them unless something writes them).
+class PassMemo {
+public:
+    PassMemo() = default;
+    PassMemo(const PassMemo&) = delete;
+    PassMemo& operator=(const PassMemo&) = delete;
+    // Gives the textures back to `pool` and forgets every pass.
+    void clear(TexturePool& pool);
+    size_t passes() const { return m_entries.size(); }
+
+private:
+    friend class PassGraph;
+    struct Entry {
+        std::string name;
+        bool valid = false;
+        std::vector<uint32_t> words;
+        std::vector<std::pair<emu::Handle, uint64_t>> outputs;
+    };
+    std::vector<Entry> m_entries;  // by pass index
+    std::map<std::pair<std::string, TextureDesc>, emu::Handle> m_textures;
 };
 
 class PassGraph;
@@ -178,8 +208,14 @@ public:
     // not. Before and after each pass `hook` (when set) is called with the pass index, to let a
     // comparison capture or replace textures. False with `error` set at the first failure.
     // `stats` gets one entry per live pass.
+    // With `memo`, a pass whose dry run (after the before-hook) gives last frame's fingerprint
+    // while its outputs still hold what it wrote is not run again (PassStats::reused), and
+    // transient textures keep their own device textures between frames (PassMemo). A hook that
+    // writes a texture changes its generation, so what reads it runs. A pass that hands device
+    // contents back (a read-back: its fingerprint is incomplete) or writes CPU data always runs.
     using Hook = std::function<bool(uint32_t pass, bool after, std::string& error)>;
-    bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {});
+    bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {},
+             PassMemo* memo = nullptr);
 
     // ---- introspection (reports, tests, --graph) ----
     struct TextureNode {

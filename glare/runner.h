@@ -21,6 +21,9 @@ class Scene;
 struct RunnerOptions {
     emu::DeviceOptions device;  // hardware class, profile, renderer (software or GL)
     uint32_t width = 0, height = 0;
+    // Skip what a frame does not need (docs/glare/README.md "Reuse"): a pass whose inputs are
+    // last frame's is not run again. Off: every pass runs every frame (`--no-skip`).
+    bool skip = true;
 };
 
 // One frame's result.
@@ -96,6 +99,7 @@ private:
     RunnerOptions m_options;
     std::unique_ptr<emu::Device> m_device;
     std::unique_ptr<TexturePool> m_pool;
+    PassMemo m_memo;  // with RunnerOptions::skip: what runFrame keeps between frames
     emu::Handle m_scene{}, m_output{};
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;

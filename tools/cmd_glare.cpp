@@ -35,7 +35,7 @@ constexpr const char* kGlareUsage =
     "       ps11 glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH]\n"
     "                  [--backend emu|gl] [--gl osmesa|egl] [--gl-mode exact|native] [--hardware H | --precision P]\n"
     "                  [--quality low|medium|high|published] [--set name=value]... [--exposure STOPS]\n"
-    "                  [--dump-passes DIR] [--graph OUT.dot] [--compare] [--json]\n";
+    "                  [--dump-passes DIR] [--graph OUT.dot] [--compare] [--json] [--no-skip]\n";
 
 int glareUsage(const std::string& msg) {
     std::cerr << "ps11 glare: " << msg << "\n" << kGlareUsage;
@@ -70,6 +70,7 @@ struct GlareOptions {
     std::string quality = "published";
     std::vector<std::string> sets;
     float exposure = 0;
+    bool noSkip = false;  // --no-skip: every pass runs every frame
 };
 
 emu::RgbaImage opaque(emu::RgbaImage img) {
@@ -232,6 +233,7 @@ int runGlare(const GlareOptions& o) {
         ro.height = height;
         ro.device.hardware = o.hardware;
         ro.device.precision = o.precision;
+        ro.skip = !o.noSkip;
         if (gl) {
             ro.device.renderer = glRendererFactory(o.glKind, err, o.glNative);
             if (!ro.device.renderer) return nullptr;
@@ -254,6 +256,7 @@ int runGlare(const GlareOptions& o) {
         ro.height = height;
         ro.device.hardware = o.hardware;
         ro.device.precision = Precision::Ideal;
+        ro.skip = !o.noSkip;
         ideal = std::make_unique<glare::Runner>(ro);
         nativeRun = makeRunner(true, err);
         for (glare::Runner* r : {ideal.get(), nativeRun.get()})
@@ -466,10 +469,11 @@ int runGlare(const GlareOptions& o) {
         for (size_t i = 0; i < lastStats.size(); ++i) {
             const glare::PassStats& s = lastStats[i];
             std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
-                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu}%s\n",
+                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu, \"reused\": %s}%s\n",
                         s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                         (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
-                        (unsigned long long)s.readBacks, (unsigned long long)s.bytes, i + 1 < lastStats.size() ? "," : "");
+                        (unsigned long long)s.readBacks, (unsigned long long)s.bytes, s.reused ? "true" : "false",
+                        i + 1 < lastStats.size() ? "," : "");
         }
         std::printf("], \"renderer\": \"%s\", \"frame_uploads\": %llu, \"frame_readbacks\": %llu}\n",
                     main->device().rendererName(), (unsigned long long)lastTransfers.uploads,
@@ -481,14 +485,22 @@ int runGlare(const GlareOptions& o) {
     std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
                 std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
                 hw.c_str(), profile.c_str(), main->device().rendererName(), o.frames, sorted[sorted.size() / 2]);
-    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s\n", "pass (last frame)", "ms", "draws", "pixels", "texels",
-                "instructions", "up", "back", "MB", "GB/s");
-    for (const glare::PassStats& s : lastStats)
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f\n", s.pass.c_str(), s.milliseconds,
-                    (unsigned long long)s.draws, (unsigned long long)s.pixels, (unsigned long long)s.texels,
-                    (unsigned long long)s.instructions, (unsigned long long)s.uploads, (unsigned long long)s.readBacks,
-                    double(s.bytes) / 1e6, s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0);
-    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time)\n");
+    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s  %s\n", "pass (last frame)", "ms", "draws", "pixels",
+                "texels", "instructions", "up", "back", "MB", "GB/s", "run");
+    for (const glare::PassStats& s : lastStats) {
+        if (s.reused) {
+            std::printf("%-22s %9.3f %6s %11s %11s %13s %4s %4s %8s %7s  reused\n", s.pass.c_str(), s.milliseconds, "-",
+                        "-", "-", "-", "-", "-", "-", "-");
+            continue;
+        }
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f  ran\n", s.pass.c_str(),
+                    s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
+                    (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
+                    (unsigned long long)s.readBacks, double(s.bytes) / 1e6,
+                    s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0);
+    }
+    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
+                " reused: its inputs were last frame's, its outputs kept, nothing ran; --no-skip runs every pass)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
@@ -566,6 +578,8 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else if (a == "--set") {
             if (!value(v)) return glareUsage("--set needs name=value");
             o.sets.push_back(v);
+        } else if (a == "--no-skip") {
+            o.noSkip = true;
         } else if (a == "--exposure") {
             char* end = nullptr;
             if (!value(v)) return glareUsage("--exposure needs a number of stops");
@@ -576,7 +590,7 @@ int cmdGlare(const std::vector<std::string>& args) {
             return glareUsage(cli::unknownOption(
                 a, {"--list", "--report", "--markdown", "--json", "--compare", "--technique", "--scene", "--in", "-o",
                     "--dump-passes", "--graph", "--frames", "--size", "--backend", "--gl", "--gl-mode", "--hardware", "--precision",
-                    "--quality", "--set", "--exposure", "--help"}));
+                    "--quality", "--set", "--exposure", "--no-skip", "--help"}));
         }
     }
     if (o.list) return listTechniques();
