@@ -8,7 +8,9 @@
 // frame's time is its passes' own time (each pass ends when the renderer has finished it); for
 // native mode also with the upload of the scene and the read-back of the result (`native_io_ms`).
 // The benchmark's own time is the emulator's fx8 frame; every mode's median and the ratios to the
-// peer are counters. Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
+// peer are counters. These runners run every pass every frame (RunnerOptions::skip off); two more
+// hold the image with reuse on and time frames after the first (`*_still_*`), and four run the
+// technique with reuse on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`). Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -38,10 +40,13 @@ int threads() {
     return t ? std::atoi(t) : 2;
 }
 
-std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err) {
+// Runners run every pass every frame (RunnerOptions::skip off) unless `skip`: the speed
+// comparison is of whole frames; the still-frame counters measure what reuse saves.
+std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip = false) {
     glare::RunnerOptions ro;
     ro.width = kW;
     ro.height = kH;
+    ro.skip = skip;
     ro.device.software.threads = threads();
     if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
     if (mode == EmuFloat) ro.device.precision = ps11::Precision::Float;
@@ -131,8 +136,53 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
             return;
         }
     std::vector<double> movingMs[2];
+    // A still input with reuse on (the default of ps11 glare): two more runners (emulator fx8, GL
+    // native) hold the same image; their first frame runs before timing, so every timed frame is
+    // one after the first, against the same renderer's whole frame (skip off) above.
+    std::unique_ptr<glare::Runner> still[2];
+    for (int k = 0; k < 2; ++k) {
+        glare::FrameResult fr;
+        if (!(still[k] = makeRunner(movingMode[k], err, true)) || !still[k]->setImage(*frame, err) ||
+            !still[k]->runFrame(t, s, 0, 2, fr, err)) {
+            state.SkipWithError(err.c_str());
+            return;
+        }
+    }
+    std::vector<double> stillMs[2];
+    // Skipping's measuring scenes (docs/glare/scenes.md): `sparse` and `dense`, moving, with
+    // reuse on, on the emulator (fx8) and GL native; each draws the scene's next frame before
+    // the timed frame (not timed).
+    std::unique_ptr<glare::Runner> panel[2][2];  // [sparse, dense][emu fx8, GL native]
+    std::unique_ptr<glare::Scene> panelScene[2][2];
+    for (int d = 0; d < 2; ++d)
+        for (int k = 0; k < 2; ++k)
+            if (!(panel[d][k] = makeRunner(movingMode[k], err, true)) ||
+                !(panelScene[d][k] = glare::makeScene(d ? "dense" : "sparse", err))) {
+                state.SkipWithError(err.c_str());
+                return;
+            }
+    std::vector<double> panelMs[2][2];
     int f = 1;
     for (auto _ : state) {
+        for (int d = 0; d < 2; ++d)
+            for (int k = 0; k < 2; ++k) {
+                double sceneMs = 0;
+                glare::FrameResult fr;
+                if (!panel[d][k]->renderScene(*panelScene[d][k], f % 60, 60, sceneMs, err) ||
+                    !panel[d][k]->runFrame(t, s, f, f + 1, fr, err)) {
+                    state.SkipWithError(err.c_str());
+                    return;
+                }
+                panelMs[d][k].push_back(fr.milliseconds);
+            }
+        for (int k = 0; k < 2; ++k) {
+            glare::FrameResult fr;
+            if (!still[k]->runFrame(t, s, f, f + 1, fr, err)) {
+                state.SkipWithError(err.c_str());
+                return;
+            }
+            stillMs[k].push_back(fr.milliseconds);
+        }
         for (int k = 0; k < 2; ++k) {
             double sceneMs = 0;
             glare::FrameResult fr;
@@ -188,6 +238,16 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["gl_native_moving_ms"] = median(movingMs[1]);
     state.counters["fx8_moving_speedup_vs_native"] = median(movingMs[1]) / median(movingMs[0]);
     state.counters["native_io_ms"] = median(nativeIoMs);
+    state.counters["emu_fx8_sparse_ms"] = median(panelMs[0][0]);
+    state.counters["emu_fx8_dense_ms"] = median(panelMs[1][0]);
+    state.counters["gl_native_sparse_ms"] = median(panelMs[0][1]);
+    state.counters["gl_native_dense_ms"] = median(panelMs[1][1]);
+    state.counters["fx8_sparse_pct"] = 100.0 * median(panelMs[0][0]) / median(panelMs[1][0]);
+    state.counters["native_sparse_pct"] = 100.0 * median(panelMs[0][1]) / median(panelMs[1][1]);
+    state.counters["emu_fx8_still_ms"] = median(stillMs[0]);
+    state.counters["gl_native_still_ms"] = median(stillMs[1]);
+    state.counters["fx8_still_pct"] = 100.0 * median(stillMs[0]) / med[EmuFx8];
+    state.counters["native_still_pct"] = 100.0 * median(stillMs[1]) / med[GlNative];
     state.counters["exact_pct"] = pixels ? 100.0 * double(exact) / double(pixels) : 0;
     state.counters["fx8_vs_ideal_max"] = fx8VsIdeal.max;
     state.counters["fx8_vs_ideal_mean"] = fx8VsIdeal.mean;

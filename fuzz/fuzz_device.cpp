@@ -5,7 +5,10 @@
 // stays fast (the limits themselves are tested elsewhere). In fx8, float and ideal every file is
 // also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path): after
 // every draw both render targets must be identical bit for bit (docs/device.md "Aligned
-// passes").
+// passes"). A third device checks fingerprints (docs/device.md "Fingerprints") at every draw: a
+// dry run of the draw writes nothing; and when the draw's fingerprint after running it equals
+// the one before, running it again must leave the target's bytes as they are (what lets a pass
+// graph skip a pass whose fingerprint and outputs are last frame's).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -21,12 +24,32 @@
 #include "ps11/diagnostics.h"
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
+#include "emu/device.h"
 #include "tools/test_draw.h"
 
 namespace {
 
 void check(bool condition) {
     if (!condition) std::abort();
+}
+
+bool samePixels(const std::vector<ps11::Vec4>& a, const std::vector<ps11::Vec4>& b) {
+    return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0);
+}
+
+std::vector<ps11::Vec4> pixels(ps11::DrawRunner& r) {
+    std::vector<ps11::Vec4> out;
+    std::string error;
+    check(r.targetPixels(out, error));
+    return out;
+}
+
+// The fingerprint of one command run as a dry run on `r`'s device.
+emu::Device::Fingerprint dryRun(ps11::DrawRunner& r, const ps11::TestCommand& cmd) {
+    r.device().beginFingerprint();
+    std::string error;
+    (void)r.draw(cmd, error);
+    return r.device().endFingerprint();
 }
 
 bool small(const ps11::TestFile& file) {
@@ -71,6 +94,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::unique_ptr<ps11::DrawRunner> quads =
             ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
         check(quads != nullptr);
+        std::string fpError;
+        std::unique_ptr<ps11::DrawRunner> prints =
+            ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, fpError);
+        check(prints != nullptr);
         for (const ps11::TestCommand& cmd : file.commands) {
             if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;
             error.clear();
@@ -81,6 +108,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             }
             const bool drawn = runner->draw(cmd, error);
             if (!drawn) check(!error.empty());
+            {
+                const std::vector<ps11::Vec4> before = pixels(*prints);
+                const emu::Device::Fingerprint first = dryRun(*prints, cmd);
+                check(samePixels(pixels(*prints), before));  // a dry run writes nothing
+                std::string e;
+                check(prints->draw(cmd, e) == drawn);
+                const std::vector<ps11::Vec4> once = pixels(*prints);
+                const emu::Device::Fingerprint again = dryRun(*prints, cmd);
+                if (drawn && first.complete && again.complete && first.words == again.words) {
+                    check(prints->draw(cmd, e));
+                    check(samePixels(pixels(*prints), once));  // equal fingerprints: the same bytes
+                }
+            }
             if (!quads) continue;
             std::string quadError;
             check(quads->draw(cmd, quadError) == drawn);

@@ -429,6 +429,56 @@ protected:
     }
 };
 
+// The measuring scenes of skipping (docs/glare/scenes.md "sparse and dense"): a view panning over
+// a wall of cells. `sparse`: the cells dark but never black (0.03–0.15, no glow mask) with
+// small glowing squares over about 1 % of the pixels at full white; `dense`: every cell bright
+// (0.85–1.0, glow mask on), above every technique's threshold.
+class PanelScene final : public SceneBase {
+public:
+    explicit PanelScene(bool dense) : SceneBase(dense ? "dense" : "sparse"), m_dense(dense) {}
+
+protected:
+    D3DCOLOR clearColor() const override { return m_dense ? 0xFFD8D8D8u : 0x00080808u; }
+
+    bool draw(int frame, int /*frameCount*/) override {
+        const float w = float(width()), h = float(height());
+        // The view pans by 3.3 pixels (at 1080p) a frame to the right and 1.1 down.
+        const float pan = h / 1080.0f, ox = -3.3f * pan * float(frame), oy = -1.1f * pan * float(frame);
+        const float cell = h / 18.0f;
+        std::vector<ScreenVertex> v;
+        auto quad = [&](float x0, float y0, float x1, float y1, DWORD c) {
+            const ScreenVertex a{x0, y0, 0.5f, 1.0f, c}, b{x1, y0, 0.5f, 1.0f, c}, d{x1, y1, 0.5f, 1.0f, c},
+                e{x0, y1, 0.5f, 1.0f, c};
+            v.insert(v.end(), {a, b, d, a, d, e});
+        };
+        const int firstI = int(std::floor(-ox / cell)) - 1, firstJ = int(std::floor(-oy / cell)) - 1;
+        for (int j = firstJ; float(j) * cell + oy < h; ++j)
+            for (int i = firstI; float(i) * cell + ox < w; ++i) {
+                const uint32_t id = uint32_t(i + 4096) * 8192u + uint32_t(j + 4096);
+                const float base = m_dense ? 0.85f + 0.15f * noise(41, id) : 0.03f + 0.12f * noise(41, id);
+                const glm::vec3 tint(1.0f - 0.1f * noise(42, id), 1.0f - 0.1f * noise(43, id), 1.0f - 0.1f * noise(44, id));
+                quad(float(i) * cell + ox, float(j) * cell + oy, float(i + 1) * cell + ox, float(j + 1) * cell + oy,
+                     packColor(base * (m_dense ? glm::vec3(1.0f) : tint), m_dense));
+            }
+        if (!m_dense) {
+            // 36 squares of h/45 pixels: 36 / 45² · h / w of the frame, 1.0 % at 16:9. Each sits in
+            // its own cell of a 9 × 4 grid of the view, so they never overlap.
+            const float side = h / 45.0f;
+            for (uint32_t k = 0; k < 36; ++k) {
+                const float gx = w / 9.0f, gy = h / 4.0f;
+                const float x = float(k % 9) * gx + (gx - side) * noise(45, k), y = float(k / 9) * gy + (gy - side) * noise(46, k);
+                const float wobble = 0.5f * std::sin(0.37f * float(frame) + float(k));
+                const glm::vec3 rgb = k % 3 == 0 ? glm::vec3(1.0f, 0.95f, 0.8f) : glm::vec3(1.0f);
+                quad(x + wobble, y, x + wobble + side, y + side, packColor(rgb, true));
+            }
+        }
+        return drawScreen(v);
+    }
+
+private:
+    bool m_dense;
+};
+
 }  // namespace
 
 const std::vector<SceneInfo>& sceneList() {
@@ -437,6 +487,8 @@ const std::vector<SceneInfo>& sceneList() {
         {"neon", "neon strips (glow mask) on a dark wall with bright non-glowing objects (glow)", 60},
         {"lights", "sparse point lights at night, some one pixel, moving by sub-pixel steps (stability, sprites)", 60},
         {"sky", "a bright sky with a saturated sun over darker ground (large bright areas)", 60},
+        {"sparse", "a panning wall of dark cells (never black) with glowing squares over 1 % of the pixels (skipping)", 60},
+        {"dense", "a panning wall of bright glowing cells, every pixel above every threshold (skipping)", 60},
     };
     return list;
 }
@@ -446,6 +498,8 @@ std::unique_ptr<Scene> makeScene(std::string_view name, std::string& error) {
     if (name == "neon") return std::make_unique<NeonScene>();
     if (name == "lights") return std::make_unique<LightsScene>();
     if (name == "sky") return std::make_unique<SkyScene>();
+    if (name == "sparse") return std::make_unique<PanelScene>(false);
+    if (name == "dense") return std::make_unique<PanelScene>(true);
     std::string names;
     for (const SceneInfo& s : sceneList()) names += (names.empty() ? "" : ", ") + std::string(s.name);
     error = "unknown scene '" + std::string(name) + "' (scenes: " + names + ")";

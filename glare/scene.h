@@ -20,7 +20,7 @@ struct SceneInfo {
     int defaultFrames;  // the animation's length when the caller names none
 };
 
-// box, neon, lights, sky (in that order).
+// box, neon, lights, sky, sparse, dense (in that order).
 const std::vector<SceneInfo>& sceneList();
 
 class Scene {

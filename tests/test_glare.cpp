@@ -878,63 +878,80 @@ TEST_CASE("docs/fits-ps11.md is what ps11 glare --report --markdown prints", "[g
     }
 }
 
-TEST_CASE("reuse: frames are byte-identical with skipping on and off, moving and still", "[glare][reuse]") {
-    // Every technique, on the 1.1-class card and under ideal: three frames of its moving scene,
-    // then the last scene frame set as an image and held for three frames (nothing changes:
-    // passes are reused), then a different image (what depends on it runs again), then the first
-    // image again.
+namespace {
+
+// Every technique with reuse on and off (RunnerOptions::skip) on one renderer and profile: three
+// frames of its moving scene, then the last scene frame set as an image and held for three
+// frames (nothing changes: passes are reused), then a different image (what depends on it runs
+// again), then the first image again. Every frame's output must be byte-identical.
+void checkReuse(const emu::DeviceOptions& device) {
     for (const glare::Technique* t : glare::techniques()) {
-        for (std::optional<ps11::Precision> precision : {std::optional<ps11::Precision>{}, std::optional{ps11::Precision::Ideal}}) {
-            INFO(t->name() << (precision ? " ideal" : " geforce4"));
-            const glare::Settings settings = *glare::presetSettings(*t, "published");
-            glare::RunnerOptions on, off;
-            on.width = off.width = 160;
-            on.height = off.height = 96;
-            on.device.precision = off.device.precision = precision;
-            off.skip = false;
-            glare::Runner a(on), b(off);
-            std::string err;
-            std::unique_ptr<glare::Scene> sa = glare::makeScene(t->scene(), err), sb = glare::makeScene(t->scene(), err);
-            REQUIRE(sa);
-            const int frames = 9;
-            size_t reusedWhileStill = 0, passesWhileStill = 0, reusedAfterChange = 0;
-            std::optional<emu::RgbaImage> held;
-            for (int f = 0; f < frames; ++f) {
-                INFO("frame " << f);
-                double ms = 0;
-                if (f < 3) {
-                    REQUIRE(a.renderScene(*sa, f, frames, ms, err));
-                    REQUIRE(b.renderScene(*sb, f, frames, ms, err));
-                    if (f == 2) held = a.readTexture(a.sceneTexture(), err);
-                } else if (f == 3 || f == 7) {
-                    REQUIRE(held);
-                    REQUIRE(a.setImage(*held, err));
-                    REQUIRE(b.setImage(*held, err));
-                } else if (f == 6) {
-                    emu::RgbaImage other = *held;
-                    for (size_t i = 0; i < other.rgba.size(); i += 97) other.rgba[i] = uint8_t(255 - other.rgba[i]);
-                    REQUIRE(a.setImage(other, err));
-                    REQUIRE(b.setImage(other, err));
-                }
-                glare::FrameResult ra, rb;
-                REQUIRE(a.runFrame(*t, settings, f, frames, ra, err));
-                REQUIRE(b.runFrame(*t, settings, f, frames, rb, err));
-                const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
-                REQUIRE(oa);
-                REQUIRE(ob);
-                REQUIRE(oa->rgba == ob->rgba);
-                size_t reused = 0;
-                for (const glare::PassStats& s : ra.passes) reused += s.reused;
-                for (const glare::PassStats& s : rb.passes) CHECK(!s.reused);
-                if (f == 4 || f == 5) reusedWhileStill += reused, passesWhileStill += ra.passes.size();
-                if (f == 6) reusedAfterChange = reused;
+        INFO(t->name());
+        const glare::Settings settings = *glare::presetSettings(*t, "published");
+        glare::RunnerOptions on, off;
+        on.width = off.width = 160;
+        on.height = off.height = 96;
+        on.device = off.device = device;
+        off.skip = false;
+        glare::Runner a(on), b(off);
+        std::string err;
+        std::unique_ptr<glare::Scene> sa = glare::makeScene(t->scene(), err), sb = glare::makeScene(t->scene(), err);
+        REQUIRE(sa);
+        const int frames = 9;
+        size_t reusedWhileStill = 0, passesWhileStill = 0, reusedAfterChange = 0;
+        std::optional<emu::RgbaImage> held;
+        for (int f = 0; f < frames; ++f) {
+            INFO("frame " << f);
+            double ms = 0;
+            if (f < 3) {
+                REQUIRE(a.renderScene(*sa, f, frames, ms, err));
+                REQUIRE(b.renderScene(*sb, f, frames, ms, err));
+                if (f == 2) held = a.readTexture(a.sceneTexture(), err);
+            } else if (f == 3 || f == 7) {
+                REQUIRE(held);
+                REQUIRE(a.setImage(*held, err));
+                REQUIRE(b.setImage(*held, err));
+            } else if (f == 6) {
+                emu::RgbaImage other = *held;
+                for (size_t i = 0; i < other.rgba.size(); i += 97) other.rgba[i] = uint8_t(255 - other.rgba[i]);
+                REQUIRE(a.setImage(other, err));
+                REQUIRE(b.setImage(other, err));
             }
-            // Held still, passes are reused in every technique (not all: a read-back step, what
-            // writes CPU data, and passes whose outputs later passes of the frame blend onto run
-            // every frame; docs/glare/README.md "Reuse"); after the image changed, fewer.
-            CHECK(reusedWhileStill >= 2);
-            CHECK(reusedWhileStill <= passesWhileStill);
-            CHECK(reusedAfterChange * 2 < reusedWhileStill + 2);
+            glare::FrameResult ra, rb;
+            REQUIRE(a.runFrame(*t, settings, f, frames, ra, err));
+            REQUIRE(b.runFrame(*t, settings, f, frames, rb, err));
+            const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
+            REQUIRE(oa);
+            REQUIRE(ob);
+            REQUIRE(oa->rgba == ob->rgba);
+            size_t reused = 0;
+            for (const glare::PassStats& st : ra.passes) reused += st.reused;
+            for (const glare::PassStats& st : rb.passes) CHECK(!st.reused);
+            if (f == 4 || f == 5) reusedWhileStill += reused, passesWhileStill += ra.passes.size();
+            if (f == 6) reusedAfterChange = reused;
         }
+        // Held still, passes are reused in every technique (not all: a read-back step, what
+        // writes CPU data, and passes whose outputs later passes of the frame blend onto run
+        // every frame; docs/glare/README.md "Reuse"); after the image changed, fewer.
+        CHECK(reusedWhileStill >= 2);
+        CHECK(reusedWhileStill <= passesWhileStill);
+        CHECK(reusedAfterChange * 2 < reusedWhileStill + 2);
     }
+}
+
+}  // namespace
+
+TEST_CASE("reuse: frames are byte-identical with skipping on and off, moving and still", "[glare][reuse]") {
+    checkReuse({});  // the 1.1-class card
+    emu::DeviceOptions ideal;
+    ideal.precision = ps11::Precision::Ideal;
+    checkReuse(ideal);
+}
+
+TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
+    std::string error;
+    emu::DeviceOptions gl;
+    gl.renderer = ps11::glRendererFactory("", error);
+    REQUIRE(gl.renderer);
+    checkReuse(gl);
 }

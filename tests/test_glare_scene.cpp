@@ -84,11 +84,13 @@ int frameCount(std::string_view name) {
 
 TEST_CASE("scene: the list and unknown names", "[scene]") {
     const auto& list = glare::sceneList();
-    REQUIRE(list.size() == 4);
+    REQUIRE(list.size() == 6);
     CHECK(list[0].name == "box");
     CHECK(list[1].name == "neon");
     CHECK(list[2].name == "lights");
     CHECK(list[3].name == "sky");
+    CHECK(list[4].name == "sparse");
+    CHECK(list[5].name == "dense");
     for (const glare::SceneInfo& s : list) {
         CHECK(s.defaultFrames > 1);
         CHECK_FALSE(s.description.empty());
@@ -98,9 +100,9 @@ TEST_CASE("scene: the list and unknown names", "[scene]") {
     }
     std::string error;
     CHECK_FALSE(glare::makeScene("x", error));
-    CHECK(error == "unknown scene 'x' (scenes: box, neon, lights, sky)");
+    CHECK(error == "unknown scene 'x' (scenes: box, neon, lights, sky, sparse, dense)");
     CHECK_FALSE(glare::makeScene("", error));
-    CHECK(error == "unknown scene '' (scenes: box, neon, lights, sky)");
+    CHECK(error == "unknown scene '' (scenes: box, neon, lights, sky, sparse, dense)");
 }
 
 TEST_CASE("scene: every scene renders, deterministically, and moves", "[scene]") {
@@ -350,4 +352,27 @@ TEST_CASE("glow-only black fog fades the glow masks with distance and leaves the
     // end <= start turns it off again.
     fogged->setGlowFog(5.0f, 5.0f);
     CHECK(render(dev, *fogged, 192, 108, 2, 8).argb == a.argb);
+}
+
+TEST_CASE("scene: sparse has about 1 % of its pixels above the thresholds, dense all of them", "[scene]") {
+    // The thresholds the techniques publish: adaptive 0.4, pyramid 0.6, the sprites' sensors 0.8
+    // (luminance); glow reads the mask (alpha 255).
+    for (int frame : {0, 17, 59}) {
+        INFO("frame " << frame);
+        const Frame sparse = render("sparse", 1920, 1080, frame, 60), dense = render("dense", 1920, 1080, frame, 60);
+        const double bright = fraction(sparse, 0.4);
+        CHECK(bright > 0.008);
+        CHECK(bright < 0.013);
+        CHECK(fraction(sparse, 0.8) > 0.008);
+        size_t black = 0, masked = 0;
+        for (uint32_t p : sparse.argb) black += (p & 0xFFFFFFu) == 0, masked += (p >> 24) == 0xFF;
+        CHECK(black == 0);  // dark, never black
+        CHECK(double(masked) / double(sparse.argb.size()) < 0.013);
+        CHECK(fraction(dense, 0.8) == 1.0);
+        size_t unmasked = 0;
+        for (uint32_t p : dense.argb) unmasked += (p >> 24) != 0xFF;
+        CHECK(unmasked == 0);
+    }
+    // The view moves.
+    CHECK(render("sparse", 192, 108, 0, 60).argb != render("sparse", 192, 108, 1, 60).argb);
 }

@@ -60,6 +60,8 @@ public:
     uint32_t height() const { return m_height; }
     // The target stores floats (values), not 8-bit levels.
     bool floatTarget() const;
+    // The device the file is set up on (the fuzzer takes fingerprints on it).
+    emu::Device& device() { return *m_device; }
 
 private:
     DrawRunner() = default;
