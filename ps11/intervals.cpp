@@ -47,11 +47,12 @@ FI regFloat(const Profile& p, const AV& r, SrcMod mod) {
 }
 
 struct State {
+    State(const Profile& p_, const IntervalInputs& in_) : p(p_), in(in_) {}
     const Profile& p;
     const IntervalInputs& in;
     Regs regs;
-    FI tc[kMaxTexCoordSets][4];
-    FI pad[2];
+    FI tc[kMaxTexCoordSets][4];  // the sets the program reads as values (m_tcRead)
+    FI pad[2]{};
     FI depth{0.0f, 1.0f, false, false};
     bool depthWritten = false;
     bool mayKill = false, allKilled = false;
@@ -326,21 +327,35 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
         t.instruction = int16_t(i);
         // Plain lookups: 1_1-1_3 tex (TC[m]), 1_4 texld from a t# (coordinates only).
         t.plain = op.op == Opcode::Tex && (e.m_p.minor < 4 || op.src[0].kind == exec::SrcKind::TexCoord);
+        // The coordinate sets read as values (lookups read coordinates only to sample).
+        const int srcSet = op.src[0].kind == exec::SrcKind::TexCoord ? op.src[0].slot & 7 : -1;
+        switch (op.op) {
+            case Opcode::TexCoord: e.m_tcRead |= uint8_t(1u << (e.m_p.minor < 4 ? op.stage : std::max(srcSet, 0))); break;
+            case Opcode::TexKill: e.m_tcRead |= uint8_t(srcSet >= 0 ? 1u << srcSet : 0); break;
+            case Opcode::TexM3x2Pad:
+            case Opcode::TexM3x3Pad:
+            case Opcode::TexM3x2Depth:
+            case Opcode::TexM3x3:
+            case Opcode::TexDp3: e.m_tcRead |= uint8_t(1u << (op.stage & 7)); break;
+            default: break;
+        }
     }
+    e.m_vRead = d.vUsed;
     return e;
 }
 
 void IntervalEvaluator::evaluate(const IntervalInputs& inputs, IntervalResult& result) const {
     using namespace intervals;
     const Profile& p = m_p;
-    State st{p, inputs, {}, {}, {}, {}, false, false, false};
+    State st{p, inputs};
     // Registers a validated program reads only after writing them: the whole range. r0 starts at
     // 0 (the executor zeroes it).
     for (auto& slot : st.regs.reg)
         for (AV& a : slot) a = wholeRange(p);
     for (AV& a : st.regs.reg[exec::kSlotR]) a = AV{}, a.f = fPoint(0.0f);
     // v# saturated to [0, 1] (NaN and −0.0 to +0.0) and, in fx, rounded to the grid (loadColors).
-    for (int v = 0; v < exec::kNumRegV; ++v)
+    for (int v = 0; v < exec::kNumRegV; ++v) {
+        if (!((m_vRead >> v) & 1)) continue;
         for (int c = 0; c < 4; ++c) {
             const FI x = fromRange(inputs.color[size_t(v)][size_t(c)]);
             auto sat = [](float s) { return s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f; };
@@ -351,9 +366,10 @@ void IntervalEvaluator::evaluate(const IntervalInputs& inputs, IntervalResult& r
             a.nlo = int32_t(std::nearbyint(double(lo) * p.g));
             a.nhi = int32_t(std::nearbyint(double(hi) * p.g));
         }
+    }
     for (int t = 0; t < kMaxTexCoordSets; ++t)
-        for (int c = 0; c < 4; ++c) st.tc[t][c] = fromRange(inputs.texcoord[size_t(t)][size_t(c)]);
-    st.pad[0] = st.pad[1] = fTop();
+        if ((m_tcRead >> t) & 1)
+            for (int c = 0; c < 4; ++c) st.tc[t][c] = fromRange(inputs.texcoord[size_t(t)][size_t(c)]);
 
     AV hold[4];
     for (size_t i = 0; i < m_ops.size(); ++i) {

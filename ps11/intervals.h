@@ -133,6 +133,8 @@ private:
     std::vector<Tap> m_taps;  // per op
     bool m_stagesKnown = false;
     bool m_writesDepth = false;
+    uint8_t m_tcRead = 0;  // texture coordinate sets read as values (texcoord, texcrd, texkill, matrix rows)
+    uint8_t m_vRead = 0;   // v0, v1 read
 };
 
 }  // namespace ps11

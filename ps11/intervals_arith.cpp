@@ -42,22 +42,32 @@ FI modFloat(SrcMod m, const FI& x) {
     }
 }
 
+// Fx: fills k; float and ideal: fills f.
+template <bool Fx>
 SV fetch(const Profile& p, const Regs& regs, const DSrc& src, int c) {
     SV s;
     const int comp = src.sw[size_t(c)];
-    const exec::SourceAffine af = exec::sourceAffine(src.mod, p.g);
+    constexpr bool fx = Fx;
     if (src.kind == SrcKind::Const) {
-        const int32_t n = p.constGrid[src.slot][size_t(comp)];
-        s.k = kPoint(int64_t(af.a) * n + af.b);
-        s.nlo = s.nhi = n;
-        s.f = fPoint(exec::applySourceModifier(src.mod, p.constF[src.slot][size_t(comp)]));
+        if constexpr (fx) {
+            const exec::SourceAffine af = exec::sourceAffine(src.mod, p.g);
+            const int32_t n = p.constGrid[src.slot][size_t(comp)];
+            s.k = kPoint(int64_t(af.a) * n + af.b);
+            s.nlo = s.nhi = n;
+        } else {
+            s.f = fPoint(exec::applySourceModifier(src.mod, p.constF[src.slot][size_t(comp)]));
+        }
         return s;
     }
     const AV& r = regs.reg[src.slot][comp];
-    const int64_t a = int64_t(af.a) * r.nlo + af.b, b = int64_t(af.a) * r.nhi + af.b;
-    s.k = {std::min(a, b), std::max(a, b)};
-    s.nlo = r.nlo, s.nhi = r.nhi;
-    s.f = modFloat(src.mod, r.f);
+    if constexpr (fx) {
+        const exec::SourceAffine af = exec::sourceAffine(src.mod, p.g);
+        const int64_t a = int64_t(af.a) * r.nlo + af.b, b = int64_t(af.a) * r.nhi + af.b;
+        s.k = {std::min(a, b), std::max(a, b)};
+        s.nlo = r.nlo, s.nhi = r.nhi;
+    } else {
+        s.f = modFloat(src.mod, r.f);
+    }
     s.var = src.slot * 4 + comp;
     if (src.mod == SrcMod::None) s.tap = r.tap, s.ch = r.ch;
     return s;
@@ -91,7 +101,7 @@ void fxWrite(const Profile& p, const DOp& op, KI num, int64_t d0, AV& out) {
         return int32_t(q > hi ? hi : q);
     };
     out.nlo = step(num.lo);
-    out.nhi = step(num.hi);
+    out.nhi = num.hi == num.lo ? out.nlo : step(num.hi);
 }
 
 // A per-component op passes source `pass` through exactly when k = 2n reaches the write step
@@ -102,7 +112,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
         // One sum of independent products, written to every enabled channel.
         KI sum{0, 0};
         for (int c = 0; c < (op.op == Opcode::Dp3 ? 3 : 4); ++c)
-            sum = kAdd(sum, kMul(fetch(p, regs, op.src[0], c).k, fetch(p, regs, op.src[1], c).k));
+            sum = kAdd(sum, kMul(fetch<true>(p, regs, op.src[0], c).k, fetch<true>(p, regs, op.src[1], c).k));
         AV r;
         fxWrite(p, op, sum, kProd, r);
         for (int c = 0; c < 4; ++c)
@@ -112,7 +122,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
     for (int c = 0; c < 4; ++c) {
         if (!((op.mask >> c) & 1)) continue;
         SV s[3];
-        for (int i = 0; i < op.numSrc; ++i) s[i] = fetch(p, regs, op.src[size_t(i)], c);
+        for (int i = 0; i < op.numSrc; ++i) s[i] = fetch<true>(p, regs, op.src[size_t(i)], c);
         KI num{0, 0};
         int64_t d0 = kLin;
         int pass = -1;  // the source passed through exactly, if any
@@ -199,7 +209,7 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
     bool finiteMatrix = stagesKnown;
     for (float m : ss.bumpMat) finiteMatrix = finiteMatrix && std::isfinite(m);
     const double scale = std::ldexp(0.5, op.shift);
-    const SV br = fetch(p, regs, op.src[1], 0), bg = fetch(p, regs, op.src[1], 1);
+    const SV br = fetch<true>(p, regs, op.src[1], 0), bg = fetch<true>(p, regs, op.src[1], 1);
     for (int c = 0; c < 2; ++c) {
         if (!((op.mask >> c) & 1)) continue;
         AV& r = out[c];
@@ -208,7 +218,7 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
             r.nlo = lo, r.nhi = hi;
             continue;
         }
-        const SV a = fetch(p, regs, op.src[0], c);
+        const SV a = fetch<true>(p, regs, op.src[0], c);
         const double mr = c == 0 ? ss.bumpMat[0] : ss.bumpMat[1], mg = c == 0 ? ss.bumpMat[2] : ss.bumpMat[3];
         double vlo = INFINITY, vhi = -INFINITY;
         for (int m = 0; m < 8; ++m) {
@@ -225,7 +235,8 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
 // Write step (executor_arith_float.inc finishFloat): ·2^shift, _sat, range clamp; each monotone,
 // NaN becomes 0 under _sat and stays NaN otherwise.
 FI floatWrite(const Profile& p, const DOp& op, FI v) {
-    const float scale = std::ldexp(1.0f, op.shift);
+    static constexpr float kScale[7] = {0.125f, 0.25f, 0.5f, 1.0f, 2.0f, 4.0f, 8.0f};  // 2^shift, exact
+    const float scale = kScale[op.shift + 3];
     const float lo = p.clampRange ? -p.maxValue : -kInf, hi = p.clampRange ? p.maxValue : kInf;
     FI s{v.lo * scale, v.hi * scale, v.nan, v.nz};
     // A negative value too small for the down-shift becomes −0.0.
@@ -274,7 +285,7 @@ FI lrpRefine(const SV* s, FI steps) {
 void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4]) {
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
         // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a), as the executor evaluates it.
-        auto term = [&](int c) { return fMul(fetch(p, regs, op.src[0], c).f, fetch(p, regs, op.src[1], c).f); };
+        auto term = [&](int c) { return fMul(fetch<false>(p, regs, op.src[0], c).f, fetch<false>(p, regs, op.src[1], c).f); };
         FI sum = fAdd(fAdd(term(0), term(1)), term(2));
         if (op.op == Opcode::Dp4) sum = fAdd(sum, term(3));
         AV r;
@@ -286,12 +297,12 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
     if (op.op == Opcode::Bem) {
         // a + (Mr·b.r + Mg·b.g) in float32; an unknown matrix gives anything.
         const StageState& ss = p.stages[op.stage];
-        const FI br = fetch(p, regs, op.src[1], 0).f, bg = fetch(p, regs, op.src[1], 1).f;
+        const FI br = fetch<false>(p, regs, op.src[1], 0).f, bg = fetch<false>(p, regs, op.src[1], 1).f;
         for (int c = 0; c < 2; ++c) {
             if (!((op.mask >> c) & 1)) continue;
             const float mr = c == 0 ? ss.bumpMat[0] : ss.bumpMat[1], mg = c == 0 ? ss.bumpMat[2] : ss.bumpMat[3];
             const FI v = stagesKnown
-                             ? fAdd(fetch(p, regs, op.src[0], c).f, fAdd(fMul(fPoint(mr), br), fMul(fPoint(mg), bg)))
+                             ? fAdd(fetch<false>(p, regs, op.src[0], c).f, fAdd(fMul(fPoint(mr), br), fMul(fPoint(mg), bg)))
                              : fTop();
             out[c] = AV{};
             out[c].f = floatWrite(p, op, v);
@@ -301,7 +312,7 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
     for (int c = 0; c < 4; ++c) {
         if (!((op.mask >> c) & 1)) continue;
         SV s[3];
-        for (int i = 0; i < op.numSrc; ++i) s[i] = fetch(p, regs, op.src[size_t(i)], c);
+        for (int i = 0; i < op.numSrc; ++i) s[i] = fetch<false>(p, regs, op.src[size_t(i)], c);
         const FI &x = s[0].f, &y = s[1].f, &z = s[2].f;
         // An exact zero of either sign: a + ±0 is a unless a is −0.0 (−0 + +0 = +0).
         auto zero = [](const FI& v) { return isPoint(v, 0.0f); };
