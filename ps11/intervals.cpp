@@ -238,17 +238,6 @@ void evalTexture(const Profile& p, bool stagesKnown, const DOp& op, int opIndex,
             }
             break;
         }
-        case Opcode::TexBem:
-        case Opcode::TexReg2AR:
-        case Opcode::TexReg2GB:
-        case Opcode::TexReg2RGB:
-        case Opcode::TexM3x2Tex:
-        case Opcode::TexM3x3Tex:
-        case Opcode::TexM3x3Spec:
-        case Opcode::TexM3x3VSpec:
-        case Opcode::TexDp3Tex:
-            st.sample(op, opIndex, false);  // dependent: the coordinates come from registers
-            break;
         case Opcode::TexM3x2Pad:
         case Opcode::TexM3x3Pad:
             st.pad[op.padIndex] = st.rowDot(op.stage, op.src[0]);
@@ -275,6 +264,9 @@ void evalTexture(const Profile& p, bool stagesKnown, const DOp& op, int opIndex,
                           regFloat(p, st.regs.reg[op.dstSlot][1], SrcMod::None));
             break;
         default:
+            // Every other lookup (texbem, texreg2*, texm3x2tex, texm3x3tex/spec/vspec, texdp3tex)
+            // is dependent: its coordinates come from registers.
+            if (samplesStage(op.op)) st.sample(op, opIndex, false);
             break;
     }
 }
