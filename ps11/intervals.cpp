@@ -319,6 +319,7 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
         t.instruction = int16_t(i);
         // Plain lookups: 1_1-1_3 tex (TC[m]), 1_4 texld from a t# (coordinates only).
         t.plain = op.op == Opcode::Tex && (e.m_p.minor < 4 || op.src[0].kind == exec::SrcKind::TexCoord);
+        if (samplesStage(op.op)) (t.plain ? e.m_plainStages : e.m_dependentStages) |= 1u << op.stage;
         // The coordinate sets read as values (lookups read coordinates only to sample).
         const int srcSet = op.src[0].kind == exec::SrcKind::TexCoord ? op.src[0].slot & 7 : -1;
         switch (op.op) {

@@ -119,6 +119,14 @@ public:
     // Bounds the program's results over `inputs`. Allocates nothing; thread-safe.
     void evaluate(const IntervalInputs& inputs, IntervalResult& result) const;
 
+    // What evaluate() reads, so a caller gathers only those ranges (bit per stage, set or v#):
+    // the stages of plain and of dependent lookups, the coordinate sets read as values
+    // (texcoord, texcrd, texkill, the matrix rows), the colours.
+    uint32_t plainLookupStages() const { return m_plainStages; }
+    uint32_t dependentLookupStages() const { return m_dependentStages; }
+    uint8_t texcoordSetsRead() const { return m_tcRead; }
+    uint8_t colorsRead() const { return m_vRead; }
+
     Precision precision() const { return m_p.precision; }
     // The decoded profile: grid scale, round(M·G), M, the constants as loaded.
     const exec::Profile& profile() const { return m_p; }
@@ -135,6 +143,7 @@ private:
     bool m_writesDepth = false;
     uint8_t m_tcRead = 0;  // texture coordinate sets read as values (texcoord, texcrd, texkill, matrix rows)
     uint8_t m_vRead = 0;   // v0, v1 read
+    uint32_t m_plainStages = 0, m_dependentStages = 0;
 };
 
 }  // namespace ps11

@@ -662,6 +662,18 @@ TEST_CASE("intervals: dependent reads need a range for any coordinates; texkill 
         CHECK(r.color[0].hi == Approx(0.5).margin(0.003));
         CHECK(r.copyStage == -1);  // a dependent lookup is never a copy the renderer could make
 
+        {
+            Diagnostics diags;
+            IntervalSetup setup;
+            setup.options.precision = prec;
+            auto e = IntervalEvaluator::create(mustAssemble(bem), setup, diags);
+            REQUIRE(e);
+            CHECK(e->plainLookupStages() == 1u);
+            CHECK(e->dependentLookupStages() == 2u);
+            CHECK(e->texcoordSetsRead() == 0);
+            CHECK(e->colorsRead() == 0);
+        }
+
         const std::string kill = "ps_1_1\ntex t0\ntexkill t1\nmov r0, t0\n";
         in.texcoord[1].fill(ValueRange::between(0, 1));
         CHECK(evaluateOnce(kill, prec, {}, in).kill == KillRange::Never);
