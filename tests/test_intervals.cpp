@@ -222,6 +222,7 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
     setup.options.precision = prec;
     if (rng.coin(0.3)) setup.options.coissuedCnd = CoissuedCnd::Sequential;  // geforce7's co-issued cnd
     if (rng.coin(0.15)) setup.options.maxValue = minor == 4 ? std::array<float, 3>{1, 2, 4}[size_t(rng.uni(0, 2))] : 2.0f;
+    if (!isFixedPoint(prec) && rng.coin(0.15)) setup.options.maxValue = 65504;  // the D3D9-class cards
     for (auto& c : setup.constants)
         for (float& f : c) {
             const int k = rng.uni(0, 9);
