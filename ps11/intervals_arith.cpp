@@ -24,7 +24,14 @@ struct SV {
     int8_t tap = -1;   // copy tag, kept only without a modifier
     uint8_t ch = 0;
     int32_t nlo = 0, nhi = 0;  // fx: the register's grid range (for the identities' clamp checks)
+    SrcMod mod = SrcMod::None;
 };
+
+// Two fetched sources are one value in every run: the same register channel under the same
+// modifier, or copies of the same lookup channel (copy tags are bit-exact).
+bool sameValue(const SV& a, const SV& b) {
+    return (a.var >= 0 && a.var == b.var && a.mod == b.mod) || (a.tap >= 0 && a.tap == b.tap && a.ch == b.ch);
+}
 
 // A float modifier over a range: the formulas are monotone, so they apply to the bounds.
 FI modFloat(SrcMod m, const FI& x) {
@@ -69,6 +76,7 @@ SV fetch(const Profile& p, const Regs& regs, const DSrc& src, int c) {
         s.f = modFloat(src.mod, r.f);
     }
     s.var = src.slot * 4 + comp;
+    s.mod = src.mod;
     if (src.mod == SrcMod::None) s.tap = r.tap, s.ch = r.ch;
     return s;
 }
@@ -154,6 +162,10 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
                 // sources its extremes are at the corners; otherwise two sound forms intersected.
                 d0 = kProd;
                 auto f = [&](int64_t kf, int64_t ka, int64_t kb) { return kf * (ka - kb) + 2 * G * kb; };
+                if (sameValue(s[1], s[2])) {  // f·a + (1 − f)·a = a exactly
+                    num = kMul(kPoint(2 * G), s[2].k), pass = 2;
+                    break;
+                }
                 if (independent(s, 3)) {
                     num = kPoint(f(s[0].k.lo, s[1].k.lo, s[2].k.lo));
                     for (int m = 0; m < 8; ++m) {
@@ -175,7 +187,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
                 const bool isCnd = op.op == Opcode::Cnd;
                 const bool allTrue = isCnd ? s[0].k.lo > G : s[0].k.lo >= 0;
                 const bool allFalse = isCnd ? s[0].k.hi <= G : s[0].k.hi < 0;
-                if (allTrue)
+                if (allTrue || sameValue(s[1], s[2]))
                     num = s[1].k, pass = 1;
                 else if (allFalse)
                     num = s[2].k, pass = 2;
@@ -345,9 +357,14 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
                     pass = 1;
                 break;
             case Opcode::Lrp: {
+                // b + (±0) is b when b is never −0.0: f exactly 0 with a − b finite, or a and b
+                // one finite value (a − a = +0) with f finite. f = 1 is not exact in float.
                 const FI d = fSub(y, z);
+                if ((zero(x) && finite(d) && !z.nz) || (sameValue(s[1], s[2]) && finite(z) && finite(x) && !z.nz)) {
+                    v = z, pass = 2;
+                    break;
+                }
                 v = lrpRefine(s, fAdd(z, fMul(x, d)));
-                if (zero(x) && finite(d) && !z.nz) pass = 2;  // b + (±0); f = 1 is not exact in float
                 break;
             }
             case Opcode::Cnd:
@@ -356,7 +373,7 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
                 const bool isCnd = op.op == Opcode::Cnd;
                 const bool allTrue = !x.nan && (isCnd ? x.lo > 0.5f : x.lo >= 0.0f);
                 const bool allFalse = isCnd ? x.hi <= 0.5f : x.hi < 0.0f;
-                if (allTrue)
+                if (allTrue || sameValue(s[1], s[2]))
                     v = y, pass = 1;
                 else if (allFalse)
                     v = z, pass = 2;

@@ -390,6 +390,10 @@ const char* kTemplates[] = {
     "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r1, c0, r0\n",
     "ps_1_4\ntexld r1, t1\ntexcrd r2.rgb, t2\nphase\ntexld r0, t0\ntexld r2, r2\nmad r0.rgb, r2, r1, r0\n",
     "ps_1_1\ntex t0\ntexkill t1\nmov r0, t0\n",
+    "ps_1_1\ntex t0\ntex t1\nmov r1, t0\nlrp r0, t1, t0, r1\n",
+    "ps_1_1\ntex t0\ntex t1\nmov r0, t1\ncnd r0, r0.a, t0, t0\n",
+    "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n",
+    "ps_1_1\ndef c0, 0.30, 0.59, 0.11, 0.0\ntex t0\ntex t1\ndp3 r1, t0, c0\nadd r0, t0, t1\nlrp r0, r1, t0, r0\n",
     "ps_1_4\ntexld r1, t1\nbem_x2 r0.rg, c0, r1\nphase\nmov r0.ba, c1\n",
     "ps_1_4\ntexld r1, t1\nbem_d2_sat r0.rg, r1, c2\nphase\ntexld r2, t2\nadd r0.ba, r2, c1\n",
     "ps_1_1\ntex t0\ntexbeml t1, t0\nmov r0, t1\n",
@@ -550,6 +554,21 @@ TEST_CASE("intervals: an additive composite over a zero glare tile is a copy of 
         CHECK(r.copyStage == -1);
         CHECK_FALSE(r.color[0].constant);
         CHECK(r.color[0].hi == Approx(isFixedPoint(prec) || prec == Precision::Float ? 1.0 : 1.1).margin(1e-6));
+    }
+}
+
+TEST_CASE("intervals: the screen and luminance composites over a zero glare tile are copies too", "[intervals]") {
+    for (Precision prec : kProfiles) {
+        INFO(precisionName(prec));
+        IntervalInputs in;
+        in.stages[0] = unormTile(0, 1);
+        in.stages[1] = unormTile(0, 0);
+        // S + G − S·G as mad: G·(1 − S) + S, the product exactly 0.
+        CHECK(evaluateOnce(glareShader("composite_screen.psh"), prec, {}, in).copyStage == 0);
+        // lrp(lum, S, S + G) with S + G a copy of S: f·S + (1 − f)·S is S.
+        const IntervalResult r = evaluateOnce(glareShader("composite_luminance.psh"), prec, {}, in);
+        CHECK(r.copyStage == 0);
+        CHECK(r.copyInstruction == 1);  // def c0, then tex t0
     }
 }
 
