@@ -39,9 +39,7 @@ using exec::SrcKind;
 // A register component as the texture stage reads it (executor_texture.cpp regFloat): fx n/G as
 // a float (monotone), then _bx2 (2x − 1) if given.
 FI regFloat(const Profile& p, const AV& r, SrcMod mod) {
-    FI x = isFixedPoint(p.precision)
-               ? FI{float(r.nlo) / float(p.g), float(r.nhi) / float(p.g), false, false}
-               : r.f;
+    FI x = isFixedPoint(p.precision) ? FI{float(r.nlo) / float(p.g), float(r.nhi) / float(p.g), false, false} : r.f;
     if (mod == SrcMod::Sign) x = norm({2.0f * x.lo - 1.0f, 2.0f * x.hi - 1.0f, x.nan, false});
     return x;
 }
@@ -323,14 +321,21 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
         // The coordinate sets read as values (lookups read coordinates only to sample).
         const int srcSet = op.src[0].kind == exec::SrcKind::TexCoord ? op.src[0].slot & 7 : -1;
         switch (op.op) {
-            case Opcode::TexCoord: e.m_tcRead |= uint8_t(1u << (e.m_p.minor < 4 ? op.stage : std::max(srcSet, 0))); break;
-            case Opcode::TexKill: e.m_tcRead |= uint8_t(srcSet >= 0 ? 1u << srcSet : 0); break;
+            case Opcode::TexCoord:
+                e.m_tcRead |= uint8_t(1u << (e.m_p.minor < 4 ? op.stage : std::max(srcSet, 0)));
+                break;
+            case Opcode::TexKill:
+                e.m_tcRead |= uint8_t(srcSet >= 0 ? 1u << srcSet : 0);
+                break;
             case Opcode::TexM3x2Pad:
             case Opcode::TexM3x3Pad:
             case Opcode::TexM3x2Depth:
             case Opcode::TexM3x3:
-            case Opcode::TexDp3: e.m_tcRead |= uint8_t(1u << (op.stage & 7)); break;
-            default: break;
+            case Opcode::TexDp3:
+                e.m_tcRead |= uint8_t(1u << (op.stage & 7));
+                break;
+            default:
+                break;
         }
     }
     e.m_vRead = d.vUsed;

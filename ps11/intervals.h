@@ -58,7 +58,7 @@ struct StageRange {
 // The ranges of one evaluation (one tile). Default: everything unknown.
 struct IntervalInputs {
     std::array<StageRange, kMaxTextureStages> stages{};
-    std::array<ValueRange4, 2> color{};                   // v0, v1 as interpolated (before the [0, 1] load)
+    std::array<ValueRange4, 2> color{};                    // v0, v1 as interpolated (before the [0, 1] load)
     std::array<ValueRange4, kMaxTexCoordSets> texcoord{};  // TC[0..7]: u v w q
 };
 
@@ -76,7 +76,7 @@ struct ChannelInterval {
 
 // Whether texkill discards pixels.
 enum class KillRange : uint8_t {
-    Never,   // no pixel (also: no texkill)
+    Never,  // no pixel (also: no texkill)
     Maybe,
     Always,  // every pixel
 };

@@ -18,10 +18,10 @@ using exec::SrcKind;
 
 // One fetched source channel (selector, then modifier).
 struct SV {
-    KI k;              // fx: the exact value is k/(2G)
-    FI f;              // float: the value
-    int var = -1;      // the register channel read (slot·4 + component); -1 for a constant
-    int8_t tap = -1;   // copy tag, kept only without a modifier
+    KI k;             // fx: the exact value is k/(2G)
+    FI f;             // float: the value
+    int var = -1;     // the register channel read (slot·4 + component); -1 for a constant
+    int8_t tap = -1;  // copy tag, kept only without a modifier
     uint8_t ch = 0;
     int32_t nlo = 0, nhi = 0;  // fx: the register's grid range (for the identities' clamp checks)
     SrcMod mod = SrcMod::None;
@@ -35,17 +35,28 @@ bool sameValue(const SV& a, const SV& b) {
 
 // A float modifier over a range: the formulas are monotone, so they apply to the bounds.
 FI modFloat(SrcMod m, const FI& x) {
-    auto up = [&](bool nz) { return norm({exec::applySourceModifier(m, x.lo), exec::applySourceModifier(m, x.hi), x.nan, nz}); };
+    auto up = [&](bool nz) {
+        return norm({exec::applySourceModifier(m, x.lo), exec::applySourceModifier(m, x.hi), x.nan, nz});
+    };
     switch (m) {
-        case SrcMod::Neg: return fNeg(x);
-        case SrcMod::Bias: return up(false);  // x − 0.5 is 0 only as +0.0
-        case SrcMod::BiasNeg: return fNeg(modFloat(SrcMod::Bias, x));
-        case SrcMod::Sign: return up(false);
-        case SrcMod::SignNeg: return fNeg(modFloat(SrcMod::Sign, x));
-        case SrcMod::Comp: return norm({1.0f - x.hi, 1.0f - x.lo, x.nan, false});
-        case SrcMod::X2: return up(x.nz);
-        case SrcMod::X2Neg: return fNeg(modFloat(SrcMod::X2, x));
-        default: return x;
+        case SrcMod::Neg:
+            return fNeg(x);
+        case SrcMod::Bias:
+            return up(false);  // x − 0.5 is 0 only as +0.0
+        case SrcMod::BiasNeg:
+            return fNeg(modFloat(SrcMod::Bias, x));
+        case SrcMod::Sign:
+            return up(false);
+        case SrcMod::SignNeg:
+            return fNeg(modFloat(SrcMod::Sign, x));
+        case SrcMod::Comp:
+            return norm({1.0f - x.hi, 1.0f - x.lo, x.nan, false});
+        case SrcMod::X2:
+            return up(x.nz);
+        case SrcMod::X2Neg:
+            return fNeg(modFloat(SrcMod::X2, x));
+        default:
+            return x;
     }
 }
 
@@ -54,9 +65,8 @@ template <bool Fx>
 SV fetch(const Profile& p, const Regs& regs, const DSrc& src, int c) {
     SV s;
     const int comp = src.sw[size_t(c)];
-    constexpr bool fx = Fx;
     if (src.kind == SrcKind::Const) {
-        if constexpr (fx) {
+        if constexpr (Fx) {
             const exec::SourceAffine af = exec::sourceAffine(src.mod, p.g);
             const int32_t n = p.constGrid[src.slot][size_t(comp)];
             s.k = kPoint(int64_t(af.a) * n + af.b);
@@ -67,7 +77,7 @@ SV fetch(const Profile& p, const Regs& regs, const DSrc& src, int c) {
         return s;
     }
     const AV& r = regs.reg[src.slot][comp];
-    if constexpr (fx) {
+    if constexpr (Fx) {
         const exec::SourceAffine af = exec::sourceAffine(src.mod, p.g);
         const int64_t a = int64_t(af.a) * r.nlo + af.b, b = int64_t(af.a) * r.nhi + af.b;
         s.k = {std::min(a, b), std::max(a, b)};
@@ -117,7 +127,7 @@ void fxWrite(const Profile& p, const DOp& op, KI num, int64_t d0, AV& out) {
 void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
     const int64_t G = p.g, kOne = 2 * G, kLin = 2, kProd = 4 * G;
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
-        // One sum of independent products, written to every enabled channel.
+        // One sum of products (each bounded at its corners), written to every enabled channel.
         KI sum{0, 0};
         for (int c = 0; c < (op.op == Opcode::Dp3 ? 3 : 4); ++c)
             sum = kAdd(sum, kMul(fetch<true>(p, regs, op.src[0], c).k, fetch<true>(p, regs, op.src[1], c).k));
@@ -297,7 +307,9 @@ FI lrpRefine(const SV* s, FI steps) {
 void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4]) {
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
         // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a), as the executor evaluates it.
-        auto term = [&](int c) { return fMul(fetch<false>(p, regs, op.src[0], c).f, fetch<false>(p, regs, op.src[1], c).f); };
+        auto term = [&](int c) {
+            return fMul(fetch<false>(p, regs, op.src[0], c).f, fetch<false>(p, regs, op.src[1], c).f);
+        };
         FI sum = fAdd(fAdd(term(0), term(1)), term(2));
         if (op.op == Opcode::Dp4) sum = fAdd(sum, term(3));
         AV r;
@@ -313,9 +325,9 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
         for (int c = 0; c < 2; ++c) {
             if (!((op.mask >> c) & 1)) continue;
             const float mr = c == 0 ? ss.bumpMat[0] : ss.bumpMat[1], mg = c == 0 ? ss.bumpMat[2] : ss.bumpMat[3];
-            const FI v = stagesKnown
-                             ? fAdd(fetch<false>(p, regs, op.src[0], c).f, fAdd(fMul(fPoint(mr), br), fMul(fPoint(mg), bg)))
-                             : fTop();
+            const FI v = stagesKnown ? fAdd(fetch<false>(p, regs, op.src[0], c).f,
+                                            fAdd(fMul(fPoint(mr), br), fMul(fPoint(mg), bg)))
+                                     : fTop();
             out[c] = AV{};
             out[c].f = floatWrite(p, op, v);
         }

@@ -81,9 +81,12 @@ struct Rng {
         if (kind == 0) return ValueRange::any();
         auto val = [&] {
             switch (uni(0, 3)) {
-                case 0: return double(uni(int(a * 255), int(b * 255))) / 255.0;
-                case 1: return double(uni(int(a * 4), int(b * 4))) / 4.0;
-                default: return real(a, b);
+                case 0:
+                    return double(uni(int(a * 255), int(b * 255))) / 255.0;
+                case 1:
+                    return double(uni(int(a * 4), int(b * 4))) / 4.0;
+                default:
+                    return real(a, b);
             }
         };
         if (kind <= 3) {
@@ -108,18 +111,25 @@ struct Rng {
         if (r.nan && coin(0.08)) return NAN;
         if (!std::isfinite(r.lo) || !std::isfinite(r.hi)) {
             switch (uni(0, 7)) {
-                case 0: return coin(0.5) ? INFINITY : -INFINITY;
-                case 1: return float(real(-1e30, 1e30));
-                case 2: return -0.0f;
-                case 3: return float(uni(-600, 600)) / 255.0f;
-                default: return float(real(-3, 3));
+                case 0:
+                    return coin(0.5) ? INFINITY : -INFINITY;
+                case 1:
+                    return float(real(-1e30, 1e30));
+                case 2:
+                    return -0.0f;
+                case 3:
+                    return float(uni(-600, 600)) / 255.0f;
+                default:
+                    return float(real(-3, 3));
             }
         }
         const float lo = ceilF(r.lo), hi = floorF(r.hi);
         if (lo > hi) return float(r.lo);
         switch (uni(0, 7)) {
-            case 0: return lo;
-            case 1: return hi;
+            case 0:
+                return lo;
+            case 1:
+                return hi;
             case 2:
                 if (lo <= 0 && hi >= 0) return r.negZero && coin(0.5) ? -0.0f : 0.0f;
                 return lo;
@@ -129,7 +139,8 @@ struct Rng {
                 if (k <= m) return float((k + double(uni(0, int(std::min(m - k, 1e6))))) / g);
                 return hi;
             }
-            default: return std::clamp(float(real(lo, hi)), lo, hi);
+            default:
+                return std::clamp(float(real(lo, hi)), lo, hi);
         }
     }
     // A grid integer inside the range (fx samplers hand back n, value n/G); unknown: anything
@@ -221,13 +232,15 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
     IntervalSetup setup;
     setup.options.precision = prec;
     if (rng.coin(0.3)) setup.options.coissuedCnd = CoissuedCnd::Sequential;  // geforce7's co-issued cnd
-    if (rng.coin(0.15)) setup.options.maxValue = minor == 4 ? std::array<float, 3>{1, 2, 4}[size_t(rng.uni(0, 2))] : 2.0f;
+    if (rng.coin(0.15))
+        setup.options.maxValue = minor == 4 ? std::array<float, 3>{1, 2, 4}[size_t(rng.uni(0, 2))] : 2.0f;
     if (!isFixedPoint(prec) && rng.coin(0.15)) setup.options.maxValue = 65504;  // the D3D9-class cards
     for (auto& c : setup.constants)
         for (float& f : c) {
             const int k = rng.uni(0, 9);
-            f = k < 4 ? std::array<float, 4>{0.0f, 1.0f, -1.0f, 0.5f}[size_t(k)]
-                      : k == 4 ? -0.0f : float(rng.real(-1.2, 1.2));
+            f = k < 4    ? std::array<float, 4>{0.0f, 1.0f, -1.0f, 0.5f}[size_t(k)]
+                : k == 4 ? -0.0f
+                         : float(rng.real(-1.2, 1.2));
         }
     for (auto& c : setup.constants)  // whole registers of 0 or 1: the identities' other operand
         if (rng.coin(0.25)) c.fill(rng.coin(0.5) ? 0.0f : 1.0f);
@@ -315,8 +328,10 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
                     ok = n >= ci.gridLo && n <= ci.gridHi && (!ci.constant || n == ci.gridLo);
                     if (copyCall >= 0) ok = ok && n == sampler.calls[size_t(copyCall)].grid[size_t(c)][size_t(l)];
                 } else {
-                    if (v == v) ok = double(v) >= ci.lo && double(v) <= ci.hi;
-                    else ok = !ci.bounded;
+                    if (v == v)
+                        ok = double(v) >= ci.lo && double(v) <= ci.hi;
+                    else
+                        ok = !ci.bounded;
                     if (isNegZero(v)) ok = ok && ci.negZero;
                     if (ci.constant) ok = ok && bitsOf(v) == bitsOf(float(ci.lo));
                     if (copyCall >= 0)
@@ -324,24 +339,27 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
                 }
                 ++tally.outputs;
                 if (!ok) {
-                    FAIL_CHECK(precisionName(prec) << " r0." << "rgba"[c] << " lane " << l << ": executor "
-                                                   << (fx ? double(n) : double(v)) << (isNegZero(v) ? " (-0)" : "")
-                                                   << ", interval [" << (fx ? ci.gridLo : ci.lo) << ", "
-                                                   << (fx ? ci.gridHi : ci.hi) << "] bounded " << ci.bounded
-                                                   << " negZero " << ci.negZero << " constant " << ci.constant
-                                                   << " copy of stage " << res.copyStage << "\n"
-                                                   << text << "\n"
-                                                   << inputsText(in));
+                    FAIL_CHECK(precisionName(prec)
+                               << " r0."
+                               << "rgba"[c] << " lane " << l << ": executor " << (fx ? double(n) : double(v))
+                               << (isNegZero(v) ? " (-0)" : "") << ", interval [" << (fx ? ci.gridLo : ci.lo) << ", "
+                               << (fx ? ci.gridHi : ci.hi) << "] bounded " << ci.bounded << " negZero " << ci.negZero
+                               << " constant " << ci.constant << " copy of stage " << res.copyStage << "\n"
+                               << text << "\n"
+                               << inputsText(in));
                     return;
                 }
             }
             if ((res.kill == KillRange::Never && killed[l]) || (res.kill == KillRange::Always && !killed[l])) {
-                FAIL_CHECK("texkill claim " << int(res.kill) << " wrong at lane " << l << "\n" << text << "\n" << inputsText(in));
+                FAIL_CHECK("texkill claim " << int(res.kill) << " wrong at lane " << l << "\n"
+                                            << text << "\n"
+                                            << inputsText(in));
                 return;
             }
             if (res.writesDepth) {
                 const float d = depth[l];
-                if (!(d >= res.depth.lo && d <= res.depth.hi) || (res.depth.constant && bitsOf(d) != bitsOf(float(res.depth.lo)))) {
+                if (!(d >= res.depth.lo && d <= res.depth.hi) ||
+                    (res.depth.constant && bitsOf(d) != bitsOf(float(res.depth.lo)))) {
                     FAIL_CHECK("depth " << d << " outside [" << res.depth.lo << ", " << res.depth.hi << "]\n" << text);
                     return;
                 }
@@ -384,7 +402,8 @@ const char* kTemplates[] = {
     "ps_1_1\ntex t0\ntex t1\nmov r0, t1\ncnd r0, r0.a, t0, t1\n",
     "ps_1_2\ntex t0\ntex t1\ncmp r0, t1, t0, c0\n",
     "ps_1_1\ntex t0\nsub_sat r0, t0, c0\nmul_x4 r0, r0, c1\n",
-    "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+    "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, "
+    "r0\n",
     "ps_1_1\ntex t0\ntex t1\nadd r0.rgb, t0, t1\n+mov r0.a, t0.a\n",
     "ps_1_4\ntexld r0, t0\ntexld r1, t1\nadd r0, r0, r1\n",
     "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r1, c0, r0\n",
@@ -398,7 +417,8 @@ const char* kTemplates[] = {
     "ps_1_4\ntexld r1, t1\nbem_d2_sat r0.rg, r1, c2\nphase\ntexld r2, t2\nadd r0.ba, r2, c1\n",
     "ps_1_1\ntex t0\ntexbeml t1, t0\nmov r0, t1\n",
     "ps_1_4\ntexcrd r0.rgb, t0_dw.xyw\nmov r0.a, r0.r\n",
-    "ps_1_4\ntexld r0, t0_dw.xyw\ntexcrd r1.rgb, t1.xyw\nphase\ntexld r2, r1_dz\nmad r0.rgb, r2, c0, r0\n+mov r0.a, r2.b\n",
+    "ps_1_4\ntexld r0, t0_dw.xyw\ntexcrd r1.rgb, t1.xyw\nphase\ntexld r2, r1_dz\nmad r0.rgb, r2, c0, r0\n+mov r0.a, "
+    "r2.b\n",
     "ps_1_3\ntex t0\ntexm3x2pad t1, t0\ntexm3x2depth t2, t0\nmov r0, t0\n",
 };
 
@@ -433,8 +453,8 @@ TEST_CASE("intervals: every executor output lies in the evaluated bounds (random
             for (Precision prec : kProfiles) checkProgram(prog, text, prec, rng, tally);
         }
     INFO("programs " << tally.programs << ", evaluations " << tally.evaluations << ", outputs " << tally.outputs
-                     << ", constant colours " << tally.constants << ", copies " << tally.copies
-                     << ", bounded channels " << tally.bounded << ", never kill " << tally.neverKill);
+                     << ", constant colours " << tally.constants << ", copies " << tally.copies << ", bounded channels "
+                     << tally.bounded << ", never kill " << tally.neverKill);
     CHECK(tally.programs > 2000);
     CHECK(tally.constants > 100);
     CHECK(tally.copies > 100);
@@ -470,7 +490,8 @@ StageRange unormTile(double lo, double hi) {
 void requireConstant(const IntervalResult& r, std::array<double, 4> want, Precision prec) {
     INFO(precisionName(prec));
     for (int c = 0; c < 4; ++c) {
-        INFO("r0." << "rgba"[c] << " [" << r.color[size_t(c)].lo << ", " << r.color[size_t(c)].hi << "]");
+        INFO("r0."
+             << "rgba"[c] << " [" << r.color[size_t(c)].lo << ", " << r.color[size_t(c)].hi << "]");
         CHECK(r.color[size_t(c)].constant);
         CHECK(r.color[size_t(c)].lo == Approx(want[size_t(c)]).margin(1e-6));
     }
@@ -509,7 +530,8 @@ TEST_CASE("intervals: a bright pass over a tile below its threshold is the const
     }
 }
 
-TEST_CASE("intervals: the adaptive bright pass is constant over dark tiles, whatever the adapted amount", "[intervals]") {
+TEST_CASE("intervals: the adaptive bright pass is constant over dark tiles, whatever the adapted amount",
+          "[intervals]") {
     // adaptive_bright.psh: c0 = (t, t, t, 0) with t = 0.4, c1 = (w, w, w, 1) with w = 1.
     Consts k{};
     k[0] = {0.4f, 0.4f, 0.4f, 0};
@@ -577,7 +599,8 @@ TEST_CASE("intervals: products and blurs of constant tiles are constants", "[int
     k[0] = {0.5f, 0.25f, 1.0f, 0.75f};
     for (Precision prec : kProfiles) {
         IntervalInputs in;
-        in.stages[0].value = {ValueRange::point(0.2), ValueRange::point(0.4), ValueRange::point(0.6), ValueRange::point(1)};
+        in.stages[0].value = {ValueRange::point(0.2), ValueRange::point(0.4), ValueRange::point(0.6),
+                              ValueRange::point(1)};
         const IntervalResult r = evaluateOnce("ps_1_1\ntex t0\nmul r0, t0, c0\n", prec, k, in);
         INFO(precisionName(prec));
         CHECK(r.constantColor());
@@ -662,7 +685,9 @@ TEST_CASE("intervals: identities that keep a copy, conditions decided by their r
         CHECK(evaluateOnce("ps_1_1\ntex t0\nmov r0, t0.a\n", prec, k, in).copyStage == -1);
         // ps_1_4: texld of a coordinate set is a plain lookup; of a register, a dependent one.
         CHECK(evaluateOnce("ps_1_4\ntexld r0, t0\n", prec, k, in).copyStage == 0);
-        CHECK(evaluateOnce("ps_1_4\ntexld r1, t1\nadd r0, r1, c1\nphase\ntexld r0, t0\n", prec, k, in).copyInstruction == 3);
+        CHECK(
+            evaluateOnce("ps_1_4\ntexld r1, t1\nadd r0, r1, c1\nphase\ntexld r0, t0\n", prec, k, in).copyInstruction ==
+            3);
     }
 }
 
