@@ -65,6 +65,45 @@ struct DOp {
     uint8_t rowBase = 0;
 };
 
+// A source modifier of an fx profile as k = a·n + b: the source's exact value is k/(2G) for the
+// register's grid integer n (docs/precision.md, "One arithmetic instruction in an fx profile"; bias
+// and _bx2 give half-grid values, hence the denominator 2G). The one statement of that table: the
+// generic fx stage, the fx8 fast path and the interval evaluator (ps11/intervals.h) read it.
+// _dz/_dw (texture coordinates, never an arithmetic source) give the plain {2, 0}.
+struct SourceAffine {
+    int32_t a, b;
+};
+constexpr SourceAffine sourceAffine(SrcMod m, int32_t g) {
+    switch (m) {
+        case SrcMod::Neg: return {-2, 0};
+        case SrcMod::Bias: return {2, -g};
+        case SrcMod::BiasNeg: return {-2, g};
+        case SrcMod::Sign: return {4, -2 * g};
+        case SrcMod::SignNeg: return {-4, 2 * g};
+        case SrcMod::Comp: return {-2, 2 * g};
+        case SrcMod::X2: return {4, 0};
+        case SrcMod::X2Neg: return {-4, 0};
+        default: return {2, 0};
+    }
+}
+
+// A source modifier of the float profiles on one value, the formulas of docs/precision.md
+// ("float and ideal") as written, signed zeros included: the float stage's constants and the
+// interval evaluator's bounds. (2x is exact, so no contraction can change 2x − 1.)
+constexpr float applySourceModifier(SrcMod m, float x) {
+    switch (m) {
+        case SrcMod::Neg: return -x;
+        case SrcMod::Bias: return x - 0.5f;
+        case SrcMod::BiasNeg: return -(x - 0.5f);
+        case SrcMod::Sign: return 2.0f * x - 1.0f;
+        case SrcMod::SignNeg: return -(2.0f * x - 1.0f);
+        case SrcMod::Comp: return 1.0f - x;
+        case SrcMod::X2: return 2.0f * x;
+        case SrcMod::X2Neg: return -(2.0f * x);
+        default: return x;
+    }
+}
+
 // What the kernels need from the executor (read-only during run()).
 struct Profile {
     Precision precision = Precision::Fx8;

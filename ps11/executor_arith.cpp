@@ -11,32 +11,12 @@
 namespace ps11::exec {
 namespace {
 
-// Source modifier as k = a·n + b (k/(2G) is the exact value, docs/precision.md table) and,
-// for float, x' = a·x + b, which rounds exactly like the written formulas (negation is exact).
-struct Affine {
-    int32_t a, b;
-};
-Affine modAffine(SrcMod m, int32_t g) {
-    switch (m) {
-        case SrcMod::None: return {2, 0};
-        case SrcMod::Neg: return {-2, 0};
-        case SrcMod::Bias: return {2, -g};
-        case SrcMod::BiasNeg: return {-2, g};
-        case SrcMod::Sign: return {4, -2 * g};
-        case SrcMod::SignNeg: return {-4, 2 * g};
-        case SrcMod::Comp: return {-2, 2 * g};
-        case SrcMod::X2: return {4, 0};
-        case SrcMod::X2Neg: return {-4, 0};
-        default: return {2, 0};  // _dz/_dw are rejected by create() on arithmetic instructions
-    }
-}
-
 void fetchFx(const Profile& p, const DOp& op, RunState& st) {
     const int n = st.n;
     for (int s = 0; s < op.numSrc; ++s) {
         const uint8_t fm = fetchMask(op, s);
         const DSrc& src = op.src[size_t(s)];
-        const Affine af = modAffine(src.mod, p.g);
+        const SourceAffine af = sourceAffine(src.mod, p.g);
         for (int c = 0; c < 4; ++c) {
             if (!((fm >> c) & 1)) continue;
             int32_t* k = st.k[s][c];

@@ -12,39 +12,13 @@
 namespace ps11::exec {
 namespace {
 
-// Source modifier as k = a·n + b for G = 255 (docs/precision.md table; as executor_arith.cpp).
+// Source modifier as k = a·n + b for G = 255 (sourceAffine, ps11/decoded_program.h); _dz/_dw have
+// no arithmetic meaning and keep a program off the fast path.
 bool fastAffine(SrcMod m, int16_t& a, int16_t& b) {
-    switch (m) {
-        case SrcMod::None:
-            a = 2, b = 0;
-            return true;
-        case SrcMod::Neg:
-            a = -2, b = 0;
-            return true;
-        case SrcMod::Bias:
-            a = 2, b = -255;
-            return true;
-        case SrcMod::BiasNeg:
-            a = -2, b = 255;
-            return true;
-        case SrcMod::Sign:
-            a = 4, b = -510;
-            return true;
-        case SrcMod::SignNeg:
-            a = -4, b = 510;
-            return true;
-        case SrcMod::Comp:
-            a = -2, b = 510;
-            return true;
-        case SrcMod::X2:
-            a = 4, b = 0;
-            return true;
-        case SrcMod::X2Neg:
-            a = -4, b = 0;
-            return true;
-        default:
-            return false;
-    }
+    if (m == SrcMod::Dz || m == SrcMod::Dw) return false;
+    const SourceAffine af = sourceAffine(m, 255);
+    a = int16_t(af.a), b = int16_t(af.b);
+    return true;
 }
 
 bool fastKind(Opcode op, FastKind& k) {
