@@ -42,10 +42,11 @@ int threads() {
 
 // Runners run every pass every frame (RunnerOptions::skip off) unless `skip`: the speed
 // comparison is of whole frames; the still-frame counters measure what reuse saves.
-std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip = false) {
+std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip = false, uint32_t w = kW,
+                                          uint32_t h = kH) {
     glare::RunnerOptions ro;
-    ro.width = kW;
-    ro.height = kH;
+    ro.width = w;
+    ro.height = h;
     ro.skip = skip;
     ro.device.software.threads = threads();
     if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
@@ -151,12 +152,17 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     std::vector<double> stillMs[2];
     // Skipping's measuring scenes (docs/glare/scenes.md): `sparse` and `dense`, moving, with
     // reuse on, on the emulator (fx8) and GL native; each draws the scene's next frame before
-    // the timed frame (not timed).
+    // the timed frame (not timed). The sprites technique draws a sprite per bright pixel (about
+    // 20 000 on sparse at 1080p, 2 million on dense: over a minute a frame), so it runs them at
+    // 480x270.
+    const bool quarterSize = name == "sprites";
+    const uint32_t panelW = quarterSize ? kW / 4 : kW, panelH = quarterSize ? kH / 4 : kH;
+    state.counters["panel_width"] = panelW;
     std::unique_ptr<glare::Runner> panel[2][2];  // [sparse, dense][emu fx8, GL native]
     std::unique_ptr<glare::Scene> panelScene[2][2];
     for (int d = 0; d < 2; ++d)
         for (int k = 0; k < 2; ++k)
-            if (!(panel[d][k] = makeRunner(movingMode[k], err, true)) ||
+            if (!(panel[d][k] = makeRunner(movingMode[k], err, true, panelW, panelH)) ||
                 !(panelScene[d][k] = glare::makeScene(d ? "dense" : "sparse", err))) {
                 state.SkipWithError(err.c_str());
                 return;
