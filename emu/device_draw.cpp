@@ -5,6 +5,7 @@
 // textures, stage states, the output merger's states and clip rect, and vertex processing
 // (emu/vertex.h) pulled by the renderer. docs/device.md "Drawing".
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -144,6 +145,63 @@ struct DrawSetup {
     VertexSetup vertexSetup;  // vertices
     DrawCall call;            // what goes to the renderer
 };
+
+namespace {
+
+// Whether a checked draw certainly writes every pixel of its one-level target, whatever the
+// target held (a fingerprint then counts the target's contents as determined): two pretransformed
+// triangles that tile an axis-aligned rectangle holding every pixel centre of the viewport, the
+// viewport the whole target, neither culled nor clipped (z in [0, 1]); no blending, alpha test,
+// depth test, scissor narrower than the target, partial colour write mask, or texkill.
+bool writesWholeTarget(const DrawSetup& d, const DeviceState& st, const ps11::Program* program) {
+    if (!d.layout || !d.layout->pretransformed || d.primitiveCount != 2 || !d.rt || d.rt->levels.size() != 1) return false;
+    const Image& im = *d.target;
+    const D3DVIEWPORT9& vp = st.viewport;
+    if (vp.X != 0 || vp.Y != 0 || vp.Width != im.width || vp.Height != im.height) return false;
+    if (st.renderState(D3DRS_ALPHABLENDENABLE) || st.renderState(D3DRS_ALPHATESTENABLE) ||
+        (st.renderState(D3DRS_COLORWRITEENABLE) & 0xF) != 0xF || (d.ds && st.renderState(D3DRS_ZENABLE)))
+        return false;
+    if (st.renderState(D3DRS_SCISSORTESTENABLE)) {
+        const RECT& r = st.scissor;
+        if (r.left > 0 || r.top > 0 || r.right < LONG(im.width) || r.bottom < LONG(im.height)) return false;
+    }
+    if (program)
+        for (const ps11::Instruction& in : program->instructions)
+            if (in.opcode() == ps11::Opcode::TexKill) return false;
+    // The triangles' vertices, in the order the device assembles them (emu/vertex.cpp).
+    const size_t count = d.type == D3DPT_TRIANGLELIST ? 6 : 4;
+    float v[6][4];
+    for (size_t i = 0; i < count; ++i) std::memcpy(v[i], static_cast<const uint8_t*>(d.vertexData) + i * d.stride, 16);
+    const int order[3][6] = {{0, 1, 2, 3, 4, 5}, {0, 1, 2, 1, 3, 2}, {1, 2, 0, 2, 3, 0}};  // list, strip, fan
+    const int* o = order[d.type == D3DPT_TRIANGLELIST ? 0 : d.type == D3DPT_TRIANGLESTRIP ? 1 : 2];
+    float x0 = v[0][0], x1 = v[0][0], y0 = v[0][1], y1 = v[0][1];
+    for (size_t i = 0; i < count; ++i) {
+        if (!(v[i][2] >= 0.0f && v[i][2] <= 1.0f) || !(v[i][3] > 0.0f)) return false;
+        x0 = std::min(x0, v[i][0]), x1 = std::max(x1, v[i][0]), y0 = std::min(y0, v[i][1]), y1 = std::max(y1, v[i][1]);
+    }
+    // Every pixel centre (integers, 0 .. size − 1) strictly inside the rectangle.
+    if (!(x0 < 0.0f && y0 < 0.0f && x1 > float(im.width - 1) && y1 > float(im.height - 1))) return false;
+    const DWORD cull = st.renderState(D3DRS_CULLMODE);
+    int omitted[2];
+    for (int t = 0; t < 2; ++t) {
+        // Corners as bits: 1 = (x0, y0), 2 = (x1, y0), 4 = (x1, y1), 8 = (x0, y1).
+        int corners = 0;
+        double area2 = 0;
+        for (int k = 0; k < 3; ++k) {
+            const float* a = v[o[3 * t + k]];
+            const float* b = v[o[3 * t + (k + 1) % 3]];
+            if ((a[0] != x0 && a[0] != x1) || (a[1] != y0 && a[1] != y1)) return false;
+            corners |= a[0] == x0 ? (a[1] == y0 ? 1 : 8) : (a[1] == y0 ? 2 : 4);
+            area2 += double(a[0]) * double(b[1]) - double(b[0]) * double(a[1]);
+        }
+        if (std::popcount(unsigned(corners)) != 3 || culledByWinding(cull, area2)) return false;
+        omitted[t] = 15 & ~corners;
+    }
+    // The two halves of one diagonal: the corners they leave out are opposite.
+    return (omitted[0] | omitted[1]) == 5 || (omitted[0] | omitted[1]) == 10;
+}
+
+}  // namespace
 
 HRESULT Device::drawFail(const CallError& error) {
     return fail(error.hr, error.code.c_str(), "DrawPrimitiveUP: " + error.message);
@@ -446,7 +504,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         const bool depthTest = d.ds && m_state.renderStates[D3DRS_ZENABLE];
         if (depthTest) fingerprintRead(d.dsRef.owner);
         if (m_state.renderStates[D3DRS_ALPHABLENDENABLE]) fingerprintRead(d.rtRef.owner);
-        fingerprintWrite(d.rtRef.owner, false);
+        const ps11::Program* program = m_state.pixelShader != Handle::Null ? pixelShaderProgram(m_state.pixelShader) : nullptr;
+        fingerprintWrite(d.rtRef.owner, writesWholeTarget(d, m_state, program));
         if (depthTest && m_state.renderStates[D3DRS_ZWRITEENABLE]) fingerprintWrite(d.dsRef.owner, false);
         return D3D_OK;
     }

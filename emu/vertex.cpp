@@ -274,7 +274,7 @@ private:
             const ScreenVertex& b = m_screen[(i + 1) % n];
             area2 += a.x * b.y - b.x * a.y;
         }
-        if (!(area2 != 0) || (m_p.cull == D3DCULL_CW && area2 > 0) || (m_p.cull == D3DCULL_CCW && area2 < 0)) {
+        if (culledByWinding(m_p.cull, area2)) {
             ++m_stats.culled;
             return;
         }

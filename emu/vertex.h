@@ -40,6 +40,13 @@ struct VertexLayout {
 // Parses an FVF; nullopt and `error` (what is wrong, without a code) for one the device refuses.
 std::optional<VertexLayout> parseFvf(DWORD fvf, std::string& error);
 
+// Whether D3DRS_CULLMODE `cull` removes a screen-space polygon whose doubled signed area (the
+// sum of x_i·y_(i+1) − x_(i+1)·y_i; > 0: clockwise on the screen, y down) is `area2`. A
+// polygon of no area is always removed.
+inline bool culledByWinding(DWORD cull, double area2) {
+    return !(area2 != 0) || (cull == D3DCULL_CW && area2 > 0) || (cull == D3DCULL_CCW && area2 < 0);
+}
+
 // A vertex after processing, in screen space: x, y in pixels (pixel centres at integers), z in
 // [MinZ, MaxZ] after the viewport, rhw = 1/w (1 for a vertex given without perspective).
 struct ScreenVertex {

@@ -190,8 +190,55 @@ void PassMemo::clear(TexturePool& pool) {
     m_entries.clear();
 }
 
+size_t PassGraph::reuseGroupEnd(size_t first, bool single) const {
+    // The live passes after `first` that write a texture an earlier pass of the group wrote (a
+    // blur adding onto the previous pass's target) join it: skipping one of them alone would
+    // leave the texture as the last of them left it, not as the first one did.
+    size_t last = first;
+    if (single) return last;
+    std::vector<uint32_t> written;
+    for (TextureId id : m_passes[first].writes) written.push_back(id.index);
+    for (size_t k = first + 1; k < m_passes.size(); ++k) {
+        const PassNode& p = m_passes[k];
+        if (!p.live) continue;
+        bool joins = false;
+        for (TextureId id : p.writes) joins = joins || std::find(written.begin(), written.end(), id.index) != written.end();
+        if (!joins) break;
+        for (TextureId id : p.writes) written.push_back(id.index);
+        last = k;
+    }
+    return last;
+}
+
+emu::Device::Fingerprint PassGraph::dryRun(size_t first, size_t last, emu::Device& device,
+                                           const std::function<bool(const std::string&)>& putBack) {
+    // One fingerprint over the group's passes, each from the graph's initial state. A pass that
+    // writes CPU data (the next frame's graph holds new data objects) or has no execute step
+    // makes the group run.
+    bool ok = true;
+    device.beginFingerprint();
+    for (size_t k = first; k <= last && ok; ++k) {
+        PassNode& p = m_passes[k];
+        if (!p.live) continue;
+        for (TextureId id : p.writes) ok = ok && !m_textures[id.index].data;
+        if (!ok || !p.execute) {
+            ok = false;
+            break;
+        }
+        ok = putBack("pass " + p.info.name + ": putting back the device state");
+        PassStats dryStats;
+        std::string dryError;
+        PassContext dry{device, dryStats, dryError, *this, uint32_t(k), {}};
+        ok = ok && p.execute(dry) && dry.refusal.empty();
+    }
+    emu::Device::Fingerprint print = device.endFingerprint();
+    print.complete = print.complete && ok;
+    return print;
+}
+
 bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook,
-                    PassMemo* memo) {
+                    PassMemo* memo, bool hookObserves) {
+    if (memo && memo->m_entries.size() < m_passes.size()) memo->m_entries.resize(m_passes.size());
     if (!m_compiled) compile();
     if (!m_compileError.empty()) {
         error = m_compileError;
@@ -222,18 +269,31 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         if (!ok) error = first;
         return ok && restored;
     };
+    // With a memo every transient texture has its own device texture, kept between frames: all
+    // are bound before the first pass (a group's dry run reads its later passes' textures).
+    if (memo)
+        for (TextureNode& t : m_textures)
+            if (!t.imported && !t.data && t.firstUse >= 0) {
+                Handle& kept = memo->m_textures[{t.name, t.desc}];
+                if (kept == Handle::Null) kept = pool.acquire(t.desc, error);
+                if (kept == Handle::Null) {
+                    error = "texture " + t.name + ": " + error;
+                    return finish(false);
+                }
+                t.device = kept;
+                auto [it, inserted] = physicalOf.emplace(uint32_t(t.device), int(physicalOf.size()));
+                t.physical = it->second;
+            }
+    // Reuse decides for groups of passes (reuseGroup): [groupFirst, groupLast], all reused or none.
+    size_t groupFirst = 0, groupLast = 0;
+    bool groupReused = false;
+    double groupMs = 0;
     for (size_t i = 0; i < m_passes.size(); ++i) {
         PassNode& p = m_passes[i];
         if (!p.live) continue;
         for (TextureNode& t : m_textures)
-            if (!t.imported && !t.data && t.firstUse == int(i)) {
-                if (memo) {
-                    Handle& kept = memo->m_textures[{t.name, t.desc}];
-                    if (kept == Handle::Null) kept = pool.acquire(t.desc, error);
-                    t.device = kept;
-                } else {
-                    t.device = pool.acquire(t.desc, error);
-                }
+            if (!memo && !t.imported && !t.data && t.firstUse == int(i)) {
+                t.device = pool.acquire(t.desc, error);
                 if (t.device == Handle::Null) {
                     error = "pass " + p.info.name + ": texture " + t.name + ": " + error;
                     return finish(false);
@@ -246,30 +306,42 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
         PassStats s;
         s.pass = p.info.name;
         const auto start = std::chrono::steady_clock::now();
-        // Reuse: the pass's calls as a dry run, compared with last frame's.
-        emu::Device::Fingerprint print;
-        bool writesData = false;
-        for (TextureId id : p.writes) writesData = writesData || m_textures[id.index].data;
-        if (memo && p.execute && !writesData) {
-            if (memo->m_entries.size() < m_passes.size()) memo->m_entries.resize(m_passes.size());
+        // Reuse: at the first pass of a group, the group's calls as one dry run, compared with
+        // last frame's; the group's passes are then all reused or all run.
+        if (memo && (i == 0 || i > groupLast)) {
+            groupFirst = i;
+            groupLast = reuseGroupEnd(i, hook && !hookObserves);
+            groupReused = false;
+            emu::Device::Fingerprint print = dryRun(i, groupLast, device, putBack);
             PassMemo::Entry& e = memo->m_entries[i];
-            PassStats dryStats;
-            std::string dryError;
-            PassContext dry{device, dryStats, dryError, *this, uint32_t(i), {}};
-            device.beginFingerprint();
-            const bool dryOk = p.execute(dry) && dry.refusal.empty();
-            print = device.endFingerprint();
-            print.complete = print.complete && dryOk;
-            bool same = print.complete && e.valid && e.name == p.info.name && e.words == print.words;
+            std::string names;
+            for (size_t k = i; k <= groupLast; ++k)
+                if (m_passes[k].live) names += m_passes[k].info.name + "\n";
+            bool same = print.complete && e.valid && e.name == names && e.words == print.words;
             for (const auto& [handle, generation] : e.outputs)
                 same = same && device.contentGeneration(handle) == generation;
             if (!putBack("pass " + p.info.name + ": putting back the device state")) return finish(false);
-            if (same) {
-                s.reused = true;
-                s.milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-                stats.push_back(s);
-                continue;
+            groupReused = same;
+            size_t count = 0;
+            for (size_t k = i; k <= groupLast; ++k) count += m_passes[k].live;
+            groupMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count() /
+                      double(std::max<size_t>(count, 1));
+            if (!same) {
+                // The group runs: this dry run is next frame's reference, with the generations
+                // its outputs have once the group has run (read after its last pass).
+                e.name = names;
+                e.valid = print.complete;
+                e.words = std::move(print.words);
+                e.writes = std::move(print.writes);
+                e.outputs.clear();
             }
+        }
+        if (memo && groupReused) {
+            s.reused = true;
+            s.milliseconds = groupMs;  // the group's dry run, shared by its passes
+            stats.push_back(s);
+            if (hook && !hook(uint32_t(i), true, error)) return finish(false);
+            continue;
         }
         PassContext ctx{device, s, error, *this, uint32_t(i), {}};
         const emu::TransferStats before = device.transfers();
@@ -298,22 +370,19 @@ bool PassGraph::run(TexturePool& pool, std::vector<PassStats>& stats, std::strin
             return finish(false);
         }
         stats.push_back(s);
-        if (memo && i < memo->m_entries.size()) {
-            // What the pass wrote, at the generations it left: next frame's dry run is compared
-            // with this one only while they stand.
-            PassMemo::Entry& e = memo->m_entries[i];
-            e.name = p.info.name;
-            e.valid = print.complete;
-            e.words = std::move(print.words);
-            e.outputs.clear();
-            for (Handle h : print.writes) e.outputs.emplace_back(h, device.contentGeneration(h));
+        if (memo && i == groupLast) {
+            // The group has run: what it wrote, at the generations it left. Next frame's dry run
+            // is compared with this one only while they stand.
+            PassMemo::Entry& e = memo->m_entries[groupFirst];
+            for (Handle h : e.writes) e.outputs.emplace_back(h, device.contentGeneration(h));
         }
         if (hook && !hook(uint32_t(i), true, error)) return finish(false);
-        for (TextureNode& t : m_textures)
-            if (!t.imported && t.lastUse == int(i)) {
-                if (!memo) pool.release(t.device);
-                t.device = Handle::Null;
-            }
+        if (!memo)
+            for (TextureNode& t : m_textures)
+                if (!t.imported && t.lastUse == int(i)) {
+                    pool.release(t.device);
+                    t.device = Handle::Null;
+                }
     }
     return finish(true);
 }

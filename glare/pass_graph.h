@@ -107,10 +107,12 @@ public:
 
 private:
     friend class PassGraph;
+    // Per group of passes (PassGraph::run), at its first pass's index.
     struct Entry {
-        std::string name;
+        std::string name;  // the group's pass names
         bool valid = false;
         std::vector<uint32_t> words;
+        std::vector<emu::Handle> writes;
         std::vector<std::pair<emu::Handle, uint64_t>> outputs;
     };
     std::vector<Entry> m_entries;  // by pass index
@@ -208,14 +210,17 @@ public:
     // not. Before and after each pass `hook` (when set) is called with the pass index, to let a
     // comparison capture or replace textures. False with `error` set at the first failure.
     // `stats` gets one entry per live pass.
-    // With `memo`, a pass whose dry run (after the before-hook) gives last frame's fingerprint
-    // while its outputs still hold what it wrote is not run again (PassStats::reused), and
-    // transient textures keep their own device textures between frames (PassMemo). A hook that
-    // writes a texture changes its generation, so what reads it runs. A pass that hands device
-    // contents back (a read-back: its fingerprint is incomplete) or writes CPU data always runs.
+    // With `memo`, passes are reused in groups: a pass and the passes right after it that write
+    // a texture it (or one of them) wrote. A group whose dry run (one fingerprint over its
+    // passes, after the first one's before-hook) is last frame's while its outputs still hold
+    // what it wrote is not run again (PassStats::reused), and transient textures keep their own
+    // device textures between frames (PassMemo). A group that hands device contents back (a
+    // read-back: its fingerprint is incomplete) or writes CPU data always runs. A hook that may
+    // write textures (`hookObserves` false) keeps every group to one pass, so its dry run comes
+    // after the hook; a hook that only looks (progress, dumps) does not.
     using Hook = std::function<bool(uint32_t pass, bool after, std::string& error)>;
     bool run(TexturePool& pool, std::vector<PassStats>& stats, std::string& error, const Hook& hook = {},
-             PassMemo* memo = nullptr);
+             PassMemo* memo = nullptr, bool hookObserves = false);
 
     // ---- introspection (reports, tests, --graph) ----
     struct TextureNode {
@@ -245,6 +250,11 @@ public:
 private:
     friend class PassBuilder;
     friend struct PassContext;
+    // Reuse (run with a memo): the last pass of the group starting at `first` (itself when
+    // `single`), and one fingerprint over the group's passes.
+    size_t reuseGroupEnd(size_t first, bool single) const;
+    emu::Device::Fingerprint dryRun(size_t first, size_t last, emu::Device& device,
+                                    const std::function<bool(const std::string&)>& putBack);
     // True when `texture` is a texture of this graph; else records the setup error (PassBuilder).
     bool declarable(uint32_t pass, TextureId texture);
     std::vector<PassNode> m_passes;

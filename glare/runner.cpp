@@ -107,7 +107,7 @@ void Runner::buildFrame(const Technique& technique, const Settings& settings, in
 
 bool Runner::runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
                       FrameResult& result, std::string& error, const PassGraph::Hook& hook,
-                      const std::function<void(PassGraph&)>& built) {
+                      const std::function<void(PassGraph&)>& built, bool hookObserves) {
     PassGraph graph;
     buildFrame(technique, settings, frame, frameCount, graph);
     if (!m_persistentError.empty()) {
@@ -116,7 +116,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     }
     if (built) built(graph);
     result.passes.clear();
-    const bool ok = graph.run(*m_pool, result.passes, error, hook, m_options.skip ? &m_memo : nullptr);
+    const bool ok = graph.run(*m_pool, result.passes, error, hook, m_options.skip ? &m_memo : nullptr, hookObserves);
     // The passes' own time: what the hooks (dumps, captures) take is not the technique's.
     result.milliseconds = 0;
     for (const PassStats& s : result.passes) result.milliseconds += s.milliseconds;

@@ -63,10 +63,11 @@ public:
     bool renderScene(Scene& scene, int frame, int frameCount, double& milliseconds, std::string& error);
 
     // Builds the technique's graph for a frame (`build` called before compile, for inspection),
-    // and runs it; the output stays in outputTexture().
+    // and runs it; the output stays in outputTexture(). `hookObserves`: the hook only looks
+    // (progress, dumps), never writes a texture (PassGraph::run).
     bool runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, FrameResult& result,
                   std::string& error, const PassGraph::Hook& hook = {},
-                  const std::function<void(PassGraph&)>& built = {});
+                  const std::function<void(PassGraph&)>& built = {}, bool hookObserves = false);
     // Builds (and compiles) without running: for reports and --graph.
     void buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
 

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <tuple>
 #include <vector>
 
 #include "emu/device.h"
@@ -160,4 +161,61 @@ TEST_CASE("generations: a small resource written with the bytes it holds keeps i
     REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xff102031u, 1, 0) == D3D_OK);  // one byte differs
     CHECK(dev.contentGeneration(tiny) > tinyGen);
     CHECK(dev.contentGeneration(Handle{999999}) == 0);
+}
+
+TEST_CASE("fingerprint: a draw certainly covering its whole target determines it", "[device][fingerprint]") {
+    Device dev;
+    const Scene s = makeScene(dev);
+    Handle killer{};
+    REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ntex t0\ntexkill t1\nmov r0, t0\n", &killer) == D3D_OK);
+    // A full-screen quad without blending, then an additive one onto what it left.
+    auto twoDraws = [&](Handle shader, DWORD colorWrite, bool halfSize) {
+        REQUIRE(dev.SetRenderTarget(0, s.targetSurface) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(shader) == D3D_OK);
+        REQUIRE(dev.SetTexture(0, s.source) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_COLORWRITEENABLE, colorWrite) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 0) == D3D_OK);
+        if (halfSize) {
+            D3DVIEWPORT9 vp{0, 0, 4, 8, 0, 1};
+            REQUIRE(dev.SetViewport(&vp) == D3D_OK);
+        }
+        REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_COLORWRITEENABLE, 0xF) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+        REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+    };
+    auto words = [&](Handle shader, DWORD colorWrite, bool halfSize) {
+        const DeviceState saved = dev.state();
+        dev.beginFingerprint();
+        twoDraws(shader, colorWrite, halfSize);
+        Device::Fingerprint f = dev.endFingerprint();
+        REQUIRE(f.complete);
+        REQUIRE(dev.applyState(saved) == D3D_OK);
+        return f.words;
+    };
+    auto changeTarget = [&] {
+        REQUIRE(dev.SetRenderTarget(0, s.targetSurface) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xff000000u + uint32_t(dev.contentGeneration(s.target)), 1, 0) ==
+                D3D_OK);
+    };
+    const auto whole = words(s.shader, 0xF, false);
+    changeTarget();
+    CHECK(words(s.shader, 0xF, false) == whole);  // the blend reads what the first draw wrote
+    for (auto [shader, mask, half] : {std::tuple{killer, DWORD(0xF), false}, std::tuple{s.shader, DWORD(0x7), false},
+                                      std::tuple{s.shader, DWORD(0xF), true}}) {
+        // texkill, a partial write mask, half the target: the target's old contents show through.
+        const auto a = words(shader, mask, half);
+        changeTarget();
+        CHECK(words(shader, mask, half) != a);
+    }
+    // And what the fingerprint claims holds: the two draws give the same bytes whatever was there.
+    const DeviceState saved = dev.state();
+    twoDraws(s.shader, 0xF, false);
+    const std::vector<uint8_t> first = pixels(dev, s.target);
+    REQUIRE(dev.applyState(saved) == D3D_OK);
+    changeTarget();
+    twoDraws(s.shader, 0xF, false);
+    CHECK(pixels(dev, s.target) == first);
 }

@@ -366,7 +366,7 @@ int runGlare(const GlareOptions& o) {
             ok = main->runFrame(
                 *technique, *settings, f, o.frames, result, err,
                 [&](uint32_t pass, bool after, std::string& e) { return hook(*built, pass, after, e); },
-                [&](glare::PassGraph& g) { built = &g; });
+                [&](glare::PassGraph& g) { built = &g; }, true);  // progress and dumps only look
         }
         if (!ok) {
             std::cerr << "ps11 glare: " << err << "\n";
