@@ -338,6 +338,14 @@ expect_rc 0 "glare on a scene" "$ps11" glare --technique adaptive --scene box --
 expect_in "$work/out" "bright_pass" "glare prints its passes"
 expect_rc 0 "glare on an image, dumped" "$ps11" glare --technique quarter --in "$work/tex.png" --dump-passes "$work/dump" -o "$work/q.png"
 [ -s "$work/dump/contact_sheet.png" ] && [ -s "$work/dump/00_downsample-quarter.png" ] || fail "glare --dump-passes wrote no pass images"
+expect_rc 0 "glare on a held image, reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 3 -o "$work/r.png"
+expect_in "$work/out" "  reused" "glare reuses passes of a still image"
+cp "$work/r_0002.png" "$work/r_reused.png"
+expect_rc 0 "glare --no-skip" "$ps11" glare --technique glow --in "$work/tex.png" --frames 3 --no-skip -o "$work/r.png"
+if grep -q "  reused$" "$work/out"; then fail "glare --no-skip reused a pass"; fi
+cmp -s "$work/r_0002.png" "$work/r_reused.png" || fail "glare: the reused frame differs from the --no-skip one"
+expect_rc 0 "glare --json says reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 2 --json -o "$work/r.png"
+expect_in "$work/out" '"reused": true' "glare --json reused"
 expect_rc 0 "glare --graph without -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p.dot"
 expect_in "$work/p.dot" 'digraph "pyramid"' "glare --graph writes Graphviz"
 expect_rc 0 "glare --json" "$ps11" glare --technique glow --scene neon --size 64x36 --set path=ffp -o "$work/f.png" --json
