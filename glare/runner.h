@@ -94,6 +94,15 @@ public:
     // Persistent textures (FrameBuild::persistent).
     emu::Handle persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial, std::string& error);
     void resetPersistent();  // the next frame starts from the initial state (a new sequence)
+    // An object of type T a technique keeps on this runner between frames under `name` (made on
+    // first use): results of device-side steps that a still input lets it keep (reuse).
+    template <typename T>
+    T& kept(const std::string& name) {
+        std::shared_ptr<void>& slot = m_kept[name];
+        if (!slot) slot = std::make_shared<T>();
+        return *static_cast<T*>(slot.get());
+    }
+    bool skips() const { return m_options.skip; }
     TexturePool& pool() { return *m_pool; }
 
 private:
@@ -101,6 +110,7 @@ private:
     std::unique_ptr<emu::Device> m_device;
     std::unique_ptr<TexturePool> m_pool;
     PassMemo m_memo;  // with RunnerOptions::skip: what runFrame keeps between frames
+    std::map<std::string, std::shared_ptr<void>> m_kept;  // kept()
     emu::Handle m_scene{}, m_output{};
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;

@@ -22,6 +22,7 @@ struct SensorSettings {
     bool clusters = true;    // an 8x8 block >= 90 % bright gives one cluster sprite, the others none
     float strength = 0.25f;  // the glare image's peak per unit of pixel colour
     float radius = 32;       // sprite radius in pixels (cluster sprites: twice)
+    bool operator==(const SensorSettings&) const = default;
 };
 
 // A frame of 8-bit pixels for the sensors: rows top to bottom, `pitch` bytes apart, 4 bytes a

@@ -934,7 +934,7 @@ void checkReuse(const emu::DeviceOptions& device, bool gl = false) {
         // writes CPU data, and passes whose outputs later passes of the frame blend onto run
         // every frame; docs/glare/README.md "Reuse"); after the image changed, fewer. On GL the
         // sprites' glare image, uploaded every frame, is new every frame (only the software
-        // renderer compares small writes), so everything after it runs.
+        // renderer compares small writes), so the passes that draw with it run.
         if (!(gl && t->name() == "sprites")) CHECK(reusedWhileStill >= 2);
         CHECK(reusedWhileStill <= passesWhileStill);
         CHECK(reusedAfterChange * 2 < reusedWhileStill + 2);
