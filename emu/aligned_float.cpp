@@ -362,8 +362,9 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
 }
 
 void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                   FloatRowScratch& sc, AlignedStats& stats) {
+                   FloatRowScratch& sc, AlignedStats& stats, const RowWindow* window) {
     const ps11::Executor& exec = *draw.executor;
+    const RowMode mode = window ? window->mode : RowMode::Shade;
     const int taps = draw.plan.count;
     std::array<RowTaps, 8> rows{};
     RowSampler sampler(draw, tri, rows);
@@ -381,10 +382,12 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
     for (int y = std::max(y0, s.yMin); y < std::min(y1, s.yMax); ++y) {
         int xl = 0, xr = 0;
         if (!rowCoverage(s, y, xl, xr)) continue;
+        if (window) xl = std::max(xl, window->x0), xr = std::min(xr, window->x1);
+        if (xl >= xr) continue;
         sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
         for (int t = 0; t < taps; ++t) {
             const FloatRowTap& tap = draw.taps[size_t(t)];
-            if (!tap.bound) continue;
+            if (!tap.bound || mode == RowMode::Fill || (mode == RowMode::Copy && t != window->copyTap)) continue;
             const float v = rowV(s, tap.coordSet, y);
             RowTaps& r = rows[size_t(t)];
             ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
@@ -397,10 +400,28 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
         }
         for (int x = xl; x < xr; x += ps11::kMaxSpan) {
             const int n = std::min(ps11::kMaxSpan, xr - x);
-            fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
-            in.count = n;
             sampler.setX(x);
-            exec.run(in, sampler, outp, &stats.exec);
+            if (mode == RowMode::Shade) {
+                fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                in.count = n;
+                exec.run(in, sampler, outp, &stats.exec);
+                stats.texels += uint64_t(n) * texelsPerPixel;
+            } else if (mode == RowMode::Copy) {
+                // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
+                const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];
+                ps11::SampleRequest req;
+                req.stage = tap.stage;
+                req.count = n;
+                req.u = kLaneIndex.data();
+                req.v = kLaneIndex.data();
+                req.precision = exec.options().precision;
+                ps11::SampleResult res;
+                for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
+                sampler.sample(req, res);
+                stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
+            } else {
+                for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+            }
             MergeInputs mi;
             mi.count = n;
             for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
@@ -411,7 +432,6 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
             mergePixels(draw.merge, mi, draw.target, &ms);
             stats.written += ms.written;
             stats.pixels += uint64_t(n);
-            stats.texels += uint64_t(n) * texelsPerPixel;
         }
     }
 }

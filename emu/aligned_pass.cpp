@@ -468,7 +468,8 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 }
 
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
-                     size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats) {
+                     size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* window) {
+    const RowMode mode = window ? window->mode : RowMode::Shade;
     const ps11::Executor& exec = *draw.executor;
     Image& target = *draw.target.color;
     const bool x8 = target.format->format == D3DFMT_X8R8G8B8;
@@ -536,10 +537,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             if (y < s.yMin || y >= s.yMax) continue;
             int xl = 0, xr = 0;
             if (!rowCoverage(s, y, xl, xr)) continue;
+            if (window) xl = std::max(xl, window->x0), xr = std::min(xr, window->x1);
+            if (xl >= xr) continue;
             ctx.tri = &tri;
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
-                if (!tap.bound) continue;
+                if (!tap.bound || mode == RowMode::Fill || (mode == RowMode::Copy && t != window->copyTap)) continue;
                 TapRow& r = rows[size_t(t)];
                 r = tapRow(tap, s, y);
                 // The H rows of the tap's long runs (built on first use, shared by taps and rows).
@@ -562,12 +565,19 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             for (int x = xl; x < xr; x += ps11::kMaxSpan) {
                 const int n = std::min(ps11::kMaxSpan, xr - x);
                 for (int t = 0; t < taps; ++t)
-                    stats.texels +=
-                        uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
+                    if (mode == RowMode::Shade || (mode == RowMode::Copy && t == window->copyTap))
+                        stats.texels +=
+                            uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
                 ctx.x = x;
-                fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
-                in.count = n;
-                exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
+                if (mode == RowMode::Shade) {
+                    fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                    in.count = n;
+                    exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
+                } else if (mode == RowMode::Copy) {
+                    fill(&ctx, window->copyTap, 0, n, r0);
+                } else {
+                    for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                }
                 stats.pixels += uint64_t(n);
                 uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
                 if (draw.directStore || draw.directAdd) {

@@ -165,9 +165,24 @@ struct AlignedStats {
     ps11::ExecutorStats exec;
 };
 
+// What the row paths do in a window of columns (emu/tile_skip.h decides it per tile): shade (run
+// the program), fill (every pixel's r0 is one constant: no texel is read and the program does not
+// run), or copy (r0 is bit for bit the lookup of one tap: that tap alone is filtered). The merge
+// and store are the draw's in every case.
+enum class RowMode : uint8_t { Shade, Fill, Copy };
+struct RowWindow {
+    int x0 = 0, x1 = 0;  // columns [x0, x1)
+    RowMode mode = RowMode::Shade;
+    int copyTap = -1;                // Copy: the tap (index in the draw's TapPlan)
+    std::array<int32_t, 4> grid{};   // Fill, fx profiles: r0's grid integers
+    std::array<float, 4> value{};    // Fill, float profiles: r0's floats
+};
+
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
-// order): row by row, each row through every triangle in order.
+// order): row by row, each row through every triangle in order. With `window`, only its columns,
+// as it says.
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
-                     size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats);
+                     size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats,
+                     const RowWindow* window = nullptr);
 
 }  // namespace emu

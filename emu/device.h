@@ -33,7 +33,7 @@ struct DeviceOptions {
     std::optional<ps11::Precision> precision;  // overrides the class's profile (draws, StretchRect weights)
     float maxValue = 0;                        // overrides the class's PixelShader1xMaxValue (0 = the class's)
     uint64_t maxResourceBytes = kMaxResourceBytes;  // per resource, checked before allocating
-    // The software renderer's own options (threads, aligned passes).
+    // The software renderer's own options (threads, aligned passes, tile skipping).
     SoftwareRendererOptions software;
     // Another renderer (emu/renderer.h), made when the device is: the GL renderer
     // (emu/gl/gl_renderer.h) comes this way. Empty: the software renderer.

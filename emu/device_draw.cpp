@@ -107,6 +107,10 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
     pixelsWritten += o.pixelsWritten;
     texelsFetched += o.texelsFetched;
     instructions += o.instructions;
+    tilesShaded += o.tilesShaded;
+    tilesFilled += o.tilesFilled;
+    tilesCopied += o.tilesCopied;
+    tilesSkipped += o.tilesSkipped;
     milliseconds += o.milliseconds;
     return *this;
 }

@@ -38,6 +38,10 @@ struct DrawStats {
     uint64_t pixelsWritten = 0;   // pixels that reached the colour or depth store (output merger)
     uint64_t texelsFetched = 0;   // texels read by the sampler
     uint64_t instructions = 0;    // instruction executions (per lane)
+    // Tiles of row-path draws (emu/tile_skip.h): shaded, filled with a constant, copied from one
+    // tap, skipped (the merge would change nothing). All zero where the renderer does not decide
+    // tiles (the GL renderer, quad-path draws, skipping off).
+    uint64_t tilesShaded = 0, tilesFilled = 0, tilesCopied = 0, tilesSkipped = 0;
     double milliseconds = 0;      // wall time of the call
     DrawStats& operator+=(const DrawStats& o);
 };

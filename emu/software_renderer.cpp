@@ -11,6 +11,7 @@
 #include "emu/blit.h"
 #include "emu/aligned_float.h"
 #include "emu/thread_pool.h"
+#include "emu/tile_skip.h"
 #include "ps11/diagnostics.h"
 
 namespace emu {
@@ -128,6 +129,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                            prepareFloatRowDraw(executor, precision, call.hardware.weightBits, kills, call.textures,
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle> floatTris;
+    // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
+    std::unique_ptr<TileSkipper> skipper;
+    if (m_options.skipTiles && (alignedDraw || floatDraw))
+        skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     std::vector<uint8_t> isAligned;
     std::vector<uint32_t> bandStart, bandFill, bandTris;
     for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
@@ -157,6 +162,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
         }
         if (setups.empty()) continue;
+        const bool tiles = skipper && setups.size() <= kMaxAlignedTriangles &&
+                           std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a != 0; });
 
         // ---- rows in bands over the workers ----
         const int firstBand = (yLo & ~1) / kBandRows;
@@ -231,6 +238,62 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             };
             const std::function<void(QuadSpan&)> emitFn = emit;
             AlignedStats as;
+            // A band of a chunk drawn wholly by a row path, tile by tile: runs of tiles with one
+            // decision are drawn (or skipped) together.
+            auto drawBandTiles = [&](int b, int by0, int by1) {
+                const TriangleSetup* bt[kMaxAlignedTriangles];
+                const AlignedTriangle* at[kMaxAlignedTriangles];
+                uint32_t idx[kMaxAlignedTriangles];
+                size_t n = 0;
+                int ty0 = by1, ty1 = by0;
+                for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1] && n < kMaxAlignedTriangles; ++k) {
+                    const uint32_t i = bandTris[k];
+                    idx[n] = i;
+                    bt[n] = &setups[i];
+                    at[n++] = floatDraw ? nullptr : &alignedTris[i];
+                    ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
+                    ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
+                }
+                if (n == 0 || ty0 >= ty1) return;
+                auto drawRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
+                    switch (d.action) {
+                        case TileAction::Shade: ws.tilesShaded += count; break;
+                        case TileAction::Fill: ws.tilesFilled += count; break;
+                        case TileAction::Copy: ws.tilesCopied += count; break;
+                        case TileAction::Skip:
+                            ws.tilesSkipped += count;
+                            // Nothing is drawn; the pixels are still covered.
+                            for (int y = by0; y < by1; ++y)
+                                for (size_t t = 0; t < n; ++t) {
+                                    int xl = 0, xr = 0;
+                                    if (y >= bt[t]->yMin && y < bt[t]->yMax && rowCoverage(*bt[t], y, xl, xr))
+                                        as.pixels += uint64_t(std::max(0, std::min(xr, xb) - std::max(xl, xa)));
+                                }
+                            return;
+                    }
+                    const RowWindow win = d.window(xa, xb);
+                    if (floatDraw) {
+                        for (size_t t = 0; t < n; ++t)
+                            drawFloatRows(floatRows, floatTris[idx[t]], *bt[t], by0, by1, ws0.floatRows, as, &win);
+                    } else {
+                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, &win);
+                    }
+                };
+                TileDecision run;
+                int runX0 = clip.x0;
+                uint64_t runTiles = 0;
+                for (int x = clip.x0; x < clip.x1; x += kSkipTileColumns) {
+                    const int xe = std::min(clip.x1, x + kSkipTileColumns);
+                    const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1);
+                    if (runTiles && !(d == run)) {
+                        drawRun(run, runX0, x, runTiles);
+                        runTiles = 0;
+                    }
+                    if (!runTiles) run = d, runX0 = x;
+                    ++runTiles;
+                }
+                if (runTiles) drawRun(run, runX0, clip.x1, runTiles);
+            };
             for (;;) {
                 const int b = next.fetch_add(1, std::memory_order_relaxed);
                 if (b >= bands) break;
@@ -244,6 +307,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
                     grouped = 0;
                 };
+                if (tiles) {
+                    drawBandTiles(b, by0, by1);
+                    continue;
+                }
                 for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
                     const uint32_t i = bandTris[k];
                     const TriangleSetup& s = setups[i];
@@ -276,6 +343,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             stats.instructions += ws.instructions;
             stats.pixelsWritten += ws.pixelsWritten;
             stats.texelsFetched += ws.texelsFetched;
+            stats.tilesShaded += ws.tilesShaded;
+            stats.tilesFilled += ws.tilesFilled;
+            stats.tilesCopied += ws.tilesCopied;
+            stats.tilesSkipped += ws.tilesSkipped;
         }
     }
     return true;

@@ -16,6 +16,9 @@ struct SoftwareRendererOptions {
     // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
     // no helper lanes, so fewer pixels shaded). Off: every draw goes through 2x2 quads.
     bool alignedPasses = true;
+    // Tiles of row-path draws whose result the interval evaluator decides are filled, copied or
+    // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile shaded.
+    bool skipTiles = true;
 };
 
 struct SoftwareDrawContext;  // the worker pool and the executor cache (software_renderer.cpp)

@@ -23,6 +23,8 @@
 
 namespace ps11 {
 
+struct TexelTiles;  // ps11/texture_tiles.h
+
 // Grid values of float texels are clamped to +-kMaxTexelGrid (about +-4112 in fx8, far beyond any
 // MaxValue) so that the exact integer sums of the sampler cannot overflow.
 constexpr int32_t kMaxTexelGrid = 1 << 20;
@@ -101,6 +103,10 @@ public:
     bool readsInPlace() const { return m_u8view != nullptr || m_valueView != nullptr; }
     // The rule the signed channels were decoded with (Snorm for textures without them).
     SignedDecode signedDecode() const { return m_signedDecode; }
+    // The per-tile facts of level 0 (ps11/texture_tiles.h) once a caller computed and kept them
+    // (null before); thread-safe. Copies of a texture share them.
+    std::shared_ptr<const TexelTiles> texelTiles() const;
+    void keepTexelTiles(std::shared_ptr<const TexelTiles> tiles) const;
 
 private:
     friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
@@ -126,6 +132,11 @@ private:
         std::vector<int32_t> g8, g12;
     };
     std::shared_ptr<Grids> m_grids = std::make_shared<Grids>();
+    struct TileCache {
+        std::mutex mutex;
+        std::shared_ptr<const TexelTiles> tiles;
+    };
+    std::shared_ptr<TileCache> m_tileCache = std::make_shared<TileCache>();
 };
 
 // Builds a texture from a parsed [texture N] section: texel words in the format's natural

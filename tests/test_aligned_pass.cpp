@@ -263,6 +263,7 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         // ps_1_4 programs run on the 1.4-class card, in fx8 (the aligned path's profile).
         if (c.program.rfind("ps_1_4", 0) == 0) {
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
@@ -276,6 +277,13 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
             Device rowDev(rowOpt);
             DrawStats rs;
             REQUIRE(drawCase(rowDev, c, rs) == expected);
+            // Tile skipping (emu/tile_skip.h) changes no byte and no covered pixel.
+            DeviceOptions skipOpt = rowOpt;
+            skipOpt.software.skipTiles = true;
+            Device skipDev(skipOpt);
+            DrawStats ks;
+            REQUIRE(drawCase(skipDev, c, ks) == expected);
+            CHECK(ks.pixelsCovered == qs.pixelsCovered);
             CHECK(rs.pixelsCovered == qs.pixelsCovered);
             CHECK(rs.pixelsWritten == qs.pixelsWritten);
             if (qs.pixelsCovered == 0) return;
@@ -303,6 +311,7 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
         quadOpt.precision = rowOpt.precision = (i / 2) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
+        rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -319,6 +328,12 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
                                          << " bound " << c.tex[0].bound << " blend " << c.blend << " mask " << c.writeMask
                                          << " alphatest " << c.alphaTest << " scissor " << c.scissor);
         REQUIRE(firstDiff == got.size());
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device skipDev(skipOpt);
+        DrawStats ks;
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        CHECK(ks.pixelsCovered == qs.pixelsCovered);
         CHECK(rs.pixelsCovered == qs.pixelsCovered);
         CHECK(rs.pixelsWritten == qs.pixelsWritten);
         if (qs.pixelsCovered == 0) continue;
@@ -598,6 +613,7 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;  // every pixel shaded: the row path's count below holds
         if (c.program.rfind("ps_1_4", 0) == 0) {
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
@@ -610,6 +626,11 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
             Device rowDev(rowOpt);
             DrawStats rs;
             REQUIRE(drawCase(rowDev, c, rs) == expected);
+            DeviceOptions skipOpt = rowOpt;
+            skipOpt.software.skipTiles = true;
+            Device skipDev(skipOpt);
+            DrawStats ks;
+            REQUIRE(drawCase(skipDev, c, ks) == expected);
             if (qs.pixelsCovered == 0) return;
             ++cases;
             if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
@@ -669,4 +690,75 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
         INFO("scale " << scale);
         CHECK(tabulated >= w - 2 * int(scale + 1));
     }
+}
+
+TEST_CASE("tile skipping: random draws over partly constant textures equal every pixel shaded", "[draw][aligned][skip]") {
+    // Textures that are zero, one constant texel, or zero with a few random blocks (a sparse
+    // glare); programs of glare passes (composites, bright passes, blurs) among the random ones;
+    // fx8, float and ideal; ONE/ONE blending often. Skipping on must give the bytes of skipping
+    // off (and of the quad path), and must really fill, copy and skip tiles.
+    const char* const programs[] = {
+        "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n",
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n",
+        "ps_1_1\ntex t0\nsub_sat r0, t0, c1\nmul_x4 r0, r0, c2\n",
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+        "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r1, c0, r0\n",
+    };
+    std::mt19937 rng(20261128);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    uint64_t filled = 0, copied = 0, skipped = 0, shaded = 0;
+    for (int i = 0; i < 360; ++i) {
+        const int profile = i % 3;  // fx8, float, ideal
+        Case c = randomCase(rng, profile != 0);
+        if (uni(0, 2)) c.program = programs[uni(0, int(std::size(programs)) - 1)];
+        if (uni(0, 1)) c.blend = 1;  // ONE/ONE
+        if (uni(0, 1)) c.rtFormat = D3DFMT_A8R8G8B8;
+        for (Case::Tex& t : c.tex) {
+            const uint32_t tb = texelBytes(t.format);
+            const int kind = uni(0, 3);
+            if (kind == 0) continue;  // random texels
+            std::vector<uint8_t> texel(tb, 0);
+            if (kind == 2)
+                for (uint8_t& b : texel) b = uint8_t(uni(0, 1) ? rng() : 0);
+            for (size_t k = 0; k < t.bytes.size(); ++k) t.bytes[k] = texel[k % tb];
+            if (kind == 3) {  // a few random blocks on zero
+                const int blocks = uni(1, 3);
+                for (int b = 0; b < blocks; ++b) {
+                    const UINT bx = UINT(uni(0, int(t.w) - 1)), by = UINT(uni(0, int(t.h) - 1));
+                    const UINT bw = UINT(uni(1, 12)), bh = UINT(uni(1, 6));
+                    for (UINT y = by; y < std::min(t.h, by + bh); ++y)
+                        for (UINT x = bx; x < std::min(t.w, bx + bw); ++x)
+                            for (uint32_t k = 0; k < tb; ++k) t.bytes[(size_t(y) * t.w + x) * tb + k] = uint8_t(rng());
+                }
+            }
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+        quadOpt.precision = rowOpt.precision =
+            profile == 0 ? ps11::Precision::Fx8 : profile == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats qs, rs, ks;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision)
+                     << ", blend " << c.blend << ", program:\n" << c.program);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        const std::vector<uint8_t> got = drawCase(skipDev, c, ks);
+        size_t firstDiff = 0;
+        while (firstDiff < got.size() && got[firstDiff] == expected[firstDiff]) ++firstDiff;
+        INFO("first difference at pixel " << firstDiff / 4 % c.w << ", " << firstDiff / 4 / c.w << "; tiles filled "
+                                          << ks.tilesFilled << " copied " << ks.tilesCopied << " skipped "
+                                          << ks.tilesSkipped);
+        REQUIRE(firstDiff == got.size());
+        CHECK(ks.pixelsCovered == qs.pixelsCovered);
+        filled += ks.tilesFilled, copied += ks.tilesCopied, skipped += ks.tilesSkipped, shaded += ks.tilesShaded;
+    }
+    INFO("tiles shaded " << shaded << ", filled " << filled << ", copied " << copied << ", skipped " << skipped);
+    CHECK(filled > 20);
+    CHECK(copied > 20);
+    CHECK(skipped > 20);
 }

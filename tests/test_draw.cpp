@@ -123,7 +123,10 @@ TEST_CASE("draw: mov r0, v0 fills exactly the quad's pixels with the diffuse col
 
 TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
     for (DWORD filter : {DWORD(D3DTEXF_POINT), DWORD(D3DTEXF_LINEAR)}) {
-        Device dev;
+        // Every pixel shaded (tile skipping would copy the texture without running the program).
+        DeviceOptions opt;
+        opt.software.skipTiles = false;
+        Device dev(opt);
         const UINT W = 67, H = 41;
         Handle rt = target(dev, W, H);
         std::vector<uint32_t> texels;
@@ -268,7 +271,9 @@ TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]
     CHECK(t.pixelsCovered == 64 + dev.lastDrawStats().pixelsCovered);
 
     // The same draw on the aligned-pass path: rows, no helper lanes.
-    Device fast;
+    DeviceOptions noSkip;
+    noSkip.software.skipTiles = false;
+    Device fast(noSkip);
     target(fast, W, H);
     shader(fast, "ps_1_1\nmov r0, v0\n");
     REQUIRE(fast.SetFVF(kQuadFvf) == D3D_OK);
@@ -277,6 +282,20 @@ TEST_CASE("draw: statistics count quads, helpers and the running total", "[draw]
     CHECK(fast.lastDrawStats().pixelsShaded == 64);
     CHECK(fast.lastDrawStats().instructions == 64);
     CHECK(fast.lastDrawStats().pixelsWritten == 64);
+    CHECK(fast.lastDrawStats().tilesShaded == 0);
+
+    // With tile skipping (the default) a constant colour fills its tiles: nothing is shaded,
+    // every covered pixel is written.
+    Device skip;
+    target(skip, W, H);
+    shader(skip, "ps_1_1\nmov r0, v0\n");
+    REQUIRE(skip.SetFVF(kQuadFvf) == D3D_OK);
+    REQUIRE(skip.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+    CHECK(skip.lastDrawStats().pixelsCovered == 64);
+    CHECK(skip.lastDrawStats().pixelsShaded == 0);
+    CHECK(skip.lastDrawStats().pixelsWritten == 64);
+    CHECK(skip.lastDrawStats().tilesFilled > 0);
+    CHECK(skip.lastDrawStats().tilesShaded == 0);
 }
 
 TEST_CASE("draw: clipping through World/View/Projection and the viewport", "[draw]") {

@@ -1,0 +1,256 @@
+// Tile skipping (emu/tile_skip.h, docs/skipping.md).
+#include "emu/tile_skip.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "emu/thread_pool.h"
+#include "emu/vertex.h"
+#include "ps11/diagnostics.h"
+#include "ps11/texture.h"
+
+namespace emu {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Texel indices [i0, i1] of one axis as the address mode maps them into [0, n − 1]: `a`..`b`
+// (a > b: none), `border` when some index falls on the border colour.
+void addressAxis(ps11::TextureAddress mode, int64_t i0, int64_t i1, int64_t n, int64_t& a, int64_t& b, bool& border) {
+    if (i0 >= 0 && i1 <= n - 1) {
+        a = i0, b = i1;
+        return;
+    }
+    switch (mode) {
+        case ps11::TextureAddress::Clamp:
+            a = std::clamp<int64_t>(i0, 0, n - 1), b = std::clamp<int64_t>(i1, 0, n - 1);
+            return;
+        case ps11::TextureAddress::Border:
+            border = true;
+            a = std::max<int64_t>(i0, 0), b = std::min<int64_t>(i1, n - 1);
+            return;
+        default:  // Wrap, Mirror, MirrorOnce: anywhere
+            a = 0, b = n - 1;
+            return;
+    }
+}
+
+// The lookups' range from the texels' range. fx filters are convex integer sums rounded to the
+// grid: inside the texels' range. Float lerps (1 − f)·a + f·b may leave it by rounding: widened
+// by a relative 2⁻²⁰, except zeros, whose lerps are zeros.
+ps11::ValueRange lookupRange(float lo, float hi, bool nan, bool negZero, bool fx) {
+    ps11::ValueRange r;
+    if (!std::isfinite(lo) || !std::isfinite(hi)) nan = true;  // ∞ · 0 in a lerp
+    r.nan = nan;
+    if (fx) return ps11::ValueRange{double(lo), double(hi), false, false};
+    if (lo == 0 && hi == 0) {
+        r.lo = r.hi = 0;
+        r.negZero = negZero;
+        return r;
+    }
+    const double m = std::max(std::fabs(double(lo)), std::fabs(double(hi))) * std::ldexp(1.0, -20);
+    r.lo = lo >= 0 ? std::max(0.0, double(lo) - m) : double(lo) - m;
+    r.hi = hi <= 0 ? std::min(0.0, double(hi) + m) : double(hi) + m;
+    r.negZero = negZero || r.lo < 0;
+    return r;
+}
+
+}  // namespace
+
+RowWindow TileDecision::window(int x0, int x1) const {
+    RowWindow w;
+    w.x0 = x0;
+    w.x1 = x1;
+    w.mode = action == TileAction::Fill ? RowMode::Fill : action == TileAction::Copy ? RowMode::Copy : RowMode::Shade;
+    w.copyTap = copyTap;
+    w.grid = grid;
+    w.value = value;
+    return w;
+}
+
+std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, const DrawCall& call,
+                                                 const ps11::TapPlan& plan, ThreadPool& pool) {
+    ps11::IntervalSetup setup;
+    setup.options = ps11::executorOptionsFor(call.hardware);
+    for (size_t i = 0; i < setup.constants.size() && i < call.program.constants.size(); ++i)
+        setup.constants[i] = call.program.constants[i];
+    setup.stagesKnown = true;
+    for (size_t s = 0; s < setup.stages.size(); ++s) setup.stages[s] = call.program.stages[s];
+    ps11::Diagnostics diags;
+    std::optional<ps11::IntervalEvaluator> eval = ps11::IntervalEvaluator::create(program, setup, diags);
+    if (!eval || eval->texcoordSetsRead() != 0 || eval->dependentLookupStages() != 0) return nullptr;
+    auto sk = std::unique_ptr<TileSkipper>(new TileSkipper());
+    sk->m_fx = ps11::isFixedPoint(call.hardware.precision);
+    sk->m_grid = double(eval->profile().g);
+    for (int t = 0; t < plan.count; ++t) {
+        Stage& st = sk->m_stages[plan.stage[size_t(t)]];
+        st.tap = st.tap == -1 && !st.read ? t : -2;
+        st.read = true;
+        st.coordSet = plan.coordSet[size_t(t)];
+    }
+    for (int s = 0; s < 8; ++s) {
+        Stage& st = sk->m_stages[size_t(s)];
+        if (st.tap < 0) st.tap = -1;
+        const bool plain = (eval->plainLookupStages() >> s) & 1;
+        if (plain && !st.read) return nullptr;  // a lookup the row path does not make
+        st.read = plain;
+        if (!plain) continue;
+        st.texture = call.textures[size_t(s)];
+        st.sampler = call.samplers[size_t(s)];
+        if (!st.texture) continue;
+        if (!ps11::hasTexelTiles(*st.texture)) return nullptr;
+        st.tiles = st.texture->texelTiles();
+        if (st.tiles) continue;
+        // First read of this texture (of this generation): its facts, tile rows over the workers.
+        auto tiles = std::make_shared<ps11::TexelTiles>();
+        ps11::prepareTexelTiles(*st.texture, *tiles);
+        const int workers = int(std::clamp<uint32_t>(tiles->tilesY / 4, 1, uint32_t(pool.size())));
+        const ps11::Texture& tex = *st.texture;
+        pool.run(workers, [&](int w) {
+            ps11::scanTexelTiles(tex, *tiles, tiles->tilesY * uint32_t(w) / uint32_t(workers),
+                                 tiles->tilesY * uint32_t(w + 1) / uint32_t(workers));
+        });
+        st.texture->keepTexelTiles(tiles);
+        st.tiles = std::move(tiles);
+    }
+    const uint8_t v = eval->colorsRead();
+    for (int k = 0; k < 2; ++k)
+        if ((v >> k) & 1)
+            for (int c = 0; c < 4; ++c) sk->m_colorAttrs |= uint64_t(1) << ((k ? kAttrSpecular : kAttrDiffuse) + c);
+    sk->m_colorAttrs &= call.usedAttributes;
+    const MergeState& m = call.merge;
+    const D3DFORMAT f = call.target.color ? call.target.color->format->format : D3DFMT_UNKNOWN;
+    const bool addOne = m.srcBlend == D3DBLEND_ONE && m.dstBlend == D3DBLEND_ONE && m.blendOp == D3DBLENDOP_ADD;
+    const bool addOneAlpha = !m.separateAlpha || (m.srcBlendAlpha == D3DBLEND_ONE && m.dstBlendAlpha == D3DBLEND_ONE &&
+                                                  m.blendOpAlpha == D3DBLENDOP_ADD);
+    sk->m_zeroAddIsNoOp = m.blend && addOne && addOneAlpha && !m.alphaTest && !m.fog && !m.depthTest && !m.depthWrite &&
+                          f == D3DFMT_A8R8G8B8;  // an X8R8G8B8 store sets the X byte
+    sk->m_writesNothing = m.writesNothing();
+    sk->m_eval = std::move(eval);
+    return sk;
+}
+
+TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1) const {
+    TileDecision shade;
+    if (count == 0 || x0 >= x1 || y0 >= y1) return shade;
+    ps11::IntervalInputs in;
+    for (int s = 0; s < 8; ++s) {
+        const Stage& st = m_stages[size_t(s)];
+        if (!st.read) continue;
+        ps11::ValueRange4& out = in.stages[size_t(s)].value;
+        if (!st.texture) {
+            for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
+            continue;
+        }
+        // The coordinates' extremes over the tile (u affine in x alone, v in y alone on the
+        // row paths), on every triangle.
+        double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
+        for (size_t i = 0; i < count; ++i) {
+            float u[2], v[2];
+            columnU(*tris[i], st.coordSet, x0, 1, &u[0]);
+            columnU(*tris[i], st.coordSet, x1 - 1, 1, &u[1]);
+            v[0] = rowV(*tris[i], st.coordSet, y0);
+            v[1] = rowV(*tris[i], st.coordSet, y1 - 1);
+            for (int k = 0; k < 2; ++k) {
+                if (!std::isfinite(u[k]) || !std::isfinite(v[k]) || std::fabs(u[k]) > 1e6f || std::fabs(v[k]) > 1e6f)
+                    return shade;
+                umin = std::min(umin, double(u[k])), umax = std::max(umax, double(u[k]));
+                vmin = std::min(vmin, double(v[k])), vmax = std::max(vmax, double(v[k]));
+            }
+        }
+        // A bilinear footprint (also covers point sampling) and one texel more each side for
+        // the samplers' own rounding of coordinates.
+        const ps11::TexelTiles& tiles = *st.tiles;
+        const int64_t W = tiles.width, H = tiles.height;
+        const int64_t i0 = int64_t(std::floor(umin * double(W) - 0.5)) - 1, i1 = int64_t(std::floor(umax * double(W) - 0.5)) + 2;
+        const int64_t j0 = int64_t(std::floor(vmin * double(H) - 0.5)) - 1, j1 = int64_t(std::floor(vmax * double(H) - 0.5)) + 2;
+        int64_t a0 = 0, a1 = 0, b0 = 0, b1 = 0;
+        bool border = false;
+        addressAxis(st.sampler.addressU, i0, i1, W, a0, a1, border);
+        addressAxis(st.sampler.addressV, j0, j1, H, b0, b1, border);
+        ps11::TexelRange r;
+        if (a0 <= a1 && b0 <= b1) r = tiles.over(uint32_t(a0), uint32_t(b0), uint32_t(a1), uint32_t(b1));
+        if (border) {
+            // fx samplers take the border colour to the grid: within one step of it.
+            const float e = m_fx ? float(1.0 / m_grid) : 0.0f;
+            ps11::TexelRange b;
+            for (int c = 0; c < 4; ++c) {
+                const float x = st.sampler.border[size_t(c)];
+                if (std::isnan(x)) b.nan |= uint8_t(1u << c);
+                if (x == 0 && std::signbit(x)) b.negZero |= uint8_t(1u << c);
+                b.lo[size_t(c)] = m_fx ? std::max(0.0f, x - e) : x;
+                b.hi[size_t(c)] = x + e;
+            }
+            r.add(b);
+        }
+        for (int c = 0; c < 4; ++c) {
+            const bool nan = (r.nan >> c) & 1;
+            if (r.lo[size_t(c)] > r.hi[size_t(c)]) {  // no value but NaN, or nothing known
+                if (!nan) return shade;
+                out[size_t(c)] = ps11::ValueRange::any();
+                continue;
+            }
+            out[size_t(c)] = lookupRange(r.lo[size_t(c)], r.hi[size_t(c)], nan, (r.negZero >> c) & 1, m_fx);
+        }
+    }
+    // Colours: constant on a triangle, or affine (extremes at the tile's corners, widened for
+    // the float rounding of the interpolation).
+    for (int k = 0; k < 2; ++k)
+        for (int c = 0; c < 4; ++c) {
+            const int attr = (k ? kAttrSpecular : kAttrDiffuse) + c;
+            if (!((m_colorAttrs >> attr) & 1)) continue;
+            double lo = kInf, hi = -kInf;
+            bool affine = false, negZero = false;
+            for (size_t i = 0; i < count; ++i) {
+                const TriangleSetup& s = *tris[i];
+                if ((s.constMask >> attr) & 1) {
+                    const float x = s.constValue[size_t(attr)];
+                    if (!std::isfinite(x)) return shade;
+                    negZero |= x == 0 && std::signbit(x);
+                    lo = std::min(lo, double(x)), hi = std::max(hi, double(x));
+                    continue;
+                }
+                affine = true;
+                const Plane& p = s.attr[size_t(attr)];
+                for (int y : {y0, y1 - 1})
+                    for (int x : {x0, x1 - 1}) {
+                        const double val = double(float(planeRowBase(p, s.ox, s.oy, y)) + float(p.dx) * float(x));
+                        if (!std::isfinite(val)) return shade;
+                        lo = std::min(lo, val), hi = std::max(hi, val);
+                    }
+            }
+            if (affine) {
+                const double m = (std::fabs(lo) + std::fabs(hi)) * 1e-6 + 1e-30;
+                lo -= m, hi += m, negZero = true;
+            }
+            in.color[size_t(k)][size_t(c)] = ps11::ValueRange{lo, hi, negZero, false};
+        }
+    ps11::IntervalResult r;
+    m_eval->evaluate(in, r);
+    if (r.kill != ps11::KillRange::Never || r.writesDepth) return shade;
+    if (r.constantColor()) {
+        TileDecision d;
+        d.action = TileAction::Fill;
+        bool zero = true;
+        for (int c = 0; c < 4; ++c) {
+            const ps11::ChannelInterval& ch = r.color[size_t(c)];
+            d.grid[size_t(c)] = m_fx ? ch.gridLo : 0;
+            d.value[size_t(c)] = m_fx ? float(ch.gridLo) / float(m_grid) : (ch.lo == 0 ? 0.0f : float(ch.lo));
+            zero = zero && (m_fx ? ch.gridLo == 0 : ch.lo == 0);
+        }
+        if (m_writesNothing || (zero && m_zeroAddIsNoOp)) d.action = TileAction::Skip;
+        return d;
+    }
+    if (r.copyStage >= 0 && r.copyStage < 8 && m_stages[size_t(r.copyStage)].tap >= 0) {
+        TileDecision d;
+        d.action = TileAction::Copy;
+        d.copyTap = m_stages[size_t(r.copyStage)].tap;
+        return d;
+    }
+    return shade;
+}
+
+}  // namespace emu

@@ -1,0 +1,81 @@
+// Tile skipping (docs/skipping.md "Within a frame"): before a tile of a row-path draw is drawn,
+// the renderer bounds what its taps can read — the per-tile facts of each texture
+// (ps11/texture_tiles.h) over the texels the tile's coordinates reach, the colours at its corners
+// — and runs the interval evaluator (ps11/intervals.h) over those ranges. Where r0 is one
+// constant the tile is filled without shading; where it is bit for bit one tap's lookup, only that
+// tap is filtered (a copy); where the merge of that constant leaves the target as it is (ONE/ONE
+// of zero into an 8-bit target), nothing is drawn. Every claim holds for every input inside the
+// ranges, so images are byte-identical with skipping off.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <optional>
+
+#include "emu/aligned_pass.h"
+#include "emu/raster.h"
+#include "emu/renderer.h"
+#include "ps11/intervals.h"
+#include "ps11/texture_tiles.h"
+
+namespace emu {
+
+class ThreadPool;
+
+// Columns per tile; a tile's rows are the renderer's band of rows.
+constexpr int kSkipTileColumns = 64;
+
+enum class TileAction : uint8_t { Shade, Fill, Copy, Skip };
+
+struct TileDecision {
+    TileAction action = TileAction::Shade;
+    int copyTap = -1;               // Copy: the tap in the draw's TapPlan
+    std::array<int32_t, 4> grid{};  // Fill: r0 (fx grid integers; float profiles: `value`)
+    std::array<float, 4> value{};
+    bool operator==(const TileDecision& o) const {
+        return action == o.action && copyTap == o.copyTap && grid == o.grid &&
+               std::memcmp(value.data(), o.value.data(), sizeof value) == 0;
+    }
+    // The row paths' window for columns [x0, x1) (Skip: nothing to draw).
+    RowWindow window(int x0, int x1) const;
+};
+
+// Tiles shaded, filled, copied and skipped (DrawStats).
+struct TileCounts {
+    uint64_t shaded = 0, filled = 0, copied = 0, skipped = 0;
+};
+
+class TileSkipper {
+public:
+    // For a draw on a row path with tap plan `plan`: nullopt when its tiles cannot be decided
+    // (texture coordinates read as values, dependent reads, a program the evaluator refuses).
+    // Computes the per-tile facts of the textures the program reads where they are missing, over
+    // `pool`.
+    static std::unique_ptr<TileSkipper> create(const ps11::Program& program, const DrawCall& call,
+                                               const ps11::TapPlan& plan, ThreadPool& pool);
+
+    // The decision for pixels [x0, x1) × [y0, y1) of the triangles `tris` (those that may
+    // cover the tile, all on the row path).
+    TileDecision decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1) const;
+
+private:
+    struct Stage {
+        bool read = false;
+        std::shared_ptr<const ps11::Texture> texture;  // null: unbound, (0, 0, 0, 1)
+        std::shared_ptr<const ps11::TexelTiles> tiles;
+        ps11::SamplerState sampler;
+        int coordSet = 0;
+        int tap = -1;  // the plan's tap of this stage (−1 when none or several)
+    };
+    std::optional<ps11::IntervalEvaluator> m_eval;
+    std::array<Stage, 8> m_stages{};
+    uint64_t m_colorAttrs = 0;
+    bool m_fx = true;
+    double m_grid = 255;          // fx: the grid scale G
+    bool m_zeroAddIsNoOp = false;  // the merge of a zero r0 leaves every target byte as it is
+    bool m_writesNothing = false;
+};
+
+}  // namespace emu

@@ -1,0 +1,48 @@
+// Per-tile facts of a texture's level 0 (docs/skipping.md): the range of each channel's values,
+// as the sampler's point reads return them, over square tiles of kTexelTileSide texels. The
+// renderer reads them to bound what a tile of a draw can sample (ps11/intervals.h decides from
+// that whether the tile needs shading); they are computed once per texture (a texture is
+// immutable, so once per generation of a device resource), in tile rows a caller can share among
+// threads.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace ps11 {
+
+class Texture;
+
+constexpr uint32_t kTexelTileSide = 32;
+
+// The values of a set of texels per channel r g b a: [lo, hi] of the non-NaN values, which
+// channels hold a NaN and which a −0.0. Empty: lo > hi.
+struct TexelRange {
+    std::array<float, 4> lo{1, 1, 1, 1}, hi{0, 0, 0, 0};
+    uint8_t nan = 0;      // bit c: channel c holds a NaN
+    uint8_t negZero = 0;  // bit c: channel c holds −0.0
+    void add(const TexelRange& o);
+};
+
+struct TexelTiles {
+    uint32_t width = 0, height = 0;    // level 0's extents
+    uint32_t tilesX = 0, tilesY = 0;
+    std::vector<TexelRange> tiles;     // row-major, tilesX per row
+    // The range of texels [x0, x1] × [y0, y1] (inclusive, inside the level) from the tiles
+    // they touch.
+    TexelRange over(uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) const;
+    TexelRange whole() const { return over(0, 0, width - 1, height - 1); }
+};
+
+// Whether texelTiles can describe the texture: a 2-D texture whose level 0 is Unorm8 or Decoded
+// (every format is).
+bool hasTexelTiles(const Texture& tex);
+// Sizes `out` for the texture's level 0 (tiles empty until scanned).
+void prepareTexelTiles(const Texture& tex, TexelTiles& out);
+// Scans tile rows [ty0, ty1) of level 0 into `out` (prepared; disjoint rows may be scanned by
+// different threads).
+void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t ty1);
+
+}  // namespace ps11
