@@ -1,4 +1,4 @@
-// Tile skipping (emu/tile_skip.h, docs/skipping.md).
+// Tile skipping (emu/tile_skip.h, docs/device.md "Tile skipping").
 #include "emu/tile_skip.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Tile skipping (docs/skipping.md "Within a frame"): before a tile of a row-path draw is drawn,
+// Tile skipping (docs/device.md "Tile skipping"): before a tile of a row-path draw is drawn,
 // the renderer bounds what its taps can read — the per-tile facts of each texture
 // (ps11/texture_tiles.h) over the texels the tile's coordinates reach, the colours at its corners
 // — and runs the interval evaluator (ps11/intervals.h) over those ranges. Where r0 is one

@@ -461,6 +461,10 @@ bool PassContext::draw(D3DPRIMITIVETYPE type, UINT count, const void* vertices, 
     stats.pixels += d.pixelsCovered;
     stats.texels += d.texelsFetched;
     stats.instructions += d.instructions;
+    stats.tilesShaded += d.tilesShaded;
+    stats.tilesFilled += d.tilesFilled;
+    stats.tilesCopied += d.tilesCopied;
+    stats.tilesSkipped += d.tilesSkipped;
     return true;
 }
 

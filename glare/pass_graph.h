@@ -64,6 +64,9 @@ struct PassStats {
     // texels fetched), and each texture it writes, once (no more than its pixels). Time over
     // this shows a pass far above its share.
     uint64_t bytes = 0;
+    // The software renderer's tiles of the pass's draws (docs/device.md "Tile skipping"): shaded,
+    // filled with a constant, copied from one tap, skipped. Zero on the GL renderer.
+    uint64_t tilesShaded = 0, tilesFilled = 0, tilesCopied = 0, tilesSkipped = 0;
     // Run with a PassMemo: the pass's fingerprint and outputs were last frame's, so its outputs
     // were kept and nothing ran (milliseconds is the dry run's).
     bool reused = false;

@@ -31,7 +31,9 @@ TextureId FrameBuild::persistent(const std::string& name, const TextureDesc& des
 }
 
 Runner::Runner(const RunnerOptions& options) : m_options(options) {
-    m_device = std::make_unique<emu::Device>(options.device);
+    emu::DeviceOptions device = options.device;
+    if (!options.skip) device.software.skipTiles = false;
+    m_device = std::make_unique<emu::Device>(device);
     m_pool = std::make_unique<TexturePool>(*m_device);
     const D3DFORMAT f = intermediateFormat();
     m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, f, D3DPOOL_DEFAULT, &m_scene);

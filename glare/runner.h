@@ -21,8 +21,10 @@ class Scene;
 struct RunnerOptions {
     emu::DeviceOptions device;  // hardware class, profile, renderer (software or GL)
     uint32_t width = 0, height = 0;
-    // Skip what a frame does not need (docs/glare/README.md "Reuse"): a pass whose inputs are
-    // last frame's is not run again. Off: every pass runs every frame (`--no-skip`).
+    // Skip what a frame does not need: a pass whose inputs are last frame's is not run again
+    // (docs/glare/README.md "Reuse"), and the software renderer fills, copies or skips the tiles
+    // its interval evaluator decides (docs/device.md "Tile skipping"). Off: every pass runs every
+    // frame and every tile is shaded (`--no-skip`; device.software.skipTiles is then off).
     bool skip = true;
 };
 

@@ -22,8 +22,8 @@ void TexelRange::add(const TexelRange& o) {
 
 TexelRange TexelTiles::over(uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) const {
     TexelRange r;
-    for (uint32_t ty = y0 / kTexelTileSide; ty <= y1 / kTexelTileSide && ty < tilesY; ++ty)
-        for (uint32_t tx = x0 / kTexelTileSide; tx <= x1 / kTexelTileSide && tx < tilesX; ++tx)
+    for (uint32_t ty = y0 / side; ty <= y1 / side && ty < tilesY; ++ty)
+        for (uint32_t tx = x0 / side; tx <= x1 / side && tx < tilesX; ++tx)
             r.add(tiles[size_t(ty) * tilesX + tx]);
     return r;
 }
@@ -34,8 +34,10 @@ void prepareTexelTiles(const Texture& tex, TexelTiles& out) {
     const TextureLevelInfo& l = tex.level(0);
     out.width = l.width;
     out.height = l.height;
-    out.tilesX = (l.width + kTexelTileSide - 1) / kTexelTileSide;
-    out.tilesY = (l.height + kTexelTileSide - 1) / kTexelTileSide;
+    out.side = kMinTexelTileSide;
+    while (out.side < kMaxTexelTileSide && std::max(l.width, l.height) > out.side * kTexelTilesPerSide) out.side *= 2;
+    out.tilesX = (l.width + out.side - 1) / out.side;
+    out.tilesY = (l.height + out.side - 1) / out.side;
     out.tiles.assign(size_t(out.tilesX) * out.tilesY, TexelRange{});
 }
 
@@ -62,9 +64,9 @@ void unorm8Row(const uint8_t* row, uint32_t x0, uint32_t x1, __m128i& mn, __m128
 void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t ty1) {
     const uint32_t w = out.width, h = out.height;
     for (uint32_t ty = ty0; ty < ty1 && ty < out.tilesY; ++ty) {
-        const uint32_t y0 = ty * kTexelTileSide, y1 = std::min(h, y0 + kTexelTileSide);
+        const uint32_t y0 = ty * out.side, y1 = std::min(h, y0 + out.side);
         for (uint32_t tx = 0; tx < out.tilesX; ++tx) {
-            const uint32_t x0 = tx * kTexelTileSide, x1 = std::min(w, x0 + kTexelTileSide);
+            const uint32_t x0 = tx * out.side, x1 = std::min(w, x0 + out.side);
             TexelRange& r = out.tiles[size_t(ty) * out.tilesX + tx];
             r = TexelRange{};
             if (tex.storage() == TexelStorage::Unorm8) {

@@ -1,5 +1,5 @@
-// Per-tile facts of a texture's level 0 (docs/skipping.md): the range of each channel's values,
-// as the sampler's point reads return them, over square tiles of kTexelTileSide texels. The
+// Per-tile facts of a texture's level 0 (docs/device.md "Tile skipping"): the range of each channel's values,
+// as the sampler's point reads return them, over square tiles of `side` texels. The
 // renderer reads them to bound what a tile of a draw can sample (ps11/intervals.h decides from
 // that whether the tile needs shading); they are computed once per texture (a texture is
 // immutable, so once per generation of a device resource), in tile rows a caller can share among
@@ -15,7 +15,10 @@ namespace ps11 {
 
 class Texture;
 
-constexpr uint32_t kTexelTileSide = 32;
+// Tiles are squares of a power of two texels, kMinTexelTileSide … kMaxTexelTileSide: the
+// smallest giving at most kTexelTilesPerSide tiles a side (a small texture, such as a
+// magnified blur, gets tiles as fine as the screen tiles that read it).
+constexpr uint32_t kMinTexelTileSide = 4, kMaxTexelTileSide = 32, kTexelTilesPerSide = 64;
 
 // The values of a set of texels per channel r g b a: [lo, hi] of the non-NaN values, which
 // channels hold a NaN and which a −0.0. Empty: lo > hi.
@@ -28,6 +31,7 @@ struct TexelRange {
 
 struct TexelTiles {
     uint32_t width = 0, height = 0;    // level 0's extents
+    uint32_t side = kMaxTexelTileSide;  // texels per tile side
     uint32_t tilesX = 0, tilesY = 0;
     std::vector<TexelRange> tiles;     // row-major, tilesX per row
     // The range of texels [x0, x1] × [y0, y1] (inclusive, inside the level) from the tiles

@@ -469,10 +469,13 @@ int runGlare(const GlareOptions& o) {
         for (size_t i = 0; i < lastStats.size(); ++i) {
             const glare::PassStats& s = lastStats[i];
             std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
-                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu, \"reused\": %s}%s\n",
+                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu, \"reused\": %s, "
+                        "\"tiles\": {\"shaded\": %llu, \"filled\": %llu, \"copied\": %llu, \"skipped\": %llu}}%s\n",
                         s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                         (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
                         (unsigned long long)s.readBacks, (unsigned long long)s.bytes, s.reused ? "true" : "false",
+                        (unsigned long long)s.tilesShaded, (unsigned long long)s.tilesFilled,
+                        (unsigned long long)s.tilesCopied, (unsigned long long)s.tilesSkipped,
                         i + 1 < lastStats.size() ? "," : "");
         }
         std::printf("], \"renderer\": \"%s\", \"frame_uploads\": %llu, \"frame_readbacks\": %llu}\n",
@@ -485,22 +488,28 @@ int runGlare(const GlareOptions& o) {
     std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
                 std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
                 hw.c_str(), profile.c_str(), main->device().rendererName(), o.frames, sorted[sorted.size() / 2]);
-    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s  %s\n", "pass (last frame)", "ms", "draws", "pixels",
-                "texels", "instructions", "up", "back", "MB", "GB/s", "run");
+    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s  %-6s %s\n", "pass (last frame)", "ms", "draws", "pixels",
+                "texels", "instructions", "up", "back", "MB", "GB/s", "run", "tiles shaded/filled/copied/skipped");
     for (const glare::PassStats& s : lastStats) {
         if (s.reused) {
-            std::printf("%-22s %9.3f %6s %11s %11s %13s %4s %4s %8s %7s  reused\n", s.pass.c_str(), s.milliseconds, "-",
+            std::printf("%-22s %9.3f %6s %11s %11s %13s %4s %4s %8s %7s  reused -\n", s.pass.c_str(), s.milliseconds, "-",
                         "-", "-", "-", "-", "-", "-", "-");
             continue;
         }
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f  ran\n", s.pass.c_str(),
+        const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
+        const std::string tileText = tiles ? std::to_string(s.tilesShaded) + "/" + std::to_string(s.tilesFilled) + "/" +
+                                                 std::to_string(s.tilesCopied) + "/" + std::to_string(s.tilesSkipped)
+                                           : "-";
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f  %-6s %s\n", s.pass.c_str(),
                     s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                     (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
                     (unsigned long long)s.readBacks, double(s.bytes) / 1e6,
-                    s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0);
+                    s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0, "ran", tileText.c_str());
     }
     std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
-                " reused: its inputs were last frame's, its outputs kept, nothing ran; --no-skip runs every pass)\n");
+                " reused: its inputs were last frame's, its outputs kept, nothing ran; tiles: 16x64-pixel tiles of the\n"
+                " software renderer's full-screen draws, shaded, filled with a constant, copied from one texture or\n"
+                " skipped, as the interval evaluator decided; --no-skip runs every pass and shades every tile)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
