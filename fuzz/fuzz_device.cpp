@@ -3,9 +3,10 @@
 // device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
 // format can express; a refused call must carry a message. Sizes are capped so each input
 // stays fast (the limits themselves are tested elsewhere). In fx8, float and ideal every file is
-// also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path): after
-// every draw both render targets must be identical bit for bit (docs/device.md "Aligned
-// passes"). A third device checks fingerprints (docs/device.md "Fingerprints") at every draw: a
+// also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path, and
+// with them tile skipping, which the first device does by default): after every draw both render
+// targets must be identical bit for bit (docs/device.md "Aligned passes", "Tile skipping"; `fill`
+// textures and constant regions make the tiles that are filled, copied or skipped). A third device checks fingerprints (docs/device.md "Fingerprints") at every draw: a
 // dry run of the draw writes nothing; and when the draw's fingerprint after running it equals
 // the one before, running it again must leave the target's bytes as they are (what lets a pass
 // graph skip a pass whose fingerprint and outputs are last frame's).
