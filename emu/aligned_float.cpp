@@ -418,6 +418,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
                 ps11::SampleResult res;
                 for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
                 sampler.sample(req, res);
+                for (int c = 0; c < 4; ++c)
+                    if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
                 stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
             } else {
                 for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);

@@ -575,6 +575,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
                 } else if (mode == RowMode::Copy) {
                     fill(&ctx, window->copyTap, 0, n, r0);
+                    for (int c = 0; c < 4; ++c)
+                        if (!((window->copyMask >> c) & 1)) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                 } else {
                     for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                 }

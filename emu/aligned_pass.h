@@ -167,13 +167,15 @@ struct AlignedStats {
 
 // What the row paths do in a window of columns (emu/tile_skip.h decides it per tile): shade (run
 // the program), fill (every pixel's r0 is one constant: no texel is read and the program does not
-// run), or copy (r0 is bit for bit the lookup of one tap: that tap alone is filtered). The merge
+// run), or copy (r0's channels are bit for bit the lookup of one tap, or constants: that tap alone
+// is filtered). The merge
 // and store are the draw's in every case.
 enum class RowMode : uint8_t { Shade, Fill, Copy };
 struct RowWindow {
     int x0 = 0, x1 = 0;  // columns [x0, x1)
     RowMode mode = RowMode::Shade;
     int copyTap = -1;                // Copy: the tap (index in the draw's TapPlan)
+    uint8_t copyMask = 0xf;          // Copy: r0's channels from the tap (bit c); the others from grid/value
     std::array<int32_t, 4> grid{};   // Fill, fx profiles: r0's grid integers
     std::array<float, 4> value{};    // Fill, float profiles: r0's floats
 };

@@ -66,6 +66,7 @@ RowWindow TileDecision::window(int x0, int x1) const {
     w.x1 = x1;
     w.mode = action == TileAction::Fill ? RowMode::Fill : action == TileAction::Copy ? RowMode::Copy : RowMode::Shade;
     w.copyTap = copyTap;
+    w.copyMask = copyMask;
     w.grid = grid;
     w.value = value;
     return w;
@@ -231,23 +232,30 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
     ps11::IntervalResult r;
     m_eval->evaluate(in, r);
     if (r.kill != ps11::KillRange::Never || r.writesDepth) return shade;
-    if (r.constantColor()) {
-        TileDecision d;
-        d.action = TileAction::Fill;
-        bool zero = true;
-        for (int c = 0; c < 4; ++c) {
-            const ps11::ChannelInterval& ch = r.color[size_t(c)];
-            d.grid[size_t(c)] = m_fx ? ch.gridLo : 0;
-            d.value[size_t(c)] = m_fx ? float(ch.gridLo) / float(m_grid) : (ch.lo == 0 ? 0.0f : float(ch.lo));
-            zero = zero && (m_fx ? ch.gridLo == 0 : ch.lo == 0);
-        }
-        if (m_writesNothing || (zero && m_zeroAddIsNoOp)) d.action = TileAction::Skip;
+    // Constant channels: the fill values (fx: the grid integer; float: the float, +0.0 for 0).
+    TileDecision d;
+    uint8_t constants = 0;
+    bool zero = true;
+    for (int c = 0; c < 4; ++c) {
+        const ps11::ChannelInterval& ch = r.color[size_t(c)];
+        if (!ch.constant) continue;
+        constants |= uint8_t(1u << c);
+        d.grid[size_t(c)] = m_fx ? ch.gridLo : 0;
+        d.value[size_t(c)] = m_fx ? float(ch.gridLo) / float(m_grid) : (ch.lo == 0 ? 0.0f : float(ch.lo));
+        zero = zero && (m_fx ? ch.gridLo == 0 : ch.lo == 0);
+    }
+    if (constants == 0xf) {
+        d.action = m_writesNothing || (zero && m_zeroAddIsNoOp) ? TileAction::Skip : TileAction::Fill;
         return d;
     }
-    if (r.copyStage >= 0 && r.copyStage < 8 && m_stages[size_t(r.copyStage)].tap >= 0) {
-        TileDecision d;
+    // A copy: every channel the lookup's own or a constant.
+    const int cs = r.channelCopyStage;
+    if (cs >= 0 && cs < 8 && m_stages[size_t(cs)].tap >= 0 && (r.copyMask | constants) == 0xf) {
         d.action = TileAction::Copy;
-        d.copyTap = m_stages[size_t(r.copyStage)].tap;
+        d.copyTap = m_stages[size_t(cs)].tap;
+        d.copyMask = r.copyMask;
+        for (int c = 0; c < 4; ++c)
+            if ((r.copyMask >> c) & 1) d.grid[size_t(c)] = 0, d.value[size_t(c)] = 0;
         return d;
     }
     return shade;

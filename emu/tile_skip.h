@@ -2,8 +2,8 @@
 // the renderer bounds what its taps can read — the per-tile facts of each texture
 // (ps11/texture_tiles.h) over the texels the tile's coordinates reach, the colours at its corners
 // — and runs the interval evaluator (ps11/intervals.h) over those ranges. Where r0 is one
-// constant the tile is filled without shading; where it is bit for bit one tap's lookup, only that
-// tap is filtered (a copy); where the merge of that constant leaves the target as it is (ONE/ONE
+// constant the tile is filled without shading; where each channel is bit for bit that channel of
+// one tap's lookup or a constant, only that tap is filtered (a copy); where the merge of that constant leaves the target as it is (ONE/ONE
 // of zero into an 8-bit target), nothing is drawn. Every claim holds for every input inside the
 // ranges, so images are byte-identical with skipping off.
 #pragma once
@@ -32,10 +32,11 @@ enum class TileAction : uint8_t { Shade, Fill, Copy, Skip };
 struct TileDecision {
     TileAction action = TileAction::Shade;
     int copyTap = -1;               // Copy: the tap in the draw's TapPlan
+    uint8_t copyMask = 0xf;         // Copy: r0's channels from the tap; the others are constants (grid/value)
     std::array<int32_t, 4> grid{};  // Fill: r0 (fx grid integers; float profiles: `value`)
     std::array<float, 4> value{};
     bool operator==(const TileDecision& o) const {
-        return action == o.action && copyTap == o.copyTap && grid == o.grid &&
+        return action == o.action && copyTap == o.copyTap && copyMask == o.copyMask && grid == o.grid &&
                std::memcmp(value.data(), o.value.data(), sizeof value) == 0;
     }
     // The row paths' window for columns [x0, x1) (Skip: nothing to draw).

@@ -401,12 +401,21 @@ void IntervalEvaluator::evaluate(const IntervalInputs& inputs, IntervalResult& r
     }
     result.kill = st.allKilled ? KillRange::Always : st.mayKill ? KillRange::Maybe : KillRange::Never;
     result.copyStage = result.copyInstruction = -1;
-    const int tap = r0[0].tap;
-    bool copy = tap >= 0;
-    for (int c = 0; c < 4; ++c) copy = copy && r0[c].tap == tap && r0[c].ch == c;
-    if (copy) {
-        result.copyStage = m_ops[size_t(tap)].stage;
-        result.copyInstruction = m_taps[size_t(tap)].instruction;
+    result.channelCopyStage = result.channelCopyInstruction = -1;
+    result.copyMask = 0;
+    // The first channel that is its own channel of a lookup names the lookup; every channel
+    // that is that lookup's same channel joins it.
+    int tap = -1;
+    for (int c = 0; c < 4 && tap < 0; ++c)
+        if (r0[c].tap >= 0 && r0[c].ch == c) tap = r0[c].tap;
+    if (tap < 0) return;
+    for (int c = 0; c < 4; ++c)
+        if (r0[c].tap == tap && r0[c].ch == c) result.copyMask |= uint8_t(1u << c);
+    result.channelCopyStage = m_ops[size_t(tap)].stage;
+    result.channelCopyInstruction = m_taps[size_t(tap)].instruction;
+    if (result.copyMask == 0xf) {
+        result.copyStage = result.channelCopyStage;
+        result.copyInstruction = result.channelCopyInstruction;
     }
 }
 

@@ -92,6 +92,13 @@ struct IntervalResult {
     // a decided cnd/cmp; lrp by exactly 0, or 1 in fx), and only when no clamp of the way can act.
     int copyStage = -1;
     int copyInstruction = -1;
+    // Per channel: the channels of r0 (bit c) that equal, bit for bit, the same channel of the
+    // plain lookup at instruction `channelCopyInstruction` from stage `channelCopyStage` (−1 and
+    // 0 when none); the same identities. A composite whose glare is zero but whose alpha is
+    // another constant copies its scene's r g b. copyStage is set where copyMask is 0xf.
+    uint8_t copyMask = 0;
+    int channelCopyStage = -1;
+    int channelCopyInstruction = -1;
 
     // All four channels of r0 are constants.
     bool constantColor() const {

@@ -198,7 +198,7 @@ private:
 };
 
 struct Tally {
-    int programs = 0, evaluations = 0, outputs = 0, constants = 0, copies = 0, bounded = 0, neverKill = 0;
+    int programs = 0, evaluations = 0, outputs = 0, constants = 0, copies = 0, channelCopies = 0, bounded = 0, neverKill = 0;
 };
 
 std::string rangeText(const ValueRange& r) {
@@ -305,14 +305,19 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
         exec->run(pin, sampler, pout);
 
         // The lookup a copy claim names: the k-th sampling instruction is the k-th request.
+        // Per channel (copyMask) as well: the channels it names are that lookup's.
         int copyCall = -1;
-        if (res.copyStage >= 0) {
+        REQUIRE((res.copyStage >= 0) == (res.copyMask == 0xf));
+        if (res.copyMask) {
+            REQUIRE(res.channelCopyStage >= 0);
+            if (res.copyStage >= 0) REQUIRE(res.copyInstruction == res.channelCopyInstruction);
             copyCall = 0;
-            for (int i = 0; i < res.copyInstruction; ++i)
+            for (int i = 0; i < res.channelCopyInstruction; ++i)
                 if (samplesStage(prog.instructions[size_t(i)].opcode())) ++copyCall;
             REQUIRE(copyCall < int(sampler.calls.size()));
-            REQUIRE(sampler.calls[size_t(copyCall)].stage == res.copyStage);
-            ++tally.copies;
+            REQUIRE(sampler.calls[size_t(copyCall)].stage == res.channelCopyStage);
+            tally.copies += res.copyMask == 0xf;
+            tally.channelCopies += res.copyMask != 0xf;
         }
         tally.constants += res.constantColor();
         tally.neverKill += res.kill == KillRange::Never;
@@ -326,7 +331,8 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
                 bool ok = true;
                 if (fx) {
                     ok = n >= ci.gridLo && n <= ci.gridHi && (!ci.constant || n == ci.gridLo);
-                    if (copyCall >= 0) ok = ok && n == sampler.calls[size_t(copyCall)].grid[size_t(c)][size_t(l)];
+                    if (copyCall >= 0 && ((res.copyMask >> c) & 1))
+                        ok = ok && n == sampler.calls[size_t(copyCall)].grid[size_t(c)][size_t(l)];
                 } else {
                     if (v == v)
                         ok = double(v) >= ci.lo && double(v) <= ci.hi;
@@ -334,7 +340,7 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
                         ok = !ci.bounded;
                     if (isNegZero(v)) ok = ok && ci.negZero;
                     if (ci.constant) ok = ok && bitsOf(v) == bitsOf(float(ci.lo));
-                    if (copyCall >= 0)
+                    if (copyCall >= 0 && ((res.copyMask >> c) & 1))
                         ok = ok && bitsOf(v) == bitsOf(sampler.calls[size_t(copyCall)].value[size_t(c)][size_t(l)]);
                 }
                 ++tally.outputs;
@@ -453,11 +459,12 @@ TEST_CASE("intervals: every executor output lies in the evaluated bounds (random
             for (Precision prec : kProfiles) checkProgram(prog, text, prec, rng, tally);
         }
     INFO("programs " << tally.programs << ", evaluations " << tally.evaluations << ", outputs " << tally.outputs
-                     << ", constant colours " << tally.constants << ", copies " << tally.copies << ", bounded channels "
+                     << ", constant colours " << tally.constants << ", copies " << tally.copies << " (channels only " << tally.channelCopies << "), bounded channels "
                      << tally.bounded << ", never kill " << tally.neverKill);
     CHECK(tally.programs > 2000);
     CHECK(tally.constants > 100);
     CHECK(tally.copies > 100);
+    CHECK(tally.channelCopies > 20);
 }
 
 }  // namespace
@@ -591,6 +598,31 @@ TEST_CASE("intervals: the screen and luminance composites over a zero glare tile
         const IntervalResult r = evaluateOnce(glareShader("composite_luminance.psh"), prec, {}, in);
         CHECK(r.copyStage == 0);
         CHECK(r.copyInstruction == 1);  // def c0, then tex t0
+    }
+}
+
+TEST_CASE("intervals: a screen composite over a zero glare whose alpha is one copies the scene's r g b", "[intervals]") {
+    // The blurred glare of a bright pass keeps alpha 1: S + G·(1 − S) then has r g b = S, and
+    // alpha 1·(1 − Sa) + Sa, which is 1 over a scene alpha of 0 and neither copy nor constant
+    // over an unknown one.
+    for (Precision prec : kProfiles) {
+        INFO(precisionName(prec));
+        IntervalInputs in;
+        in.stages[0] = unormTile(0, 1);
+        in.stages[0].value[3] = ValueRange::point(0);
+        in.stages[1] = unormTile(0, 0);
+        in.stages[1].value[3] = ValueRange::point(1);
+        IntervalResult r = evaluateOnce(glareShader("composite_screen.psh"), prec, {}, in);
+        CHECK(r.copyStage == -1);
+        CHECK(r.copyMask == 0x7);
+        CHECK(r.channelCopyStage == 0);
+        CHECK(r.channelCopyInstruction == 0);  // tex t0
+        CHECK(r.color[3].constant);
+        CHECK(r.color[3].lo == 1.0);
+        in.stages[0].value[3] = ValueRange::between(0, 1, false);
+        r = evaluateOnce(glareShader("composite_screen.psh"), prec, {}, in);
+        CHECK(r.copyMask == 0x7);
+        CHECK_FALSE(r.color[3].constant);
     }
 }
 
