@@ -10,7 +10,8 @@
 // The benchmark's own time is the emulator's fx8 frame; every mode's median and the ratios to the
 // peer are counters. These runners run every pass every frame (RunnerOptions::skip off); two more
 // hold the image with reuse on and time frames after the first (`*_still_*`), and four run the
-// technique with reuse on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`). Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
+// technique with skipping on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`; on the
+// emulator also with it off, `*_noskip_*`, and the sparse frame's tile decisions on stderr). Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -158,20 +159,23 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     const bool quarterSize = name == "sprites";
     const uint32_t panelW = quarterSize ? kW / 4 : kW, panelH = quarterSize ? kH / 4 : kH;
     state.counters["panel_width"] = panelW;
-    std::unique_ptr<glare::Runner> panel[2][2];  // [sparse, dense][emu fx8, GL native]
-    std::unique_ptr<glare::Scene> panelScene[2][2];
+    // [sparse, dense][emu fx8, GL native, emu fx8 with --no-skip (no reuse, every tile shaded)]
+    std::unique_ptr<glare::Runner> panel[2][3];
+    std::unique_ptr<glare::Scene> panelScene[2][3];
     for (int d = 0; d < 2; ++d)
-        for (int k = 0; k < 2; ++k)
-            if (!(panel[d][k] = makeRunner(movingMode[k], err, true, panelW, panelH)) ||
+        for (int k = 0; k < 3; ++k)
+            if (!(panel[d][k] = makeRunner(k == 2 ? EmuFx8 : movingMode[k], err, k != 2, panelW, panelH)) ||
                 !(panelScene[d][k] = glare::makeScene(d ? "dense" : "sparse", err))) {
                 state.SkipWithError(err.c_str());
                 return;
             }
-    std::vector<double> panelMs[2][2];
+    std::vector<double> panelMs[2][3];
+    uint64_t sparseBytes = 0;
+    glare::FrameResult sparseFrame;  // the last sparse frame on the emulator, for its tile counts
     int f = 1;
     for (auto _ : state) {
         for (int d = 0; d < 2; ++d)
-            for (int k = 0; k < 2; ++k) {
+            for (int k = 0; k < 3; ++k) {
                 double sceneMs = 0;
                 glare::FrameResult fr;
                 if (!panel[d][k]->renderScene(*panelScene[d][k], f % 60, 60, sceneMs, err) ||
@@ -180,6 +184,11 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
                     return;
                 }
                 panelMs[d][k].push_back(fr.milliseconds);
+                if (d == 0 && k == 0) {
+                    sparseBytes = 0;
+                    for (const glare::PassStats& p : fr.passes) sparseBytes += p.bytes;
+                    sparseFrame = fr;
+                }
             }
         for (int k = 0; k < 2; ++k) {
             glare::FrameResult fr;
@@ -250,6 +259,24 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["gl_native_dense_ms"] = median(panelMs[1][1]);
     state.counters["fx8_sparse_pct"] = 100.0 * median(panelMs[0][0]) / median(panelMs[1][0]);
     state.counters["native_sparse_pct"] = 100.0 * median(panelMs[0][1]) / median(panelMs[1][1]);
+    // What skipping saves on the moving scenes, and the sparse frame's floor: the bytes its passes
+    // must move at least (each texture read and written once), over its time.
+    state.counters["emu_fx8_sparse_noskip_ms"] = median(panelMs[0][2]);
+    state.counters["emu_fx8_dense_noskip_ms"] = median(panelMs[1][2]);
+    state.counters["fx8_sparse_vs_noskip_pct"] = 100.0 * median(panelMs[0][0]) / median(panelMs[0][2]);
+    state.counters["fx8_dense_vs_noskip_pct"] = 100.0 * median(panelMs[1][0]) / median(panelMs[1][2]);
+    state.counters["fx8_sparse_floor_mb"] = double(sparseBytes) / 1e6;
+    state.counters["fx8_sparse_gbps"] = double(sparseBytes) / 1e6 / median(panelMs[0][0]);
+    uint64_t tiles[4] = {};
+    for (const glare::PassStats& p : sparseFrame.passes) {
+        tiles[0] += p.tilesShaded, tiles[1] += p.tilesFilled, tiles[2] += p.tilesCopied, tiles[3] += p.tilesSkipped;
+        if (p.tilesShaded + p.tilesFilled + p.tilesCopied + p.tilesSkipped)
+            std::fprintf(stderr, "%s sparse %s: tiles shaded %llu filled %llu copied %llu skipped %llu\n", name.c_str(),
+                         p.pass.c_str(), (unsigned long long)p.tilesShaded, (unsigned long long)p.tilesFilled,
+                         (unsigned long long)p.tilesCopied, (unsigned long long)p.tilesSkipped);
+    }
+    state.counters["fx8_sparse_tiles_shaded"] = double(tiles[0]);
+    state.counters["fx8_sparse_tiles_decided"] = double(tiles[1] + tiles[2] + tiles[3]);
     state.counters["emu_fx8_still_ms"] = median(stillMs[0]);
     state.counters["gl_native_still_ms"] = median(stillMs[1]);
     state.counters["fx8_still_pct"] = 100.0 * median(stillMs[0]) / med[EmuFx8];
