@@ -950,6 +950,59 @@ TEST_CASE("reuse: frames are byte-identical with skipping on and off, moving and
     checkReuse(ideal);
 }
 
+TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on and off, every hardware class",
+          "[glare][reuse]") {
+    // Skipping's measuring scenes, moving, on every hardware class (fx8, fx12, float) and under
+    // ideal: the software renderer fills, copies and skips tiles (docs/device.md "Tile
+    // skipping") and reuses passes; the frames must be those of every pass run and every tile
+    // shaded.
+    uint64_t decided = 0;
+    std::vector<emu::DeviceOptions> devices;
+    for (const ps11::HardwareClass& h : ps11::hardwareClasses()) {
+        emu::DeviceOptions d;
+        d.hardware = &h;
+        devices.push_back(d);
+    }
+    devices.emplace_back().precision = ps11::Precision::Ideal;
+    for (const emu::DeviceOptions& device : devices) {
+        INFO((device.hardware ? std::string(device.hardware->name) : std::string("ideal")));
+        for (const glare::Technique* t : glare::techniques()) {
+            INFO(t->name());
+            const glare::Settings settings = *glare::presetSettings(*t, "published");
+            for (const char* sceneName : {"sparse", "dense"}) {
+                INFO(sceneName);
+                glare::RunnerOptions on, off;
+                on.width = off.width = 192;
+                on.height = off.height = 108;
+                on.device = off.device = device;
+                off.skip = false;
+                glare::Runner a(on), b(off);
+                std::string err;
+                std::unique_ptr<glare::Scene> sa = glare::makeScene(sceneName, err), sb = glare::makeScene(sceneName, err);
+                REQUIRE(sa);
+                for (int f = 0; f < 3; ++f) {
+                    INFO("frame " << f);
+                    double ms = 0;
+                    REQUIRE(a.renderScene(*sa, f, 60, ms, err));
+                    REQUIRE(b.renderScene(*sb, f, 60, ms, err));
+                    glare::FrameResult ra, rb;
+                    REQUIRE(a.runFrame(*t, settings, f, 60, ra, err));
+                    REQUIRE(b.runFrame(*t, settings, f, 60, rb, err));
+                    const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
+                    REQUIRE(oa);
+                    REQUIRE(ob);
+                    REQUIRE(oa->rgba == ob->rgba);
+                    for (const glare::PassStats& st : ra.passes) decided += st.tilesFilled + st.tilesCopied + st.tilesSkipped;
+                    for (const glare::PassStats& st : rb.passes)
+                        CHECK(st.tilesFilled + st.tilesCopied + st.tilesSkipped == 0);
+                }
+            }
+        }
+    }
+    INFO("tiles filled, copied or skipped: " << decided);
+    CHECK(decided > 1000);
+}
+
 TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
     std::string error;
     emu::DeviceOptions gl;
