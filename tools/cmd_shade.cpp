@@ -20,9 +20,10 @@ namespace {
 constexpr const char* kShadeUsage =
     "usage: ps11 shade SHADER.psh [--texN IMG] [--filterN point|linear] [--cN x,y,z,w] [--size WxH]\n"
     "                  [--backend emu|gl] [--gl osmesa|egl] [--gl-mode exact|native] [--hardware H | --precision P]\n"
-    "                  [--exposure STOPS]\n"
+    "                  [--exposure STOPS] [--no-skip]\n"
     "                  -o OUT.png\n"
-    "  N is a texture stage 0..3 (ps_1_4: 0..5) or a constant 0..7; the output size defaults to texture 0's\n";
+    "  N is a texture stage 0..3 (ps_1_4: 0..5) or a constant 0..7; the output size defaults to texture 0's\n"
+    "  --no-skip  the emulator shades every tile (no tile skipping; for comparison: the image is the same)\n";
 
 int shadeUsage(const std::string& msg) {
     std::cerr << "ps11 shade: " << msg << "\n" << kShadeUsage;
@@ -47,6 +48,7 @@ int cmdShade(const std::vector<std::string>& args) {
     const HardwareClass* hardware = nullptr;
     std::optional<Precision> precision;
     float exposure = 0;
+    bool noSkip = false;  // --no-skip: the emulator shades every tile
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         std::string v;
@@ -103,12 +105,15 @@ int cmdShade(const std::vector<std::string>& args) {
             exposure = std::strtof(v.c_str(), &end);
             if (end == v.c_str() || *end || !std::isfinite(exposure) || std::fabs(exposure) > 64)
                 return shadeUsage("--exposure takes stops in -64 .. 64");
+        } else if (a == "--no-skip") {
+            noSkip = true;
         } else if (a == "-o" || a == "--out") {
             if (!value()) return shadeUsage("-o needs a file name");
             out = v;
         } else if (a.size() > 1 && a[0] == '-') {
             return shadeUsage(cli::unknownOption(a, {"--tex0", "--filter0", "--c0", "--size", "--backend", "--gl", "--gl-mode",
-                                                     "--hardware", "--precision", "--exposure", "-o", "--help"}));
+                                                     "--hardware", "--precision", "--exposure", "--no-skip", "-o",
+                                                     "--help"}));
         } else if (shaderPath.empty()) {
             shaderPath = a;
         } else {
@@ -147,6 +152,7 @@ int cmdShade(const std::vector<std::string>& args) {
     emu::DeviceOptions options;
     options.hardware = hardware;
     options.precision = precision;
+    options.software.skipTiles = !noSkip;
     std::string err;
     if (backend == "gl") {
         options.renderer = glRendererFactory(glKind, err, glNative);

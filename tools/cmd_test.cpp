@@ -27,7 +27,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: ps11 test FILE.ps11test|FOLDER... [--backend emu|gl|both] [--gl osmesa|egl] [--gl-mode exact|native]\n"
-    "                 [--hardware H] [--precision fx8|fx12|float|ideal] [--stats] [-v]\n"
+    "                 [--hardware H] [--precision fx8|fx12|float|ideal] [--no-skip] [--stats] [-v]\n"
     "  --backend B    emu (the software renderer), gl (the OpenGL renderer) or both: every draw and eval\n"
     "                 on both renderers, their results compared (disagreements fail the file)\n"
     "  --gl KIND      the OpenGL context: osmesa or egl (default: the first that works)\n"
@@ -35,7 +35,11 @@ constexpr const char* kUsage =
     "                 interpolation, filtering, float arithmetic and blending: run and measured against\n"
     "                 the emulator, its probes and differences counted, not failed)\n"
     "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists\n"
-    "                 them); `all` runs the files once per class\n";
+    "                 them); `all` runs the files once per class\n"
+    "  --no-skip      the emulator shades every tile (no tile skipping; for comparison: the images are\n"
+    "                 the same); with --backend gl or both it applies to the emu side only\n"
+    "  --stats        executor statistics and draw statistics per file (with the tiles shaded, filled,\n"
+    "                 copied and skipped)\n";
 
 int usageError(const std::string& message) {
     std::cerr << "ps11 test: " << message << "\n" << kUsage;
@@ -50,6 +54,7 @@ struct RunOptions {
     bool stats = false;  // print executor statistics per file
     RendererFactory glRenderer;  // --backend gl|both
     bool glNative = false;       // --gl-mode native
+    bool skipTiles = true;       // --no-skip: false
 };
 
 enum class Outcome { Passed, Failed, NotRunnable };
@@ -178,6 +183,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
     run.shaderDiags = &shaderDiags;
     run.glRenderer = opts.glRenderer;
     run.glNative = opts.glNative;
+    run.skipTiles = opts.skipTiles;
     CommandTally& t = result.tally;
     runCommands(file, path, program ? &*program : nullptr, run, t);
     if (opts.stats && t.evals) {
@@ -192,7 +198,8 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         std::cout << path << ": draw stats (" << hw.describe() << "): " << d.draws << " draws, "
                   << d.pixelsShaded << " pixels shaded, " << d.pixelsWritten << " written, " << d.instructions
                   << " instructions executed, " << d.texelsFetched << " texels fetched, " << d.milliseconds
-                  << " ms\n";
+                  << " ms, tiles shaded/filled/copied/skipped " << d.tilesShaded << "/" << d.tilesFilled << "/"
+                  << d.tilesCopied << "/" << d.tilesSkipped << "\n";
     }
     if (t.error || t.probesFailed || t.disagreements)
         result.outcome = Outcome::Failed;
@@ -253,13 +260,16 @@ int cmdTest(const std::vector<std::string>& args) {
             }
         } else if (a == "--stats") {
             opts.stats = true;
+        } else if (a == "--no-skip") {
+            opts.skipTiles = false;
         } else if (a == "-v" || a == "--verbose") {
             opts.verbose = true;
         } else if (a == "-h" || a == "--help") {
             std::cout << kUsage;
             return cli::kOk;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usageError(cli::unknownOption(a, {"--backend", "--gl", "--gl-mode", "--hardware", "--precision", "--stats", "--verbose", "--help"}));
+            return usageError(cli::unknownOption(a, {"--backend", "--gl", "--gl-mode", "--hardware", "--precision",
+                                                     "--no-skip", "--stats", "--verbose", "--help"}));
         } else {
             std::error_code ec;
             if (std::filesystem::is_directory(a, ec)) {

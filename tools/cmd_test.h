@@ -9,7 +9,7 @@
 
 namespace ps11 {
 
-// `ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision P] [--stats] [-v]`. Returns 0 when
+// `ps11 test FILE.ps11test... [--backend emu|gl|both] [--precision P] [--no-skip] [--stats] [-v]`. Returns 0 when
 // every runnable check passed, 1 on any failure or parse error, 2 on usage errors.
 int cmdTest(const std::vector<std::string>& args);
 

@@ -271,7 +271,7 @@ DrawRunner::~DrawRunner() = default;
 
 std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::string& path, const Program* program,
                                                const HardwareConfig& hardware, std::string& error,
-                                               bool alignedPasses, const RendererFactory& renderer) {
+                                               bool alignedPasses, const RendererFactory& renderer, bool skipTiles) {
     std::unique_ptr<DrawRunner> r(new DrawRunner());
     r->m_path = path;
     emu::DeviceOptions options;
@@ -279,6 +279,7 @@ std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::
     options.precision = hardware.precision;
     options.maxValue = hardware.maxValue;
     options.software.alignedPasses = alignedPasses;
+    options.software.skipTiles = skipTiles;
     options.renderer = renderer;
     r->m_device = std::make_unique<Device>(options);
     Device& d = *r->m_device;
@@ -404,6 +405,10 @@ bool DrawRunner::draw(const TestCommand& command, std::string& error) {
     m_tally.texelsFetched += stats.texelsFetched;
     m_tally.instructions += stats.instructions;
     m_tally.milliseconds += stats.milliseconds;
+    m_tally.tilesShaded += stats.tilesShaded;
+    m_tally.tilesFilled += stats.tilesFilled;
+    m_tally.tilesCopied += stats.tilesCopied;
+    m_tally.tilesSkipped += stats.tilesSkipped;
     return true;
 }
 

@@ -30,6 +30,9 @@ struct DrawTally {
     uint64_t texelsFetched = 0;
     uint64_t instructions = 0;
     double milliseconds = 0;
+    // The software renderer's 16x64 tiles by decision (docs/device.md "Tile skipping"); 0 on
+    // renderers and draws that do not tile.
+    uint64_t tilesShaded = 0, tilesFilled = 0, tilesCopied = 0, tilesSkipped = 0;
 };
 
 class DrawRunner {
@@ -38,10 +41,12 @@ public:
     // and render states, transforms, constants and the pixel shader (`program`, null = fixed
     // function) on a device of `hardware`. Returns null with `error` set ("FILE:LINE: …") when
     // the device refuses a call. `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer
-    // draws both ways); `renderer` makes the device's renderer (empty: the software renderer).
+    // draws both ways); `renderer` makes the device's renderer (empty: the software renderer);
+    // `skipTiles` is emu::DeviceOptions::software.skipTiles (`ps11 test --no-skip` turns it off).
     static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
                                               const HardwareConfig& hardware, std::string& error,
-                                              bool alignedPasses = true, const RendererFactory& renderer = {});
+                                              bool alignedPasses = true, const RendererFactory& renderer = {},
+                                              bool skipTiles = true);
     ~DrawRunner();
 
     // Runs a `draw quad` / `draw triangles|strip|fan` command; false with `error` set when the

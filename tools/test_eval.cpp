@@ -330,7 +330,7 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
                 std::string error;
                 if (!device) {
                     device = DrawRunner::create(file, path, program, opts.hardware, error, true,
-                                                gl ? opts.glRenderer : RendererFactory{});
+                                                gl ? opts.glRenderer : RendererFactory{}, opts.skipTiles);
                     if (!device) {
                         std::cout << error << (gl ? " [gl]" : "") << "\n";
                         deviceFailed = tally.error = true;
@@ -417,6 +417,10 @@ void runCommands(const TestFile& file, const std::string& path, const Program* p
             tally.draws.texelsFetched += d.texelsFetched;
             tally.draws.instructions += d.instructions;
             tally.draws.milliseconds += d.milliseconds;
+            tally.draws.tilesShaded += d.tilesShaded;
+            tally.draws.tilesFilled += d.tilesFilled;
+            tally.draws.tilesCopied += d.tilesCopied;
+            tally.draws.tilesSkipped += d.tilesSkipped;
         }
     }
     if (state.sampler) tally.texelsFetched = state.sampler->texelsFetched();

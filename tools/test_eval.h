@@ -98,6 +98,8 @@ struct CommandRunOptions {
     // The GL renderer runs in native mode (emu/gl/gl_renderer.h): not bit-exact by design, so its
     // results are measured against the emulator's instead of checked.
     bool glNative = false;
+    // emu::DeviceOptions::software.skipTiles of the emu backend's devices (`--no-skip`: false).
+    bool skipTiles = true;
 };
 
 // Runs (or counts) every command of `file` whose if(...) matches the run. `program` is the

@@ -3,6 +3,7 @@
 # 2 usage) and that user errors name the file and place. Usage: cli_test.sh PATH/TO/ps11
 set -u
 ps11="$1"
+root="$(cd "$(dirname "$0")/../.." && pwd)"  # the project (the corpus under tests/shaders)
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 failures=0
@@ -367,6 +368,26 @@ expect_rc 1 "glare a missing image" "$ps11" glare --technique glow --in "$work/n
 expect_in "$work/err" "none.exr" "glare names the missing image"
 expect_rc 1 "glare an image too small" "$ps11" glare --technique glow --in "$work/hdr.png" -o "$work/x.png"
 expect_in "$work/err" "at least 8x8" "glare says the frame is too small"
+
+# --no-skip on shade and test: every tile shaded (docs/device.md "Tile skipping"), the same images.
+expect_rc 0 "shade a constant, tiles skipped" "$ps11" shade "$work/flat.psh" --c0 0.5,0.25,1,1 --size 200x100 -o "$work/ns_flat.png"
+expect_rc 0 "shade a constant --no-skip" "$ps11" shade "$work/flat.psh" --c0 0.5,0.25,1,1 --size 200x100 --no-skip -o "$work/ns_flat_all.png"
+cmp -s "$work/ns_flat.png" "$work/ns_flat_all.png" || fail "shade --no-skip wrote another image (constant)"
+expect_rc 0 "shade an image, tiles skipped" "$ps11" shade "$work/tex.psh" --tex0 "$work/g_0000.png" --c0 0.5,1,1,1 --size 300x170 -o "$work/ns_tex.png"
+expect_rc 0 "shade an image --no-skip" "$ps11" shade "$work/tex.psh" --tex0 "$work/g_0000.png" --c0 0.5,1,1,1 --size 300x170 --no-skip -o "$work/ns_tex_all.png"
+cmp -s "$work/ns_tex.png" "$work/ns_tex_all.png" || fail "shade --no-skip wrote another image (texture)"
+expect_rc 2 "shade --no-skip mistyped" "$ps11" shade "$work/flat.psh" --size 4x4 --no-skp -o "$work/x.png"
+expect_in "$work/err" "did you mean '--no-skip'?" "shade suggests --no-skip"
+corpus_file="$root/tests/shaders/draw/address_wrap_linear.ps11test"
+expect_rc 0 "test a corpus file --stats" "$ps11" test "$corpus_file" --stats
+expect_in "$work/out" "tiles shaded/filled/copied/skipped " "test --stats prints the tile decisions"
+if grep -q "tiles shaded/filled/copied/skipped 0/0/0/0" "$work/out"; then fail "test: the corpus file's draw was not tiled"; fi
+expect_rc 0 "test a corpus file --no-skip" "$ps11" test "$corpus_file" --no-skip --stats
+expect_in "$work/out" "1 file: 1 passed, 0 failed" "test --no-skip passes"
+expect_in "$work/out" "32 pixels shaded, 32 written" "test --no-skip shades every pixel"
+expect_in "$work/out" "tiles shaded/filled/copied/skipped 0/0/0/0" "test --no-skip cuts no tiles"
+expect_rc 0 "test the draw corpus --no-skip" "$ps11" test "$root/tests/shaders/draw" --no-skip
+expect_in "$work/out" " passed, 0 failed, 0 not yet runnable" "the draw corpus passes with --no-skip"
 if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "glare --compare" "$ps11" glare --technique adaptive --scene box --size 64x36 --compare
     expect_in "$work/out" "agreement: every pass within 1 level" "glare --compare agrees"
@@ -395,6 +416,8 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "test --gl-mode native" "$ps11" test "$work/n.ps11test" --backend both --gl-mode native
     expect_in "$work/out" "gl native mode, measured against the emulated card: 0 probes differ" "test counts native differences"
     expect_rc 2 "test --gl-mode without gl" "$ps11" test "$work/d.ps11test" --gl-mode native
+    expect_rc 0 "test --backend both --no-skip" "$ps11" test "$corpus_file" --backend both --no-skip
+    expect_in "$work/out" "0 disagreements" "--no-skip on the emu side agrees with gl"
     expect_rc 0 "compare --gl-mode native" "$ps11" compare "$work/n.ps11test" --gl-mode native
     expect_in "$work/out" "gl native against ideal: max |d| 0 levels" "compare reports the distance from ideal"
     expect_rc 2 "compare --random --gl-mode native" "$ps11" compare --random 2 --gl-mode native
