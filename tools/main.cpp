@@ -52,7 +52,7 @@ const char* kUsageText =
     "  glare --list | --report [--json|--markdown]\n"
     "  glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH] [--backend emu|gl]\n"
     "        [--hardware H | --precision P] [--quality Q] [--set name=value] [--dump-passes DIR]\n"
-    "        [--graph OUT.dot] [--compare] [--json]\n"
+    "        [--graph OUT.dot] [--compare] [--json] [--no-skip]\n"
     "                         the glare techniques on a built-in scene or an image, pass by pass\n"
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
