@@ -362,9 +362,16 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
 }
 
 void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                   FloatRowScratch& sc, AlignedStats& stats, const RowWindow* window) {
+                   FloatRowScratch& sc, AlignedStats& stats, const RowWindow* windows, size_t windowCount) {
     const ps11::Executor& exec = *draw.executor;
-    const RowMode mode = window ? window->mode : RowMode::Shade;
+    // No windows: every column shaded. Windows are disjoint, in column order.
+    const RowWindow whole{std::numeric_limits<int>::min(), std::numeric_limits<int>::max()};
+    if (!windows || windowCount == 0) windows = &whole, windowCount = 1;
+    uint32_t neededTaps = 0;  // taps some window samples
+    for (size_t wi = 0; wi < windowCount; ++wi)
+        neededTaps |= windows[wi].mode == RowMode::Shade ? 0xffu
+                      : windows[wi].mode == RowMode::Copy ? 1u << windows[wi].copyTap
+                                                          : 0u;
     const int taps = draw.plan.count;
     std::array<RowTaps, 8> rows{};
     RowSampler sampler(draw, tri, rows);
@@ -382,12 +389,12 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
     for (int y = std::max(y0, s.yMin); y < std::min(y1, s.yMax); ++y) {
         int xl = 0, xr = 0;
         if (!rowCoverage(s, y, xl, xr)) continue;
-        if (window) xl = std::max(xl, window->x0), xr = std::min(xr, window->x1);
+        xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[windowCount - 1].x1);
         if (xl >= xr) continue;
         sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
         for (int t = 0; t < taps; ++t) {
             const FloatRowTap& tap = draw.taps[size_t(t)];
-            if (!tap.bound || mode == RowMode::Fill || (mode == RowMode::Copy && t != window->copyTap)) continue;
+            if (!tap.bound || !((neededTaps >> t) & 1)) continue;
             const float v = rowV(s, tap.coordSet, y);
             RowTaps& r = rows[size_t(t)];
             ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
@@ -398,42 +405,47 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
                 r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(tap, r.j0, sc) : nullptr;
             }
         }
-        for (int x = xl; x < xr; x += ps11::kMaxSpan) {
-            const int n = std::min(ps11::kMaxSpan, xr - x);
-            sampler.setX(x);
-            if (mode == RowMode::Shade) {
-                fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
-                in.count = n;
-                exec.run(in, sampler, outp, &stats.exec);
-                stats.texels += uint64_t(n) * texelsPerPixel;
-            } else if (mode == RowMode::Copy) {
-                // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
-                const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];
-                ps11::SampleRequest req;
-                req.stage = tap.stage;
-                req.count = n;
-                req.u = kLaneIndex.data();
-                req.v = kLaneIndex.data();
-                req.precision = exec.options().precision;
-                ps11::SampleResult res;
-                for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
-                sampler.sample(req, res);
-                for (int c = 0; c < 4; ++c)
-                    if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
-                stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
-            } else {
-                for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+        for (size_t wi = 0; wi < windowCount; ++wi) {
+            const RowWindow* window = &windows[wi];
+            const RowMode mode = window->mode;
+            const int wl = std::max(xl, window->x0), wr = std::min(xr, window->x1);
+            for (int x = wl; x < wr; x += ps11::kMaxSpan) {
+                const int n = std::min(ps11::kMaxSpan, wr - x);
+                sampler.setX(x);
+                if (mode == RowMode::Shade) {
+                    fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                    in.count = n;
+                    exec.run(in, sampler, outp, &stats.exec);
+                    stats.texels += uint64_t(n) * texelsPerPixel;
+                } else if (mode == RowMode::Copy) {
+                    // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
+                    const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];
+                    ps11::SampleRequest req;
+                    req.stage = tap.stage;
+                    req.count = n;
+                    req.u = kLaneIndex.data();
+                    req.v = kLaneIndex.data();
+                    req.precision = exec.options().precision;
+                    ps11::SampleResult res;
+                    for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
+                    sampler.sample(req, res);
+                    for (int c = 0; c < 4; ++c)
+                        if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                    stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
+                } else {
+                    for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                }
+                MergeInputs mi;
+                mi.count = n;
+                for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                mi.x = sc.x;
+                mi.y = sc.y;
+                for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
+                MergeStats ms;
+                mergePixels(draw.merge, mi, draw.target, &ms);
+                stats.written += ms.written;
+                stats.pixels += uint64_t(n);
             }
-            MergeInputs mi;
-            mi.count = n;
-            for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
-            mi.x = sc.x;
-            mi.y = sc.y;
-            for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
-            MergeStats ms;
-            mergePixels(draw.merge, mi, draw.target, &ms);
-            stats.written += ms.written;
-            stats.pixels += uint64_t(n);
         }
     }
 }

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <limits>
 
 #include "emu/aligned_pass_kernels.h"
 #include "ps11/texture_sampler_fast.h"
@@ -468,8 +469,16 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 }
 
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
-                     size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* window) {
-    const RowMode mode = window ? window->mode : RowMode::Shade;
+                     size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* windows,
+                     size_t windowCount) {
+    // No windows: every column shaded. Windows are disjoint, in column order.
+    const RowWindow whole{std::numeric_limits<int>::min(), std::numeric_limits<int>::max()};
+    if (!windows || windowCount == 0) windows = &whole, windowCount = 1;
+    uint32_t neededTaps = 0;  // taps some window filters
+    for (size_t wi = 0; wi < windowCount; ++wi)
+        neededTaps |= windows[wi].mode == RowMode::Shade ? 0xffu
+                      : windows[wi].mode == RowMode::Copy ? 1u << windows[wi].copyTap
+                                                          : 0u;
     const ps11::Executor& exec = *draw.executor;
     Image& target = *draw.target.color;
     const bool x8 = target.format->format == D3DFMT_X8R8G8B8;
@@ -537,12 +546,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             if (y < s.yMin || y >= s.yMax) continue;
             int xl = 0, xr = 0;
             if (!rowCoverage(s, y, xl, xr)) continue;
-            if (window) xl = std::max(xl, window->x0), xr = std::min(xr, window->x1);
+            xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[windowCount - 1].x1);
             if (xl >= xr) continue;
             ctx.tri = &tri;
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
-                if (!tap.bound || mode == RowMode::Fill || (mode == RowMode::Copy && t != window->copyTap)) continue;
+                if (!tap.bound || !((neededTaps >> t) & 1)) continue;
                 TapRow& r = rows[size_t(t)];
                 r = tapRow(tap, s, y);
                 // The H rows of the tap's long runs (built on first use, shared by taps and rows).
@@ -562,54 +571,59 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                 }
             }
-            for (int x = xl; x < xr; x += ps11::kMaxSpan) {
-                const int n = std::min(ps11::kMaxSpan, xr - x);
-                for (int t = 0; t < taps; ++t)
-                    if (mode == RowMode::Shade || (mode == RowMode::Copy && t == window->copyTap))
-                        stats.texels +=
-                            uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
-                ctx.x = x;
-                if (mode == RowMode::Shade) {
-                    fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
-                    in.count = n;
-                    exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
-                } else if (mode == RowMode::Copy) {
-                    fill(&ctx, window->copyTap, 0, n, r0);
-                    for (int c = 0; c < 4; ++c)
-                        if (!((window->copyMask >> c) & 1)) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
-                } else {
-                    for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
-                }
-                stats.pixels += uint64_t(n);
-                uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
-                if (draw.directStore || draw.directAdd) {
-                    int done = 0;
-                    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r0c, n, orMask, row);
-                    const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
-                    if (draw.directAdd)
-                        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
-                    else
-                        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
-                    stats.written += uint64_t(n);
-                    continue;
-                }
-                // Anything else: the output merger over the row.
-                MergeInputs mi;
-                mi.count = n;
-                for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
-                mi.x = sc.x;
-                mi.y = sc.y;
-                for (int c = 0; c < 4; ++c) {
-                    for (int i = 0; i < n; ++i) {
-                        sc.grid[c][i] = sc.r0[c][i];
-                        sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
+            for (size_t wi = 0; wi < windowCount; ++wi) {
+                const RowWindow* window = &windows[wi];
+                const RowMode mode = window->mode;
+                const int wl = std::max(xl, window->x0), wr = std::min(xr, window->x1);
+                for (int x = wl; x < wr; x += ps11::kMaxSpan) {
+                    const int n = std::min(ps11::kMaxSpan, wr - x);
+                    for (int t = 0; t < taps; ++t)
+                        if (mode == RowMode::Shade || (mode == RowMode::Copy && t == window->copyTap))
+                            stats.texels +=
+                                uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
+                    ctx.x = x;
+                    if (mode == RowMode::Shade) {
+                        fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        in.count = n;
+                        exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
+                    } else if (mode == RowMode::Copy) {
+                        fill(&ctx, window->copyTap, 0, n, r0);
+                        for (int c = 0; c < 4; ++c)
+                            if (!((window->copyMask >> c) & 1)) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                    } else {
+                        for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     }
-                    mi.color[c] = sc.colorOut[c];
-                    mi.grid[c] = sc.grid[c];
+                    stats.pixels += uint64_t(n);
+                    uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
+                    if (draw.directStore || draw.directAdd) {
+                        int done = 0;
+                        if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r0c, n, orMask, row);
+                        const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
+                        if (draw.directAdd)
+                            storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
+                        else
+                            storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
+                        stats.written += uint64_t(n);
+                        continue;
+                    }
+                    // Anything else: the output merger over the row.
+                    MergeInputs mi;
+                    mi.count = n;
+                    for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                    mi.x = sc.x;
+                    mi.y = sc.y;
+                    for (int c = 0; c < 4; ++c) {
+                        for (int i = 0; i < n; ++i) {
+                            sc.grid[c][i] = sc.r0[c][i];
+                            sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
+                        }
+                        mi.color[c] = sc.colorOut[c];
+                        mi.grid[c] = sc.grid[c];
+                    }
+                    MergeStats ms;
+                    mergePixels(draw.merge, mi, draw.target, &ms);
+                    stats.written += ms.written;
                 }
-                MergeStats ms;
-                mergePixels(draw.merge, mi, draw.target, &ms);
-                stats.written += ms.written;
             }
         }
     }

@@ -181,10 +181,11 @@ struct RowWindow {
 };
 
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
-// order): row by row, each row through every triangle in order. With `window`, only its columns,
-// as it says.
+// order): row by row, each row through every triangle in order. With `windows` (disjoint, in
+// column order), only their columns, each as it says; every texel row the windows need is
+// filtered once per pixel row for all of them.
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats,
-                     const RowWindow* window = nullptr);
+                     const RowWindow* windows = nullptr, size_t windowCount = 0);
 
 }  // namespace emu

@@ -238,8 +238,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             };
             const std::function<void(QuadSpan&)> emitFn = emit;
             AlignedStats as;
-            // A band of a chunk drawn wholly by a row path, tile by tile: runs of tiles with one
-            // decision are drawn (or skipped) together.
+            std::vector<RowWindow> windows;
+            TileMemo memo;
+            // A band of a chunk drawn wholly by a row path, tile by tile (emu/tile_skip.h).
             auto drawBandTiles = [&](int b, int by0, int by1) {
                 const TriangleSetup* bt[kMaxAlignedTriangles];
                 const AlignedTriangle* at[kMaxAlignedTriangles];
@@ -255,7 +256,18 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
                 }
                 if (n == 0 || ty0 >= ty1) return;
-                auto drawRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
+                // The columns the band's triangles cover (a small quad decides only its own tiles).
+                int tx0 = clip.x1, tx1 = clip.x0;
+                for (size_t t = 0; t < n; ++t)
+                    for (int y = std::max(ty0, bt[t]->yMin); y < std::min(ty1, bt[t]->yMax); ++y) {
+                        int xl = 0, xr = 0;
+                        if (rowCoverage(*bt[t], y, xl, xr)) tx0 = std::min(tx0, xl), tx1 = std::max(tx1, xr);
+                    }
+                if (tx0 >= tx1) return;
+                // Runs of tiles with one decision become the windows of one pass over the band's
+                // rows (each texel row the windows need is filtered once per pixel row).
+                windows.clear();
+                auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
                     switch (d.action) {
                         case TileAction::Shade: ws.tilesShaded += count; break;
                         case TileAction::Fill: ws.tilesFilled += count; break;
@@ -271,28 +283,30 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                 }
                             return;
                     }
-                    const RowWindow win = d.window(xa, xb);
-                    if (floatDraw) {
-                        for (size_t t = 0; t < n; ++t)
-                            drawFloatRows(floatRows, floatTris[idx[t]], *bt[t], by0, by1, ws0.floatRows, as, &win);
-                    } else {
-                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, &win);
-                    }
+                    windows.push_back(d.window(xa, xb));
                 };
                 TileDecision run;
-                int runX0 = clip.x0;
+                int runX0 = tx0;
                 uint64_t runTiles = 0;
-                for (int x = clip.x0; x < clip.x1; x += kSkipTileColumns) {
-                    const int xe = std::min(clip.x1, x + kSkipTileColumns);
-                    const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1);
+                for (int x = tx0; x < tx1; x += kSkipTileColumns) {
+                    const int xe = std::min(tx1, x + kSkipTileColumns);
+                    const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1, memo);
                     if (runTiles && !(d == run)) {
-                        drawRun(run, runX0, x, runTiles);
+                        addRun(run, runX0, x, runTiles);
                         runTiles = 0;
                     }
                     if (!runTiles) run = d, runX0 = x;
                     ++runTiles;
                 }
-                if (runTiles) drawRun(run, runX0, clip.x1, runTiles);
+                if (runTiles) addRun(run, runX0, tx1, runTiles);
+                if (windows.empty()) return;
+                if (floatDraw) {
+                    for (size_t t = 0; t < n; ++t)
+                        drawFloatRows(floatRows, floatTris[idx[t]], *bt[t], by0, by1, ws0.floatRows, as, windows.data(),
+                                      windows.size());
+                } else {
+                    drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
+                }
             };
             for (;;) {
                 const int b = next.fetch_add(1, std::memory_order_relaxed);

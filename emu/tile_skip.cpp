@@ -2,6 +2,7 @@
 #include "emu/tile_skip.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -16,6 +17,7 @@ namespace emu {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr uint64_t kParallelScanTexels = 1u << 18;
 
 // Texel indices [i0, i1] of one axis as the address mode maps them into [0, n − 1]: `a`..`b`
 // (a > b: none), `border` when some index falls on the border colour.
@@ -84,6 +86,8 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
     std::optional<ps11::IntervalEvaluator> eval = ps11::IntervalEvaluator::create(program, setup, diags);
     if (!eval || eval->texcoordSetsRead() != 0 || eval->dependentLookupStages() != 0) return nullptr;
     auto sk = std::unique_ptr<TileSkipper>(new TileSkipper());
+    static std::atomic<uint64_t> ids{0};
+    sk->m_id = ++ids;
     sk->m_fx = ps11::isFixedPoint(call.hardware.precision);
     sk->m_grid = double(eval->profile().g);
     for (int t = 0; t < plan.count; ++t) {
@@ -108,12 +112,18 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
         // First read of this texture (of this generation): its facts, tile rows over the workers.
         auto tiles = std::make_shared<ps11::TexelTiles>();
         ps11::prepareTexelTiles(*st.texture, *tiles);
-        const int workers = int(std::clamp<uint32_t>(tiles->tilesY / 4, 1, uint32_t(pool.size())));
+        // Over the workers only where the scan outweighs waking them (about a megabyte of texels).
         const ps11::Texture& tex = *st.texture;
-        pool.run(workers, [&](int w) {
-            ps11::scanTexelTiles(tex, *tiles, tiles->tilesY * uint32_t(w) / uint32_t(workers),
-                                 tiles->tilesY * uint32_t(w + 1) / uint32_t(workers));
-        });
+        const uint64_t texels = uint64_t(tiles->width) * tiles->height;
+        if (texels < kParallelScanTexels) {
+            ps11::scanTexelTiles(tex, *tiles, 0, tiles->tilesY);
+        } else {
+            const int workers = int(std::clamp<uint32_t>(tiles->tilesY / 4, 1, uint32_t(pool.size())));
+            pool.run(workers, [&](int w) {
+                ps11::scanTexelTiles(tex, *tiles, tiles->tilesY * uint32_t(w) / uint32_t(workers),
+                                     tiles->tilesY * uint32_t(w + 1) / uint32_t(workers));
+            });
+        }
         st.texture->keepTexelTiles(tiles);
         st.tiles = std::move(tiles);
     }
@@ -134,10 +144,21 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
     return sk;
 }
 
-TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1) const {
+namespace {
+
+bool sameRange(const ps11::ValueRange& a, const ps11::ValueRange& b) {
+    return a.lo == b.lo && a.hi == b.hi && a.negZero == b.negZero && a.nan == b.nan;
+}
+
+}  // namespace
+
+TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1,
+                                 TileMemo& memo) const {
     TileDecision shade;
     if (count == 0 || x0 >= x1 || y0 >= y1) return shade;
-    ps11::IntervalInputs in;
+    if (memo.skipper != m_id) memo = TileMemo{}, memo.skipper = m_id;
+    // Only the ranges this draw reads are written (the rest stay unknown from the start).
+    ps11::IntervalInputs& in = memo.in;
     for (int s = 0; s < 8; ++s) {
         const Stage& st = m_stages[size_t(s)];
         if (!st.read) continue;
@@ -229,6 +250,22 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
             }
             in.color[size_t(k)][size_t(c)] = ps11::ValueRange{lo, hi, negZero, false};
         }
+    // The same ranges as the worker's last tile: the same decision.
+    bool same = memo.valid;
+    for (int s = 0; s < 8 && same; ++s)
+        if (m_stages[size_t(s)].read)
+            for (int c = 0; c < 4 && same; ++c) same = sameRange(in.stages[size_t(s)].value[size_t(c)], memo.last.stages[size_t(s)].value[size_t(c)]);
+    for (int k = 0; k < 2 && same; ++k)
+        for (int c = 0; c < 4 && same; ++c) same = sameRange(in.color[size_t(k)][size_t(c)], memo.last.color[size_t(k)][size_t(c)]);
+    if (same) return memo.decision;
+    memo.decision = evaluate(in);
+    memo.last = in;
+    memo.valid = true;
+    return memo.decision;
+}
+
+TileDecision TileSkipper::evaluate(const ps11::IntervalInputs& in) const {
+    const TileDecision shade;
     ps11::IntervalResult r;
     m_eval->evaluate(in, r);
     if (r.kill != ps11::KillRange::Never || r.writesDepth) return shade;

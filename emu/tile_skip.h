@@ -48,6 +48,15 @@ struct TileCounts {
     uint64_t shaded = 0, filled = 0, copied = 0, skipped = 0;
 };
 
+// A worker's last evaluation: tiles whose input ranges equal the last one's (a run of zero or
+// constant tiles) take its decision without evaluating again. Valid within one draw.
+struct TileMemo {
+    uint64_t skipper = 0;  // the id of the draw's TileSkipper it belongs to
+    bool valid = false;
+    ps11::IntervalInputs in, last;
+    TileDecision decision;
+};
+
 class TileSkipper {
 public:
     // For a draw on a row path with tap plan `plan`: nullopt when its tiles cannot be decided
@@ -58,10 +67,12 @@ public:
                                                const ps11::TapPlan& plan, ThreadPool& pool);
 
     // The decision for pixels [x0, x1) × [y0, y1) of the triangles `tris` (those that may
-    // cover the tile, all on the row path).
-    TileDecision decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1) const;
+    // cover the tile, all on the row path); `memo` is the calling worker's.
+    TileDecision decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1,
+                        TileMemo& memo) const;
 
 private:
+    TileDecision evaluate(const ps11::IntervalInputs& in) const;
     struct Stage {
         bool read = false;
         std::shared_ptr<const ps11::Texture> texture;  // null: unbound, (0, 0, 0, 1)
@@ -70,6 +81,7 @@ private:
         int coordSet = 0;
         int tap = -1;  // the plan's tap of this stage (−1 when none or several)
     };
+    uint64_t m_id = 0;  // unique per TileSkipper (memos of an earlier draw never match)
     std::optional<ps11::IntervalEvaluator> m_eval;
     std::array<Stage, 8> m_stages{};
     uint64_t m_colorAttrs = 0;
