@@ -26,6 +26,8 @@ constexpr int64_t kMinStretchPixelsPerWorker = 16384;
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
 constexpr uint32_t kChunkTriangles = 1024;
+// A program whose tiles did not pay to decide is decided again after this many draws.
+constexpr uint32_t kTileRetryDraws = 8;
 
 // Executor outputs and the merged live mask of one span.
 struct Lanes {
@@ -55,6 +57,13 @@ struct SoftwareDrawContext {
     std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
     // Executors by DrawProgram::key (a program's identity for the device's lifetime).
     std::unordered_map<uint64_t, std::unique_ptr<ps11::Executor>> executors;
+    // By DrawProgram::key: whether deciding tiles paid on the program's last decided draw (a
+    // quarter of its tiles or more filled, copied or skipped), and its draws since.
+    struct TileHistory {
+        bool paid = true;
+        uint32_t since = 0;
+    };
+    std::unordered_map<uint64_t, TileHistory> tileHistory;
 };
 
 SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_options(options) {}
@@ -130,9 +139,15 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle> floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
+    // Deciding costs about a microsecond a tile: a program whose tiles mostly needed shading last
+    // time is shaded without deciding, and tried again every kTileRetryDraws draws (which tiles
+    // are decided never changes a byte, only the time).
     std::unique_ptr<TileSkipper> skipper;
-    if (m_options.skipTiles && (alignedDraw || floatDraw))
+    if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
+    SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
+    if (m_options.skipTiles && (alignedDraw || floatDraw) && (history.paid || ++history.since >= kTileRetryDraws))
         skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
+    const DrawStats tilesBefore = stats;
     std::vector<uint8_t> isAligned;
     std::vector<uint32_t> bandStart, bandFill, bandTris;
     for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
@@ -362,6 +377,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             stats.tilesCopied += ws.tilesCopied;
             stats.tilesSkipped += ws.tilesSkipped;
         }
+    }
+    if (skipper) {
+        const uint64_t shaded = stats.tilesShaded - tilesBefore.tilesShaded;
+        const uint64_t decided = stats.tilesFilled + stats.tilesCopied + stats.tilesSkipped - tilesBefore.tilesFilled -
+                                 tilesBefore.tilesCopied - tilesBefore.tilesSkipped;
+        history.paid = decided * 4 >= shaded + decided;
+        history.since = 0;
     }
     return true;
 }

@@ -121,6 +121,33 @@ TEST_CASE("draw: mov r0, v0 fills exactly the quad's pixels with the diffuse col
     CHECK(st.trianglesDrawn == 2);
 }
 
+TEST_CASE("draw: tiles of a program that needed shading are not decided again for seven draws", "[draw][skip]") {
+    // Deciding a tile costs about a microsecond: a program whose tiles mostly needed shading is
+    // shaded without deciding, and tried again on its eighth draw (docs/device.md "Tile
+    // skipping"). The bytes are the same either way.
+    Device dev;
+    const UINT W = 130, H = 40;
+    Handle rt = target(dev, W, H);
+    (void)rt;
+    std::vector<uint32_t> texels;
+    Handle tex = randomTexture(dev, W, H, texels, 11);
+    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+    shader(dev, "ps_1_1\ntex t0\nmul r0, t0, t0\n");
+    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    auto v = quad(W, H, 0xffffffff);
+    std::vector<uint64_t> decidedTiles;
+    for (int i = 0; i < 10; ++i) {
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        const DrawStats& st = dev.lastDrawStats();
+        decidedTiles.push_back(st.tilesShaded + st.tilesFilled + st.tilesCopied + st.tilesSkipped);
+        CHECK(st.pixelsCovered == W * H);
+    }
+    CHECK(decidedTiles[0] > 0);
+    for (int i = 1; i < 8; ++i) CHECK(decidedTiles[size_t(i)] == 0);
+    CHECK(decidedTiles[8] > 0);
+    CHECK(decidedTiles[9] == 0);
+}
+
 TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
     for (DWORD filter : {DWORD(D3DTEXF_POINT), DWORD(D3DTEXF_LINEAR)}) {
         // Every pixel shaded (tile skipping would copy the texture without running the program).
