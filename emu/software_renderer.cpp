@@ -26,8 +26,8 @@ constexpr int64_t kMinStretchPixelsPerWorker = 16384;
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
 constexpr uint32_t kChunkTriangles = 1024;
-// A program whose tiles did not pay to decide is decided again after this many draws.
-constexpr uint32_t kTileRetryDraws = 8;
+// A program whose tiles did not pay to decide is decided again this many draws later.
+constexpr uint32_t kTileRetryDraws = 4;
 
 // Executor outputs and the merged live mask of one span.
 struct Lanes {
@@ -140,8 +140,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     std::vector<FloatRowTriangle> floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
     // Deciding costs about a microsecond a tile: a program whose tiles mostly needed shading last
-    // time is shaded without deciding, and tried again every kTileRetryDraws draws (which tiles
-    // are decided never changes a byte, only the time).
+    // time is shaded without deciding, and decided again on its kTileRetryDraws-th draw after
+    // (which tiles are decided never changes a byte, only the time).
     std::unique_ptr<TileSkipper> skipper;
     if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
