@@ -364,14 +364,9 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
 void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
                    FloatRowScratch& sc, AlignedStats& stats, const RowWindow* windows, size_t windowCount) {
     const ps11::Executor& exec = *draw.executor;
-    // No windows: every column shaded. Windows are disjoint, in column order.
-    const RowWindow whole{std::numeric_limits<int>::min(), std::numeric_limits<int>::max()};
-    if (!windows || windowCount == 0) windows = &whole, windowCount = 1;
-    uint32_t neededTaps = 0;  // taps some window samples
-    for (size_t wi = 0; wi < windowCount; ++wi)
-        neededTaps |= windows[wi].mode == RowMode::Shade ? 0xffu
-                      : windows[wi].mode == RowMode::Copy ? 1u << windows[wi].copyTap
-                                                          : 0u;
+    const RowWindows ws = rowWindows(windows, windowCount);
+    windows = ws.data, windowCount = ws.count;
+    const uint32_t neededTaps = ws.taps;
     const int taps = draw.plan.count;
     std::array<RowTaps, 8> rows{};
     RowSampler sampler(draw, tri, rows);

@@ -468,17 +468,21 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
     return true;
 }
 
+RowWindows rowWindows(const RowWindow* windows, size_t count) {
+    static const RowWindow whole{std::numeric_limits<int>::min(), std::numeric_limits<int>::max()};
+    RowWindows w{windows, count, 0};
+    if (!windows || count == 0) w.data = &whole, w.count = 1;
+    for (size_t i = 0; i < w.count; ++i)
+        w.taps |= w.data[i].mode == RowMode::Shade ? 0xffu : w.data[i].mode == RowMode::Copy ? 1u << w.data[i].copyTap : 0u;
+    return w;
+}
+
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* windows,
                      size_t windowCount) {
-    // No windows: every column shaded. Windows are disjoint, in column order.
-    const RowWindow whole{std::numeric_limits<int>::min(), std::numeric_limits<int>::max()};
-    if (!windows || windowCount == 0) windows = &whole, windowCount = 1;
-    uint32_t neededTaps = 0;  // taps some window filters
-    for (size_t wi = 0; wi < windowCount; ++wi)
-        neededTaps |= windows[wi].mode == RowMode::Shade ? 0xffu
-                      : windows[wi].mode == RowMode::Copy ? 1u << windows[wi].copyTap
-                                                          : 0u;
+    const RowWindows ws = rowWindows(windows, windowCount);
+    windows = ws.data, windowCount = ws.count;
+    const uint32_t neededTaps = ws.taps;
     const ps11::Executor& exec = *draw.executor;
     Image& target = *draw.target.color;
     const bool x8 = target.format->format == D3DFMT_X8R8G8B8;

@@ -180,6 +180,15 @@ struct RowWindow {
     std::array<float, 4> value{};    // Fill, float profiles: r0's floats
 };
 
+// The windows a row path draws: those given (disjoint, in column order), or with none given one
+// that shades every column; and the taps some window reads (bit per tap of the TapPlan).
+struct RowWindows {
+    const RowWindow* data = nullptr;
+    size_t count = 0;
+    uint32_t taps = 0;
+};
+RowWindows rowWindows(const RowWindow* windows, size_t count);
+
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is

@@ -253,6 +253,18 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     return out;
 }
 
+// Tile skipping (emu/tile_skip.h) changes no byte and no covered pixel: the case drawn by a device
+// like `rowOpt` with skipping on must give the quad path's bytes.
+void requireSkippingEqual(const DeviceOptions& rowOpt, const Case& c, const std::vector<uint8_t>& expected,
+                          const DrawStats& qs) {
+    DeviceOptions skipOpt = rowOpt;
+    skipOpt.software.skipTiles = true;
+    Device skipDev(skipOpt);
+    DrawStats ks;
+    REQUIRE(drawCase(skipDev, c, ks) == expected);
+    CHECK(ks.pixelsCovered == qs.pixelsCovered);
+}
+
 }  // namespace
 
 TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte for byte", "[draw][aligned]") {
@@ -277,13 +289,7 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
             Device rowDev(rowOpt);
             DrawStats rs;
             REQUIRE(drawCase(rowDev, c, rs) == expected);
-            // Tile skipping (emu/tile_skip.h) changes no byte and no covered pixel.
-            DeviceOptions skipOpt = rowOpt;
-            skipOpt.software.skipTiles = true;
-            Device skipDev(skipOpt);
-            DrawStats ks;
-            REQUIRE(drawCase(skipDev, c, ks) == expected);
-            CHECK(ks.pixelsCovered == qs.pixelsCovered);
+            requireSkippingEqual(rowOpt, c, expected, qs);
             CHECK(rs.pixelsCovered == qs.pixelsCovered);
             CHECK(rs.pixelsWritten == qs.pixelsWritten);
             if (qs.pixelsCovered == 0) return;
@@ -328,12 +334,7 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
                                          << " bound " << c.tex[0].bound << " blend " << c.blend << " mask " << c.writeMask
                                          << " alphatest " << c.alphaTest << " scissor " << c.scissor);
         REQUIRE(firstDiff == got.size());
-        DeviceOptions skipOpt = rowOpt;
-        skipOpt.software.skipTiles = true;
-        Device skipDev(skipOpt);
-        DrawStats ks;
-        REQUIRE(drawCase(skipDev, c, ks) == expected);
-        CHECK(ks.pixelsCovered == qs.pixelsCovered);
+        requireSkippingEqual(rowOpt, c, expected, qs);
         CHECK(rs.pixelsCovered == qs.pixelsCovered);
         CHECK(rs.pixelsWritten == qs.pixelsWritten);
         if (qs.pixelsCovered == 0) continue;
@@ -626,11 +627,7 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
             Device rowDev(rowOpt);
             DrawStats rs;
             REQUIRE(drawCase(rowDev, c, rs) == expected);
-            DeviceOptions skipOpt = rowOpt;
-            skipOpt.software.skipTiles = true;
-            Device skipDev(skipOpt);
-            DrawStats ks;
-            REQUIRE(drawCase(skipDev, c, ks) == expected);
+            requireSkippingEqual(rowOpt, c, expected, qs);
             if (qs.pixelsCovered == 0) return;
             ++cases;
             if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
