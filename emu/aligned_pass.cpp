@@ -83,6 +83,40 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
     }
 }
 
+// A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
+// zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
+// ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
+// the texel bytes are the target's (| orMask for X8R8G8B8), then the constant channels. False
+// where the columns do not qualify (the caller filters).
+bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
+                const RowWindow& window, int x, int n, uint32_t orMask, uint8_t* dst) {
+    const int t = window.copyTap;
+    const AlignedTap& tap = draw.taps[size_t(t)];
+    const TapRow& row = rows[size_t(t)];
+    if (!tap.bound || !row.row0 || row.wy != 0) return false;
+    const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+    const size_t i0 = size_t(x - tri.x0);
+    const int32_t o = cols.off0[i0];
+    if (o < 0) return false;
+    for (int i = 0; i < n; ++i)
+        if (cols.off0[i0 + size_t(i)] != o + 4 * i || cols.w[i0 + size_t(i)] != 0) return false;
+    std::memcpy(dst, row.row0 + o, size_t(n) * 4);
+    uint32_t keep = ~0u, set = orMask;  // the constant channels' bytes (b g r a: r g b a at 2 1 0 3)
+    for (int c = 0; c < 4; ++c)
+        if (!((window.copyMask >> c) & 1)) {
+            const int shift = 8 * ps11::kUnorm8Byte[c];
+            keep &= ~(0xffu << shift);
+            set |= uint32_t(std::clamp<int32_t>(window.grid[size_t(c)], 0, 255)) << shift;
+        }
+    if (keep != ~0u || set != 0)
+        for (int i = 0; i < n; ++i) {
+            uint32_t w = load32(dst + 4 * i);
+            w = (w & keep) | set;
+            std::memcpy(dst + 4 * i, &w, 4);
+        }
+    return true;
+}
+
 // The texel rows and vertical weight of a tap on pixel row y.
 }  // namespace
 
@@ -591,6 +625,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         in.count = n;
                         exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
                     } else if (mode == RowMode::Copy) {
+                        if (draw.directStore && copyTexels(draw, tri, rows, *window, x, n, orMask,
+                                                           target.texel(uint32_t(x), uint32_t(y)))) {
+                            stats.pixels += uint64_t(n);
+                            stats.written += uint64_t(n);
+                            continue;
+                        }
                         fill(&ctx, window->copyTap, 0, n, r0);
                         for (int c = 0; c < 4; ++c)
                             if (!((window->copyMask >> c) & 1)) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
