@@ -41,6 +41,18 @@ void Device::fingerprintRead(Handle owner) {
     if (owner == Handle::Null) return;
     const std::vector<Handle>& d = m_fingerprint.determined;
     if (std::find(d.begin(), d.end(), owner) != d.end()) return;  // written whole by an earlier call
+    // A renderer that keeps copies writes where the front cannot compare, so every write of its
+    // makes a new generation: a small resource is read by its bytes instead (brought back first),
+    // and a write that changed none of them reads as the same (a converged 1×1 adaptation state).
+    auto it = m_resources.find(uint32_t(owner));
+    if (it != m_resources.end() && m_renderer->keepsCopies() && resourceLevelBytes(it->second) <= kComparedResourceBytes) {
+        Resource& r = it->second;
+        syncResource(r);
+        const uint32_t head[4] = {uint32_t(owner), ~0u, ~0u, uint32_t(resourceLevelBytes(r))};  // no generation is 2⁶⁴ − 1
+        fingerprintWords(head, sizeof head);
+        for (const Image& im : r.levels) fingerprintWords(im.bytes.data(), levelBytes(im));
+        return;
+    }
     const uint64_t g = contentGeneration(owner);
     const uint32_t words[3] = {uint32_t(owner), uint32_t(g), uint32_t(g >> 32)};
     fingerprintWords(words, sizeof words);

@@ -341,16 +341,6 @@ void Device::regenerateMips(Resource& r) {
     r.mipsDirty = false;
 }
 
-namespace {
-
-// Resources of at most this many bytes keep their generation through a write that changes no
-// byte (a 1×1 adaptation state that has converged, a glare sprite image uploaded every frame);
-// larger ones are not compared (a copy and a compare per write).
-constexpr size_t kComparedResourceBytes = 65536;
-
-size_t levelBytes(const Image& im) { return size_t(im.slicePitch) * im.depth; }
-
-}  // namespace
 
 void Device::markWritten(Resource& r, uint32_t level) {
     r.levelGeneration.resize(r.levels.size(), 0);
@@ -396,8 +386,7 @@ void Device::prepareWrite(Resource& r) {
     if (r.storeShared()) detachStore(r);
     // A small resource whose bytes the front holds: kept, to tell an unchanging write.
     r.bytesBefore.clear();
-    size_t total = 0;
-    for (const Image& im : r.levels) total += levelBytes(im);
+    const size_t total = resourceLevelBytes(r);
     if (total <= kComparedResourceBytes && !m_renderer->keepsCopies() &&
         std::none_of(r.rendererNewer.begin(), r.rendererNewer.end(), [](uint8_t b) { return b != 0; })) {
         r.bytesBefore.reserve(total);

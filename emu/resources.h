@@ -133,6 +133,22 @@ using ps11::kMaxResourceBytes;  // ps11/caps.h
 using ps11::kMaxTextureSide;
 using ps11::kMaxVolumeSide;
 
+// Resources of at most this many bytes are told unchanged by their bytes (a 1×1 adaptation state
+// that has converged, a glare sprite image uploaded every frame): on the software renderer a write
+// that leaves them equal keeps the generation; on a renderer that keeps copies, whose writes the
+// front does not see, a fingerprint reads their bytes instead of their generation
+// (docs/device.md "Generations", "Fingerprints"). Larger ones cost a copy and a compare too many.
+constexpr size_t kComparedResourceBytes = 65536;
+
+// Bytes of one level's image (all its slices).
+inline size_t levelBytes(const Image& im) { return size_t(im.slicePitch) * im.depth; }
+// Bytes of every level of a resource.
+inline size_t resourceLevelBytes(const Resource& r) {
+    size_t total = 0;
+    for (const Image& im : r.levels) total += levelBytes(im);
+    return total;
+}
+
 // Row pitch of a level in bytes: width * texel size rounded up to 4 bytes (D3D9 pitches are
 // DWORD aligned; callers must use the pitch, never width * size).
 uint32_t rowPitchOf(const FormatInfo& f, uint32_t width);

@@ -239,3 +239,46 @@ TEST_CASE("gl renderer native mode: a filtered, blended pass lands within a few 
     CHECK(maxDiff <= 3);
     CHECK(differ > 0);  // and not the emulator's result by accident: native is another computation
 }
+
+TEST_CASE("gl renderer: a fingerprint reads a small resource by its bytes, a large one by its generation",
+          "[gl][fingerprint]") {
+    // GL writes where the front cannot compare them, so each one makes a new generation; a 1×1
+    // state written again with the value it held must still read as unchanged (docs/device.md
+    // "Fingerprints"), while a 256×256 texture counts by generation.
+    Device dev(glOptions(true));
+    Handle tiny{}, tinySurface{}, big{}, bigSurface{}, out{}, outSurface{}, ps{};
+    REQUIRE(dev.CreateTexture(1, 1, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &tiny) == D3D_OK);
+    REQUIRE(dev.GetSurfaceLevel(tiny, 0, &tinySurface) == D3D_OK);
+    REQUIRE(dev.CreateTexture(256, 256, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &big) == D3D_OK);
+    REQUIRE(dev.GetSurfaceLevel(big, 0, &bigSurface) == D3D_OK);
+    REQUIRE(dev.CreateTexture(8, 8, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &out) == D3D_OK);
+    REQUIRE(dev.GetSurfaceLevel(out, 0, &outSurface) == D3D_OK);
+    REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n", &ps) == D3D_OK);
+    auto fill = [&](Handle surface, D3DCOLOR c) {
+        REQUIRE(dev.SetRenderTarget(0, surface) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, c, 1, 0) == D3D_OK);
+    };
+    // A draw that reads both textures, dry-run.
+    auto print = [&] {
+        dev.beginFingerprint();
+        REQUIRE(dev.SetRenderTarget(0, outSurface) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
+        REQUIRE(dev.SetTexture(0, tiny) == D3D_OK);
+        REQUIRE(dev.SetTexture(1, big) == D3D_OK);
+        REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+        return dev.endFingerprint();
+    };
+    fill(tinySurface, 0xff102030u);
+    fill(bigSurface, 0xff405060u);
+    const Device::Fingerprint a = print();
+    REQUIRE(a.complete);
+    fill(tinySurface, 0xff102030u);  // the same bytes: a new generation on GL, the same fingerprint
+    const Device::Fingerprint b = print();
+    CHECK(b.words == a.words);
+    fill(tinySurface, 0xff102031u);  // one byte differs
+    CHECK(print().words != a.words);
+    fill(tinySurface, 0xff102030u);
+    CHECK(print().words == a.words);
+    fill(bigSurface, 0xff405060u);  // the same bytes, but 256 KB: by generation
+    CHECK(print().words != a.words);
+}
