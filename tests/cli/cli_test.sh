@@ -402,8 +402,10 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "info lists the GL modes" "$ps11" info
     expect_in "$work/out" "GL renderer modes: exact" "info names the exact mode"
     expect_in "$work/out" "native (GL's own interpolation" "info names the native mode"
-    expect_rc 0 "glare --backend gl table" "$ps11" glare --technique pyramid --scene sky --size 64x36 --backend gl -o "$work/pgl.png"
+    expect_rc 0 "glare --backend gl table" "$ps11" glare --technique pyramid --scene sky --size 64x36 --backend gl --no-skip -o "$work/pgl.png"
     expect_in "$work/out" "0 uploaded, 1 read back" "a glare frame on GL reads back once and uploads nothing"
+    expect_rc 0 "glare --backend gl with reuse" "$ps11" glare --technique pyramid --scene sky --size 64x36 --backend gl -o "$work/pgl.png"
+    expect_in "$work/out" "0 uploaded," "a glare frame on GL with reuse uploads nothing"
     expect_rc 0 "glare --gl-mode native" "$ps11" glare --technique glow --scene neon --size 64x36 --backend gl --gl-mode native -o "$work/gn.png"
     expect_in "$work/out" "gl-native renderer" "glare names the native renderer"
     expect_rc 0 "glare --compare --gl-mode native" "$ps11" glare --technique quarter --scene neon --size 64x36 --compare --gl-mode native --json
