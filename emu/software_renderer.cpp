@@ -145,7 +145,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     std::unique_ptr<TileSkipper> skipper;
     if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
-    if (m_options.skipTiles && (alignedDraw || floatDraw) && (history.paid || ++history.since >= kTileRetryDraws))
+    // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
+    if (m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles &&
+        (history.paid || ++history.since >= kTileRetryDraws))
         skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t> isAligned;
