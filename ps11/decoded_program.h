@@ -49,6 +49,7 @@ struct DSrc {
 
 struct DOp {
     Opcode op = Opcode::Nop;
+    int32_t instruction = -1;  // its index in Program::instructions (diagnostics, traces)
     const OpcodeInfo* info = nullptr;  // the opcode-table row (components read, writes its destination)
     bool texture = false;   // texture-address instruction
     bool hold = false;      // first member of a co-issued pair: result held until the partner has read

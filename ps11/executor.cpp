@@ -75,6 +75,11 @@ public:
 
     void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
              ExecutorStats* stats) const override;
+    void trace(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+               std::vector<TraceStep>& steps) const override {
+        steps.clear();
+        runGeneric(inputs, sampler, outputs, &steps);
+    }
     bool tapPlan(TapPlan& plan) const override;
     bool plainTaps(TapPlan& plan) const override;
     void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
@@ -87,7 +92,8 @@ private:
         for (int c = 0; c < 4; ++c)
             constantOf(m_p.precision, v[size_t(c)], m_p.constGrid[size_t(i)][size_t(c)], m_p.constF[size_t(i)][size_t(c)]);
     }
-    void runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const;
+    void runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                    std::vector<TraceStep>* steps = nullptr) const;
     // Adds count pixels and their executed instructions (phase excluded) to stats, if given.
     void countRun(ExecutorStats* stats, int count) const {
         if (!stats) return;
@@ -98,7 +104,7 @@ private:
         stats->instructions += executed * uint64_t(count);
     }
     void loadColors(RunState& st) const;
-    void runChunk(RunState& st, const FloatArithKernels& floatArith) const;
+    void runChunk(RunState& st, const FloatArithKernels& floatArith, std::vector<TraceStep>* steps) const;
 
     ExecutorOptions m_options;
     Profile m_p;
@@ -136,7 +142,7 @@ void ExecutorImpl::loadColors(RunState& st) const {
     }
 }
 
-void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith) const {
+void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith, std::vector<TraceStep>* steps) const {
     const bool fx = isFixedPoint(m_p.precision);
     std::memset(st.killed, 0, sizeof st.killed);
     loadColors(st);
@@ -148,6 +154,23 @@ void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith) c
             execArithFx(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
         } else {
             floatArith.arith(m_p, op, st, op.hold ? st.bf.hold : st.bf.reg[op.dstSlot]);
+        }
+        if (steps) {
+            // Lane 0 of the destination (a first member's held result where it writes).
+            TraceStep t;
+            t.instruction = op.instruction;
+            t.writes = op.info->writesDst;
+            t.mask = op.texture ? uint8_t(0xf) : op.mask;
+            for (int c = 0; c < 4 && t.writes; ++c) {
+                const bool held = op.hold && ((op.mask >> c) & 1);
+                if (fx) {
+                    t.grid[size_t(c)] = held ? st.bi.hold[c][0] : st.bi.reg[op.dstSlot][c][0];
+                    t.value[size_t(c)] = float(t.grid[size_t(c)]) / float(m_p.g);
+                } else {
+                    t.value[size_t(c)] = held ? st.bf.hold[c][0] : st.bf.reg[op.dstSlot][c][0];
+                }
+            }
+            steps->push_back(t);
         }
         if (!op.hold && (&op != m_ops.data()) && (&op - 1)->hold) {
             // Co-issued pair: the second member has read and written; now the first writes
@@ -207,7 +230,8 @@ void ExecutorImpl::run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs
     countRun(stats, count);
 }
 
-void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) const {
+void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                              std::vector<TraceStep>* steps) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     std::unique_ptr<RunState> st(new RunState);  // default-init: no 60 KB zero fill per call
     st->in = &inputs;
@@ -223,7 +247,7 @@ void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, Pixel
         st->offset = off;
         st->n = std::min(kChunk, count - off);
         st->depthWritten = false;
-        runChunk(*st, floatArith);
+        runChunk(*st, floatArith, off == 0 ? steps : nullptr);
         for (int c = 0; c < 4; ++c) {
             if (fx) {
                 const int32_t* r = st->bi.reg[kSlotR][c];
@@ -385,6 +409,7 @@ bool exec::decodeProgram(const Program& program, const ExecutorOptions& options,
         DOp d;
         d.op = opc;
         d.info = ins.info;
+        d.instruction = int32_t(&ins - program.instructions.data());
         if (opc == Opcode::Phase) {
             ops.push_back(d);
             continue;

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "ps11/caps.h"
 #include "ps11/diagnostics.h"
@@ -90,6 +91,17 @@ struct TapPlan {
     std::array<uint8_t, 8> coordSet{};
 };
 
+// One executed instruction of a traced pixel (Executor::trace).
+struct TraceStep {
+    int instruction = -1;  // index in Program::instructions
+    bool writes = false;   // writes its destination register (the opcode table's writesDst)
+    uint8_t mask = 0;      // the channels it writes (texture-address instructions: all four)
+    // The destination register after the instruction, r g b a (a co-issued first member: the
+    // values it writes once its partner has read); fx profiles also as grid integers.
+    std::array<float, 4> value{};
+    std::array<int32_t, 4> grid{};
+};
+
 class Executor {
 public:
     // Prepares the program (decode once). Reports E40xx and returns null for programs it cannot
@@ -114,6 +126,10 @@ public:
     // outputs when the sampler is (run keeps no per-call state in the object).
     virtual void run(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
                      ExecutorStats* stats = nullptr) const = 0;
+    // run() on the generic path (the same results), recording each executed instruction of the
+    // first pixel (phase excluded) into `steps` (`ps11 debug`).
+    virtual void trace(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
+                       std::vector<TraceStep>& steps) const = 0;
 
     // Pre-sampled runs, for callers that sample screen-aligned rows themselves (the device's
     // aligned-pass path, emu/aligned_pass.h). Available when the program runs on the fx8 fast

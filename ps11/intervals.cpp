@@ -54,17 +54,21 @@ struct State {
     FI depth{0.0f, 1.0f, false, false};
     bool depthWritten = false;
     bool mayKill = false, allKilled = false;
+    WriteFindings wf;  // the current instruction's (trace)
 
     FI srcFloat(const DSrc& s, int comp) const {
         return s.kind == SrcKind::TexCoord ? tc[s.slot & 7][comp] : regFloat(p, regs.reg[s.slot][comp], s.mod);
     }
     // executor_texture.cpp writeFloat: fx rounds (nearbyint, ties to even) then clamps, NaN to the
     // lower clamp; float saturates (NaN to 0) or keeps NaN, then clamps to ±M.
-    AV writeValue(const FI& v, bool sat) const {
+    AV writeValue(const FI& v, bool sat, uint8_t channel = 0) {
         AV a;
         if (isFixedPoint(p.precision)) {
             const double g = p.g;
             const double lo = sat ? 0.0 : -double(p.nMax), hi = sat ? double(p.g < p.nMax ? p.g : p.nMax) : p.nMax;
+            if (v.nan || std::nearbyint(double(v.lo) * g) < lo || std::nearbyint(double(v.hi) * g) > hi)
+                (sat ? wf.saturate : wf.clamp) |= channel;
+            if (v.lo != v.hi || std::nearbyint(double(v.lo) * g) != double(v.lo) * g) wf.round |= channel;
             auto f = [&](float x) {
                 double t = std::nearbyint(double(x) * g);
                 t = t > lo ? t : lo;
@@ -79,6 +83,8 @@ struct State {
             x = x < lo ? lo : x;
             return x > hi ? hi : x;
         };
+        if (sat ? (v.nan || v.lo < 0.0f || v.hi > 1.0f) : (v.lo < lo || v.hi > hi))
+            (sat ? wf.saturate : wf.clamp) |= channel;
         if (sat) {
             auto f = [&](float x) {
                 x = x > 0.0f ? x : 0.0f;
@@ -130,6 +136,7 @@ struct State {
                 a.f = norm({clamp(v.lo), clamp(v.hi), v.nan, v.nz});
             }
             if (plain && inside) a.tap = int8_t(opIndex), a.ch = uint8_t(c);
+            if (!inside) wf.clamp |= uint8_t(1u << c);
         }
     }
     // depth = (w == 0) ? 1 : z/w, then clamped to [0, 1] with NaN to 0 (texm3x2depth, texdepth).
@@ -169,7 +176,8 @@ void evalTexture(const Profile& p, bool stagesKnown, const DOp& op, int opIndex,
         case Opcode::TexCoord:
             if (!v14) {
                 // texcoord: (sat u, sat v, sat w, 1).
-                for (int c = 0; c < 3; ++c) st.regs.reg[op.dstSlot][c] = st.writeValue(st.tc[op.stage][c], true);
+                for (int c = 0; c < 3; ++c)
+                    st.regs.reg[op.dstSlot][c] = st.writeValue(st.tc[op.stage][c], true, uint8_t(1u << c));
                 st.regs.reg[op.dstSlot][3] = st.writeValue(fPoint(1.0f), false);
             } else {
                 // texcrd: the swizzled coordinates, _dz/_dw dividing x and y (a zero divisor gives
@@ -184,7 +192,7 @@ void evalTexture(const Profile& p, bool stagesKnown, const DOp& op, int opIndex,
                         c[k] = isPoint(d, 0.0f) ? fPoint(1.0f) : (has0(d) || d.nan) ? fTop() : fDiv(c[k], d);
                 }
                 for (int k = 0; k < 4; ++k)
-                    if ((op.mask >> k) & 1) st.regs.reg[op.dstSlot][k] = st.writeValue(c[k], op.sat);
+                    if ((op.mask >> k) & 1) st.regs.reg[op.dstSlot][k] = st.writeValue(c[k], op.sat, uint8_t(1u << k));
             }
             break;
         case Opcode::Tex:
@@ -246,14 +254,14 @@ void evalTexture(const Profile& p, bool stagesKnown, const DOp& op, int opIndex,
         case Opcode::TexM3x3: {
             const FI w = st.rowDot(op.stage, op.src[0]);
             AV* d = st.regs.reg[op.dstSlot];
-            d[0] = st.writeValue(st.pad[0], false);
-            d[1] = st.writeValue(st.pad[1], false);
-            d[2] = st.writeValue(w, false);
+            d[0] = st.writeValue(st.pad[0], false, 1);
+            d[1] = st.writeValue(st.pad[1], false, 2);
+            d[2] = st.writeValue(w, false, 4);
             d[3] = st.writeValue(fPoint(1.0f), false);
             break;
         }
         case Opcode::TexDp3: {
-            const AV v = st.writeValue(st.rowDot(op.stage, op.src[0]), false);
+            const AV v = st.writeValue(st.rowDot(op.stage, op.src[0]), false, 0xf);
             for (int c = 0; c < 4; ++c) st.regs.reg[op.dstSlot][c] = v;
             break;
         }
@@ -305,16 +313,11 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
             exec::constantOf(e.m_p.precision, v[size_t(c)], e.m_p.constGrid[size_t(i)][size_t(c)],
                              e.m_p.constF[size_t(i)][size_t(c)]);
     }
-    // decodeProgram keeps one op per instruction except def, nop, comment and end: pair them up
-    // to name the instruction a copy comes from.
     e.m_taps.resize(e.m_ops.size());
-    size_t k = 0;
-    for (size_t i = 0; i < program.instructions.size() && k < e.m_ops.size(); ++i) {
-        const Opcode o = program.instructions[i].opcode();
-        if (o == Opcode::Def || o == Opcode::Nop || o == Opcode::Comment || o == Opcode::End) continue;
+    for (size_t k = 0; k < e.m_ops.size(); ++k) {
         const exec::DOp& op = e.m_ops[k];
-        Tap& t = e.m_taps[k++];
-        t.instruction = int16_t(i);
+        Tap& t = e.m_taps[k];
+        t.instruction = int16_t(op.instruction);
         // Plain lookups: 1_1-1_3 tex (TC[m]), 1_4 texld from a t# (coordinates only).
         t.plain = op.op == Opcode::Tex && (e.m_p.minor < 4 || op.src[0].kind == exec::SrcKind::TexCoord);
         if (samplesStage(op.op)) (t.plain ? e.m_plainStages : e.m_dependentStages) |= 1u << op.stage;
@@ -343,6 +346,17 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
 }
 
 void IntervalEvaluator::evaluate(const IntervalInputs& inputs, IntervalResult& result) const {
+    run(inputs, result, nullptr);
+}
+
+void IntervalEvaluator::trace(const IntervalInputs& inputs, IntervalResult& result,
+                              std::vector<InstructionInterval>& steps) const {
+    steps.clear();
+    run(inputs, result, &steps);
+}
+
+void IntervalEvaluator::run(const IntervalInputs& inputs, IntervalResult& result,
+                            std::vector<InstructionInterval>* steps) const {
     using namespace intervals;
     const Profile& p = m_p;
     State st{p, inputs};
@@ -373,14 +387,33 @@ void IntervalEvaluator::evaluate(const IntervalInputs& inputs, IntervalResult& r
     for (size_t i = 0; i < m_ops.size(); ++i) {
         const exec::DOp& op = m_ops[i];
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values
+        st.wf = WriteFindings{};
         if (op.texture) {
             evalTexture(p, m_stagesKnown, op, int(i), m_taps[i].plain, st);
         } else {
             AV out[4];
-            evalArith(p, m_stagesKnown, op, st.regs, out);
+            evalArith(p, m_stagesKnown, op, st.regs, out, steps ? &st.wf : nullptr);
             AV* dst = op.hold ? hold : st.regs.reg[op.dstSlot];
             for (int c = 0; c < 4; ++c)
                 if ((op.mask >> c) & 1) dst[c] = out[c];
+        }
+        if (steps) {
+            InstructionInterval s;
+            s.instruction = m_taps[i].instruction;
+            s.op = int(i);
+            s.writes = op.info->writesDst;
+            if (s.writes) {
+                // The destination as the instruction leaves it (a co-issued first member: what it
+                // is about to write), every channel.
+                const AV* d = op.hold ? hold : st.regs.reg[op.dstSlot];
+                for (int c = 0; c < 4; ++c)
+                    s.dst[size_t(c)] = channelOf(p, (op.mask >> c) & 1 || !op.hold ? d[c] : st.regs.reg[op.dstSlot][c]);
+                s.mask = op.texture ? uint8_t(0xf) : op.mask;
+            }
+            s.clamps = st.wf.clamp;
+            s.saturates = st.wf.saturate;
+            s.rounds = st.wf.round;
+            steps->push_back(s);
         }
         if (!op.hold && i > 0 && m_ops[i - 1].hold) {
             // Co-issued pair: both have read; now the first member writes.

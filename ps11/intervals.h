@@ -116,6 +116,23 @@ struct IntervalSetup {
     std::array<StageState, kMaxTextureStages> stages{};
 };
 
+// What one instruction leaves over the ranges (IntervalEvaluator::trace).
+struct InstructionInterval {
+    int instruction = -1;  // index in Program::instructions
+    int op = -1;           // index in the decoded op list (phase included)
+    bool writes = false;   // writes its destination register (the opcode table's writesDst)
+    uint8_t mask = 0;      // the channels it writes (texture-address instructions: all four)
+    // The destination register after the instruction, all four channels (a co-issued first
+    // member: the values it writes once its partner has read).
+    std::array<ChannelInterval, 4> dst{};
+    // Channels (bit per channel) whose value before the write step can leave [−MaxValue,
+    // MaxValue], so the register clamp acts (without _sat), and those _sat cuts (outside [0, 1]).
+    uint8_t clamps = 0;
+    uint8_t saturates = 0;
+    // fx profiles: channels whose result can fall off the grid, so the write rounds it.
+    uint8_t rounds = 0;
+};
+
 class IntervalEvaluator {
 public:
     // Decodes the program as Executor::create does (the same E40xx diagnostics, nullopt when the
@@ -125,6 +142,9 @@ public:
 
     // Bounds the program's results over `inputs`. Allocates nothing; thread-safe.
     void evaluate(const IntervalInputs& inputs, IntervalResult& result) const;
+    // evaluate(), and per executed instruction (phase excluded) what it leaves (`ps11 check
+    // --ranges`, ps11/range_proof.h).
+    void trace(const IntervalInputs& inputs, IntervalResult& result, std::vector<InstructionInterval>& steps) const;
 
     // What evaluate() reads, so a caller gathers only those ranges (bit per stage, set or v#):
     // the stages of plain and of dependent lookups, the coordinate sets read as values
@@ -137,8 +157,11 @@ public:
     Precision precision() const { return m_p.precision; }
     // The decoded profile: grid scale, round(M·G), M, the constants as loaded.
     const exec::Profile& profile() const { return m_p; }
+    // The decoded op list trace() steps through (ps11/decoded_program.h).
+    const std::vector<exec::DOp>& ops() const { return m_ops; }
 
 private:
+    void run(const IntervalInputs& inputs, IntervalResult& result, std::vector<InstructionInterval>* steps) const;
     struct Tap {
         int16_t instruction = -1;  // index in Program::instructions of the op
         bool plain = false;        // a plain lookup (see StageRange::anyCoords)

@@ -107,12 +107,19 @@ void fxClamp(const Profile& p, bool sat, int32_t& lo, int32_t& hi) {
 
 // Write step of a numerator over d0 (2 for linear ops, 4G for products): shift, round once
 // (roundHalfEven, monotone), _sat, range clamp — applied to both bounds.
-void fxWrite(const Profile& p, const DOp& op, KI num, int64_t d0, AV& out) {
+void fxWrite(const Profile& p, const DOp& op, KI num, int64_t d0, AV& out, WriteFindings* wf = nullptr,
+             uint8_t channels = 0) {
     int64_t den = d0;
     if (op.shift > 0) num.lo *= int64_t(1) << op.shift, num.hi *= int64_t(1) << op.shift;
     if (op.shift < 0) den <<= -op.shift;
     int32_t lo, hi;
     fxClamp(p, op.sat, lo, hi);
+    if (wf) {
+        const int64_t qlo = roundHalfEven(num.lo, den), qhi = roundHalfEven(num.hi, den);
+        if (op.sat && (qlo < 0 || qhi > p.g)) wf->saturate |= channels;
+        if (!op.sat && (qlo < -p.nMax || qhi > p.nMax)) wf->clamp |= channels;
+        if (num.lo != num.hi || num.lo % den != 0) wf->round |= channels;
+    }
     auto step = [&](int64_t v) {
         int64_t q = roundHalfEven(v, den);
         q = q < lo ? lo : q;
@@ -124,7 +131,7 @@ void fxWrite(const Profile& p, const DOp& op, KI num, int64_t d0, AV& out) {
 
 // A per-component op passes source `pass` through exactly when k = 2n reaches the write step
 // whole: adding k = 0, multiplying by k = 2G (1.0), lrp by 0 or 1, a decided cnd/cmp.
-void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
+void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4], WriteFindings* wf) {
     const int64_t G = p.g, kOne = 2 * G, kLin = 2, kProd = 4 * G;
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
         // One sum of products (each bounded at its corners), written to every enabled channel.
@@ -132,7 +139,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
         for (int c = 0; c < (op.op == Opcode::Dp3 ? 3 : 4); ++c)
             sum = kAdd(sum, kMul(fetch<true>(p, regs, op.src[0], c).k, fetch<true>(p, regs, op.src[1], c).k));
         AV r;
-        fxWrite(p, op, sum, kProd, r);
+        fxWrite(p, op, sum, kProd, r, wf, op.mask);
         for (int c = 0; c < 4; ++c)
             if ((op.mask >> c) & 1) out[c] = r;
         return;
@@ -210,7 +217,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
         }
         AV& r = out[c];
         r = AV{};
-        fxWrite(p, op, num, d0, r);
+        fxWrite(p, op, num, d0, r, wf, uint8_t(1u << c));
         // The copy tag survives when the source is the register unmodified (k = 2n), nothing is
         // shifted, and the clamps of the write step cannot act on its range.
         if (pass >= 0 && s[pass].tap >= 0 && op.shift == 0) {
@@ -224,7 +231,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4]) {
 // bem (1_4): d.r = a.r + M00·b.r + M10·b.g, d.g = a.g + M01·b.r + M11·b.g in double, rounded
 // once with nearbyint (executor_arith.cpp). Every step is monotone in each input (the matrix
 // fixed), so the extremes are at the corners of the box.
-void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4]) {
+void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4], WriteFindings* wf) {
     int32_t lo, hi;
     fxClamp(p, op.sat, lo, hi);
     const StageState& ss = p.stages[op.stage];
@@ -238,6 +245,7 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
         r = AV{};
         if (!finiteMatrix) {  // any matrix: any value the clamps leave
             r.nlo = lo, r.nhi = hi;
+            if (wf) (op.sat ? wf->saturate : wf->clamp) |= uint8_t(1u << c);
             continue;
         }
         const SV a = fetch<true>(p, regs, op.src[0], c);
@@ -245,7 +253,10 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
         double vlo = INFINITY, vhi = -INFINITY;
         for (int m = 0; m < 8; ++m) {
             const int64_t ka = m & 1 ? a.k.hi : a.k.lo, kr = m & 2 ? br.k.hi : br.k.lo, kg = m & 4 ? bg.k.hi : bg.k.lo;
-            double v = std::nearbyint((double(ka) + mr * double(kr) + mg * double(kg)) * scale);
+            const double exact = (double(ka) + mr * double(kr) + mg * double(kg)) * scale;
+            double v = std::nearbyint(exact);
+            if (wf && (v < lo || v > hi)) (op.sat ? wf->saturate : wf->clamp) |= uint8_t(1u << c);
+            if (wf && v != exact) wf->round |= uint8_t(1u << c);
             v = v < lo ? lo : (v > hi ? hi : v);
             vlo = std::min(vlo, v), vhi = std::max(vhi, v);
         }
@@ -256,7 +267,7 @@ void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, 
 // ---------------------------------------------------------------- float, ideal
 // Write step (executor_arith_float.inc finishFloat): ·2^shift, _sat, range clamp; each monotone,
 // NaN becomes 0 under _sat and stays NaN otherwise.
-FI floatWrite(const Profile& p, const DOp& op, FI v) {
+FI floatWrite(const Profile& p, const DOp& op, FI v, WriteFindings* wf = nullptr, uint8_t channels = 0) {
     static constexpr float kScale[7] = {0.125f, 0.25f, 0.5f, 1.0f, 2.0f, 4.0f, 8.0f};  // 2^shift, exact
     const float scale = kScale[op.shift + 3];
     const float lo = p.clampRange ? -p.maxValue : -kInf, hi = p.clampRange ? p.maxValue : kInf;
@@ -266,6 +277,10 @@ FI floatWrite(const Profile& p, const DOp& op, FI v) {
         (v.hi < -std::numeric_limits<float>::denorm_min() ? v.hi : -std::numeric_limits<float>::denorm_min()) * scale ==
             0.0f)
         s.nz = true;
+    if (wf) {
+        if (op.sat && (s.nan || s.lo < 0.0f || s.hi > 1.0f)) wf->saturate |= channels;
+        if (!op.sat && (s.lo < lo || s.hi > hi)) wf->clamp |= channels;
+    }
     if (op.sat) {
         auto f = [&](float x) {
             x = x > 0.0f ? x : 0.0f;
@@ -304,7 +319,7 @@ FI lrpRefine(const SV* s, FI steps) {
     return norm(steps);
 }
 
-void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4]) {
+void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4], WriteFindings* wf) {
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
         // ((a.r·b.r + a.g·b.g) + a.b·b.b) (+ a.a·b.a), as the executor evaluates it.
         auto term = [&](int c) {
@@ -313,7 +328,7 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
         FI sum = fAdd(fAdd(term(0), term(1)), term(2));
         if (op.op == Opcode::Dp4) sum = fAdd(sum, term(3));
         AV r;
-        r.f = floatWrite(p, op, sum);
+        r.f = floatWrite(p, op, sum, wf, op.mask);
         for (int c = 0; c < 4; ++c)
             if ((op.mask >> c) & 1) out[c] = r;
         return;
@@ -329,7 +344,7 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
                                             fAdd(fMul(fPoint(mr), br), fMul(fPoint(mg), bg)))
                                      : fTop();
             out[c] = AV{};
-            out[c].f = floatWrite(p, op, v);
+            out[c].f = floatWrite(p, op, v, wf, uint8_t(1u << c));
         }
         return;
     }
@@ -399,7 +414,7 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
         }
         AV& r = out[c];
         r = AV{};
-        r.f = floatWrite(p, op, v);
+        r.f = floatWrite(p, op, v, wf, uint8_t(1u << c));
         // The copy tag survives an exact identity when nothing is shifted and the write step
         // leaves the value alone: _sat turns −0.0 into +0.0, the clamp acts outside [−M, M].
         if (pass >= 0 && s[pass].tap >= 0 && op.shift == 0) {
@@ -414,14 +429,14 @@ void arithFloat(const Profile& p, bool stagesKnown, const DOp& op, const Regs& r
 
 }  // namespace
 
-void evalArith(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4]) {
+void evalArith(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4], WriteFindings* wf) {
     if (isFixedPoint(p.precision)) {
         if (op.op == Opcode::Bem)
-            bemFx(p, stagesKnown, op, regs, out);
+            bemFx(p, stagesKnown, op, regs, out, wf);
         else
-            arithFx(p, op, regs, out);
+            arithFx(p, op, regs, out, wf);
     } else {
-        arithFloat(p, stagesKnown, op, regs, out);
+        arithFloat(p, stagesKnown, op, regs, out, wf);
     }
 }
 

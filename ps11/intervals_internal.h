@@ -132,7 +132,16 @@ struct Regs {
 // The whole range of a profile's register (what an unknown value can be after the write step).
 AV wholeRange(const exec::Profile& p);
 
-// An arithmetic instruction (mov … bem) into out[c] for the channels of op.mask.
-void evalArith(const exec::Profile& p, bool stagesKnown, const exec::DOp& op, const Regs& regs, AV out[4]);
+// What the write step of one instruction did to its channels (bit per channel): the range clamp
+// to ±MaxValue acted on a value past it (without _sat), _sat cut a value outside [0, 1], or an
+// fx profile rounded a value off its grid.
+struct WriteFindings {
+    uint8_t clamp = 0, saturate = 0, round = 0;
+};
+
+// An arithmetic instruction (mov … bem) into out[c] for the channels of op.mask; `findings`, when
+// given, receives where the write step can act.
+void evalArith(const exec::Profile& p, bool stagesKnown, const exec::DOp& op, const Regs& regs, AV out[4],
+               WriteFindings* findings = nullptr);
 
 }  // namespace ps11::intervals

@@ -44,6 +44,10 @@ public:
     // Sets a stage's sampler state; false for a stage outside 0..7.
     bool setSamplerState(int stage, const SamplerState& state);
     const SamplerState& samplerState(int stage) const { return m_stages[size_t(stage)].state; }
+    // The texture bound to a stage (null: none, or a stage outside 0..7).
+    const Texture* texture(int stage) const {
+        return stage >= 0 && stage < kMaxSamplerStages ? m_stages[size_t(stage)].texture.get() : nullptr;
+    }
 
     void sample(const SampleRequest& req, SampleResult& out) override;
     bool hasTexture(int stage) const override;

@@ -3,6 +3,8 @@
 #include "tools/cli_util.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +15,7 @@
 #include <sstream>
 
 #include "ps11/suggest.h"
+#include "ps11/testfile.h"
 
 namespace ps11::cli {
 
@@ -134,6 +137,49 @@ std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine) {
         out += (i + 1 == tokens.size() || (i + 1) % perLine == 0) ? '\n' : ' ';
     }
     return out;
+}
+
+std::optional<float> parseFloat(const std::string& s) {
+    if (s.empty()) return std::nullopt;
+    const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
+    const char* end = s.data() + s.size();
+    float v = 0;
+    auto [ptr, ec] = std::from_chars(begin, end, v);
+    if (ec != std::errc() || ptr != end || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::optional<uint32_t> parseHexWord(const std::string& s) {
+    if (s.size() < 3 || s.size() > 10 || s[0] != '0' || (s[1] != 'x' && s[1] != 'X')) return std::nullopt;
+    uint32_t v = 0;
+    auto [ptr, ec] = std::from_chars(s.data() + 2, s.data() + s.size(), v, 16);
+    if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
+    return v;
+}
+
+std::optional<std::array<float, 4>> parseVector(const std::string& s, bool allowWord) {
+    if (allowWord)
+        if (std::optional<uint32_t> w = parseHexWord(s))
+            return Color::fromArgb(*w).rgba;
+    std::array<float, 4> v{0, 0, 0, 0};
+    size_t start = 0;
+    for (size_t c = 0;; ++c) {
+        if (c == 4) return std::nullopt;
+        size_t comma = s.find(',', start);
+        std::optional<float> f = parseFloat(s.substr(start, comma == std::string::npos ? comma : comma - start));
+        if (!f) return std::nullopt;
+        v[c] = *f;
+        if (comma == std::string::npos) return v;
+        start = comma + 1;
+    }
+}
+
+std::optional<std::pair<float, float>> parseRange(const std::string& s) {
+    const size_t comma = s.find(',');
+    if (comma == std::string::npos) return std::nullopt;
+    std::optional<float> lo = parseFloat(s.substr(0, comma)), hi = parseFloat(s.substr(comma + 1));
+    if (!lo || !hi || *lo > *hi) return std::nullopt;
+    return std::pair<float, float>{*lo, *hi};
 }
 
 }  // namespace ps11::cli

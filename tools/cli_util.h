@@ -2,11 +2,13 @@
 // the -D/-I options, and locating the project's own data (shader corpus, golden files).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "ps11/assembler.h"
@@ -39,5 +41,15 @@ std::vector<std::string> listFiles(const std::string& dir, const std::string& ex
 std::string unknownOption(std::string_view arg, std::initializer_list<std::string_view> options);
 
 std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine = 8);
+
+// A finite float (an optional leading '+'), nothing else in the string.
+std::optional<float> parseFloat(const std::string& s);
+// "0x" and 1-8 hex digits.
+std::optional<uint32_t> parseHexWord(const std::string& s);
+// "x,y,z,w" with 1-4 components (missing ones 0), or with `allowWord` one 0xAARRGGBB colour
+// word (r g b a in [0, 1]).
+std::optional<std::array<float, 4>> parseVector(const std::string& s, bool allowWord);
+// "lo,hi": two finite floats with lo <= hi.
+std::optional<std::pair<float, float>> parseRange(const std::string& s);
 
 }  // namespace ps11::cli

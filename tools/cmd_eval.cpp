@@ -38,13 +38,17 @@ constexpr const char* kUsage =
     "  --hardware picks the emulated GPU (`ps11 hardware` lists them; default: the 1.1-class card,\n"
     "  or the 1.4-class card for ps_1_4); --precision and --max-value override its values\n";
 
+// The command whose arguments are parsed ("eval" or "debug") and its usage text.
+const char* g_command = "eval";
+const char* g_usage = kUsage;
+
 int usageError(const std::string& message) {
-    std::cerr << "ps11: eval: " << message << "\n" << kUsage;
+    std::cerr << "ps11: " << g_command << ": " << message << "\n" << g_usage;
     return cli::kUsage;
 }
 
 int userError(const std::string& message) {
-    std::cerr << "ps11: eval: " << message << "\n";
+    std::cerr << "ps11: " << g_command << ": " << message << "\n";
     return cli::kUserError;
 }
 
@@ -53,58 +57,11 @@ std::string lower(std::string s) {
     return s;
 }
 
-std::optional<float> parseFloat(const std::string& s) {
-    if (s.empty()) return std::nullopt;
-    const char* begin = s.data() + (s[0] == '+' ? 1 : 0);
-    const char* end = s.data() + s.size();
-    float v = 0;
-    auto [ptr, ec] = std::from_chars(begin, end, v);
-    if (ec != std::errc() || ptr != end || !std::isfinite(v)) return std::nullopt;
-    return v;
-}
-
-std::optional<uint32_t> parseHexWord(const std::string& s) {
-    if (s.size() < 3 || s.size() > 10 || s[0] != '0' || (s[1] != 'x' && s[1] != 'X')) return std::nullopt;
-    uint32_t v = 0;
-    auto [ptr, ec] = std::from_chars(s.data() + 2, s.data() + s.size(), v, 16);
-    if (ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
-    return v;
-}
-
-// "x,y,z,w" with 1-4 components (missing ones 0), or for colours one 0xAARRGGBB word.
-std::optional<Vec4> parseVector(const std::string& s, bool allowWord) {
-    if (allowWord)
-        if (std::optional<uint32_t> w = parseHexWord(s)) return Color::fromArgb(*w).rgba;
-    Vec4 v{0, 0, 0, 0};
-    size_t start = 0;
-    for (int c = 0;; ++c) {
-        if (c == 4) return std::nullopt;
-        size_t comma = s.find(',', start);
-        std::optional<float> f = parseFloat(s.substr(start, comma == std::string::npos ? comma : comma - start));
-        if (!f) return std::nullopt;
-        v[c] = *f;
-        if (comma == std::string::npos) return v;
-        start = comma + 1;
-    }
-}
-
 std::string num(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.6g", v);
     return buf;
 }
-
-struct EvalArgs {
-    std::string shader;
-    std::array<std::optional<Vec4>, 2> color;
-    std::array<std::optional<Vec4>, kMaxTexCoordSets> texcoord;
-    std::array<std::optional<Vec4>, exec::kNumConsts> constant;
-    std::array<std::optional<uint32_t>, kMaxTextureStages> texture;  // 1x1 texel word per stage
-    std::array<TexFormat, kMaxTextureStages> textureFormat{};        // its format (A8R8G8B8 unless FORMAT: given)
-    const HardwareClass* hardware = nullptr;         // null = the default class of the version
-    std::optional<Precision> precision;              // overrides the class's profile
-    float maxValue = 0;                              // overrides the class's MaxValue (0 = none)
-};
 
 // Parses NAME=VALUE; returns an exit code (kOk = consumed).
 int takeRegister(const std::string& arg, EvalArgs& out) {
@@ -120,7 +77,7 @@ int takeRegister(const std::string& arg, EvalArgs& out) {
     }
     if (!slot) return usageError("unknown input " + quote(arg.substr(0, eq)) + " (expected v0, v1, t0..t7 or c0..c7)");
     if (*slot) return userError(name + " given twice");
-    std::optional<Vec4> v = parseVector(value, name[0] == 'v');
+    std::optional<Vec4> v = cli::parseVector(value, name[0] == 'v');
     if (!v) return userError("bad value for " + name + ": " + quote(value));
     *slot = v;
     return cli::kOk;
@@ -128,13 +85,14 @@ int takeRegister(const std::string& arg, EvalArgs& out) {
 
 }  // namespace
 
-int cmdEval(const std::vector<std::string>& args) {
-    EvalArgs ea;
+int parseEvalArgs(const std::vector<std::string>& args, const char* command, const char* usage, EvalArgs& ea) {
+    g_command = command;
+    g_usage = usage;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         if (a == "-h" || a == "--help") {
-            std::cout << kUsage;
-            return cli::kOk;
+            std::cout << usage;
+            return kHelpShown;
         }
         bool isTex = a.size() == 6 && a.compare(0, 5, "--tex") == 0 && a[5] >= '0' && a[5] <= '7';
         if (a == "--precision" || a == "--max-value" || a == "--hardware" || isTex) {
@@ -149,7 +107,7 @@ int cmdEval(const std::vector<std::string>& args) {
                 if (!p) return usageError("unknown precision " + quote(v) + " (expected fx8, fx12, float or ideal)");
                 ea.precision = *p;
             } else if (a == "--max-value") {
-                std::optional<float> m = parseFloat(v);
+                std::optional<float> m = cli::parseFloat(v);
                 if (!m || *m <= 0)
                     return userError("bad value for --max-value: " + quote(v) + " (expected a float > 0)");
                 ea.maxValue = *m;
@@ -165,7 +123,7 @@ int cmdEval(const std::vector<std::string>& args) {
                     ea.textureFormat[size_t(stage)] = *f;
                     word = v.substr(colon + 1);
                 }
-                std::optional<uint32_t> w = parseHexWord(word);
+                std::optional<uint32_t> w = cli::parseHexWord(word);
                 const int bits = formatBits(ea.textureFormat[size_t(stage)]);
                 if (!w || (bits < 32 && (*w >> bits) != 0))
                     return userError("bad value for " + a + ": " + quote(v) + " (expected a hex word of " +
@@ -183,32 +141,39 @@ int cmdEval(const std::vector<std::string>& args) {
             return usageError("eval takes one shader file (" + quote(a) + " is a second one)");
         }
     }
-    if (ea.shader.empty()) return usageError("eval needs a shader file");
+    if (ea.shader.empty()) return usageError(std::string(command) + " needs a shader file");
+    return cli::kOk;
+}
 
+int loadEvalProgram(const EvalArgs& ea, std::optional<Program>& program, HardwareConfig& hw) {
     std::optional<std::string> text = cli::readFile(ea.shader);
     if (!text) return cli::kUserError;
     Diagnostics diags;
     std::string name = ea.shader == "-" ? "<stdin>" : ea.shader;
-    std::optional<Program> program = parseAssembly(*text, name, AssembleOptions{}, diags);
+    program = parseAssembly(*text, name, AssembleOptions{}, diags);
     if (program) validate(*program, diags);
     std::cerr << diags.formatAll();
     if (!program || diags.hasErrors()) return cli::kUserError;
 
-    const HardwareConfig hw = resolveHardware(ea.hardware, program->version.minor, ea.precision, ea.maxValue);
+    hw = resolveHardware(ea.hardware, program->version.minor, ea.precision, ea.maxValue);
     if (program->version.minor > hw.hardware->maxMinor)
         return userError("hardware " + std::string(hw.hardware->name) + " runs ps_1_1 ... ps_1_" +
                          std::to_string(hw.hardware->maxMinor) + "; " + name + " is ps_1_" +
                          std::to_string(program->version.minor));
-    const ExecutorOptions eo = executorOptionsFor(hw);
-    Diagnostics execDiags = diags;  // the same file ids as the program's source places
-    execDiags.clear();
-    std::unique_ptr<Executor> executor = Executor::create(*program, eo, execDiags);
-    std::cerr << execDiags.formatAll();
-    if (!executor) return cli::kUserError;
+    return cli::kOk;
+}
+
+std::unique_ptr<Executor> makeEvalExecutor(const Program& program, const HardwareConfig& hw, const EvalArgs& ea) {
+    Diagnostics diags;
+    std::unique_ptr<Executor> executor = Executor::create(program, executorOptionsFor(hw), diags);
+    std::cerr << diags.formatAll();
+    if (!executor) return nullptr;
     for (int c = 0; c < exec::kNumConsts; ++c)
         if (ea.constant[c]) executor->setConstant(c, *ea.constant[c]);
+    return executor;
+}
 
-    TextureSampler sampler;
+int bindEvalTextures(const EvalArgs& ea, const HardwareConfig& hw, uint32_t sampled, TextureSampler& sampler) {
     sampler.setWeightBits(hw.weightBits);
     for (int stage = 0; stage < kMaxTextureStages; ++stage) {
         if (!ea.texture[stage]) continue;
@@ -226,18 +191,33 @@ int cmdEval(const std::vector<std::string>& args) {
         if (!texture) return userError("cannot build the texture of --tex" + std::to_string(stage) + ": " + why);
         sampler.bind(stage, std::make_shared<const Texture>(std::move(*texture)));
     }
-    uint32_t sampled = executor->sampledStages();
     for (int stage = 0; stage < kMaxTextureStages; ++stage)
         if ((sampled & (1u << stage)) && !ea.texture[stage])
-            std::cerr << "ps11: eval: note: the shader samples stage " << stage << ", which has no --tex" << stage
-                      << "; D3D returns (0, 0, 0, 1) there\n";
+            std::cerr << "ps11: " << g_command << ": note: the shader samples stage " << stage << ", which has no --tex"
+                      << stage << "; D3D returns (0, 0, 0, 1) there\n";
+    return cli::kOk;
+}
 
+EvalInputs EvalArgs::inputs() const {
     EvalInputs in;
     for (int r = 0; r < 2; ++r)
-        if (ea.color[r]) in.color[r] = &*ea.color[r];
+        if (color[size_t(r)]) in.color[size_t(r)] = &*color[size_t(r)];
     for (int r = 0; r < 8; ++r)
-        if (ea.texcoord[r]) in.texture[r] = &*ea.texcoord[r];
-    EvalOutcome out = evalOnePixel(*executor, sampler, in);
+        if (texcoord[size_t(r)]) in.texture[size_t(r)] = &*texcoord[size_t(r)];
+    return in;
+}
+
+int cmdEval(const std::vector<std::string>& args) {
+    EvalArgs ea;
+    if (int rc = parseEvalArgs(args, "eval", kUsage, ea); rc != cli::kOk) return rc == kHelpShown ? cli::kOk : rc;
+    std::optional<Program> program;
+    HardwareConfig hw;
+    if (int rc = loadEvalProgram(ea, program, hw); rc != cli::kOk) return rc;
+    std::unique_ptr<Executor> executor = makeEvalExecutor(*program, hw, ea);
+    if (!executor) return cli::kUserError;
+    TextureSampler sampler;
+    if (int rc = bindEvalTextures(ea, hw, executor->sampledStages(), sampler); rc != cli::kOk) return rc;
+    EvalOutcome out = evalOnePixel(*executor, sampler, ea.inputs());
 
     const Precision p = hw.precision;
     std::cout << "ps_" << program->version.major << "_" << program->version.minor << ", hardware " << hw.describe()

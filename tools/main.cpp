@@ -6,6 +6,8 @@
 #include <cstring>
 #include <filesystem>
 #include <iostream>
+
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,8 @@
 #include "tools/cmd_hardware.h"
 #include "tools/cmd_info.h"
 #include "tools/cmd_compare.h"
+#include "tools/cmd_debug.h"
+#include "tools/cmd_ranges.h"
 #include "tools/cmd_glare.h"
 #include "tools/cmd_shade.h"
 #include "tools/cmd_test.h"
@@ -39,6 +43,10 @@ const char* kUsageText =
     "                         tokens (binary, or hex words with --hex-input) → text\n"
     "  check FILE... [--json] [-D NAME[=VALUE]] [-I DIR]\n"
     "                         validate and print statistics (slots, constants, read ports)\n"
+    "  check --ranges FILE... [--hardware H] [--cN x,y,z,w] [--texN-range lo,hi] [--texN-point]\n"
+    "        [--vN-range lo,hi] [--tcN-range lo,hi] [--json]\n"
+    "                         value ranges per instruction, where clamps act and from which\n"
+    "                         input on, and r0's worst-case fx8/fx12 rounding against float\n"
     "  test FILE.ps11test... [--backend emu|gl|both] [--gl osmesa|egl] [--hardware H] [--precision P]\n"
     "       [--no-skip] [-v]\n"
     "                         run .ps11test files (both: cross-check the two renderers)\n"
@@ -57,6 +65,9 @@ const char* kUsageText =
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
+    "  debug SHADER.psh [the inputs of eval] [--hardware H] [--json]\n"
+    "                         one pixel instruction by instruction, the class beside ideal,\n"
+    "                         why they differ and where they first part by more than a level\n"
     "  hardware [--json]      the emulated GPUs (hardware classes) and what each one changes\n"
     "  info [--gl osmesa|egl] [--json]\n"
     "                         version, default hardware, executor kernels, the OpenGL context\n"
@@ -208,8 +219,9 @@ int cmdDisasm(const std::vector<std::string>& args) {
 
 int cmdCheck(const std::vector<std::string>& args) {
     std::vector<std::string> inputs;
-    bool json = false, hexInput = false;
+    bool json = false, hexInput = false, ranges = false, rangeOptionGiven = false;
     PreprocessOptions pp;
+    RangeOptions rangeOptions;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         std::string err;
@@ -217,17 +229,26 @@ int cmdCheck(const std::vector<std::string>& args) {
             json = true;
         } else if (a == "--hex-input") {
             hexInput = true;
+        } else if (a == "--ranges") {
+            ranges = true;
         } else if (takePreprocessorOption(args, i, pp, err)) {
             if (!err.empty()) return usage(err);
+        } else if (takeRangeOption(args, i, rangeOptions, err)) {
+            if (!err.empty()) return usage("check: " + err);
+            rangeOptionGiven = true;
         } else if (a.size() > 1 && a[0] == '-') {
-            return usage("check: " + unknownOption(a, {"--json", "--hex-input", "-D", "-I"}));
+            return usage("check: " + unknownOption(a, {"--json", "--hex-input", "--ranges", "--hardware", "--c0",
+                                                       "--tex0-range", "--tex0-point", "--v0-range", "--tc0-range",
+                                                       "-D", "-I"}));
         } else {
             inputs.push_back(a);
         }
     }
     if (inputs.empty()) return usage("check needs at least one shader file");
+    if (rangeOptionGiven && !ranges) return usage("check: --hardware, --cN and the range options need --ranges");
     int status = kOk;
-    if (json) std::cout << "[";
+    nlohmann::ordered_json rangeJson = nlohmann::ordered_json::array();
+    if (json && !ranges) std::cout << "[";
     for (size_t n = 0; n < inputs.size(); ++n) {
         const std::string& path = inputs[n];
         Diagnostics diags;
@@ -249,6 +270,15 @@ int cmdCheck(const std::vector<std::string>& args) {
         std::cerr << diags.formatAll();
         bool ok = prog && !diags.hasErrors();
         if (!ok) status = kUserError;
+        if (ranges) {
+            nlohmann::ordered_json one;
+            if (ok && checkRanges(*prog, path, rangeOptions, json, &one)) {
+                if (json) rangeJson.push_back(std::move(one));
+            } else {
+                status = kUserError;
+            }
+            continue;
+        }
         if (json) {
             std::cout << (n ? ",\n" : "\n") << "{\"file\": \"";
             for (char c : path) {
@@ -264,7 +294,9 @@ int cmdCheck(const std::vector<std::string>& args) {
             if (prog) std::cout << statsToText(stats) << "\n";
         }
     }
-    if (json) std::cout << "\n]\n";
+    if (json && !ranges) std::cout << "\n]\n";
+    // One shader: its object (docs/intervals.md "The range proof"); several: an array of them.
+    if (json && ranges) std::cout << (rangeJson.size() == 1 ? rangeJson[0] : rangeJson).dump(2) << "\n";
     return status;
 }
 
@@ -367,6 +399,7 @@ int main(int argc, char** argv) {
         {"glare", ps11::cmdGlare},
         {"shade", ps11::cmdShade},
         {"eval", ps11::cmdEval},
+        {"debug", ps11::cmdDebug},
         {"golden", cmdGolden},
         {"demo", cmdDemo},
         {"hardware", ps11::cmdHardware},

@@ -85,6 +85,45 @@ expect_rc 1 "a 1 MB line" "$ps11" asm "$work/long.psh"
 expect_in "$work/err" "long.psh:1:8: error P1111: unexpected text after the version: 'xxx" "long line names line:col"
 [ "$(wc -c <"$work/err")" -lt 300 ] || fail "a 1 MB line gave $(wc -c <"$work/err") bytes of diagnostics"
 
+# check --ranges: Sousa's mov_x4 then mul clamps from t0 > 0.25 (ps11/range_proof.h).
+printf 'ps_1_1\ntex t0\nmov_x4 r1, t0\nmul r0, r1, t0\n' >"$work/sq.psh"
+expect_rc 0 "check --ranges" "$ps11" check --ranges "$work/sq.psh"
+expect_in "$work/out" "CLAMPS .rgba at ±1; from t0 > 0.251" "check --ranges onset"
+expect_in "$work/out" "not range-safe: line 3 (mov_x4 r1, t0) clamps" "check --ranges verdict"
+expect_rc 0 "check --ranges restricted" "$ps11" check --ranges "$work/sq.psh" --tex0-range 0,0.2
+expect_in "$work/out" "range-safe: no register clamp acts" "check --ranges with t0 in [0, 0.2]"
+expect_rc 0 "check --ranges --json" "$ps11" check --ranges --json "$work/sq.psh" --tex0-point
+python3 - "$work/out" <<'PY' || fail "check --ranges --json: fields"
+import json, sys
+j = json.load(open(sys.argv[1]))
+i = j["instructions"]
+assert [x["line"] for x in i] == [2, 3, 4], i
+assert i[1]["clamps"] and not i[0]["clamps"] and not i[2]["clamps"]
+assert i[1]["dst"] == "r1" and i[1]["min"] == [0, 0, 0, 0] and i[1]["max"] == [1, 1, 1, 1]
+assert i[1]["clamp_onsets"][0]["input"] == "t0" and 0.24 < i[1]["clamp_onsets"][0]["above"] < 0.252
+b = j["outputs"]["r0"]["bound_levels"]
+assert 0 < b["fx12"] < b["fx8"] < 10, b
+assert j["range_safe"] is False
+PY
+expect_rc 2 "check --ranges bad range" "$ps11" check --ranges "$work/sq.psh" --tex0-range 1,0
+expect_in "$work/err" "--tex0-range" "bad range names the option"
+expect_rc 2 "range option without --ranges" "$ps11" check "$work/sq.psh" --tex0-range 0,1
+# debug: one pixel, the class beside ideal; mov_x4 of 0.627 clamps on the 1.1-class card.
+expect_rc 0 "debug" "$ps11" debug "$work/sq.psh" --tex0 0xffa0a0a0
+expect_in "$work/out" ">> 3" "debug marks the first divergence"
+expect_in "$work/out" "clamp" "debug names the clamp"
+expect_rc 0 "debug --json" "$ps11" debug "$work/sq.psh" --tex0 0xff202020 --json
+python3 - "$work/out" <<'PY' || fail "debug --json: fields"
+import json, sys
+j = json.load(open(sys.argv[1]))
+s = j["steps"]
+assert [x["line"] for x in s] == [2, 3, 4], s
+assert s[0]["grid"] == [32, 32, 32, 255] and s[0]["emulated"] == s[0]["ideal"]
+assert j["first_divergence"] is None or j["first_divergence"] in (3, 4)
+assert all(isinstance(x["why"], list) for x in s)
+PY
+expect_rc 2 "debug without a shader" "$ps11" debug
+expect_rc 1 "debug of a missing file" "$ps11" debug "$work/missing.psh"
 # eval: one pixel on the executor.
 printf 'ps_1_1\nmov r0, v0\n' >"$work/e.psh"
 expect_rc 0 "eval" "$ps11" eval "$work/e.psh" v0=0.5,0.25,1
