@@ -40,4 +40,9 @@ std::string unknownOption(std::string_view arg, std::initializer_list<std::strin
 
 std::string hexWords(const std::vector<uint32_t>& tokens, size_t perLine = 8);
 
+// "WxH" (or "WXH") with both sides in 1..maxSide; false for anything else.
+bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide = 8192);
+// A whole decimal number in lo..hi; false for anything else (signs, spaces, overflow).
+bool parseCount(const std::string& text, int lo, int hi, int& value);
+
 }  // namespace ps11::cli
