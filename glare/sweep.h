@@ -53,7 +53,7 @@ struct SweepSpec {
     std::optional<emu::FloatImage> image;
     std::string imageName, scene;
     uint32_t width = 1920, height = 1080;
-    int frames = 10;  // timed frames per row, after one warm-up frame
+    int frames = 20;  // timed frames per row, after one warm-up frame
     int threads = 0;  // the software renderer's worker threads (0: all cores)
 };
 

@@ -30,7 +30,7 @@ constexpr const char* kBenchUsage =
     "                  [--exposure STOPS] [--size WxH] [--frames N] [--json]\n"
     "  T, Q and H also take comma-separated lists; --hardware takes `ideal` (the reference profile) too.\n"
     "  Defaults: every technique on its own scene, published quality, the default card, both renderers\n"
-    "  (GL in native mode), 1920x1080, 10 timed frames after one warm-up.\n";
+    "  (GL in native mode), 1920x1080, 20 timed frames after one warm-up.\n";
 
 int benchUsage(const std::string& msg) {
     std::cerr << "ps11 bench: " << msg << "\n" << kBenchUsage;
@@ -107,10 +107,10 @@ void printTable(const std::vector<glare::SweepRow>& rows, const glare::SweepSpec
     std::printf("run time against error: %d timed frame(s) per row after one warm-up; error of the 8-bit output over RGB\n"
                 "against the technique's ideal reference (same settings, same input), in 8-bit levels\n\n",
                 spec.frames);
-    size_t sw = 8;
-    for (const glare::SweepRow& r : rows) sw = std::max(sw, sweptText(r).size());
-    std::printf("%-9s %-7s %-9s %-10s %-*s %-10s %-5s %-9s %8s %8s %8s %5s %7s %7s %6s | %5s %7s %7s %6s  %s\n", "technique",
-                "scene", "size", "quality", int(sw), "settings", "hardware", "prec", "backend", "ms med", "min", "max",
+    size_t sw = 8, cw = 7;
+    for (const glare::SweepRow& r : rows) sw = std::max(sw, sweptText(r).size()), cw = std::max(cw, r.scene.size());
+    std::printf("%-9s %-*s %-9s %-10s %-*s %-10s %-5s %-9s %8s %8s %8s %5s %7s %7s %6s | %5s %7s %7s %6s  %s\n", "technique",
+                int(cw), "scene", "size", "quality", int(sw), "settings", "hardware", "prec", "backend", "ms med", "min", "max",
                 "max", "mean", ">1 %", "PSNR", "max", "mean", ">1 %", "PSNR", "front");
     for (const glare::SweepRow& r : rows) {
         char intended[64] = "    -       -       -      -";
@@ -118,8 +118,8 @@ void printTable(const std::vector<glare::SweepRow>& rows, const glare::SweepSpec
             std::snprintf(intended, sizeof intended, "%5d %7.3f %7.2f %6s", r.intendedError->max, r.intendedError->mean,
                           r.intendedError->overOnePercent, psnrText(r.intendedError->psnr).c_str());
         const std::string size = std::to_string(r.width) + "x" + std::to_string(r.height);
-        std::printf("%-9s %-7s %-9s %-10s %-*s %-10s %-5s %-9s %8.2f %8.2f %8.2f %5d %7.3f %7.2f %6s | %s  %s\n",
-                    r.technique.c_str(), r.scene.c_str(), size.c_str(), r.quality.c_str(), int(sw), sweptText(r).c_str(),
+        std::printf("%-9s %-*s %-9s %-10s %-*s %-10s %-5s %-9s %8.2f %8.2f %8.2f %5d %7.3f %7.2f %6s | %s  %s\n",
+                    r.technique.c_str(), int(cw), r.scene.c_str(), size.c_str(), r.quality.c_str(), int(sw), sweptText(r).c_str(),
                     r.hardware.c_str(), r.precision.c_str(), backendText(r).c_str(), r.msMedian, r.msMin, r.msMax, r.error.max,
                     r.error.mean, r.error.overOnePercent, psnrText(r.error.psnr).c_str(), intended, r.pareto ? "*" : "");
     }
@@ -153,7 +153,7 @@ int cmdBench(const std::vector<std::string>& args) {
     std::string scene, in;
     std::vector<std::string> sets;
     uint32_t width = 0, height = 0;
-    int frames = 10;
+    int frames = 20;
     float exposure = 0;
     bool json = false, glModeGiven = false;
     for (size_t i = 0; i < args.size(); ++i) {

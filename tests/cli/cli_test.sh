@@ -177,7 +177,7 @@ for b in rows:
 assert sorted(r["settings"]["blur_passes"] for r in rows) == [2, 2, 5, 5]
 PY
 fi
-expect_rc 0 "bench text" "$ps11" bench --technique pyramid --size 96x64 --frames 1 --backend emu
+expect_rc 0 "bench text" "$ps11" bench --technique pyramid --scene box --size 96x64 --frames 1 --backend emu
 expect_in "$work/out" "Pareto front" "bench prints the front"
 expect_in "$work/out" "pyramid on box 96x64:" "bench names the front's technique"
 expect_rc 2 "bench unknown technique" "$ps11" bench --technique glwo
@@ -467,6 +467,13 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_in "$work/out" "0 disagreements" "--no-skip on the emu side agrees with gl"
     expect_rc 0 "compare --gl-mode native" "$ps11" compare "$work/n.ps11test" --gl-mode native
     expect_in "$work/out" "gl native against ideal: max |d| 0 levels" "compare reports the distance from ideal"
+    expect_rc 0 "bench --backend both" "$ps11" bench --technique quarter --size 64x36 --frames 1 --backend both --json
+    expect_in "$work/out" '"backend": "gl"' "bench runs a GL row"
+    expect_in "$work/out" '"gl_mode": "native"' "bench's GL rows run native mode by default"
+    expect_rc 0 "bench --gl-mode exact" "$ps11" bench --technique quarter --size 64x36 --frames 1 --backend gl --gl-mode exact
+    expect_in "$work/out" "gl-exact" "bench names the exact mode"
+    expect_rc 2 "bench --gl-mode without gl" "$ps11" bench --backend emu --gl-mode exact
+    expect_in "$work/err" "--gl-mode needs --backend gl or both" "bench says what --gl-mode needs"
     expect_rc 2 "compare --random --gl-mode native" "$ps11" compare --random 2 --gl-mode native
     expect_rc 0 "shade --gl-mode native" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --backend gl --gl-mode native -o "$work/sn.png"
     expect_rc 2 "shade --gl-mode without gl" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --gl-mode native -o "$work/sn.png"
