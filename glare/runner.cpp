@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <limits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -254,19 +256,22 @@ SceneRun runOnScene(const Technique& technique, const RunnerOptions& options, in
 ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b) {
     ImageError e;
     const size_t px = std::min(a.rgba.size(), b.rgba.size()) / 4;
-    uint64_t sum = 0, over = 0;
+    uint64_t sum = 0, over = 0, squares = 0;
     for (size_t i = 0; i < px; ++i) {
         int worst = 0;
         for (size_t c = 0; c < 3; ++c) {
             const int d = std::abs(int(a.rgba[i * 4 + c]) - int(b.rgba[i * 4 + c]));
             worst = std::max(worst, d);
             sum += uint64_t(d);
+            squares += uint64_t(d * d);
         }
         e.max = std::max(e.max, worst);
         over += worst > 1;
     }
     e.mean = px ? double(sum) / double(px * 3) : 0;
     e.overOnePercent = px ? 100.0 * double(over) / double(px) : 0;
+    e.psnr = squares ? 10.0 * std::log10(255.0 * 255.0 * double(px * 3) / double(squares))
+                     : std::numeric_limits<double>::infinity();
     return e;
 }
 

@@ -136,6 +136,7 @@ struct ImageError {
     int max = 0;
     double mean = 0;
     double overOnePercent = 0;  // pixels whose largest channel difference is more than 1 level
+    double psnr = 0;            // dB over RGB, peak 255: 10·log10(255² / mean squared difference); +inf when equal
 };
 ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b);
 

@@ -25,6 +25,12 @@ const Technique* findTechnique(std::string_view name) {
     return nullptr;
 }
 
+std::string unknownTechniqueMessage(std::string_view name) {
+    std::string names;
+    for (const Technique* t : techniques()) names += (names.empty() ? "" : ", ") + std::string(t->name());
+    return "unknown technique '" + std::string(name) + "' (techniques: " + names + ")";
+}
+
 std::optional<Settings> presetSettings(const Technique& t, std::string_view preset) {
     for (size_t i = 0; i < kPresetNames.size(); ++i)
         if (kPresetNames[i] == preset) {

@@ -73,6 +73,8 @@ public:
 
 const std::vector<const Technique*>& techniques();
 const Technique* findTechnique(std::string_view name);
+// "unknown technique 'x' (techniques: adaptive, glow, pyramid, quarter, sprites)".
+std::string unknownTechniqueMessage(std::string_view name);
 
 // The settings of a preset ("low", "medium", "high", "published"); nullopt for an unknown name.
 std::optional<Settings> presetSettings(const Technique& t, std::string_view preset);

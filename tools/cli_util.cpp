@@ -182,4 +182,23 @@ std::optional<std::pair<float, float>> parseRange(const std::string& s) {
     return std::pair<float, float>{*lo, *hi};
 }
 
+bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide) {
+    unsigned long a = 0, b = 0;
+    char x = 0, tail = 0;
+    if (std::sscanf(text.c_str(), "%lu%c%lu%c", &a, &x, &b, &tail) != 3 || (x != 'x' && x != 'X')) return false;
+    if (text.find_first_of("+- ") != std::string::npos) return false;
+    if (a < 1 || b < 1 || a > maxSide || b > maxSide) return false;
+    width = uint32_t(a);
+    height = uint32_t(b);
+    return true;
+}
+
+bool parseCount(const std::string& text, int lo, int hi, int& value) {
+    if (text.empty() || text.size() > 9 || text.find_first_not_of("0123456789") != std::string::npos) return false;
+    const long v = std::stol(text);
+    if (v < lo || v > hi) return false;
+    value = int(v);
+    return true;
+}
+
 }  // namespace ps11::cli

@@ -51,5 +51,9 @@ std::optional<uint32_t> parseHexWord(const std::string& s);
 std::optional<std::array<float, 4>> parseVector(const std::string& s, bool allowWord);
 // "lo,hi": two finite floats with lo <= hi.
 std::optional<std::pair<float, float>> parseRange(const std::string& s);
+// "WxH" (or "WXH") with both sides in 1..maxSide; false for anything else.
+bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide = 8192);
+// A whole decimal number in lo..hi; false for anything else (signs, spaces, overflow).
+bool parseCount(const std::string& text, int lo, int hi, int& value);
 
 }  // namespace ps11::cli

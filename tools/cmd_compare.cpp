@@ -437,11 +437,8 @@ int cmdCompare(const std::vector<std::string>& args) {
         } else if (a == "--gl-filtering") {
             opts.glFiltering = true;
         } else if (a == "--size") {
-            unsigned w = 0, h = 0;
-            char x = 0;
-            if (!value(v) || std::sscanf(v.c_str(), "%u%c%u", &w, &x, &h) != 3 || x != 'x' || w < 1 || h < 1 ||
-                w > 4096 || h > 4096)
-                return usageError("--size takes WxH with sides 1..4096");
+            uint32_t w = 0, h = 0;
+            if (!value(v) || !cli::parseSize(v, w, h, 4096)) return usageError("--size takes WxH with sides 1..4096");
             opts.width = w, opts.height = h;
         } else if (a == "--seed") {
             if (!value(v) || v.empty() || v.find_first_not_of("0123456789") != std::string::npos)

@@ -48,15 +48,6 @@ std::string fmt(const char* f, double v) {
     return buf;
 }
 
-bool parseSize(const std::string& v, uint32_t& w, uint32_t& h) {
-    unsigned a = 0, b = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(v.c_str(), "%u%c%u%c", &a, &x, &b, &extra) != 3 || x != 'x' || a < 1 || b < 1 || a > 8192 || b > 8192)
-        return false;
-    w = a, h = b;
-    return true;
-}
-
 struct GlareOptions {
     bool list = false, report = false, markdown = false, json = false, compare = false;
     std::string technique, scene, in, out, dumpDir, graph;
@@ -190,11 +181,7 @@ private:
 
 int runGlare(const GlareOptions& o) {
     const glare::Technique* technique = glare::findTechnique(o.technique);
-    if (!technique) {
-        std::string names;
-        for (const glare::Technique* t : glare::techniques()) names += (names.empty() ? "" : ", ") + std::string(t->name());
-        return glareUsage("unknown technique '" + o.technique + "' (techniques: " + names + ")");
-    }
+    if (!technique) return glareUsage(glare::unknownTechniqueMessage(o.technique));
     std::optional<glare::Settings> settings = glare::presetSettings(*technique, o.quality);
     if (!settings) return glareUsage("unknown --quality '" + o.quality + "' (low, medium, high, published)");
     for (const std::string& s : o.sets) {
@@ -558,12 +545,9 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else if (a == "--graph") {
             if (!value(o.graph)) return glareUsage("--graph needs a file name");
         } else if (a == "--frames") {
-            if (!value(v) || v.empty() || v.size() > 5 || v.find_first_not_of("0123456789") != std::string::npos ||
-                std::stoi(v) < 1)
-                return glareUsage("--frames takes a count 1..99999");
-            o.frames = std::stoi(v);
+            if (!value(v) || !cli::parseCount(v, 1, 99999, o.frames)) return glareUsage("--frames takes a count 1..99999");
         } else if (a == "--size") {
-            if (!value(v) || !parseSize(v, o.width, o.height)) return glareUsage("--size takes WxH with sides 1..8192");
+            if (!value(v) || !cli::parseSize(v, o.width, o.height)) return glareUsage("--size takes WxH with sides 1..8192");
         } else if (a == "--backend") {
             if (!value(o.backend) || (o.backend != "emu" && o.backend != "gl"))
                 return glareUsage("--backend takes emu or gl");

@@ -75,11 +75,8 @@ int cmdShade(const std::vector<std::string>& args) {
                 return shadeUsage(a + " takes four numbers x,y,z,w");
             request.constants.push_back({n, c});
         } else if (a == "--size") {
-            unsigned w = 0, h = 0;
-            char x = 0, extra = 0;
-            if (!value() || std::sscanf(v.c_str(), "%u%c%u%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1 ||
-                w > 8192 || h > 8192)
-                return shadeUsage("--size takes WxH with sides 1..8192");
+            uint32_t w = 0, h = 0;
+            if (!value() || !cli::parseSize(v, w, h)) return shadeUsage("--size takes WxH with sides 1..8192");
             request.width = w, request.height = h;
         } else if (a == "--backend") {
             if (!value() || (v != "emu" && v != "gl")) return shadeUsage("--backend takes emu or gl");

@@ -1,5 +1,5 @@
 // The ps11 command line: one binary, one subcommand per job (asm, disasm, check, test,
-// eval, golden, isa, demo, version). Each subcommand parses its own options; user errors print a message that
+// eval, golden, isa, demo, bench, version). Each subcommand parses its own options; user errors print a message that
 // names the file and place and exit 1, usage errors exit 2.
 #include <cctype>
 #include <cstdio>
@@ -20,6 +20,7 @@
 #include "ps11/validator.h"
 #include "ps11/version.h"
 #include "tools/cli_util.h"
+#include "tools/cmd_bench.h"
 #include "tools/cmd_demo.h"
 #include "tools/cmd_eval.h"
 #include "tools/cmd_golden.h"
@@ -62,6 +63,10 @@ const char* kUsageText =
     "        [--hardware H | --precision P] [--quality Q] [--set name=value] [--dump-passes DIR]\n"
     "        [--graph OUT.dot] [--compare] [--json] [--no-skip]\n"
     "                         the glare techniques on a built-in scene or an image, pass by pass\n"
+    "  bench [--technique T|all] [--quality Q|all] [--set name=v1,v2,...] [--hardware H|all]\n"
+    "        [--backend emu|gl|both] [--gl-mode native|exact] [--scene S | --in IMG] [--size WxH] [--frames N] [--json]\n"
+    "                         run time against error: a sweep of settings, hardware and renderers, each row\n"
+    "                         timed and measured against ideal (and the intended math), with the Pareto front\n"
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
@@ -300,17 +305,6 @@ int cmdCheck(const std::vector<std::string>& args) {
     return status;
 }
 
-// Parses "WxH" into two sizes in 1..16384.
-bool parseSize(const std::string& s, uint32_t& w, uint32_t& h) {
-    unsigned long a = 0, b = 0;
-    char x = 0, tail = 0;
-    if (std::sscanf(s.c_str(), "%lu%c%lu%c", &a, &x, &b, &tail) != 3 || (x != 'x' && x != 'X')) return false;
-    if (a < 1 || b < 1 || a > 16384 || b > 16384) return false;
-    w = uint32_t(a);
-    h = uint32_t(b);
-    return true;
-}
-
 // The main job (README): the project's shader corpus checked in one line, then the five glare
 // techniques on the built-in scenes (tools/cmd_demo.cpp).
 int cmdDemo(const std::vector<std::string>& args) {
@@ -325,7 +319,7 @@ int cmdDemo(const std::vector<std::string>& args) {
                 demo.hardware = findHardware(v);
                 if (!demo.hardware) return usage("demo: " + unknownHardwareMessage(v));
             } else if (a == "--size") {
-                if (!parseSize(v, demo.width, demo.height) || demo.width < 8 || demo.height < 8 || demo.width > 8192 ||
+                if (!parseSize(v, demo.width, demo.height, 16384) || demo.width < 8 || demo.height < 8 || demo.width > 8192 ||
                     demo.height > 8192)
                     return usage("demo: --size takes WIDTHxHEIGHT with sides 8..8192, not " + quote(v));
             } else if (a == "--out") {
@@ -397,6 +391,7 @@ int main(int argc, char** argv) {
         {"test", ps11::cmdTest},
         {"compare", ps11::cmdCompare},
         {"glare", ps11::cmdGlare},
+        {"bench", ps11::cmdBench},
         {"shade", ps11::cmdShade},
         {"eval", ps11::cmdEval},
         {"debug", ps11::cmdDebug},

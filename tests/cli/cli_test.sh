@@ -190,6 +190,51 @@ sed -i '8d' "$work/t.ps11test"
 expect_rc 0 "test with passing eval probes" "$ps11" test "$work/t.ps11test" --stats
 expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "summary"
 expect_in "$work/out" "1 pixels, 1 instructions executed" "--stats"
+# ps11 bench: a tiny sweep (2 values x 2 hardware x emu), its JSON, the ideal row's zero error and
+# the Pareto front's definition; bad arguments name themselves and exit 2.
+expect_rc 0 "bench --json" "$ps11" bench --technique adaptive --set blur_passes=2,5 --hardware geforce4,ideal --size 160x90 --frames 2 --backend emu --json
+expect_in "$work/err" "ps11 bench: [4/4] adaptive" "bench progress on stderr"
+if command -v python3 >/dev/null; then
+    python3 - "$work/out" <<'PY' || fail "bench --json: rows, fields, ideal error or Pareto front wrong"
+import json, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+assert len(rows) == 4, len(rows)
+for r in rows:
+    for k in ("technique", "quality", "settings", "hardware", "precision", "backend", "scene", "size",
+              "ms_median", "ms_min", "ms_max", "error", "pareto"):
+        assert k in r, k
+    for k in ("max_levels", "mean_levels", "differing_pct", "psnr"):
+        assert k in r["error"], k
+    if r["hardware"] == "ideal":
+        assert r["error"]["max_levels"] == 0 and r["error"]["mean_levels"] == 0 and r["error"]["psnr"] is None, r
+def acc(r): return (r["error"]["mean_levels"], r["error"]["max_levels"])
+def beats(a, b): return a["ms_median"] < b["ms_median"] and acc(a) < acc(b)
+for b in rows:
+    dominated = [a for a in rows if a is not b and beats(a, b)]
+    assert b["pareto"] == (not dominated), b
+    assert b["pareto"] or any(a["pareto"] for a in dominated), b
+assert sorted(r["settings"]["blur_passes"] for r in rows) == [2, 2, 5, 5]
+PY
+fi
+expect_rc 0 "bench text" "$ps11" bench --technique pyramid --scene box --size 96x64 --frames 1 --backend emu
+expect_in "$work/out" "Pareto front" "bench prints the front"
+expect_in "$work/out" "pyramid on box 96x64:" "bench names the front's technique"
+expect_rc 2 "bench unknown technique" "$ps11" bench --technique glwo
+expect_in "$work/err" "unknown technique 'glwo' (techniques: adaptive, glow" "bench lists the techniques"
+expect_rc 2 "bench unknown setting" "$ps11" bench --technique quarter --set radius=1,2
+expect_in "$work/err" "--set radius=1,2: no setting 'radius' in quarter" "bench names the setting"
+expect_rc 2 "bench bad setting value" "$ps11" bench --technique glow --set radius=4,x
+expect_in "$work/err" "--set radius=4,x:" "bench names the bad value's --set"
+expect_rc 2 "bench bad hardware" "$ps11" bench --hardware geforce9
+expect_in "$work/err" "--hardware: unknown hardware class" "bench names the hardware argument"
+expect_rc 2 "bench bad frames" "$ps11" bench --frames 0
+expect_in "$work/err" "--frames takes a count" "bench says what --frames takes"
+expect_rc 2 "bench bad backend" "$ps11" bench --backend vulkan
+expect_in "$work/err" "--backend takes emu, gl or both, not 'vulkan'" "bench lists the backends"
+expect_rc 2 "bench scene and image" "$ps11" bench --scene box --in "$work/tex.png"
+expect_rc 1 "bench missing image" "$ps11" bench --in "$work/none.png" --backend emu
+expect_in "$work/err" "none.png" "bench names the missing image"
+
 if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "evals run on gl as one-pixel draws" "$ps11" test "$work/t.ps11test" --backend gl
     expect_in "$work/out" "1 file: 1 passed, 0 failed, 0 not yet runnable; probes: 2 passed, 0 failed, 1 todo" "gl evals"
@@ -461,6 +506,13 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_in "$work/out" "0 disagreements" "--no-skip on the emu side agrees with gl"
     expect_rc 0 "compare --gl-mode native" "$ps11" compare "$work/n.ps11test" --gl-mode native
     expect_in "$work/out" "gl native against ideal: max |d| 0 levels" "compare reports the distance from ideal"
+    expect_rc 0 "bench --backend both" "$ps11" bench --technique quarter --size 64x36 --frames 1 --backend both --json
+    expect_in "$work/out" '"backend": "gl"' "bench runs a GL row"
+    expect_in "$work/out" '"gl_mode": "native"' "bench's GL rows run native mode by default"
+    expect_rc 0 "bench --gl-mode exact" "$ps11" bench --technique quarter --size 64x36 --frames 1 --backend gl --gl-mode exact
+    expect_in "$work/out" "gl-exact" "bench names the exact mode"
+    expect_rc 2 "bench --gl-mode without gl" "$ps11" bench --backend emu --gl-mode exact
+    expect_in "$work/err" "--gl-mode needs --backend gl or both" "bench says what --gl-mode needs"
     expect_rc 2 "compare --random --gl-mode native" "$ps11" compare --random 2 --gl-mode native
     expect_rc 0 "shade --gl-mode native" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --backend gl --gl-mode native -o "$work/sn.png"
     expect_rc 2 "shade --gl-mode without gl" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --gl-mode native -o "$work/sn.png"
