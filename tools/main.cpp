@@ -25,6 +25,7 @@
 #include "tools/cmd_info.h"
 #include "tools/cmd_compare.h"
 #include "tools/cmd_glare.h"
+#include "tools/cmd_stress.h"
 #include "tools/cmd_shade.h"
 #include "tools/cmd_test.h"
 
@@ -57,6 +58,9 @@ const char* kUsageText =
     "  eval SHADER.psh [v0=r,g,b,a] [t0=u,v,w,q] [c0=x,y,z,w] ... [--hardware H] [--precision P]\n"
     "       [--max-value M] [--texN [FORMAT:]WORD]\n"
     "                         run a shader for one pixel and print r0\n"
+    "  stress [--json] [--size N] [--hardware H]\n"
+    "                         numerical stability: each 8-bit pitfall predicted, measured and fixed on the\n"
+    "                         1.1-class card, the quality metrics per technique, robustness (NaN, Inf, HDR)\n"
     "  hardware [--json]      the emulated GPUs (hardware classes) and what each one changes\n"
     "  info [--gl osmesa|egl] [--json]\n"
     "                         version, default hardware, executor kernels, the OpenGL context\n"
@@ -365,6 +369,7 @@ int main(int argc, char** argv) {
         {"test", ps11::cmdTest},
         {"compare", ps11::cmdCompare},
         {"glare", ps11::cmdGlare},
+        {"stress", ps11::cmdStress},
         {"shade", ps11::cmdShade},
         {"eval", ps11::cmdEval},
         {"golden", cmdGolden},
