@@ -151,6 +151,39 @@ bool adaptationLevels(const StressOptions& o, const Settings& settings, const st
     return true;
 }
 
+std::vector<int> predictSmoothingLevels(double a, int target, int start, int frames) {
+    const double a8 = std::nearbyint(a * 255);
+    std::vector<int> out;
+    double level = start;
+    for (int f = 0; f < frames; ++f) {
+        level = std::nearbyint((a8 * target + level * (255 - a8)) / 255);
+        out.push_back(int(level));
+    }
+    return out;
+}
+
+std::vector<int> predictFeedbackLevels(const Settings& glowSettings, int y0, int frames) {
+    const std::vector<double> q = quantiseWeights(glowKernel(glowSettings), ps11::Precision::Fx8);
+    auto blur = [&](double y) {
+        double total = 0;
+        for (size_t first = 0; first < q.size(); first += 4) {
+            double r = 0;
+            for (size_t i = first; i < std::min(first + 4, q.size()); ++i)
+                r = std::nearbyint(y * std::nearbyint(q[i] * 255) / 255 + r);
+            total += r;
+        }
+        return std::min(total, 255.0);
+    };
+    const double k8 = std::nearbyint(glowSettings.at("decay") * 255);
+    std::vector<int> out;
+    double y = y0;
+    for (int f = 0; f < frames; ++f) {
+        y = blur(blur(std::nearbyint(y * k8 / 255)));
+        out.push_back(int(y));
+    }
+    return out;
+}
+
 // --- smoothing_dead_band --------------------------------------------------------------------
 
 bool stressSmoothingDeadBand(const StressOptions& o, StressItem& item, std::string& error) {
@@ -202,7 +235,12 @@ bool stressSmoothingDeadBand(const StressOptions& o, StressItem& item, std::stri
     item.setup = "adaptive, smoothing " + std::to_string(a).substr(0, 5) + " (the card holds " +
                  std::to_string(int(std::nearbyint(a * 255))) + "/255), uniform grey 0.35 (L = " + std::to_string(target) +
                  "), 16x16, " + std::to_string(frames) + " frames from black and from a converged white";
-    item.predicted = {{"from_below", 0.5 / aCard}, {"from_above", 0.5 / aCard}};
+    const std::vector<int> pb = predictSmoothingLevels(a, target, 0, frames),
+                           pa = predictSmoothingLevels(a, target, 255, frames - 1);
+    item.predicted = {{"from_below", 0.5 / aCard},
+                      {"from_above", 0.5 / aCard},
+                      {"from_below_recurrence", double(target - pb.back())},
+                      {"from_above_recurrence", double(pa.back() - target)}};
     item.measured = {{"from_below", mb}, {"from_above", ma}};
     item.fix = "dither=temporal: adaptive_amount_dither.psh adds a per-frame offset over ±0.5/a levels before the "
                "blend (mean |A − L| over the last 200 frames)";
@@ -431,6 +469,10 @@ bool stressFeedbackResidue(const StressOptions& o, StressItem& item, std::string
     // kernels round each tap's small share of a residue away inside the loop (the published
     // radius is measured beside it).
     const int radius = 1, publishedRadius = int(published("glow").at("radius"));
+    Settings loop = published("glow");
+    loop["afterimage"] = 2;
+    loop["decay"] = k;
+    loop["radius"] = radius;
     std::vector<int> fb, src, wide;
     if (!glowHistory(o, 2, k, radius, 26, 60, 120, fb, error) || !glowHistory(o, 1, k, radius, 26, 60, 120, src, error) ||
         !glowHistory(o, 2, k, publishedRadius, 26, 60, 120, wide, error))
@@ -444,7 +486,11 @@ bool stressFeedbackResidue(const StressOptions& o, StressItem& item, std::string
                 "constant source (levels) whose glow reaches white";
     item.setup = "glow, radius 1 (3 taps), afterimage=feedback, decay k = 0.9, uniform source (alpha 1) of 26 levels "
                  "for 60 frames then black, 32x32 (glow buffer 8x8), centre texel";
-    item.predicted = {{"residue", std::floor(0.5 / (1 - k))}, {"saturates_above", 255 * (1 - k)}};
+    // The formula's residue, and the loop's own (its blur's roundings included), predicted from
+    // the measured level of the last lit frame.
+    item.predicted = {{"residue", std::floor(0.5 / (1 - k))},
+                      {"saturates_above", 255 * (1 - k)},
+                      {"residue_loop", double(predictFeedbackLevels(loop, fb.at(59), 120).back())}};
     item.measured = {{"residue", double(fb.back())},
                      {"saturates_above", double(satFb)},
                      {"residue_radius_" + std::to_string(publishedRadius), double(wide.back())}};

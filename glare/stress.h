@@ -55,6 +55,15 @@ bool stressDecimationCapture(const StressOptions& o, StressItem& item, std::stri
 // the card's rules: 8-bit sub-texel weights, each tap and each instruction rounded (to nearest,
 // ties to even) or truncated. Returns energy after / before.
 double predictPinwheelEnergy(int passes, bool truncate, int side = 32);
+// The 8-bit smoothing recurrence of the adapted amount (GLARE.md §1, §7), in levels: the card holds
+// a as a8 = round(255a); each frame A ← round_half_even((a8·L + (255 − a8)·A)/255). The levels after
+// each of `frames` frames from `start`.
+std::vector<int> predictSmoothingLevels(double a, int target, int start, int frames);
+// The glow's feedback loop once its source is black (GLARE.md §7), in levels: y ← B_v(B_h(Q(k8·y/255)))
+// where a 1D pass B of a uniform level Y is the weighted4.psh chain r ← round(Y·n_i/255 + r) over
+// each 4 error-diffused weights n_i, the passes after the first added exactly (ONE, ONE). The
+// levels after each of `frames` frames from y0.
+std::vector<int> predictFeedbackLevels(const Settings& glowSettings, int y0, int frames);
 // The kernels the weight-sum items run: the pyramid's 5/16, 6/16, 5/16 and the glow's published 1D kernel.
 std::vector<std::pair<std::string, std::vector<double>>> stressKernels();
 
