@@ -279,7 +279,6 @@ bool stressRobustness(const StressOptions& o, std::vector<RobustnessCheck>& chec
             RobustnessCheck c;
             c.name = std::string(t->name()) + "_" + sp.name;
             emu::RgbaImage out;
-            std::string runError;
             if (!run(sp.v, out)) {
                 c.pass = false;
                 c.detail = "the run failed: " + error;

@@ -15,8 +15,9 @@ namespace {
 StressItem item(bool (*f)(const StressOptions&, StressItem&, std::string&)) {
     StressItem it;
     std::string error;
+    const bool ok = f(StressOptions{}, it, error);
     INFO(error);
-    REQUIRE(f(StressOptions{}, it, error));
+    REQUIRE(ok);
     return it;
 }
 
