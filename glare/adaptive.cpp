@@ -1,7 +1,9 @@
 // Adaptive glare (Tiago Sousa, ShaderX3 4.2, CryEngine / Far Cry): GLARE.md §1,
 // docs/glare/adaptive.md.
 #include <algorithm>
+#include <cmath>
 
+#include "glare/adaptive.h"
 #include "glare/passes.h"
 #include "glare/runner.h"
 
@@ -31,6 +33,12 @@ public:
              {}, true},
             {"composite", "", "screen S+G(1-S), add S+G, or luminance lerp(S+G, S, lum S)", 0, 2, {0, 0, 0, 0},
              {"screen", "add", "luminance"}, false},
+            {"dither", "", "off, or temporal: a per-frame offset over ±0.5/smoothing levels added before the smoothing "
+             "blend, so the 8-bit adaptation reaches its target (docs/stress.md)",
+             0, 1, {0, 0, 0, 0}, {"off", "temporal"}, false},
+            {"blur_sum", "", "the blur's four taps summed with mad by 0.25 (64/255 on the 8-bit grid, as published) or "
+             "by halving adds (exactly 1/4 each, docs/stress.md)",
+             0, 1, {0, 0, 0, 0}, {"mad", "halving"}, false},
         };
         return p;
     }
@@ -53,15 +61,22 @@ public:
         const TextureId adapted = fb.persistent("adapted glare amount", {1, 1, f}, 0);
         const bool blend = !(fb.frame == 0 && fb.choice("start") == 0);
         const float a = float(fb.get("smoothing"));
+        const bool dither = fb.choice("dither") == 1;
+        QuadPass amount{dither ? "adaptive_amount_dither.psh" : "adaptive_amount.psh",
+                        adapted,
+                        {pointTap(lum, 0.25f, 0.25f), pointTap(lum, 0.75f, 0.25f), pointTap(lum, 0.25f, 0.75f),
+                         pointTap(lum, 0.75f, 0.75f)},
+                        {{2, {0, 0, 0, a}}},
+                        blend ? Blend::Alpha : Blend::None};
+        if (dither) {
+            const float d = blend ? float(adaptationDither(fb.frame, a)) : 0.0f;
+            amount.constants.push_back({3, {d, d, d, 0}});
+        }
         addQuadPass(fb, "glare_amount",
-                    blend ? "4·avg² of the 2x2 luminance → luminance, blended into 1x1 with alpha = smoothing"
-                          : "4·avg² of the 2x2 luminance → luminance, written (the converged start)",
-                    QuadPass{"adaptive_amount.psh",
-                             adapted,
-                             {pointTap(lum, 0.25f, 0.25f), pointTap(lum, 0.75f, 0.25f), pointTap(lum, 0.25f, 0.75f),
-                              pointTap(lum, 0.75f, 0.75f)},
-                             {{2, {0, 0, 0, a}}},
-                             blend ? Blend::Alpha : Blend::None});
+                    std::string(blend ? "4·avg² of the 2x2 luminance → luminance, blended into 1x1 with alpha = smoothing"
+                                      : "4·avg² of the 2x2 luminance → luminance, written (the converged start)") +
+                        (dither ? ", plus this frame's dither offset" : ""),
+                    amount);
 
         // The bright pass: W/d x H/d, point-sampling the scene.
         const uint32_t d = uint32_t(fb.get("divisor"));
@@ -83,7 +98,7 @@ public:
             addQuadPass(fb, "blur_" + std::to_string(k),
                         "4 bilinear taps, weight 0.25, at (±" + std::to_string(s).substr(0, 4) + ", ±" +
                             std::to_string(l).substr(0, 4) + ") texels, rotating",
-                        QuadPass{"blur4.psh",
+                        QuadPass{fb.choice("blur_sum") == 1 ? "blur4_halve.psh" : "blur4.psh",
                                  dst,
                                  {texelTap(fb, src, +s, +l), texelTap(fb, src, -l, +s), texelTap(fb, src, -s, -l),
                                   texelTap(fb, src, +l, -s)}});
@@ -99,6 +114,17 @@ public:
 };
 
 }  // namespace
+
+double adaptationDither(int frame, double smoothing) {
+    // The 8-bit step a·(L + d − A) rounds once: d spread evenly over one level of the step
+    // (±0.5/a levels of the output) makes its rounding right on average. The offsets follow the
+    // golden-ratio sequence (evenly spread over any run of frames) and sit on the grid.
+    if (smoothing <= 0) return 0;
+    const double a8 = std::max(1.0, std::nearbyint(smoothing * 255));  // the constant as the card holds it
+    const double span = 255.0 / a8;                                     // levels of output per level of step
+    const double u = std::fmod(double(frame) * 0.6180339887498949, 1.0) - 0.5;
+    return std::clamp(std::nearbyint(u * span), -255.0, 255.0) / 255.0;
+}
 
 const Technique& adaptiveTechnique() {
     static const Adaptive t;

@@ -18,6 +18,7 @@
 #include "glare/scene.h"
 #include "glare/shader_library.h"
 #include "glare/sprites.h"
+#include "glare/stress.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
 #include "tools/gl_backend.h"
@@ -496,20 +497,16 @@ TEST_CASE("adaptive: the glare amount follows A_n = a·L + (1 − a)·A_(n−1),
                 CHECK(values[size_t(n - 1)] == Approx(1 - std::pow(1 - a, n)).margin(1e-4));
             }
         } else {
-            // The 8-bit recurrence, exactly: the smoothing constant sits on the grid (a8 = round(a·255)),
-            // the blend computes L·a8 + A·(255 − a8) exactly and rounds once to a level, ties to even.
-            const int a8 = int(std::lround(a * 255));
-            int level = 0;
+            // The 8-bit recurrence, exactly (glare/stress.h, the prediction `ps11 stress` prints): the
+            // smoothing constant sits on the grid, the blend rounds once to a level, ties to even.
+            const std::vector<int> predicted = predictSmoothingLevels(a, 255, 0, 400);
             for (int f = 0; f < 400; ++f) {
-                const double exact = (255.0 * a8 + double(level) * (255 - a8)) / 255.0;
-                level = int(std::nearbyint(exact));
                 INFO("frame " << f);
-                REQUIRE(values[size_t(f)] * 255 == Approx(level).margin(1e-6));
+                REQUIRE(values[size_t(f)] * 255 == Approx(predicted[size_t(f)]).margin(1e-6));
             }
-            // Stuck below 1.0 by the dead band: about 0.5/a' levels short (a' = a8/255), and no longer moving.
-            const double levelsShort = 255 - values.back() * 255;
-            CHECK(levelsShort >= 0.5 * 255 / a8 - 1);
-            CHECK(levelsShort <= 0.5 * 255 / a8 + 1);
+            // Stuck below 1.0 by the dead band (the stress suite's smoothing_dead_band measures its size
+            // from both sides), and no longer moving.
+            CHECK(values.back() < 1.0);
             CHECK(values[399] == values[300]);
         }
     }
@@ -622,29 +619,14 @@ TEST_CASE("glow: feedback decays by k per frame, and 8-bit rounding leaves a res
             for (int f = 21; f < 30; ++f) CHECK(glow[size_t(f)] == Approx(0.8 * glow[size_t(f - 1)]).epsilon(1e-3));
             CHECK(glow[59] * 255 < 0.5);  // fades below half a level
         } else {
-            // Once the source is black: y ← B_v(B_h(round(k8·y/255))). A 4-tap pass of a uniform level
-            // Y is the mul/mad chain r ← round(Y·w_i/255 + r), each instruction rounding once, ties
-            // to even; the passes after the first add exactly (ONE, ONE). Predicted frame by frame
-            // from frame 19's value, it must match exactly, and it stops at a residue that never fades.
-            const std::vector<double> q = quantiseWeights(glowKernel(s), ps11::Precision::Fx8);
-            auto roundEven = [](double x) { return std::nearbyint(x); };
-            auto blur = [&](double y) {
-                double sum = 0;
-                for (size_t first = 0; first < q.size(); first += 4) {
-                    double r = 0;
-                    for (size_t i = first; i < std::min(first + 4, q.size()); ++i)
-                        r = roundEven(y * double(std::lround(q[i] * 255)) / 255 + r);
-                    sum += r;
-                }
-                return sum;
-            };
-            const double k8 = double(std::lround(0.8 * 255));
-            double y = std::nearbyint(glow[19] * 255);
+            // Once the source is black: y ← B_v(B_h(round(k8·y/255))) (glare/stress.h, predicted frame
+            // by frame from frame 19's value): it must match exactly, and stop at a residue that never fades.
+            const std::vector<int> predicted = predictFeedbackLevels(s, int(std::nearbyint(glow[19] * 255)), 40);
             for (int f = 20; f < 60; ++f) {
-                y = blur(blur(roundEven(y * k8 / 255)));
                 INFO("frame " << f);
-                REQUIRE(glow[size_t(f)] * 255 == Approx(y).margin(1e-6));
+                REQUIRE(glow[size_t(f)] * 255 == Approx(predicted[size_t(f - 20)]).margin(1e-6));
             }
+            const int y = predicted.back();
             CHECK(y >= 1);
             CHECK(glow[59] == glow[50]);
         }

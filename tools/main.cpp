@@ -30,6 +30,7 @@
 #include "tools/cmd_debug.h"
 #include "tools/cmd_ranges.h"
 #include "tools/cmd_glare.h"
+#include "tools/cmd_stress.h"
 #include "tools/cmd_shade.h"
 #include "tools/cmd_test.h"
 
@@ -73,6 +74,9 @@ const char* kUsageText =
     "  debug SHADER.psh [the inputs of eval] [--hardware H] [--json]\n"
     "                         one pixel instruction by instruction, the class beside ideal,\n"
     "                         why they differ and where they first part by more than a level\n"
+    "  stress [--json] [--size N] [--hardware H]\n"
+    "                         numerical stability: each 8-bit pitfall predicted, measured and fixed on the\n"
+    "                         1.1-class card, the quality metrics per technique, robustness (NaN, Inf, HDR)\n"
     "  hardware [--json]      the emulated GPUs (hardware classes) and what each one changes\n"
     "  info [--gl osmesa|egl] [--json]\n"
     "                         version, default hardware, executor kernels, the OpenGL context\n"
@@ -392,6 +396,7 @@ int main(int argc, char** argv) {
         {"compare", ps11::cmdCompare},
         {"glare", ps11::cmdGlare},
         {"bench", ps11::cmdBench},
+        {"stress", ps11::cmdStress},
         {"shade", ps11::cmdShade},
         {"eval", ps11::cmdEval},
         {"debug", ps11::cmdDebug},

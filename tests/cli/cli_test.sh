@@ -518,6 +518,29 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 2 "shade --gl-mode without gl" "$ps11" shade "$work/a.psh" --tex0 "$work/tex.png" --gl-mode native -o "$work/sn.png"
 fi
 
+# ps11 stress (docs/stress.md): valid JSON with every item of the issue, numbers or objects of
+# numbers (null where not measured), and every robustness check passing.
+expect_rc 0 "stress --json" "$ps11" stress --json --size 128
+python3 - "$work/out" <<'PY' || fail "stress --json: $(head -c 400 "$work/out")"
+import json, numbers, sys
+d = json.load(open(sys.argv[1]))
+names = [i["name"] for i in d["items"]]
+want = ["smoothing_dead_band", "blur_energy_drift", "weight_sum_rounded", "weight_sum_diffused",
+        "feedback_residue", "decimation_capture"]
+assert names == want, names
+def value(v):
+    return v is None or isinstance(v, numbers.Number) or (
+        isinstance(v, dict) and all(x is None or isinstance(x, numbers.Number) for x in v.values()))
+for i in d["items"]:
+    assert all(k in i for k in ("predicted", "measured", "fix", "measured_with_fix")), i["name"]
+    assert value(i["predicted"]) and value(i["measured"]) and value(i["measured_with_fix"]), i["name"]
+assert {m["technique"] for m in d["metrics"]} == {"adaptive", "glow", "pyramid", "quarter", "sprites"}
+assert d["robustness"] and all(c["pass"] for c in d["robustness"])
+PY
+expect_rc 2 "stress --size 100" "$ps11" stress --size 100
+expect_rc 2 "stress unknown option" "$ps11" stress --jsn
+expect_in "$work/err" "--json" "stress suggests --json"
+
 if [ "$failures" != 0 ]; then
     echo "$failures CLI check(s) failed"
     exit 1
