@@ -36,6 +36,9 @@ public:
             {"dither", "", "off, or temporal: a per-frame offset over ±0.5/smoothing levels added before the smoothing "
              "blend, so the 8-bit adaptation reaches its target (docs/stress.md)",
              0, 1, {0, 0, 0, 0}, {"off", "temporal"}, false},
+            {"square", "", "the glare amount's square: as the shipped sample (Cg 1.2's mov_x4 then mul, "
+             "avg·min(4·avg, 1) on the card) or mul_x4 (min(4·avg², 1), glare gone from avg 0.5; docs/glare/adaptive.md)",
+             0, 1, {0, 0, 0, 0}, {"sample", "mul_x4"}, false},
             {"blur_sum", "", "the blur's four taps summed with mad by 0.25 (64/255 on the 8-bit grid, as published) or "
              "by halving adds (exactly 1/4 each, docs/stress.md)",
              0, 1, {0, 0, 0, 0}, {"mad", "halving"}, false},
@@ -62,7 +65,8 @@ public:
         const bool blend = !(fb.frame == 0 && fb.choice("start") == 0);
         const float a = float(fb.get("smoothing"));
         const bool dither = fb.choice("dither") == 1;
-        QuadPass amount{dither ? "adaptive_amount_dither.psh" : "adaptive_amount.psh",
+        const bool mulx4 = fb.choice("square") == 1;
+        QuadPass amount{std::string("adaptive_amount") + (dither ? "_dither" : "") + (mulx4 ? "_mulx4" : "") + ".psh",
                         adapted,
                         {pointTap(lum, 0.25f, 0.25f), pointTap(lum, 0.75f, 0.25f), pointTap(lum, 0.25f, 0.75f),
                          pointTap(lum, 0.75f, 0.75f)},
@@ -73,8 +77,9 @@ public:
             amount.constants.push_back({3, {d, d, d, 0}});
         }
         addQuadPass(fb, "glare_amount",
-                    std::string(blend ? "4·avg² of the 2x2 luminance → luminance, blended into 1x1 with alpha = smoothing"
-                                      : "4·avg² of the 2x2 luminance → luminance, written (the converged start)") +
+                    std::string(mulx4 ? "min(4·avg², 1)" : "avg·min(4·avg, 1)") +
+                        (blend ? " of the 2x2 luminance → luminance, blended into 1x1 with alpha = smoothing"
+                               : " of the 2x2 luminance → luminance, written (the converged start)") +
                         (dither ? ", plus this frame's dither offset" : ""),
                     amount);
 

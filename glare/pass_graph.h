@@ -9,11 +9,13 @@
 // and reaches only the textures it declared.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "emu/d3d9types.h"
@@ -149,6 +151,10 @@ struct PassInfo {
     PassKind kind = PassKind::Shader;
     std::string shader;  // Shader: the .psh file name
     std::string note;    // what the pass does, or why it is not 1.1
+    // Shader: the constants it sets (c#, value) and the stages it samples with POINT, for the
+    // range proof of the fits report (glare/report.h).
+    std::vector<std::pair<int, std::array<float, 4>>> constants = {};
+    uint8_t pointStages = 0;
 };
 
 // What a pass's execute step sees. It starts from the device state run() found (every pass

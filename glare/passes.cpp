@@ -86,8 +86,11 @@ bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q) {
 
 void addQuadPass(FrameBuild& fb, const std::string& name, const std::string& note, const QuadPass& q) {
     Runner* runner = &fb.runner;
+    PassInfo info{name, PassKind::Shader, q.shader, note, q.constants};
+    for (size_t i = 0; i < q.taps.size(); ++i)
+        if (q.taps[i].filter == D3DTEXF_POINT) info.pointStages = uint8_t(info.pointStages | (1u << i));
     fb.graph.addPass(
-        PassInfo{name, PassKind::Shader, q.shader, note},
+        std::move(info),
         [&](PassBuilder& b) {
             for (const Tap& t : q.taps) b.read(t.texture);
             if (q.blend != Blend::None) b.read(q.target);

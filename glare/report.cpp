@@ -10,6 +10,7 @@
 #include "glare/shade.h"
 #include "ps11/assembler.h"
 #include "ps11/hardware.h"
+#include "ps11/range_proof.h"
 #include "ps11/validator.h"
 
 namespace glare {
@@ -19,6 +20,7 @@ namespace {
 struct ShaderFacts {
     ps11::ShaderStats stats;
     std::string error;
+    std::optional<ps11::Program> program;  // when it assembled and validated
 };
 
 const ShaderFacts& shaderFacts(const std::string& file) {
@@ -33,9 +35,29 @@ const ShaderFacts& shaderFacts(const std::string& file) {
         ps11::Diagnostics diags;
         std::optional<ps11::Program> p = ps11::parseAssembly(*text, "glare/shaders/" + file, {}, diags);
         if (p) ps11::validate(*p, diags, &facts.stats);
-        if (!p || diags.hasErrors()) facts.error = diags.formatAll();
+        if (!p || diags.hasErrors())
+            facts.error = diags.formatAll();
+        else
+            facts.program = std::move(p);
     }
-    return cache.emplace(file, facts).first->second;
+    return cache.emplace(file, std::move(facts)).first->second;
+}
+
+// The range proof of one shader pass on `hardware` with the constants the pass sets, its
+// textures 8-bit ([0, 1]) and filtered as its taps are: empty when no register clamp acts, else
+// "line N: instruction".
+std::string rangeClamp(const ps11::Program& program, const PassInfo& info, const ps11::HardwareConfig& hardware) {
+    ps11::RangeProofSetup setup;
+    setup.options = ps11::executorOptionsFor(hardware);
+    for (const auto& [index, value] : info.constants)
+        if (index >= 0 && index < 8) setup.constants[size_t(index)] = value;
+    for (int stage = 0; stage < ps11::kMaxTextureStages; ++stage)
+        setup.filtered[size_t(stage)] = !((info.pointStages >> stage) & 1);
+    ps11::Diagnostics diags;
+    const std::optional<ps11::RangeProof> proof = ps11::proveRanges(program, setup, diags);
+    if (!proof) return "not analysed: " + diags.formatAll();
+    const ps11::InstructionRange* first = proof->firstClamp();
+    return first ? "line " + std::to_string(first->loc.line) + ": `" + first->text + "`" : std::string();
 }
 
 std::string fmt(const char* f, double v) {
@@ -97,6 +119,7 @@ FitsReport fitsReport(uint32_t width, uint32_t height) {
                     f.fits = facts.error.empty() && st.valid && st.version.minor == 1 && st.texSlots <= st.texLimit &&
                              st.arithSlots <= st.arithLimit;
                     if (!facts.error.empty()) f.note = facts.error;
+                    if (facts.program) f.rangeClamp = rangeClamp(*facts.program, n.info, runner.device().hardware());
                 } else if (n.info.kind == PassKind::DeviceSide) {
                     // The glare image is computed on the CPU and uploaded, as the paper's precomputed image:
                     // a texture upload, which 1.1-class hardware takes. The sensors are the step past 1.1.
@@ -123,6 +146,8 @@ std::string fitsReportJson(const FitsReport& r) {
              ", \"arith_slots\": " + std::to_string(f.arithSlots) + ", \"arith_limit\": " + std::to_string(f.arithLimit) +
              ", \"constants\": [" + consts + "], \"target\": [" + std::to_string(f.width) + ", " +
              std::to_string(f.height) + "], \"fits_ps_1_1\": " + (f.fits ? "true" : "false") +
+             ", \"range_safe\": " + (f.rangeClamp.empty() ? "true" : "false") +
+             ", \"range_clamp\": " + jsonString(f.rangeClamp) +
              ", \"note\": " + jsonString(f.note) + "}" + (i + 1 < r.passes.size() ? "," : "") + "\n";
     }
     return j + "  ]\n}\n";
@@ -248,7 +273,11 @@ std::string fitsReportMarkdown(const FitsReport& r) {
         "and 8 arithmetic slots, c0–c7, 2 read ports per register type) as the default 1.1-class card (`" +
         r.hardware +
         "`) runs it. StretchRect, Clear and fixed-function texture stages are what 1.1-class hardware does without a "
-        "shader. A step marked **no** needs more than 1.1, and the table says why.\n\n";
+        "shader. A step marked **no** needs more than 1.1, and the table says why. **range-safe** is the other limit "
+        "of the hardware, the value range: the range proof of `ps11 check --ranges` (docs/intervals.md) on the card, "
+        "with the constants the pass sets and its textures in [0, 1]: `yes` when no register clamp to ±MaxValue can act, "
+        "else the first instruction whose result can pass it (a finding, not an error: Sousa's `mov_x4` is meant to "
+        "clamp).\n\n";
     // One table per technique: the passes of the published preset, then what the other presets change.
     for (const Technique* t : techniques()) {
         md += "## " + std::string(t->title()) + " (`" + std::string(t->name()) + "`)\n\n";
@@ -258,8 +287,8 @@ std::string fitsReportMarkdown(const FitsReport& r) {
             const Settings s = *presetSettings(*t, preset);
             std::string settings;
             for (const ParamInfo& pi : t->params()) settings += (settings.empty() ? "" : ", ") + pi.name + "=" + settingText(pi, s.at(pi.name));
-            md += settings + "\n\n| pass | kind | shader | version | tex slots | arith slots | constants | target | fits 1.1 |\n"
-                             "|---|---|---|---|---|---|---|---|---|\n";
+            md += settings + "\n\n| pass | kind | shader | version | tex slots | arith slots | constants | target | fits 1.1 | "
+                             "range-safe |\n|---|---|---|---|---|---|---|---|---|---|\n";
             int total = 0, fitting = 0;
             for (const PassFit& f : r.passes) {
                 if (f.technique != t->name() || f.preset != preset) continue;
@@ -274,7 +303,8 @@ std::string fitsReportMarkdown(const FitsReport& r) {
                       (shader ? std::to_string(f.arithSlots) + "/" + std::to_string(f.arithLimit) : "—") + " | " +
                       (consts.empty() ? "—" : consts) + " | " +
                       (f.width ? std::to_string(f.width) + "x" + std::to_string(f.height) : "CPU") + " | " +
-                      (f.fits ? "yes" : "**no**: " + f.note) + " |\n";
+                      (f.fits ? "yes" : "**no**: " + f.note) + " | " +
+                      (!shader ? "—" : f.rangeClamp.empty() ? "yes" : "clamps at " + f.rangeClamp) + " |\n";
             }
             md += "\n" + std::to_string(fitting) + " of " + std::to_string(total) + " passes fit ps_1_1.\n\n";
         }

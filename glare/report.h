@@ -21,6 +21,9 @@ struct PassFit {
     int draws = 1;
     bool fits = true;
     std::string note;  // the pass's note; for a non-1.1 step, why
+    // Shader: the range proof on the card with the pass's constants (ps11/range_proof.h): empty
+    // when no register clamp can act, else the first instruction that clamps ("line N: `text`").
+    std::string rangeClamp;
 };
 
 struct FitsReport {

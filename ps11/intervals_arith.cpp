@@ -4,6 +4,7 @@
 // identities of each profile (docs/intervals.md).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "ps11/intervals_internal.h"
 #include "ps11/precision.h"
@@ -99,6 +100,37 @@ bool independent(const SV* s, int n) {
 }
 
 // ---------------------------------------------------------------- fx
+// mad whose sources share a register channel outside the product (the screen composite's
+// t1·(1 − t0) + t0): each source is k = a·n + b of its channel's grid integer n, so the numerator
+// k0·k1 + 2G·k2 is multilinear in the distinct channels and its extremes lie at the corners of
+// their ranges (exact, where the independent bound adds the two t0 terms apart).
+KI madCorners(const Profile& p, const SV* s) {
+    int vars[3], nv = 0, which[3];
+    for (int i = 0; i < 3; ++i) {
+        which[i] = -1;
+        if (s[i].var < 0) continue;
+        for (int j = 0; j < nv; ++j)
+            if (vars[j] == s[i].var) which[i] = j;
+        if (which[i] < 0) which[i] = nv, vars[nv++] = s[i].var;
+    }
+    KI r{INT64_MAX, INT64_MIN};
+    for (int m = 0; m < (1 << nv); ++m) {
+        int64_t k[3];
+        for (int i = 0; i < 3; ++i) {
+            if (which[i] < 0) {
+                k[i] = s[i].k.lo;  // a constant: one value
+                continue;
+            }
+            const exec::SourceAffine af = exec::sourceAffine(s[i].mod, p.g);
+            const int64_t n = (m >> which[i]) & 1 ? s[i].nhi : s[i].nlo;
+            k[i] = int64_t(af.a) * n + af.b;
+        }
+        const int64_t v = k[0] * k[1] + 2 * int64_t(p.g) * k[2];
+        r.lo = std::min(r.lo, v), r.hi = std::max(r.hi, v);
+    }
+    return r;
+}
+
 // The clamp bounds of the write step (executor_arith.cpp arithFx).
 void fxClamp(const Profile& p, bool sat, int32_t& lo, int32_t& hi) {
     lo = sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
@@ -169,6 +201,8 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4], Write
                 break;
             case Opcode::Mad:
                 num = kAdd(kMul(s[0].k, s[1].k), kMul(kPoint(2 * G), s[2].k)), d0 = kProd;
+                if (!independent(s, 3) && !(s[0].var >= 0 && s[0].var == s[1].var))
+                    num = kIntersect(num, madCorners(p, s));
                 if (isPoint(s[0].k, 0) || isPoint(s[1].k, 0))
                     pass = 2;
                 else if (isPoint(s[2].k, 0))

@@ -474,12 +474,14 @@ TEST_CASE("every technique and preset runs and matches the GL renderer pass by p
 }
 
 TEST_CASE("adaptive: the glare amount follows A_n = a·L + (1 − a)·A_(n−1), and stops short in 8 bits", "[glare]") {
-    // A uniform grey 0.5: avg = 0.5, 4·avg² = 1 per channel, luminance 1.0 (clamped), so L = 1.
-    // From black, ideal: A_n = 1 − (1 − a)^n. fx8 with round-to-nearest stops where the step
-    // a·(L − A) falls below half a level: about 0.5/a = 20 levels short (GLARE.md §7).
+    // A uniform grey 0.5 squared by mul_x4: 4·avg² = 1 per channel, luminance 1.0 (clamped), so
+    // L = 1 in both profiles (the published square, avg·min(4·avg, 1), gives 0.5 on the card and
+    // 1 under ideal). From black, ideal: A_n = 1 − (1 − a)^n. fx8 with round-to-nearest stops
+    // where the step a·(L − A) falls below half a level: about 0.5/a = 20 levels short (GLARE.md §7).
     const Technique& t = *findTechnique("adaptive");
     Settings s = preset("adaptive");
-    s["start"] = 1;  // black
+    s["start"] = 1;   // black
+    s["square"] = 1;  // mul_x4
     const double a = s.at("smoothing");
     for (auto p : {ps11::Precision::Ideal, ps11::Precision::Fx8}) {
         Runner run(options(16, 16, p));

@@ -603,8 +603,9 @@ TEST_CASE("intervals: the screen and luminance composites over a zero glare tile
 
 TEST_CASE("intervals: a screen composite over a zero glare whose alpha is one copies the scene's r g b", "[intervals]") {
     // The blurred glare of a bright pass keeps alpha 1: S + G·(1 − S) then has r g b = S, and
-    // alpha 1·(1 − Sa) + Sa, which is 1 over a scene alpha of 0 and neither copy nor constant
-    // over an unknown one.
+    // alpha 1·(1 − Sa) + Sa, which is 1 over a scene alpha of 0. Over an unknown one the fx
+    // profiles still give exactly 1 (the numerator 2G·(2G − 2n) + 2G·2n is 4G² for every n, which
+    // the mad's corners over the shared t0.a find); float's rounding is not proven.
     for (Precision prec : kProfiles) {
         INFO(precisionName(prec));
         IntervalInputs in;
@@ -622,7 +623,12 @@ TEST_CASE("intervals: a screen composite over a zero glare whose alpha is one co
         in.stages[0].value[3] = ValueRange::between(0, 1, false);
         r = evaluateOnce(glareShader("composite_screen.psh"), prec, {}, in);
         CHECK(r.copyMask == 0x7);
-        CHECK_FALSE(r.color[3].constant);
+        if (isFixedPoint(prec)) {
+            CHECK(r.color[3].constant);
+            CHECK(r.color[3].lo == 1.0);
+        } else {
+            CHECK_FALSE(r.color[3].constant);
+        }
     }
 }
 
