@@ -204,8 +204,8 @@ bool stressSmoothingDeadBand(const StressOptions& o, StressItem& item, std::stri
 
     std::vector<int> below(size_t(frames), 0), above(size_t(frames), 0);
     above[0] = 1;  // frame 0 white (converged start), then the grey
+    std::vector<int> lb, la;  // the last run's levels from below and from above
     auto run = [&](const Settings& st, double& fromBelow, double& fromAbove, bool meanOfTail) {
-        std::vector<int> lb, la;
         Settings sb = st, sa = st;
         sb["start"] = 1;  // black
         sa["start"] = 0;  // converged on frame 0's white
@@ -223,9 +223,17 @@ bool stressSmoothingDeadBand(const StressOptions& o, StressItem& item, std::stri
     };
     double mb = 0, ma = 0, fb = 0, fa = 0;
     if (!run(s, mb, ma, false)) return false;
+    const std::vector<int> plainBelow = lb;
     Settings dithered = s;
     dithered["dither"] = 1;
     if (!run(dithered, fb, fa, true)) return false;
+    auto curve = [](const std::vector<int>& v) { return std::vector<double>(v.begin(), v.end()); };
+    std::vector<double> unrounded(static_cast<size_t>(frames));
+    for (int f = 0; f < frames; ++f) unrounded[size_t(f)] = target * (1 - std::pow(1 - a, f + 1));
+    item.series = {{"published (8-bit blend)", curve(plainBelow)},
+                   {"dither=temporal", curve(lb)},
+                   {"exact a·L + (1 − a)·A", unrounded}};
+    item.seriesUnit = "adapted amount A (levels) per frame, from black towards L = " + std::to_string(target);
 
     // GLARE.md §7: with round-to-nearest the step a·(L − A) is lost once under half a level, so the
     // smoothing stops 0.5/a levels away, from either side; the card holds a as round(255a)/255.
@@ -497,6 +505,15 @@ bool stressFeedbackResidue(const StressOptions& o, StressItem& item, std::string
     item.fix = "afterimage=source: the chapter's other after-image, the previous frame's sources dimmed by k and added "
                "once (no loop)";
     item.measuredWithFix = {{"residue", double(src.back())}, {"saturates_above", double(satSrc)}};
+    auto curve = [](const std::vector<int>& v) { return std::vector<double>(v.begin(), v.end()); };
+    std::vector<double> unrounded(fb.size());
+    for (size_t f = 0; f < fb.size(); ++f)
+        unrounded[f] = f < 60 ? double(fb[f]) : double(fb.at(59)) * std::pow(k, double(f - 59));
+    item.series = {{"afterimage=feedback, radius 1", curve(fb)},
+                   {"afterimage=feedback, radius " + std::to_string(publishedRadius), curve(wide)},
+                   {"afterimage=source (fix)", curve(src)},
+                   {"exact decay k^n", unrounded}};
+    item.seriesUnit = "glow level at the centre per frame (source lit for 60 frames, then black)";
     item.note = "the card holds k as " + std::to_string(int(std::nearbyint(k * 255))) +
                 "/255; the blur's roundings also act inside the loop; the fix's saturation is 255/(1 + k) = " +
                 std::to_string(255 / (1 + k)).substr(0, 5) + " predicted";
@@ -510,6 +527,7 @@ bool stressDecimationCapture(const StressOptions& o, StressItem& item, std::stri
     // published adaptive (A held at 0): how many positions the W/d point-sampled bright pass sees,
     // and the spread of the total glare energy (output − scene) over the positions.
     const uint32_t side = 256, cell = side / 2;
+    std::vector<double> cells;  // the last sweep's energy per position, relative to its largest
     auto sweep = [&](int divisor, double& share, double& flicker) {
         Runner run(stressRunnerOptions(o, side, side));
         Settings s = published("adaptive");
@@ -533,6 +551,9 @@ bool stressDecimationCapture(const StressOptions& o, StressItem& item, std::stri
                 energy.push_back(double(sum(out)));
             }
         share = seen / 64.0;
+        const double top = *std::max_element(energy.begin(), energy.end());
+        cells.clear();
+        for (double e : energy) cells.push_back(top > 0 ? e / top : 0);
         const double mean = std::accumulate(energy.begin(), energy.end(), 0.0) / double(energy.size());
         flicker = mean > 0 ? (*std::max_element(energy.begin(), energy.end()) -
                               *std::min_element(energy.begin(), energy.end())) / mean
@@ -540,7 +561,12 @@ bool stressDecimationCapture(const StressOptions& o, StressItem& item, std::stri
         return true;
     };
     double share = 0, flicker = 0, shareFix = 0, flickerFix = 0;
-    if (!sweep(8, share, flicker) || !sweep(2, shareFix, flickerFix)) return false;
+    if (!sweep(8, share, flicker)) return false;
+    const std::vector<double> published8 = cells;
+    if (!sweep(2, shareFix, flickerFix)) return false;
+    item.series = {{"divisor 8 (published)", published8}, {"divisor 2 (fix)", cells}};
+    item.seriesUnit = "8x8 grid: the glare energy of a 1-pixel source at each position of a cell, relative to the "
+                      "largest";
     item.name = "decimation_capture";
     item.unit = "share: positions of a 1-pixel source the bright pass sees; flicker: (max − min)/mean of the glare "
                 "energy over the positions";

@@ -31,6 +31,10 @@ struct StressItem {
     std::string fix;
     StressValue measuredWithFix;
     std::string note;      // where the measurement and the prediction part, and why
+    // What a picture of the pitfall plots (a report draws them): named curves over frames, or
+    // the cells of a grid, row by row; `seriesUnit` says what the values are.
+    std::vector<std::pair<std::string, std::vector<double>>> series;
+    std::string seriesUnit;
 };
 
 struct StressOptions {

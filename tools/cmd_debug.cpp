@@ -112,16 +112,7 @@ std::vector<InstructionInterval> classFindings(const Program& program, const Har
 
 }  // namespace
 
-int cmdDebug(const std::vector<std::string>& argsIn) {
-    bool json = false;
-    std::vector<std::string> args;
-    for (const std::string& a : argsIn) (a == "--json" ? json = true : (args.push_back(a), false));
-    EvalArgs ea;
-    if (int rc = parseEvalArgs(args, "debug", kUsage, ea); rc != cli::kOk) return rc == kHelpShown ? cli::kOk : rc;
-    if (ea.precision == Precision::Ideal) {
-        std::cerr << "ps11: debug: --precision ideal is the reference it is compared with; pick another profile\n";
-        return cli::kUsage;
-    }
+int debugPixel(const EvalArgs& ea, DebugTrace& out) {
     std::optional<Program> program;
     HardwareConfig hw;
     if (int rc = loadEvalProgram(ea, program, hw); rc != cli::kOk) return rc;
@@ -141,21 +132,26 @@ int cmdDebug(const std::vector<std::string>& argsIn) {
     const Run a = trace(*ex, sx, px), b = trace(*ei, si, px);
     const std::vector<InstructionInterval> findings = classFindings(*program, hw, ea, sx);
     const bool fx = isFixedPoint(hw.precision);
-
-    struct Row {
-        const Instruction* inst;
-        const TraceStep *emu, *ideal;
-        std::vector<std::string> why;
-        double levels = 0;  // max |Δ| over written channels, 8-bit levels
-    };
-    std::vector<Row> rows;
-    int firstDivergence = -1;  // index in rows
+    out = DebugTrace{};
+    out.shader = ea.shader;
+    out.hardware = std::string(hw.hardware->name);
+    out.describe = hw.describe();
+    out.precision = hw.precision;
+    out.version = "ps_" + std::to_string(program->version.major) + "_" + std::to_string(program->version.minor);
+    for (int c = 0; c < 4; ++c) out.r0Emulated[size_t(c)] = a.r0[c], out.r0Ideal[size_t(c)] = b.r0[c];
+    out.killedEmulated = a.killed != 0, out.killedIdeal = b.killed != 0;
     for (size_t k = 0; k < a.steps.size() && k < b.steps.size(); ++k) {
-        Row row{&program->instructions[size_t(a.steps[k].instruction)], &a.steps[k], &b.steps[k], {}, 0};
-        const TraceStep& s = *row.emu;
+        const TraceStep &s = a.steps[k], &si_ = b.steps[k];
+        const Instruction& inst = program->instructions[size_t(s.instruction)];
+        DebugRow row;
+        row.line = inst.loc.line;
+        row.text = formatInstruction(inst, program->version);
+        row.writes = s.writes;
+        row.mask = s.mask;
+        row.emulated = s.value, row.grid = s.grid, row.ideal = si_.value;
         for (int c = 0; c < 4; ++c)
             if (s.writes && ((s.mask >> c) & 1))
-                row.levels = std::max(row.levels, std::fabs(double(s.value[size_t(c)]) - row.ideal->value[size_t(c)]) * 255.0);
+                row.levels = std::max(row.levels, std::fabs(double(s.value[size_t(c)]) - si_.value[size_t(c)]) * 255.0);
         const InstructionInterval* f = nullptr;
         for (const InstructionInterval& i : findings)
             if (i.instruction == s.instruction) f = &i;
@@ -163,35 +159,50 @@ int cmdDebug(const std::vector<std::string>& argsIn) {
         if (f && f->rounds && fx) row.why.push_back("round");
         if (f && f->clamps) row.why.push_back("clamp");
         if (f && f->saturates && differs) row.why.push_back("saturate");
-        const Opcode op = row.inst->opcode();
-        if (samplesStage(op) && differs) {
-            const int stage = row.inst->dst.index;  // ps_1_1 … 1_3 t#, ps_1_4 the sampler stage of texld
+        if (samplesStage(inst.opcode()) && differs) {
+            const int stage = inst.dst.index;  // ps_1_1 … 1_3 t#, ps_1_4 the sampler stage of texld
             const Texture* tex = stage >= 0 && stage < kMaxTextureStages ? sx.texture(stage) : nullptr;
             if (tex && formatRow(tex->format()).cls == FormatClass::Signed)
                 row.why.push_back("signed_decode");
             else if (tex && (tex->level(0).width > 1 || tex->level(0).height > 1))
                 row.why.push_back("filter_weight");
-            else if (fx && !row.why.size())
+            else if (fx && row.why.empty())
                 row.why.push_back("round");
         }
-        if (firstDivergence < 0 && row.levels > 1.0) firstDivergence = int(rows.size());
-        rows.push_back(row);
+        if (out.firstDivergence < 0 && row.levels > 1.0) out.firstDivergence = int(out.rows.size());
+        out.rows.push_back(std::move(row));
     }
+    return cli::kOk;
+}
+
+int cmdDebug(const std::vector<std::string>& argsIn) {
+    bool json = false;
+    std::vector<std::string> args;
+    for (const std::string& a : argsIn) (a == "--json" ? json = true : (args.push_back(a), false));
+    EvalArgs ea;
+    if (int rc = parseEvalArgs(args, "debug", kUsage, ea); rc != cli::kOk) return rc == kHelpShown ? cli::kOk : rc;
+    if (ea.precision == Precision::Ideal) {
+        std::cerr << "ps11: debug: --precision ideal is the reference it is compared with; pick another profile\n";
+        return cli::kUsage;
+    }
+    DebugTrace d;
+    if (int rc = debugPixel(ea, d); rc != cli::kOk) return rc;
+    const bool fx = isFixedPoint(d.precision);
 
     if (json) {
         nlohmann::ordered_json j;
-        j["file"] = ea.shader;
-        j["hardware"] = hw.hardware->name;
-        j["precision"] = precisionName(hw.precision);
+        j["file"] = d.shader;
+        j["hardware"] = d.hardware;
+        j["precision"] = precisionName(d.precision);
         nlohmann::ordered_json steps = nlohmann::ordered_json::array();
-        for (const Row& r : rows) {
+        for (const DebugRow& r : d.rows) {
             nlohmann::ordered_json s;
-            s["line"] = r.inst->loc.line;
-            s["text"] = formatInstruction(*r.inst, program->version);
-            if (r.emu->writes) {
-                s["emulated"] = r.emu->value;
-                if (fx) s["grid"] = r.emu->grid;
-                s["ideal"] = r.ideal->value;
+            s["line"] = r.line;
+            s["text"] = r.text;
+            if (r.writes) {
+                s["emulated"] = r.emulated;
+                if (fx) s["grid"] = r.grid;
+                s["ideal"] = r.ideal;
             } else {
                 s["emulated"] = nullptr;
                 s["ideal"] = nullptr;
@@ -201,46 +212,43 @@ int cmdDebug(const std::vector<std::string>& argsIn) {
             steps.push_back(s);
         }
         j["steps"] = steps;
-        j["first_divergence"] = firstDivergence >= 0 ? nlohmann::ordered_json(rows[size_t(firstDivergence)].inst->loc.line)
-                                                     : nlohmann::ordered_json(nullptr);
-        j["r0"] = {{"emulated", a.r0}, {"ideal", b.r0}};
-        j["killed"] = {{"emulated", a.killed != 0}, {"ideal", b.killed != 0}};
+        j["first_divergence"] = d.firstDivergence >= 0 ? nlohmann::ordered_json(d.rows[size_t(d.firstDivergence)].line)
+                                                       : nlohmann::ordered_json(nullptr);
+        j["r0"] = {{"emulated", d.r0Emulated}, {"ideal", d.r0Ideal}};
+        j["killed"] = {{"emulated", d.killedEmulated}, {"ideal", d.killedIdeal}};
         std::cout << j.dump(2) << "\n";
         return cli::kOk;
     }
 
-    std::cout << ea.shader << ": ps_" << program->version.major << "_" << program->version.minor << " on "
-              << hw.describe() << ", beside ideal\n";
-    std::printf("   %-5s %-26s %-36s %-32s %-6s %s\n", "line", "instruction", std::string(hw.hardware->name).c_str(),
-                "ideal", "Δ lvl", "why");
-    for (size_t k = 0; k < rows.size(); ++k) {
-        const Row& r = rows[k];
+    std::cout << d.shader << ": " << d.version << " on " << d.describe << ", beside ideal\n";
+    std::printf("   %-5s %-26s %-36s %-32s %-6s %s\n", "line", "instruction", d.hardware.c_str(), "ideal", "Δ lvl", "why");
+    for (size_t k = 0; k < d.rows.size(); ++k) {
+        const DebugRow& r = d.rows[k];
         std::string e, i;
         for (int c = 0; c < 4; ++c) {
-            if (!r.emu->writes || !((r.emu->mask >> c) & 1)) {
+            if (!r.writes || !((r.mask >> c) & 1)) {
                 e += c ? "       " : "      ", i += c ? "       " : "      ";
                 continue;
             }
-            e += (c ? " " : "") + num(r.emu->value[size_t(c)]);
-            i += (c ? " " : "") + num(r.ideal->value[size_t(c)]);
+            e += (c ? " " : "") + num(r.emulated[size_t(c)]);
+            i += (c ? " " : "") + num(r.ideal[size_t(c)]);
         }
-        if (fx && r.emu->writes) {
+        if (fx && r.writes) {
             e += " [";
             for (int c = 0; c < 4; ++c)
-                if ((r.emu->mask >> c) & 1) e += (e.back() == '[' ? "" : " ") + std::to_string(r.emu->grid[size_t(c)]);
+                if ((r.mask >> c) & 1) e += (e.back() == '[' ? "" : " ") + std::to_string(r.grid[size_t(c)]);
             e += "]";
         }
         std::string why;
         for (const std::string& w : r.why) why += (why.empty() ? "" : ", ") + w;
         if (why.empty() && r.levels > 0) why = "(from its sources)";
-        std::string text = formatInstruction(*r.inst, program->version);
-        if (text.size() > 26) text = text.substr(0, 25) + "~";
-        std::printf("%s %-5u %-26s %-36s %-32s %-6s %s\n", int(k) == firstDivergence ? ">>" : "  ", r.inst->loc.line,
-                    text.c_str(), e.c_str(), r.emu->writes ? i.c_str() : "", r.emu->writes ? levelText(r.levels).c_str() : "",
+        std::string text = r.text.size() > 26 ? r.text.substr(0, 25) + "~" : r.text;
+        std::printf("%s %-5u %-26s %-36s %-32s %-6s %s\n", int(k) == d.firstDivergence ? ">>" : "  ", r.line,
+                    text.c_str(), e.c_str(), r.writes ? i.c_str() : "", r.writes ? levelText(r.levels).c_str() : "",
                     why.c_str());
     }
-    if (firstDivergence >= 0)
-        std::cout << ">> line " << rows[size_t(firstDivergence)].inst->loc.line
+    if (d.firstDivergence >= 0)
+        std::cout << ">> line " << d.rows[size_t(d.firstDivergence)].line
                   << ": the first instruction where the class and ideal part by more than one 8-bit level\n";
     else
         std::cout << "the class stays within one 8-bit level of ideal at every instruction\n";

@@ -21,7 +21,7 @@
 #include "ps11/version.h"
 #include "tools/cli_util.h"
 #include "tools/cmd_bench.h"
-#include "tools/cmd_demo.h"
+#include "tools/demo_report.h"
 #include "tools/cmd_eval.h"
 #include "tools/cmd_golden.h"
 #include "tools/cmd_hardware.h"
@@ -83,9 +83,10 @@ const char* kUsageText =
     "  golden (--check|--regen) [DIR]\n"
     "                         golden disassembly and round trips of the shader corpus\n"
     "  isa                    print the instruction table (markdown, as in docs/isa.md)\n"
-    "  demo [--size WxH] [--threads N] [--repeats N] [--hardware H] [--out DIR]\n"
-    "                         the main job: the five glare techniques on the built-in scenes,\n"
-    "                         emulated and ideal (time per frame, error), and the fits-ps_1_1 table\n"
+    "  demo [--out DIR] [--quick] [--size WxH] [--threads N] [--hardware H]\n"
+    "                         the main job: the five glare techniques on the built-in scenes, emulated,\n"
+    "                         ideal and on GL, fits ps_1_1, time against error, stability, a debug\n"
+    "                         trace: a report in DIR/index.html (default ps11-demo/)\n"
     "  version, --version     print the ps11 version\n"
     "  help, --help           print this text\n";
 
@@ -309,70 +310,33 @@ int cmdCheck(const std::vector<std::string>& args) {
     return status;
 }
 
-// The main job (README): the project's shader corpus checked in one line, then the five glare
-// techniques on the built-in scenes (tools/cmd_demo.cpp).
+// The main job (README): the report of tools/demo_report.h.
 int cmdDemo(const std::vector<std::string>& args) {
-    GlareDemoOptions demo;
+    DemoReportOptions demo;
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
-        if (a == "--size" || a == "--threads" || a == "--repeats" || a == "--out" || a == "--hardware") {
+        if (a == "--quick") {
+            demo.quick = true;
+        } else if (a == "--size" || a == "--threads" || a == "--out" || a == "--hardware") {
             if (i + 1 >= args.size()) return usage("demo: " + a + " needs a value");
             const std::string& v = args[++i];
-            char* end = nullptr;
             if (a == "--hardware") {
                 demo.hardware = findHardware(v);
                 if (!demo.hardware) return usage("demo: " + unknownHardwareMessage(v));
             } else if (a == "--size") {
-                if (!parseSize(v, demo.width, demo.height, 16384) || demo.width < 8 || demo.height < 8 || demo.width > 8192 ||
-                    demo.height > 8192)
+                if (!parseSize(v, demo.width, demo.height, 8192) || demo.width < 8 || demo.height < 8)
                     return usage("demo: --size takes WIDTHxHEIGHT with sides 8..8192, not " + quote(v));
             } else if (a == "--out") {
                 demo.outDir = v;
-            } else {
-                long n = std::strtol(v.c_str(), &end, 10);
-                if (*end || n < (a == "--threads" ? 0 : 1) || n > 256)
-                    return usage("demo: " + a + " takes a number" + (a == "--threads" ? " 0..256" : " 1..256") +
-                                 ", not " + quote(v));
-                (a == "--threads" ? demo.threads : demo.repeats) = int(n);
+            } else if (!parseCount(v, 0, 256, demo.threads)) {
+                return usage("demo: --threads takes a number 0..256, not " + quote(v));
             }
         } else {
             return usage("demo: unknown argument " + quote(a) +
-                         didYouMean(a, {"--size", "--threads", "--repeats", "--out", "--hardware"}));
+                         didYouMean(a, {"--quick", "--out", "--size", "--threads", "--hardware"}));
         }
     }
-    // The corpus: every shader assembled, validated and round-tripped through tokens and text.
-    const std::string dir = projectDir();
-    if (!dir.empty()) {
-        std::vector<std::string> files = listFiles(dir + "/tests/shaders/corpus", ".psh");
-        int failures = 0;
-        for (const std::string& path : files) {
-            Diagnostics diags;
-            ShaderStats stats;
-            std::optional<Program> prog = assembleFile(path, {}, true, &stats, diags);
-            const std::string rel = path.substr(dir.size() + 1);
-            bool roundTrip = false;
-            if (prog && !diags.hasErrors()) {
-                std::vector<uint32_t> tokens = encode(*prog);
-                Diagnostics d2;
-                std::optional<Program> back = decode(tokens, d2.addFile(rel), d2);
-                if (back) {
-                    Diagnostics d3;
-                    std::optional<Program> again = parseAssembly(disassemble(*back), rel, {}, d3);
-                    roundTrip = again && encode(*again) == tokens;
-                }
-            } else {
-                std::cerr << diags.formatAll();
-            }
-            if (!roundTrip) {
-                std::printf("corpus: %s: %s\n", rel.c_str(), prog ? "round trip differs" : "invalid");
-                ++failures;
-            }
-        }
-        std::printf("ps11 demo: %zu corpus shaders assembled, validated and round-tripped: %s\n\n", files.size(),
-                    failures ? "FAILURES above" : "all identical");
-        if (failures) return kUserError;
-    }
-    return runGlareDemo(demo);
+    return writeDemoReport(demo);
 }
 
 }  // namespace
