@@ -205,7 +205,7 @@ int cmdDebug(const std::vector<std::string>& argsIn) {
                                                      : nlohmann::ordered_json(nullptr);
         j["r0"] = {{"emulated", a.r0}, {"ideal", b.r0}};
         j["killed"] = {{"emulated", a.killed != 0}, {"ideal", b.killed != 0}};
-        std::cout << j.dump(2) << "\n";
+        std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
         return cli::kOk;
     }
 
