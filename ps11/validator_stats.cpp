@@ -68,7 +68,8 @@ std::string statsToJson(const ShaderStats& s) {
     Json phases = Json::array();
     if (s.version.minor == 4)
         for (size_t p = s.hasPhase ? 0 : 1; p < 2; ++p)
-            phases.push_back({{"phase", p + 1}, {"texSlots", s.phaseTexSlots[p]}, {"arithSlots", s.phaseArithSlots[p]}});
+            phases.push_back(
+                {{"phase", p + 1}, {"texSlots", s.phaseTexSlots[p]}, {"arithSlots", s.phaseArithSlots[p]}});
     j["phases"] = std::move(phases);
     j["counts"] = {{"dp4", s.dp4Count}, {"cmp", s.cmpCount}, {"bem", s.bemCount}};
     j["constantsRead"] = s.constantsRead;

@@ -102,13 +102,15 @@ TEST_CASE("json: glare --report --json: odd names read back, numbers and layout 
     CHECK(j["frame"] == nlohmann::json({64, 36}));
     CHECK(j["hardware"] == kOddRead);
     REQUIRE(j["passes"].size() == 2);
-    for (const char* k : {"technique", "preset", "pass", "shader", "version", "note"}) CHECK(j["passes"][0][k] == kOddRead);
+    for (const char* k : {"technique", "preset", "pass", "shader", "version", "note"})
+        CHECK(j["passes"][0][k] == kOddRead);
     CHECK(j["passes"][0]["constants"] == nlohmann::json({0, 3}));
     CHECK(j["passes"][0]["target"] == nlohmann::json({16, 9}));
     CHECK(j["passes"][0]["fits_ps_1_1"] == false);
     CHECK(j["passes"][1]["fits_ps_1_1"] == true);
     // The layout of before: the frame on the first line, one pass per line.
     CHECK(text.rfind("{\n  \"frame\": [64, 36],\n  \"hardware\": ", 0) == 0);
-    CHECK(text.find("\n    {\"technique\": \"\", \"preset\": \"\", \"pass\": \"\", \"kind\": \"shader\"") != std::string::npos);
+    CHECK(text.find("\n    {\"technique\": \"\", \"preset\": \"\", \"pass\": \"\", \"kind\": \"shader\"") !=
+          std::string::npos);
     CHECK(text.ends_with("\"note\": \"\"}\n  ]\n}\n"));
 }

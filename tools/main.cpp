@@ -16,8 +16,8 @@
 #include "ps11/disassembler.h"
 #include "ps11/encoder.h"
 #include "ps11/isa_doc.h"
-#include "ps11/suggest.h"
 #include "ps11/json_internal.h"
+#include "ps11/suggest.h"
 #include "ps11/validator.h"
 #include "ps11/version.h"
 #include "tools/cli_util.h"
@@ -306,7 +306,8 @@ int cmdCheck(const std::vector<std::string>& args) {
     if (json && !ranges) std::cout << json::dump(jsonOut, 1) << "\n";
     // One shader: its object (docs/intervals.md "The range proof"); several: an array of them.
     if (json && ranges)
-        std::cout << (jsonOut.size() == 1 ? jsonOut[0] : jsonOut).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace)
+        std::cout << (jsonOut.size() == 1 ? jsonOut[0] : jsonOut)
+                         .dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace)
                   << "\n";
     return status;
 }
