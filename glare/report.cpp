@@ -11,6 +11,7 @@
 #include "ps11/assembler.h"
 #include "ps11/hardware.h"
 #include "ps11/range_proof.h"
+#include "ps11/json_internal.h"
 #include "ps11/validator.h"
 
 namespace glare {
@@ -64,17 +65,6 @@ std::string fmt(const char* f, double v) {
     char buf[64];
     std::snprintf(buf, sizeof buf, f, v);
     return buf;
-}
-
-std::string jsonString(const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
-        else if (c == '\n') out += "\\n";
-        else if (uint8_t(c) < 0x20) out += fmt("\\u%04x", double(uint8_t(c)));
-        else out += c;
-    }
-    return out + "\"";
 }
 
 }  // namespace
@@ -133,24 +123,31 @@ FitsReport fitsReport(uint32_t width, uint32_t height) {
 }
 
 std::string fitsReportJson(const FitsReport& r) {
-    std::string j = "{\n  \"frame\": [" + std::to_string(r.width) + ", " + std::to_string(r.height) +
-                    "],\n  \"hardware\": " + jsonString(r.hardware) + ",\n  \"passes\": [\n";
-    for (size_t i = 0; i < r.passes.size(); ++i) {
-        const PassFit& f = r.passes[i];
-        std::string consts;
-        for (int c : f.constants) consts += (consts.empty() ? "" : ", ") + std::to_string(c);
-        j += "    {\"technique\": " + jsonString(f.technique) + ", \"preset\": " + jsonString(f.preset) +
-             ", \"pass\": " + jsonString(f.pass) + ", \"kind\": " + jsonString(passKindName(f.kind)) +
-             ", \"shader\": " + jsonString(f.shader) + ", \"version\": " + jsonString(f.version) +
-             ", \"tex_slots\": " + std::to_string(f.texSlots) + ", \"tex_limit\": " + std::to_string(f.texLimit) +
-             ", \"arith_slots\": " + std::to_string(f.arithSlots) + ", \"arith_limit\": " + std::to_string(f.arithLimit) +
-             ", \"constants\": [" + consts + "], \"target\": [" + std::to_string(f.width) + ", " +
-             std::to_string(f.height) + "], \"fits_ps_1_1\": " + (f.fits ? "true" : "false") +
-             ", \"range_safe\": " + (f.rangeClamp.empty() ? "true" : "false") +
-             ", \"range_clamp\": " + jsonString(f.rangeClamp) +
-             ", \"note\": " + jsonString(f.note) + "}" + (i + 1 < r.passes.size() ? "," : "") + "\n";
-    }
-    return j + "  ]\n}\n";
+    using ps11::json::Json;
+    Json passes = Json::array();
+    for (const PassFit& f : r.passes)
+        passes.push_back({{"technique", f.technique},
+                          {"preset", f.preset},
+                          {"pass", f.pass},
+                          {"kind", passKindName(f.kind)},
+                          {"shader", f.shader},
+                          {"version", f.version},
+                          {"tex_slots", f.texSlots},
+                          {"tex_limit", f.texLimit},
+                          {"arith_slots", f.arithSlots},
+                          {"arith_limit", f.arithLimit},
+                          {"constants", f.constants},
+                          {"target", {f.width, f.height}},
+                          {"fits_ps_1_1", f.fits},
+                          {"range_safe", f.rangeClamp.empty()},
+                          {"range_clamp", f.rangeClamp},
+                          {"note", f.note}});
+    Json j;
+    j["frame"] = {r.width, r.height};
+    j["hardware"] = r.hardware;
+    j["passes"] = std::move(passes);
+    // One pass per line, as before.
+    return ps11::json::dump(j, 2) + "\n";
 }
 
 namespace {

@@ -1,42 +1,10 @@
 // The validator stage, reports: ShaderStats as readable text and as JSON (`ps11 check`,
 // `ps11 check --json`).
+#include "ps11/json_internal.h"
 #include "ps11/validator_internal.h"
 
 namespace ps11 {
 namespace {
-
-std::string jsonEscape(const std::string& s) {
-    std::string out = "\"";
-    for (unsigned char c : s) {
-        switch (c) {
-            case '"':
-                out += "\\\"";
-                break;
-            case '\\':
-                out += "\\\\";
-                break;
-            case '\n':
-                out += "\\n";
-                break;
-            case '\r':
-                out += "\\r";
-                break;
-            case '\t':
-                out += "\\t";
-                break;
-            default:
-                if (c < 0x20) {
-                    static const char* hex = "0123456789abcdef";
-                    out += "\\u00";
-                    out += hex[c >> 4];
-                    out += hex[c & 15];
-                } else {
-                    out += char(c);
-                }
-        }
-    }
-    return out + "\"";
-}
 
 std::string intList(const std::vector<int>& v, const char* prefix, const char* sep) {
     std::string out;
@@ -88,43 +56,41 @@ std::string statsToText(const ShaderStats& s) {
 }
 
 std::string statsToJson(const ShaderStats& s) {
-    std::string out = "{";
-    out += "\"version\":" + jsonEscape(versionString(s.version));
-    out += ",\"valid\":" + std::string(s.valid ? "true" : "false");
-    out += ",\"texSlots\":" + std::to_string(s.texSlots) + ",\"texLimit\":" + std::to_string(s.texLimit);
-    out += ",\"arithSlots\":" + std::to_string(s.arithSlots) + ",\"arithLimit\":" + std::to_string(s.arithLimit);
-    out += ",\"limitsPerPhase\":" + std::string(s.version.minor == 4 ? "true" : "false");
-    out += ",\"phases\":[";
-    if (s.version.minor == 4) {
-        for (size_t p = s.hasPhase ? 0 : 1; p < 2; ++p) {
-            if (p == 1 && s.hasPhase) out += ",";
-            out += "{\"phase\":" + std::to_string(p + 1) + ",\"texSlots\":" + std::to_string(s.phaseTexSlots[p]) +
-                   ",\"arithSlots\":" + std::to_string(s.phaseArithSlots[p]) + "}";
-        }
-    }
-    out += "]";
-    out += ",\"counts\":{\"dp4\":" + std::to_string(s.dp4Count) + ",\"cmp\":" + std::to_string(s.cmpCount) +
-           ",\"bem\":" + std::to_string(s.bemCount) + "}";
-    out += ",\"constantsRead\":[" + intList(s.constantsRead, "", ",") + "]";
-    out += ",\"constantsDefined\":[" + intList(s.constantsDefined, "", ",") + "]";
-    out += ",\"readPorts\":{";
-    for (size_t t = 0; t < 4; ++t) {
-        if (t) out += ",";
-        out += std::string("\"") + regPrefix(RegType(t)) + "\":{\"max\":" + std::to_string(s.maxReadPorts[t]) +
-               ",\"limit\":" + std::to_string(s.readPortLimit[t]) +
-               ",\"pairMax\":" + std::to_string(s.maxPairReadPorts[t]) + "}";
-    }
-    out += "},\"pairReadPortLimit\":" + std::to_string(s.pairReadPortLimit);
-    out += ",\"instructions\":[";
-    for (size_t i = 0; i < s.table.size(); ++i) {
-        const InstructionStats& row = s.table[i];
-        if (i) out += ",";
-        out += "{\"index\":" + std::to_string(row.instruction) + ",\"line\":" + std::to_string(row.loc.line) +
-               ",\"col\":" + std::to_string(row.loc.col) + ",\"phase\":" + std::to_string(row.phase) +
-               ",\"texSlots\":" + std::to_string(row.texSlots) + ",\"arithSlots\":" + std::to_string(row.arithSlots) +
-               ",\"coissue\":" + (row.coissue ? "true" : "false") + ",\"text\":" + jsonEscape(row.text) + "}";
-    }
-    out += "]}";
-    return out;
+    using json::Json;
+    Json j;
+    j["version"] = versionString(s.version);
+    j["valid"] = s.valid;
+    j["texSlots"] = s.texSlots;
+    j["texLimit"] = s.texLimit;
+    j["arithSlots"] = s.arithSlots;
+    j["arithLimit"] = s.arithLimit;
+    j["limitsPerPhase"] = s.version.minor == 4;
+    Json phases = Json::array();
+    if (s.version.minor == 4)
+        for (size_t p = s.hasPhase ? 0 : 1; p < 2; ++p)
+            phases.push_back(
+                {{"phase", p + 1}, {"texSlots", s.phaseTexSlots[p]}, {"arithSlots", s.phaseArithSlots[p]}});
+    j["phases"] = std::move(phases);
+    j["counts"] = {{"dp4", s.dp4Count}, {"cmp", s.cmpCount}, {"bem", s.bemCount}};
+    j["constantsRead"] = s.constantsRead;
+    j["constantsDefined"] = s.constantsDefined;
+    Json ports = Json::object();
+    for (size_t t = 0; t < 4; ++t)
+        ports[regPrefix(RegType(t))] = {
+            {"max", s.maxReadPorts[t]}, {"limit", s.readPortLimit[t]}, {"pairMax", s.maxPairReadPorts[t]}};
+    j["readPorts"] = std::move(ports);
+    j["pairReadPortLimit"] = s.pairReadPortLimit;
+    Json rows = Json::array();
+    for (const InstructionStats& row : s.table)
+        rows.push_back({{"index", row.instruction},
+                        {"line", row.loc.line},
+                        {"col", row.loc.col},
+                        {"phase", row.phase},
+                        {"texSlots", row.texSlots},
+                        {"arithSlots", row.arithSlots},
+                        {"coissue", row.coissue},
+                        {"text", row.text}});
+    j["instructions"] = std::move(rows);
+    return json::dumpCompact(j);
 }
 }  // namespace ps11

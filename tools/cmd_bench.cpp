@@ -324,7 +324,7 @@ int cmdBench(const std::vector<std::string>& args) {
     if (json) {
         nlohmann::ordered_json out = {{"rows", nlohmann::ordered_json::array()}};
         for (const glare::SweepRow& r : rows) out["rows"].push_back(rowJson(r));
-        std::cout << out.dump(1) << "\n";
+        std::cout << out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
         return cli::kOk;
     }
     if (spec.gl && !glRendererDescription().empty()) std::printf("GL renderer: %s\n", glRendererDescription().c_str());

@@ -15,6 +15,7 @@
 #include "emu/image_file.h"
 #include "ps11/assembler.h"
 #include "ps11/hardware.h"
+#include "ps11/json_internal.h"
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
@@ -206,24 +207,6 @@ void compareText(const std::string& text, const std::string& path, const Options
     }
 }
 
-std::string jsonEscape(const std::string& s) {
-    std::string o;
-    for (char ch : s) {
-        const unsigned char c = static_cast<unsigned char>(ch);
-        if (c == '"' || c == '\\') {
-            o += '\\';
-            o += ch;
-        } else if (c < 0x20) {
-            char b[8];
-            std::snprintf(b, sizeof b, "\\u%04x", c);
-            o += b;
-        } else {
-            o += ch;
-        }
-    }
-    return o;
-}
-
 std::string number(double v) {
     std::ostringstream o;
     o << v;
@@ -248,28 +231,38 @@ Distance distanceOf(const std::vector<DrawDiff>& draws) {
 void printReport(const std::string& path, const Report& r, const Options& opts) {
     const Distance card = distanceOf(r.draws), ideal = distanceOf(r.idealDraws);
     if (opts.json) {
-        std::cout << "{\"file\": \"" << jsonEscape(path) << "\", \"gl_mode\": \"" << (opts.native ? "native" : "exact")
-                  << "\", \"pixels\": " << r.sum(&DrawDiff::pixels)
-                  << ", \"exact\": " << r.sum(&DrawDiff::exact) << ", \"over_one\": " << r.sum(&DrawDiff::overOne)
-                  << ", \"max_diff\": " << number(r.maxDiff()) << ", \"draws\": [";
-        for (size_t i = 0; i < r.draws.size(); ++i) {
-            const DrawDiff& d = r.draws[i];
-            std::cout << (i ? ", " : "") << "{\"line\": " << d.line << ", \"pixels\": " << d.pixels
-                      << ", \"exact\": " << d.exact << ", \"over_one\": " << d.overOne
-                      << ", \"max_diff\": " << number(d.maxDiff) << ", \"unit\": \"" << (d.values ? "value" : "level")
-                      << "\", \"distinct_emu\": " << d.distinctEmu << ", \"distinct_gl\": " << d.distinctGl << "}";
+        // Numbers with the digits the old output had (ostream's default: %g).
+        auto num = [](double v) { return json::rounded(v, "%g"); };
+        json::Json j;
+        j["file"] = path;
+        j["gl_mode"] = opts.native ? "native" : "exact";
+        j["pixels"] = r.sum(&DrawDiff::pixels);
+        j["exact"] = r.sum(&DrawDiff::exact);
+        j["over_one"] = r.sum(&DrawDiff::overOne);
+        j["max_diff"] = num(r.maxDiff());
+        json::Json draws = json::Json::array();
+        for (const DrawDiff& d : r.draws)
+            draws.push_back({{"line", d.line},
+                             {"pixels", d.pixels},
+                             {"exact", d.exact},
+                             {"over_one", d.overOne},
+                             {"max_diff", num(d.maxDiff)},
+                             {"unit", d.values ? "value" : "level"},
+                             {"distinct_emu", d.distinctEmu},
+                             {"distinct_gl", d.distinctGl}});
+        j["draws"] = std::move(draws);
+        json::Json unsupported = json::Json::array();
+        for (const auto& [line, why] : r.unsupported) unsupported.push_back({{"line", line}, {"why", why}});
+        j["unsupported"] = std::move(unsupported);
+        if (opts.native) {
+            auto distance = [&](const Distance& x) {
+                return json::Json{{"max", num(x.max)}, {"mean", num(x.mean)}, {"over_one_pct", num(x.overOnePct)}};
+            };
+            j["vs_card"] = distance(card);
+            j["vs_ideal"] = distance(ideal);
         }
-        std::cout << "], \"unsupported\": [";
-        for (size_t i = 0; i < r.unsupported.size(); ++i)
-            std::cout << (i ? ", " : "") << "{\"line\": " << r.unsupported[i].first << ", \"why\": \""
-                      << jsonEscape(r.unsupported[i].second) << "\"}";
-        std::cout << "]";
-        if (opts.native)
-            std::cout << ", \"vs_card\": {\"max\": " << number(card.max) << ", \"mean\": " << number(card.mean)
-                      << ", \"over_one_pct\": " << number(card.overOnePct) << "}, \"vs_ideal\": {\"max\": "
-                      << number(ideal.max) << ", \"mean\": " << number(ideal.mean)
-                      << ", \"over_one_pct\": " << number(ideal.overOnePct) << "}";
-        std::cout << ", \"gl\": \"" << jsonEscape(glRendererDescription()) << "\"}\n";
+        j["gl"] = glRendererDescription();
+        std::cout << json::dump(j) << "\n";
         return;
     }
     std::cout << "gl: " << glRendererDescription() << "\n";
@@ -396,12 +389,17 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
                       << std::endl;  // at once: a long run may be stopped
     }
     if (opts.json) {
-        std::cout << "{\"programs\": " << programs << ", \"pixels\": " << pixels << ", \"exact\": " << exact
-                  << ", \"over_one\": " << overOne << ", \"max_diff\": " << number(maxDiff) << ", \"mismatches\": [";
-        for (size_t i = 0; i < mismatches.size(); ++i)
-            std::cout << (i ? ", " : "") << "{\"seed\": " << mismatches[i].first << ", \"file\": \""
-                      << jsonEscape(mismatches[i].second) << "\"}";
-        std::cout << "], \"gl\": \"" << jsonEscape(glRendererDescription()) << "\"}\n";
+        json::Json j;
+        j["programs"] = programs;
+        j["pixels"] = pixels;
+        j["exact"] = exact;
+        j["over_one"] = overOne;
+        j["max_diff"] = json::rounded(maxDiff, "%g");
+        json::Json list = json::Json::array();
+        for (const auto& [seed, file] : mismatches) list.push_back({{"seed", seed}, {"file", file}});
+        j["mismatches"] = std::move(list);
+        j["gl"] = glRendererDescription();
+        std::cout << json::dump(j) << "\n";
     } else {
         std::cout << "gl: " << glRendererDescription() << "\n"
                   << "random: " << programs << " programs (seeds " << opts.seed << ".." << opts.seed + programs - 1

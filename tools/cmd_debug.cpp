@@ -216,7 +216,7 @@ int cmdDebug(const std::vector<std::string>& argsIn) {
                                                        : nlohmann::ordered_json(nullptr);
         j["r0"] = {{"emulated", d.r0Emulated}, {"ideal", d.r0Ideal}};
         j["killed"] = {{"emulated", d.killedEmulated}, {"ideal", d.killedIdeal}};
-        std::cout << j.dump(2) << "\n";
+        std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
         return cli::kOk;
     }
 

@@ -22,6 +22,7 @@
 #include "glare/scene.h"
 #include "glare/shade.h"
 #include "ps11/hardware.h"
+#include "ps11/json_internal.h"
 #include "tools/cli_util.h"
 #include "tools/gl_backend.h"
 
@@ -396,28 +397,31 @@ int runGlare(const GlareOptions& o) {
             vsIdeal = glare::imageError(*g, *i);
         }
         auto errorJson = [](const glare::ImageError& e) {
-            char b[160];
-            std::snprintf(b, sizeof b, "{\"max_levels\": %d, \"mean_levels\": %.4f, \"over_one_pct\": %.4f}", e.max, e.mean,
-                          e.overOnePercent);
-            return std::string(b);
+            return json::Json{{"max_levels", e.max},
+                              {"mean_levels", json::rounded(e.mean, "%.4f")},
+                              {"over_one_pct", json::rounded(e.overOnePercent, "%.4f")}};
         };
         if (o.json) {
-            std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"gl\": \"%s\", \"frames\": %d, "
-                        "\"passes\": [\n",
-                        std::string(technique->name()).c_str(), hw.c_str(), profile.c_str(),
-                        glRendererDescription().c_str(), o.frames);
+            json::Json j;
+            j["technique"] = std::string(technique->name());
+            j["hardware"] = hw;
+            j["profile"] = profile;
+            j["gl"] = glRendererDescription();
+            j["frames"] = o.frames;
             std::vector<glare::PassAgreement> all;
             if (scene) all.push_back(sceneAgreement);
             all.insert(all.end(), agreement.begin(), agreement.end());
-            for (size_t i = 0; i < all.size(); ++i)
-                std::printf("  {\"pass\": \"%s\", \"pixels\": %llu, \"exact\": %llu, \"over_one\": %llu, \"max_diff\": %g}%s\n",
-                            all[i].pass.c_str(), (unsigned long long)all[i].pixels, (unsigned long long)all[i].exact,
-                            (unsigned long long)all[i].overOne, all[i].maxDiff, i + 1 < all.size() ? "," : "");
-            std::printf("], \"gl_mode\": \"%s\"", o.glNative ? "native" : "exact");
-            if (ideal)
-                std::printf(", \"end_to_end\": {\"vs_card\": %s, \"vs_ideal\": %s}", errorJson(vsCard).c_str(),
-                            errorJson(vsIdeal).c_str());
-            std::printf("}\n");
+            json::Json passes = json::Json::array();
+            for (const glare::PassAgreement& a : all)
+                passes.push_back({{"pass", a.pass},
+                                  {"pixels", a.pixels},
+                                  {"exact", a.exact},
+                                  {"over_one", a.overOne},
+                                  {"max_diff", json::rounded(a.maxDiff, "%g")}});
+            j["passes"] = std::move(passes);
+            j["gl_mode"] = o.glNative ? "native" : "exact";
+            if (ideal) j["end_to_end"] = {{"vs_card", errorJson(vsCard)}, {"vs_ideal", errorJson(vsIdeal)}};
+            std::cout << json::dump(j, 2) << "\n";
         } else {
             std::printf("%s on %ux%u, %d frame(s), %s / %s: the emulator against %s, pass-isolated\n",
                         std::string(technique->name()).c_str(), width, height, o.frames, hw.c_str(), profile.c_str(),
@@ -450,24 +454,34 @@ int runGlare(const GlareOptions& o) {
         return over == 0 ? cli::kOk : cli::kUserError;
     }
     if (o.json) {
-        std::printf("{\"technique\": \"%s\", \"hardware\": \"%s\", \"profile\": \"%s\", \"size\": [%u, %u], \"frames\": %d, "
-                    "\"passes\": [\n",
-                    std::string(technique->name()).c_str(), hw.c_str(), profile.c_str(), width, height, o.frames);
-        for (size_t i = 0; i < lastStats.size(); ++i) {
-            const glare::PassStats& s = lastStats[i];
-            std::printf("  {\"pass\": \"%s\", \"ms\": %.3f, \"draws\": %llu, \"pixels\": %llu, \"texels\": %llu, "
-                        "\"instructions\": %llu, \"uploads\": %llu, \"readbacks\": %llu, \"bytes\": %llu, \"reused\": %s, "
-                        "\"tiles\": {\"shaded\": %llu, \"filled\": %llu, \"copied\": %llu, \"skipped\": %llu}}%s\n",
-                        s.pass.c_str(), s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
-                        (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
-                        (unsigned long long)s.readBacks, (unsigned long long)s.bytes, s.reused ? "true" : "false",
-                        (unsigned long long)s.tilesShaded, (unsigned long long)s.tilesFilled,
-                        (unsigned long long)s.tilesCopied, (unsigned long long)s.tilesSkipped,
-                        i + 1 < lastStats.size() ? "," : "");
-        }
-        std::printf("], \"renderer\": \"%s\", \"frame_uploads\": %llu, \"frame_readbacks\": %llu}\n",
-                    main->device().rendererName(), (unsigned long long)lastTransfers.uploads,
-                    (unsigned long long)lastTransfers.readBacks);
+        json::Json j;
+        j["technique"] = std::string(technique->name());
+        j["hardware"] = hw;
+        j["profile"] = profile;
+        j["size"] = {width, height};
+        j["frames"] = o.frames;
+        json::Json passes = json::Json::array();
+        for (const glare::PassStats& s : lastStats)
+            passes.push_back({{"pass", s.pass},
+                              {"ms", json::rounded(s.milliseconds, "%.3f")},
+                              {"draws", s.draws},
+                              {"pixels", s.pixels},
+                              {"texels", s.texels},
+                              {"instructions", s.instructions},
+                              {"uploads", s.uploads},
+                              {"readbacks", s.readBacks},
+                              {"bytes", s.bytes},
+                              {"reused", s.reused},
+                              {"tiles",
+                               {{"shaded", s.tilesShaded},
+                                {"filled", s.tilesFilled},
+                                {"copied", s.tilesCopied},
+                                {"skipped", s.tilesSkipped}}}});
+        j["passes"] = std::move(passes);
+        j["renderer"] = main->device().rendererName();
+        j["frame_uploads"] = lastTransfers.uploads;
+        j["frame_readbacks"] = lastTransfers.readBacks;
+        std::cout << json::dump(j, 2) << "\n";
         return cli::kOk;
     }
     std::vector<double> sorted = frameMs;

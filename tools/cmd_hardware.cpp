@@ -6,6 +6,7 @@
 #include <iostream>
 
 #include "ps11/hardware.h"
+#include "ps11/json_internal.h"
 #include "tools/cli_util.h"
 
 namespace ps11 {
@@ -30,19 +31,19 @@ int cmdHardware(const std::vector<std::string>& args) {
         }
     }
     if (json) {
-        std::cout << "[";
-        bool first = true;
-        for (const HardwareClass& h : hardwareClasses()) {
-            std::printf("%s\n  {\"name\": \"%.*s\", \"kind\": \"%.*s\", \"gpus\": \"%.*s\", \"max_version\": \"ps_1_%d\", "
-                        "\"precision\": \"%s\", \"max_value\": %g, \"signed_decode\": \"%s\", "
-                        "\"coissued_cnd\": \"%s\", \"bilinear_weight_bits\": %d, \"default\": %s}",
-                        first ? "" : ",", int(h.name.size()), h.name.data(), int(h.kind.size()), h.kind.data(),
-                        int(h.gpus.size()), h.gpus.data(), h.maxMinor, precisionName(h.precision), double(h.maxValue),
-                        signedDecodeName(h.signedDecode), cndName(h.coissuedCnd), h.bilinearWeightBits,
-                        (&h == &defaultHardware(1) || &h == &defaultHardware(4)) ? "true" : "false");
-            first = false;
-        }
-        std::printf("\n]\n");
+        json::Json rows = json::Json::array();
+        for (const HardwareClass& h : hardwareClasses())
+            rows.push_back({{"name", h.name},
+                            {"kind", h.kind},
+                            {"gpus", h.gpus},
+                            {"max_version", "ps_1_" + std::to_string(h.maxMinor)},
+                            {"precision", precisionName(h.precision)},
+                            {"max_value", json::rounded(double(h.maxValue), "%g")},
+                            {"signed_decode", signedDecodeName(h.signedDecode)},
+                            {"coissued_cnd", cndName(h.coissuedCnd)},
+                            {"bilinear_weight_bits", h.bilinearWeightBits},
+                            {"default", &h == &defaultHardware(1) || &h == &defaultHardware(4)}});
+        std::cout << json::dump(rows, 1) << "\n";
         return cli::kOk;
     }
     std::printf("%-11s %-10s %-7s %-8s %9s %-11s %-11s %7s  %s\n", "hardware", "kind", "up to", "profile", "max value",

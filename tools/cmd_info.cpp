@@ -11,6 +11,7 @@
 #include "ps11/cpu_features.h"
 #include "ps11/executor_fast.h"
 #include "ps11/hardware.h"
+#include "ps11/json_internal.h"
 #include "ps11/simd_dispatch.h"
 #include "ps11/suggest.h"
 #include "ps11/version.h"
@@ -24,21 +25,6 @@ namespace ps11 {
 namespace {
 
 constexpr const char* kInfoUsage = "usage: ps11 info [--gl osmesa|egl] [--json]\n";
-
-std::string jsonString(std::string_view s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') {
-            out += '\\';
-            out += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-            out += ' ';
-        } else {
-            out += c;
-        }
-    }
-    return out + "\"";
-}
 
 // The GL part of the report: the context's facts, or the error.
 struct GlReport {
@@ -113,21 +99,22 @@ int cmdInfo(const std::vector<std::string>& args) {
     if (cpuText.empty()) cpuText = "none of avx2, fma, f16c";
     GlReport r = probeGl(gl);
     if (json) {
-        std::cout << "{\"version\": " << jsonString(versionString()) << ", \"hardware\": " << jsonString(hw.name)
-                  << ", \"simd_level\": " << jsonString(simdLevelName(level))
-                  << ", \"executor_kernels\": " << jsonString(kernelName) << ", \"cpu\": {\"avx2\": "
-                  << (cpu.avx2 ? "true" : "false") << ", \"fma\": " << (cpu.fma ? "true" : "false")
-                  << ", \"f16c\": " << (cpu.f16c ? "true" : "false") << "}, \"gl\": {";
-        if (r.ok) {
-            std::cout << "\"kind\": " << jsonString(r.kind) << ", \"platform\": " << jsonString(r.platform)
-                      << ", \"GL_RENDERER\": " << jsonString(r.renderer)
-                      << ", \"GL_VERSION\": " << jsonString(r.version)
-                      << ", \"GL_SHADING_LANGUAGE_VERSION\": " << jsonString(r.glsl)
-                      << ", \"modes\": [\"exact\", \"native\"]";
-        } else {
-            std::cout << "\"error\": " << jsonString(r.error);
-        }
-        std::cout << "}}\n";
+        json::Json j;
+        j["version"] = versionString();
+        j["hardware"] = hw.name;
+        j["simd_level"] = simdLevelName(level);
+        j["executor_kernels"] = kernelName;
+        j["cpu"] = {{"avx2", cpu.avx2}, {"fma", cpu.fma}, {"f16c", cpu.f16c}};
+        if (r.ok)
+            j["gl"] = {{"kind", r.kind},
+                       {"platform", r.platform},
+                       {"GL_RENDERER", r.renderer},
+                       {"GL_VERSION", r.version},
+                       {"GL_SHADING_LANGUAGE_VERSION", r.glsl},
+                       {"modes", json::Json::array({"exact", "native"})}};
+        else
+            j["gl"] = {{"error", r.error}};
+        std::cout << json::dump(j) << "\n";
     } else {
         std::cout << "ps11 " << versionString() << "\n"
                   << "default hardware: " << hw.name << " (" << hw.kind << ")\n"

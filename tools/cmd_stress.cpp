@@ -131,7 +131,7 @@ int cmdStress(const std::vector<std::string>& args) {
         for (const glare::RobustnessCheck& c : r.robustness)
             j["robustness"].push_back({{"name", c.name}, {"pass", c.pass}, {"detail", c.detail}});
         j["seconds"] = seconds;
-        std::cout << j.dump(2) << "\n";
+        std::cout << j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
         return r.robust() ? cli::kOk : cli::kUserError;
     }
 

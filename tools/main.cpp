@@ -16,6 +16,7 @@
 #include "ps11/disassembler.h"
 #include "ps11/encoder.h"
 #include "ps11/isa_doc.h"
+#include "ps11/json_internal.h"
 #include "ps11/suggest.h"
 #include "ps11/validator.h"
 #include "ps11/version.h"
@@ -257,8 +258,8 @@ int cmdCheck(const std::vector<std::string>& args) {
     if (inputs.empty()) return usage("check needs at least one shader file");
     if (rangeOptionGiven && !ranges) return usage("check: --hardware, --cN and the range options need --ranges");
     int status = kOk;
-    nlohmann::ordered_json rangeJson = nlohmann::ordered_json::array();
-    if (json && !ranges) std::cout << "[";
+    // --json: one object per file; --ranges --json: the range proof's object per file.
+    nlohmann::ordered_json jsonOut = nlohmann::ordered_json::array();
     for (size_t n = 0; n < inputs.size(); ++n) {
         const std::string& path = inputs[n];
         Diagnostics diags;
@@ -283,30 +284,32 @@ int cmdCheck(const std::vector<std::string>& args) {
         if (ranges) {
             nlohmann::ordered_json one;
             if (ok && checkRanges(*prog, path, rangeOptions, json, &one)) {
-                if (json) rangeJson.push_back(std::move(one));
+                if (json) jsonOut.push_back(std::move(one));
             } else {
                 status = kUserError;
             }
             continue;
         }
         if (json) {
-            std::cout << (n ? ",\n" : "\n") << "{\"file\": \"";
-            for (char c : path) {
-                if (c == '"' || c == '\\') std::cout << '\\';
-                if (static_cast<unsigned char>(c) < 0x20) continue;
-                std::cout << c;
-            }
-            std::cout << "\", \"valid\": " << (ok ? "true" : "false") << ", \"errors\": " << diags.errorCount();
-            if (prog) std::cout << ", \"stats\": " << statsToJson(stats);
-            std::cout << "}";
+            nlohmann::ordered_json one;
+            one["file"] = path;
+            one["valid"] = ok;
+            one["errors"] = diags.errorCount();
+            // statsToJson is ps11core's text (the library keeps nlohmann out of its headers): read back.
+            if (prog) one["stats"] = nlohmann::ordered_json::parse(statsToJson(stats));
+            jsonOut.push_back(std::move(one));
         } else {
             std::cout << path << ": " << (ok ? "valid" : "INVALID") << "\n";
             if (prog) std::cout << statsToText(stats) << "\n";
         }
     }
-    if (json && !ranges) std::cout << "\n]\n";
+    // One object per file, each on its own line.
+    if (json && !ranges) std::cout << json::dump(jsonOut, 1) << "\n";
     // One shader: its object (docs/intervals.md "The range proof"); several: an array of them.
-    if (json && ranges) std::cout << (rangeJson.size() == 1 ? rangeJson[0] : rangeJson).dump(2) << "\n";
+    if (json && ranges)
+        std::cout << (jsonOut.size() == 1 ? jsonOut[0] : jsonOut)
+                         .dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace)
+                  << "\n";
     return status;
 }
 

@@ -17,6 +17,10 @@ expect_rc() { # expected-rc description command...
 expect_in() { # file text description
     grep -qF -- "$2" "$1" || fail "$3: '$2' not in $(basename "$1"): $(head -c 400 "$1")"
 }
+expect_json() { # file description: the file is one JSON document
+    python3 -c 'import json, sys; json.load(open(sys.argv[1], encoding="utf-8"))' "$1" 2>/dev/null ||
+        fail "$2: not JSON: $(head -c 400 "$1")"
+}
 
 printf 'ps_1_1\ntex t0\nadd r0.rgb, t0, v0\n+mov r0.a, t0\n' >"$work/a.psh"
 expect_rc 0 "asm --hex" "$ps11" asm "$work/a.psh" --hex
@@ -34,7 +38,20 @@ expect_rc 0 "asm from stdin" "$ps11" asm - --hex <"$work/a.psh"
 expect_rc 0 "check" "$ps11" check "$work/a.psh" "$work/a.bin"
 expect_in "$work/out" "arithmetic slots: 1/8" "check statistics"
 expect_rc 0 "check --json" "$ps11" check --json "$work/a.psh"
-expect_in "$work/out" '"arithSlots":1' "check --json"
+expect_in "$work/out" '"arithSlots": 1' "check --json"
+# Names JSON must escape (quote, backslash, newline, tab, a control byte, a byte that is not UTF-8),
+# and an unreadable first file: still one valid JSON array, each name read back as written.
+odd="$work/q\"uo\\te
+tab	ctl$(printf '\001')lat$(printf '\351').psh"
+cp "$work/a.psh" "$odd"
+expect_rc 1 "check --json odd names" "$ps11" check --json "$work/missing.psh" "$odd" "$work/a.psh"
+python3 - "$work/out" "$odd" "$work/a.psh" <<'PY' || fail "check --json with odd names: $(head -c 400 "$work/out")"
+import json, os, sys
+j = json.load(open(sys.argv[1], encoding="utf-8"))
+odd = os.fsencode(sys.argv[2]).decode("utf-8", "replace")  # a byte that is not UTF-8 becomes U+FFFD
+assert [f["file"] for f in j] == [odd, sys.argv[3]], [f["file"] for f in j]
+assert all(f["valid"] and f["stats"]["arithSlots"] == 1 for f in j)
+PY
 printf 'ps_1_1\n#ifdef TWO\nmov r0, v1\n#else\nmov r0, v0\n#endif\n' >"$work/d.psh"
 expect_rc 0 "asm -D" "$ps11" asm "$work/d.psh" -D TWO --hex
 expect_in "$work/out" "0x90e40001" "-D selects the #ifdef branch"
@@ -165,6 +182,7 @@ expect_rc 0 "hardware" "$ps11" hardware
 expect_in "$work/out" "geforce4    1.1-class  ps_1_3" "hardware lists the default class"
 expect_in "$work/out" "(default for ps_1_4)" "hardware marks the ps_1_4 default"
 expect_rc 0 "hardware --json" "$ps11" hardware --json
+expect_json "$work/out" "hardware --json"
 expect_in "$work/out" '"name": "geforce7", "kind": "D3D9-class"' "hardware --json"
 expect_in "$work/out" '"coissued_cnd": "sequential"' "hardware --json behaviours"
 expect_rc 2 "hardware bad option" "$ps11" hardware --bogus
@@ -329,6 +347,7 @@ expect_in "$work/err" "ps11: PS11_SIMD=bogus: unknown SIMD level" "an unknown PS
 expect_in "$work/out" "simd level: " "an unknown PS11_SIMD still gives a level"
 expect_rc 0 "info --json" "$ps11" info --json
 expect_in "$work/out" '"hardware": "geforce4"' "info --json"
+expect_json "$work/out" "info --json"
 if grep -q "PS11_GL=OFF" "$work/out"; then
     expect_rc 1 "info --gl egl without the GL backend" "$ps11" info --gl egl
 else
@@ -368,6 +387,7 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "compare a test file" "$ps11" compare "$work/x.ps11test" --json
     expect_in "$work/out" '"pixels": 16, "exact": 16, "over_one": 0, "max_diff": 0, "draws": [{"line": ' "compare --json totals"
     expect_in "$work/out" '"unsupported": []' "compare --json lists nothing unsupported"
+    expect_json "$work/out" "compare --json"
     printf 'ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, v0, c0\n' >"$work/bem.psh"
     expect_rc 0 "compare a bare shader" "$ps11" compare "$work/bem.psh" --size 16x8 --seed 7 --heatmap "$work/heat.png"
     expect_in "$work/out" "128 pixels, 128 exact" "compare draws the shader over random inputs"
@@ -416,6 +436,7 @@ expect_rc 0 "glare --list" "$ps11" glare --list
 for t in adaptive glow pyramid quarter sprites; do expect_in "$work/out" "$t " "glare --list names $t"; done
 expect_in "$work/out" "box " "glare --list names the scenes"
 expect_rc 0 "glare --report --json" "$ps11" glare --report --json
+python3 -c 'import json, sys; assert json.load(open(sys.argv[1]))["passes"]' "$work/out" || fail "glare --report --json is not JSON"
 expect_in "$work/out" '"pass": "sensors", "kind": "device side"' "the report labels the device-side step"
 expect_in "$work/out" '"fits_ps_1_1": false' "the report says what does not fit"
 expect_rc 0 "glare on a scene" "$ps11" glare --technique adaptive --scene box --size 64x36 --frames 2 -o "$work/g.png"
@@ -432,6 +453,7 @@ expect_in "$work/out" "tiles shaded/filled/copied/skipped" "glare prints the til
 cmp -s "$work/r_0002.png" "$work/r_reused.png" || fail "glare: the reused frame differs from the --no-skip one"
 expect_rc 0 "glare --json says reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 2 --json -o "$work/r.png"
 expect_in "$work/out" '"reused": true' "glare --json reused"
+expect_json "$work/out" "glare --json"
 expect_rc 0 "glare --graph without -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p.dot"
 expect_in "$work/p.dot" 'digraph "pyramid"' "glare --graph writes Graphviz"
 expect_rc 0 "glare --json" "$ps11" glare --technique glow --scene neon --size 64x36 --set path=ffp -o "$work/f.png" --json
@@ -482,6 +504,7 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 2 "glare --compare with --backend" "$ps11" glare --technique pyramid --scene sky --compare --backend gl
     expect_rc 0 "glare --compare --json" "$ps11" glare --technique sprites --scene lights --size 64x36 --compare --json
     expect_in "$work/out" '"pass": "draw_sprites", "pixels": 2304, "exact": 2304, "over_one": 0' "glare --compare --json per pass"
+    expect_json "$work/out" "glare --compare --json"
     # The GL renderer's two modes (docs/gl-backend.md "Modes").
     expect_rc 0 "info lists the GL modes" "$ps11" info
     expect_in "$work/out" "GL renderer modes: exact" "info names the exact mode"
@@ -493,7 +516,12 @@ if ! grep -q "PS11_GL=OFF" <("$ps11" info 2>&1); then
     expect_rc 0 "glare --gl-mode native" "$ps11" glare --technique glow --scene neon --size 64x36 --backend gl --gl-mode native -o "$work/gn.png"
     expect_in "$work/out" "gl-native renderer" "glare names the native renderer"
     expect_rc 0 "glare --compare --gl-mode native" "$ps11" glare --technique quarter --scene neon --size 64x36 --compare --gl-mode native --json
-    expect_in "$work/out" '"gl_mode": "native", "end_to_end": {"vs_card": {"max_levels": ' "glare native distances in JSON"
+    python3 - "$work/out" <<'PY' || fail "glare native distances in JSON: $(head -c 400 "$work/out")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["gl_mode"] == "native"
+assert all(k in j["end_to_end"][ref] for ref in ("vs_card", "vs_ideal") for k in ("max_levels", "mean_levels", "over_one_pct"))
+PY
     expect_rc 2 "glare --gl-mode without gl" "$ps11" glare --technique glow --scene neon --gl-mode native -o "$work/x.png"
     expect_in "$work/err" "--gl-mode needs --backend gl or --compare" "glare says what --gl-mode needs"
     expect_rc 2 "glare --gl-mode bad" "$ps11" glare --technique glow --scene neon --backend gl --gl-mode fast -o "$work/x.png"
