@@ -40,6 +40,7 @@ struct StressItem {
 struct StressOptions {
     const ps11::HardwareClass* hardware = nullptr;  // null: the default 1.1-class card
     uint32_t size = 256;                            // the side of the §6 metric images (and the blur's scene)
+    int adaptationFrames = 10000;                   // the long adaptation run of the robustness checks
 };
 
 // The options of a Runner on the suite's card, w x h, skipping off (every pass runs).

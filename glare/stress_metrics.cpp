@@ -294,7 +294,7 @@ bool stressRobustness(const StressOptions& o, std::vector<RobustnessCheck>& chec
         }
     }
     RobustnessCheck longRun;
-    if (!stressLongAdaptation(o, 10000, longRun, error)) return false;
+    if (!stressLongAdaptation(o, o.adaptationFrames, longRun, error)) return false;
     checks.push_back(longRun);
     return true;
 }

@@ -354,7 +354,8 @@ std::string stressValue(const glare::StressValue& v) {
     return s.empty() ? "—" : s;
 }
 
-std::string stressSection(const glare::StressReport& r, uint32_t size) {
+std::string stressSection(const glare::StressReport& r, const glare::StressOptions& o) {
+    const uint32_t size = o.size;
     std::string s = "<section id=\"stress\"><h2>Numerical stability</h2>\n<p><code>ps11 stress</code> on <code>" +
                     htmlEscape(r.hardware) +
                     "</code>: each 8-bit pitfall of GLARE.md §7 computed from its formula, measured on the card's real "
@@ -404,7 +405,8 @@ std::string stressSection(const glare::StressReport& r, uint32_t size) {
         pass += k.pass;
         if (!k.pass) failed += "<li>" + htmlEscape(k.name + ": " + k.detail) + "</li>";
     }
-    s += "</table>\n<p>Robustness (NaN, ±Inf and 10⁶ inputs in every technique; 10 000 frames of adaptation): " +
+    s += "</table>\n<p>Robustness (NaN, ±Inf and 10⁶ inputs in every technique; " + std::to_string(o.adaptationFrames) +
+         " frames of adaptation): " +
          std::to_string(pass) + " of " + std::to_string(r.robustness.size()) + " checks pass.</p>" +
          (failed.empty() ? "" : "<ul class=\"bad\">" + failed + "</ul>") + "</section>\n";
     return s;
@@ -526,6 +528,7 @@ int writeDemoReport(const DemoReportOptions& o) {
     glare::StressOptions so;
     so.hardware = c.cls;
     so.size = o.quick ? 64 : 128;
+    so.adaptationFrames = o.quick ? 1000 : 10000;
     glare::StressReport stress;
     if (!glare::runStress(so, stress, c.error)) return fail("stress");
 
@@ -549,7 +552,7 @@ int writeDemoReport(const DemoReportOptions& o) {
     html += fitsSection(fits);
     html += agreementSection(c, shows);
     html += benchSection(c, rows, spec);
-    html += stressSection(stress, so.size);
+    html += stressSection(stress, so);
     html += debugSection(debug, debugCommand);
     html += "<footer><p>Written in " + fmt("%.1f", c.progress.seconds()) + " s.</p></footer></body></html>\n";
     if (!cli::writeFile(c.dir + "/index.html", html)) return cli::kUserError;
