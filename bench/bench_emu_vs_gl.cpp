@@ -27,7 +27,7 @@
 #include "emu/device.h"
 #include "emu/fullscreen.h"
 #include "emu/gl/gl_renderer.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace {
 
@@ -126,7 +126,7 @@ void Scene::setup(Pass pass, Kind kind) {
         setenv("LP_NUM_THREADS", "2", 0);
         std::string why;
         const char* glKind = std::getenv("PS11_GL");  // "egl" for a GPU driver
-        o.renderer = ps11::glRendererFactory(glKind ? glKind : "osmesa", why, kind == Kind::GlNative);
+        o.renderer = ps11test::glRendererFactory(glKind ? glKind : "osmesa", why, kind == Kind::GlNative);
         if (!o.renderer) {
             error = why;
             if (glError.empty()) glError = error;
@@ -204,7 +204,7 @@ struct PassScenes {
 
 // Both devices of a pass, made on first use and compared once. Never destroyed: at exit,
 // libOSMesa's own state may be gone before a static destructor would release a context
-// (tools/gl_backend.cpp).
+// (runner/gl_backend.cpp).
 PassScenes& scenes(Pass pass) {
     static PassScenes* all = new PassScenes[kPasses];
     PassScenes& p = all[int(pass)];
@@ -262,7 +262,7 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
     state.counters["uploads"] = double(after.uploads - before.uploads) / n;
     state.counters["readbacks"] = double(after.readBacks - before.readBacks) / n;
     if (kind == Kind::GlNative) state.counters["native_max_diff"] = ps.nativeMaxDiff;
-    state.SetLabel(isGl(kind) ? ps11::glRendererDescription() : "software, 2 threads");
+    state.SetLabel(isGl(kind) ? ps11test::glRendererDescription() : "software, 2 threads");
 }
 
 }  // namespace

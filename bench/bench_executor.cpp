@@ -22,6 +22,7 @@
 #include "ps11/sampler.h"
 #include "ps11/simd_dispatch.h"
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 #include "ps11/validator.h"

@@ -27,7 +27,7 @@
 #include "glare/compare.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace {
 
@@ -55,7 +55,7 @@ std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip
     if (mode == GlNative || mode == GlExact) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe reads it when its screen is made
         const char* kind = std::getenv("PS11_GL");
-        ro.device.renderer = ps11::glRendererFactory(kind ? kind : "osmesa", err, mode == GlNative);
+        ro.device.renderer = ps11test::glRendererFactory(kind ? kind : "osmesa", err, mode == GlNative);
         if (!ro.device.renderer) return nullptr;
     }
     return std::make_unique<glare::Runner>(ro);
@@ -286,7 +286,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["fx8_vs_ideal_mean"] = fx8VsIdeal.mean;
     state.counters["native_vs_fx8_max"] = nativeVsFx8.max;
     state.counters["native_vs_fx8_mean"] = nativeVsFx8.mean;
-    state.SetLabel(ps11::glRendererDescription());
+    state.SetLabel(ps11test::glRendererDescription());
     std::fprintf(stderr, "%s, per pass (median ms): %-22s %9s %9s %9s %9s %9s\n", name.c_str(), "pass", kModeNames[0],
                  kModeNames[1], kModeNames[2], kModeNames[3], kModeNames[4]);
     for (const std::string& p : passOrder) {

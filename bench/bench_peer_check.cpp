@@ -9,7 +9,7 @@
 //    `hand_sync_ms` is the same frame with a glFinish after every pass (as the pass graph
 //    times the native side), which also gives the hand version's per-pass times.
 //  - BM_AdaptiveNative's side: the same frame through the project: a glare::Runner whose device
-//    renderer is the GL renderer in native mode (tools/gl_backend.h); time =
+//    renderer is the GL renderer in native mode (runner/gl_backend.h); time =
 //    FrameResult::milliseconds (each pass ends with the renderer finished).
 // Both benchmarks run one frame of each side per iteration (order alternating); they differ only
 // in which side's time is the benchmark's own. Counters: the medians, native/hand ratios, and
@@ -34,7 +34,7 @@
 #include "emu/gl/shader_program.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace {
 
@@ -370,7 +370,7 @@ Peers* peers() {
         // Native mode.
         glare::RunnerOptions no;
         no.width = kW, no.height = kH;
-        no.device.renderer = ps11::glRendererFactory(glKind(), err, /*native=*/true);
+        no.device.renderer = ps11test::glRendererFactory(glKind(), err, /*native=*/true);
         if (!no.device.renderer) return q;
         q->native = std::make_unique<glare::Runner>(no);
         if (!q->native->setImage(*img, err)) return q;
@@ -413,7 +413,7 @@ Peers* peers() {
             if (!q->native->runFrame(*q->technique, s, f, f + 1, r, err)) return q;
             q->hand.frame(true, false);
         }
-        q->label = ps11::glRendererDescription();
+        q->label = ps11test::glRendererDescription();
         return q;
     }();
     return p;

@@ -1,6 +1,6 @@
 // Benchmarks of the software sampler (Google Benchmark; never run by ctest): ns per lookup of
 // the fast Unorm8 kernels against the reference path of TextureSampler, and the cost of handing
-// a 1080p A8R8G8B8 texture to the sampler through the old .ps11test model (textureFromDesc)
+// a 1080p A8R8G8B8 texture to the sampler through the old .ps11test model (textureFromDesc, ps11/testfile_textures.h)
 // against Texture::fromLevels. A and B run interleaved inside every iteration (A B A B ...), each
 // timed on its own, so the reported ratio is taken under the same machine load; read the medians
 // of repetitions. Times are this thread's CPU time. How to run: bench/README.md.
@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 #include "ps11/simd_dispatch.h"

@@ -275,7 +275,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
     if (kills || wantZ || merge.fog || !target.color || executor.writesDepth()) return false;
     FloatRowDraw d;
-    if (!executor.plainTaps(d.plan)) return false;
+    if (!ps11::plainTaps(executor, d.plan)) return false;
     static std::atomic<uint64_t> serials{0};
     d.serial = ++serials;
     d.executor = &executor;

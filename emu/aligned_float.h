@@ -18,6 +18,7 @@
 #include "emu/output_merger.h"
 #include "emu/raster.h"
 #include "ps11/executor.h"
+#include "ps11/executor_presampled_internal.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 

@@ -290,7 +290,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
     if (precision != ps11::Precision::Fx8 || wantZ || merge.fog || !target.color) return false;
     AlignedDraw d;
-    if (!executor.tapPlan(d.plan)) return false;
+    if (!ps11::tapPlan(executor, d.plan)) return false;
     static std::atomic<uint64_t> serials{0};
     d.serial = ++serials;
     d.executor = &executor;
@@ -538,7 +538,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         const std::array<TapRow, 8>* rows;
         int x;
     } ctx{&draw, nullptr, &rows, 0};
-    const ps11::Executor::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
+    const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
                   count, dst);
@@ -623,7 +623,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
-                        exec.runPresampled(in, fill, &ctx, r0, &stats.exec);
+                        ps11::runPresampled(exec, in, fill, &ctx, r0, &stats.exec);
                     } else if (mode == RowMode::Copy) {
                         if (draw.directStore && copyTexels(draw, tri, rows, *window, x, n, orMask,
                                                            target.texel(uint32_t(x), uint32_t(y)))) {

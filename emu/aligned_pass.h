@@ -1,7 +1,7 @@
 // The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): triangles whose
 // texture coordinates are screen-aligned (u depends on x only, v on y only, no perspective) in
-// fx8, with a program whose texture reads are plain (ps11::Executor::tapPlan), are drawn row by
-// row without quads or per-lane coordinates: each tap's texel columns and weights are tabulated
+// fx8, with a program whose texture reads are plain (ps11::tapPlan,
+// ps11/executor_presampled_internal.h), are drawn row by row without quads or per-lane coordinates: each tap's texel columns and weights are tabulated
 // once per triangle and its rows once per pixel row, texels are filtered into int16 lanes (runs
 // with a fixed weight and step through shared, cached H rows), the executor runs pre-sampled, and 8-bit
 // targets take plain and additive stores directly. Results are bit-identical to the quad path.
@@ -15,6 +15,7 @@
 #include "emu/output_merger.h"
 #include "emu/raster.h"
 #include "ps11/executor.h"
+#include "ps11/executor_presampled_internal.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 

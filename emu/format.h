@@ -9,7 +9,6 @@
 #include "emu/d3d9types.h"
 #include "ps11/formats.h"
 #include "ps11/hardware.h"
-#include "ps11/testfile.h"
 #include "ps11/texture.h"
 
 namespace emu {

@@ -8,7 +8,6 @@
 #include <cstring>
 
 #include "ps11/precision.h"
-#include "ps11/testfile.h"
 
 namespace emu {
 

@@ -26,7 +26,7 @@
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
 #include "emu/device.h"
-#include "tools/test_draw.h"
+#include "runner/test_draw.h"
 
 namespace {
 
@@ -38,7 +38,7 @@ bool samePixels(const std::vector<ps11::Vec4>& a, const std::vector<ps11::Vec4>&
     return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0);
 }
 
-std::vector<ps11::Vec4> pixels(ps11::DrawRunner& r) {
+std::vector<ps11::Vec4> pixels(ps11test::DrawRunner& r) {
     std::vector<ps11::Vec4> out;
     std::string error;
     check(r.targetPixels(out, error));
@@ -46,7 +46,7 @@ std::vector<ps11::Vec4> pixels(ps11::DrawRunner& r) {
 }
 
 // The fingerprint of one command run as a dry run on `r`'s device.
-emu::Device::Fingerprint dryRun(ps11::DrawRunner& r, const ps11::TestCommand& cmd) {
+emu::Device::Fingerprint dryRun(ps11test::DrawRunner& r, const ps11::TestCommand& cmd) {
     r.device().beginFingerprint();
     std::string error;
     (void)r.draw(cmd, error);
@@ -86,18 +86,18 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::string error;
         const ps11::HardwareConfig hw = ps11::resolveHardware(file.require.hardware.value, program ? program->version.minor : 1,
                                                               p, file.require.maxValue.value);
-        auto runner = ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, error);
+        auto runner = ps11test::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, error);
         if (!runner) {
             check(!error.empty());
             continue;
         }
         std::string quadError;
-        std::unique_ptr<ps11::DrawRunner> quads =
-            ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
+        std::unique_ptr<ps11test::DrawRunner> quads =
+            ps11test::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, quadError, false);
         check(quads != nullptr);
         std::string fpError;
-        std::unique_ptr<ps11::DrawRunner> prints =
-            ps11::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, fpError);
+        std::unique_ptr<ps11test::DrawRunner> prints =
+            ps11test::DrawRunner::create(file, "fuzz.ps11test", program ? &*program : nullptr, hw, fpError);
         check(prints != nullptr);
         for (const ps11::TestCommand& cmd : file.commands) {
             if (std::holds_alternative<ps11::Eval>(cmd.op)) continue;

@@ -46,7 +46,7 @@ struct SweepSpec {
     std::vector<SweepHardware> hardware;  // empty: the default class
     bool emu = true, gl = false;          // renderers
     bool glNative = true;                 // the GL renderer's mode (native: the speed peer)
-    // Makes a device's GL renderer (tools/gl_backend.h glRendererFactory); needed when `gl`.
+    // Makes a device's GL renderer (runner/gl_backend.h glRendererFactory); needed when `gl`.
     std::function<std::unique_ptr<emu::Renderer>()> glRenderer;
     // The input: an image (`image`, named `imageName`), else the built-in scene `scene`, else each
     // technique's own scene (Technique::scene), drawn at width x height (frame 0 of its animation).

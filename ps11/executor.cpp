@@ -80,10 +80,11 @@ public:
         steps.clear();
         runGeneric(inputs, sampler, outputs, &steps);
     }
-    bool tapPlan(TapPlan& plan) const override;
-    bool plainTaps(TapPlan& plan) const override;
+    // ps11/executor_presampled_internal.h
+    bool tapPlan(TapPlan& plan) const;
+    bool plainTaps(TapPlan& plan) const;
     void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
-                       ExecutorStats* stats) const override;
+                       ExecutorStats* stats) const;
 
 private:
     void refreshConstant(int i) {
@@ -500,6 +501,20 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
     if (!exec::decodeProgram(program, options, diags, d)) return nullptr;
     return std::make_unique<exec::ExecutorImpl>(options, d.profile, std::move(d.ops), d.defs, d.defMask,
                                                 d.stagesUsed, d.writesDepth, d.vUsed);
+}
+
+// ExecutorImpl is the only Executor (Executor::create makes it).
+bool tapPlan(const Executor& executor, TapPlan& plan) {
+    return static_cast<const exec::ExecutorImpl&>(executor).tapPlan(plan);
+}
+
+bool plainTaps(const Executor& executor, TapPlan& plan) {
+    return static_cast<const exec::ExecutorImpl&>(executor).plainTaps(plan);
+}
+
+void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, void* ctx,
+                   int16_t* const r0[4], ExecutorStats* stats) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, ctx, r0, stats);
 }
 
 }  // namespace ps11

@@ -82,15 +82,6 @@ struct ExecutorStats {
     uint64_t instructions = 0;  // instruction executions (per pixel)
 };
 
-// The texture reads of a program that can take its texels pre-sampled (Executor::tapPlan): tap
-// i is the i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy with
-// no projection and no dependency on other registers.
-struct TapPlan {
-    int count = 0;
-    std::array<uint8_t, 8> stage{};
-    std::array<uint8_t, 8> coordSet{};
-};
-
 // One executed instruction of a traced pixel (Executor::trace).
 struct TraceStep {
     int instruction = -1;  // index in Program::instructions
@@ -130,27 +121,6 @@ public:
     // first pixel (phase excluded) into `steps` (`ps11 debug`).
     virtual void trace(const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs,
                        std::vector<TraceStep>& steps) const = 0;
-
-    // Pre-sampled runs, for callers that sample screen-aligned rows themselves (the device's
-    // aligned-pass path, emu/aligned_pass.h). Available when the program runs on the fx8 fast
-    // path and its only texture instructions are plain reads: `tex t#` in ps_1_1–1_3 on a stage
-    // without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw,
-    // .xy as written). Fills `plan` and returns true, else false.
-    virtual bool tapPlan(TapPlan& plan) const = 0;
-    // The same plan in any profile, without the fx8 fast path: true when every texture
-    // instruction is a plain read as above (the float row path, emu/aligned_float.h, samples
-    // them for run() with a sampler of its own).
-    virtual bool plainTaps(TapPlan& plan) const = 0;
-    // Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from
-    // `fill` instead of a sampler: fill(ctx, i, first, n, dst) writes the fx8 grid integers of
-    // tap i for lanes [first, first + n) into dst[c][0 .. n) (c = r g b a): 8-bit texels, values
-    // in [0, 255] (the executor relies on that, and clamps them to ±round(M·G) when that is
-    // smaller, as it does sampled texels). v0/v1 come from inputs.color. r0[c][lane]
-    // receives r0's grid integers. Same results as run() with a sampler returning those texels.
-    // Only valid after tapPlan() returned true.
-    using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);
-    virtual void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
-                               ExecutorStats* stats = nullptr) const = 0;
 };
 
 }  // namespace ps11

@@ -300,7 +300,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       Executor::TapFill fill, void* ctx, int16_t* const r0[4]) {
+                       TapFill fill, void* ctx, int16_t* const r0[4]) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     ThreadState ts;
     std::unique_ptr<FastRunState>& fs = ts.fs;
@@ -325,7 +325,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase) continue;
             if (op.texture) {
-                // A plain read (Executor::tapPlan): the caller's texels, clamped to ±M as sampleInto does
+                // A plain read (tapPlan): the caller's texels, clamped to ±M as sampleInto does
                 // (a no-op for 8-bit texels when M >= 1).
                 int16_t* const dst[4] = {bank.reg[op.dstSlot][0], bank.reg[op.dstSlot][1], bank.reg[op.dstSlot][2],
                                          bank.reg[op.dstSlot][3]};

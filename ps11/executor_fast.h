@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "ps11/executor_internal.h"
+#include "ps11/executor_presampled_internal.h"
 #include "ps11/simd_dispatch.h"
 
 namespace ps11::exec {
@@ -116,13 +117,13 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram
 void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops, uint8_t vUsed,
              bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
-// Executor::runPresampled on the fast path (the kernels of simdLevel()): texture instructions (plain reads, Executor::tapPlan)
-// have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
+// runPresampled (ps11/executor_presampled_internal.h) on the fast path (the kernels of
+// simdLevel()): texture instructions (plain reads, tapPlan) have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
 // sampled texels are) instead of sampling; r0's int16 lanes are the output.
 // `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       Executor::TapFill fill, void* ctx, int16_t* const r0[4]);
+                       TapFill fill, void* ctx, int16_t* const r0[4]);
 
 // fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
 // 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.

@@ -1,7 +1,8 @@
-// Software textures: decoding .ps11test texel words and float tuples into per-channel storage,
+// Software textures: decoding texel words and float tuples into per-channel storage,
 // mip chain generation (2x2 / 2x2x2 box, rounded half-even in the stored representation) and
 // the per-profile grid values the sampler reads (docs/textures.md, docs/precision.md "Inputs").
 #include "ps11/texture.h"
+#include "ps11/texture_internal.h"
 
 #include <algorithm>
 #include <bit>
@@ -78,10 +79,10 @@ std::array<int32_t, 4> decodeSigned(const FormatRow& row, uint32_t w) {
     return out;
 }
 
-// Float texels of the .ps11test model (components not written are 0 0 0 1, testfile.h): the
-// channels the format has, half-rounded where it stores halves; the others 1.
-Vec4 decodeFloat(const FormatRow& row, const Texel& t) {
-    Vec4 v = t.value;
+// Float texel values (channels not given are 0 0 0 1): the channels the format has,
+// half-rounded where it stores halves; the others 1 (Zero channels 0).
+std::array<float, 4> decodeFloat(const FormatRow& row, const std::array<float, 4>& value) {
+    std::array<float, 4> v = value;
     for (size_t c = 0; c < 4; ++c) {
         const ChannelKind k = row.rgba[c].kind;
         v[c] = k == ChannelKind::Half    ? roundToHalf(v[c])
@@ -175,9 +176,9 @@ size_t Texture::texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const 
     return l.offset + (size_t(z) * l.height + y) * l.width + x;
 }
 
-Vec4 Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
+std::array<float, 4> Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
     size_t i = texelIndex(level, x, y, z) * 4;
-    Vec4 v;
+    std::array<float, 4> v;
     for (size_t c = 0; c < 4; ++c)
         v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[unorm8()[i + size_t(kUnorm8Byte[c])]] : values()[i + c];
     return v;
@@ -260,10 +261,10 @@ const int32_t* Texture::grid(Precision p) const {
     return out.data();
 }
 
-Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
+std::array<float, 4> signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
     const FormatInfo info = formatInfo(f);
     const std::array<int32_t, 4> raw = decodeSigned(formatRow(f), word);
-    Vec4 v{0, 0, 0, 1};
+    std::array<float, 4> v{0, 0, 0, 1};
     for (size_t c = 0; c < 4; ++c) {
         const SignedValue sv = info.signedBits[c] ? decodeSignedChannel(decode, raw[c], info.signedBits[c])
                                                   : SignedValue{raw[c], info.den[c]};
@@ -272,140 +273,91 @@ Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode) {
     return v;
 }
 
-std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error) {
-    const TexFormat fmt = desc.format.value;
+bool TextureBuilder::start(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth,
+                           uint32_t count, std::string& error) {
     const FormatInfo info = formatInfo(fmt);
-    const FormatRow& row = formatRow(fmt);
-    const bool volume = desc.isVolume();
-    const uint32_t depth = volume ? desc.depth : 1;
-    if (desc.width == 0 || desc.height == 0) {
+    m_row = &formatRow(fmt);
+    m_storage = info.storage;
+    m_floats = info.floats;
+    m_half = info.half;
+    depth = volume ? depth : 1;
+    if (width == 0 || height == 0) {
         error = "texture has no size";
-        return std::nullopt;
+        return false;
     }
-    if (desc.width > kMaxTextureSide || desc.height > kMaxTextureSide || depth > kMaxVolumeSide) {
-        error = "texture size " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
+    if (width > kMaxTextureSide || height > kMaxTextureSide || depth > kMaxVolumeSide) {
+        error = "texture size " + std::to_string(width) + "x" + std::to_string(height) +
                 (volume ? "x" + std::to_string(depth) : "") + " is beyond the limits (" +
                 std::to_string(kMaxTextureSide) + " per side, depth " + std::to_string(kMaxVolumeSide) + ")";
-        return std::nullopt;
+        return false;
     }
-    const uint32_t possible = fullMipCount(desc.width, desc.height, depth);
-    const uint32_t count = desc.levels.value == 0 ? possible : desc.levels.value;
+    const uint32_t possible = fullMipCount(width, height, depth);
+    if (count == 0) count = possible;
     if (count > possible) {
         error = "levels " + std::to_string(count) + " is more than the texture has (" + std::to_string(possible) + ")";
-        return std::nullopt;
+        return false;
     }
-
-    Texture t;
-    if (!t.layout(fmt, volume, desc.width, desc.height, depth, count, error)) return std::nullopt;
-    const size_t total = t.m_texelCount;
-
-    // Which levels the description gives; the others (levels 0) are generated.
-    std::vector<const TextureLevel*> given(count, nullptr);
-    for (const TextureLevel& l : desc.data) {
-        if (l.level >= count) {
-            error = "data for level " + std::to_string(l.level) + " beyond the texture's " + std::to_string(count) +
-                    " levels";
-            return std::nullopt;
-        }
-        const TextureLevelInfo& li = t.m_levels[l.level];
-        size_t n = size_t(li.width) * li.height * li.depth;
-        if (!l.hasFill && l.texels.size() != n) {
-            error = "level " + std::to_string(l.level) + " has " + std::to_string(l.texels.size()) +
-                    " texels, expected " + std::to_string(n);
-            return std::nullopt;
-        }
-        given[l.level] = &l;
-    }
-    if (!given[0]) {
-        error = "texture has no data for level 0";
-        return std::nullopt;
-    }
-    if (desc.levels.value != 0)
-        for (uint32_t k = 1; k < count; ++k)
-            if (!given[k]) {
-                error = "texture has no data for level " + std::to_string(k);
-                return std::nullopt;
-            }
-
-    const int bits = formatBits(fmt);
-    auto checkTexel = [&](const Texel& x) {
-        if (info.floats != (x.count > 0)) {
-            error = std::string("format ") + texFormatName(fmt) +
-                    (info.floats ? " takes float texels" : " takes packed texel words, not floats");
-            return false;
-        }
-        if (!info.floats && bits < 32 && (x.bits >> bits) != 0) {
-            error = "texel word " + std::to_string(x.bits) + " does not fit format " + texFormatName(fmt);
-            return false;
-        }
-        return true;
-    };
-
-    std::vector<int32_t> raw;  // signed formats while building
-    std::vector<float> rawf;   // float formats while building
-    if (info.storage == TexelStorage::Unorm8)
-        t.m_u8.assign(total * 4, 0);
-    else if (info.floats)
-        rawf.assign(total * 4, 0.0f);
+    if (!m_texture.layout(fmt, volume, width, height, depth, count, error)) return false;
+    const size_t total = m_texture.m_texelCount;
+    if (m_storage == TexelStorage::Unorm8)
+        m_texture.m_u8.assign(total * 4, 0);
+    else if (m_floats)
+        m_rawf.assign(total * 4, 0.0f);
     else
-        raw.assign(total * 4, 0);
+        m_raw.assign(total * 4, 0);
+    return true;
+}
 
-    auto store = [&](size_t index, const Texel& x) {
-        if (info.storage == TexelStorage::Unorm8) {
-            std::array<uint8_t, 4> b = decodeUnorm8(row, x.bits);
-            std::copy(b.begin(), b.end(), t.m_u8.begin() + ptrdiff_t(index * 4));
-        } else if (info.floats) {
-            Vec4 v = decodeFloat(row, x);
-            std::copy(v.begin(), v.end(), rawf.begin() + ptrdiff_t(index * 4));
-        } else {
-            std::array<int32_t, 4> r = decodeSigned(row, x.bits);
-            std::copy(r.begin(), r.end(), raw.begin() + ptrdiff_t(index * 4));
-        }
-    };
+uint32_t TextureBuilder::levelCount() const { return uint32_t(m_texture.m_levels.size()); }
 
-    for (uint32_t k = 0; k < count; ++k) {
-        const TextureLevelInfo& li = t.m_levels[k];
-        size_t n = size_t(li.width) * li.height * li.depth;
-        if (given[k]) {
-            const TextureLevel& l = *given[k];
-            if (l.hasFill) {
-                if (!checkTexel(l.fill)) return std::nullopt;
-                for (size_t i = 0; i < n; ++i) store(li.offset + i, l.fill);
-            } else {
-                for (size_t i = 0; i < n; ++i) {
-                    if (!checkTexel(l.texels[i])) return std::nullopt;
-                    store(li.offset + i, l.texels[i]);
-                }
-            }
-            continue;
-        }
-        // Generated level: box filter of the previous one, rounded half-even in the stored form.
-        const TextureLevelInfo& src = t.m_levels[k - 1];
-        if (info.storage == TexelStorage::Unorm8) {
-            boxDown(t.m_u8, src, li, volume, [](const std::vector<uint8_t>& d, const size_t* taps, int m, int c) {
-                int64_t s = 0;
-                for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
-                return uint8_t(roundHalfEven(s, m));
-            });
-        } else if (info.floats) {
-            bool half = info.half;
-            boxDown(rawf, src, li, volume, [half](const std::vector<float>& d, const size_t* taps, int m, int c) {
-                double s = 0;
-                for (int i = 0; i < m; ++i) s += double(d[taps[i] * 4 + size_t(c)]);
-                float v = float(s / m);
-                return half ? roundToHalf(v) : v;
-            });
-        } else {
-            boxDown(raw, src, li, volume, [](const std::vector<int32_t>& d, const size_t* taps, int m, int c) {
-                int64_t s = 0;
-                for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
-                return int32_t(roundHalfEven(s, m));
-            });
-        }
+const TextureLevelInfo& TextureBuilder::level(uint32_t k) const { return m_texture.m_levels[k]; }
+
+void TextureBuilder::storeWord(size_t index, uint32_t word) {
+    if (m_storage == TexelStorage::Unorm8) {
+        const std::array<uint8_t, 4> b = decodeUnorm8(*m_row, word);
+        std::copy(b.begin(), b.end(), m_texture.m_u8.begin() + ptrdiff_t(index * 4));
+    } else if (!m_floats) {
+        const std::array<int32_t, 4> r = decodeSigned(*m_row, word);
+        std::copy(r.begin(), r.end(), m_raw.begin() + ptrdiff_t(index * 4));
     }
+}
 
-    if (info.storage == TexelStorage::Decoded) t.finishDecoded(raw, std::move(rawf), decode);
-    return t;
+void TextureBuilder::storeFloats(size_t index, const std::array<float, 4>& value) {
+    if (!m_floats) return;
+    const std::array<float, 4> v = decodeFloat(*m_row, value);
+    std::copy(v.begin(), v.end(), m_rawf.begin() + ptrdiff_t(index * 4));
+}
+
+void TextureBuilder::generateLevel(uint32_t k) {
+    const TextureLevelInfo& src = m_texture.m_levels[k - 1];
+    const TextureLevelInfo& li = m_texture.m_levels[k];
+    const bool volume = m_texture.m_volume;
+    if (m_storage == TexelStorage::Unorm8) {
+        boxDown(m_texture.m_u8, src, li, volume, [](const std::vector<uint8_t>& d, const size_t* taps, int m, int c) {
+            int64_t s = 0;
+            for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
+            return uint8_t(roundHalfEven(s, m));
+        });
+    } else if (m_floats) {
+        const bool half = m_half;
+        boxDown(m_rawf, src, li, volume, [half](const std::vector<float>& d, const size_t* taps, int m, int c) {
+            double s = 0;
+            for (int i = 0; i < m; ++i) s += double(d[taps[i] * 4 + size_t(c)]);
+            float v = float(s / m);
+            return half ? roundToHalf(v) : v;
+        });
+    } else {
+        boxDown(m_raw, src, li, volume, [](const std::vector<int32_t>& d, const size_t* taps, int m, int c) {
+            int64_t s = 0;
+            for (int i = 0; i < m; ++i) s += d[taps[i] * 4 + size_t(c)];
+            return int32_t(roundHalfEven(s, m));
+        });
+    }
+}
+
+Texture TextureBuilder::finish(SignedDecode decode) {
+    if (m_storage == TexelStorage::Decoded) m_texture.finishDecoded(m_raw, std::move(m_rawf), decode);
+    return std::move(m_texture);
 }
 
 uint32_t bytesPerTexel(TexFormat f) { return formatRow(f).bytes; }

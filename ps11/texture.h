@@ -1,8 +1,9 @@
 // Software textures (docs/textures.md): a format, 2D or volume, a mip chain, and the texels
 // decoded per channel so that every precision profile reads exact values (8-bit channels as
-// bytes, signed and float formats as per-profile grid integers and float32). Built from the
-// .ps11test model by textureFromDesc() or from levels in D3D's memory layout by
-// Texture::fromLevels() (the device's hand-over, which samples A8R8G8B8 levels where they are);
+// bytes, signed and float formats as per-profile grid integers and float32). Built from levels in
+// D3D's memory layout by Texture::fromLevels() (the device's hand-over, which samples A8R8G8B8
+// levels where they are), or texel by texel by the library's TextureBuilder
+// (ps11/texture_internal.h; the .ps11test model's textureFromDesc, ps11/testfile_textures.h);
 // immutable afterwards, shared by samplers.
 #pragma once
 
@@ -19,11 +20,11 @@
 #include "ps11/formats.h"
 #include "ps11/hardware.h"
 #include "ps11/precision.h"
-#include "ps11/testfile.h"
 
 namespace ps11 {
 
-struct TexelTiles;  // ps11/texture_tiles.h
+struct TexelTiles;      // ps11/texture_tiles.h
+class TextureBuilder;  // ps11/texture_internal.h
 
 // Grid values of float texels are clamped to +-kMaxTexelGrid (about +-4112 in fx8, far beyond any
 // MaxValue) so that the exact integer sums of the sampler cannot overflow.
@@ -70,7 +71,7 @@ public:
     size_t texelCount() const { return m_texelCount; }
 
     // The decoded value of one texel (float profiles): r g b a.
-    Vec4 texelValue(int level, uint32_t x, uint32_t y, uint32_t z = 0) const;
+    std::array<float, 4> texelValue(int level, uint32_t x, uint32_t y, uint32_t z = 0) const;
     // The grid value of one texel in a fixed-point profile (value = grid / G).
     std::array<int32_t, 4> texelGrid(int level, uint32_t x, uint32_t y, uint32_t z, Precision p) const;
 
@@ -87,7 +88,7 @@ public:
     // Builds a texture from every level of a mip chain in D3D's memory layout (the device's
     // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
     // (level k has the extents of level 0 halved k times). The result reads as the one
-    // textureFromDesc gives for the same texels.
+    // TextureBuilder (the .ps11test model's textureFromDesc) gives for the same texels.
     // A8R8G8B8 and A32B32G32R32F levels laid out exactly as the texture keeps them (one buffer,
     // rows of width * 4 bytes or width * 4 floats, level after level with no gap) are not copied
     // when `owner` is given: the texture
@@ -109,7 +110,7 @@ public:
     void keepTexelTiles(std::shared_ptr<const TexelTiles> tiles) const;
 
 private:
-    friend std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
+    friend class TextureBuilder;
     size_t texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const;
     // Sets format and level extents; false (with `error`) beyond kMaxResourceBytes.
     bool layout(TexFormat fmt, bool volume, uint32_t width, uint32_t height, uint32_t depth, uint32_t count,
@@ -139,15 +140,9 @@ private:
     std::shared_ptr<TileCache> m_tileCache = std::make_shared<TileCache>();
 };
 
-// Builds a texture from a parsed [texture N] section: texel words in the format's natural
-// packing (docs/test-format.md) or float tuples, `fill`, and `levels 0` (generate the whole chain
-// from level 0). On failure returns nullopt and sets `error`; never allocates more than
-// kMaxResourceBytes. Signed channels decode as `decode` says (the hardware class's rule).
-std::optional<Texture> textureFromDesc(const TextureDesc& desc, SignedDecode decode, std::string& error);
-
 // The value of one texel word of a signed (bump) format (V8U8, L6V5U5, X8L8V8U8, Q8W8V8U8,
 // V16U16) as the sampler reads it, r g b a, under `decode`.
-Vec4 signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode);
+std::array<float, 4> signedTexelValue(TexFormat f, uint32_t word, SignedDecode decode);
 
 // Number of levels of a full chain (down to 1x1x1).
 uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);

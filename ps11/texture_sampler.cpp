@@ -261,18 +261,6 @@ alignas(64) const float kZeros[kMaxSpan] = {};
 
 }  // namespace
 
-SamplerState samplerStateFromDesc(const SamplerDesc& desc) {
-    SamplerState s;
-    s.minFilter = desc.minFilter.value;
-    s.magFilter = desc.magFilter.value;
-    s.mipFilter = desc.mipFilter.value;
-    s.addressU = desc.addressU.value;
-    s.addressV = desc.addressV.value;
-    s.addressW = desc.addressW.value;
-    s.border = desc.border.value.rgba;
-    return s;
-}
-
 TextureSampler::TextureSampler(bool fastPath) : m_fastPath(fastPath) {
     for (int i = 0; i < kMaxSamplerStages; ++i) setSamplerState(i, SamplerState{});
 }

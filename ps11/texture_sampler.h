@@ -11,7 +11,6 @@
 
 #include "ps11/caps.h"
 #include "ps11/sampler.h"
-#include "ps11/testfile.h"
 #include "ps11/texture.h"
 
 namespace ps11 {
@@ -28,11 +27,8 @@ struct SamplerState {
     TextureAddress addressU = TextureAddress::Wrap;
     TextureAddress addressV = TextureAddress::Wrap;
     TextureAddress addressW = TextureAddress::Wrap;
-    Vec4 border{0, 0, 0, 0};  // r g b a
+    std::array<float, 4> border{0, 0, 0, 0};  // r g b a
 };
-
-// The state a [sampler N] section describes (D3D9 defaults where it is silent).
-SamplerState samplerStateFromDesc(const SamplerDesc& desc);
 
 class TextureSampler final : public Sampler {
 public:

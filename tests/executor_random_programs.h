@@ -18,7 +18,7 @@
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
 
-namespace ps11test {
+namespace execrand {
 
 // ---------------------------------------------------------------- program model
 enum Op { MOV, ADD, SUB, MUL, MAD, DP3, DP4, LRP, CND, CMP, NOPS };
@@ -328,4 +328,4 @@ inline std::optional<ps11::Program> assemble(const std::string& text, std::strin
     return prog;
 }
 
-}  // namespace ps11test
+}  // namespace execrand

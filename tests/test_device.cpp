@@ -19,6 +19,7 @@
 #include "ps11/assembler.h"
 #include "ps11/encoder.h"
 #include "ps11/executor.h"
+#include "ps11/testfile.h"
 #include "ps11/texture_sampler.h"
 
 using namespace emu;

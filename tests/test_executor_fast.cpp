@@ -22,6 +22,7 @@
 #include "ps11/executor.h"
 #include "ps11/executor_fast.h"
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture_sampler.h"
 #include "ps11/validator.h"
 
@@ -361,7 +362,7 @@ TEST_CASE("fast: every op over all operand pairs, each modifier, shift and _sat 
 }
 
 TEST_CASE("fast: random valid programs over spans of 1..256 pixels equal the generic path", "[fast]") {
-    using namespace ps11test;
+    using namespace execrand;
     ps11::NullSampler sampler;
     struct Run {
         uint32_t seed;

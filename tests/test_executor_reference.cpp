@@ -66,7 +66,7 @@ float fsubv(float a, float b) {
     return r;
 }
 
-using namespace ps11test;
+using namespace execrand;
 
 // ---------------------------------------------------------------- fx reference
 struct FxRef {

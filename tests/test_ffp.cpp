@@ -15,6 +15,7 @@
 #include "emu/ffp.h"
 #include "ps11/disassembler.h"
 #include "ps11/executor.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture_sampler.h"
 
 namespace {

@@ -1,6 +1,6 @@
 // The GL renderer against the software renderer under the same device front: overlapping
 // blended and depth-tested triangles (the batches and texture barriers of emu/gl/gl_renderer.cpp),
-// every render-target and depth format, random valid programs (tools/random_program.h), and a
+// every render-target and depth format, random valid programs (runner/random_program.h), and a
 // draw after a state block was applied (Device::applyState), each compared byte for byte
 // (docs/gl-backend.md).
 #include <catch2/catch.hpp>
@@ -13,20 +13,20 @@
 #include "emu/device.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
-#include "tools/gl_backend.h"
-#include "tools/random_program.h"
-#include "tools/test_draw.h"
+#include "runner/gl_backend.h"
+#include "runner/random_program.h"
+#include "runner/test_draw.h"
 
 using namespace emu;
 
 namespace {
 
-// A device's handle on the process's GL renderer (tools/gl_backend.h: one context for every
+// A device's handle on the process's GL renderer (runner/gl_backend.h: one context for every
 // device, as the command line has; a context per device would also leave llvmpipe's per-context
 // allocations behind on every destruction). The test fails (CI installs OpenGL) without one.
 std::unique_ptr<Renderer> glRenderer() {
     std::string error;
-    const ps11::RendererFactory factory = ps11::glRendererFactory("", error);
+    const ps11test::RendererFactory factory = ps11test::glRendererFactory("", error);
     INFO(error);
     REQUIRE(factory);
     return factory();
@@ -130,12 +130,12 @@ TEST_CASE("gl renderer: overlapping blended, masked, depth-tested triangles equa
 
 TEST_CASE("gl renderer: random valid programs draw the emulator's images bit for bit", "[gl]") {
     std::string error;
-    const ps11::RendererFactory factory = glRenderer;
+    const ps11test::RendererFactory factory = glRenderer;
     int compared = 0;
     for (uint64_t seed = 1; seed <= 60; ++seed) {
         std::mt19937_64 rng(seed);
-        ps11tools::RandomCaseOptions ro;
-        const ps11tools::RandomCase c = ps11tools::randomCase(rng, ro);
+        ps11test::RandomCaseOptions ro;
+        const ps11test::RandomCase c = ps11test::randomCase(rng, ro);
         ps11::TestFile file;
         std::vector<ps11::TestFileError> errors;
         REQUIRE(ps11::parseTestFile(c.testText, "random", file, errors));
@@ -146,8 +146,8 @@ TEST_CASE("gl renderer: random valid programs draw the emulator's images bit for
         ps11::validate(*program, diags);
         REQUIRE_FALSE(diags.hasErrors());
         const ps11::HardwareConfig hw = ps11::resolveHardware(nullptr, program->version.minor, std::nullopt, 0);
-        auto emu = ps11::DrawRunner::create(file, "random", &*program, hw, error);
-        auto glr = ps11::DrawRunner::create(file, "random", &*program, hw, error, true, factory);
+        auto emu = ps11test::DrawRunner::create(file, "random", &*program, hw, error);
+        auto glr = ps11test::DrawRunner::create(file, "random", &*program, hw, error, true, factory);
         REQUIRE(emu);
         REQUIRE(glr);
         for (const ps11::TestCommand& cmd : file.commands) {

@@ -13,7 +13,7 @@
 #include "emu/fullscreen.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 using namespace emu;
 
@@ -22,7 +22,7 @@ namespace {
 DeviceOptions glOptions(bool native, std::optional<ps11::Precision> precision = std::nullopt) {
     std::string error;
     DeviceOptions o;
-    o.renderer = ps11::glRendererFactory("", error, native);
+    o.renderer = ps11test::glRendererFactory("", error, native);
     INFO(error);
     REQUIRE(o.renderer);
     o.precision = precision;

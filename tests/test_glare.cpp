@@ -21,7 +21,7 @@
 #include "glare/stress.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 using namespace glare;
 
@@ -444,7 +444,7 @@ TEST_CASE("pass graph: a transient texture read before any live pass wrote it is
 
 TEST_CASE("every technique and preset runs and matches the GL renderer pass by pass", "[glare][gl]") {
     std::string error;
-    const ps11::RendererFactory gl = ps11::glRendererFactory("", error);
+    const ps11test::RendererFactory gl = ps11test::glRendererFactory("", error);
     REQUIRE(gl);
     for (const Technique* t : techniques())
         for (std::string_view presetName : kPresetNames) {
@@ -990,7 +990,7 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
 TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
     std::string error;
     emu::DeviceOptions gl;
-    gl.renderer = ps11::glRendererFactory("", error);
+    gl.renderer = ps11test::glRendererFactory("", error);
     REQUIRE(gl.renderer);
     checkReuse(gl);
 }

@@ -12,7 +12,7 @@
 
 #include "emu/device.h"
 #include "glare/scene.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 using namespace emu;
 
@@ -300,7 +300,7 @@ TEST_CASE("scene sky: a large bright area", "[scene]") {
 
 TEST_CASE("scene: the GL renderer draws the same bytes", "[scene][gl]") {
     std::string error;
-    const ps11::RendererFactory factory = ps11::glRendererFactory("", error);
+    const ps11test::RendererFactory factory = ps11test::glRendererFactory("", error);
     INFO(error);
     REQUIRE(factory);
     for (const glare::SceneInfo& s : glare::sceneList()) {

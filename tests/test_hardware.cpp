@@ -112,7 +112,7 @@ TEST_CASE("hardware: the device decodes signed textures by its class", "[hardwar
         REQUIRE(sampled);
         INFO(c.name);
         CHECK(sampled->signedDecode() == o.hardware->signedDecode);
-        const Vec4 t = sampled->texelValue(0, 0, 0);
+        const std::array<float, 4> t = sampled->texelValue(0, 0, 0);
         CHECK(t[0] == c.u);
         CHECK(t[1] == c.v);
         CHECK(t[2] == 1.0f);

@@ -1,6 +1,6 @@
 // The interval evaluator (ps11/intervals.h, docs/intervals.md) against the executor it bounds.
 // Soundness: random programs (the arithmetic generator of executor_random_programs.h with some
-// coordinate reads turned into texture lookups, the full generator of tools/random_program.h with
+// coordinate reads turned into texture lookups, the full generator of runner/random_program.h with
 // every texture-address instruction, and small templates made to reach the constant and copy
 // claims), random constants, stage states and input ranges, then random inputs inside those
 // ranges (ends, zeros of both signs, NaN and infinities where a range admits them) run through
@@ -18,7 +18,7 @@
 #include "executor_random_programs.h"
 #include "ps11/executor.h"
 #include "ps11/intervals.h"
-#include "tools/random_program.h"
+#include "runner/random_program.h"
 
 using namespace ps11;
 
@@ -376,8 +376,8 @@ void checkProgram(const Program& prog, const std::string& text, Precision prec, 
 
 // The arithmetic generator's programs with some coordinate reads (texcoord, texcrd) turned into
 // lookups of the same stage, so that sampled ranges flow through every arithmetic instruction.
-std::string withLookups(const ps11test::Prog& p, Rng& rng) {
-    std::istringstream lines(ps11test::progText(p));
+std::string withLookups(const execrand::Prog& p, Rng& rng) {
+    std::istringstream lines(execrand::progText(p));
     std::ostringstream out;
     std::string line;
     while (std::getline(lines, line)) {
@@ -433,7 +433,7 @@ TEST_CASE("intervals: every executor output lies in the evaluated bounds (random
     Rng rng(0x1a7e5);
     // The arithmetic generator, with lookups.
     for (int minor = 1; minor <= 4; ++minor) {
-        ps11test::Gen gen(1000u + uint32_t(minor));
+        execrand::Gen gen(1000u + uint32_t(minor));
         int made = 0;
         for (int attempt = 0; attempt < 4000 && made < 70; ++attempt) {
             const std::string text = withLookups(gen.program(minor), rng);
@@ -444,12 +444,12 @@ TEST_CASE("intervals: every executor output lies in the evaluated bounds (random
         }
         CHECK(made == 70);
     }
-    // Every texture-address instruction, bem, texkill, depth (tools/random_program.h).
+    // Every texture-address instruction, bem, texkill, depth (runner/random_program.h).
     std::mt19937_64 caseRng(77);
     for (int i = 0; i < 160; ++i) {
-        ps11tools::RandomCaseOptions options;
+        ps11test::RandomCaseOptions options;
         options.minor = 1 + i % 4;
-        const std::string text = ps11tools::randomCase(caseRng, options).shaderText();
+        const std::string text = ps11test::randomCase(caseRng, options).shaderText();
         const Program prog = mustAssemble(text);
         for (Precision prec : kProfiles) checkProgram(prog, text, prec, rng, tally);
     }

@@ -1,4 +1,4 @@
-// tools/random_program: random ps_1_x cases for differential fuzzing. A seed gives one case;
+// runner/random_program: random ps_1_x cases for differential fuzzing. A seed gives one case;
 // 2000 cases (500 per version) assemble and validate without a diagnostic and cover every
 // instruction of each version with the modifiers, selectors, shifts and pairs the versions have,
 // and their environments every feature the renderers must agree on (texture formats, volumes,
@@ -25,14 +25,14 @@
 #include "ps11/hardware.h"
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
-#include "tools/random_program.h"
-#include "tools/test_draw.h"
+#include "runner/random_program.h"
+#include "runner/test_draw.h"
 
-using namespace ps11tools;
+using namespace ps11test;
 
 namespace {
 
-ps11tools::RandomCase caseOf(uint64_t seed, int minor, int width = 8, int height = 8) {
+ps11test::RandomCase caseOf(uint64_t seed, int minor, int width = 8, int height = 8) {
     std::mt19937_64 rng(seed);
     RandomCaseOptions options;
     options.minor = minor;
@@ -343,8 +343,8 @@ TEST_CASE("random programs: 300 generated files parse and draw on the emu device
         if (req.precision.isSet()) precision = req.precision.value;
         const ps11::HardwareConfig hw = ps11::resolveHardware(req.hardware.value, c.minor, precision, 0);
         std::string error;
-        std::unique_ptr<ps11::DrawRunner> runner =
-            ps11::DrawRunner::create(file, "random.ps11test", &*program, hw, error);
+        std::unique_ptr<ps11test::DrawRunner> runner =
+            ps11test::DrawRunner::create(file, "random.ps11test", &*program, hw, error);
         INFO(error);
         REQUIRE(runner);
         CHECK(runner->draw(file.commands[0], error));

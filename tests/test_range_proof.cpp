@@ -21,7 +21,7 @@
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 #include "ps11/validator.h"
-#include "tools/random_program.h"
+#include "runner/random_program.h"
 
 using namespace ps11;
 
@@ -243,9 +243,9 @@ TEST_CASE("range proof: the bound holds on the corpus and on random programs", "
     CHECK(corpus > 100);
     // Random programs of every version.
     for (int i = 0; i < 300; ++i) {
-        ps11tools::RandomCaseOptions o;
+        ps11test::RandomCaseOptions o;
         o.minor = 1 + i % 4;
-        const ps11tools::RandomCase c = ps11tools::randomCase(rng, o);
+        const ps11test::RandomCase c = ps11test::randomCase(rng, o);
         std::optional<Program> p = assembleOk(c.shaderText());
         if (!p) continue;
         checkBound(*p, "random " + std::to_string(i) + ":\n" + c.shaderText(), rng, tally);

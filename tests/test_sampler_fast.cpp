@@ -18,6 +18,7 @@
 #include "emu/device.h"
 #include "emu/format.h"
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 #include "simd_levels.h"

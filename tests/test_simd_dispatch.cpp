@@ -154,7 +154,7 @@ std::unique_ptr<ps11::Executor> makeFloat(const ps11::Program& program, ps11::Pr
 }  // namespace
 
 TEST_CASE("simd dispatch: float arithmetic gives the same bits at every level (float, ideal)", "[simd][executor]") {
-    using namespace ps11test;
+    using namespace execrand;
     Gen g(0x51d0f10u);
     int valid = 0, generated = 0, compared = 0;
     int64_t bad = 0;

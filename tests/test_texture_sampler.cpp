@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 

@@ -18,7 +18,7 @@
 #include "glare/sweep.h"
 #include "ps11/hardware.h"
 #include "tools/cli_util.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace ps11 {
 
@@ -305,7 +305,7 @@ int cmdBench(const std::vector<std::string>& args) {
     if (spec.gl) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe's threads, as the peer is measured (PERF.md); read when its screen is made
         std::string err;
-        spec.glRenderer = glRendererFactory(glKind, err, spec.glNative);
+        spec.glRenderer = ps11test::glRendererFactory(glKind, err, spec.glNative);
         if (!spec.glRenderer) {
             std::cerr << "ps11 bench: --backend " << backend << ": the GL renderer is not available: " << err << "\n";
             return cli::kUserError;
@@ -327,7 +327,8 @@ int cmdBench(const std::vector<std::string>& args) {
         std::cout << out.dump(1, ' ', false, nlohmann::json::error_handler_t::replace) << "\n";
         return cli::kOk;
     }
-    if (spec.gl && !glRendererDescription().empty()) std::printf("GL renderer: %s\n", glRendererDescription().c_str());
+    if (spec.gl && !ps11test::glRendererDescription().empty())
+        std::printf("GL renderer: %s\n", ps11test::glRendererDescription().c_str());
     printTable(rows, spec);
     return cli::kOk;
 }

@@ -19,9 +19,9 @@
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
-#include "tools/gl_backend.h"
-#include "tools/random_program.h"
-#include "tools/test_draw.h"
+#include "runner/gl_backend.h"
+#include "runner/random_program.h"
+#include "runner/test_draw.h"
 
 namespace ps11 {
 
@@ -113,8 +113,8 @@ DrawDiff diffTargets(const std::vector<Vec4>& a, const std::vector<Vec4>& b, boo
 }
 
 // Runs every draw of a .ps11test on both renderers (probes and evals are not compared).
-void compareText(const std::string& text, const std::string& path, const Options& opts, const RendererFactory& gl,
-                 Report& report) {
+void compareText(const std::string& text, const std::string& path, const Options& opts,
+                 const ps11test::RendererFactory& gl, Report& report) {
     TestFile file;
     std::vector<TestFileError> errors;
     if (!parseTestFile(text, path, file, errors)) {
@@ -138,18 +138,19 @@ void compareText(const std::string& text, const std::string& path, const Options
     if (!precision && req.precision.isSet()) precision = req.precision.value;
     const HardwareConfig hw = resolveHardware(named, minor, precision, req.maxValue.value);
     std::string error;
-    std::unique_ptr<DrawRunner> emu = DrawRunner::create(file, path, program ? &*program : nullptr, hw, error);
+    std::unique_ptr<ps11test::DrawRunner> emu =
+        ps11test::DrawRunner::create(file, path, program ? &*program : nullptr, hw, error);
     if (!emu) {
         report.error = error;
         return;
     }
-    std::unique_ptr<DrawRunner> glr =
-        DrawRunner::create(file, path, program ? &*program : nullptr, hw, error, true, gl);
+    std::unique_ptr<ps11test::DrawRunner> glr =
+        ps11test::DrawRunner::create(file, path, program ? &*program : nullptr, hw, error, true, gl);
     // Native mode: the same draws under `ideal` on the emulator, the other end of the distance.
-    std::unique_ptr<DrawRunner> ideal;
+    std::unique_ptr<ps11test::DrawRunner> ideal;
     if (opts.native) {
         const HardwareConfig ihw = resolveHardware(named, minor, Precision::Ideal, req.maxValue.value);
-        ideal = DrawRunner::create(file, path, program ? &*program : nullptr, ihw, error);
+        ideal = ps11test::DrawRunner::create(file, path, program ? &*program : nullptr, ihw, error);
         if (!ideal) {
             report.error = error;
             return;
@@ -261,11 +262,11 @@ void printReport(const std::string& path, const Report& r, const Options& opts) 
             j["vs_card"] = distance(card);
             j["vs_ideal"] = distance(ideal);
         }
-        j["gl"] = glRendererDescription();
+        j["gl"] = ps11test::glRendererDescription();
         std::cout << json::dump(j) << "\n";
         return;
     }
-    std::cout << "gl: " << glRendererDescription() << "\n";
+    std::cout << "gl: " << ps11test::glRendererDescription() << "\n";
     for (const DrawDiff& d : r.draws)
         std::cout << path << ":" << d.line << ": draw: " << d.pixels << " pixels, " << d.exact << " exact, "
                   << d.overOne << " more than " << (d.values ? "1e-4" : "one level") << " apart, max |d| "
@@ -321,7 +322,7 @@ bool writeHeatmap(const std::string& out, const Report& r) {
 }
 
 // A bare shader as a test file: random textures of the formats its instructions need, random
-// interpolants and constants, one full-target draw (tools/random_program.h).
+// interpolants and constants, one full-target draw (runner/random_program.h).
 std::optional<std::string> shaderCase(const std::string& source, const std::string& path, const Options& opts) {
     Diagnostics diags;
     std::optional<Program> program = parseAssembly(source, path, AssembleOptions{}, diags);
@@ -344,21 +345,21 @@ std::optional<std::string> shaderCase(const std::string& source, const std::stri
         lines.push_back(line);
     }
     std::mt19937_64 rng(opts.seed);
-    ps11tools::RandomCaseOptions ro;
+    ps11test::RandomCaseOptions ro;
     ro.width = int(opts.width), ro.height = int(opts.height);
-    return ps11tools::caseForProgram(rng, program->version.minor, lines, ro).testText;
+    return ps11test::caseForProgram(rng, program->version.minor, lines, ro).testText;
 }
 
-int runRandom(const Options& opts, const RendererFactory& gl) {
+int runRandom(const Options& opts, const ps11test::RendererFactory& gl) {
     uint64_t programs = 0, pixels = 0, exact = 0, overOne = 0;
     double maxDiff = 0;
     std::vector<std::pair<uint64_t, std::string>> mismatches;
-    ps11tools::RandomCaseOptions ro;
+    ps11test::RandomCaseOptions ro;
     ro.minor = opts.minor;
     for (long i = 0; i < opts.random; ++i) {
         const uint64_t seed = opts.seed + uint64_t(i);
         std::mt19937_64 rng(seed);
-        const ps11tools::RandomCase c = ps11tools::randomCase(rng, ro);
+        const ps11test::RandomCase c = ps11test::randomCase(rng, ro);
         Report r;
         compareText(c.testText, "random-" + std::to_string(seed), opts, gl, r);
         ++programs;
@@ -367,12 +368,12 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
         overOne += r.sum(&DrawDiff::overOne);
         maxDiff = std::max(maxDiff, r.maxDiff());
         if (r.agrees()) continue;
-        auto stillFails = [&](const ps11tools::RandomCase& k) {
+        auto stillFails = [&](const ps11test::RandomCase& k) {
             Report s;
             compareText(k.testText, "shrink", opts, gl, s);
             return s.error.empty() && !s.agrees();
         };
-        const ps11tools::RandomCase small = ps11tools::shrinkCase(c, stillFails);
+        const ps11test::RandomCase small = ps11test::shrinkCase(c, stillFails);
         Report sr;
         compareText(small.testText, "shrunk", opts, gl, sr);
         std::ostringstream head;
@@ -398,10 +399,10 @@ int runRandom(const Options& opts, const RendererFactory& gl) {
         json::Json list = json::Json::array();
         for (const auto& [seed, file] : mismatches) list.push_back({{"seed", seed}, {"file", file}});
         j["mismatches"] = std::move(list);
-        j["gl"] = glRendererDescription();
+        j["gl"] = ps11test::glRendererDescription();
         std::cout << json::dump(j) << "\n";
     } else {
-        std::cout << "gl: " << glRendererDescription() << "\n"
+        std::cout << "gl: " << ps11test::glRendererDescription() << "\n"
                   << "random: " << programs << " programs (seeds " << opts.seed << ".." << opts.seed + programs - 1
                   << "), " << pixels << " pixels, " << exact << " exact ("
                   << (pixels ? 100.0 * double(exact) / double(pixels) : 100.0) << " %), " << overOne
@@ -484,7 +485,7 @@ int cmdCompare(const std::vector<std::string>& args) {
         return usageError("--random looks for disagreements of the exact mode; --gl-mode native does not apply");
     if (opts.native && opts.glFiltering) return usageError("--gl-filtering is an exact-mode option; native filters with GL");
     std::string error;
-    const RendererFactory gl = glRendererFactory(glName, error, opts.native, opts.glFiltering);
+    const ps11test::RendererFactory gl = ps11test::glRendererFactory(glName, error, opts.native, opts.glFiltering);
     if (!gl) {
         std::cerr << "ps11 compare: " << error << "\n";
         return cli::kUserError;

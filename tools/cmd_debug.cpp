@@ -35,7 +35,7 @@ struct OnePixel {
     float color[2][4] = {};
     float tc[kMaxTexCoordSets][4] = {};
     PixelInputs in;
-    explicit OnePixel(const EvalInputs& e) {
+    explicit OnePixel(const ps11test::EvalInputs& e) {
         in.count = 1;
         for (int v = 0; v < 2; ++v)
             for (int c = 0; c < 4; ++c) {
@@ -90,7 +90,7 @@ std::vector<InstructionInterval> classFindings(const Program& program, const Har
     std::vector<InstructionInterval> steps;
     if (!e) return steps;
     IntervalInputs in;
-    const EvalInputs ei = ea.inputs();
+    const ps11test::EvalInputs ei = ea.inputs();
     for (int v = 0; v < 2; ++v)
         for (int c = 0; c < 4; ++c)
             in.color[size_t(v)][size_t(c)] = ValueRange::point(ei.color[size_t(v)] ? (*ei.color[size_t(v)])[size_t(c)] : 0.0f);

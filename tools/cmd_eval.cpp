@@ -19,11 +19,12 @@
 #include "ps11/diagnostics.h"
 #include "ps11/executor.h"
 #include "ps11/testfile.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
-#include "tools/test_eval.h"
+#include "runner/test_eval.h"
 
 namespace ps11 {
 namespace {
@@ -198,8 +199,8 @@ int bindEvalTextures(const EvalArgs& ea, const HardwareConfig& hw, uint32_t samp
     return cli::kOk;
 }
 
-EvalInputs EvalArgs::inputs() const {
-    EvalInputs in;
+ps11test::EvalInputs EvalArgs::inputs() const {
+    ps11test::EvalInputs in;
     for (int r = 0; r < 2; ++r)
         if (color[size_t(r)]) in.color[size_t(r)] = &*color[size_t(r)];
     for (int r = 0; r < 8; ++r)
@@ -217,7 +218,7 @@ int cmdEval(const std::vector<std::string>& args) {
     if (!executor) return cli::kUserError;
     TextureSampler sampler;
     if (int rc = bindEvalTextures(ea, hw, executor->sampledStages(), sampler); rc != cli::kOk) return rc;
-    EvalOutcome out = evalOnePixel(*executor, sampler, ea.inputs());
+    ps11test::EvalOutcome out = ps11test::evalOnePixel(*executor, sampler, ea.inputs());
 
     const Precision p = hw.precision;
     std::cout << "ps_" << program->version.major << "_" << program->version.minor << ", hardware " << hw.describe()

@@ -16,7 +16,7 @@
 #include "ps11/ir.h"
 #include "ps11/testfile.h"
 #include "ps11/texture_sampler.h"
-#include "tools/test_eval.h"
+#include "runner/test_eval.h"
 
 namespace ps11 {
 
@@ -32,7 +32,7 @@ struct EvalArgs {
     std::optional<Precision> precision;                              // overrides the class's profile
     float maxValue = 0;                                              // overrides the class's MaxValue (0 = none)
 
-    EvalInputs inputs() const;  // pointers into this object
+    ps11test::EvalInputs inputs() const;  // pointers into this object
 };
 
 // parseEvalArgs' result for -h/--help (the usage was printed).

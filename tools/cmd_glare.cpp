@@ -24,7 +24,7 @@
 #include "ps11/hardware.h"
 #include "ps11/json_internal.h"
 #include "tools/cli_util.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace ps11 {
 
@@ -223,7 +223,7 @@ int runGlare(const GlareOptions& o) {
         ro.device.precision = o.precision;
         ro.skip = !o.noSkip;
         if (gl) {
-            ro.device.renderer = glRendererFactory(o.glKind, err, o.glNative);
+            ro.device.renderer = ps11test::glRendererFactory(o.glKind, err, o.glNative);
             if (!ro.device.renderer) return nullptr;
         }
         return std::make_unique<glare::Runner>(ro);
@@ -406,7 +406,7 @@ int runGlare(const GlareOptions& o) {
             j["technique"] = std::string(technique->name());
             j["hardware"] = hw;
             j["profile"] = profile;
-            j["gl"] = glRendererDescription();
+            j["gl"] = ps11test::glRendererDescription();
             j["frames"] = o.frames;
             std::vector<glare::PassAgreement> all;
             if (scene) all.push_back(sceneAgreement);
@@ -425,7 +425,7 @@ int runGlare(const GlareOptions& o) {
         } else {
             std::printf("%s on %ux%u, %d frame(s), %s / %s: the emulator against %s, pass-isolated\n",
                         std::string(technique->name()).c_str(), width, height, o.frames, hw.c_str(), profile.c_str(),
-                        glRendererDescription().c_str());
+                        ps11test::glRendererDescription().c_str());
             std::printf("%-26s %12s %9s %10s %9s\n", "pass", "pixels", "exact", "|d|>1", "max |d|");
             auto row = [](const glare::PassAgreement& a) {
                 if (a.pixels == 0) {  // a device-side step: no texture to compare

@@ -11,7 +11,7 @@
 #include "ps11/hardware.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace ps11 {
 
@@ -152,7 +152,7 @@ int cmdShade(const std::vector<std::string>& args) {
     options.software.skipTiles = !noSkip;
     std::string err;
     if (backend == "gl") {
-        options.renderer = glRendererFactory(glKind, err, glNative);
+        options.renderer = ps11test::glRendererFactory(glKind, err, glNative);
         if (!options.renderer) {
             std::cerr << "ps11 shade: the GL renderer is not available: " << err << "\n";
             return cli::kUserError;

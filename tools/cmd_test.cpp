@@ -1,8 +1,8 @@
 // `ps11 test` (stage: command line over the .ps11test reader, the assembler, the validator
 // and the executor). Each file is parsed, its [pixel shader] is assembled and validated (or must
 // fail with the expected diagnostic), its evals and eval probes run on the executor
-// (tools/test_eval.cpp), and its draws and pixel probes run on the emu device
-// (tools/test_draw.cpp). Commands asked of the gl backend are counted as "not yet runnable".
+// (runner/test_eval.cpp), and its draws and pixel probes run on the emu device
+// (runner/test_draw.cpp). Commands asked of the gl backend are counted as "not yet runnable".
 #include "tools/cmd_test.h"
 
 #include <filesystem>
@@ -20,7 +20,7 @@
 #include "ps11/testfile.h"
 #include "ps11/validator.h"
 #include "tools/cli_util.h"
-#include "tools/test_eval.h"
+#include "runner/test_eval.h"
 
 namespace ps11 {
 namespace {
@@ -52,7 +52,7 @@ struct RunOptions {
     std::optional<Precision> precision;       // overrides [require] precision when given
     bool verbose = false;
     bool stats = false;  // print executor statistics per file
-    RendererFactory glRenderer;  // --backend gl|both
+    ps11test::RendererFactory glRenderer;  // --backend gl|both
     bool glNative = false;       // --gl-mode native
     bool skipTiles = true;       // --no-skip: false
 };
@@ -61,7 +61,7 @@ enum class Outcome { Passed, Failed, NotRunnable };
 
 struct FileResult {
     Outcome outcome = Outcome::Passed;
-    CommandTally tally;   // evals run, probes, commands not runnable yet
+    ps11test::CommandTally tally;   // evals run, probes, commands not runnable yet
     bool skipped = false;  // [require] backend excludes every backend of this run
     bool skippedHardware = false;  // --hardware names a class that cannot run the file's shader
 };
@@ -176,7 +176,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         result.skipped = !file.commands.empty();
         return result;
     }
-    CommandRunOptions run;
+    ps11test::CommandRunOptions run;
     run.backends = backends;
     run.hardware = hw;
     run.verbose = opts.verbose;
@@ -184,8 +184,8 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
     run.glRenderer = opts.glRenderer;
     run.glNative = opts.glNative;
     run.skipTiles = opts.skipTiles;
-    CommandTally& t = result.tally;
-    runCommands(file, path, program ? &*program : nullptr, run, t);
+    ps11test::CommandTally& t = result.tally;
+    ps11test::runCommands(file, path, program ? &*program : nullptr, run, t);
     if (opts.stats && t.evals) {
         const ExecutorStats& s = t.stats;
         std::cout << path << ": stats (" << hw.describe() << "): " << t.evals << " evals, " << s.pixels
@@ -194,7 +194,7 @@ FileResult runFile(const std::string& path, const RunOptions& opts) {
         std::cout << ", " << t.texelsFetched << " texels fetched\n";
     }
     if (opts.stats && t.draws.draws) {
-        const DrawTally& d = t.draws;
+        const ps11test::DrawTally& d = t.draws;
         std::cout << path << ": draw stats (" << hw.describe() << "): " << d.draws << " draws, "
                   << d.pixelsShaded << " pixels shaded, " << d.pixelsWritten << " written, " << d.instructions
                   << " instructions executed, " << d.texelsFetched << " texels fetched, " << d.milliseconds
@@ -289,7 +289,7 @@ int cmdTest(const std::vector<std::string>& args) {
     if (glModeGiven && !(opts.backends & kBackendGl)) return usageError("--gl-mode needs --backend gl or both");
     if (opts.backends & kBackendGl) {
         std::string error;
-        opts.glRenderer = glRendererFactory(glKind, error, opts.glNative);
+        opts.glRenderer = ps11test::glRendererFactory(glKind, error, opts.glNative);
         if (!opts.glRenderer) {
             std::cerr << "ps11 test: --backend " << (opts.backends & kBackendEmu ? "both" : "gl") << ": " << error << "\n";
             return cli::kUserError;
@@ -308,10 +308,10 @@ namespace {
 
 int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool perClass) {
     size_t passed = 0, failed = 0, notRunnable = 0, skipped = 0, skippedHardware = 0;
-    CommandTally total;
+    ps11test::CommandTally total;
     for (const std::string& path : files) {
         FileResult r = runFile(path, opts);
-        const CommandTally& t = r.tally;
+        const ps11test::CommandTally& t = r.tally;
         total.evals += t.evals;
         total.probesPassed += t.probesPassed;
         total.probesFailed += t.probesFailed;
@@ -368,7 +368,7 @@ int runFiles(const std::vector<std::string>& files, const RunOptions& opts, bool
     std::cout << "\n";
     if (total.comparedDraws) {
         std::cout << (perClass ? std::string(opts.hardware->name) + ": " : std::string()) << "cross-check ("
-                  << glRendererDescription() << "): " << plural(total.comparedDraws, "draw", "draws") << ", "
+                  << ps11test::glRendererDescription() << "): " << plural(total.comparedDraws, "draw", "draws") << ", "
                   << total.comparedPixels << " pixels, " << total.exactPixels << " exact ("
                   << (total.comparedPixels ? 100.0 * double(total.exactPixels) / double(total.comparedPixels) : 100.0)
                   << " %), " << total.overOnePixels << " past the target, max |d| " << total.maxDiff << "; "

@@ -27,7 +27,7 @@
 #include "ps11/version.h"
 #include "tools/cli_util.h"
 #include "tools/cmd_debug.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 #include "tools/svg_plot.h"
 
 namespace ps11 {
@@ -84,7 +84,7 @@ struct Ctx {
     const DemoReportOptions& o;
     std::string dir;
     Progress progress;
-    ps11::RendererFactory glNative, glExact;
+    ps11test::RendererFactory glNative, glExact;
     std::string glDescription, glMissing;
     const HardwareClass* cls = nullptr;
     std::string error;
@@ -489,10 +489,10 @@ int writeDemoReport(const DemoReportOptions& o) {
         return cli::kUserError;
     };
     std::string glErr;
-    c.glExact = glRendererFactory("", glErr, false);
+    c.glExact = ps11test::glRendererFactory("", glErr, false);
     if (c.glExact) {
-        c.glNative = glRendererFactory("", glErr, true);
-        c.glDescription = glRendererDescription();
+        c.glNative = ps11test::glRendererFactory("", glErr, true);
+        c.glDescription = ps11test::glRendererDescription();
     } else {
         c.glMissing = glErr;
     }

@@ -188,7 +188,7 @@ GLuint GlState::texture(const std::shared_ptr<const ps11::Texture>& tex, ps11::P
             for (uint32_t z = 0; z < li.depth; ++z)
                 for (uint32_t y = 0; y < li.height; ++y)
                     for (uint32_t x = 0; x < li.width; ++x, ++i) {
-                        const ps11::Vec4 v = tex->texelValue(l, x, y, z);
+                        const std::array<float, 4> v = tex->texelValue(l, x, y, z);
                         for (int c = 0; c < 4; ++c) data[i * 4 + size_t(c)] = v[size_t(c)];
                     }
             image(l, li, GL_RGBA32F, GL_RGBA, GL_FLOAT, data.data());

@@ -1,13 +1,13 @@
-// Random ps_1_x cases for differential fuzzing (tools/random_program.h). Programs are built as
+// Random ps_1_x cases for differential fuzzing (runner/random_program.h). Programs are built as
 // IR instructions from the opcode table's rows for the version and written by the
 // disassembler's formatInstruction; each instruction (or texm3x2/texm3x3 sequence, or co-issued
 // pair) is kept only when the program so far still validates without a diagnostic, so the
 // validator, not this file, is the judge of every rule. The generator tracks only what it needs
 // to pick sources that are likely to be accepted: which register components are written. The
 // test file around a program is written as text (docs/test-format.md), with the environment of
-// randomCase drawn feature by feature (tools/random_program.h); the shrinker reduces the program
+// randomCase drawn feature by feature (runner/random_program.h); the shrinker reduces the program
 // as IR and the environment as lines of that text.
-#include "tools/random_program.h"
+#include "runner/random_program.h"
 
 #include <algorithm>
 #include <array>
@@ -25,7 +25,7 @@
 #include "ps11/token_format.h"
 #include "ps11/validator.h"
 
-namespace ps11tools {
+namespace ps11test {
 
 using ps11::Instruction;
 using ps11::OpClass;
@@ -838,7 +838,7 @@ std::string testTextOf(Dice& dice, const ps11::Program& program, const std::stri
                        bool full) {
     const int minor = program.version.minor;
     std::string out = "% a random ps_1_" + std::to_string(minor) +
-                      " case (tools/random_program.cpp): one draw, no probes\n[require]\nversion ps_1_" +
+                      " case (runner/random_program.cpp): one draw, no probes\n[require]\nversion ps_1_" +
                       std::to_string(minor) + "\n";
     Environment env;
     env.full = full;
@@ -1178,4 +1178,4 @@ RandomCase shrinkCase(const RandomCase& start, const std::function<bool(const Ra
     return best;
 }
 
-}  // namespace ps11tools
+}  // namespace ps11test

@@ -1,11 +1,13 @@
-// The process's GL renderer (tools/gl_backend.h).
-#include "tools/gl_backend.h"
+// The process's GL renderer (runner/gl_backend.h).
+#include "runner/gl_backend.h"
 
 #ifdef PS11_HAVE_GL
 #include "emu/gl/gl_renderer.h"
 #endif
 
-namespace ps11 {
+namespace ps11test {
+
+using namespace ps11;
 
 #ifdef PS11_HAVE_GL
 namespace {
@@ -56,4 +58,4 @@ RendererFactory glRendererFactory(const std::string&, std::string& error, bool, 
 std::string glRendererDescription() { return ""; }
 #endif
 
-}  // namespace ps11
+}  // namespace ps11test

@@ -9,7 +9,7 @@
 
 #include "emu/renderer.h"
 
-namespace ps11 {
+namespace ps11test {
 
 using RendererFactory = std::function<std::unique_ptr<emu::Renderer>()>;
 
@@ -27,4 +27,4 @@ RendererFactory glRendererFactory(const std::string& kind, std::string& error, b
 // or "" before glRendererFactory succeeded.
 std::string glRendererDescription();
 
-}  // namespace ps11
+}  // namespace ps11test

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace ps11tools {
+namespace ps11test {
 
 struct RandomCaseOptions {
     int minor = 0;              // 1..4 = that ps_1_x version; 0 = pick one at random per case
@@ -85,4 +85,4 @@ bool isCleanProgram(int minor, const std::vector<std::string>& lines);
 // case found (start itself when nothing could be removed or simplified).
 RandomCase shrinkCase(const RandomCase& start, const std::function<bool(const RandomCase&)>& stillFails);
 
-}  // namespace ps11tools
+}  // namespace ps11test

@@ -2,8 +2,8 @@
 // one pixel on the executor (emu backend; the GL backend comes with the device) with the file's
 // precision, max value, [constants], [stage N] state and [texture N]/[sampler N] textures, and
 // `probe eval` compares r0 with an absolute tolerance. Draws and pixel probes run on the emu device
-// (tools/test_draw.cpp); on the gl backend every command is counted as not runnable yet.
-#include "tools/test_eval.h"
+// (runner/test_draw.cpp); on the gl backend every command is counted as not runnable yet.
+#include "runner/test_eval.h"
 
 #include <cmath>
 #include <cstdio>
@@ -14,13 +14,16 @@
 
 #include "ps11/diagnostics.h"
 #include "ps11/texture.h"
+#include "ps11/testfile_textures.h"
 #include "ps11/texture_sampler.h"
 #include "emu/format.h"
 #include "emu/renderer.h"
 #include "ps11/opcodes.h"
-#include "tools/test_draw.h"
+#include "runner/test_draw.h"
 
-namespace ps11 {
+namespace ps11test {
+
+using namespace ps11;
 namespace {
 
 std::string where(const std::string& path, uint32_t line) { return path + ":" + std::to_string(line); }
@@ -535,4 +538,4 @@ std::optional<EvalOutcome> RendererEval::eval(const EvalInputs& in, std::string&
     return out;
 }
 
-}  // namespace ps11
+}  // namespace ps11test

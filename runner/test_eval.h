@@ -13,9 +13,21 @@
 #include "ps11/ir.h"
 #include "ps11/sampler.h"
 #include "ps11/testfile.h"
-#include "tools/test_draw.h"
+#include "runner/test_draw.h"
 
-namespace ps11 {
+namespace ps11test {
+
+// The executor's types the evaluator speaks (ps11/executor.h, ps11/sampler.h), beside
+// test_draw.h's.
+using ps11::Diagnostics;
+using ps11::Executor;
+using ps11::ExecutorStats;
+using ps11::kBackendEmu;
+using ps11::kMaxTexCoordSets;
+using ps11::Sampler;
+using ps11::StageDesc;
+using ps11::StageState;
+using ps11::TextureDesc;
 
 // r0 (and friends) of one evaluated pixel.
 struct EvalOutcome {
@@ -108,4 +120,4 @@ struct CommandRunOptions {
 void runCommands(const TestFile& file, const std::string& path, const Program* program,
                  const CommandRunOptions& options, CommandTally& tally);
 
-}  // namespace ps11
+}  // namespace ps11test

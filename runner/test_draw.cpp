@@ -1,7 +1,7 @@
 // `ps11 test`, the device part: a .ps11test's sections as D3D9 calls on emu::Device, its draws
 // as DrawPrimitiveUP and its pixel probes against the read-back render target
 // (docs/test-format.md).
-#include "tools/test_draw.h"
+#include "runner/test_draw.h"
 
 #include <cmath>
 #include <cstdio>
@@ -12,7 +12,9 @@
 #include "emu/format.h"
 #include "ps11/encoder.h"
 
-namespace ps11 {
+namespace ps11test {
+
+using namespace ps11;
 namespace {
 
 // D3D9 names (D3DRS_*, D3DFMT_*, …) live in namespace emu.
@@ -512,4 +514,4 @@ std::string DrawRunner::probe(const Probe& probe, std::string& error) {
     return s;
 }
 
-}  // namespace ps11
+}  // namespace ps11test

@@ -14,13 +14,22 @@
 #include "ps11/ir.h"
 #include "ps11/precision.h"
 #include "ps11/testfile.h"
-#include "tools/gl_backend.h"
+#include "runner/gl_backend.h"
 
 namespace emu {
 class Device;
 }
 
-namespace ps11 {
+namespace ps11test {
+
+// The test model and toolchain types the runner speaks (ps11/testfile.h, ps11/ir.h, ps11/hardware.h).
+using ps11::HardwareConfig;
+using ps11::Probe;
+using ps11::Program;
+using ps11::TestCommand;
+using ps11::TestFile;
+using ps11::TexFormat;
+using ps11::Vec4;
 
 // Statistics over a file's draws (Device::lastDrawStats summed).
 struct DrawTally {
@@ -83,4 +92,4 @@ private:
     DrawTally m_tally;
 };
 
-}  // namespace ps11
+}  // namespace ps11test

@@ -1,0 +1,43 @@
+// Pre-sampled runs of an Executor, for the device's row paths that sample screen-aligned rows
+// themselves (emu/aligned_pass.h, emu/aligned_float.h). Not part of the public API (not
+// installed): the callbacks take a `void*` context and the int16 lanes of the fx8 fast path.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "ps11/executor.h"
+
+namespace ps11 {
+
+// The texture reads of a program that can take its texels pre-sampled (tapPlan): tap i is the
+// i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy with no
+// projection and no dependency on other registers.
+struct TapPlan {
+    int count = 0;
+    std::array<uint8_t, 8> stage{};
+    std::array<uint8_t, 8> coordSet{};
+};
+
+// Available when the program runs on the fx8 fast path and its only texture instructions are
+// plain reads: `tex t#` in ps_1_1–1_3 on a stage without D3DTTFF_PROJECTED (as set now by
+// setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw, .xy as written). Fills `plan` and
+// returns true, else false.
+bool tapPlan(const Executor& executor, TapPlan& plan);
+// The same plan in any profile, without the fx8 fast path: true when every texture instruction
+// is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with
+// a sampler of its own).
+bool plainTaps(const Executor& executor, TapPlan& plan);
+
+// fill(ctx, i, first, n, dst) writes the fx8 grid integers of tap i for lanes [first, first + n)
+// into dst[c][0 .. n) (c = r g b a): 8-bit texels, values in [0, 255] (the executor relies on
+// that, and clamps them to ±round(M·G) when that is smaller, as it does sampled texels).
+using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);
+// Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from `fill`
+// instead of a sampler. v0/v1 come from inputs.color. r0[c][lane] receives r0's grid integers.
+// Same results as Executor::run() with a sampler returning those texels. Only valid after
+// tapPlan() returned true.
+void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
+                   ExecutorStats* stats = nullptr);
+
+}  // namespace ps11
