@@ -146,6 +146,21 @@ private:
     uint32_t m_pass;
 };
 
+// How a quad pass writes its target.
+enum class Blend : uint8_t {
+    None,
+    Add,    // ONE / ONE: additive multipass, composites
+    Alpha,  // SRCALPHA / INVSRCALPHA: exponential smoothing
+};
+
+// One texture stage of a shader pass as drawn: its texture, where the quad's corners sample it,
+// its filter (clamp addressing, no mips: glare/passes.h bindTap).
+struct PassStage {
+    TextureId texture;
+    emu::QuadCoords coords;
+    D3DTEXTUREFILTERTYPE filter = D3DTEXF_LINEAR;
+};
+
 struct PassInfo {
     std::string name;
     PassKind kind = PassKind::Shader;
@@ -155,6 +170,11 @@ struct PassInfo {
     // range proof of the fits report (glare/report.h).
     std::vector<std::pair<int, std::array<float, 4>>> constants = {};
     uint8_t pointStages = 0;
+    // Shader: its stages (stage i = stages[i]) and blend, one full-target quad; StretchRect:
+    // the source and filter (stages[0]). What `ps11 debug --technique` follows a pixel back
+    // through and retraces it with (glare/frame_debug.h).
+    std::vector<PassStage> stages = {};
+    Blend blend = Blend::None;
 };
 
 // What a pass's execute step sees. It starts from the device state run() found (every pass

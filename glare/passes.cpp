@@ -87,8 +87,11 @@ bool drawQuadPass(PassContext& c, Runner& runner, const QuadPass& q) {
 void addQuadPass(FrameBuild& fb, const std::string& name, const std::string& note, const QuadPass& q) {
     Runner* runner = &fb.runner;
     PassInfo info{name, PassKind::Shader, q.shader, note, q.constants};
-    for (size_t i = 0; i < q.taps.size(); ++i)
+    for (size_t i = 0; i < q.taps.size(); ++i) {
         if (q.taps[i].filter == D3DTEXF_POINT) info.pointStages = uint8_t(info.pointStages | (1u << i));
+        info.stages.push_back(PassStage{q.taps[i].texture, q.taps[i].coords, q.taps[i].filter});
+    }
+    info.blend = q.blend;
     fb.graph.addPass(
         std::move(info),
         [&](PassBuilder& b) {
@@ -102,8 +105,10 @@ void addQuadPass(FrameBuild& fb, const std::string& name, const std::string& not
 void addStretchPass(FrameBuild& fb, const std::string& name, TextureId source, TextureId dest,
                     D3DTEXTUREFILTERTYPE filter) {
     const std::string note = std::string(filter == D3DTEXF_LINEAR ? "bilinear" : "point") + " copy";
+    PassInfo info{name, PassKind::StretchRect, "", note};
+    info.stages.push_back(PassStage{source, {}, filter});
     fb.graph.addPass(
-        PassInfo{name, PassKind::StretchRect, "", note},
+        info,
         [&](PassBuilder& b) {
             b.read(source);
             b.write(dest);

@@ -11,12 +11,6 @@
 
 namespace glare {
 
-enum class Blend : uint8_t {
-    None,
-    Add,    // ONE / ONE: additive multipass, composites
-    Alpha,  // SRCALPHA / INVSRCALPHA: exponential smoothing
-};
-
 // One texture stage of a quad pass: which texture, where the quad's corners sample it, filter.
 struct Tap {
     TextureId texture;

@@ -445,7 +445,7 @@ std::string debugSection(const DebugTrace& d, const std::string& command) {
                     "level (marked).</p>\n<table><tr><th>line</th><th>instruction</th><th>" + htmlEscape(d.hardware) +
                     "</th><th>ideal</th><th>Δ levels</th><th>why</th></tr>\n";
     for (size_t k = 0; k < d.rows.size(); ++k) {
-        const DebugRow& st = d.rows[k];
+        const DebugStep& st = d.rows[k];
         auto vec = [&](const std::array<float, 4>& v) {
             std::string x;
             for (int c = 0; c < 4; ++c)

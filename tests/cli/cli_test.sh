@@ -141,6 +141,33 @@ assert all(isinstance(x["why"], list) for x in s)
 PY
 expect_rc 2 "debug without a shader" "$ps11" debug
 expect_rc 1 "debug of a missing file" "$ps11" debug "$work/missing.psh"
+# debug --technique: one output pixel of a glare frame followed back through its passes.
+expect_rc 0 "debug --technique" "$ps11" debug --technique adaptive --scene box --size 160x90 --pixel 80,45
+expect_in "$work/out" "composite (shader composite_screen.psh), pixel (80, 45)" "debug --technique traces the composite"
+expect_in "$work/out" "most error added by pass" "debug --technique names the pass that added the most error"
+expect_rc 0 "debug --technique --json" "$ps11" debug --technique adaptive --scene box --size 160x90 --pixel 80,45 --json
+python3 - "$work/out" <<'PY' || fail "debug --technique --json: fields"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["technique"] == "adaptive" and j["pixel"] == [80, 45] and j["frame"] == 0
+p = j["passes"]
+assert len(p) > 5 and p[-1]["pass"] == "composite" and p[-1]["pixel"] == [80, 45]
+names = [x["pass"] for x in p]
+assert j["most_error"]["pass"] in names, j["most_error"]
+for x in p:
+    assert {"pass", "shader", "pixel", "target", "steps", "first_divergence", "output"} <= set(x), x.keys()
+    assert set(x["output"]) == {"emulated", "ideal", "levels"}
+    if x["kind"] == "shader":
+        assert x["steps"] and all({"line", "text", "emulated", "ideal", "why"} <= set(s) for s in x["steps"])
+        assert x["traced"]["emulated"] == x["output"]["emulated"], x["pass"]
+assert any(s["origin"] == "scene input" for x in p for s in x["sources"])
+PY
+expect_rc 2 "debug --technique: pixel outside the frame" "$ps11" debug --technique adaptive --scene box --size 160x90 --pixel 160,0
+expect_in "$work/err" "--pixel 160,0" "the outside pixel names --pixel"
+expect_rc 2 "debug --technique: bad --pixel" "$ps11" debug --technique adaptive --scene box --pixel 3
+expect_rc 2 "debug --technique: unknown technique" "$ps11" debug --technique nope --scene box --pixel 1,1
+expect_rc 2 "debug --technique: unknown scene" "$ps11" debug --technique adaptive --scene nope --pixel 1,1
+expect_rc 1 "debug --technique: missing image" "$ps11" debug --technique adaptive --in "$work/missing.png" --pixel 1,1
 # eval: one pixel on the executor.
 printf 'ps_1_1\nmov r0, v0\n' >"$work/e.psh"
 expect_rc 0 "eval" "$ps11" eval "$work/e.psh" v0=0.5,0.25,1
