@@ -319,21 +319,24 @@ expect_rc 1 "test [require] hardware beyond the version" "$ps11" test "$work/h3.
 expect_in "$work/out" "h3.ps11test:2: hardware geforce3 runs ps_1_1 ... ps_1_1, but the file needs ps_1_2" "the [require] line named"
 expect_rc 2 "test unknown class" "$ps11" test --hardware voodoo "$work/h.ps11test"
 
-# demo: options and their usage errors.
-expect_rc 0 "demo at a small size" "$ps11" demo --size 64x36 --repeats 1 --threads 1 --out "$work/demo"
-expect_in "$work/out" "The five glare techniques, each on its scene at 64x36" "demo header"
-expect_in "$work/out" "emulated on geforce4 (fx8)" "demo runs the default class"
-for row in "adaptive  box" "glow      neon" "pyramid   sky" "quarter   neon" "sprites   lights"; do
-    expect_in "$work/out" "$row" "demo row $row"
+# demo: the report and its usage errors (the page itself: tests/cli/report_page.sh).
+expect_rc 0 "demo --quick" "$ps11" demo --quick --size 64x36 --threads 1 --hardware geforce3 --out "$work/demo"
+expect_in "$work/out" "report: $work/demo/index.html" "demo names its report"
+expect_in "$work/out" "emulated geforce3" "demo runs --hardware"
+for id in techniques fits agreement bench stress debug; do
+    expect_in "$work/demo/index.html" "<section id=\"$id\">" "demo report section $id"
 done
-expect_in "$work/out" "sensors: sensors need vertex texture fetch (vs_3_0)" "demo's fits table names the non-1.1 step"
-expect_rc 0 "demo one class" "$ps11" demo --size 32x18 --repeats 1 --threads 1 --hardware d3d9 --out "$work/demo9"
-expect_in "$work/out" "emulated on d3d9 (float)" "demo --hardware d3d9"
+for t in adaptive glow pyramid quarter sprites; do
+    [ -s "$work/demo/img/$t-emulated.png" ] && [ -s "$work/demo/img/$t-ideal.png" ] && [ -s "$work/demo/img/$t-input.png" ] ||
+        fail "demo wrote no images for $t"
+done
+expect_in "$work/demo/index.html" "sensors need vertex texture fetch (vs_3_0)" "demo's fits table names the non-1.1 step"
+expect_in "$work/err" "stress:" "demo progress on stderr"
 expect_rc 2 "demo unknown class" "$ps11" demo --hardware voodoo
-[ -s "$work/demo/adaptive-box-emulated.png" ] && [ -s "$work/demo/sprites-lights-ideal.png" ] || fail "demo --out wrote no images"
 expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
 expect_rc 2 "demo bad threads" "$ps11" demo --threads many
 expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
+expect_in "$work/err" "unknown argument" "demo names the bad argument"
 
 # Usage errors: exit 2.
 expect_rc 2 "no command" "$ps11"
