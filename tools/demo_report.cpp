@@ -517,7 +517,7 @@ int writeDemoReport(const DemoReportOptions& o) {
     spec.glRenderer = c.glNative;
     spec.width = o.quick ? 480 : 1920;
     spec.height = o.quick ? 270 : 1080;
-    spec.frames = o.quick ? 2 : 5;
+    spec.frames = o.quick ? 2 : 10;
     spec.threads = o.threads;
     std::vector<glare::SweepRow> rows;
     if (!glare::runSweep(spec, rows, c.error, [&](const std::string& line) { c.progress("bench: " + line); }))

@@ -25,12 +25,14 @@ std::string tick(double v) {
 struct Frame {
     PlotAxes axes;
     double x0 = 0, x1 = 1, y0 = 0, y1 = 1;
-    static constexpr int kLeft = 58, kRight = 16, kTop = 28, kBottom = 44;
+    static constexpr int kLeft = 58, kTop = 28, kBottom = 44;
+    int right = 16;     // room right of the data (a scatter's labels need more)
+    bool padX = false;  // widen the x range (scatter points off the frame's edge)
 
     double tx(double x) const {
         double a = axes.logX ? std::log10(std::max(x, 1e-9)) : x, lo = axes.logX ? std::log10(x0) : x0,
                hi = axes.logX ? std::log10(x1) : x1;
-        return kLeft + (a - lo) / (hi - lo) * (axes.width - kLeft - kRight);
+        return kLeft + (a - lo) / (hi - lo) * (axes.width - kLeft - right);
     }
     double ty(double y) const { return axes.height - kBottom - (y - y0) / (y1 - y0) * (axes.height - kTop - kBottom); }
 
@@ -40,7 +42,7 @@ struct Frame {
         y0 = std::min(0.0, *std::min_element(ys.begin(), ys.end())), y1 = *std::max_element(ys.begin(), ys.end());
         if (axes.logX) {
             x0 = std::max(x0 / 1.3, 1e-6), x1 = x1 * 1.3;
-        } else {
+        } else if (padX || x1 == x0) {
             const double pad = (x1 - x0) * 0.08 + (x1 == x0 ? std::max(1.0, std::fabs(x0) * 0.1) : 0);
             x0 -= pad, x1 += pad;
         }
@@ -54,12 +56,12 @@ struct Frame {
         s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
         s += "<text x=\"" + std::to_string(axes.width / 2) + "\" y=\"16\" text-anchor=\"middle\" font-size=\"13\">" +
              htmlEscape(axes.title) + "</text>\n";
-        const double left = kLeft, right = axes.width - kRight, top = kTop, bottom = axes.height - kBottom;
-        s += "<path d=\"M" + num(left) + " " + num(top) + " V" + num(bottom) + " H" + num(right) +
+        const double left = kLeft, rightEdge = axes.width - right, top = kTop, bottom = axes.height - kBottom;
+        s += "<path d=\"M" + num(left) + " " + num(top) + " V" + num(bottom) + " H" + num(rightEdge) +
              "\" stroke=\"#444\" fill=\"none\"/>\n";
         for (int i = 0; i <= 4; ++i) {
             const double fy = y0 + (y1 - y0) * i / 4, py = ty(fy);
-            s += "<line x1=\"" + num(left) + "\" x2=\"" + num(right) + "\" y1=\"" + num(py) + "\" y2=\"" + num(py) +
+            s += "<line x1=\"" + num(left) + "\" x2=\"" + num(rightEdge) + "\" y1=\"" + num(py) + "\" y2=\"" + num(py) +
                  "\" stroke=\"#eee\"/><text x=\"" + num(left - 4) + "\" y=\"" + num(py + 4) +
                  "\" text-anchor=\"end\">" + tick(fy) + "</text>\n";
             const double fx = axes.logX ? std::pow(10.0, std::log10(x0) + (std::log10(x1) - std::log10(x0)) * i / 4)
@@ -67,7 +69,7 @@ struct Frame {
             s += "<text x=\"" + num(tx(fx)) + "\" y=\"" + num(bottom + 14) + "\" text-anchor=\"middle\">" + tick(fx) +
                  "</text>\n";
         }
-        s += "<text x=\"" + num((left + right) / 2) + "\" y=\"" + num(bottom + 32) + "\" text-anchor=\"middle\">" +
+        s += "<text x=\"" + num((left + rightEdge) / 2) + "\" y=\"" + num(bottom + 32) + "\" text-anchor=\"middle\">" +
              htmlEscape(axes.xLabel) + "</text>\n";
         s += "<text transform=\"translate(14 " + num((top + bottom) / 2) + ") rotate(-90)\" text-anchor=\"middle\">" +
              htmlEscape(axes.yLabel) + "</text>\n";
@@ -95,6 +97,7 @@ std::string htmlEscape(const std::string& text) {
 
 std::string svgScatter(const PlotAxes& axes, const std::vector<PlotPoint>& points) {
     Frame f{axes};
+    f.right = 80, f.padX = true;
     std::vector<double> xs, ys;
     for (const PlotPoint& p : points)
         if (std::isfinite(p.x) && std::isfinite(p.y)) xs.push_back(p.x), ys.push_back(p.y);
@@ -136,7 +139,7 @@ std::string svgLines(const PlotAxes& axes, const std::vector<PlotSeries>& series
                 d += (d.empty() ? "M" : " L") + num(f.tx(l.x[i])) + " " + num(f.ty(l.y[i]));
         s += "<path d=\"" + d + "\" stroke=\"" + l.color + "\" stroke-width=\"1.6\" fill=\"none\"" +
              (l.dashed ? " stroke-dasharray=\"5 3\"" : "") + "/>\n";
-        const double ly = Frame::kTop + 8 + 14.0 * double(k), lx = axes.width - Frame::kRight - 170;
+        const double ly = Frame::kTop + 8 + 14.0 * double(k), lx = axes.width - f.right - 170;
         s += "<line x1=\"" + num(lx) + "\" x2=\"" + num(lx + 18) + "\" y1=\"" + num(ly) + "\" y2=\"" + num(ly) +
              "\" stroke=\"" + l.color + "\" stroke-width=\"2\"" + (l.dashed ? " stroke-dasharray=\"5 3\"" : "") +
              "/><text x=\"" + num(lx + 22) + "\" y=\"" + num(ly + 4) + "\">" + htmlEscape(l.name) + "</text>\n";
