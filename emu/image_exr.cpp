@@ -29,6 +29,7 @@
 #include <exception>
 #include <memory>
 #include <new>
+#include <utility>
 
 #include "emu/image_file.h"
 #include "emu/image_file_internal.h"
@@ -68,6 +69,17 @@ public:
         }
         m_pos += uint64_t(n);
         return m_pos < m_size;
+    }
+    // `n` bytes at `pos` without moving the read position or setting `ended`: false past the end or
+    // when the file cannot be read (then OpenEXR meets the same failure and says so).
+    bool readAt(uint64_t pos, void* out, size_t n) {
+        if (pos > m_size || n > m_size - pos) return false;
+        if (!m_file) {
+            std::memcpy(out, m_data + pos, n);
+            return true;
+        }
+        m_filePos = UINT64_MAX;
+        return fseeko(m_file, off_t(pos), SEEK_SET) == 0 && std::fread(out, 1, n, m_file) == n;
     }
     uint64_t tellg() override { return m_pos; }
     void seekg(uint64_t pos) override { m_pos = pos; }
@@ -113,6 +125,97 @@ uint64_t linesPerChunk(Imf::Compression c) {
     case Imf::DWAA_COMPRESSION: return 32;
     case Imf::DWAB_COMPRESSION: return 256;
     default: return 1;  // NONE, RLE, ZIPS
+    }
+}
+
+// The bytes OpenEXR 3.1 reads of a header attribute's value for the types whose value it reads whatever
+// the size field says (Header::readFrom, each type's readValueFrom); 0 for the others.
+uint64_t fixedAttributeBytes(const std::string& type) {
+    static const std::pair<const char*, uint64_t> kFixed[] = {
+        {"box2i", 16},  {"box2f", 16},    {"compression", 1}, {"chromaticities", 32}, {"deepImageState", 1},
+        {"double", 8},  {"envmap", 1},    {"float", 4},       {"int", 4},             {"keycode", 28},
+        {"lineOrder", 1}, {"m33d", 72},   {"m33f", 36},       {"m44d", 128},          {"m44f", 64},
+        {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},    {"v2d", 16},            {"v2f", 8},
+        {"v2i", 8},     {"v3d", 24},      {"v3f", 12},        {"v3i", 12}};
+    for (const auto& [name, bytes] : kFixed)
+        if (type == name) return bytes;
+    return 0;
+}
+
+// Walks the header's attributes the way Header::readFrom will, before it does: OpenEXR allocates an
+// attribute's value by its size field (a string, a string or float vector, a preview image, an ID
+// manifest, an attribute of a type it does not know) and only then finds the bytes missing, so a
+// mutated size field of 2 GiB cost 2 GiB of zeroed memory. Returns why the header cannot be what it
+// claims ("" if it can, or where the walk cannot follow it: OpenEXR then refuses it itself).
+std::string headerAttributeProblem(ExrStream& s) {
+    const uint64_t total = s.size();
+    uint64_t at = 8;  // after the magic number and version
+    // A name as Xdr::read(is, 255, name) reads it: up to 256 bytes, the last of them NUL.
+    const auto readName = [&](std::string& out) {
+        char buffer[256];
+        const size_t n = size_t(std::min<uint64_t>(sizeof buffer, total - std::min(total, at)));
+        if (n == 0 || !s.readAt(at, buffer, n)) return false;
+        const auto* nul = static_cast<const char*>(std::memchr(buffer, 0, n));
+        if (!nul) return false;
+        out.assign(buffer, size_t(nul - buffer));
+        at += uint64_t(nul - buffer) + 1;
+        return true;
+    };
+    std::string name, type, channel;
+    for (;;) {
+        if (!readName(name) || name.empty() || !readName(type)) return "";
+        uint8_t sizeBytes[4];
+        if (!s.readAt(at, sizeBytes, 4)) return "";
+        at += 4;
+        const int32_t size = int32_t(uint32_t(sizeBytes[0]) | uint32_t(sizeBytes[1]) << 8 |
+                                     uint32_t(sizeBytes[2]) << 16 | uint32_t(sizeBytes[3]) << 24);
+        if (size < 0) return "";  // OpenEXR refuses it before allocating
+        const uint64_t left = total - std::min(total, at);
+        uint64_t value = fixedAttributeBytes(type);
+        if (value == 0 && type == "chlist") {  // channels: name, then type, pLinear, 3 reserved, x and y sampling
+            for (;;) {
+                if (!readName(channel)) return "";
+                if (channel.empty()) break;
+                at += 16;
+            }
+        } else if (value == 0) {
+            // Allocated by the size field: a string, a string or float vector, a preview image (whose
+            // size OpenEXR checks against its width and height), an ID manifest (8 bytes of size, then
+            // its size field less 4), any other type's opaque bytes.
+            value = type == "idmanifest" ? uint64_t(size) + 4 : uint64_t(size);
+            if (value > left)
+                return "truncated EXR: header attribute \"" + printable(name, 32) + "\" (" + printable(type, 32) +
+                       ") claims " + std::to_string(value) + " bytes but only " + std::to_string(left) +
+                       " bytes follow it";
+        }
+        at += value;
+    }
+}
+
+// The most a chunk's pixels can expand from their bytes in the file, for each compression, and its name.
+// NONE stores them as they are (a shorter chunk would leave OpenEXR's buffer partly unread). RLE: a run
+// of at most 127 bytes in 2. ZIP, ZIPS: deflate, at most 1032:1 (zlib.net/zlib_tech.html). PXR24: floats
+// cut to 24 bits, then deflate: 1032 * 4/3. PIZ: Huffman codes of at least 1 bit and a run code of 8 bits
+// for at most 256 16-bit values: 409.6:1. B44, B44A: a 4x4 block of halves (32 bytes) in at least 3.
+// DWAA, DWAB: a channel they take as RLE is run-length encoded, then deflated: 63.5 * 1032 (their DCT
+// blocks, 128 bytes in at least a 2-byte DC and a 2-byte AC end, deflated, expand less).
+struct CompressionBound {
+    const char* name;
+    uint64_t ratio;
+};
+CompressionBound compressionBound(Imf::Compression c) {
+    switch (c) {
+    case Imf::NO_COMPRESSION: return {"NONE", 1};
+    case Imf::RLE_COMPRESSION: return {"RLE", 64};
+    case Imf::ZIPS_COMPRESSION: return {"ZIPS", 1032};
+    case Imf::ZIP_COMPRESSION: return {"ZIP", 1032};
+    case Imf::PIZ_COMPRESSION: return {"PIZ", 410};
+    case Imf::PXR24_COMPRESSION: return {"PXR24", 1376};
+    case Imf::B44_COMPRESSION: return {"B44", 11};
+    case Imf::B44A_COMPRESSION: return {"B44A", 11};
+    case Imf::DWAA_COMPRESSION: return {"DWAA", 65536};
+    case Imf::DWAB_COMPRESSION: return {"DWAB", 65536};
+    default: return {"an unknown compression", 1};  // sanityCheck refuses it first
     }
 }
 
@@ -192,6 +295,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
         return fail("corrupt EXR: OpenEXR: " + message);
     };
 
+    if (const std::string problem = headerAttributeProblem(s); !problem.empty()) return fail(problem);
     Imf::Header header;
     try {
         header.readFrom(s, version);
@@ -245,6 +349,22 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
                     (tiled ? " tiles" : " blocks of rows") + " needs at least " + std::to_string(leastBytes) +
                     " bytes of offsets and chunk headers but only " + std::to_string(follow) +
                     " bytes follow its header");
+    // The pixels' bytes uncompressed (a subsampled channel's samples counted down), and the least
+    // bytes of chunk data they can come from.
+    uint64_t rawBytes = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        const Imf::Channel& c = it.channel();
+        rawBytes += (c.type == Imf::HALF ? 2 : 4) * (width / uint64_t(std::max(1, c.xSampling))) *
+                    (height / uint64_t(std::max(1, c.ySampling)));
+    }
+    const CompressionBound bound = compressionBound(header.compression());
+    const uint64_t leastPixels = (rawBytes + bound.ratio - 1) / bound.ratio;
+    if (follow - leastBytes < leastPixels)
+        return fail("truncated EXR: a " + sizeText + " image of " + std::to_string(rawBytes) +
+                    " bytes of pixels needs at least " + std::to_string(leastPixels) + " bytes of " + bound.name +
+                    " data (at most " + std::to_string(bound.ratio) + ":1) besides " + std::to_string(leastBytes) +
+                    " bytes of offsets and chunk headers, but only " + std::to_string(follow) +
+                    " bytes follow its header");
 
     FloatImage image;
     image.width = uint32_t(width);
@@ -253,23 +373,31 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
         s.seekg(0);
         Imf::InputFile file(s);
         s.ended = false;  // a scanline file's broken offset table is rebuilt by reading to the end
+        // The first band is one block of rows (or a row of tiles), the rest about 16 MiB each; the band
+        // is not zeroed (OpenEXR writes every value of the slices, missing channels with their fill).
         const uint64_t bandRows = std::max<uint64_t>(1, kBandFloats / (width * 4));
-        std::vector<float> band(size_t(std::min(bandRows, height) * width * 4));
-        for (uint64_t y0 = 0; y0 < height; y0 += bandRows) {
-            const uint64_t rows = std::min(bandRows, height - y0);
+        std::unique_ptr<float[]> band;
+        uint64_t bandFloats = 0;
+        for (uint64_t y0 = 0, rows = 0; y0 < height; y0 += rows) {
+            rows = std::min(y0 == 0 ? std::min(bandRows, chunkRows) : bandRows, height - y0);
+            if (rows * width * 4 > bandFloats) {
+                band.reset();
+                band = std::make_unique_for_overwrite<float[]>(size_t(rows * width * 4));
+                bandFloats = rows * width * 4;
+            }
             const int first = int(int64_t(window.min.y) + int64_t(y0));
             Imf::FrameBuffer buffer;
             for (int c = 0; c < 4; ++c) {
                 if (layout.grey && (c == 1 || c == 2)) continue;
                 buffer.insert(layout.names[c],
-                              Imf::Slice::Make(Imf::FLOAT, band.data() + c, Imath::V2i(window.min.x, first),
+                              Imf::Slice::Make(Imf::FLOAT, band.get() + c, Imath::V2i(window.min.x, first),
                                                int64_t(width), int64_t(rows), kFloatPixelBytes,
                                                kFloatPixelBytes * width, 1, 1, c == 3 ? 1.0 : 0.0));
             }
             file.setFrameBuffer(buffer);
             file.readPixels(first, first + int(rows) - 1);
             for (uint64_t i = 0; i < rows * width; ++i) {
-                float* px = band.data() + i * 4;
+                float* px = band.get() + i * 4;
                 if (layout.grey) px[1] = px[2] = px[0];
                 for (int c = 0; c < 4; ++c) {
                     if (!std::isfinite(px[c]))
@@ -282,7 +410,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
             // The whole image is reserved once its first band has decoded: a file that claims a large
             // image and has nothing behind its header fails before it costs that much.
             if (y0 == 0) image.rgba.reserve(size_t(width * height * 4));
-            image.rgba.insert(image.rgba.end(), band.begin(), band.begin() + ptrdiff_t(rows * width * 4));
+            image.rgba.insert(image.rgba.end(), band.get(), band.get() + rows * width * 4);
         }
     } catch (const std::bad_alloc&) {
         return fail("out of memory for a " + sizeText + " image");
