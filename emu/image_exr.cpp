@@ -30,6 +30,7 @@
 #include <memory>
 #include <new>
 #include <utility>
+#include <vector>
 
 #include "emu/image_file.h"
 #include "emu/image_file_internal.h"
@@ -219,6 +220,117 @@ CompressionBound compressionBound(Imf::Compression c) {
     }
 }
 
+// Floor division, as OpenEXR's divp.
+int64_t floorDiv(int64_t x, int64_t y) { return x >= 0 ? x / y : -((-x + y - 1) / y); }
+
+// The chunks of an uncompressed (NONE) file that OpenEXR 3.1 would read short: it decodes a chunk whose
+// size field is below its pixels' bytes as raw data all the same, from a buffer only that far filled,
+// so the rest of the image would be whatever its buffer held. The chunks are found as OpenEXR finds
+// them: through the offset table at `tableAt`, or, where an entry is 0 (an incomplete file), by
+// walking the chunks one after another from the table's end. Returns why, or "".
+std::string uncompressedChunkProblem(ExrStream& s, const Imf::Header& header, bool tiled, uint64_t tableAt) {
+    const Imath::Box2i window = header.dataWindow();
+    const int64_t minX = window.min.x, maxX = window.max.x, minY = window.min.y, maxY = window.max.y;
+    const uint64_t total = s.size();
+    const auto get32 = [](const uint8_t* p) {
+        return int32_t(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24);
+    };
+    uint64_t entries = 0, pixelBytes = 0;
+    uint64_t tileW = 1, tileH = 1, tilesX = 0, tilesY = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        pixelBytes += it.channel().type == Imf::HALF ? 2 : 4;
+    if (tiled) {
+        // The table holds every level's tiles (TileOffsets): its size is where the walk starts.
+        const Imf::TileDescription& d = header.tileDescription();
+        tileW = d.xSize;
+        tileH = d.ySize;
+        const auto log2 = [&](uint64_t x) {
+            int y = 0, up = 0;
+            for (; x > 1; x >>= 1, ++y) up |= int(x & 1);
+            return d.roundingMode == Imf::ROUND_UP ? y + up : y;
+        };
+        const auto levelSize = [&](uint64_t size, int level) {
+            uint64_t n = size >> level;
+            if (d.roundingMode == Imf::ROUND_UP && (n << level) < size) ++n;
+            return std::max<uint64_t>(n, 1);
+        };
+        const uint64_t w = uint64_t(maxX - minX + 1), h = uint64_t(maxY - minY + 1);
+        const auto across = [&](int l) { return (levelSize(w, l) + tileW - 1) / tileW; };
+        const auto down = [&](int l) { return (levelSize(h, l) + tileH - 1) / tileH; };
+        tilesX = across(0);
+        tilesY = down(0);
+        if (d.mode == Imf::ONE_LEVEL) {
+            entries = tilesX * tilesY;
+        } else if (d.mode == Imf::MIPMAP_LEVELS) {
+            for (int l = 0; l <= log2(std::max(w, h)); ++l) entries += across(l) * down(l);
+        } else {
+            for (int ly = 0; ly <= log2(h); ++ly)
+                for (int lx = 0; lx <= log2(w); ++lx) entries += across(lx) * down(ly);
+        }
+    } else {
+        entries = uint64_t(maxY - minY + 1);  // one row a chunk
+    }
+    // A chunk at `at` (`next`: where the one after it starts): "" when it is not one OpenEXR would take
+    // as level 0's (it refuses those itself) or it holds all its pixels.
+    const auto check = [&](uint64_t at, uint64_t& next) -> std::string {
+        uint8_t h[20];
+        const size_t headerBytes = tiled ? 20 : 8;
+        next = UINT64_MAX;
+        if (!s.readAt(at, h, headerBytes)) return "";
+        const int32_t size = get32(h + headerBytes - 4);
+        if (size < 0) return "";
+        next = at + headerBytes + uint64_t(size);
+        uint64_t need = 0;
+        std::string what;
+        if (tiled) {
+            const int64_t dx = get32(h), dy = get32(h + 4);
+            if (get32(h + 8) != 0 || get32(h + 12) != 0 || dx < 0 || dy < 0 || uint64_t(dx) >= tilesX ||
+                uint64_t(dy) >= tilesY)
+                return "";
+            const int64_t x0 = minX + dx * int64_t(tileW), y0 = minY + dy * int64_t(tileH);
+            need = uint64_t(std::min(maxX, x0 + int64_t(tileW) - 1) - x0 + 1) *
+                   uint64_t(std::min(maxY, y0 + int64_t(tileH) - 1) - y0 + 1) * pixelBytes;
+            what = "tile (" + std::to_string(dx) + ", " + std::to_string(dy) + ")";
+        } else {
+            const int64_t y = get32(h);
+            if (y < minY || y > maxY) return "";
+            for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+                const Imf::Channel& c = it.channel();
+                if (floorDiv(y, c.ySampling) * c.ySampling != y) continue;
+                need += uint64_t(floorDiv(maxX, c.xSampling) - floorDiv(minX - 1, c.xSampling)) *
+                        (c.type == Imf::HALF ? 2 : 4);
+            }
+            what = "row " + std::to_string(y - minY);
+        }
+        if (uint64_t(size) >= need) return "";
+        return "corrupt EXR: the uncompressed (NONE) " + what + " holds " + std::to_string(size) +
+               " bytes but its pixels take " + std::to_string(need);
+    };
+    // The table, in blocks: any 0 entry has OpenEXR walk the chunks instead.
+    bool complete = true;
+    std::vector<uint64_t> block;
+    for (uint64_t i = 0; i < entries && complete; i += block.size()) {
+        block.resize(size_t(std::min<uint64_t>(entries - i, 8192)));
+        if (!s.readAt(tableAt + i * 8, block.data(), block.size() * 8)) return "";  // OpenEXR finds the end
+        complete = std::find(block.begin(), block.end(), uint64_t(0)) == block.end();
+    }
+    uint64_t next = 0;
+    if (complete) {
+        const uint64_t level0 = tiled ? tilesX * tilesY : entries;  // level 0 comes first
+        for (uint64_t i = 0; i < level0; i += block.size()) {
+            block.resize(size_t(std::min<uint64_t>(level0 - i, 8192)));
+            if (!s.readAt(tableAt + i * 8, block.data(), block.size() * 8)) return "";
+            for (const uint64_t at : block)
+                if (std::string problem = check(at, next); !problem.empty()) return problem;
+        }
+        return "";
+    }
+    uint64_t at = tableAt + entries * 8;
+    for (uint64_t i = 0; i < entries && at < total; ++i, at = next)
+        if (std::string problem = check(at, next); !problem.empty() || next == UINT64_MAX) return problem;
+    return "";
+}
+
 // Which channels are read, and into which of r g b a: Y into r (then copied to g and b).
 struct ExrLayout {
     bool grey = false;
@@ -365,6 +477,9 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
                     " data (at most " + std::to_string(bound.ratio) + ":1) besides " + std::to_string(leastBytes) +
                     " bytes of offsets and chunk headers, but only " + std::to_string(follow) +
                     " bytes follow its header");
+    if (header.compression() == Imf::NO_COMPRESSION)
+        if (const std::string problem = uncompressedChunkProblem(s, header, tiled, s.tellg()); !problem.empty())
+            return fail(problem);
 
     FloatImage image;
     image.width = uint32_t(width);
