@@ -198,8 +198,9 @@ std::string headerAttributeProblem(ExrStream& s) {
 // of at most 127 bytes in 2. ZIP, ZIPS: deflate, at most 1032:1 (zlib.net/zlib_tech.html). PXR24: floats
 // cut to 24 bits, then deflate: 1032 * 4/3. PIZ: Huffman codes of at least 1 bit and a run code of 8 bits
 // for at most 256 16-bit values: 409.6:1. B44, B44A: a 4x4 block of halves (32 bytes) in at least 3.
-// DWAA, DWAB: a channel they take as RLE is run-length encoded, then deflated: 63.5 * 1032 (their DCT
-// blocks, 128 bytes in at least a 2-byte DC and a 2-byte AC end, deflated, expand less).
+// DWAA, DWAB: an 8x8 DCT block of a float channel (256 bytes) in at least a 2-byte DC value and a
+// 2-byte end of its AC values, each stream deflated: 256 * 1032 / 4 = 66048; a channel they take as
+// RLE is run-length encoded, then deflated: 63.5 * 1032; 2^17 leaves a margin.
 struct CompressionBound {
     const char* name;
     uint64_t ratio;
@@ -214,8 +215,8 @@ CompressionBound compressionBound(Imf::Compression c) {
     case Imf::PXR24_COMPRESSION: return {"PXR24", 1376};
     case Imf::B44_COMPRESSION: return {"B44", 11};
     case Imf::B44A_COMPRESSION: return {"B44A", 11};
-    case Imf::DWAA_COMPRESSION: return {"DWAA", 65536};
-    case Imf::DWAB_COMPRESSION: return {"DWAB", 65536};
+    case Imf::DWAA_COMPRESSION: return {"DWAA", 131072};
+    case Imf::DWAB_COMPRESSION: return {"DWAB", 131072};
     default: return {"an unknown compression", 1};  // sanityCheck refuses it first
     }
 }

@@ -543,7 +543,7 @@ TEST_CASE("exr: a small file that claims much more than it holds is refused befo
     CHECK(refuse(tiled.bytes) ==
           "small.exr: truncated EXR: a 8192x8192 image of 402653184 bytes of pixels needs at least 402653184 bytes of "
           "NONE data (at most 1:1) besides 28 bytes of offsets and chunk headers, but only 78 bytes follow its header");
-    // 32 DWAB blocks of 256 rows, each 50 bytes: DWAB expands at most 65536:1.
+    // 32 DWAB blocks of 256 rows, each 50 bytes: DWAB expands at most 131072:1.
     HandExr dwab(8192, 8192, Imf::DWAB_COMPRESSION);
     const size_t headerEnd = dwab.end();
     for (uint64_t i = 0; i < 32; ++i) {
@@ -555,8 +555,8 @@ TEST_CASE("exr: a small file that claims much more than it holds is refused befo
         dwab.bytes.resize(dwab.bytes.size() + 50);
     }
     CHECK(refuse(dwab.bytes) ==
-          "small.exr: truncated EXR: a 8192x8192 image of 402653184 bytes of pixels needs at least 6144 bytes of "
-          "DWAB data (at most 65536:1) besides 512 bytes of offsets and chunk headers, but only 2112 bytes follow its "
+          "small.exr: truncated EXR: a 8192x8192 image of 402653184 bytes of pixels needs at least 3072 bytes of "
+          "DWAB data (at most 131072:1) besides 512 bytes of offsets and chunk headers, but only 2112 bytes follow its "
           "header");
     // An uncompressed 4x3 file whose row 1 holds 10 of its 24 bytes (and 14 bytes after the last row, so
     // that the file is long enough in all): OpenEXR 3.1 would decode it from a buffer filled that far.
