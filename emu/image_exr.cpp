@@ -29,6 +29,8 @@
 #include <exception>
 #include <memory>
 #include <new>
+#include <utility>
+#include <vector>
 
 #include "emu/image_file.h"
 #include "emu/image_file_internal.h"
@@ -68,6 +70,17 @@ public:
         }
         m_pos += uint64_t(n);
         return m_pos < m_size;
+    }
+    // `n` bytes at `pos` without moving the read position or setting `ended`: false past the end or
+    // when the file cannot be read (then OpenEXR meets the same failure and says so).
+    bool readAt(uint64_t pos, void* out, size_t n) {
+        if (pos > m_size || n > m_size - pos) return false;
+        if (!m_file) {
+            std::memcpy(out, m_data + pos, n);
+            return true;
+        }
+        m_filePos = UINT64_MAX;
+        return fseeko(m_file, off_t(pos), SEEK_SET) == 0 && std::fread(out, 1, n, m_file) == n;
     }
     uint64_t tellg() override { return m_pos; }
     void seekg(uint64_t pos) override { m_pos = pos; }
@@ -114,6 +127,209 @@ uint64_t linesPerChunk(Imf::Compression c) {
     case Imf::DWAB_COMPRESSION: return 256;
     default: return 1;  // NONE, RLE, ZIPS
     }
+}
+
+// The bytes OpenEXR 3.1 reads of a header attribute's value for the types whose value it reads whatever
+// the size field says (Header::readFrom, each type's readValueFrom); 0 for the others.
+uint64_t fixedAttributeBytes(const std::string& type) {
+    static const std::pair<const char*, uint64_t> kFixed[] = {
+        {"box2i", 16},  {"box2f", 16},    {"compression", 1}, {"chromaticities", 32}, {"deepImageState", 1},
+        {"double", 8},  {"envmap", 1},    {"float", 4},       {"int", 4},             {"keycode", 28},
+        {"lineOrder", 1}, {"m33d", 72},   {"m33f", 36},       {"m44d", 128},          {"m44f", 64},
+        {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},    {"v2d", 16},            {"v2f", 8},
+        {"v2i", 8},     {"v3d", 24},      {"v3f", 12},        {"v3i", 12}};
+    for (const auto& [name, bytes] : kFixed)
+        if (type == name) return bytes;
+    return 0;
+}
+
+// Walks the header's attributes the way Header::readFrom will, before it does: OpenEXR allocates an
+// attribute's value by its size field (a string, a string or float vector, a preview image, an ID
+// manifest, an attribute of a type it does not know) and only then finds the bytes missing, so a
+// mutated size field of 2 GiB cost 2 GiB of zeroed memory. Returns why the header cannot be what it
+// claims ("" if it can, or where the walk cannot follow it: OpenEXR then refuses it itself).
+std::string headerAttributeProblem(ExrStream& s) {
+    const uint64_t total = s.size();
+    uint64_t at = 8;  // after the magic number and version
+    // A name as Xdr::read(is, 255, name) reads it: up to 256 bytes, the last of them NUL.
+    const auto readName = [&](std::string& out) {
+        char buffer[256];
+        const size_t n = size_t(std::min<uint64_t>(sizeof buffer, total - std::min(total, at)));
+        if (n == 0 || !s.readAt(at, buffer, n)) return false;
+        const auto* nul = static_cast<const char*>(std::memchr(buffer, 0, n));
+        if (!nul) return false;
+        out.assign(buffer, size_t(nul - buffer));
+        at += uint64_t(nul - buffer) + 1;
+        return true;
+    };
+    std::string name, type, channel;
+    for (;;) {
+        if (!readName(name) || name.empty() || !readName(type)) return "";
+        uint8_t sizeBytes[4];
+        if (!s.readAt(at, sizeBytes, 4)) return "";
+        at += 4;
+        const int32_t size = int32_t(uint32_t(sizeBytes[0]) | uint32_t(sizeBytes[1]) << 8 |
+                                     uint32_t(sizeBytes[2]) << 16 | uint32_t(sizeBytes[3]) << 24);
+        if (size < 0) return "";  // OpenEXR refuses it before allocating
+        const uint64_t left = total - std::min(total, at);
+        uint64_t value = fixedAttributeBytes(type);
+        if (value == 0 && type == "chlist") {  // channels: name, then type, pLinear, 3 reserved, x and y sampling
+            for (;;) {
+                if (!readName(channel)) return "";
+                if (channel.empty()) break;
+                at += 16;
+            }
+        } else if (value == 0) {
+            // Allocated by the size field: a string, a string or float vector, a preview image (whose
+            // size OpenEXR checks against its width and height), an ID manifest (8 bytes of size, then
+            // its size field less 4), any other type's opaque bytes.
+            value = type == "idmanifest" ? uint64_t(size) + 4 : uint64_t(size);
+            if (value > left)
+                return "truncated EXR: header attribute \"" + printable(name, 32) + "\" (" + printable(type, 32) +
+                       ") claims " + std::to_string(value) + " bytes but only " + std::to_string(left) +
+                       " bytes follow it";
+        }
+        at += value;
+    }
+}
+
+// The most a chunk's pixels can expand from their bytes in the file, for each compression, and its name.
+// NONE stores them as they are (a shorter chunk would leave OpenEXR's buffer partly unread). RLE: a run
+// of at most 127 bytes in 2. ZIP, ZIPS: deflate, at most 1032:1 (zlib.net/zlib_tech.html). PXR24: floats
+// cut to 24 bits, then deflate: 1032 * 4/3. PIZ: Huffman codes of at least 1 bit and a run code of 8 bits
+// for at most 256 16-bit values: 409.6:1. B44, B44A: a 4x4 block of halves (32 bytes) in at least 3.
+// DWAA, DWAB: an 8x8 DCT block of a float channel (256 bytes) in at least a 2-byte DC value and a
+// 2-byte end of its AC values, each stream deflated: 256 * 1032 / 4 = 66048; a channel they take as
+// RLE is run-length encoded, then deflated: 63.5 * 1032; 2^17 leaves a margin.
+struct CompressionBound {
+    const char* name;
+    uint64_t ratio;
+};
+CompressionBound compressionBound(Imf::Compression c) {
+    switch (c) {
+    case Imf::NO_COMPRESSION: return {"NONE", 1};
+    case Imf::RLE_COMPRESSION: return {"RLE", 64};
+    case Imf::ZIPS_COMPRESSION: return {"ZIPS", 1032};
+    case Imf::ZIP_COMPRESSION: return {"ZIP", 1032};
+    case Imf::PIZ_COMPRESSION: return {"PIZ", 410};
+    case Imf::PXR24_COMPRESSION: return {"PXR24", 1376};
+    case Imf::B44_COMPRESSION: return {"B44", 11};
+    case Imf::B44A_COMPRESSION: return {"B44A", 11};
+    case Imf::DWAA_COMPRESSION: return {"DWAA", 131072};
+    case Imf::DWAB_COMPRESSION: return {"DWAB", 131072};
+    default: return {"an unknown compression", 1};  // sanityCheck refuses it first
+    }
+}
+
+// Floor division, as OpenEXR's divp.
+int64_t floorDiv(int64_t x, int64_t y) { return x >= 0 ? x / y : -((-x + y - 1) / y); }
+
+// The chunks of an uncompressed (NONE) file that OpenEXR 3.1 would read short: it decodes a chunk whose
+// size field is below its pixels' bytes as raw data all the same, from a buffer only that far filled,
+// so the rest of the image would be whatever its buffer held. The chunks are found as OpenEXR finds
+// them: through the offset table at `tableAt`, or, where an entry is 0 (an incomplete file), by
+// walking the chunks one after another from the table's end. Returns why, or "".
+std::string uncompressedChunkProblem(ExrStream& s, const Imf::Header& header, bool tiled, uint64_t tableAt) {
+    const Imath::Box2i window = header.dataWindow();
+    const int64_t minX = window.min.x, maxX = window.max.x, minY = window.min.y, maxY = window.max.y;
+    const uint64_t total = s.size();
+    const auto get32 = [](const uint8_t* p) {
+        return int32_t(uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24);
+    };
+    uint64_t entries = 0, pixelBytes = 0;
+    uint64_t tileW = 1, tileH = 1, tilesX = 0, tilesY = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it)
+        pixelBytes += it.channel().type == Imf::HALF ? 2 : 4;
+    if (tiled) {
+        // The table holds every level's tiles (TileOffsets): its size is where the walk starts.
+        const Imf::TileDescription& d = header.tileDescription();
+        tileW = d.xSize;
+        tileH = d.ySize;
+        const auto log2 = [&](uint64_t x) {
+            int y = 0, up = 0;
+            for (; x > 1; x >>= 1, ++y) up |= int(x & 1);
+            return d.roundingMode == Imf::ROUND_UP ? y + up : y;
+        };
+        const auto levelSize = [&](uint64_t size, int level) {
+            uint64_t n = size >> level;
+            if (d.roundingMode == Imf::ROUND_UP && (n << level) < size) ++n;
+            return std::max<uint64_t>(n, 1);
+        };
+        const uint64_t w = uint64_t(maxX - minX + 1), h = uint64_t(maxY - minY + 1);
+        const auto across = [&](int l) { return (levelSize(w, l) + tileW - 1) / tileW; };
+        const auto down = [&](int l) { return (levelSize(h, l) + tileH - 1) / tileH; };
+        tilesX = across(0);
+        tilesY = down(0);
+        if (d.mode == Imf::ONE_LEVEL) {
+            entries = tilesX * tilesY;
+        } else if (d.mode == Imf::MIPMAP_LEVELS) {
+            for (int l = 0; l <= log2(std::max(w, h)); ++l) entries += across(l) * down(l);
+        } else {
+            for (int ly = 0; ly <= log2(h); ++ly)
+                for (int lx = 0; lx <= log2(w); ++lx) entries += across(lx) * down(ly);
+        }
+    } else {
+        entries = uint64_t(maxY - minY + 1);  // one row a chunk
+    }
+    // A chunk at `at` (`next`: where the one after it starts): "" when it is not one OpenEXR would take
+    // as level 0's (it refuses those itself) or it holds all its pixels.
+    const auto check = [&](uint64_t at, uint64_t& next) -> std::string {
+        uint8_t h[20];
+        const size_t headerBytes = tiled ? 20 : 8;
+        next = UINT64_MAX;
+        if (!s.readAt(at, h, headerBytes)) return "";
+        const int32_t size = get32(h + headerBytes - 4);
+        if (size < 0) return "";
+        next = at + headerBytes + uint64_t(size);
+        uint64_t need = 0;
+        std::string what;
+        if (tiled) {
+            const int64_t dx = get32(h), dy = get32(h + 4);
+            if (get32(h + 8) != 0 || get32(h + 12) != 0 || dx < 0 || dy < 0 || uint64_t(dx) >= tilesX ||
+                uint64_t(dy) >= tilesY)
+                return "";
+            const int64_t x0 = minX + dx * int64_t(tileW), y0 = minY + dy * int64_t(tileH);
+            need = uint64_t(std::min(maxX, x0 + int64_t(tileW) - 1) - x0 + 1) *
+                   uint64_t(std::min(maxY, y0 + int64_t(tileH) - 1) - y0 + 1) * pixelBytes;
+            what = "tile (" + std::to_string(dx) + ", " + std::to_string(dy) + ")";
+        } else {
+            const int64_t y = get32(h);
+            if (y < minY || y > maxY) return "";
+            for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+                const Imf::Channel& c = it.channel();
+                if (floorDiv(y, c.ySampling) * c.ySampling != y) continue;
+                need += uint64_t(floorDiv(maxX, c.xSampling) - floorDiv(minX - 1, c.xSampling)) *
+                        (c.type == Imf::HALF ? 2 : 4);
+            }
+            what = "row " + std::to_string(y - minY);
+        }
+        if (uint64_t(size) >= need) return "";
+        return "corrupt EXR: the uncompressed (NONE) " + what + " holds " + std::to_string(size) +
+               " bytes but its pixels take " + std::to_string(need);
+    };
+    // The table, in blocks: any 0 entry has OpenEXR walk the chunks instead.
+    bool complete = true;
+    std::vector<uint64_t> block;
+    for (uint64_t i = 0; i < entries && complete; i += block.size()) {
+        block.resize(size_t(std::min<uint64_t>(entries - i, 8192)));
+        if (!s.readAt(tableAt + i * 8, block.data(), block.size() * 8)) return "";  // OpenEXR finds the end
+        complete = std::find(block.begin(), block.end(), uint64_t(0)) == block.end();
+    }
+    uint64_t next = 0;
+    if (complete) {
+        const uint64_t level0 = tiled ? tilesX * tilesY : entries;  // level 0 comes first
+        for (uint64_t i = 0; i < level0; i += block.size()) {
+            block.resize(size_t(std::min<uint64_t>(level0 - i, 8192)));
+            if (!s.readAt(tableAt + i * 8, block.data(), block.size() * 8)) return "";
+            for (const uint64_t at : block)
+                if (std::string problem = check(at, next); !problem.empty()) return problem;
+        }
+        return "";
+    }
+    uint64_t at = tableAt + entries * 8;
+    for (uint64_t i = 0; i < entries && at < total; ++i, at = next)
+        if (std::string problem = check(at, next); !problem.empty() || next == UINT64_MAX) return problem;
+    return "";
 }
 
 // Which channels are read, and into which of r g b a: Y into r (then copied to g and b).
@@ -192,6 +408,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
         return fail("corrupt EXR: OpenEXR: " + message);
     };
 
+    if (const std::string problem = headerAttributeProblem(s); !problem.empty()) return fail(problem);
     Imf::Header header;
     try {
         header.readFrom(s, version);
@@ -245,6 +462,25 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
                     (tiled ? " tiles" : " blocks of rows") + " needs at least " + std::to_string(leastBytes) +
                     " bytes of offsets and chunk headers but only " + std::to_string(follow) +
                     " bytes follow its header");
+    // The pixels' bytes uncompressed (a subsampled channel's samples counted down), and the least
+    // bytes of chunk data they can come from.
+    uint64_t rawBytes = 0;
+    for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+        const Imf::Channel& c = it.channel();
+        rawBytes += (c.type == Imf::HALF ? 2 : 4) * (width / uint64_t(std::max(1, c.xSampling))) *
+                    (height / uint64_t(std::max(1, c.ySampling)));
+    }
+    const CompressionBound bound = compressionBound(header.compression());
+    const uint64_t leastPixels = (rawBytes + bound.ratio - 1) / bound.ratio;
+    if (follow - leastBytes < leastPixels)
+        return fail("truncated EXR: a " + sizeText + " image of " + std::to_string(rawBytes) +
+                    " bytes of pixels needs at least " + std::to_string(leastPixels) + " bytes of " + bound.name +
+                    " data (at most " + std::to_string(bound.ratio) + ":1) besides " + std::to_string(leastBytes) +
+                    " bytes of offsets and chunk headers, but only " + std::to_string(follow) +
+                    " bytes follow its header");
+    if (header.compression() == Imf::NO_COMPRESSION)
+        if (const std::string problem = uncompressedChunkProblem(s, header, tiled, s.tellg()); !problem.empty())
+            return fail(problem);
 
     FloatImage image;
     image.width = uint32_t(width);
@@ -253,23 +489,31 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
         s.seekg(0);
         Imf::InputFile file(s);
         s.ended = false;  // a scanline file's broken offset table is rebuilt by reading to the end
+        // The first band is one block of rows (or a row of tiles), the rest about 16 MiB each; the band
+        // is not zeroed (OpenEXR writes every value of the slices, missing channels with their fill).
         const uint64_t bandRows = std::max<uint64_t>(1, kBandFloats / (width * 4));
-        std::vector<float> band(size_t(std::min(bandRows, height) * width * 4));
-        for (uint64_t y0 = 0; y0 < height; y0 += bandRows) {
-            const uint64_t rows = std::min(bandRows, height - y0);
+        std::unique_ptr<float[]> band;
+        uint64_t bandFloats = 0;
+        for (uint64_t y0 = 0, rows = 0; y0 < height; y0 += rows) {
+            rows = std::min(y0 == 0 ? std::min(bandRows, chunkRows) : bandRows, height - y0);
+            if (rows * width * 4 > bandFloats) {
+                band.reset();
+                band = std::make_unique_for_overwrite<float[]>(size_t(rows * width * 4));
+                bandFloats = rows * width * 4;
+            }
             const int first = int(int64_t(window.min.y) + int64_t(y0));
             Imf::FrameBuffer buffer;
             for (int c = 0; c < 4; ++c) {
                 if (layout.grey && (c == 1 || c == 2)) continue;
                 buffer.insert(layout.names[c],
-                              Imf::Slice::Make(Imf::FLOAT, band.data() + c, Imath::V2i(window.min.x, first),
+                              Imf::Slice::Make(Imf::FLOAT, band.get() + c, Imath::V2i(window.min.x, first),
                                                int64_t(width), int64_t(rows), kFloatPixelBytes,
                                                kFloatPixelBytes * width, 1, 1, c == 3 ? 1.0 : 0.0));
             }
             file.setFrameBuffer(buffer);
             file.readPixels(first, first + int(rows) - 1);
             for (uint64_t i = 0; i < rows * width; ++i) {
-                float* px = band.data() + i * 4;
+                float* px = band.get() + i * 4;
                 if (layout.grey) px[1] = px[2] = px[0];
                 for (int c = 0; c < 4; ++c) {
                     if (!std::isfinite(px[c]))
@@ -282,7 +526,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
             // The whole image is reserved once its first band has decoded: a file that claims a large
             // image and has nothing behind its header fails before it costs that much.
             if (y0 == 0) image.rgba.reserve(size_t(width * height * 4));
-            image.rgba.insert(image.rgba.end(), band.begin(), band.begin() + ptrdiff_t(rows * width * 4));
+            image.rgba.insert(image.rgba.end(), band.get(), band.get() + rows * width * 4);
         }
     } catch (const std::bad_alloc&) {
         return fail("out of memory for a " + sizeText + " image");

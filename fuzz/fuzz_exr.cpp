@@ -1,7 +1,9 @@
 // libFuzzer target for the OpenEXR reader (emu/image_file.h): the input bytes are read with
 // readExrMemory. Whatever decodes must be a whole float RGBA image within the limits, finite and not
 // negative; whatever does not must say why in one line, naming the input. Seeds live in fuzz/corpus_exr/
-// (scanline and tiled, NONE/ZIP/PIZ/DWAB/RLE, half and float, RGBA and Y).
+// (scanline and tiled, NONE/ZIP/PIZ/DWAB/RLE, half and float, RGBA and Y; and two small files that claim
+// 8192x8192 images, an uncompressed tile behind 50 bytes and 32 DWAB blocks of 50 bytes, which cost
+// seconds to minutes a run before the reader bounded the work by what a file holds).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>

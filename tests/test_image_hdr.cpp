@@ -11,7 +11,9 @@
 #include <ImfMultiPartOutputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfPartType.h>
+#include <ImfStringAttribute.h>
 #include <ImfTileDescription.h>
+#include <ImfTiledInputFile.h>
 #include <ImfTiledOutputFile.h>
 #include <stb/stb_image_write.h>
 
@@ -54,6 +56,8 @@ struct ExrSpec {
     Imf::Compression compression = Imf::NO_COMPRESSION;
     bool tiled = false;
     int tileW = 16, tileH = 8;
+    Imf::LevelMode levels = Imf::ONE_LEVEL;  // tiled: MIPMAP_LEVELS and RIPMAP_LEVELS write every level
+    Imf::LevelRoundingMode rounding = Imf::ROUND_DOWN;
     bool pixels = true;               // false: the header (and offset table) only
     std::vector<std::vector<float>> values;  // per channel, width * height, rows top to bottom
 };
@@ -65,7 +69,7 @@ void writeExr(const std::string& path, const ExrSpec& spec) {
     header.displayWindow() = window;
     header.compression() = spec.compression;
     for (const auto& c : spec.channels) header.channels().insert(c, Imf::Channel(spec.type));
-    if (spec.tiled) header.setTileDescription(Imf::TileDescription(spec.tileW, spec.tileH, Imf::ONE_LEVEL));
+    if (spec.tiled) header.setTileDescription(Imf::TileDescription(spec.tileW, spec.tileH, spec.levels, spec.rounding));
     std::vector<std::vector<half>> halves(spec.channels.size());
     std::vector<std::vector<float>> floats(spec.channels.size());
     Imf::FrameBuffer buffer;
@@ -82,7 +86,11 @@ void writeExr(const std::string& path, const ExrSpec& spec) {
         Imf::TiledOutputFile out(path.c_str(), header);
         if (!spec.pixels) return;
         out.setFrameBuffer(buffer);
-        out.writeTiles(0, out.numXTiles() - 1, 0, out.numYTiles() - 1);
+        // Each level's tiles from the level-0 buffer (a smaller level's pixels are its top-left corner).
+        for (int ly = 0; ly < out.numYLevels(); ++ly)
+            for (int lx = 0; lx < out.numXLevels(); ++lx)
+                if (spec.levels == Imf::RIPMAP_LEVELS || lx == ly)
+                    out.writeTiles(0, out.numXTiles(lx) - 1, 0, out.numYTiles(ly) - 1, lx, ly);
     } else {
         Imf::OutputFile out(path.c_str(), header);
         if (!spec.pixels) return;
@@ -464,6 +472,211 @@ TEST_CASE("exr: what is not a readable EXR is refused with what is wrong", "[ima
     CHECK(message(exrHeaderOnly(dir, "short.exr", 4000, 4000)) ==
           ": truncated EXR: a 4000x4000 image of 250 blocks of rows needs at least 4000 bytes of offsets and chunk "
           "headers but only 2000 bytes follow its header");
+}
+
+namespace {
+
+// EXR files written byte by byte: a header of the standard attributes for a `width` x `height` image of
+// half B G R channels, then `extra` attributes as given, without the header's end when `open` is set.
+struct HandExr {
+    std::vector<uint8_t> bytes;
+    void raw(const void* p, size_t n) {
+        const size_t at = bytes.size();
+        bytes.resize(at + n);
+        std::memcpy(bytes.data() + at, p, n);
+    }
+    void i32(int32_t v) { raw(&v, 4); }  // the tests run little-endian, as EXR is
+    void text(const std::string& s) { raw(s.c_str(), s.size() + 1); }
+    void attribute(const std::string& name, const std::string& type, const std::vector<uint8_t>& value) {
+        text(name);
+        text(type);
+        i32(int32_t(value.size()));
+        raw(value.data(), value.size());
+    }
+    template <class... T> static std::vector<uint8_t> pack(T... values) {
+        HandExr h;
+        (h.raw(&values, sizeof values), ...);
+        return h.bytes;
+    }
+    HandExr() = default;
+    HandExr(int32_t width, int32_t height, Imf::Compression compression, uint32_t tile = 0) {
+        raw("\x76\x2f\x31\x01", 4);
+        i32(tile ? 0x202 : 2);
+        HandExr channels;
+        for (const char* c : {"B", "G", "R"}) {
+            channels.text(c);
+            channels.raw(pack(int32_t(Imf::HALF), uint8_t(0), uint8_t(0), uint16_t(0), int32_t(1), int32_t(1)).data(), 16);
+        }
+        channels.bytes.push_back(0);
+        attribute("channels", "chlist", channels.bytes);
+        attribute("compression", "compression", {uint8_t(compression)});
+        attribute("dataWindow", "box2i", pack(0, 0, width - 1, height - 1));
+        attribute("displayWindow", "box2i", pack(0, 0, width - 1, height - 1));
+        attribute("lineOrder", "lineOrder", {0});
+        attribute("pixelAspectRatio", "float", pack(1.0f));
+        attribute("screenWindowCenter", "v2f", pack(0.0f, 0.0f));
+        attribute("screenWindowWidth", "float", pack(1.0f));
+        if (tile) attribute("tiles", "tiledesc", pack(tile, tile, uint8_t(0)));
+    }
+    size_t end() {  // ends the header; the bytes so far
+        bytes.push_back(0);
+        return bytes.size();
+    }
+};
+
+}  // namespace
+
+TEST_CASE("exr: a small file that claims much more than it holds is refused before decoding", "[image][exr]") {
+    TempDir dir;
+    std::string error;
+    const auto refuse = [&](const std::vector<uint8_t>& bytes) {
+        CHECK_FALSE(readExrMemory(bytes.data(), bytes.size(), "small.exr", error));
+        return error;
+    };
+    // One 8192x8192 tile, uncompressed, behind 50 bytes: 3 half channels need 402653184 bytes. OpenEXR
+    // 3.1 would take the short chunk, decode 64 M pixels from its uninitialised buffer and return them.
+    HandExr tiled(8192, 8192, Imf::NO_COMPRESSION, 8192);
+    const uint64_t offset = tiled.end() + 8;
+    tiled.raw(&offset, 8);
+    tiled.raw(HandExr::pack(0, 0, 0, 0, 50).data(), 20);
+    tiled.bytes.resize(tiled.bytes.size() + 50);
+    CHECK(refuse(tiled.bytes) ==
+          "small.exr: truncated EXR: a 8192x8192 image of 402653184 bytes of pixels needs at least 402653184 bytes of "
+          "NONE data (at most 1:1) besides 28 bytes of offsets and chunk headers, but only 78 bytes follow its header");
+    // 32 DWAB blocks of 256 rows, each 50 bytes: DWAB expands at most 131072:1.
+    HandExr dwab(8192, 8192, Imf::DWAB_COMPRESSION);
+    const size_t headerEnd = dwab.end();
+    for (uint64_t i = 0; i < 32; ++i) {
+        const uint64_t at = headerEnd + 32 * 8 + i * 58;
+        dwab.raw(&at, 8);
+    }
+    for (int32_t i = 0; i < 32; ++i) {
+        dwab.raw(HandExr::pack(i * 256, 50).data(), 8);
+        dwab.bytes.resize(dwab.bytes.size() + 50);
+    }
+    CHECK(refuse(dwab.bytes) ==
+          "small.exr: truncated EXR: a 8192x8192 image of 402653184 bytes of pixels needs at least 3072 bytes of "
+          "DWAB data (at most 131072:1) besides 512 bytes of offsets and chunk headers, but only 2112 bytes follow its "
+          "header");
+    // An uncompressed 4x3 file whose row 1 holds 10 of its 24 bytes (and 14 bytes after the last row, so
+    // that the file is long enough in all): OpenEXR 3.1 would decode it from a buffer filled that far.
+    const auto rows = [&](int32_t shortRow, bool tableComplete) {
+        HandExr h(4, 3, Imf::NO_COMPRESSION);
+        const size_t end = h.end();
+        uint64_t at = end + 3 * 8;
+        for (int32_t y = 0; y < 3; ++y) {
+            const uint64_t entry = !tableComplete && y == 2 ? 0 : at;
+            h.raw(&entry, 8);
+            at += 8 + (y == shortRow ? 10 : 24);
+        }
+        for (int32_t y = 0; y < 3; ++y) {
+            h.raw(HandExr::pack(y, y == shortRow ? 10 : 24).data(), 8);
+            h.bytes.resize(h.bytes.size() + (y == shortRow ? 10 : 24), 0x3c);  // half 1.0 is 3c00
+        }
+        h.bytes.resize(h.bytes.size() + 14);
+        return h.bytes;
+    };
+    for (bool complete : {true, false}) {
+        INFO((complete ? "offset table complete" : "offset table incomplete: OpenEXR walks the chunks"));
+        CHECK(refuse(rows(1, complete)) ==
+              "small.exr: corrupt EXR: the uncompressed (NONE) row 1 holds 10 bytes but its pixels take 24");
+        const auto whole = rows(-1, complete);
+        const auto image = readExrMemory(whole.data(), whole.size(), "whole.exr", error);
+        REQUIRE(image);
+        CHECK(image->width == 4);
+        CHECK(image->rgba[0] == 1.05859375f);  // half 3c3c: 1 + 60/1024
+    }
+    // Header attributes whose size fields claim more than the file holds: OpenEXR would allocate (and, for a
+    // string, zero) that much before finding the bytes missing.
+    const auto claim = [&](const std::string& name, const std::string& type, int32_t size) {
+        HandExr h(64, 64, Imf::ZIP_COMPRESSION);
+        h.text(name);
+        h.text(type);
+        h.i32(size);
+        h.bytes.resize(h.bytes.size() + 10);
+        return refuse(h.bytes);
+    };
+    CHECK(claim("comments", "string", 0x7fff0000) ==
+          "small.exr: truncated EXR: header attribute \"comments\" (string) claims 2147418112 bytes but only 10 bytes "
+          "follow it");
+    CHECK(claim("notes", "blob", 1 << 30) ==
+          "small.exr: truncated EXR: header attribute \"notes\" (blob) claims 1073741824 bytes but only 10 bytes "
+          "follow it");
+    CHECK(claim("manifest", "idmanifest", 8) ==
+          "small.exr: truncated EXR: header attribute \"manifest\" (idmanifest) claims 12 bytes but only 10 bytes "
+          "follow it");
+    CHECK(claim("names", "stringvector", 11) ==
+          "small.exr: truncated EXR: header attribute \"names\" (stringvector) claims 11 bytes but only 10 bytes "
+          "follow it");
+    // Within what the file holds, the same attributes are OpenEXR's to read (here the data ends).
+    CHECK(claim("comments", "string", 10).rfind("small.exr: truncated EXR: the data ends after ", 0) == 0);
+    // A real file with an attribute of an unknown type and a string still reads.
+    {
+        Imf::Header header(4, 3);
+        header.channels().insert("Y", Imf::Channel(Imf::HALF));
+        header.insert("comments", Imf::StringAttribute("a string attribute"));
+        Imf::OutputFile out(dir.file("attributes.exr").c_str(), header);
+        std::vector<half> y(12, half(0.5f));
+        Imf::FrameBuffer fb;
+        fb.insert("Y", Imf::Slice(Imf::HALF, reinterpret_cast<char*>(y.data()), sizeof(half), 4 * sizeof(half)));
+        out.setFrameBuffer(fb);
+        out.writePixels(3);
+    }
+    const auto image = readExr(dir.file("attributes.exr"), error);
+    REQUIRE(image);
+    CHECK(image->rgba[0] == 0.5f);
+}
+
+TEST_CASE("exr: mip and rip maps read as level 0; uncompressed tiles are checked as OpenEXR finds them",
+          "[image][exr]") {
+    TempDir dir;
+    std::string error;
+    for (Imf::LevelMode mode : {Imf::MIPMAP_LEVELS, Imf::RIPMAP_LEVELS})
+        for (Imf::LevelRoundingMode rounding : {Imf::ROUND_DOWN, Imf::ROUND_UP}) {
+            INFO((mode == Imf::MIPMAP_LEVELS ? "mip" : "rip") << (rounding == Imf::ROUND_UP ? " up" : " down"));
+            ExrSpec spec = randomSpec(13, 7, {"R", "G", "B"}, 31);
+            spec.tiled = true;
+            spec.tileW = spec.tileH = 4;
+            spec.levels = mode;
+            spec.rounding = rounding;
+            const std::string path = dir.file("levels.exr");
+            writeExr(path, spec);
+            auto image = readExr(path, error);
+            REQUIRE(image);
+            CHECK(image->rgba == expectedRgba(spec));
+
+            // Where the offset table starts: its first entry points just past it, at tile (0, 0) of level 0.
+            uint64_t entries = 0;
+            {
+                Imf::TiledInputFile in(path.c_str());
+                for (int ly = 0; ly < in.numYLevels(); ++ly)
+                    for (int lx = 0; lx < in.numXLevels(); ++lx)
+                        if (mode == Imf::RIPMAP_LEVELS || lx == ly) entries += uint64_t(in.numXTiles(lx)) * in.numYTiles(ly);
+            }
+            const std::vector<uint8_t> bytes = slurp(path);
+            const auto u64 = [&](const std::vector<uint8_t>& b, size_t at) {
+                uint64_t v;
+                std::memcpy(&v, b.data() + at, 8);
+                return v;
+            };
+            size_t table = 8;
+            while (table + 8 <= bytes.size() && u64(bytes, table) != table + entries * 8) ++table;
+            REQUIRE(table + 8 <= bytes.size());
+            // The last entry (the smallest level's) 0: OpenEXR walks the chunks from the table's end.
+            auto incomplete = bytes;
+            std::memset(incomplete.data() + table + (entries - 1) * 8, 0, 8);
+            image = readExrMemory(incomplete.data(), incomplete.size(), "walked.exr", error);
+            REQUIRE(image);
+            CHECK(image->rgba == expectedRgba(spec));
+            // Level 0's tile (1, 0) says it holds 2 bytes less than its 4x4 pixels of 6 bytes.
+            for (const std::vector<uint8_t>& source : {incomplete, bytes}) {
+                auto changed = source;
+                changed[size_t(u64(bytes, table + 8)) + 16] -= 2;
+                CHECK_FALSE(readExrMemory(changed.data(), changed.size(), "short.exr", error));
+                CHECK(error == "short.exr: corrupt EXR: the uncompressed (NONE) tile (1, 0) holds 94 bytes but its "
+                               "pixels take 96");
+            }
+        }
 }
 
 TEST_CASE("exr: NaN and infinite pixels are refused; negative values read as 0", "[image][exr]") {

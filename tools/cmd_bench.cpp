@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "emu/image_file.h"
+#include "glare/photos.h"
 #include "glare/scene.h"
 #include "glare/sweep.h"
 #include "ps11/hardware.h"
@@ -26,7 +28,7 @@ namespace {
 
 constexpr const char* kBenchUsage =
     "usage: ps11 bench [--technique T|all] [--quality Q|all] [--set name=v1,v2,...]... [--hardware H|all]\n"
-    "                  [--backend emu|gl|both] [--gl-mode native|exact] [--gl osmesa|egl] [--scene S | --in IMG]\n"
+    "                  [--backend emu|gl|both] [--gl-mode native|exact] [--gl osmesa|egl] [--scene S | --in IMG|DIR]\n"
     "                  [--exposure STOPS] [--size WxH] [--frames N] [--json]\n"
     "  T, Q and H also take comma-separated lists; --hardware takes `ideal` (the reference profile) too.\n"
     "  Defaults: every technique on its own scene, published quality, the default card, both renderers\n"
@@ -197,7 +199,7 @@ int cmdBench(const std::vector<std::string>& args) {
             if (!value() || v.empty()) return benchUsage("--scene needs a name");
             scene = v;
         } else if (a == "--in") {
-            if (!value() || v.empty()) return benchUsage("--in needs an image file");
+            if (!value() || v.empty()) return benchUsage("--in needs an image file or a folder of them");
             in = v;
         } else if (a == "--size") {
             if (!value() || !cli::parseSize(v, width, height) || width < 8 || height < 8)
@@ -292,16 +294,35 @@ int cmdBench(const std::vector<std::string>& args) {
         std::string err;
         if (!glare::makeScene(scene, err)) return benchUsage("--scene: " + err);
     }
+    // --in DIR: each image file of the folder in turn (glare::imageFilesIn), its rows named after it.
+    std::vector<std::string> inputs;
     if (!in.empty()) {
+        std::error_code ec;
+        if (std::filesystem::is_directory(in, ec)) {
+            std::string err;
+            std::optional<std::vector<std::string>> files = glare::imageFilesIn(in, err);
+            if (!files || files->empty()) {
+                std::cerr << "ps11 bench: --in: "
+                          << (files ? in + ": no image files (*.png, *.hdr, *.exr) in the folder" : err) << "\n";
+                return cli::kUserError;
+            }
+            inputs = *files;
+        } else {
+            inputs.push_back(in);
+        }
+    }
+    const auto loadInput = [&](const std::string& path) {
         std::string err;
-        std::optional<emu::LoadedImage> loaded = emu::readImage(in, err);
+        std::optional<emu::LoadedImage> loaded = emu::readImage(path, err);
         if (!loaded) {
             std::cerr << "ps11 bench: --in: " << err << "\n";
-            return cli::kUserError;
+            return false;
         }
         spec.image = loaded->hdr ? emu::exposeUnclamped(loaded->image, exposure) : loaded->image;
-        spec.imageName = in;
-    }
+        spec.imageName = path;
+        return true;
+    };
+    if (!inputs.empty() && !loadInput(inputs.front())) return cli::kUserError;
     if (spec.gl) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe's threads, as the peer is measured (PERF.md); read when its screen is made
         std::string err;
@@ -313,13 +334,18 @@ int cmdBench(const std::vector<std::string>& args) {
     }
 
     std::vector<glare::SweepRow> rows;
-    std::string err;
-    const bool ok = glare::runSweep(spec, rows, err, [](const std::string& line) {
-        std::fprintf(stderr, "ps11 bench: %s\n", line.c_str());
-    });
-    if (!ok) {
-        std::cerr << "ps11 bench: " << err << "\n";
-        return cli::kUserError;
+    for (size_t i = 0; i < std::max<size_t>(1, inputs.size()); ++i) {
+        if (i > 0 && !loadInput(inputs[i])) return cli::kUserError;
+        std::vector<glare::SweepRow> these;
+        std::string err;
+        const bool ok = glare::runSweep(spec, these, err, [](const std::string& line) {
+            std::fprintf(stderr, "ps11 bench: %s\n", line.c_str());
+        });
+        if (!ok) {
+            std::cerr << "ps11 bench: " << err << "\n";
+            return cli::kUserError;
+        }
+        rows.insert(rows.end(), these.begin(), these.end());
     }
     if (json) {
         nlohmann::ordered_json out = {{"rows", nlohmann::ordered_json::array()}};

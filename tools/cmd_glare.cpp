@@ -17,6 +17,7 @@
 #include "emu/fullscreen.h"
 #include "emu/image_file.h"
 #include "glare/compare.h"
+#include "glare/photos.h"
 #include "glare/report.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
@@ -33,7 +34,7 @@ namespace {
 constexpr const char* kGlareUsage =
     "usage: ps11 glare --list\n"
     "       ps11 glare --report [--json | --markdown]\n"
-    "       ps11 glare --technique T (--scene S | --in IMG) [-o OUT.png] [--frames N] [--size WxH]\n"
+    "       ps11 glare --technique T (--scene S | --in IMG|DIR) [-o OUT.png] [--frames N] [--size WxH]\n"
     "                  [--backend emu|gl] [--gl osmesa|egl] [--gl-mode exact|native] [--hardware H | --precision P]\n"
     "                  [--quality low|medium|high|published] [--set name=value]... [--exposure STOPS]\n"
     "                  [--dump-passes DIR] [--graph OUT.dot] [--compare] [--json] [--no-skip]\n";
@@ -521,6 +522,54 @@ int runGlare(const GlareOptions& o) {
     return cli::kOk;
 }
 
+// `path` with `_tag` before its extension: out.png -> out_city.png.
+std::string tagged(const std::string& path, const std::string& tag) {
+    const std::filesystem::path p(path);
+    return (p.parent_path() / (p.stem().string() + "_" + tag + p.extension().string())).string();
+}
+
+// `--in DIR`: every image file of the folder in turn (glare::imageFilesIn: *.png, *.hdr, *.exr, sorted),
+// each run as `--in FILE` with its outputs named after the image: -o OUT.png -> OUT_<stem>.png,
+// --dump-passes D -> D/<stem>/, --graph G.dot -> G_<stem>.dot (<stem>_<ext> where two files share a stem).
+// Text output: a "== FILE" line before each image's; --json: an array of each image's object. The first
+// image that fails stops the run with its status.
+int runGlareFolder(const GlareOptions& o) {
+    std::string err;
+    std::optional<std::vector<std::string>> files = glare::imageFilesIn(o.in, err);
+    if (!files) {
+        std::cerr << "ps11 glare: " << err << "\n";
+        return cli::kUserError;
+    }
+    if (files->empty()) {
+        std::cerr << "ps11 glare: " << o.in << ": no image files (*.png, *.hdr, *.exr) in the folder\n";
+        return cli::kUserError;
+    }
+    std::map<std::string, int> stems;
+    for (const std::string& f : *files) ++stems[std::filesystem::path(f).stem().string()];
+    if (o.json) std::printf("[\n");
+    for (size_t i = 0; i < files->size(); ++i) {
+        const std::filesystem::path file((*files)[i]);
+        std::string tag = safeName(file.stem().string());
+        if (stems[file.stem().string()] > 1) tag += "_" + safeName(file.extension().string().substr(1));
+        GlareOptions each = o;
+        each.in = file.string();
+        if (!o.out.empty()) each.out = tagged(o.out, tag);
+        if (!o.dumpDir.empty()) each.dumpDir = (std::filesystem::path(o.dumpDir) / tag).string();
+        if (!o.graph.empty()) each.graph = tagged(o.graph, tag);
+        if (o.json && i) std::printf(",\n");
+        if (!o.json) std::printf("== %s (%zu of %zu)\n", each.in.c_str(), i + 1, files->size());
+        std::fflush(stdout);
+        const int status = runGlare(each);
+        std::fflush(stdout);
+        if (status != cli::kOk) {
+            if (o.json) std::printf("]\n");
+            return status;
+        }
+    }
+    if (o.json) std::printf("]\n");
+    return cli::kOk;
+}
+
 }  // namespace
 
 int cmdGlare(const std::vector<std::string>& args) {
@@ -551,7 +600,7 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else if (a == "--scene") {
             if (!value(o.scene)) return glareUsage("--scene needs a name");
         } else if (a == "--in") {
-            if (!value(o.in)) return glareUsage("--in needs an image file");
+            if (!value(o.in)) return glareUsage("--in needs an image file or a folder of them");
         } else if (a == "-o" || a == "--out") {
             if (!value(o.out)) return glareUsage("-o needs a file name");
         } else if (a == "--dump-passes") {
@@ -610,6 +659,8 @@ int cmdGlare(const std::vector<std::string>& args) {
     if (o.glModeGiven && o.backend != "gl" && !o.compare) return glareUsage("--gl-mode needs --backend gl or --compare");
     if (o.out.empty() && o.graph.empty() && o.dumpDir.empty() && !o.compare)
         return glareUsage("say where the result goes: -o OUT.png (or --dump-passes, --graph, --compare)");
+    std::error_code ec;
+    if (!o.in.empty() && std::filesystem::is_directory(o.in, ec)) return runGlareFolder(o);
     return runGlare(o);
 }
 

@@ -15,10 +15,12 @@
 #include <optional>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "emu/image_file.h"
 #include "glare/compare.h"
+#include "glare/photos.h"
 #include "glare/report.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
@@ -271,6 +273,88 @@ std::string agreementSection(const Ctx& c, const std::vector<TechniqueShow>& sho
             any = true;
         }
     if (!any) s += "<p>Every pass of every technique is bit for bit the same on both renderers: no heat map to show.</p>\n";
+    return s + "</section>\n";
+}
+
+// ---- real photographs -------------------------------------------------------------------------
+
+struct PhotoShow {
+    glare::Photo photo;
+    std::string input;
+    std::vector<std::tuple<std::string, std::string, std::string, glare::ImageError>> results;  // technique, emu, gl, |emu − gl|
+};
+
+// The sample photographs (tools/sample-images.sh) the report shows: the flame, the city at dusk
+// and the night sky first, the first `count` of them present.
+std::vector<glare::Photo> pickPhotos(const std::vector<glare::Photo>& all, size_t count) {
+    std::vector<glare::Photo> out;
+    for (const char* want : {"CandleGlass", "GoldenGate", "night", "Desk", "StillLife", "sunset"})
+        for (const glare::Photo& p : all)
+            if (out.size() < count && p.name.find(want) != std::string::npos) out.push_back(p);
+    return out;
+}
+
+bool showPhoto(Ctx& c, const glare::Photo& photo, PhotoShow& show) {
+    std::string& err = c.error;
+    std::optional<emu::LoadedImage> loaded = emu::readImage(photo.path, err);
+    if (!loaded) return false;
+    const emu::FloatImage image = loaded->hdr ? emu::exposeUnclamped(loaded->image, 0) : loaded->image;
+    show.photo = photo;
+    const std::string stem = safeName(std::filesystem::path(photo.name).stem().string());
+    for (const glare::Technique* t : glare::techniques()) {
+        c.progress("photographs: " + photo.name + ": " + std::string(t->name()));
+        const glare::Settings settings = *glare::presetSettings(*t, "published");
+        glare::Runner emu(c.runnerOptions(image.width, image.height));
+        glare::FrameResult r;
+        std::optional<emu::RgbaImage> out;
+        if (!emu.setImage(image, err) || !emu.runFrame(*t, settings, 0, 1, r, err) || !(out = emu.readOutput(err)))
+            return false;
+        if (show.input.empty()) {
+            std::optional<emu::RgbaImage> in = emu.readTexture(emu.sceneTexture(), err);
+            if (!in) return false;
+            show.input = "img/photo-" + stem + "-input.png";
+            if (!c.png(show.input, opaque(*in))) return false;
+        }
+        const std::string name(t->name());
+        std::string emuFile = "img/photo-" + stem + "-" + name + "-emulated.png", glFile;
+        if (!c.png(emuFile, opaque(*out))) return false;
+        glare::ImageError e;
+        if (c.glNative) {
+            glare::RunnerOptions no = c.runnerOptions(image.width, image.height);
+            no.device.renderer = c.glNative;
+            glare::Runner native(no);
+            std::optional<emu::RgbaImage> g;
+            if (!native.setImage(image, err) || !native.runFrame(*t, settings, 0, 1, r, err) || !(g = native.readOutput(err)))
+                return false;
+            glFile = "img/photo-" + stem + "-" + name + "-gl-native.png";
+            if (!c.png(glFile, opaque(*g))) return false;
+            e = glare::imageError(opaque(*out), opaque(*g));
+        }
+        show.results.emplace_back(name, emuFile, glFile, e);
+    }
+    return true;
+}
+
+std::string photosSection(const std::vector<PhotoShow>& shows, const std::string& missing) {
+    std::string s = "<section id=\"photos\"><h2>Real photographs</h2>\n";
+    if (shows.empty())
+        return s + "<p>No sample photographs here: " + htmlEscape(missing) + "</p></section>\n";
+    s += "<p>HDR photographs from Debian packages (fetched by <code>tools/sample-images.sh</code>, never part of "
+         "the repository), exposure 0, published settings: each technique on the emulated card and on the GL "
+         "renderer's native mode, with their difference in 8-bit levels.</p>\n";
+    for (const PhotoShow& p : shows) {
+        s += "<h3>" + htmlEscape(p.photo.name) + "</h3>\n<p><small>" + htmlEscape(p.photo.description) + "; licence " +
+             htmlEscape(p.photo.licence) + ", from the Debian package " + htmlEscape(p.photo.package) +
+             "</small></p>\n<div class=\"row\">" + figure(p.input, "input (the 8-bit scene the card sees)", 240);
+        for (const auto& [name, emuFile, glFile, e] : p.results) {
+            s += figure(emuFile, htmlEscape(name) + ", emulated", 240);
+            if (!glFile.empty())
+                s += figure(glFile, htmlEscape(name) + ", GL native: against the card max " + std::to_string(e.max) +
+                                        ", mean " + fmt("%.3f", e.mean),
+                            240);
+        }
+        s += "</div>\n";
+    }
     return s + "</section>\n";
 }
 
@@ -537,6 +621,16 @@ int writeDemoReport(const DemoReportOptions& o) {
     std::string debugCommand;
     if (!debugTrace(c, debug, debugCommand)) return fail("debug");
 
+    std::vector<PhotoShow> photoShows;
+    std::string photosMissing;
+    if (std::optional<std::vector<glare::Photo>> all = glare::listPhotos(photosMissing, o.photosDir)) {
+        for (const glare::Photo& p : pickPhotos(*all, o.quick ? 1 : 3)) {
+            PhotoShow ps;
+            if (!showPhoto(c, p, ps)) return fail(p.name);
+            photoShows.push_back(std::move(ps));
+        }
+    }
+
     std::string html = "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>ps11 demo</title><style>" +
                        std::string(kStyle) + "</style></head><body>\n<h1>ps11: Direct3D 8/9 pixel shaders, emulated</h1>\n";
     html += "<p>ps11 " + htmlEscape(std::string(versionString())) +
@@ -547,6 +641,7 @@ int writeDemoReport(const DemoReportOptions& o) {
             " hardware threads" + (c.glDescription.empty() ? "" : "; GL: " + htmlEscape(c.glDescription)) + ".</p>\n";
     html += "<nav><a href=\"#techniques\">techniques</a><a href=\"#fits\">fits ps_1_1</a><a href=\"#agreement\">emulator "
             "vs GL</a><a href=\"#bench\">time vs error</a><a href=\"#stress\">stability</a><a href=\"#debug\">debug</a>"
+            "<a href=\"#photos\">photographs</a>"
             "</nav>\n";
     html += techniquesSection(c, shows, w, h);
     html += fitsSection(fits);
@@ -554,6 +649,7 @@ int writeDemoReport(const DemoReportOptions& o) {
     html += benchSection(c, rows, spec);
     html += stressSection(stress, so);
     html += debugSection(debug, debugCommand);
+    html += photosSection(photoShows, photosMissing);
     html += "<footer><p>Written in " + fmt("%.1f", c.progress.seconds()) + " s.</p></footer></body></html>\n";
     if (!cli::writeFile(c.dir + "/index.html", html)) return cli::kUserError;
     c.progress("done");

@@ -323,7 +323,7 @@ expect_rc 2 "test unknown class" "$ps11" test --hardware voodoo "$work/h.ps11tes
 expect_rc 0 "demo --quick" "$ps11" demo --quick --size 64x36 --threads 1 --hardware geforce3 --out "$work/demo"
 expect_in "$work/out" "report: $work/demo/index.html" "demo names its report"
 expect_in "$work/out" "emulated geforce3" "demo runs --hardware"
-for id in techniques fits agreement bench stress debug; do
+for id in techniques fits agreement bench stress debug photos; do
     expect_in "$work/demo/index.html" "<section id=\"$id\">" "demo report section $id"
 done
 for t in adaptive glow pyramid quarter sprites; do
@@ -484,6 +484,29 @@ cmp -s "$work/r_0002.png" "$work/r_reused.png" || fail "glare: the reused frame 
 expect_rc 0 "glare --json says reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 2 --json -o "$work/r.png"
 expect_in "$work/out" '"reused": true' "glare --json reused"
 expect_json "$work/out" "glare --json"
+# --in DIR: each image file of the folder in turn, sorted, outputs named after the image.
+mkdir -p "$work/photos/sub.png" "$work/glare_out" "$work/no_photos"
+cp "$work/tex.png" "$work/photos/b.png"
+{ printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 8\n'; for _ in $(seq 64); do printf '\200\100\040\201'; done; } >"$work/photos/A.hdr"
+echo "not an image" >"$work/photos/notes.txt"
+expect_rc 0 "glare --in a folder" "$ps11" glare --technique quarter --in "$work/photos" -o "$work/glare_out/q.png" --dump-passes "$work/glare_out/d"
+expect_in "$work/out" "== $work/photos/A.hdr (1 of 2)" "glare --in DIR runs the first image (sorted)"
+expect_in "$work/out" "== $work/photos/b.png (2 of 2)" "glare --in DIR runs the second image"
+expect_in "$work/out" "quarter on 24x16 ($work/photos/b.png)" "glare --in DIR runs each image at its size"
+[ -s "$work/glare_out/q_A.png" ] && [ -s "$work/glare_out/q_b.png" ] || fail "glare --in DIR did not write q_A.png and q_b.png"
+[ -s "$work/glare_out/d/A/contact_sheet.png" ] && [ -s "$work/glare_out/d/b/contact_sheet.png" ] || fail "glare --in DIR: no dump folder per image"
+[ "$(find "$work/glare_out" -maxdepth 1 -name '*.png' | wc -l)" = 2 ] || fail "glare --in DIR wrote other images than one per picture"
+expect_rc 0 "glare --in a folder --json" "$ps11" glare --technique quarter --in "$work/photos" -o "$work/glare_out/q.png" --json
+python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); assert [r["size"] for r in d] == [[8, 8], [24, 16]], d' "$work/out" ||
+    fail "glare --in DIR --json: not an array of each image's object"
+expect_rc 1 "glare --in an empty folder" "$ps11" glare --technique quarter --in "$work/no_photos" -o "$work/x.png"
+expect_in "$work/err" "$work/no_photos: no image files (*.png, *.hdr, *.exr) in the folder" "glare --in DIR says it found none"
+printf 'v/1\001\002' >"$work/no_photos/broken.exr"
+expect_rc 1 "glare --in a folder with a broken image" "$ps11" glare --technique quarter --in "$work/no_photos" -o "$work/x.png"
+expect_in "$work/err" "$work/no_photos/broken.exr: " "glare --in DIR names the image that failed"
+expect_rc 0 "bench --in a folder" "$ps11" bench --technique quarter --in "$work/photos" --frames 1 --backend emu
+expect_in "$work/out" "$work/photos/A.hdr" "bench --in DIR has rows of the first image"
+expect_in "$work/out" "$work/photos/b.png" "bench --in DIR has rows of the second image"
 expect_rc 0 "glare --graph without -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p.dot"
 expect_in "$work/p.dot" 'digraph "pyramid"' "glare --graph writes Graphviz"
 expect_rc 0 "glare --json" "$ps11" glare --technique glow --scene neon --size 64x36 --set path=ffp -o "$work/f.png" --json

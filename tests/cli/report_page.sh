@@ -22,7 +22,7 @@ document.getElementById('f').onload = function () {
     var im = d.images[i];
     if (!im.complete || im.naturalWidth === 0) { broken++; r.push('BROKEN ' + im.getAttribute('src')); }
   }
-  ['techniques', 'fits', 'agreement', 'bench', 'stress', 'debug'].forEach(function (id) {
+  ['techniques', 'fits', 'agreement', 'bench', 'stress', 'debug', 'photos'].forEach(function (id) {
     var s = d.getElementById(id);
     if (!s) r.push('MISSING ' + id);
     else if (s.textContent.trim().length < 40) r.push('EMPTY ' + id);
@@ -50,6 +50,6 @@ if grep -E "CONSOLE" "$work/log" | grep -v "_page_check.html" | grep -q .; then
 fi
 [ -s "$dir/screenshot.png" ] || fail "no screenshot"
 if [ "$failures" = 0 ]; then
-    echo "report page: $(grep -oE 'IMAGES [0-9]+' "$work/dom" | head -1), $(grep -oE 'SVG [0-9]+' "$work/dom" | head -1), six sections, no console message; screenshot $dir/screenshot.png"
+    echo "report page: $(grep -oE 'IMAGES [0-9]+' "$work/dom" | head -1), $(grep -oE 'SVG [0-9]+' "$work/dom" | head -1), seven sections, no console message; screenshot $dir/screenshot.png"
 fi
 exit $((failures > 0))
