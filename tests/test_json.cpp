@@ -52,7 +52,7 @@ TEST_CASE("json: dump escapes every name and keeps the line layout", "[json]") {
         const nlohmann::ordered_json back = nlohmann::ordered_json::parse(text);
         CHECK(back[kOddRead] == kOddRead);
         CHECK(back["list"][0]["name"] == kOddRead);
-        CHECK(back["pair"] == nlohmann::json({1, 2}));
+        CHECK(back["pair"] == nlohmann::ordered_json({1, 2}));
         CHECK(back.begin().key() == kOddRead);  // key order kept
     }
     // depth 0: one line; 2: the top object and the list broken, the records and pairs inline.
@@ -99,13 +99,13 @@ TEST_CASE("json: glare --report --json: odd names read back, numbers and layout 
     INFO(text);
     REQUIRE(nlohmann::json::accept(text));
     const nlohmann::ordered_json j = nlohmann::ordered_json::parse(text);
-    CHECK(j["frame"] == nlohmann::json({64, 36}));
+    CHECK(j["frame"] == nlohmann::ordered_json({64, 36}));
     CHECK(j["hardware"] == kOddRead);
     REQUIRE(j["passes"].size() == 2);
     for (const char* k : {"technique", "preset", "pass", "shader", "version", "note"})
         CHECK(j["passes"][0][k] == kOddRead);
-    CHECK(j["passes"][0]["constants"] == nlohmann::json({0, 3}));
-    CHECK(j["passes"][0]["target"] == nlohmann::json({16, 9}));
+    CHECK(j["passes"][0]["constants"] == nlohmann::ordered_json({0, 3}));
+    CHECK(j["passes"][0]["target"] == nlohmann::ordered_json({16, 9}));
     CHECK(j["passes"][0]["fits_ps_1_1"] == false);
     CHECK(j["passes"][1]["fits_ps_1_1"] == true);
     // The layout of before: the frame on the first line, one pass per line.
