@@ -139,10 +139,18 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle> floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
-    // Deciding costs about a microsecond a tile: a program whose tiles mostly needed shading last
-    // time is shaded without deciding, and decided again on its kTileRetryDraws-th draw after
+    // Deciding costs about a microsecond a tile: a program of which fewer than a quarter of the
+    // tiles saved work last time (filled, skipped, or copied where that saves) is shaded without
+    // deciding, and decided again on its kTileRetryDraws-th draw after
     // (which tiles are decided never changes a byte, only the time).
     std::unique_ptr<TileSkipper> skipper;
+    // A copied tile saves work where the program reads more than that one tap, where its texels
+    // go straight to an 8-bit target (no filter, no program), or where the program is the float
+    // executor's; the fx8 kernels of a one-tap program blended over the target cost little next
+    // to filtering the tap, which the copy does too, so those copies do not pay for deciding.
+    const int tapCount = alignedDraw ? aligned.plan.count : floatDraw ? floatRows.plan.count : 0;
+    const bool copiesSave = tapCount > 1 || floatDraw || (alignedDraw && aligned.directStore);
+    std::atomic<uint64_t> copiesSaving{0};
     if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
@@ -288,7 +296,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     switch (d.action) {
                         case TileAction::Shade: ws.tilesShaded += count; break;
                         case TileAction::Fill: ws.tilesFilled += count; break;
-                        case TileAction::Copy: ws.tilesCopied += count; break;
+                        case TileAction::Copy:
+                            ws.tilesCopied += count;
+                            if (copiesSave) copiesSaving.fetch_add(count, std::memory_order_relaxed);
+                            break;
                         case TileAction::Skip:
                             ws.tilesSkipped += count;
                             // Nothing is drawn; the pixels are still covered.
@@ -382,9 +393,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     }
     if (skipper) {
         const uint64_t shaded = stats.tilesShaded - tilesBefore.tilesShaded;
-        const uint64_t decided = stats.tilesFilled + stats.tilesCopied + stats.tilesSkipped - tilesBefore.tilesFilled -
-                                 tilesBefore.tilesCopied - tilesBefore.tilesSkipped;
-        history.paid = decided * 4 >= shaded + decided;
+        const uint64_t copied = stats.tilesCopied - tilesBefore.tilesCopied;
+        const uint64_t saved = stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled -
+                               tilesBefore.tilesSkipped + copiesSaving.load();
+        history.paid = saved * 4 >= shaded + copied + saved - copiesSaving.load();
         history.since = 0;
     }
     return true;

@@ -279,7 +279,29 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
             }
             FastOp& f = out[idx];
             uint8_t result = 0;
-            if (f.small && f.src[0].a > 0 && f.src[1].a > 0) {
+            // A factor 1 − n with n known in [0, 255] is 255 − n, also in [0, 255]: the 16-bit
+            // kernel takes it (Sousa's screen composite, mad r0, t1, 1-t0, t0).
+            if (!f.small && (f.kind == FastKind::Mul || f.kind == FastKind::Mad) && f.shift == 0 && p.nMax <= 255) {
+                auto plain = [](const FastSrc& s) { return s.a == 2 && s.b == 0; };
+                auto comp = [](const FastSrc& s) { return s.a == -2 && s.b == 510; };
+                bool ok = f.kind == FastKind::Mul || ((f.src[2].a == 2 || f.src[2].a == -2) && f.src[2].b == 0);
+                uint8_t compMask = 0;
+                for (int s = 0; s < 2 && ok; ++s) {
+                    const FastSrc& src = f.src[size_t(s)];
+                    ok = plain(src) || comp(src);
+                    for (int c = 0; c < 4 && ok; ++c)
+                        if ((f.mask >> c) & 1) ok = known(src, c);
+                    if (comp(src)) compMask = uint8_t(compMask | (1u << s));
+                }
+                if (ok && compMask) {
+                    f.small = true;
+                    f.nonNegative = true;
+                    f.complement = compMask;
+                    for (int c = 0; c < 4; ++c)
+                        if ((f.mask >> c) & 1 && (f.kind == FastKind::Mul || (f.src[2].a > 0 && known(f.src[2], c))))
+                            result |= uint8_t(1u << c);
+                }
+            } else if (f.small && f.src[0].a > 0 && f.src[1].a > 0) {
                 bool all = true;
                 for (int c = 0; c < 4; ++c)
                     if ((f.mask >> c) & 1) all = all && known(f.src[0], c) && known(f.src[1], c);

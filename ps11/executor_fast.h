@@ -41,6 +41,7 @@ struct FastOp {
     bool half = false;     // products: every source k is even, formed halved (see the kernels)
     bool small = false;    // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
     bool nonNegative = false;  // small, and both factors unnegated and >= 0 in every lane (set per run)
+    uint8_t complement = 0;    // nonNegative only: bit s, factor s is 1 − n (255 − n, n known in [0, 255])
     uint8_t dst = 0;
     uint8_t mask = kMaskAll;
     int8_t shift = 0;

@@ -45,6 +45,9 @@ const char* const kPrograms[] = {
     "ps_1_4\ntexld r3, t3\nmov_x4 r0, r3\nmad r0, r0, c0, -r3\n",
     "ps_1_1\nmov r0, v0\n",
     "ps_1_1\ntex t0\nmul r0.rgb, t0, v0\n",  // r0.a never written: reads 0
+    // 1 − n factors of known non-negative values (the 16-bit product kernel's complement).
+    "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n",
+    "ps_1_1\ntex t0\ntex t1\nmul r1, 1-t0, 1-t1\nmad r0, 1-r1, t0, -t1\n",
 };
 
 const D3DFORMAT kTexFormats[] = {D3DFMT_A8R8G8B8, D3DFMT_X8R8G8B8, D3DFMT_L8, D3DFMT_A8, D3DFMT_A8L8};
