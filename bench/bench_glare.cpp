@@ -8,7 +8,8 @@
 // frame's time is its passes' own time (each pass ends when the renderer has finished it); for
 // native mode also with the upload of the scene and the read-back of the result (`native_io_ms`).
 // The benchmark's own time is the emulator's fx8 frame; every mode's median and the ratios to the
-// peer are counters. These runners run every pass every frame (RunnerOptions::skip off); two more
+// peer are counters. These runners run every pass every frame (RunnerOptions::skip off; the
+// *_tiles modes decide tiles but reuse no pass); two more
 // hold the image with reuse on and time frames after the first (`*_still_*`), and four run the
 // technique with skipping on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`; on the
 // emulator also with it off, `*_noskip_*`, and the sparse frame's tile decisions on stderr). Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
@@ -33,8 +34,11 @@ namespace {
 
 constexpr uint32_t kW = 1920, kH = 1080;
 
-enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, EmuFloat, kModes };
-const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact", "emu_float"};
+// The *_tiles modes: the emulator with its tiles decided (skipping on) but no pass reused from the
+// last frame (RunnerOptions::reuse off), what a moving scene gets with the default options.
+enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, EmuFloat, EmuFx8Tiles, EmuFloatTiles, kModes };
+const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact", "emu_float", "emu_fx8_tiles",
+                                        "emu_float_tiles"};
 
 int threads() {
     const char* t = std::getenv("PS11_THREADS");
@@ -48,10 +52,11 @@ std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip
     glare::RunnerOptions ro;
     ro.width = w;
     ro.height = h;
-    ro.skip = skip;
+    ro.skip = skip || mode == EmuFx8Tiles || mode == EmuFloatTiles;
+    ro.reuse = skip;
     ro.device.software.threads = threads();
     if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
-    if (mode == EmuFloat) ro.device.precision = ps11::Precision::Float;
+    if (mode == EmuFloat || mode == EmuFloatTiles) ro.device.precision = ps11::Precision::Float;
     if (mode == GlNative || mode == GlExact) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe reads it when its screen is made
         const char* kind = std::getenv("PS11_GL");
@@ -129,15 +134,16 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     // A moving scene: two more runners (emulator fx8, GL native) draw the scene's next frame on
     // their own renderer before each timed frame, so the technique's first reads of a freshly
     // drawn target are in the time, as in an application.
-    std::unique_ptr<glare::Runner> moving[2];
-    std::unique_ptr<glare::Scene> movingScene[2];  // a Scene serves one device
-    const Mode movingMode[2] = {EmuFx8, GlNative};
-    for (int k = 0; k < 2; ++k)
+    // A third decides tiles (the scene's tile facts are then taken anew every frame).
+    std::unique_ptr<glare::Runner> moving[3];
+    std::unique_ptr<glare::Scene> movingScene[3];  // a Scene serves one device
+    const Mode movingMode[3] = {EmuFx8, GlNative, EmuFx8Tiles};
+    for (int k = 0; k < 3; ++k)
         if (!(moving[k] = makeRunner(movingMode[k], err)) || !(movingScene[k] = glare::makeScene(t.scene(), err))) {
             state.SkipWithError(err.c_str());
             return;
         }
-    std::vector<double> movingMs[2];
+    std::vector<double> movingMs[3];
     // A still input with reuse on (the default of ps11 glare): two more runners (emulator fx8, GL
     // native) hold the same image; their first frame runs before timing, so every timed frame is
     // one after the first, against the same renderer's whole frame (skip off) above.
@@ -198,7 +204,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
             }
             stillMs[k].push_back(fr.milliseconds);
         }
-        for (int k = 0; k < 2; ++k) {
+        for (int k = 0; k < 3; ++k) {
             double sceneMs = 0;
             glare::FrameResult fr;
             if (!moving[k]->renderScene(*movingScene[k], f % 8, 8, sceneMs, err) || !moving[k]->runFrame(t, s, f, f + 1, fr, err)) {
@@ -248,10 +254,14 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["fx8_speedup_vs_native"] = med[GlNative] / med[EmuFx8];
     state.counters["ideal_speedup_vs_native"] = med[GlNative] / med[EmuIdeal];
     state.counters["float_speedup_vs_native"] = med[GlNative] / med[EmuFloat];
+    state.counters["fx8_tiles_speedup_vs_native"] = med[GlNative] / med[EmuFx8Tiles];
+    state.counters["float_tiles_speedup_vs_native"] = med[GlNative] / med[EmuFloatTiles];
     state.counters["exact_over_native"] = med[GlExact] / med[GlNative];
     state.counters["emu_fx8_moving_ms"] = median(movingMs[0]);
     state.counters["gl_native_moving_ms"] = median(movingMs[1]);
     state.counters["fx8_moving_speedup_vs_native"] = median(movingMs[1]) / median(movingMs[0]);
+    state.counters["emu_fx8_tiles_moving_ms"] = median(movingMs[2]);
+    state.counters["fx8_tiles_moving_speedup_vs_native"] = median(movingMs[1]) / median(movingMs[2]);
     state.counters["native_io_ms"] = median(nativeIoMs);
     state.counters["emu_fx8_sparse_ms"] = median(panelMs[0][0]);
     state.counters["emu_fx8_dense_ms"] = median(panelMs[1][0]);
@@ -287,11 +297,12 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["native_vs_fx8_max"] = nativeVsFx8.max;
     state.counters["native_vs_fx8_mean"] = nativeVsFx8.mean;
     state.SetLabel(ps11test::glRendererDescription());
-    std::fprintf(stderr, "%s, per pass (median ms): %-22s %9s %9s %9s %9s %9s\n", name.c_str(), "pass", kModeNames[0],
-                 kModeNames[1], kModeNames[2], kModeNames[3], kModeNames[4]);
+    std::fprintf(stderr, "%s, per pass (median ms): %-22s", name.c_str(), "pass");
+    for (int m = 0; m < kModes; ++m) std::fprintf(stderr, " %15s", kModeNames[m]);
+    std::fprintf(stderr, "\n");
     for (const std::string& p : passOrder) {
         std::fprintf(stderr, "%s, per pass (median ms): %-22s", name.c_str(), p.c_str());
-        for (int m = 0; m < kModes; ++m) std::fprintf(stderr, " %9.3f", median(passMs[m][p]));
+        for (int m = 0; m < kModes; ++m) std::fprintf(stderr, " %15.3f", median(passMs[m][p]));
         std::fprintf(stderr, "\n");
     }
 }

@@ -13,6 +13,10 @@
 #include <cstring>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "emu/aligned_pass_kernels.h"
 #include "ps11/texture_sampler_fast.h"
 
@@ -86,10 +90,11 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 // A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
 // zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
 // ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
-// the texel bytes are the target's (| orMask for X8R8G8B8), then the constant channels. False
-// where the columns do not qualify (the caller filters).
+// the texel bytes are the target's (| orMask for X8R8G8B8), then the constant channels; an
+// additive store (ONE/ONE into an 8-bit target) adds those bytes to the target's with saturation,
+// as storeRow does. False where the columns do not qualify (the caller filters).
 bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
-                const RowWindow& window, int x, int n, uint32_t orMask, uint8_t* dst) {
+                const RowWindow& window, int x, int n, uint32_t orMask, bool additive, uint8_t* dst) {
     const int t = window.copyTap;
     const AlignedTap& tap = draw.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
@@ -98,9 +103,18 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
     const size_t i0 = size_t(x - tri.x0);
     const int32_t o = cols.off0[i0];
     if (o < 0) return false;
-    for (int i = 0; i < n; ++i)
-        if (cols.off0[i0 + size_t(i)] != o + 4 * i || cols.w[i0 + size_t(i)] != 0) return false;
-    std::memcpy(dst, row.row0 + o, size_t(n) * 4);
+    // A vector run of step 1 and weight 0 covering the columns qualifies as a whole; otherwise
+    // each column is checked.
+    const int32_t r = cols.run[i0];
+    bool whole = false;
+    if (r >= 0) {
+        const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+        const HConfig& h = tri.configs[size_t(cols.configs[size_t(run.config)])];
+        whole = !run.tabulated && h.step == 1 && h.wx == 0 && run.x1 >= x + n;
+    }
+    if (!whole)
+        for (int i = 0; i < n; ++i)
+            if (cols.off0[i0 + size_t(i)] != o + 4 * i || cols.w[i0 + size_t(i)] != 0) return false;
     uint32_t keep = ~0u, set = orMask;  // the constant channels' bytes (b g r a: r g b a at 2 1 0 3)
     for (int c = 0; c < 4; ++c)
         if (!((window.copyMask >> c) & 1)) {
@@ -108,12 +122,33 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
             keep &= ~(0xffu << shift);
             set |= uint32_t(std::clamp<int32_t>(window.grid[size_t(c)], 0, 255)) << shift;
         }
-    if (keep != ~0u || set != 0)
-        for (int i = 0; i < n; ++i) {
-            uint32_t w = load32(dst + 4 * i);
-            w = (w & keep) | set;
-            std::memcpy(dst + 4 * i, &w, 4);
-        }
+    const uint8_t* src = row.row0 + o;
+    if (!additive) {
+        std::memcpy(dst, src, size_t(n) * 4);
+        if (keep != ~0u || set != 0)
+            for (int i = 0; i < n; ++i) {
+                uint32_t w = load32(dst + 4 * i);
+                w = (w & keep) | set;
+                std::memcpy(dst + 4 * i, &w, 4);
+            }
+        return true;
+    }
+    int i = 0;
+#if defined(__SSE2__)
+    const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
+    for (; i + 4 <= n; i += 4) {
+        const __m128i w = _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
+        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
+        _mm_storeu_si128(d, _mm_adds_epu8(_mm_loadu_si128(d), w));
+    }
+#endif
+    for (; i < n; ++i) {
+        const uint32_t w = (load32(src + 4 * i) & keep) | set, old = load32(dst + 4 * i);
+        uint32_t sum = 0;
+        for (int b = 0; b < 4; ++b)
+            sum |= std::min<uint32_t>(((w >> (8 * b)) & 0xff) + ((old >> (8 * b)) & 0xff), 255u) << (8 * b);
+        std::memcpy(dst + 4 * i, &sum, 4);
+    }
     return true;
 }
 
@@ -625,10 +660,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         in.count = n;
                         ps11::runPresampled(exec, in, fill, &ctx, r0, &stats.exec);
                     } else if (mode == RowMode::Copy) {
-                        if (draw.directStore && copyTexels(draw, tri, rows, *window, x, n, orMask,
-                                                           target.texel(uint32_t(x), uint32_t(y)))) {
+                        if ((draw.directStore || draw.directAdd) &&
+                            copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
+                                       target.texel(uint32_t(x), uint32_t(y)))) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
+                            stats.copiedDirect += uint64_t(n);
                             continue;
                         }
                         fill(&ctx, window->copyTap, 0, n, r0);

@@ -163,6 +163,7 @@ void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, in
 
 struct AlignedStats {
     uint64_t pixels = 0, written = 0, texels = 0;
+    uint64_t copiedDirect = 0;  // pixels of copied windows stored straight from the texel row
     ps11::ExecutorStats exec;
 };
 

@@ -144,13 +144,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     // deciding, and decided again on its kTileRetryDraws-th draw after
     // (which tiles are decided never changes a byte, only the time).
     std::unique_ptr<TileSkipper> skipper;
-    // A copied tile saves work where the program reads more than that one tap, where its texels
-    // go straight to an 8-bit target (no filter, no program), or where the program is the float
-    // executor's; the fx8 kernels of a one-tap program blended over the target cost little next
-    // to filtering the tap, which the copy does too, so those copies do not pay for deciding.
+    // A copied tile saves work where the program reads more than that one tap, where the program
+    // is the float executor's, or where its texels went straight to an 8-bit target (no filter, no
+    // program: counted as drawn); the fx8 kernels of a one-tap program cost little next to filtering
+    // the tap, which a copy does too, so such copies do not pay for deciding.
     const int tapCount = alignedDraw ? aligned.plan.count : floatDraw ? floatRows.plan.count : 0;
-    const bool copiesSave = tapCount > 1 || floatDraw || (alignedDraw && aligned.directStore);
-    std::atomic<uint64_t> copiesSaving{0};
+    const bool copiesSave = tapCount > 1 || floatDraw;
+    std::atomic<uint64_t> copiesSaving{0}, copiedDirect{0};
     if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
@@ -373,6 +373,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             // The draw's textures are not kept alive past it: a texture read in place would
             // otherwise be copied on its next write (Device::prepareWrite).
             for (int s = 0; s < kMaxSamplers; ++s) sampler.bind(s, nullptr);
+            copiedDirect.fetch_add(as.copiedDirect, std::memory_order_relaxed);
             ws.pixelsCovered += as.pixels;
             ws.pixelsShaded = es.pixels + as.exec.pixels;
             ws.instructions = es.instructions + as.exec.instructions;
@@ -394,9 +395,11 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     if (skipper) {
         const uint64_t shaded = stats.tilesShaded - tilesBefore.tilesShaded;
         const uint64_t copied = stats.tilesCopied - tilesBefore.tilesCopied;
+        const uint64_t copiesSaved =
+            std::min(copied, copiesSaving.load() + copiedDirect.load() / uint64_t(kBandRows * kSkipTileColumns));
         const uint64_t saved = stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled -
-                               tilesBefore.tilesSkipped + copiesSaving.load();
-        history.paid = saved * 4 >= shaded + copied + saved - copiesSaving.load();
+                               tilesBefore.tilesSkipped + copiesSaved;
+        history.paid = saved * 4 >= shaded + copied + saved - copiesSaved;
         history.since = 0;
     }
     return true;

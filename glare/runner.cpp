@@ -120,7 +120,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     }
     if (built) built(graph);
     result.passes.clear();
-    const bool ok = graph.run(*m_pool, result.passes, error, hook, m_options.skip ? &m_memo : nullptr, hookObserves);
+    const bool ok = graph.run(*m_pool, result.passes, error, hook, reuses() ? &m_memo : nullptr, hookObserves);
     // The passes' own time: what the hooks (dumps, captures) take is not the technique's.
     result.milliseconds = 0;
     for (const PassStats& s : result.passes) result.milliseconds += s.milliseconds;

@@ -26,6 +26,9 @@ struct RunnerOptions {
     // its interval evaluator decides (docs/device.md "Tile skipping"). Off: every pass runs every
     // frame and every tile is shaded (`--no-skip`; device.software.skipTiles is then off).
     bool skip = true;
+    // With skip: whether passes are reused from frame to frame (off: every pass runs every frame and
+    // only the tiles are decided, what a moving scene gets; benchmarks time whole frames so).
+    bool reuse = true;
 };
 
 // One frame's result.
@@ -104,7 +107,8 @@ public:
         if (!slot) slot = std::make_shared<T>();
         return *static_cast<T*>(slot.get());
     }
-    bool skips() const { return m_options.skip; }
+    // Whether passes are reused from frame to frame (RunnerOptions::skip and reuse).
+    bool reuses() const { return m_options.skip && m_options.reuse; }
     TexturePool& pool() { return *m_pool; }
 
 private:

@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -22,7 +23,9 @@ namespace glare {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 // A pixel's luminance from its r, g, b bytes; the sensors fire where it reaches the threshold.
-float luminance(uint32_t r, uint32_t g, uint32_t b) { return (0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b)) / 255.0f; }
+float luminance(uint32_t r, uint32_t g, uint32_t b) {
+    return (0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b)) / 255.0f;
+}
 
 // The number of bits set in each byte value (no POPCNT on the baseline x86-64).
 constexpr auto kBitsSet = [] {
@@ -31,29 +34,45 @@ constexpr auto kBitsSet = [] {
     return t;
 }();
 
-// Sets bit x of `fires` where luminance(pixel x of the row) >= threshold, over one row of `width`
-// pixels, each a 32-bit word whose bytes at bit shifts rs, 8 and bs are r, g and b. The same float
-// operations in the same order as luminance(), four pixels at a time where SSE2 is there (every
-// x86-64). `fires` holds (width + 63) / 64 words, zero on entry.
-void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float threshold, uint64_t* fires) {
+// The weighted sum luminance() divides by 255.
+float luminanceSum(uint32_t r, uint32_t g, uint32_t b) { return 0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b); }
+
+}  // namespace
+
+float sensorSumThreshold(float threshold) {
+    if (std::isnan(threshold)) return std::numeric_limits<float>::infinity();
+    if (threshold <= 0) return -std::numeric_limits<float>::infinity();
+    float s = threshold * 255.0f;
+    while (s / 255.0f >= threshold) s = std::nextafter(s, -std::numeric_limits<float>::infinity());
+    while (s / 255.0f < threshold) s = std::nextafter(s, std::numeric_limits<float>::infinity());
+    return s;
+}
+
+namespace {
+
+// Sets bit x of `fires` where luminance(pixel x of the row) >= threshold, given as sensorSumThreshold(),
+// over one row of `width` pixels, each a 32-bit word whose bytes at bit shifts rs, 8 and bs are r,
+// g and b. The same float operations in the same order as luminanceSum(), four pixels at a time
+// where SSE2 is there (every x86-64). `fires` holds (width + 63) / 64 words, zero on entry.
+void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeast, uint64_t* fires) {
     uint32_t x = 0;
 #if defined(__SSE2__)
     const __m128i m = _mm_set1_epi32(0xff);
     const __m128 kr = _mm_set1_ps(0.30f), kg = _mm_set1_ps(0.59f), kb = _mm_set1_ps(0.11f);
-    const __m128 k255 = _mm_set1_ps(255.0f), t = _mm_set1_ps(threshold);
+    const __m128 t = _mm_set1_ps(sumAtLeast);
     const __m128i sr = _mm_cvtsi32_si128(rs), sb = _mm_cvtsi32_si128(bs);
     for (; x + 4 <= width; x += 4) {
         const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + size_t(x) * 4));
         const __m128 r = _mm_cvtepi32_ps(_mm_and_si128(_mm_srl_epi32(w, sr), m));
         const __m128 g = _mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, 8), m));
         const __m128 b = _mm_cvtepi32_ps(_mm_and_si128(_mm_srl_epi32(w, sb), m));
-        const __m128 l = _mm_div_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(kr, r), _mm_mul_ps(kg, g)), _mm_mul_ps(kb, b)), k255);
+        const __m128 l = _mm_add_ps(_mm_add_ps(_mm_mul_ps(kr, r), _mm_mul_ps(kg, g)), _mm_mul_ps(kb, b));
         fires[x / 64] |= uint64_t(_mm_movemask_ps(_mm_cmpge_ps(l, t))) << (x % 64);
     }
 #endif
     for (; x < width; ++x) {
         const uint8_t* p = row + size_t(x) * 4;
-        if (luminance(p[rs / 8], p[1], p[bs / 8]) >= threshold) fires[x / 64] |= uint64_t(1) << (x % 64);
+        if (luminanceSum(p[rs / 8], p[1], p[bs / 8]) >= sumAtLeast) fires[x / 64] |= uint64_t(1) << (x % 64);
     }
 }
 }  // namespace
@@ -84,8 +103,9 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
     const size_t wpr = (size_t(width) + 63) / 64;
     std::vector<uint64_t> fires(wpr * height, 0);
     auto fired = [&](uint32_t x, uint32_t y) { return (fires[size_t(y) * wpr + x / 64] >> (x % 64)) & 1; };
+    const float sumAtLeast = sensorSumThreshold(s.threshold);
     inBands(height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
-        for (uint32_t y = y0; y < y1; ++y) fireRow(pixel(0, y), width, rs, bs, s.threshold, &fires[size_t(y) * wpr]);
+        for (uint32_t y = y0; y < y1; ++y) fireRow(pixel(0, y), width, rs, bs, sumAtLeast, &fires[size_t(y) * wpr]);
     });
     // Cluster blocks first: 8x8 blocks at least 90 % bright.
     const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;
@@ -277,7 +297,7 @@ public:
                       Kept& kept = runner->kept<Kept>("sprites: sensors");
                       const emu::Handle sceneTexture = c.texture(scene);
                       const uint64_t generation = c.device.contentGeneration(sceneTexture);
-                      if (runner->skips() && kept.valid && kept.texture == sceneTexture && kept.generation == generation &&
+                      if (runner->reuses() && kept.valid && kept.texture == sceneTexture && kept.generation == generation &&
                           kept.settings == ss) {
                           *sprites = kept.sprites;
                           c.stats.reused = true;

@@ -34,6 +34,12 @@ struct SensorFrame {
     bool bgra = false;
 };
 
+// The least float s with s / 255.0f >= threshold (a float division): a sensor's luminance, the
+// sum 0.30·r + 0.59·g + 0.11·b (bytes, float arithmetic in that order) over 255, reaches the
+// threshold exactly where the sum reaches s, since the division rounds monotonically; the sensors
+// compare sums and never divide. A NaN threshold gives +inf (never fires), one <= 0 gives −inf.
+float sensorSumThreshold(float threshold);
+
 // The sprites of a frame. Grouping: a group's sprite sits
 // at the luminance-weighted centre of its firing pixels, Σ L_i p_i / Σ L_i, and carries the sum of
 // their colours, so its energy equals that of the N² single-pixel sprites it replaces. A cluster

@@ -762,3 +762,56 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
     CHECK(copied > 20);
     CHECK(skipped > 10);
 }
+
+TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain and ONE/ONE", "[draw][aligned][skip]") {
+    // The sprites' composite (mul r0, t0, c0 with c0 = (1, 1, 1, 0), ONE/ONE) and plain copies: every
+    // tile is a copy whatever the texels, and the copy goes from the texture's row to the target
+    // (a row copy, or a saturating byte add). Bytes must equal skipping off and the quad path.
+    std::mt19937 rng(20261127);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n",
+                                    "ps_1_1\ntex t0\nmov r0.rgb, t0\n+mov r0.a, c1.a\n"};
+    uint64_t copied = 0;
+    for (int i = 0; i < 48; ++i) {
+        Case c = randomCase(rng);
+        c.w = UINT(uni(1, 300)), c.h = UINT(uni(1, 40));
+        c.rtFormat = uni(0, 2) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        for (Case::Tex& t : c.tex) {
+            t.w = c.w, t.h = c.h;
+            t.format = uni(0, 2) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : 255);
+            t.filter = uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.bound = true;
+        }
+        c.program = programs[size_t(i) % std::size(programs)];
+        for (int k = 0; k < 4; ++k) c.consts[0][k] = k < 3 ? 1.0f : 0.0f;
+        c.consts[1][3] = float(uni(0, 4)) * 0.25f;
+        c.verts.clear();
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
+            for (int s = 0; s < 4; ++s) q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            c.verts.push_back(q);
+        }
+        c.blend = DWORD(i % 2);  // plain, ONE/ONE
+        c.alphaTest = false, c.writeMask = 0xf, c.scissor = uni(0, 5) == 0;
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats qs, rs, ks;
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", blend " << c.blend << ", program:\n" << c.program);
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        copied += ks.tilesCopied;
+    }
+    CHECK(copied > 48);
+}

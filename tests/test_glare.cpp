@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -993,4 +994,41 @@ TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
     gl.renderer = ps11test::glRendererFactory("", error);
     REQUIRE(gl.renderer);
     checkReuse(gl);
+}
+
+TEST_CASE("sprites: comparing the luminance sum with sensorSumThreshold is comparing luminance, for every colour",
+          "[glare]") {
+    // Every r, g, b byte triple against thresholds on and off the 8-bit grid, past the ends and NaN.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<float> thresholds = {0.8f, 0.5f, 0.31f, 1.0f / 255.0f, 1.0f, 0.0f, -0.25f, 1.5f, nan};
+    // Some colours' own luminances and their float neighbours: the sums right at the threshold.
+    std::mt19937 rng(2026);
+    for (int k = 0; k < 4; ++k) {
+        const float l = (0.30f * float(rng() % 256) + 0.59f * float(rng() % 256) + 0.11f * float(rng() % 256)) / 255.0f;
+        for (const float t : {l, std::nextafter(l, 0.0f), std::nextafter(l, 2.0f)}) thresholds.push_back(t);
+    }
+    for (const float t : thresholds) {
+        const float s = sensorSumThreshold(t);
+        uint64_t mismatches = 0, fires = 0;
+        for (int r = 0; r < 256; ++r)
+            for (int g = 0; g < 256; ++g)
+                for (int b = 0; b < 256; ++b) {
+                    const float sum = 0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b);
+                    const bool byLuminance = sum / 255.0f >= t;
+                    fires += byLuminance;
+                    mismatches += byLuminance != (sum >= s);
+                }
+        INFO("threshold " << t << ", sum threshold " << s << ", colours firing " << fires);
+        CHECK(mismatches == 0);
+    }
+    // The least such sum for many thresholds (division rounds monotonically, so the least float s
+    // with s / 255 >= t is the whole rule): s reaches t, the float below it does not.
+    uint64_t notLeast = 0;
+    for (int k = 0; k < 200000; ++k) {
+        const float l = (0.30f * float(rng() % 256) + 0.59f * float(rng() % 256) + 0.11f * float(rng() % 256)) / 255.0f;
+        const float t = k % 3 == 0 ? l : k % 3 == 1 ? std::nextafter(l, 0.0f) : std::nextafter(l, 2.0f);
+        const float s = sensorSumThreshold(t);
+        notLeast += !(s / 255.0f >= t) || std::nextafter(s, -1.0f) / 255.0f >= t;
+    }
+    CHECK(notLeast == 0);
 }
