@@ -39,13 +39,9 @@ inline int32_t divRoundEven(int64_t num) {
 // Saturate to [0, 1]; NaN becomes 0.
 inline float sat(float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; }
 
-// float(b) / 255.0f for every byte b (a destination byte as the float blend reads it), without a
-// division per channel.
-const std::array<float, 256> kUnitOfByte = [] {
-    std::array<float, 256> t{};
-    for (uint32_t b = 0; b < 256; ++b) t[b] = float(b) / 255.0f;
-    return t;
-}();
+// float(b) / 255.0f for every byte b (a destination byte as the float blend reads it): the texture
+// values' table.
+const float* const kUnitOfByte = ps11::Texture::unorm8Values();
 
 // round_half_even(v * 255) of a float already in [0, 1] (ps11::unorm8OfFloat without the clamp).
 inline uint32_t byteOfUnit(float v) { return uint32_t(ps11::roundEvenSmall(double(v) * 255.0)); }
