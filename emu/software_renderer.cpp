@@ -20,8 +20,8 @@ namespace {
 
 // Rows per band handed to a worker: even (quads) and small enough to balance two threads.
 constexpr int kBandRows = 16;
-// A StretchRect shares its rows among the workers from this many destination pixels per worker.
-constexpr int64_t kMinStretchPixelsPerWorker = 16384;
+// A StretchRect shares its rows among the workers from this many texels read per worker.
+constexpr int64_t kMinStretchTexelsPerWorker = 16384;
 // Executors kept per renderer (cleared when full).
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
@@ -79,8 +79,10 @@ bool SoftwareRenderer::stretchRect(const StretchCall& call) {
     if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
     // Destination rows in bands over the workers (each row is written by one of them).
     const int64_t rows = call.destRect.y1 - call.destRect.y0;
-    const int64_t pixels = rows * (call.destRect.x1 - call.destRect.x0);
-    const int workers = int(std::clamp<int64_t>(pixels / kMinStretchPixelsPerWorker, 1, m_context->pool.size()));
+    // The work is the texels read: four a pixel for LINEAR, whose scattered reads of a reduction
+    // wait on memory.
+    const int64_t texels = rows * (call.destRect.x1 - call.destRect.x0) * (call.linear ? 4 : 1);
+    const int workers = int(std::clamp<int64_t>(texels / kMinStretchTexelsPerWorker, 1, m_context->pool.size()));
     m_context->pool.run(workers, [&](int w) {
         stretchImages(call, RowRange{rows * w / workers, rows * (w + 1) / workers});
     });
