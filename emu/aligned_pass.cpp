@@ -172,8 +172,8 @@ void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, in
 
 namespace {
 
-TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
-    TapRow r;
+// Sets the texel rows and vertical weight of `r` (its H-row planes are the caller's to set).
+void setTapRow(TapRow& r, const AlignedTap& tap, const TriangleSetup& s, int y) {
     const float v = rowV(s, tap.coordSet, y);
     int32_t j0 = 0, j1 = 0, w = 0;
     ps11::fastpath::axisTable(tap.addressV, tap.linear, 1, &v, tap.height, &j0, &j1, &w);
@@ -181,7 +181,6 @@ TapRow tapRow(const AlignedTap& tap, const TriangleSetup& s, int y) {
     r.row0 = j0 >= 0 ? tap.texels + size_t(j0) * pitch : nullptr;
     r.row1 = j1 >= 0 ? tap.texels + size_t(j1) * pitch : nullptr;
     r.wy = w;
-    return r;
 }
 
 // Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count); vector runs
@@ -226,13 +225,13 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
 // Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
 // the current pixel row (so every pointer handed out for a row stays valid until the next row),
 // or a new one. `fresh` tells whether it must be filled.
-HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, bool& fresh) {
+HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
     HRowCache::Slot* victim = nullptr;
     for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
         HRowCache::Slot& sl = *sp;
         const HConfig& k = sl.config;
         if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == key.tableId) {
+            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
             sl.stamp = cache.stamp;
             fresh = false;
             return sl;
@@ -245,6 +244,7 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
     }
     victim->row = row;
     victim->config = key;
+    victim->config.tableId = tableId;
     victim->stamp = cache.stamp;
     fresh = true;
     return *victim;
@@ -261,11 +261,11 @@ void slotPlanes(HRowCache::Slot& sl, int n, int pad, uint16_t* out[4]) {
 // Texel rows are first deinterleaved once per draw (a "staged" slot over the triangle's texel
 // range of that texture), then combined per configuration; weight 0 at step 1 is the staged row
 // itself.
-void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, const HConfig& config,
+void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, const HConfig& config, uint64_t tableId,
           std::array<const uint16_t*, 4>& planes) {
     bool fresh = false;
     if (config.wx == -2) {  // tabulated: straight from the texel row, per column
-        HRowCache::Slot& h = slotFor(cache, row, config, fresh);
+        HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
         if (fresh) {
             const int n = config.jhi - config.jlo;
             uint16_t* out[4];
@@ -279,7 +279,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         return;
     }
     const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
-    HRowCache::Slot& staged = slotFor(cache, row, stageKey, fresh);
+    HRowCache::Slot& staged = slotFor(cache, row, stageKey, stageKey.tableId, fresh);
     const int first = config.step * config.jlo + config.phase - config.stageLo;  // staged element of jlo
     if (fresh) {
         uint16_t* out[4];
@@ -292,7 +292,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
             planes[size_t(c)] = staged.data.data() + size_t(c) * size_t(staged.stride) + size_t(first);
         return;
     }
-    HRowCache::Slot& h = slotFor(cache, row, config, fresh);
+    HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
     if (fresh) {
         uint16_t* out[4];
         slotPlanes(h, config.jhi - config.jlo, kHRowPad, out);
@@ -587,7 +587,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     std::array<const uint16_t*, 4> planes{};
     // Tabulated configurations: a triangle whose table equals an earlier one's over the same
     // columns takes that one's id, so their H rows are shared (a full-screen quad's two halves).
-    std::array<std::array<uint64_t, 8 * kMaxTapConfigs>, kMaxAlignedTriangles> tabIds{};
+    // (Only the entries of existing configurations are set and read.)
+    std::array<std::array<uint64_t, 8 * kMaxTapConfigs>, kMaxAlignedTriangles> tabIds;
     for (size_t ti = 0; ti < count && ti < kMaxAlignedTriangles; ++ti) {
         const std::vector<HConfig>& cs = tris[ti]->configs;
         for (size_t c = 0; c < cs.size() && c < tabIds[ti].size(); ++c) {
@@ -626,7 +627,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 const AlignedTap& tap = draw.taps[size_t(t)];
                 if (!tap.bound || !((neededTaps >> t) & 1)) continue;
                 TapRow& r = rows[size_t(t)];
-                r = tapRow(tap, s, y);
+                setTapRow(r, tap, s, y);
                 // The H rows of the tap's long runs (built on first use, shared by taps and rows).
                 const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
                 const bool rowsOk = r.row0 && (r.row1 || r.wy == 0);
@@ -634,12 +635,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     r.ready[size_t(c)] = rowsOk;
                     if (!rowsOk) continue;
                     const size_t ci = size_t(cols.configs[size_t(c)]);
-                    HConfig h = tri.configs[ci];
-                    if (ti < kMaxAlignedTriangles && ci < tabIds[ti].size()) h.tableId = tabIds[ti][ci];
-                    hRow(*draw.kernels, cache, r.row0, h, planes);
+                    const HConfig& h = tri.configs[ci];
+                    const uint64_t id = ti < kMaxAlignedTriangles && ci < tabIds[ti].size() ? tabIds[ti][ci] : h.tableId;
+                    hRow(*draw.kernels, cache, r.row0, h, id, planes);
                     for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
                     if (r.wy != 0) {
-                        hRow(*draw.kernels, cache, r.row1, h, planes);
+                        hRow(*draw.kernels, cache, r.row1, h, id, planes);
                         for (int ch = 0; ch < 4; ++ch) r.h1[size_t(c)].p[ch] = planes[size_t(ch)];
                     }
                 }
