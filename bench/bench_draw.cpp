@@ -34,8 +34,8 @@ struct QuadVertex {
 // Down2: 1080p texture to a 960×540 target, one bilinear tap on the corner of each 2×2 block.
 // Down4: 1080p texture to 480×270, the blur program's four bilinear taps at ±1 texel around the
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4 };
-constexpr int kPasses = 6;
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small };
+constexpr int kPasses = 7;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -47,7 +47,7 @@ struct Scene {
     UINT w = kW, h = kH;
 
     Scene(Pass pass, int threads, bool aligned = true) {
-        if (pass == Pass::CopySmall) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
+        if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         if (pass == Pass::Down2) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4) w = kW / 4, h = kH / 4;
         // The texture: the target's size, or 1080p for the reductions.
@@ -69,7 +69,7 @@ struct Scene {
             for (UINT x = 0; x < tw; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
-        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4;
+        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small;
         const int stages = fourTaps ? 4 : 1;
         const DWORD filter = pass == Pass::CopyPoint ? D3DTEXF_POINT : D3DTEXF_LINEAR;
         for (int s = 0; s < stages; ++s) {
@@ -223,6 +223,11 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->UseRealTime();
 
 BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, blur4_240x135_fx8, Pass::Blur4Small)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)
