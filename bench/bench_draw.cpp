@@ -34,8 +34,10 @@ struct QuadVertex {
 // Down2: 1080p texture to a 960×540 target, one bilinear tap on the corner of each 2×2 block.
 // Down4: 1080p texture to 480×270, the blur program's four bilinear taps at ±1 texel around the
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small };
-constexpr int kPasses = 7;
+// Sprites: 400 quads of 64x64 pixels at sub-pixel positions over a 1080p target, each a 32x32
+// texture magnified 2x and scaled by c0, added ONE/ONE (the sprites technique's draw).
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites };
+constexpr int kPasses = 8;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -52,7 +54,7 @@ struct Scene {
         if (pass == Pass::Down4) w = kW / 4, h = kH / 4;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down4;
-        const UINT tw = down ? kW : w, th = down ? kH : h;
+        const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : w, th = down ? kH : pass == Pass::Sprites ? 32 : h;
         DeviceOptions o;
         o.software.threads = threads;
         o.software.alignedPasses = aligned;
@@ -79,7 +81,9 @@ struct Scene {
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
         }
-        if (dev->CreatePixelShaderFromText(fourTaps ? kBlur4 : kCopy, &ps) != D3D_OK) return;
+        const char* const kSprite = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
+        if (dev->CreatePixelShaderFromText(fourTaps ? kBlur4 : pass == Pass::Sprites ? kSprite : kCopy, &ps) != D3D_OK)
+            return;
         dev->SetPixelShader(ps);
         const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
         dev->SetPixelShaderConstantF(0, c0, 1);
@@ -90,6 +94,23 @@ struct Scene {
         const float off[4][2] = {{-k, -k}, {k, -k}, {-k, k}, {k, k}};
         const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+        if (pass == Pass::Sprites) {
+            dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
+            dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
+            dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
+            std::uniform_real_distribution<float> px(-32.0f, float(w) - 32.0f), py(-32.0f, float(h) - 32.0f);
+            for (int k = 0; k < 400; ++k) {
+                const float x0 = px(rng), y0 = py(rng);
+                const float sx[4] = {x0, x0 + 64, x0 + 64, x0}, sy[4] = {y0, y0, y0 + 64, y0 + 64};
+                for (int c : {0, 1, 2, 0, 2, 3}) {
+                    QuadVertex q{sx[c], sy[c], 0.0f, 1.0f, {}};
+                    q.uv[0][0] = us[c], q.uv[0][1] = vs[c];
+                    quad.push_back(q);
+                }
+            }
+            ok = draw();
+            return;
+        }
         for (int c : {0, 1, 2, 0, 2, 3}) {
             QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
             for (int s = 0; s < 4; ++s) {
@@ -101,7 +122,9 @@ struct Scene {
         ok = draw();  // warm-up: builds the sampler's copy of the texture and the executor
     }
 
-    bool draw() { return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(QuadVertex)) == D3D_OK; }
+    bool draw() {
+        return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(quad.size() / 3), quad.data(), sizeof(QuadVertex)) == D3D_OK;
+    }
 };
 
 Scene& scene(Pass pass, int threads, bool aligned = true) {
@@ -239,6 +262,16 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_1080p_fx8, Pass::Blur4)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_1080p_fx8, Pass::CopyLinear)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_Draw, sprites_400x64x64_1080p_fx8, Pass::Sprites)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, sprites_400x64x64_1080p_fx8, Pass::Sprites)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

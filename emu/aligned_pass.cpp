@@ -183,6 +183,10 @@ void setTapRow(TapRow& r, const AlignedTap& tap, const TriangleSetup& s, int y) 
     r.wy = w;
 }
 
+// Stretches of columns outside vector runs at least this long are filtered with the tabulated
+// kernels directly (filterTap).
+constexpr int kMinDirectColumns = 8;
+
 // Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count); vector runs
 // (only where the draw has kernels) with `kernels`.
 void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
@@ -213,11 +217,32 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
             x = e;
             continue;
         }
-        // Border texels, short runs, or no vector kernels: one pixel at a time up to the next
-        // vector run.
+        // Up to the next vector run: columns whose texels are all inside the texture, with both
+        // texel rows at hand, have their H rows built for these columns alone and blended at once
+        // (the tabulated kernels without the cache: a narrow triangle's, whose rows serve few pixel
+        // rows); border texels, short stretches or no vector kernels, one pixel at a time.
         int e = x + 1;
         while (e < end && vectorRun(e) < 0) ++e;
-        filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
+        bool inside = kernels && e - x >= kMinDirectColumns && row.row0 && (row.wy == 0 || row.row1);
+        for (int i = x; inside && i < e; ++i)
+            inside = cols.off0[size_t(i - colBase)] >= 0 && cols.off1[size_t(i - colBase)] >= 0;
+        if (inside) {
+            alignas(32) uint16_t planes[2][4][ps11::kMaxSpan + kHRowPad];
+            uint16_t* const h0[4] = {planes[0][0], planes[0][1], planes[0][2], planes[0][3]};
+            uint16_t* const h1[4] = {planes[1][0], planes[1][1], planes[1][2], planes[1][3]};
+            const size_t at = size_t(x - colBase);
+            for (int done = 0; done < e - x; done += ps11::kMaxSpan) {
+                const int n = std::min(ps11::kMaxSpan, e - x - done);
+                const size_t k = at + size_t(done);
+                kernels->buildTabulated(row.row0, &cols.off0[k], &cols.off1[k], &cols.w[k], n, h0);
+                if (row.wy != 0) kernels->buildTabulated(row.row1, &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1);
+                const uint16_t* const c0[4] = {h0[0], h0[1], h0[2], h0[3]};
+                const uint16_t* const c1[4] = {h1[0], h1[1], h1[2], h1[3]};
+                kernels->vertical(HKind::H, c0, c1, row.wy, n, x + done - first, out);
+            }
+        } else {
+            filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
+        }
         x = e;
     }
 }
@@ -226,28 +251,33 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
 // the current pixel row (so every pointer handed out for a row stays valid until the next row),
 // or a new one. `fresh` tells whether it must be filled.
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
-    HRowCache::Slot* victim = nullptr;
-    for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
-        HRowCache::Slot& sl = *sp;
-        const HConfig& k = sl.config;
-        if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
-            sl.stamp = cache.stamp;
-            fresh = false;
-            return sl;
+    const size_t n = cache.slots.size();
+    size_t victim = n;
+    for (size_t i = 0; i < n; ++i) {
+        if (cache.rowOf[i] == row) {
+            HRowCache::Slot& sl = *cache.slots[i];
+            const HConfig& k = sl.config;
+            if (k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
+                k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
+                sl.stamp = cache.stampOf[i] = cache.stamp;
+                fresh = false;
+                return sl;
+            }
         }
-        if (sl.stamp != cache.stamp && (!victim || sl.stamp < victim->stamp)) victim = &sl;
+        if (cache.stampOf[i] != cache.stamp && (victim == n || cache.stampOf[i] < cache.stampOf[victim])) victim = i;
     }
-    if (!victim) {
+    if (victim == n) {
         cache.slots.push_back(std::make_unique<HRowCache::Slot>());
-        victim = cache.slots.back().get();
+        cache.rowOf.push_back(nullptr);
+        cache.stampOf.push_back(0);
     }
-    victim->row = row;
-    victim->config = key;
-    victim->config.tableId = tableId;
-    victim->stamp = cache.stamp;
+    HRowCache::Slot& sl = *cache.slots[victim];
+    sl.row = cache.rowOf[victim] = row;
+    sl.config = key;
+    sl.config.tableId = tableId;
+    sl.stamp = cache.stampOf[victim] = cache.stamp;
     fresh = true;
-    return *victim;
+    return sl;
 }
 
 // Sizes a slot for n elements per plane (plus the kernels' padding) and returns its planes.
@@ -401,8 +431,18 @@ float rowV(const TriangleSetup& s, int set, int y) {
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
     if (!screenAligned(draw.plan, s)) return false;
-    out.x0 = s.clip.x0;
-    out.x1 = s.clip.x1;
+    // The columns of the tables: the clip rect's, or for a triangle covering less than half of
+    // them (a sprite) its own. Triangles of one full-screen quad thus have equal tables and share
+    // their H rows.
+    int xlo = s.clip.x1, xhi = s.clip.x0;
+    for (int y = s.yMin; y < s.yMax; ++y) {
+        int xl = 0, xr = 0;
+        if (rowCoverage(s, y, xl, xr)) xlo = std::min(xlo, xl), xhi = std::max(xhi, xr);
+    }
+    if (xlo >= xhi) return false;  // covers nothing: the quad path finds that too
+    const bool narrow = 2 * (xhi - xlo) < s.clip.x1 - s.clip.x0;
+    out.x0 = narrow ? xlo : s.clip.x0;
+    out.x1 = narrow ? xhi : s.clip.x1;
     out.configs.clear();
     const int n = out.x1 - out.x0;
     std::vector<float> u(size_t(std::max(n, 0)));
@@ -474,7 +514,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
                    (cols.w[size_t(x)] == 0 || cols.off1[size_t(x)] >= 0);
         };
         int tabSlot = -1, tabConfig = -1;
-        for (int x = 0; draw.kernels && x < n;) {
+        for (int x = 0; draw.kernels && !narrow && x < n;) {
             if (!tabOk(x)) {
                 ++x;
                 continue;
@@ -582,6 +622,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     if (cache.serial != draw.serial) {
         // Another draw: its textures may have changed since (the slots keep their memory).
         for (const std::unique_ptr<HRowCache::Slot>& sl : cache.slots) sl->row = nullptr, sl->stamp = 0;
+        std::fill(cache.rowOf.begin(), cache.rowOf.end(), nullptr);
+        std::fill(cache.stampOf.begin(), cache.stampOf.end(), 0);
         cache.serial = draw.serial;
     }
     std::array<const uint16_t*, 4> planes{};

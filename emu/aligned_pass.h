@@ -110,9 +110,14 @@ struct AlignedTriangle {
 // colours constant or affine) and then fills its tables.
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out);
 
-// Largest number of triangles (after setup) a draw may have for the aligned path: tables cost
-// about the clip width per tap per triangle, so meshes stay on the quad path.
+// Triangles drawn row by row together (drawAlignedRows' group), and the most a chunk may have for
+// tile skipping.
 constexpr size_t kMaxAlignedTriangles = 16;
+// Columns of tables a chunk's aligned triangles may hold, in target widths (each triangle's tables
+// span the columns it covers, 16 bytes a column per tap: about 2 MB a tap at 1080p); triangles past
+// it take the quad path, so a chunk of 1024 sprite triangles 64 pixels wide takes the row path and a
+// mesh of large ones stays bounded.
+constexpr int64_t kMaxAlignedColumnsPerTarget = 64;
 
 // Per-worker cache of texel rows, kept for the rows of one draw: staged (deinterleaved into
 // uint16 planes, once per texel row) and H rows (a staged row filtered horizontally for one
@@ -127,6 +132,10 @@ struct HRowCache {
         std::vector<uint16_t> data;
     };
     std::vector<std::unique_ptr<Slot>> slots;
+    // slots[i]->row and ->stamp side by side, what a lookup scans (a draw of many small triangles
+    // keeps many slots: one cache line covers eight of them).
+    std::vector<const uint8_t*> rowOf;
+    std::vector<uint64_t> stampOf;
     uint64_t serial = 0;  // the draw the slots belong to
     uint64_t stamp = 0;
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)

@@ -177,10 +177,16 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         }
         stats.trianglesDrawn += setups.size();
         isAligned.assign(setups.size(), 0);
-        if (alignedDraw && setups.size() <= kMaxAlignedTriangles) {
+        if (alignedDraw) {
+            // Tables for the chunk's triangles, in order, while their columns fit the budget.
             alignedTris.resize(setups.size());
-            for (size_t i = 0; i < setups.size(); ++i)
+            const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
+            int64_t columns = 0;
+            for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
+                if (isAligned[i]) columns += alignedTris[i].x1 - alignedTris[i].x0;
+                if (columns > budget) isAligned[i] = 0;
+            }
         }
         if (floatDraw && setups.size() <= kMaxAlignedTriangles) {
             floatTris.resize(setups.size());
@@ -363,6 +369,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         continue;
                     }
                     if (isAligned[i]) {
+                        if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
                         group[grouped] = &alignedTris[i];
                         groupSetups[grouped++] = &s;
                         continue;
