@@ -50,6 +50,9 @@ struct TapRow {
     };
     std::array<Planes, kMaxTapConfigs> h0{}, h1{};
     std::array<bool, kMaxTapConfigs> ready{};
+    // Point texels of one row at step 1 (a 1:1 point tap, weight 0 both ways): filterTap
+    // deinterleaves them from the texel row into the lanes, no H row staged.
+    std::array<bool, kMaxTapConfigs> direct{};
 };
 
 // Any footprint, one pixel at a time: the exact four-texel sum of the reference.
@@ -206,6 +209,16 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
         if (r >= 0) {
             const AlignedTriangle::Run& run = cols.runs[size_t(r)];
             const int e = std::min(end, int(run.x1));
+            if (row.direct[size_t(run.config)]) {
+                const int n = e - x, n16 = n & ~15;  // whole groups: the kernel writes no lane past them
+                const int lane = x - first;
+                uint16_t* const dst[4] = {reinterpret_cast<uint16_t*>(out[0] + lane), reinterpret_cast<uint16_t*>(out[1] + lane),
+                                          reinterpret_cast<uint16_t*>(out[2] + lane), reinterpret_cast<uint16_t*>(out[3] + lane)};
+                if (n16) kernels->deinterleave(row.row0 + cols.off0[size_t(x - colBase)], n16, dst);
+                if (n > n16) filterScalar(tap, cols, row, colBase, x + n16, n - n16, lane + n16, out);
+                x = e;
+                continue;
+            }
             const int j = run.j0 + (x - run.x0);
             const TapRow::Planes& p0 = row.h0[size_t(run.config)];
             const TapRow::Planes& p1 = row.h1[size_t(run.config)];
@@ -678,6 +691,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     if (!rowsOk) continue;
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     const HConfig& h = tri.configs[ci];
+                    r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
+                    if (r.direct[size_t(c)]) continue;
                     const uint64_t id = ti < kMaxAlignedTriangles && ci < tabIds[ti].size() ? tabIds[ti][ci] : h.tableId;
                     hRow(*draw.kernels, cache, r.row0, h, id, planes);
                     for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
