@@ -138,31 +138,6 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
                 continue;
             }
 #if defined(__SSE2__)
-            // Four columns two or four texels apart with consecutive pairs (a 2:1 or 4:1
-            // reduction's taps): whole vectors of the row, shuffled; the same lerp.
-            const int32_t stride = x + 4 <= w ? i0[x + 1] - k : 0;
-            if ((stride == 2 || stride == 4) && k >= 0 && size_t(k) + 4 * size_t(stride) <= tw &&
-                i0[x + 2] == k + 2 * stride && i0[x + 3] == k + 3 * stride && i1[x] == k + 1 &&
-                i1[x + 1] == k + stride + 1 && i1[x + 2] == k + 2 * stride + 1 && i1[x + 3] == k + 3 * stride + 1) {
-                const __m128 fv = _mm_loadu_ps(f + x), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
-                for (size_t c = 0; c < 4; ++c) {
-                    const float* d = dec + c * tw + size_t(k);
-                    __m128 a, b;
-                    if (stride == 2) {
-                        const __m128 v0 = _mm_loadu_ps(d), v1 = _mm_loadu_ps(d + 4);
-                        a = _mm_shuffle_ps(v0, v1, _MM_SHUFFLE(2, 0, 2, 0));
-                        b = _mm_shuffle_ps(v0, v1, _MM_SHUFFLE(3, 1, 3, 1));
-                    } else {
-                        const __m128 t0 = _mm_unpacklo_ps(_mm_loadu_ps(d), _mm_loadu_ps(d + 4));
-                        const __m128 t1 = _mm_unpacklo_ps(_mm_loadu_ps(d + 8), _mm_loadu_ps(d + 12));
-                        a = _mm_movelh_ps(t0, t1);
-                        b = _mm_movehl_ps(t1, t0);
-                    }
-                    _mm_storeu_ps(out + c * w + x, _mm_add_ps(_mm_mul_ps(gv, a), _mm_mul_ps(fv, b)));
-                }
-                x += 3;
-                continue;
-            }
             // Any four columns whose texels all lie in the row (no border): loads one by one,
             // the lerp four at a time.
             if (x + 4 <= w && (k | i0[x + 1] | i0[x + 2] | i0[x + 3] | i1[x] | i1[x + 1] | i1[x + 2] | i1[x + 3]) >= 0) {
