@@ -58,6 +58,21 @@ HRESULT Device::GetRenderTargetData(Handle renderTarget, Handle destSurface) {
         return fail(D3DERR_INVALIDCALL, "E4106", "GetRenderTargetData: a surface is locked");
     syncLevel(*src, srcRef.level);  // the read-back of a renderer that keeps copies
     prepareWrite(*dst);
+    // A renderer that draws into the front's images moves the rows itself, as an unscaled
+    // StretchRect (the software renderer over its workers: a 1080p read-back is an 8 MB copy);
+    // otherwise the front copies the image brought back.
+    if (!m_renderer->keepsCopies()) {
+        StretchCall sc;
+        sc.source = surfaceDesc(srcRef, *src);
+        sc.dest = surfaceDesc(dstRef, *dst);
+        sc.sourceRect = sc.destRect = PixelBox{0, 0, int64_t(s->width), int64_t(s->height)};
+        sc.fixedPoint = ps11::isFixedPoint(m_hardware.precision);
+        sc.decode = m_hardware.hardware->signedDecode;
+        if (m_renderer->stretchRect(sc)) {
+            markWritten(*dst, dstRef.level);
+            return D3D_OK;
+        }
+    }
     const size_t row = size_t(s->width) * s->format->bytes;
     for (uint32_t y = 0; y < s->height; ++y) std::copy_n(s->texel(0, y), row, d->texel(0, y));
     markWritten(*dst, dstRef.level);

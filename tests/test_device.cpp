@@ -1022,6 +1022,32 @@ TEST_CASE("device: StretchRect point and linear", "[device]") {
     }
 }
 
+TEST_CASE("device: GetRenderTargetData of a large target over two workers copies every byte", "[device]") {
+    // 301x217: more rows than the workers' share and an odd width (the software renderer moves the
+    // rows as an unscaled StretchRect over its workers).
+    DeviceOptions o;
+    o.software.threads = 2;
+    Device dev(o);
+    const UINT w = 301, h = 217;
+    Handle rt{}, sys{};
+    REQUIRE(dev.CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 1, &rt) == D3D_OK);
+    std::mt19937 rng(5);
+    std::vector<uint8_t> bytes(size_t(w) * h * 4);
+    for (uint8_t& b : bytes) b = uint8_t(rng());
+    D3DLOCKED_RECT lr{};
+    REQUIRE(dev.LockRect(rt, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < h; ++y) std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &bytes[size_t(y) * w * 4], w * 4);
+    REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+    REQUIRE(dev.CreateOffscreenPlainSurface(w, h, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &sys) == D3D_OK);
+    REQUIRE(dev.GetRenderTargetData(rt, sys) == D3D_OK);
+    REQUIRE(dev.LockRect(sys, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+    size_t wrong = 0;
+    for (UINT y = 0; y < h; ++y)
+        wrong += std::memcmp(static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch, &bytes[size_t(y) * w * 4], w * 4) != 0;
+    REQUIRE(dev.UnlockRect(sys) == D3D_OK);
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("device: GetRenderTargetData copies into SYSTEMMEM", "[device]") {
     Device dev;
     Handle rt{}, sys{}, sysSmall{}, def{}, sysTex{}, sysLevel{};
