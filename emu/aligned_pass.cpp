@@ -264,33 +264,28 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
 // the current pixel row (so every pointer handed out for a row stays valid until the next row),
 // or a new one. `fresh` tells whether it must be filled.
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
-    const size_t n = cache.slots.size();
-    size_t victim = n;
-    for (size_t i = 0; i < n; ++i) {
-        if (cache.rowOf[i] == row) {
-            HRowCache::Slot& sl = *cache.slots[i];
-            const HConfig& k = sl.config;
-            if (k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-                k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
-                sl.stamp = cache.stampOf[i] = cache.stamp;
-                fresh = false;
-                return sl;
-            }
+    HRowCache::Slot* victim = nullptr;
+    for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
+        HRowCache::Slot& sl = *sp;
+        const HConfig& k = sl.config;
+        if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
+            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
+            sl.stamp = cache.stamp;
+            fresh = false;
+            return sl;
         }
-        if (cache.stampOf[i] != cache.stamp && (victim == n || cache.stampOf[i] < cache.stampOf[victim])) victim = i;
+        if (sl.stamp != cache.stamp && (!victim || sl.stamp < victim->stamp)) victim = &sl;
     }
-    if (victim == n) {
+    if (!victim) {
         cache.slots.push_back(std::make_unique<HRowCache::Slot>());
-        cache.rowOf.push_back(nullptr);
-        cache.stampOf.push_back(0);
+        victim = cache.slots.back().get();
     }
-    HRowCache::Slot& sl = *cache.slots[victim];
-    sl.row = cache.rowOf[victim] = row;
-    sl.config = key;
-    sl.config.tableId = tableId;
-    sl.stamp = cache.stampOf[victim] = cache.stamp;
+    victim->row = row;
+    victim->config = key;
+    victim->config.tableId = tableId;
+    victim->stamp = cache.stamp;
     fresh = true;
-    return sl;
+    return *victim;
 }
 
 // Sizes a slot for n elements per plane (plus the kernels' padding) and returns its planes.
@@ -635,8 +630,6 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     if (cache.serial != draw.serial) {
         // Another draw: its textures may have changed since (the slots keep their memory).
         for (const std::unique_ptr<HRowCache::Slot>& sl : cache.slots) sl->row = nullptr, sl->stamp = 0;
-        std::fill(cache.rowOf.begin(), cache.rowOf.end(), nullptr);
-        std::fill(cache.stampOf.begin(), cache.stampOf.end(), 0);
         cache.serial = draw.serial;
     }
     std::array<const uint16_t*, 4> planes{};

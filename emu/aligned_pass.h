@@ -132,10 +132,6 @@ struct HRowCache {
         std::vector<uint16_t> data;
     };
     std::vector<std::unique_ptr<Slot>> slots;
-    // slots[i]->row and ->stamp side by side, what a lookup scans (a draw of many small triangles
-    // keeps many slots: one cache line covers eight of them).
-    std::vector<const uint8_t*> rowOf;
-    std::vector<uint64_t> stampOf;
     uint64_t serial = 0;  // the draw the slots belong to
     uint64_t stamp = 0;
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)
