@@ -132,7 +132,8 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
 #else
                 for (size_t c = 0; c < 4; ++c)
                     for (size_t q = 0; q < 4; ++q)
-                        out[c * w + x + q] = lerpf(dec[c * tw + size_t(k) + q], dec[c * tw + size_t(k) + q + 1], f[x + q]);
+                        out[c * w + x + q] =
+                            lerpf(dec[c * tw + size_t(k) + q], dec[c * tw + size_t(k) + q + 1], f[x + q]);
 #endif
                 x += 3;
                 continue;
@@ -140,7 +141,8 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
 #if defined(__SSE2__)
             // Any four columns whose texels all lie in the row (no border): loads one by one,
             // the lerp four at a time.
-            if (x + 4 <= w && (k | i0[x + 1] | i0[x + 2] | i0[x + 3] | i1[x] | i1[x + 1] | i1[x + 2] | i1[x + 3]) >= 0) {
+            if (x + 4 <= w &&
+                (k | i0[x + 1] | i0[x + 2] | i0[x + 3] | i1[x] | i1[x + 1] | i1[x + 2] | i1[x + 3]) >= 0) {
                 const __m128 fv = _mm_loadu_ps(f + x), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
                 for (size_t c = 0; c < 4; ++c) {
                     const float* d = dec + c * tw;
@@ -185,11 +187,11 @@ const auto kLaneIndex = [] {
 // each stage read by one tap (prepareFloatRowDraw checks it).
 class RowSampler final : public ps11::Sampler {
 public:
-    RowSampler(const FloatRowDraw& draw, const FloatRowTriangle& tri, const std::array<RowTaps, 8>& rows)
-        : m_draw(draw), m_tri(tri), m_rows(rows) {
+    RowSampler(const FloatRowDraw& draw, const std::array<RowTaps, 8>& rows) : m_draw(draw), m_rows(rows) {
         m_tapOf.fill(-1);
         for (int t = 0; t < draw.plan.count; ++t) m_tapOf[draw.plan.stage[size_t(t)]] = int8_t(t);
     }
+    void setTriangle(const FloatRowTriangle& tri) { m_tri = &tri; }
     void setX(int x) { m_x = x; }
 
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
@@ -201,13 +203,14 @@ public:
             return;
         }
         const RowTaps& r = m_rows[size_t(t)];
-        const size_t first = size_t(m_x - m_tri.x0) + size_t(req.u[0]);  // lanes are consecutive
+        const size_t first = size_t(m_x - m_tri->x0) + size_t(req.u[0]);  // lanes are consecutive
         if (tap->linear) {
-            const size_t w = size_t(m_tri.x1 - m_tri.x0);
+            const size_t w = size_t(m_tri->x1 - m_tri->x0);
             if (r.fy == 0.0f && tap->nonNegative) {
                 // (1 − 0)·a + 0·b is a: 8-bit texels, the border colour and their lerps are
                 // finite and not negative (a 1:1 row under 8-bit weights).
-                for (int c = 0; c < 4; ++c) std::memcpy(out.value[c], r.h0 + size_t(c) * w + first, sizeof(float) * size_t(n));
+                for (int c = 0; c < 4; ++c)
+                    std::memcpy(out.value[c], r.h0 + size_t(c) * w + first, sizeof(float) * size_t(n));
                 m_fetched += uint64_t(n) * 4;
                 return;
             }
@@ -219,14 +222,15 @@ public:
 #if defined(__SSE2__)
                 const __m128 fv = _mm_set1_ps(r.fy), gv = _mm_set1_ps(1.0f - r.fy);
                 for (; i + 4 <= n; i += 4)
-                    _mm_storeu_ps(o + i, _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + i)), _mm_mul_ps(fv, _mm_loadu_ps(b + i))));
+                    _mm_storeu_ps(o + i,
+                                  _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + i)), _mm_mul_ps(fv, _mm_loadu_ps(b + i))));
 #endif
                 for (; i < n; ++i) o[i] = lerpf(a[i], b[i], r.fy);
             }
             m_fetched += uint64_t(n) * 4;
             return;
         }
-        const int32_t* i0 = m_tri.taps[size_t(t)].i0.data() + first;
+        const int32_t* i0 = m_tri->taps[size_t(t)].i0.data() + first;
         if (r.dec) {
             // Columns of a decoded row: runs of consecutive texels copied four at a time.
             const size_t tw = tap->width;
@@ -238,7 +242,8 @@ public:
                     i += 4;
                     continue;
                 }
-                for (int c = 0; c < 4; ++c) out.value[c][i] = k >= 0 ? r.dec[size_t(c) * tw + size_t(k)] : tap->border[size_t(c)];
+                for (int c = 0; c < 4; ++c)
+                    out.value[c][i] = k >= 0 ? r.dec[size_t(c) * tw + size_t(k)] : tap->border[size_t(c)];
                 ++i;
             }
             m_fetched += uint64_t(n);
@@ -259,7 +264,7 @@ public:
 
 private:
     const FloatRowDraw& m_draw;
-    const FloatRowTriangle& m_tri;
+    const FloatRowTriangle* m_tri = nullptr;
     const std::array<RowTaps, 8>& m_rows;
     std::array<int8_t, 8> m_tapOf{};
     int m_x = 0;
@@ -361,15 +366,16 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
     }
 }
 
-void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                   FloatRowScratch& sc, AlignedStats& stats, const RowWindow* windows, size_t windowCount) {
+void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris, const TriangleSetup* const* setups,
+                   size_t count, int y0, int y1, FloatRowScratch& sc, AlignedStats& stats, const RowWindow* windows,
+                   size_t windowCount) {
     const ps11::Executor& exec = *draw.executor;
     const RowWindows ws = rowWindows(windows, windowCount);
     windows = ws.data, windowCount = ws.count;
     const uint32_t neededTaps = ws.taps;
     const int taps = draw.plan.count;
     std::array<RowTaps, 8> rows{};
-    RowSampler sampler(draw, tri, rows);
+    RowSampler sampler(draw, rows);
     ps11::PixelInputs in;
     for (int c = 0; c < 4; ++c) {
         if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
@@ -381,65 +387,74 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const 
     uint64_t texelsPerPixel = 0;
     for (int t = 0; t < taps; ++t)
         texelsPerPixel += draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0;
-    for (int y = std::max(y0, s.yMin); y < std::min(y1, s.yMax); ++y) {
-        int xl = 0, xr = 0;
-        if (!rowCoverage(s, y, xl, xr)) continue;
-        xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[windowCount - 1].x1);
-        if (xl >= xr) continue;
+    // Row by row, and within a row the triangles in primitive order (every pixel sees them in
+    // order; the H rows of a pixel row serve all of them: a full-screen quad's two triangles
+    // share their tables, so each texel row is filtered once, not once per triangle).
+    for (int y = y0; y < y1; ++y) {
         sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
-        for (int t = 0; t < taps; ++t) {
-            const FloatRowTap& tap = draw.taps[size_t(t)];
-            if (!tap.bound || !((neededTaps >> t) & 1)) continue;
-            const float v = rowV(s, tap.coordSet, y);
-            RowTaps& r = rows[size_t(t)];
-            ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
-            if (tap.linear) {
-                r.h0 = hRow(draw, tri, t, r.j0, sc);
-                r.h1 = hRow(draw, tri, t, r.j1, sc);
-            } else {
-                r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(tap, r.j0, sc) : nullptr;
-            }
-        }
-        for (size_t wi = 0; wi < windowCount; ++wi) {
-            const RowWindow* window = &windows[wi];
-            const RowMode mode = window->mode;
-            const int wl = std::max(xl, window->x0), wr = std::min(xr, window->x1);
-            for (int x = wl; x < wr; x += ps11::kMaxSpan) {
-                const int n = std::min(ps11::kMaxSpan, wr - x);
-                sampler.setX(x);
-                if (mode == RowMode::Shade) {
-                    fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
-                    in.count = n;
-                    exec.run(in, sampler, outp, &stats.exec);
-                    stats.texels += uint64_t(n) * texelsPerPixel;
-                } else if (mode == RowMode::Copy) {
-                    // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
-                    const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];
-                    ps11::SampleRequest req;
-                    req.stage = tap.stage;
-                    req.count = n;
-                    req.u = kLaneIndex.data();
-                    req.v = kLaneIndex.data();
-                    req.precision = exec.options().precision;
-                    ps11::SampleResult res;
-                    for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
-                    sampler.sample(req, res);
-                    for (int c = 0; c < 4; ++c)
-                        if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
-                    stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
+        for (size_t ti = 0; ti < count; ++ti) {
+            const FloatRowTriangle& tri = *tris[ti];
+            const TriangleSetup& s = *setups[ti];
+            if (y < s.yMin || y >= s.yMax) continue;
+            int xl = 0, xr = 0;
+            if (!rowCoverage(s, y, xl, xr)) continue;
+            xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[windowCount - 1].x1);
+            if (xl >= xr) continue;
+            sampler.setTriangle(tri);
+            for (int t = 0; t < taps; ++t) {
+                const FloatRowTap& tap = draw.taps[size_t(t)];
+                if (!tap.bound || !((neededTaps >> t) & 1)) continue;
+                const float v = rowV(s, tap.coordSet, y);
+                RowTaps& r = rows[size_t(t)];
+                ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
+                if (tap.linear) {
+                    r.h0 = hRow(draw, tri, t, r.j0, sc);
+                    r.h1 = hRow(draw, tri, t, r.j1, sc);
                 } else {
-                    for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                    r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(tap, r.j0, sc) : nullptr;
                 }
-                MergeInputs mi;
-                mi.count = n;
-                for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
-                mi.x = sc.x;
-                mi.y = sc.y;
-                for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
-                MergeStats ms;
-                mergePixels(draw.merge, mi, draw.target, &ms);
-                stats.written += ms.written;
-                stats.pixels += uint64_t(n);
+            }
+            for (size_t wi = 0; wi < windowCount; ++wi) {
+                const RowWindow* window = &windows[wi];
+                const RowMode mode = window->mode;
+                const int wl = std::max(xl, window->x0), wr = std::min(xr, window->x1);
+                for (int x = wl; x < wr; x += ps11::kMaxSpan) {
+                    const int n = std::min(ps11::kMaxSpan, wr - x);
+                    sampler.setX(x);
+                    if (mode == RowMode::Shade) {
+                        fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        in.count = n;
+                        exec.run(in, sampler, outp, &stats.exec);
+                        stats.texels += uint64_t(n) * texelsPerPixel;
+                    } else if (mode == RowMode::Copy) {
+                        // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
+                        const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];
+                        ps11::SampleRequest req;
+                        req.stage = tap.stage;
+                        req.count = n;
+                        req.u = kLaneIndex.data();
+                        req.v = kLaneIndex.data();
+                        req.precision = exec.options().precision;
+                        ps11::SampleResult res;
+                        for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
+                        sampler.sample(req, res);
+                        for (int c = 0; c < 4; ++c)
+                            if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                        stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
+                    } else {
+                        for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                    }
+                    MergeInputs mi;
+                    mi.count = n;
+                    for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                    mi.x = sc.x;
+                    mi.y = sc.y;
+                    for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
+                    MergeStats ms;
+                    mergePixels(draw.merge, mi, draw.target, &ms);
+                    stats.written += ms.written;
+                    stats.pixels += uint64_t(n);
+                }
             }
         }
     }

@@ -111,10 +111,11 @@ struct FloatRowScratch {
     uint64_t stamp = 0, rowStart = 0;
 };
 
-// Draws rows [y0, y1) of one prepared triangle; with `windows` (disjoint, in column order), only
-// their columns, each as it says (emu/aligned_pass.h).
-void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle& tri, const TriangleSetup& s, int y0, int y1,
-                   FloatRowScratch& sc, AlignedStats& stats, const RowWindow* windows = nullptr,
-                   size_t windowCount = 0);
+// Draws rows [y0, y1) of prepared triangles tris[0 .. count), row by row and within a row in
+// primitive order; with `windows` (disjoint, in column order), only their columns, each as it
+// says (emu/aligned_pass.h).
+void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris, const TriangleSetup* const* setups,
+                   size_t count, int y0, int y1, FloatRowScratch& sc, AlignedStats& stats,
+                   const RowWindow* windows = nullptr, size_t windowCount = 0);
 
 }  // namespace emu

@@ -277,13 +277,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             auto drawBandTiles = [&](int b, int by0, int by1) {
                 const TriangleSetup* bt[kMaxAlignedTriangles];
                 const AlignedTriangle* at[kMaxAlignedTriangles];
-                uint32_t idx[kMaxAlignedTriangles];
+                const FloatRowTriangle* ft[kMaxAlignedTriangles];
                 size_t n = 0;
                 int ty0 = by1, ty1 = by0;
                 for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1] && n < kMaxAlignedTriangles; ++k) {
                     const uint32_t i = bandTris[k];
-                    idx[n] = i;
                     bt[n] = &setups[i];
+                    ft[n] = floatDraw ? &floatTris[i] : nullptr;
                     at[n++] = floatDraw ? nullptr : &alignedTris[i];
                     ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
                     ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
@@ -337,9 +337,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 if (runTiles) addRun(run, runX0, tx1, runTiles);
                 if (windows.empty()) return;
                 if (floatDraw) {
-                    for (size_t t = 0; t < n; ++t)
-                        drawFloatRows(floatRows, floatTris[idx[t]], *bt[t], by0, by1, ws0.floatRows, as, windows.data(),
-                                      windows.size());
+                    drawFloatRows(floatRows, ft, bt, n, by0, by1, ws0.floatRows, as, windows.data(), windows.size());
                 } else {
                     drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
                 }
@@ -351,10 +349,14 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 const int by1 = by0 + kBandRows;
                 // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
                 const AlignedTriangle* group[kMaxAlignedTriangles];
+                const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
                 const TriangleSetup* groupSetups[kMaxAlignedTriangles];
                 size_t grouped = 0;
                 auto flush = [&] {
-                    if (grouped) drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
+                    if (grouped && floatDraw)
+                        drawFloatRows(floatRows, floatGroup, groupSetups, grouped, by0, by1, ws0.floatRows, as);
+                    else if (grouped)
+                        drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
                     grouped = 0;
                 };
                 if (tiles) {
@@ -364,13 +366,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
                     const uint32_t i = bandTris[k];
                     const TriangleSetup& s = setups[i];
-                    if (isAligned[i] && floatDraw) {
-                        drawFloatRows(floatRows, floatTris[i], s, by0, by1, ws0.floatRows, as);
-                        continue;
-                    }
                     if (isAligned[i]) {
                         if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
-                        group[grouped] = &alignedTris[i];
+                        if (floatDraw) floatGroup[grouped] = &floatTris[i];
+                        else group[grouped] = &alignedTris[i];
                         groupSetups[grouped++] = &s;
                         continue;
                     }

@@ -824,7 +824,9 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
     uint64_t rowShaded = 0, quadShaded = 0;
-    for (int i = 0; i < 24; ++i) {
+    // Cases 24 on: float and ideal, whose row path takes up to 16 triangles, row by row.
+    for (int i = 0; i < 40; ++i) {
+        const bool floatCase = i >= 24;
         Case c = randomCase(rng);
         c.w = UINT(uni(64, 300)), c.h = UINT(uni(16, 60));
         c.rtInit.resize(size_t(c.w) * c.h * 4);
@@ -840,7 +842,7 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
         c.blend = DWORD(uni(0, 2) ? 1 : 0);
         c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
         c.verts.clear();
-        const int quads = uni(20, 300);
+        const int quads = floatCase ? uni(2, 8) : uni(20, 300);
         for (int q = 0; q < quads; ++q) {
             const float size = real(2.0f, 40.0f);
             const float x0 = real(-10.0f, float(c.w)), y0 = real(-10.0f, float(c.h));
@@ -856,9 +858,11 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (floatCase) quadOpt.precision = rowOpt.precision = i % 4 < 2 ? ps11::Precision::Float : ps11::Precision::Ideal;
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << quads << " quads, blend " << c.blend);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << quads << " quads, blend " << c.blend
+                     << (floatCase ? ", float/ideal" : ", fx8"));
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
         REQUIRE(drawCase(rowDev, c, rs) == expected);
         CHECK(rs.pixelsShaded <= qs.pixelsShaded);
