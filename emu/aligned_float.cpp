@@ -12,6 +12,7 @@
 #include <xmmintrin.h>
 #endif
 
+#include "emu/aligned_float_kernels.h"
 #include "emu/vertex.h"
 
 namespace emu {
@@ -40,6 +41,67 @@ inline void texel(const FloatRowTap& tap, int32_t ix, int32_t iy, float t[4]) {
     }
 }
 
+// ---- the Baseline level's kernels (emu/aligned_float_kernels.h) ----
+
+void lerpColumnsBase(const float* a, const float* b, const float* f, int n, float* out) {
+    int j = 0;
+#if defined(__SSE2__)
+    for (; j + 4 <= n; j += 4) {
+        const __m128 fv = _mm_loadu_ps(f + j), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
+        _mm_storeu_ps(out + j, _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + j)), _mm_mul_ps(fv, _mm_loadu_ps(b + j))));
+    }
+#endif
+    for (; j < n; ++j) out[j] = lerpf(a[j], b[j], f[j]);
+}
+
+void lerpGatherBase(const float* d, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out) {
+    for (int j = 0; j < n; ++j) out[j] = lerpf(d[i0[j]], d[i1[j]], f[j]);
+}
+
+void lerpRowBase(const float* a, const float* b, float f, int n, float* out) {
+    int j = 0;
+#if defined(__SSE2__)
+    const __m128 fv = _mm_set1_ps(f), gv = _mm_set1_ps(1.0f - f);
+    for (; j + 4 <= n; j += 4)
+        _mm_storeu_ps(out + j, _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + j)), _mm_mul_ps(fv, _mm_loadu_ps(b + j))));
+#endif
+    for (; j < n; ++j) out[j] = lerpf(a[j], b[j], f);
+}
+
+void decodeBase(const uint8_t* row, int n, float* out, size_t stride) {
+    int i = 0;
+#if defined(__SSE2__)
+    // kUnorm8[b] is float(b) / 255.0f for every byte (tests/test_texture_sampler.cpp checks it): four
+    // texels per step, each channel's bytes shifted out of the b g r a words and divided.
+    const __m128i byte = _mm_set1_epi32(0xff);
+    const __m128 k255 = _mm_set1_ps(255.0f);
+    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a
+    for (; i + 4 <= n; i += 4) {
+        const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + 4 * i));
+        for (size_t c = 0; c < 4; ++c)
+            _mm_storeu_ps(out + c * stride + size_t(i),
+                          _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, kShift[c]), byte)), k255));
+    }
+#endif
+    for (; i < n; ++i)
+        for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = kUnorm8[row[4 * i + ps11::kUnorm8Byte[c]]];
+}
+
+const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpRowBase, &decodeBase};
+
+}  // namespace
+
+const FloatRowKernels& floatRowKernels(ps11::SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return *ps11::simdTable<FloatRowKernels>(level, &kBaseline, &avx2::kFloatRow);
+#else
+    (void)level;
+    return kBaseline;
+#endif
+}
+
+namespace {
+
 // One tap's texel rows for the pixel row being drawn.
 struct RowTaps {
     int32_t j0 = 0, j1 = 0;
@@ -51,7 +113,7 @@ struct RowTaps {
 
 // Texel row j (in the texture) of an 8-bit tap as planar r g b a floats (kUnorm8 values),
 // decoded once per worker and kept while recent; valid until the next pixel row.
-const float* decodedRow(const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
+const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
     const uint8_t* row = tap.bytes + size_t(j) * tap.width * 4;
     FloatRowScratch::DecodedRow* slot = nullptr;
     for (FloatRowScratch::DecodedRow& d : sc.decoded) {
@@ -64,27 +126,11 @@ const float* decodedRow(const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) 
     if (!slot) slot = &sc.decoded.emplace_back();  // every row serves this pixel row
     const size_t tw = tap.width;
     slot->v.resize(4 * tw);
-    float* dec = slot->v.data();
-    size_t i = 0;
-#if defined(__SSE2__)
-    // kUnorm8[b] is float(b) / 255.0f for every byte (tests/test_texture_sampler.cpp checks it): four
-    // texels per step, each channel's bytes shifted out of the b g r a words and divided.
-    const __m128i byte = _mm_set1_epi32(0xff);
-    const __m128 k255 = _mm_set1_ps(255.0f);
-    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a
-    for (; i + 4 <= tw; i += 4) {
-        const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + i * 4));
-        for (size_t c = 0; c < 4; ++c)
-            _mm_storeu_ps(dec + c * tw + i,
-                          _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, kShift[c]), byte)), k255));
-    }
-#endif
-    for (; i < tw; ++i)
-        for (size_t c = 0; c < 4; ++c) dec[c * tw + i] = kUnorm8[row[i * 4 + size_t(ps11::kUnorm8Byte[c])]];
+    draw.kernels->decode(row, int(tw), slot->v.data(), tw);
     slot->row = row;
     slot->width = tap.width;
     slot->stamp = ++sc.stamp;
-    return dec;
+    return slot->v.data();
 }
 
 // The H row of texel row j for a linear tap: per column, the horizontal lerp of its texel pair
@@ -109,58 +155,41 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     h.h.resize(4 * w);
     size_t x = 0;
     if (tap.unorm8 && j >= 0) {
-        // Blocks of four columns whose pairs are consecutive texels (i0 = k .. k+3 and i1 = i0 +
-        // 1: every column of a 1:1 mapping away from clamped edges) take vector loads; the same
-        // operations in the same order as lerpf.
+        // By stretches (prepareFloatRowTriangle): consecutive texel pairs with vector loads, other
+        // pairs inside the row gathered, border columns one at a time; the same operations in the
+        // same order as lerpf.
+        const FloatRowKernels& k = *draw.kernels;
         const size_t tw = tap.width;
-        const float* dec = decodedRow(tap, j, sc);
+        const float* dec = decodedRow(draw, tap, j, sc);
         const int32_t* i0 = cols.i0.data();
         const int32_t* i1 = cols.i1.data();
         const float* f = cols.f.data();
         float* out = h.h.data();
-        for (; x < w; ++x) {
-            const int32_t k = i0[x];
-            if (x + 4 <= w && k >= 0 && i0[x + 3] == k + 3 && i1[x] == k + 1 && i1[x + 3] == k + 4 &&
-                i0[x + 1] == k + 1 && i0[x + 2] == k + 2 && i1[x + 1] == k + 2 && i1[x + 2] == k + 3) {
-#if defined(__SSE2__)
-                const __m128 fv = _mm_loadu_ps(f + x), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
-                for (size_t c = 0; c < 4; ++c) {
-                    const float* d = dec + c * tw + size_t(k);
-                    _mm_storeu_ps(out + c * w + x,
-                                  _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(d)), _mm_mul_ps(fv, _mm_loadu_ps(d + 1))));
-                }
-#else
-                for (size_t c = 0; c < 4; ++c)
-                    for (size_t q = 0; q < 4; ++q)
-                        out[c * w + x + q] =
-                            lerpf(dec[c * tw + size_t(k) + q], dec[c * tw + size_t(k) + q + 1], f[x + q]);
-#endif
-                x += 3;
-                continue;
-            }
-#if defined(__SSE2__)
-            // Any four columns whose texels all lie in the row (no border): loads one by one,
-            // the lerp four at a time.
-            if (x + 4 <= w &&
-                (k | i0[x + 1] | i0[x + 2] | i0[x + 3] | i1[x] | i1[x + 1] | i1[x + 2] | i1[x + 3]) >= 0) {
-                const __m128 fv = _mm_loadu_ps(f + x), gv = _mm_sub_ps(_mm_set1_ps(1.0f), fv);
-                for (size_t c = 0; c < 4; ++c) {
-                    const float* d = dec + c * tw;
-                    const __m128 a = _mm_setr_ps(d[k], d[i0[x + 1]], d[i0[x + 2]], d[i0[x + 3]]);
-                    const __m128 b = _mm_setr_ps(d[i1[x]], d[i1[x + 1]], d[i1[x + 2]], d[i1[x + 3]]);
-                    _mm_storeu_ps(out + c * w + x, _mm_add_ps(_mm_mul_ps(gv, a), _mm_mul_ps(fv, b)));
-                }
-                x += 3;
-                continue;
-            }
-#endif
-            const int32_t k1 = i1[x];
-            for (size_t c = 0; c < 4; ++c) {
-                const float a = k >= 0 ? dec[c * tw + size_t(k)] : tap.border[c];
-                const float b = k1 >= 0 ? dec[c * tw + size_t(k1)] : tap.border[c];
-                out[c * w + x] = lerpf(a, b, f[x]);
+        for (const FloatRowTriangle::Columns::Stretch& st : cols.stretches) {
+            const int n = st.x1 - st.x0;
+            const size_t x0 = size_t(st.x0);
+            switch (st.kind) {
+                case FloatRowTriangle::Columns::kSeq:
+                    for (size_t c = 0; c < 4; ++c) {
+                        const float* d = dec + c * tw + size_t(i0[x0]);
+                        k.lerpColumns(d, d + 1, f + x0, n, out + c * w + x0);
+                    }
+                    break;
+                case FloatRowTriangle::Columns::kInside:
+                    for (size_t c = 0; c < 4; ++c)
+                        k.lerpGather(dec + c * tw, i0 + x0, i1 + x0, f + x0, n, out + c * w + x0);
+                    break;
+                case FloatRowTriangle::Columns::kBorder:
+                    for (size_t q = x0; q < size_t(st.x1); ++q)
+                        for (size_t c = 0; c < 4; ++c) {
+                            const float a = i0[q] >= 0 ? dec[c * tw + size_t(i0[q])] : tap.border[c];
+                            const float b = i1[q] >= 0 ? dec[c * tw + size_t(i1[q])] : tap.border[c];
+                            out[c * w + q] = lerpf(a, b, f[q]);
+                        }
+                    break;
             }
         }
+        x = w;
     }
     float a[4], b[4];
     for (; x < w; ++x) {
@@ -214,19 +243,9 @@ public:
                 m_fetched += uint64_t(n) * 4;
                 return;
             }
-            for (int c = 0; c < 4; ++c) {
-                const float* a = r.h0 + size_t(c) * w + first;
-                const float* b = r.h1 + size_t(c) * w + first;
-                float* o = out.value[c];
-                int i = 0;
-#if defined(__SSE2__)
-                const __m128 fv = _mm_set1_ps(r.fy), gv = _mm_set1_ps(1.0f - r.fy);
-                for (; i + 4 <= n; i += 4)
-                    _mm_storeu_ps(o + i,
-                                  _mm_add_ps(_mm_mul_ps(gv, _mm_loadu_ps(a + i)), _mm_mul_ps(fv, _mm_loadu_ps(b + i))));
-#endif
-                for (; i < n; ++i) o[i] = lerpf(a[i], b[i], r.fy);
-            }
+            for (int c = 0; c < 4; ++c)
+                m_draw.kernels->lerpRow(r.h0 + size_t(c) * w + first, r.h1 + size_t(c) * w + first, r.fy, n,
+                                        out.value[c]);
             m_fetched += uint64_t(n) * 4;
             return;
         }
@@ -283,6 +302,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     if (!ps11::plainTaps(executor, d.plan)) return false;
     static std::atomic<uint64_t> serials{0};
     d.serial = ++serials;
+    d.kernels = &floatRowKernels(ps11::simdLevel());
     d.executor = &executor;
     d.weights8 = weightBits == 8 && precision == ps11::Precision::Float;
     uint32_t stagesSeen = 0;
@@ -321,6 +341,45 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     return true;
 }
 
+namespace {
+
+// Runs of consecutive texel pairs shorter than this are gathered.
+constexpr int kMinSeqColumns = 8;
+
+void columnStretches(FloatRowTriangle::Columns& cols, int n) {
+    using C = FloatRowTriangle::Columns;
+    cols.stretches.clear();
+    auto add = [&](int x0, int x1, C::Kind kind) {
+        // (Two runs of consecutive pairs never merge: each starts at its own texel.)
+        if (kind != C::kSeq && !cols.stretches.empty() && cols.stretches.back().kind == kind &&
+            cols.stretches.back().x1 == x0)
+            cols.stretches.back().x1 = x1;
+        else
+            cols.stretches.push_back({x0, x1, kind});
+    };
+    const int32_t* i0 = cols.i0.data();
+    const int32_t* i1 = cols.i1.data();
+    int x = 0;
+    while (x < n) {
+        if (i0[x] < 0 || i1[x] < 0) {
+            add(x, x + 1, C::kBorder);
+            ++x;
+            continue;
+        }
+        int e = x + 1;
+        while (e < n && i0[e] == i0[x] + (e - x) && i1[e] == i0[e] + 1) ++e;
+        if (i1[x] == i0[x] + 1 && e - x >= kMinSeqColumns) {
+            add(x, e, C::kSeq);
+            x = e;
+            continue;
+        }
+        add(x, x + 1, C::kInside);
+        ++x;
+    }
+}
+
+}  // namespace
+
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     if (!screenAligned(draw.plan, s)) return false;
     out.x0 = s.clip.x0;
@@ -337,6 +396,7 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
         cols.f.resize(size_t(n));
         ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u.data(), tap.width, cols.i0.data(),
                             cols.i1.data(), cols.f.data());
+        columnStretches(cols, n);
     }
     return true;
 }
@@ -411,7 +471,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     r.h0 = hRow(draw, tri, t, r.j0, sc);
                     r.h1 = hRow(draw, tri, t, r.j1, sc);
                 } else {
-                    r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(tap, r.j0, sc) : nullptr;
+                    r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
                 }
             }
             for (size_t wi = 0; wi < windowCount; ++wi) {

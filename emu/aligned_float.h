@@ -28,9 +28,9 @@ namespace emu {
 struct FloatRowTap {
     bool bound = false;  // no texture: every lookup is (0, 0, 0, 1)
     int stage = 0, coordSet = 0;
-    bool unorm8 = false;               // texels as b g r a bytes (else float r g b a values)
-    const uint8_t* bytes = nullptr;    // level 0 (Unorm8)
-    const float* values = nullptr;     // level 0 (Decoded)
+    bool unorm8 = false;             // texels as b g r a bytes (else float r g b a values)
+    const uint8_t* bytes = nullptr;  // level 0 (Unorm8)
+    const float* values = nullptr;   // level 0 (Decoded)
     uint32_t width = 1, height = 1;
     bool linear = false;
     ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;
@@ -40,9 +40,12 @@ struct FloatRowTap {
     bool nonNegative = false;
 };
 
+struct FloatRowKernels;
+
 // What one draw needs, shared read-only by the workers.
 struct FloatRowDraw {
-    uint64_t serial = 0;  // unique per draw: H rows kept by workers are valid within one draw only
+    uint64_t serial = 0;                       // unique per draw: H rows kept by workers are valid within one draw only
+    const FloatRowKernels* kernels = nullptr;  // the SIMD level's (emu/aligned_float_kernels.h)
     const ps11::Executor* executor = nullptr;
     ps11::TapPlan plan;
     std::array<FloatRowTap, 8> taps{};
@@ -66,6 +69,15 @@ struct FloatRowTriangle {
     struct Columns {
         std::vector<int32_t> i0, i1;
         std::vector<float> f;
+        // The columns in stretches, in order, covering them all: kSeq, texel pairs k + q and
+        // k + q + 1 (a 1:1 or minified-by-none run); kInside, both texels in the row; kBorder, a
+        // border texel among them.
+        enum Kind : uint8_t { kSeq, kInside, kBorder };
+        struct Stretch {
+            int32_t x0, x1;
+            Kind kind;
+        };
+        std::vector<Stretch> stretches;
         // Equal tables of one draw share their H rows (a full-screen quad's two triangles, the
         // taps of a vertical blur): shareFloatRowTables gives them the id of the first.
         uint64_t tableId = 0;

@@ -326,6 +326,12 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
         INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", program:\n"
                      << c.program);
+        // Every SIMD level the CPU runs (the float row kernels, emu/aligned_float_kernels.h).
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device levelDev(rowOpt);
+            DrawStats ls;
+            CHECK(drawCase(levelDev, c, ls) == expected);
+        });
         const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
         size_t firstDiff = 0;
         while (firstDiff < got.size() && got[firstDiff] == expected[firstDiff]) ++firstDiff;

@@ -1,0 +1,37 @@
+// The vector kernels of the float row path (emu/aligned_float.h): a table per SIMD level
+// (ps11/simd_dispatch.h), fetched once per draw (FloatRowDraw::kernels). Every kernel performs
+// the reference sampler's float operations in its order, one lane at a time as far as the
+// result is concerned (IEEE single precision, no fused multiply-add: the Avx2 file is built with
+// -ffp-contract=off), so both levels give the same floats bit for bit. Internal to
+// emu/aligned_float*.cpp.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "ps11/simd_dispatch.h"
+
+namespace emu {
+
+struct FloatRowKernels {
+    // out[j] = (1 − f[j])·a[j] + f[j]·b[j] for j in [0, n): the horizontal lerps of a run of
+    // columns whose texel pairs are consecutive (a = the row at the run's first texel, b = a + 1).
+    void (*lerpColumns)(const float* a, const float* b, const float* f, int n, float* out);
+    // out[j] = (1 − f[j])·d[i0[j]] + f[j]·d[i1[j]] for j in [0, n), every index valid: the
+    // horizontal lerps of any columns whose texels lie in the row (a magnified tap's).
+    void (*lerpGather)(const float* d, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out);
+    // out[j] = (1 − f)·a[j] + f·b[j] for j in [0, n): a pixel row's vertical lerp of two H rows.
+    void (*lerpRow)(const float* a, const float* b, float f, int n, float* out);
+    // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::
+    // unorm8Values()): channel c of texel i at out[c·stride + i].
+    void (*decode)(const uint8_t* row, int n, float* out, size_t stride);
+};
+
+// The table of a level (Baseline: SSE2 on x86-64, scalar elsewhere).
+const FloatRowKernels& floatRowKernels(ps11::SimdLevel level);
+// The Avx2 table (x86-64 builds only); use floatRowKernels().
+namespace avx2 {
+extern const FloatRowKernels kFloatRow;
+}
+
+}  // namespace emu
