@@ -110,19 +110,6 @@ void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv)
             std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
 }
 
-// The calling thread's run state, kept between calls (no 60 KB allocation per span); taken out
-// of the cache while in use, so a nested or concurrent call on the same thread allocates its own.
-struct ThreadState {
-    static std::unique_ptr<FastRunState>& cache() {
-        thread_local std::unique_ptr<FastRunState> c;
-        return c;
-    }
-    std::unique_ptr<FastRunState> fs;
-    ThreadState() : fs(std::move(cache())) {
-        if (!fs) fs.reset(new FastRunState);  // default-init: no zero fill of the banks
-    }
-    ~ThreadState() { cache() = std::move(fs); }
-};
 
 }  // namespace
 
@@ -201,8 +188,7 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram
 void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops, uint8_t vUsed,
              bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    ThreadState ts;
-    std::unique_ptr<FastRunState>& fs = ts.fs;
+    const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     RunState& st = fs->st;
     FastBank& bank = fs->bank;
     st.in = &inputs;
@@ -324,8 +310,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
                        TapFill fill, void* ctx, int16_t* const r0[4]) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    ThreadState ts;
-    std::unique_ptr<FastRunState>& fs = ts.fs;
+    const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
     alignas(64) static const float zeros[kChunk] = {};
     // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).

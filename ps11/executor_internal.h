@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 
 #include "ps11/decoded_program.h"
 #include "ps11/executor.h"
@@ -41,6 +42,29 @@ struct RunState {
     // Set by the fx8 fast path around tex/texld: sampleInto then leaves the ±M clamp of the
     // texels to the caller, which clamps while converting to its int16 registers.
     bool deferTexelClamp = false;
+};
+
+// The calling thread's T (a run state of tens of KB), kept between calls so a span costs no
+// allocation; taken out of the cache while in use, so a nested call on the same thread allocates
+// its own. T is default-initialised: callers set what they read.
+template <class T>
+class ThreadCached {
+public:
+    ThreadCached() : m_v(std::move(cache())) {
+        if (!m_v) m_v.reset(new T);
+    }
+    ~ThreadCached() { cache() = std::move(m_v); }
+    ThreadCached(const ThreadCached&) = delete;
+    ThreadCached& operator=(const ThreadCached&) = delete;
+    T& operator*() const { return *m_v; }
+    T* operator->() const { return m_v.get(); }
+
+private:
+    static std::unique_ptr<T>& cache() {
+        thread_local std::unique_ptr<T> c;
+        return c;
+    }
+    std::unique_ptr<T> m_v;
 };
 
 // Channels of source s an op reads, as a mask of output channels (the opcode table's
