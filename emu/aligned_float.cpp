@@ -54,7 +54,8 @@ void lerpColumnsBase(const float* a, const float* b, const float* f, int n, floa
     for (; j < n; ++j) out[j] = lerpf(a[j], b[j], f[j]);
 }
 
-void lerpGatherBase(const float* d, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out) {
+void lerpGatherBase(const float* d, int /*len*/, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                    float* out) {
     for (int j = 0; j < n; ++j) out[j] = lerpf(d[i0[j]], d[i1[j]], f[j]);
 }
 
@@ -177,7 +178,7 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
                     break;
                 case FloatRowTriangle::Columns::kInside:
                     for (size_t c = 0; c < 4; ++c)
-                        k.lerpGather(dec + c * tw, i0 + x0, i1 + x0, f + x0, n, out + c * w + x0);
+                        k.lerpGather(dec + c * tw, int(tw), i0 + x0, i1 + x0, f + x0, n, out + c * w + x0);
                     break;
                 case FloatRowTriangle::Columns::kBorder:
                     for (size_t q = x0; q < size_t(st.x1); ++q)
@@ -509,6 +510,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
                     mi.x = sc.x;
                     mi.y = sc.y;
+                    mi.row = true;
                     for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
                     MergeStats ms;
                     mergePixels(draw.merge, mi, draw.target, &ms);

@@ -744,6 +744,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
                     mi.x = sc.x;
                     mi.y = sc.y;
+                    mi.row = true;
                     for (int c = 0; c < 4; ++c) {
                         for (int i = 0; i < n; ++i) {
                             sc.grid[c][i] = sc.r0[c][i];

@@ -438,6 +438,27 @@ void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const
     const Surf cs = p.colorSurf;
     const Lanes lanes(in, p);
     const uint8_t* live = in.live;
+    if (in.row && !live && count > 0) {
+        // One run of a row: the words straight into it.
+        uint32_t x, y;
+        const bool inside = lanes.inside(0, x, y) && x + uint32_t(count) <= p.boundW;
+        assert(inside && in.x[count - 1] == in.x[0] + count - 1 && in.y[count - 1] == in.y[0]);
+        if (inside) {
+            uint8_t* q = cs.at(x, y);
+            if (!Additive && mask == 0xffffffffu) {
+                std::memcpy(q, words, 4 * size_t(count));
+            } else {
+                for (int i = 0; i < count; ++i, q += 4) {
+                    uint32_t w = words[i];
+                    const uint32_t old = load32(q);
+                    if constexpr (Additive) w = addSaturateBytes(w, old);
+                    store32(q, (w & mask) | (old & ~mask));
+                }
+            }
+            n.written += uint64_t(count);
+            return;
+        }
+    }
     uint64_t written = 0;
     for (int i = 0; i < count; ++i) {
         uint32_t x, y;
@@ -825,10 +846,20 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     // sat(s) + d in float, then the words (the merger's 8-bit words kernel), then the stores.
     alignas(32) uint32_t old[ps11::kMaxSpan];
     alignas(32) uint8_t stores[ps11::kMaxSpan];
-    for (int i = 0; i < count; ++i) {
+    uint8_t* run = nullptr;  // a row path's run: its first pixel
+    if (in.row && !live && count > 0) {
         uint32_t x, y;
-        stores[i] = uint8_t((!live || live[i]) && lanes.inside(i, x, y));
-        old[i] = stores[i] ? load32(cs.at(x, y)) : 0u;
+        if (lanes.inside(0, x, y) && x + uint32_t(count) <= p.boundW) run = cs.at(x, y);
+        assert(run && in.x[count - 1] == in.x[0] + count - 1 && in.y[count - 1] == in.y[0]);
+    }
+    if (run) {
+        std::memcpy(old, run, 4 * size_t(count));
+    } else {
+        for (int i = 0; i < count; ++i) {
+            uint32_t x, y;
+            stores[i] = uint8_t((!live || live[i]) && lanes.inside(i, x, y));
+            old[i] = stores[i] ? load32(cs.at(x, y)) : 0u;
+        }
     }
     alignas(32) float sum[4][ps11::kMaxSpan];
     constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
@@ -854,6 +885,13 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
     // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both.
     mergerKernels(ps11::simdLevel()).unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
+    if (run) {
+        if (mask != 0xffffffffu)
+            for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (old[i] & ~mask);
+        std::memcpy(run, words, 4 * size_t(count));
+        n.written += uint64_t(count);
+        return;
+    }
     uint64_t written = 0;
     for (int i = 0; i < count; ++i) {
         if (!stores[i]) continue;

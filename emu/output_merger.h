@@ -49,6 +49,9 @@ struct MergeInputs {
     const int32_t* x = nullptr;  // pixel coordinates inside the target
     const int32_t* y = nullptr;
     const uint8_t* live = nullptr;  // 1 = covered and not discarded by texkill; null = all live
+    // The lanes are pixels x[0] .. x[0] + count − 1 of row y[0] (the row paths' spans): the
+    // merger may store them as one run (x and y must still be given and say the same).
+    bool row = false;
     // r0 from the executor: color always (real values); grid in fx profiles (value = grid / G),
     // null otherwise. The merger uses grid when given.
     const float* color[4] = {};
