@@ -26,11 +26,28 @@ void lerpColumnsAvx2(const float* a, const float* b, const float* f, int n, floa
     for (; j < n; ++j) out[j] = lerp1(a[j], b[j], f[j]);
 }
 
-void lerpGatherAvx2(const float* d, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out) {
+void lerpGatherAvx2(const float* d, int len, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out) {
+    const __m256i seven = _mm256_set1_epi32(7);
     int j = 0;
     for (; j + 8 <= n; j += 8) {
-        const __m256 a = _mm256_i32gather_ps(d, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j)), 4);
-        const __m256 b = _mm256_i32gather_ps(d, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i1 + j)), 4);
+        const __m256i k0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j));
+        const __m256i k1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i1 + j));
+        __m256 a, b;
+        const int base = i0[j];
+        const __m256i r0 = _mm256_sub_epi32(k0, _mm256_set1_epi32(base));
+        const __m256i r1 = _mm256_sub_epi32(k1, _mm256_set1_epi32(base));
+        // Eight columns over at most eight texels from the first one's (a magnification): one
+        // load and two permutes; else two gathers.
+        const __m256i out0 = _mm256_or_si256(_mm256_cmpgt_epi32(r0, seven), _mm256_cmpgt_epi32(r1, seven));
+        const __m256i neg = _mm256_or_si256(r0, r1);
+        if (base + 8 <= len && _mm256_testz_si256(out0, out0) && _mm256_movemask_ps(_mm256_castsi256_ps(neg)) == 0) {
+            const __m256 row = _mm256_loadu_ps(d + base);
+            a = _mm256_permutevar8x32_ps(row, r0);
+            b = _mm256_permutevar8x32_ps(row, r1);
+        } else {
+            a = _mm256_i32gather_ps(d, k0, 4);
+            b = _mm256_i32gather_ps(d, k1, 4);
+        }
         _mm256_storeu_ps(out + j, lerp8(a, b, _mm256_loadu_ps(f + j)));
     }
     for (; j < n; ++j) out[j] = lerp1(d[i0[j]], d[i1[j]], f[j]);

@@ -17,9 +17,10 @@ struct FloatRowKernels {
     // out[j] = (1 − f[j])·a[j] + f[j]·b[j] for j in [0, n): the horizontal lerps of a run of
     // columns whose texel pairs are consecutive (a = the row at the run's first texel, b = a + 1).
     void (*lerpColumns)(const float* a, const float* b, const float* f, int n, float* out);
-    // out[j] = (1 − f[j])·d[i0[j]] + f[j]·d[i1[j]] for j in [0, n), every index valid: the
+    // out[j] = (1 − f[j])·d[i0[j]] + f[j]·d[i1[j]] for j in [0, n), every index in [0, len): the
     // horizontal lerps of any columns whose texels lie in the row (a magnified tap's).
-    void (*lerpGather)(const float* d, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out);
+    void (*lerpGather)(const float* d, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                       float* out);
     // out[j] = (1 − f)·a[j] + f·b[j] for j in [0, n): a pixel row's vertical lerp of two H rows.
     void (*lerpRow)(const float* a, const float* b, float f, int n, float* out);
     // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::
