@@ -109,25 +109,35 @@ struct RowTaps {
     float fy = 0;
     const float* h0 = nullptr;  // linear taps: H rows of j0 and j1 (planar, `width` columns)
     const float* h1 = nullptr;
-    const float* dec = nullptr;  // point taps of 8-bit textures: texel row j0 decoded (planar)
+    const float* dec = nullptr;  // point taps: texel row j0 as planar floats (decodedRow)
 };
 
-// Texel row j (in the texture) of an 8-bit tap as planar r g b a floats (kUnorm8 values),
-// decoded once per worker and kept while recent; valid until the next pixel row.
+// Texel row j (in the texture) of a tap as planar r g b a floats: an 8-bit tap's decoded
+// (kUnorm8 values), a float tap's deinterleaved; done once per worker and kept while recent;
+// valid until the next pixel row.
 const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
-    const uint8_t* row = tap.bytes + size_t(j) * tap.width * 4;
+    const size_t tw = tap.width;
+    const uint8_t* row =
+        tap.unorm8 ? tap.bytes + size_t(j) * tw * 4 : reinterpret_cast<const uint8_t*>(tap.values + size_t(j) * tw * 4);
     FloatRowScratch::DecodedRow* slot = nullptr;
     for (FloatRowScratch::DecodedRow& d : sc.decoded) {
-        if (d.row == row && d.width == tap.width) {
+        if (d.serial == draw.serial && d.row == row && d.width == tap.width) {
             d.stamp = ++sc.stamp;
             return d.v.data();
         }
         if (d.stamp <= sc.rowStart && (!slot || d.stamp < slot->stamp)) slot = &d;
     }
     if (!slot) slot = &sc.decoded.emplace_back();  // every row serves this pixel row
-    const size_t tw = tap.width;
     slot->v.resize(4 * tw);
-    draw.kernels->decode(row, int(tw), slot->v.data(), tw);
+    if (tap.unorm8) {
+        draw.kernels->decode(row, int(tw), slot->v.data(), tw);
+    } else {
+        const float* v = tap.values + size_t(j) * tw * 4;
+        float* out = slot->v.data();
+        for (size_t i = 0; i < tw; ++i)
+            for (size_t c = 0; c < 4; ++c) out[c * tw + i] = v[4 * i + c];
+    }
+    slot->serial = draw.serial;
     slot->row = row;
     slot->width = tap.width;
     slot->stamp = ++sc.stamp;
@@ -155,7 +165,7 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     const size_t w = size_t(tri.x1 - tri.x0);
     h.h.resize(4 * w);
     size_t x = 0;
-    if (tap.unorm8 && j >= 0) {
+    if (j >= 0) {
         // By stretches (prepareFloatRowTriangle): consecutive texel pairs with vector loads, other
         // pairs inside the row gathered, border columns one at a time; the same operations in the
         // same order as lerpf.
@@ -472,7 +482,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     r.h0 = hRow(draw, tri, t, r.j0, sc);
                     r.h1 = hRow(draw, tri, t, r.j1, sc);
                 } else {
-                    r.dec = tap.unorm8 && r.j0 >= 0 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
+                    r.dec = r.j0 >= 0 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
                 }
             }
             for (size_t wi = 0; wi < windowCount; ++wi) {

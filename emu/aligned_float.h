@@ -111,9 +111,11 @@ struct FloatRowScratch {
         std::vector<float> h;
     };
     std::vector<HRow> hrows;
-    // 8-bit texel rows decoded into planar r g b a floats (the taps of a horizontal blur read
-    // one row), keyed by the row's first byte and its width; kept like the H rows.
+    // Texel rows as planar r g b a floats (8-bit ones decoded, float ones deinterleaved: the
+    // taps of a horizontal blur read one row), keyed by draw, the row's first byte and its
+    // width (a texture's memory is rewritten between draws); kept like the H rows.
     struct DecodedRow {
+        uint64_t serial = 0;
         const uint8_t* row = nullptr;
         uint32_t width = 0;
         uint64_t stamp = 0;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "emu/aligned_float.h"
 #include "emu/aligned_pass.h"
 #include "emu/aligned_pass_kernels.h"
 #include "emu/device.h"
@@ -399,11 +400,15 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
           "[draw][aligned]") {
     // What the row path may keep between spans or draws (the sign analysis of the constants,
     // filtered texel rows) must follow every change: the same calls on both devices, compared
-    // after every draw.
+    // after every draw. In each profile with a row path: fx8, and float and ideal (the float row
+    // path's H rows and decoded texel rows).
+    const ps11::Precision precision = GENERATE(ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal);
+    INFO("precision " << ps11::precisionName(precision));
     std::mt19937 rng(4242);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     const UINT w = 203, h = 19;
     DeviceOptions quadOpt, rowOpt;
+    quadOpt.precision = rowOpt.precision = precision;
     quadOpt.software.alignedPasses = false;
     quadOpt.software.threads = rowOpt.software.threads = 2;
     Device quadDev(quadOpt), rowDev(rowOpt);
@@ -561,6 +566,84 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
     // itself.
     if (alignedKernels(ps11::simdLevel())) CHECK(scratch->hrows.built == uint64_t(h + 1));
     delete scratch;
+}
+
+TEST_CASE("float row path: texel rows kept by a worker never outlive their draw", "[draw][aligned]") {
+    // As above for the float row path's H rows and decoded texel rows: the same buffer, rewritten
+    // between two draws, read by a worker that keeps its scratch; each draw must equal the same
+    // draw on a fresh scratch.
+    const int w = 48, h = 6;
+    ps11::Diagnostics diags;
+    std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    ps11::ExecutorOptions eo;
+    eo.precision = ps11::Precision::Float;
+    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, eo, diags);
+    REQUIRE(exec);
+    std::vector<uint8_t> texels(size_t(w) * h * 4);
+    auto makeTarget = [&] {
+        Image t;
+        t.format = formatInfo(D3DFMT_A8R8G8B8);
+        t.width = w, t.height = h, t.rowPitch = 4 * w;
+        t.bytes.assign(size_t(w) * h * 4, 0);
+        return t;
+    };
+    Image kept = makeTarget(), fresh = makeTarget();
+    // The 1:1 quad with the tap a quarter texel right, and one a quarter texel down (each row
+    // reads H rows of two texel rows) in a second stage.
+    ScreenTriangle tris[2];
+    const double xs[4] = {-0.5, w - 0.5, w - 0.5, -0.5}, ys[4] = {-0.5, -0.5, h - 0.5, h - 0.5};
+    const int order[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int t = 0; t < 2; ++t)
+        for (int k = 0; k < 3; ++k) {
+            ScreenVertex& v = tris[t].v[size_t(k)];
+            const int c = order[t][k];
+            v.x = xs[c], v.y = ys[c], v.rhw = 1;
+            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + 0.25f / w;
+            v.attr[size_t(attrTex(0, 1))] = (c >= 2 ? 1.0f : 0.0f) + 0.25f / h;
+        }
+    const uint64_t used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
+    TriangleSetup setups[2];
+    for (int t = 0; t < 2; ++t) REQUIRE(setupTriangle(tris[t], used, ClipRect{0, 0, w, h}, setups[t]));
+    auto scratch = std::make_unique<FloatRowScratch>();  // one worker's, kept across the draws
+    std::mt19937 rng(99);
+    for (int draw = 0; draw < 2; ++draw) {
+        for (uint8_t& b : texels) b = uint8_t(rng());
+        for (Image* target : {&kept, &fresh}) {
+            FloatRowDraw d;
+            std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+            std::array<ps11::SamplerState, 8> samplers{};
+            MergeState merge;
+            merge.precision = ps11::Precision::Float;
+            REQUIRE(prepareFloatRowDraw(*exec, ps11::Precision::Float, 0, false, none, samplers, merge,
+                                        MergeTarget{target, nullptr}, false, used, d));
+            FloatRowTap& tap = d.taps[0];
+            tap.bound = true;
+            tap.unorm8 = true;
+            tap.bytes = texels.data();
+            tap.width = w, tap.height = h;
+            tap.linear = true;
+            tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+            tap.nonNegative = true;
+            FloatRowTriangle ft[2];
+            for (int t = 0; t < 2; ++t) REQUIRE(prepareFloatRowTriangle(d, setups[t], ft[t]));
+            const uint8_t prepared[2] = {1, 1};
+            shareFloatRowTables(d, ft, prepared, 2);
+            const FloatRowTriangle* tp[2] = {&ft[0], &ft[1]};
+            const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
+            AlignedStats stats;
+            // The second draw covers only the rows the first ended on: the kept scratch holds
+            // rows of the same texel addresses.
+            const int y0 = draw == 0 ? 0 : h - 2;
+            FloatRowScratch own;
+            drawFloatRows(d, tp, sp, 2, y0, h, target == &kept ? *scratch : own, stats);
+            CHECK(stats.pixels == uint64_t(w) * uint64_t(h - y0));
+        }
+        INFO("draw " << draw);
+        CHECK(std::vector<uint8_t>(kept.bytes.begin(), kept.bytes.end()) ==
+              std::vector<uint8_t>(fresh.bytes.begin(), fresh.bytes.end()));
+    }
 }
 
 TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad path byte for byte",
