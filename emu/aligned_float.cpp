@@ -115,7 +115,8 @@ struct RowTaps {
 // Texel row j (in the texture) of a tap as planar r g b a floats: an 8-bit tap's decoded
 // (kUnorm8 values), a float tap's deinterleaved; done once per worker and kept while recent;
 // valid until the next pixel row.
-const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_t j, FloatRowScratch& sc) {
+const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_t j, FloatRowScratch& sc,
+                        bool* nan = nullptr) {
     const size_t tw = tap.width;
     const uint8_t* row =
         tap.unorm8 ? tap.bytes + size_t(j) * tw * 4 : reinterpret_cast<const uint8_t*>(tap.values + size_t(j) * tw * 4);
@@ -123,20 +124,29 @@ const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_
     for (FloatRowScratch::DecodedRow& d : sc.decoded) {
         if (d.serial == draw.serial && d.row == row && d.width == tap.width) {
             d.stamp = ++sc.stamp;
+            if (nan) *nan = d.nan;
             return d.v.data();
         }
         if (d.stamp <= sc.rowStart && (!slot || d.stamp < slot->stamp)) slot = &d;
     }
     if (!slot) slot = &sc.decoded.emplace_back();  // every row serves this pixel row
     slot->v.resize(4 * tw);
+    slot->nan = false;
     if (tap.unorm8) {
         draw.kernels->decode(row, int(tw), slot->v.data(), tw);
     } else {
         const float* v = tap.values + size_t(j) * tw * 4;
         float* out = slot->v.data();
+        bool nanSeen = false;
         for (size_t i = 0; i < tw; ++i)
-            for (size_t c = 0; c < 4; ++c) out[c * tw + i] = v[4 * i + c];
+            for (size_t c = 0; c < 4; ++c) {
+                const float x = v[4 * i + c];
+                nanSeen |= x != x;
+                out[c * tw + i] = x;
+            }
+        slot->nan = nanSeen;
     }
+    if (nan) *nan = slot->nan;
     slot->serial = draw.serial;
     slot->row = row;
     slot->width = tap.width;
@@ -165,13 +175,18 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     const size_t w = size_t(tri.x1 - tri.x0);
     h.h.resize(4 * w);
     size_t x = 0;
-    if (j >= 0) {
+    // A row holding a NaN is filtered by lerpf one column at a time below: which of two NaNs a sum
+    // returns depends on the order of its operands, which the compiler picks for lerpf as it does
+    // for the reference sampler's; without NaNs the vector kernels' results are the same whatever
+    // the order.
+    bool nan = false;
+    const float* dec = j >= 0 ? decodedRow(draw, tap, j, sc, &nan) : nullptr;
+    if (dec && !nan) {
         // By stretches (prepareFloatRowTriangle): consecutive texel pairs with vector loads, other
         // pairs inside the row gathered, border columns one at a time; the same operations in the
         // same order as lerpf.
         const FloatRowKernels& k = *draw.kernels;
         const size_t tw = tap.width;
-        const float* dec = decodedRow(draw, tap, j, sc);
         const int32_t* i0 = cols.i0.data();
         const int32_t* i1 = cols.i1.data();
         const float* f = cols.f.data();

@@ -119,6 +119,7 @@ struct FloatRowScratch {
         const uint8_t* row = nullptr;
         uint32_t width = 0;
         uint64_t stamp = 0;
+        bool nan = false;  // holds a NaN (float textures)
         std::vector<float> v;
     };
     std::vector<DecodedRow> decoded;

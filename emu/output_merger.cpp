@@ -915,6 +915,47 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
     v[kZero] = 0.0f, v[kOne] = 1.0f;
     for (int c = 0; c < 4; ++c) v[kBf + c] = float(p.bfByte[c]) / 255.0f;
     const uint8_t* live = in.live;
+#if defined(__SSE2__)
+    // A row path's run into an A32B32G32R32F target whose blend factors are constants (ZERO, ONE,
+    // the blend factor: the additive passes): blendFloat's operations four channels at a time,
+    // pixel by pixel along the run.
+    const auto constant = [](const Factor& fa) { return fa.slot == kZero || fa.slot == kOne || fa.slot >= kBf; };
+    bool constFactors = p.target == TargetKind::Rgba32F && in.row && !live && in.count > 0;
+    for (int c = 0; c < 4 && constFactors; ++c)
+        constFactors = ch[c].kind == OpKind::Linear && constant(ch[c].src) && constant(ch[c].dst);
+    uint32_t x0 = 0, y0 = 0;
+    if (constFactors && lanes.inside(0, x0, y0) && x0 + uint32_t(in.count) <= p.boundW) {
+        assert(in.x[in.count - 1] == in.x[0] + in.count - 1 && in.y[in.count - 1] == in.y[0]);
+        alignas(16) float fs[4], fd[4], ks[4], kd[4];
+        alignas(16) uint32_t zs[4], zd[4], on[4];
+        for (int c = 0; c < 4; ++c) {
+            const ChannelPlan& cp = ch[c];
+            fs[c] = cp.src.inv ? 1.0f - v[cp.src.slot] : v[cp.src.slot];
+            fd[c] = cp.dst.inv ? 1.0f - v[cp.dst.slot] : v[cp.dst.slot];
+            ks[c] = float(cp.cs), kd[c] = float(cp.cd);
+            zs[c] = cp.src.slot == kZero && !cp.src.inv ? ~0u : 0u;
+            zd[c] = cp.dst.slot == kZero && !cp.dst.inv ? ~0u : 0u;
+            on[c] = (p.channels >> c & 1u) ? ~0u : 0u;
+        }
+        const __m128 fsv = _mm_load_ps(fs), fdv = _mm_load_ps(fd), ksv = _mm_load_ps(ks), kdv = _mm_load_ps(kd);
+        const __m128 zsv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(zs)));
+        const __m128 zdv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(zd)));
+        const __m128 onv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(on)));
+        float* q = reinterpret_cast<float*>(cs.at(x0, y0));
+        const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
+        for (int i = 0; i < in.count; ++i, q += 4) {
+            const __m128 sv = _mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), dv = _mm_loadu_ps(q);
+            const __m128 ts = _mm_mul_ps(ksv, _mm_mul_ps(sv, fsv)), td = _mm_mul_ps(kdv, _mm_mul_ps(dv, fdv));
+            // zs: (zd ? 0 : td); else zd ? ts : ts + td.
+            const __m128 a = _mm_andnot_ps(zdv, td);
+            const __m128 b = _mm_or_ps(_mm_and_ps(zdv, ts), _mm_andnot_ps(zdv, _mm_add_ps(ts, td)));
+            const __m128 r = _mm_or_ps(_mm_and_ps(zsv, a), _mm_andnot_ps(zsv, b));
+            _mm_storeu_ps(q, _mm_or_ps(_mm_and_ps(onv, r), _mm_andnot_ps(onv, dv)));
+        }
+        n.written += uint64_t(in.count);
+        return;
+    }
+#endif
     uint64_t written = 0;
     for (int i = 0; i < in.count; ++i) {
         uint32_t x, y;
