@@ -408,9 +408,8 @@ void columnStretches(FloatRowTriangle::Columns& cols, int n) {
 
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     if (!screenAligned(draw.plan, s)) return false;
-    out.x0 = s.clip.x0;
-    out.x1 = s.clip.x1;
-    const int n = std::max(out.x1 - out.x0, 0);
+    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    const int n = out.x1 - out.x0;
     std::vector<float> u(static_cast<size_t>(n));
     for (int i = 0; i < draw.plan.count; ++i) {
         const FloatRowTap& tap = draw.taps[size_t(i)];
@@ -444,7 +443,9 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
         for (int t = 0; t < draw.plan.count; ++t) {
             FloatRowTriangle::Columns& c = tris[i].taps[size_t(t)];
             c.tableId = 0;
-            for (size_t j = 0; j <= i && !c.tableId; ++j)
+            // The triangle before (a quad's other half) and this one's earlier taps: a draw of
+            // many triangles compares each with a few, not all.
+            for (size_t j = i > 0 ? i - 1 : 0; j <= i && !c.tableId; ++j)
                 for (int u = 0; u < (j < i ? draw.plan.count : t) && !c.tableId; ++u)
                     if (prepared[j] && sameRows(i, t, j, u)) c.tableId = tris[j].taps[size_t(u)].tableId;
             if (!c.tableId) c.tableId = ++ids;

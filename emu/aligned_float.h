@@ -85,7 +85,7 @@ struct FloatRowTriangle {
     std::array<Columns, 8> taps;
 };
 
-// Gives each tap's table of tris[0 .. count) an id, the same to taps of any triangle whose H
+// Gives each tap's table of tris[0 .. count) an id, the same to taps of the triangle or the one before whose H
 // rows are equal (same texels, border, columns, texel pairs and weights), so drawFloatRows
 // builds their H rows once.
 void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count);

@@ -436,21 +436,24 @@ float rowV(const TriangleSetup& s, int set, int y) {
     return (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
 }
 
-bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
-    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
-    if (!screenAligned(draw.plan, s)) return false;
-    // The columns of the tables: the clip rect's, or for a triangle covering less than half of
-    // them (a sprite) its own. Triangles of one full-screen quad thus have equal tables and share
-    // their H rows.
+bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
     int xlo = s.clip.x1, xhi = s.clip.x0;
     for (int y = s.yMin; y < s.yMax; ++y) {
         int xl = 0, xr = 0;
         if (rowCoverage(s, y, xl, xr)) xlo = std::min(xlo, xl), xhi = std::max(xhi, xr);
     }
-    if (xlo >= xhi) return false;  // covers nothing: the quad path finds that too
+    if (xlo >= xhi) return false;
     const bool narrow = 2 * (xhi - xlo) < s.clip.x1 - s.clip.x0;
-    out.x0 = narrow ? xlo : s.clip.x0;
-    out.x1 = narrow ? xhi : s.clip.x1;
+    x0 = narrow ? xlo : s.clip.x0;
+    x1 = narrow ? xhi : s.clip.x1;
+    return true;
+}
+
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
+    if (!screenAligned(draw.plan, s)) return false;
+    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    const bool narrow = out.x1 - out.x0 < s.clip.x1 - s.clip.x0;  // a sprite's own columns
     out.configs.clear();
     const int n = out.x1 - out.x0;
     std::vector<float> u(size_t(std::max(n, 0)));

@@ -110,6 +110,11 @@ struct AlignedTriangle {
 // colours constant or affine) and then fills its tables.
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out);
 
+// The columns [x0, x1) a row path's tables of the triangle span: the clip rect's, or for a
+// triangle covering less than half of them (a sprite) its own. Triangles of one full-screen quad
+// thus have equal tables and share their H rows. False when it covers no pixel.
+bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
+
 // Triangles drawn row by row together (drawAlignedRows' group), and the most a chunk may have for
 // tile skipping.
 constexpr size_t kMaxAlignedTriangles = 16;

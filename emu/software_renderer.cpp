@@ -188,10 +188,16 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 if (columns > budget) isAligned[i] = 0;
             }
         }
-        if (floatDraw && setups.size() <= kMaxAlignedTriangles) {
+        if (floatDraw) {
+            // The same budget (a float table holds 12 bytes a column per tap).
             floatTris.resize(setups.size());
-            for (size_t i = 0; i < setups.size(); ++i)
+            const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
+            int64_t columns = 0;
+            for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 isAligned[i] = prepareFloatRowTriangle(floatRows, setups[i], floatTris[i]);
+                if (isAligned[i]) columns += floatTris[i].x1 - floatTris[i].x0;
+                if (columns > budget) isAligned[i] = 0;
+            }
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
         }
         if (setups.empty()) continue;
