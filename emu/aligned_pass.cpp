@@ -140,7 +140,8 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
 #if defined(__SSE2__)
     const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
     for (; i + 4 <= n; i += 4) {
-        const __m128i w = _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
+        const __m128i w =
+            _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
         __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
         _mm_storeu_si128(d, _mm_adds_epu8(_mm_loadu_si128(d), w));
     }
@@ -212,8 +213,9 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
             if (row.direct[size_t(run.config)]) {
                 const int n = e - x, n16 = n & ~15;  // whole groups: the kernel writes no lane past them
                 const int lane = x - first;
-                uint16_t* const dst[4] = {reinterpret_cast<uint16_t*>(out[0] + lane), reinterpret_cast<uint16_t*>(out[1] + lane),
-                                          reinterpret_cast<uint16_t*>(out[2] + lane), reinterpret_cast<uint16_t*>(out[3] + lane)};
+                uint16_t* const dst[4] = {
+                    reinterpret_cast<uint16_t*>(out[0] + lane), reinterpret_cast<uint16_t*>(out[1] + lane),
+                    reinterpret_cast<uint16_t*>(out[2] + lane), reinterpret_cast<uint16_t*>(out[3] + lane)};
                 if (n16) kernels->deinterleave(row.row0 + cols.off0[size_t(x - colBase)], n16, dst);
                 if (n > n16) filterScalar(tap, cols, row, colBase, x + n16, n - n16, lane + n16, out);
                 x = e;
@@ -247,8 +249,9 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
             for (int done = 0; done < e - x; done += ps11::kMaxSpan) {
                 const int n = std::min(ps11::kMaxSpan, e - x - done);
                 const size_t k = at + size_t(done);
-                kernels->buildTabulated(row.row0, &cols.off0[k], &cols.off1[k], &cols.w[k], n, h0);
-                if (row.wy != 0) kernels->buildTabulated(row.row1, &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1);
+                kernels->buildTabulated(row.row0, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h0);
+                if (row.wy != 0)
+                    kernels->buildTabulated(row.row1, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1);
                 const uint16_t* const c0[4] = {h0[0], h0[1], h0[2], h0[3]};
                 const uint16_t* const c1[4] = {h1[0], h1[1], h1[2], h1[3]};
                 kernels->vertical(HKind::H, c0, c1, row.wy, n, x + done - first, out);
@@ -308,7 +311,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
             const int n = config.jhi - config.jlo;
             uint16_t* out[4];
             slotPlanes(h, n, kHRowPad, out);
-            kernels.buildTabulated(row, config.off0, config.off1, config.w, n, out);
+            kernels.buildTabulated(row, config.rowTexels, config.off0, config.off1, config.w, n, out);
             ++cache.built;
         } else {
             ++cache.hits;
@@ -428,7 +431,8 @@ bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {
 void columnU(const TriangleSetup& s, int set, int x0, int n, float* u) {
     const int k = attrTex(set, 0);
     for (int x = 0; x < n; ++x)
-        u[x] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, x0 + x, s.yMin);
+        u[x] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
+                                      : planeValue(s.attr[size_t(k)], s.ox, s.oy, x0 + x, s.yMin);
 }
 
 float rowV(const TriangleSetup& s, int set, int y) {
@@ -452,7 +456,7 @@ bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
     if (!screenAligned(draw.plan, s)) return false;
-    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    if (!tableColumns(s, out.x0, out.x1)) return false;           // covers nothing: the quad path finds that too
     const bool narrow = out.x1 - out.x0 < s.clip.x1 - s.clip.x0;  // a sprite's own columns
     out.configs.clear();
     const int n = out.x1 - out.x0;
@@ -559,6 +563,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
         if (tabConfig >= 0) {
             HConfig& h = out.configs[size_t(tabConfig)];
             const size_t at = size_t(h.jlo - out.x0), len = size_t(h.jhi - h.jlo);
+            h.rowTexels = int32_t(tap.width);
             h.off0 = cols.off0.data() + at;
             h.off1 = cols.off1.data() + at;
             h.w = cols.w.data() + at;
@@ -593,7 +598,9 @@ RowWindows rowWindows(const RowWindow* windows, size_t count) {
     RowWindows w{windows, count, 0};
     if (!windows || count == 0) w.data = &whole, w.count = 1;
     for (size_t i = 0; i < w.count; ++i)
-        w.taps |= w.data[i].mode == RowMode::Shade ? 0xffu : w.data[i].mode == RowMode::Copy ? 1u << w.data[i].copyTap : 0u;
+        w.taps |= w.data[i].mode == RowMode::Shade  ? 0xffu
+                  : w.data[i].mode == RowMode::Copy ? 1u << w.data[i].copyTap
+                                                    : 0u;
     return w;
 }
 
@@ -626,8 +633,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     } ctx{&draw, nullptr, &rows, 0};
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
-        filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)], f.tri->x0, f.x + first,
-                  count, dst);
+        filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)],
+                  f.tri->x0, f.x + first, count, dst);
     };
     HRowCache& cache = sc.hrows;
     if (cache.serial != draw.serial) {
@@ -689,7 +696,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     const HConfig& h = tri.configs[ci];
                     r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
                     if (r.direct[size_t(c)]) continue;
-                    const uint64_t id = ti < kMaxAlignedTriangles && ci < tabIds[ti].size() ? tabIds[ti][ci] : h.tableId;
+                    const uint64_t id =
+                        ti < kMaxAlignedTriangles && ci < tabIds[ti].size() ? tabIds[ti][ci] : h.tableId;
                     hRow(*draw.kernels, cache, r.row0, h, id, planes);
                     for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
                     if (r.wy != 0) {
@@ -724,7 +732,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         }
                         fill(&ctx, window->copyTap, 0, n, r0);
                         for (int c = 0; c < 4; ++c)
-                            if (!((window->copyMask >> c) & 1)) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                            if (!((window->copyMask >> c) & 1))
+                                std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     } else {
                         for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     }

@@ -1,9 +1,9 @@
 // The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): triangles whose
 // texture coordinates are screen-aligned (u depends on x only, v on y only, no perspective) in
 // fx8, with a program whose texture reads are plain (ps11::tapPlan,
-// ps11/executor_presampled_internal.h), are drawn row by row without quads or per-lane coordinates: each tap's texel columns and weights are tabulated
-// once per triangle and its rows once per pixel row, texels are filtered into int16 lanes (runs
-// with a fixed weight and step through shared, cached H rows), the executor runs pre-sampled, and 8-bit
+// ps11/executor_presampled_internal.h), are drawn row by row without quads or per-lane coordinates: each tap's texel
+// columns and weights are tabulated once per triangle and its rows once per pixel row, texels are filtered into int16
+// lanes (runs with a fixed weight and step through shared, cached H rows), the executor runs pre-sampled, and 8-bit
 // targets take plain and additive stores directly. Results are bit-identical to the quad path.
 #pragma once
 
@@ -83,6 +83,7 @@ struct HConfig {
     const int32_t* off0 = nullptr;
     const int32_t* off1 = nullptr;
     const int32_t* w = nullptr;
+    int32_t rowTexels = 0;  // texels in a texel row (the texture's width)
     uint64_t hash = 0;
     uint64_t tableId = 0;  // unique per prepared table (a slot that checked it needs no second look)
 };
@@ -186,10 +187,10 @@ enum class RowMode : uint8_t { Shade, Fill, Copy };
 struct RowWindow {
     int x0 = 0, x1 = 0;  // columns [x0, x1)
     RowMode mode = RowMode::Shade;
-    int copyTap = -1;                // Copy: the tap (index in the draw's TapPlan)
-    uint8_t copyMask = 0xf;          // Copy: r0's channels from the tap (bit c); the others from grid/value
-    std::array<int32_t, 4> grid{};   // Fill, fx profiles: r0's grid integers
-    std::array<float, 4> value{};    // Fill, float profiles: r0's floats
+    int copyTap = -1;               // Copy: the tap (index in the draw's TapPlan)
+    uint8_t copyMask = 0xf;         // Copy: r0's channels from the tap (bit c); the others from grid/value
+    std::array<int32_t, 4> grid{};  // Fill, fx profiles: r0's grid integers
+    std::array<float, 4> value{};   // Fill, float profiles: r0's floats
 };
 
 // The windows a row path draws: those given (disjoint, in column order), or with none given one

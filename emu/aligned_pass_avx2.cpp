@@ -123,8 +123,8 @@ void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx,
         }
 }
 
-void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
-                               uint16_t* const out[4]) {
+void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t* off0, const int32_t* off1,
+                               const int32_t* w, int n, uint16_t* const out[4]) {
     static constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a within a b g r a word
     // Per channel: byte of a to bits 0-7 of each dword, byte of b to bits 16-23 (pmaddwd pairs).
     __m256i selA[4], selB[4];
@@ -139,6 +139,7 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const in
         selB[c] = loadu(mb);
     }
     const __m256i zero = _mm256_setzero_si256(), w256 = _mm256_set1_epi32(256);
+    const __m256i seven = _mm256_set1_epi32(7), three = _mm256_set1_epi32(3);
     const int* base = reinterpret_cast<const int*>(row);
     int j = 0;
     for (; j + 16 <= n; j += 16) {
@@ -146,7 +147,25 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, const int32_t* off0, const in
         for (int h = 0; h < 2; ++h) {
             const int k = j + 8 * h;
             const __m256i i0 = _mm256_max_epi32(loadu(off0 + k), zero), i1 = _mm256_max_epi32(loadu(off1 + k), zero);
-            const __m256i a = _mm256_i32gather_epi32(base, i0, 1), b = _mm256_i32gather_epi32(base, i1, 1);
+            // Eight columns over at most eight texels from the first one's (a magnification): one
+            // load and two permutes; else two gathers.
+            __m256i a, b;
+            const int first = std::max(off0[k], 0) >> 2;
+            const __m256i firstV = _mm256_set1_epi32(first);
+            const __m256i r0 = _mm256_sub_epi32(_mm256_srli_epi32(i0, 2), firstV);
+            const __m256i r1 = _mm256_sub_epi32(_mm256_srli_epi32(i1, 2), firstV);
+            const __m256i outside =
+                _mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi32(r0, seven), _mm256_cmpgt_epi32(r1, seven)),
+                                _mm256_or_si256(_mm256_cmpgt_epi32(zero, _mm256_or_si256(r0, r1)),
+                                                _mm256_and_si256(_mm256_or_si256(i0, i1), three)));
+            if (first + 8 <= rowTexels && _mm256_testz_si256(outside, outside)) {
+                const __m256i words = loadu(base + first);
+                a = _mm256_permutevar8x32_epi32(words, r0);
+                b = _mm256_permutevar8x32_epi32(words, r1);
+            } else {
+                a = _mm256_i32gather_epi32(base, i0, 1);
+                b = _mm256_i32gather_epi32(base, i1, 1);
+            }
             const __m256i wv = loadu(w + k);
             const __m256i wp = _mm256_or_si256(_mm256_sub_epi32(w256, wv), _mm256_slli_epi32(wv, 16));
             for (int c = 0; c < 4; ++c)

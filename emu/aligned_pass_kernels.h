@@ -43,10 +43,10 @@ struct AlignedKernels {
     void (*combine)(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
 
     // Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b
-    // the channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets;
-    // negative offsets read texel 0: such elements are never used).
-    void (*buildTabulated)(const uint8_t* row, const int32_t* off0, const int32_t* off1, const int32_t* w, int n,
-                           uint16_t* const out[4]);
+    // the channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets within
+    // the row's `rowTexels` words; negative offsets read texel 0: such elements are never used).
+    void (*buildTabulated)(const uint8_t* row, int rowTexels, const int32_t* off0, const int32_t* off1,
+                           const int32_t* w, int n, uint16_t* const out[4]);
 
     // Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of
     // kind `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
