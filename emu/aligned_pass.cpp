@@ -216,8 +216,16 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
                 uint16_t* const dst[4] = {
                     reinterpret_cast<uint16_t*>(out[0] + lane), reinterpret_cast<uint16_t*>(out[1] + lane),
                     reinterpret_cast<uint16_t*>(out[2] + lane), reinterpret_cast<uint16_t*>(out[3] + lane)};
-                if (n16) kernels->deinterleave(row.row0 + cols.off0[size_t(x - colBase)], n16, dst);
-                if (n > n16) filterScalar(tap, cols, row, colBase, x + n16, n - n16, lane + n16, out);
+                const uint8_t* texels = row.row0 + cols.off0[size_t(x - colBase)];
+                if (n16) kernels->deinterleave(texels, n16, dst);
+                if (n > n16) {
+                    // The last texels into a group of its own (the kernel fills a whole group and
+                    // reads no texel past the count), then the lanes that are this run's.
+                    alignas(32) uint16_t tail[4][16];
+                    uint16_t* const t[4] = {tail[0], tail[1], tail[2], tail[3]};
+                    kernels->deinterleave(texels + 4 * n16, n - n16, t);
+                    for (int c = 0; c < 4; ++c) std::memcpy(dst[c] + n16, tail[c], sizeof(uint16_t) * size_t(n - n16));
+                }
                 x = e;
                 continue;
             }
