@@ -628,7 +628,10 @@ void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[
 
 // s * Fs (op) d * Fd in float32, evaluated as written (two products, one sum; a ZERO factor
 // contributes nothing, so 0 * inf does not make a NaN). v holds the slots.
-inline float blendFloat(const ChannelPlan& cp, const float* v, float s, float d) {
+// Not inlined: which of two NaNs ts + td passes on follows the operand order the compiler gives
+// the sum, so every path blends through this one copy (the row paths' vector blend hands it its
+// lanes holding a NaN).
+[[gnu::noinline]] float blendFloat(const ChannelPlan& cp, const float* v, float s, float d) {
     if (cp.kind == OpKind::Min) return s < d ? s : d;
     if (cp.kind == OpKind::Max) return s > d ? s : d;
     const bool zs = cp.src.slot == kZero && !cp.src.inv, zd = cp.dst.slot == kZero && !cp.dst.inv;
@@ -945,6 +948,11 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
         const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
         for (int i = 0; i < in.count; ++i, q += 4) {
             const __m128 sv = _mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), dv = _mm_loadu_ps(q);
+            if (_mm_movemask_ps(_mm_cmpunord_ps(sv, dv))) {  // a NaN: blendFloat's own order
+                float sc[4] = {f0[i], f1[i], f2[i], f3[i]};
+                blendIntoFloatTarget(p, ch, v, sc, reinterpret_cast<uint8_t*>(q));
+                continue;
+            }
             const __m128 ts = _mm_mul_ps(ksv, _mm_mul_ps(sv, fsv)), td = _mm_mul_ps(kdv, _mm_mul_ps(dv, fdv));
             // zs: (zd ? 0 : td); else zd ? ts : ts + td.
             const __m128 a = _mm_andnot_ps(zdv, td);
