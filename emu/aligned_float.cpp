@@ -482,11 +482,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
         for (size_t ti = 0; ti < count; ++ti) {
             const FloatRowTriangle& tri = *tris[ti];
             const TriangleSetup& s = *setups[ti];
-            if (y < s.yMin || y >= s.yMax) continue;
             int xl = 0, xr = 0;
-            if (!rowCoverage(s, y, xl, xr)) continue;
-            xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[windowCount - 1].x1);
-            if (xl >= xr) continue;
+            if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             sampler.setTriangle(tri);
             for (int t = 0; t < taps; ++t) {
                 const FloatRowTap& tap = draw.taps[size_t(t)];

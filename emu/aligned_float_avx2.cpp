@@ -7,6 +7,7 @@
 #include <immintrin.h>
 
 #include "emu/aligned_float_kernels.h"
+#include "emu/lanes_avx2.h"
 #include "ps11/texture.h"
 
 namespace emu {
@@ -27,7 +28,6 @@ void lerpColumnsAvx2(const float* a, const float* b, const float* f, int n, floa
 }
 
 void lerpGatherAvx2(const float* d, int len, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out) {
-    const __m256i seven = _mm256_set1_epi32(7);
     int j = 0;
     for (; j + 8 <= n; j += 8) {
         const __m256i k0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j));
@@ -38,9 +38,7 @@ void lerpGatherAvx2(const float* d, int len, const int32_t* i0, const int32_t* i
         const __m256i r1 = _mm256_sub_epi32(k1, _mm256_set1_epi32(base));
         // Eight columns over at most eight texels from the first one's (a magnification): one
         // load and two permutes; else two gathers.
-        const __m256i out0 = _mm256_or_si256(_mm256_cmpgt_epi32(r0, seven), _mm256_cmpgt_epi32(r1, seven));
-        const __m256i neg = _mm256_or_si256(r0, r1);
-        if (base + 8 <= len && _mm256_testz_si256(out0, out0) && _mm256_movemask_ps(_mm256_castsi256_ps(neg)) == 0) {
+        if (base + 8 <= len && withinEight(r0, r1)) {
             const __m256 row = _mm256_loadu_ps(d + base);
             a = _mm256_permutevar8x32_ps(row, r0);
             b = _mm256_permutevar8x32_ps(row, r1);

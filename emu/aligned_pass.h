@@ -7,6 +7,7 @@
 // targets take plain and additive stores directly. Results are bit-identical to the quad path.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -200,7 +201,16 @@ struct RowWindows {
     size_t count = 0;
     uint32_t taps = 0;
 };
+
 RowWindows rowWindows(const RowWindow* windows, size_t count);
+
+// The columns [xl, xr) of pixel row y that triangle s covers within the windows' span
+// (windows[0].x0 to windows[count − 1].x1); false when there are none.
+inline bool rowSpan(const TriangleSetup& s, int y, const RowWindow* windows, size_t count, int& xl, int& xr) {
+    if (y < s.yMin || y >= s.yMax || !rowCoverage(s, y, xl, xr)) return false;
+    xl = std::max(xl, windows[0].x0), xr = std::min(xr, windows[count - 1].x1);
+    return xl < xr;
+}
 
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in

@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "emu/aligned_pass_kernels.h"
+#include "emu/lanes_avx2.h"
 
 namespace emu {
 
@@ -139,7 +140,7 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t*
         selB[c] = loadu(mb);
     }
     const __m256i zero = _mm256_setzero_si256(), w256 = _mm256_set1_epi32(256);
-    const __m256i seven = _mm256_set1_epi32(7), three = _mm256_set1_epi32(3);
+    const __m256i three = _mm256_set1_epi32(3);
     const int* base = reinterpret_cast<const int*>(row);
     int j = 0;
     for (; j + 16 <= n; j += 16) {
@@ -154,11 +155,8 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t*
             const __m256i firstV = _mm256_set1_epi32(first);
             const __m256i r0 = _mm256_sub_epi32(_mm256_srli_epi32(i0, 2), firstV);
             const __m256i r1 = _mm256_sub_epi32(_mm256_srli_epi32(i1, 2), firstV);
-            const __m256i outside =
-                _mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi32(r0, seven), _mm256_cmpgt_epi32(r1, seven)),
-                                _mm256_or_si256(_mm256_cmpgt_epi32(zero, _mm256_or_si256(r0, r1)),
-                                                _mm256_and_si256(_mm256_or_si256(i0, i1), three)));
-            if (first + 8 <= rowTexels && _mm256_testz_si256(outside, outside)) {
+            const __m256i unaligned = _mm256_and_si256(_mm256_or_si256(i0, i1), three);  // byte offsets of whole texels
+            if (first + 8 <= rowTexels && _mm256_testz_si256(unaligned, unaligned) && withinEight(r0, r1)) {
                 const __m256i words = loadu(base + first);
                 a = _mm256_permutevar8x32_epi32(words, r0);
                 b = _mm256_permutevar8x32_epi32(words, r1);

@@ -365,7 +365,8 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", program:\n"
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision)
+                     << ", program:\n"
                      << c.program);
         // Every SIMD level the CPU runs (the float row kernels, emu/aligned_float_kernels.h).
         testutil::forEachSimdLevel([&](ps11::SimdLevel) {
@@ -376,13 +377,15 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         const std::vector<uint8_t> got = drawCase(rowDev, c, rs);
         size_t firstDiff = 0;
         while (firstDiff < got.size() && got[firstDiff] == expected[firstDiff]) ++firstDiff;
-        INFO("first difference at byte " << firstDiff << " (pixel " << firstDiff / 4 % c.w << ", " << firstDiff / 4 / c.w
-                                         << "), tex0 format " << c.tex[0].format << " filter " << c.tex[0].filter
-                                         << " got " << (firstDiff < got.size() ? int(got[firstDiff]) : -1) << " want "
-                                         << (firstDiff < got.size() ? int(expected[firstDiff]) : -1) << " tex " << c.tex[0].w
-                                         << "x" << c.tex[0].h << " addr " << c.tex[0].addressU << "," << c.tex[0].addressV
-                                         << " bound " << c.tex[0].bound << " blend " << c.blend << " mask " << c.writeMask
-                                         << " alphatest " << c.alphaTest << " scissor " << c.scissor);
+        INFO("first difference at byte " << firstDiff << " (pixel " << firstDiff / 4 % c.w << ", "
+                                         << firstDiff / 4 / c.w << "), tex0 format " << c.tex[0].format << " filter "
+                                         << c.tex[0].filter << " got "
+                                         << (firstDiff < got.size() ? int(got[firstDiff]) : -1) << " want "
+                                         << (firstDiff < got.size() ? int(expected[firstDiff]) : -1) << " tex "
+                                         << c.tex[0].w << "x" << c.tex[0].h << " addr " << c.tex[0].addressU << ","
+                                         << c.tex[0].addressV << " bound " << c.tex[0].bound << " blend " << c.blend
+                                         << " mask " << c.writeMask << " alphatest " << c.alphaTest << " scissor "
+                                         << c.scissor);
         REQUIRE(firstDiff == got.size());
         requireSkippingEqual(rowOpt, c, expected, qs);
         CHECK(rs.pixelsCovered == qs.pixelsCovered);
@@ -530,23 +533,24 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
     }
 }
 
-TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[draw][aligned]") {
-    // The device may place a new texture copy where a freed one was, so two draws can sample the
-    // same address with different texels. Driven below the device: the same buffer, rewritten
-    // between two draws of the same triangles, must give each draw its own texels.
-    const int w = 48, h = 6;
+namespace {
+
+// Below the device: a copy program (`mov r0, t0`) for the profile's executor.
+std::unique_ptr<ps11::Executor> copyExecutor(ps11::Precision precision) {
     ps11::Diagnostics diags;
     std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
     REQUIRE(program);
     REQUIRE(ps11::validate(*program, diags));
-    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, ps11::ExecutorOptions{}, diags);
+    ps11::ExecutorOptions eo;
+    eo.precision = precision;
+    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, eo, diags);
     REQUIRE(exec);
-    std::vector<uint8_t> texels(size_t(w) * h * 4);
-    Image target;
-    target.format = formatInfo(D3DFMT_A8R8G8B8);
-    target.width = w, target.height = h, target.rowPitch = 4 * w;
-    target.bytes.assign(size_t(w) * h * 4, 0);
-    // The 1:1 quad with the tap a quarter texel right (one weight along whole rows).
+    return exec;
+}
+
+// The two triangles of the 1:1 quad over a w×h target, tap 0's coordinates shifted by (du, dv)
+// texels; `used` is what they interpolate.
+void quadSetups(int w, int h, float du, float dv, TriangleSetup setups[2], uint64_t& used) {
     ScreenTriangle tris[2];
     const double xs[4] = {-0.5, w - 0.5, w - 0.5, -0.5}, ys[4] = {-0.5, -0.5, h - 0.5, h - 0.5};
     const int order[2][3] = {{0, 1, 2}, {0, 2, 3}};
@@ -555,12 +559,30 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
             ScreenVertex& v = tris[t].v[size_t(k)];
             const int c = order[t][k];
             v.x = xs[c], v.y = ys[c], v.rhw = 1;
-            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + 0.25f / w;
-            v.attr[size_t(attrTex(0, 1))] = c >= 2 ? 1.0f : 0.0f;
+            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + du / float(w);
+            v.attr[size_t(attrTex(0, 1))] = (c >= 2 ? 1.0f : 0.0f) + dv / float(h);
         }
-    const uint64_t used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
-    TriangleSetup setups[2];
+    used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
     for (int t = 0; t < 2; ++t) REQUIRE(setupTriangle(tris[t], used, ClipRect{0, 0, w, h}, setups[t]));
+}
+
+}  // namespace
+
+TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[draw][aligned]") {
+    // The device may place a new texture copy where a freed one was, so two draws can sample the
+    // same address with different texels. Driven below the device: the same buffer, rewritten
+    // between two draws of the same triangles, must give each draw its own texels.
+    const int w = 48, h = 6;
+    const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Fx8);
+    std::vector<uint8_t> texels(size_t(w) * h * 4);
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = w, target.height = h, target.rowPitch = 4 * w;
+    target.bytes.assign(size_t(w) * h * 4, 0);
+    // The 1:1 quad with the tap a quarter texel right (one weight along whole rows).
+    TriangleSetup setups[2];
+    uint64_t used = 0;
+    quadSetups(w, h, 0.25f, 0.0f, setups, used);
     AlignedScratch* scratch = new AlignedScratch;  // one worker's, kept across the draws
     std::mt19937 rng(99);
     for (int draw = 0; draw < 2; ++draw) {
@@ -613,14 +635,7 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
     // between two draws, read by a worker that keeps its scratch; each draw must equal the same
     // draw on a fresh scratch.
     const int w = 48, h = 6;
-    ps11::Diagnostics diags;
-    std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
-    REQUIRE(program);
-    REQUIRE(ps11::validate(*program, diags));
-    ps11::ExecutorOptions eo;
-    eo.precision = ps11::Precision::Float;
-    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, eo, diags);
-    REQUIRE(exec);
+    const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Float);
     std::vector<uint8_t> texels(size_t(w) * h * 4);
     auto makeTarget = [&] {
         Image t;
@@ -630,22 +645,11 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
         return t;
     };
     Image kept = makeTarget(), fresh = makeTarget();
-    // The 1:1 quad with the tap a quarter texel right, and one a quarter texel down (each row
-    // reads H rows of two texel rows) in a second stage.
-    ScreenTriangle tris[2];
-    const double xs[4] = {-0.5, w - 0.5, w - 0.5, -0.5}, ys[4] = {-0.5, -0.5, h - 0.5, h - 0.5};
-    const int order[2][3] = {{0, 1, 2}, {0, 2, 3}};
-    for (int t = 0; t < 2; ++t)
-        for (int k = 0; k < 3; ++k) {
-            ScreenVertex& v = tris[t].v[size_t(k)];
-            const int c = order[t][k];
-            v.x = xs[c], v.y = ys[c], v.rhw = 1;
-            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + 0.25f / w;
-            v.attr[size_t(attrTex(0, 1))] = (c >= 2 ? 1.0f : 0.0f) + 0.25f / h;
-        }
-    const uint64_t used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
+    // The 1:1 quad with the tap a quarter texel right and a quarter texel down (each pixel row
+    // reads H rows of two texel rows).
     TriangleSetup setups[2];
-    for (int t = 0; t < 2; ++t) REQUIRE(setupTriangle(tris[t], used, ClipRect{0, 0, w, h}, setups[t]));
+    uint64_t used = 0;
+    quadSetups(w, h, 0.25f, 0.25f, setups, used);
     auto scratch = std::make_unique<FloatRowScratch>();  // one worker's, kept across the draws
     std::mt19937 rng(99);
     for (int draw = 0; draw < 2; ++draw) {
@@ -821,7 +825,8 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
     }
 }
 
-TEST_CASE("tile skipping: random draws over partly constant textures equal every pixel shaded", "[draw][aligned][skip]") {
+TEST_CASE("tile skipping: random draws over partly constant textures equal every pixel shaded",
+          "[draw][aligned][skip]") {
     // Textures that are zero, one constant texel, or zero with a few random blocks (a sparse
     // glare); programs of glare passes (composites, bright passes, blurs) among the random ones;
     // fx8, float and ideal; ONE/ONE blending often. Skipping on must give the bytes of skipping
@@ -830,7 +835,8 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
         "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n",
         "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n",
         "ps_1_1\ntex t0\nsub_sat r0, t0, c1\nmul_x4 r0, r0, c2\n",
-        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, "
+        "c0, r0\n",
         "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r1, c0, r0\n",
     };
     std::mt19937 rng(20261128);
@@ -866,15 +872,17 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         rowOpt.software.skipTiles = false;
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        quadOpt.precision = rowOpt.precision =
-            profile == 0 ? ps11::Precision::Fx8 : profile == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        quadOpt.precision = rowOpt.precision = profile == 0   ? ps11::Precision::Fx8
+                                               : profile == 1 ? ps11::Precision::Float
+                                                              : ps11::Precision::Ideal;
         DeviceOptions skipOpt = rowOpt;
         skipOpt.software.skipTiles = true;
         Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
         DrawStats qs, rs, ks;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision)
-                     << ", blend " << c.blend << ", program:\n" << c.program);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", blend "
+                     << c.blend << ", program:\n"
+                     << c.program);
         REQUIRE(drawCase(rowDev, c, rs) == expected);
         const std::vector<uint8_t> got = drawCase(skipDev, c, ks);
         size_t firstDiff = 0;
@@ -923,7 +931,8 @@ TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain a
         const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
         for (int k : {0, 1, 2, 0, 2, 3}) {
             Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
-            for (int s = 0; s < 4; ++s) q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            for (int s = 0; s < 4; ++s)
+                q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
             c.verts.push_back(q);
         }
         c.blend = DWORD(i % 2);  // plain, ONE/ONE
@@ -987,7 +996,8 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (floatCase) quadOpt.precision = rowOpt.precision = i % 4 < 2 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        if (floatCase)
+            quadOpt.precision = rowOpt.precision = i % 4 < 2 ? ps11::Precision::Float : ps11::Precision::Ideal;
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         INFO("case " << i << ": " << c.w << "x" << c.h << ", " << quads << " quads, blend " << c.blend

@@ -1,0 +1,22 @@
+// Lane helpers shared by the row paths' Avx2 kernels (emu/aligned_pass_avx2.cpp,
+// emu/aligned_float_avx2.cpp); included only by files built with the Avx2 level's flags.
+#pragma once
+
+#if !defined(__AVX2__)
+#error "emu/lanes_avx2.h is for files built with the Avx2 level's flags (CMakeLists.txt)"
+#endif
+#include <immintrin.h>
+
+namespace emu {
+
+// Whether every lane of r0 and r1 (texel indices relative to a block's first texel) lies in
+// [0, 7]: then one load of eight texels and a permute each serve the block instead of two
+// gathers (a magnification's columns).
+inline bool withinEight(__m256i r0, __m256i r1) {
+    const __m256i seven = _mm256_set1_epi32(7);
+    const __m256i bad = _mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi32(r0, seven), _mm256_cmpgt_epi32(r1, seven)),
+                                        _mm256_srai_epi32(_mm256_or_si256(r0, r1), 31));
+    return _mm256_testz_si256(bad, bad);
+}
+
+}  // namespace emu
