@@ -406,9 +406,11 @@ void columnStretches(FloatRowTriangle::Columns& cols, int n) {
 
 }  // namespace
 
-bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
+bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
+                             const std::pair<int, int>* columns) {
     if (!screenAligned(draw.plan, s)) return false;
     if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    if (columns) out.x0 = columns->first, out.x1 = columns->second;
     const int n = out.x1 - out.x0;
     std::vector<float> u(static_cast<size_t>(n));
     for (int i = 0; i < draw.plan.count; ++i) {

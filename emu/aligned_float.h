@@ -92,7 +92,9 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
 
 // True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
 // colours constant or affine), and then fills its tables.
-bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out);
+// `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
+bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
+                             const std::pair<int, int>* columns = nullptr);
 
 // Per-worker buffers, allocated once and kept by the worker.
 struct FloatRowScratch {

@@ -242,8 +242,8 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
         }
         // Up to the next vector run: columns whose texels are all inside the texture, with both
         // texel rows at hand, have their H rows built for these columns alone and blended at once
-        // (the tabulated kernels without the cache: a narrow triangle's, whose rows serve few pixel
-        // rows); border texels, short stretches or no vector kernels, one pixel at a time.
+        // (the tabulated kernels without the cache: stretches shorter than a run); border texels,
+        // short stretches or no vector kernels, one pixel at a time.
         int e = x + 1;
         while (e < end && vectorRun(e) < 0) ++e;
         bool inside = kernels && e - x >= kMinDirectColumns && row.row0 && (row.wy == 0 || row.row1);
@@ -271,32 +271,53 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
     }
 }
 
-// Finds the slot for (row, key) or takes one for it: the least recently used slot not used on
-// the current pixel row (so every pointer handed out for a row stays valid until the next row),
-// or a new one. `fresh` tells whether it must be filled.
+// Finds the slot for (row, key) or takes one for it: the least recently used slot used on neither
+// the current pixel row (so every pointer handed out for a row stays valid until the next row) nor
+// the one before, or a new one. `fresh` tells whether it must be filled.
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
-    HRowCache::Slot* victim = nullptr;
-    for (const std::unique_ptr<HRowCache::Slot>& sp : cache.slots) {
-        HRowCache::Slot& sl = *sp;
+    // A cheap key over the fields that identify the row (never 0: 0 marks an empty slot); slots
+    // with the key are then compared field by field.
+    uint64_t h = (uint64_t(reinterpret_cast<uintptr_t>(row)) ^ (tableId * 0x9E3779B97F4A7C15ull) ^
+                  (uint64_t(uint32_t(key.jlo)) << 40) ^ (uint64_t(uint32_t(key.wx) & 0xffu) << 32) ^
+                  (uint64_t(uint32_t(key.phase)) << 24) ^ uint64_t(uint32_t(key.step)) << 16) *
+                 0xff51afd7ed558ccdull;
+    h |= 1;
+    const size_t n = cache.keys.size();
+    auto same = [&](size_t i) {
+        const HRowCache::Slot& sl = *cache.slots[i];
         const HConfig& k = sl.config;
-        if (sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step && k.phase == key.phase &&
-            k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId) {
-            sl.stamp = cache.stamp;
-            fresh = false;
-            return sl;
-        }
-        if (sl.stamp != cache.stamp && (!victim || sl.stamp < victim->stamp)) victim = &sl;
+        return cache.keys[i] == h && sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step &&
+               k.phase == key.phase && k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId;
+    };
+    uint32_t& hint = cache.hint[size_t(h >> 8) & 255];
+    size_t found = hint > 0 && hint <= n && same(hint - 1) ? hint - 1 : n;
+    for (size_t i = 0; found == n && i < n; ++i)
+        if (same(i)) found = i;
+    if (found < n) {
+        cache.stamps[found] = cache.stamp;
+        hint = uint32_t(found + 1);
+        fresh = false;
+        return *cache.slots[found];
     }
-    if (!victim) {
+    // Not one used on this pixel row or the one before (the rows a magnified tap's next pixel row
+    // most likely reads again): the oldest of the others, or a new slot.
+    size_t victim = n;
+    for (size_t i = 0; i < n; ++i)
+        if (cache.stamps[i] + 1 < cache.stamp && (victim == n || cache.stamps[i] < cache.stamps[victim])) victim = i;
+    if (victim == n) {
         cache.slots.push_back(std::make_unique<HRowCache::Slot>());
-        victim = cache.slots.back().get();
+        cache.keys.push_back(0);
+        cache.stamps.push_back(0);
     }
-    victim->row = row;
-    victim->config = key;
-    victim->config.tableId = tableId;
-    victim->stamp = cache.stamp;
+    HRowCache::Slot& sl = *cache.slots[victim];
+    sl.row = row;
+    sl.config = key;
+    sl.config.tableId = tableId;
+    cache.keys[victim] = h;
+    cache.stamps[victim] = cache.stamp;
+    hint = uint32_t(victim + 1);
     fresh = true;
-    return *victim;
+    return sl;
 }
 
 // Sizes a slot for n elements per plane (plus the kernels' padding) and returns its planes.
@@ -461,11 +482,20 @@ bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
     return true;
 }
 
-bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair<int, int>& out) {
+    const int width = clip.x1 - clip.x0;
+    const bool narrow = a1 - a0 < width && b1 - b0 < width;
+    if (!narrow || std::max(a0, b0) >= std::min(a1, b1)) return false;
+    out = {std::min(a0, b0), std::max(a1, b1)};
+    return true;
+}
+
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
+                            const std::pair<int, int>* columns) {
     // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
     if (!screenAligned(draw.plan, s)) return false;
-    if (!tableColumns(s, out.x0, out.x1)) return false;           // covers nothing: the quad path finds that too
-    const bool narrow = out.x1 - out.x0 < s.clip.x1 - s.clip.x0;  // a sprite's own columns
+    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    if (columns) out.x0 = columns->first, out.x1 = columns->second;
     out.configs.clear();
     const int n = out.x1 - out.x0;
     std::vector<float> u(size_t(std::max(n, 0)));
@@ -537,7 +567,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
                    (cols.w[size_t(x)] == 0 || cols.off1[size_t(x)] >= 0);
         };
         int tabSlot = -1, tabConfig = -1;
-        for (int x = 0; draw.kernels && !narrow && x < n;) {
+        for (int x = 0; draw.kernels && x < n;) {
             if (!tabOk(x)) {
                 ++x;
                 continue;
@@ -647,7 +677,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     HRowCache& cache = sc.hrows;
     if (cache.serial != draw.serial) {
         // Another draw: its textures may have changed since (the slots keep their memory).
-        for (const std::unique_ptr<HRowCache::Slot>& sl : cache.slots) sl->row = nullptr, sl->stamp = 0;
+        for (const std::unique_ptr<HRowCache::Slot>& sl : cache.slots) sl->row = nullptr;
+        std::fill(cache.keys.begin(), cache.keys.end(), 0);
+        std::fill(cache.stamps.begin(), cache.stamps.end(), 0);
         cache.serial = draw.serial;
     }
     std::array<const uint16_t*, 4> planes{};

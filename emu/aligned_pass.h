@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "emu/output_merger.h"
@@ -110,12 +111,20 @@ struct AlignedTriangle {
 
 // True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
 // colours constant or affine) and then fills its tables.
-bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out);
+// `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
+                            const std::pair<int, int>* columns = nullptr);
 
 // The columns [x0, x1) a row path's tables of the triangle span: the clip rect's, or for a
 // triangle covering less than half of them (a sprite) its own. Triangles of one full-screen quad
 // thus have equal tables and share their H rows. False when it covers no pixel.
 bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
+
+// The columns two consecutive triangles' tables should share (their union), when both have
+// narrow tables that overlap: the two halves of a sprite's quad cover column ranges a pixel apart
+// at their slanted edges, so their own columns would give tables (and H rows) that are never
+// shared. False when they are no such pair.
+bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair<int, int>& out);
 
 // Triangles drawn row by row together (drawAlignedRows' group), and the most a chunk may have for
 // tile skipping.
@@ -134,11 +143,16 @@ struct HRowCache {
     struct Slot {
         const uint8_t* row = nullptr;  // the texel row (identifies texture and row)
         HConfig config;                // wx = −1: the staged row, texels [jlo, jhi)
-        uint64_t stamp = 0;            // the pixel row that last used it (slots in use are never evicted)
         int32_t stride = 0;            // elements per plane
         std::vector<uint16_t> data;
     };
     std::vector<std::unique_ptr<Slot>> slots;
+    // Per slot, side by side for the lookup's scan (a group of sprites keeps dozens of slots): a
+    // hash of its row and configuration (0: empty), and the pixel row that last used it (slots
+    // in use on the current pixel row are never evicted).
+    std::vector<uint64_t> keys, stamps;
+    // A direct-mapped hint per key's low bits: the slot last found or filled for it, plus 1.
+    std::array<uint32_t, 256> hint{};
     uint64_t serial = 0;  // the draw the slots belong to
     uint64_t stamp = 0;
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)

@@ -7,9 +7,9 @@
 #include <atomic>
 #include <unordered_map>
 
+#include "emu/aligned_float.h"
 #include "emu/aligned_pass.h"
 #include "emu/blit.h"
-#include "emu/aligned_float.h"
 #include "emu/thread_pool.h"
 #include "emu/tile_skip.h"
 #include "ps11/diagnostics.h"
@@ -130,9 +130,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     std::vector<TriangleSetup> setups;
     // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
     AlignedDraw aligned;
-    const bool alignedDraw = m_options.alignedPasses && prepareAlignedDraw(executor, precision, call.textures,
-                                                                           call.samplers, merge, mtarget, wantZ,
-                                                                           used, aligned);
+    const bool alignedDraw =
+        m_options.alignedPasses &&
+        prepareAlignedDraw(executor, precision, call.textures, call.samplers, merge, mtarget, wantZ, used, aligned);
     std::vector<AlignedTriangle> alignedTris;
     // The float profiles' row path (emu/aligned_float.h), the same per-triangle decision.
     FloatRowDraw floatRows;
@@ -182,8 +182,23 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             alignedTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
+            bool paired = false;  // the triangle before was paired with the one before it
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
+                // A quad's two halves over the same columns, so they share tables and H rows.
+                std::pair<int, int> both;
+                const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
+                                  pairColumns(alignedTris[i - 1].x0, alignedTris[i - 1].x1, alignedTris[i].x0,
+                                              alignedTris[i].x1, clip, both);
+                if (pair && (alignedTris[i - 1].x0 != both.first || alignedTris[i - 1].x1 != both.second ||
+                             alignedTris[i].x0 != both.first || alignedTris[i].x1 != both.second)) {
+                    columns -= alignedTris[i - 1].x1 - alignedTris[i - 1].x0;
+                    isAligned[i - 1] = prepareAlignedTriangle(aligned, setups[i - 1], alignedTris[i - 1], &both);
+                    isAligned[i] =
+                        isAligned[i - 1] && prepareAlignedTriangle(aligned, setups[i], alignedTris[i], &both);
+                    if (isAligned[i - 1]) columns += alignedTris[i - 1].x1 - alignedTris[i - 1].x0;
+                }
+                paired = pair;
                 if (isAligned[i]) columns += alignedTris[i].x1 - alignedTris[i].x0;
                 if (columns > budget) isAligned[i] = 0;
             }
@@ -193,8 +208,23 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             floatTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
+            bool paired = false;  // the triangle before was paired with the one before it
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 isAligned[i] = prepareFloatRowTriangle(floatRows, setups[i], floatTris[i]);
+                // A quad's two halves over the same columns, so they share tables and H rows.
+                std::pair<int, int> both;
+                const bool pair =
+                    isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
+                    pairColumns(floatTris[i - 1].x0, floatTris[i - 1].x1, floatTris[i].x0, floatTris[i].x1, clip, both);
+                if (pair && (floatTris[i - 1].x0 != both.first || floatTris[i - 1].x1 != both.second ||
+                             floatTris[i].x0 != both.first || floatTris[i].x1 != both.second)) {
+                    columns -= floatTris[i - 1].x1 - floatTris[i - 1].x0;
+                    isAligned[i - 1] = prepareFloatRowTriangle(floatRows, setups[i - 1], floatTris[i - 1], &both);
+                    isAligned[i] =
+                        isAligned[i - 1] && prepareFloatRowTriangle(floatRows, setups[i], floatTris[i], &both);
+                    if (isAligned[i - 1]) columns += floatTris[i - 1].x1 - floatTris[i - 1].x0;
+                }
+                paired = pair;
                 if (isAligned[i]) columns += floatTris[i].x1 - floatTris[i].x0;
                 if (columns > budget) isAligned[i] = 0;
             }
@@ -212,14 +242,16 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // sprites, visits each triangle only in the bands it touches).
         bandStart.assign(size_t(bands) + 1, 0);
         for (const TriangleSetup& t : setups)
-            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax;
+                 ++b)
                 ++bandStart[size_t(b) + 1];
         for (int b = 0; b < bands; ++b) bandStart[size_t(b) + 1] += bandStart[size_t(b)];
         bandTris.resize(bandStart[size_t(bands)]);
         bandFill.assign(bandStart.begin(), bandStart.end() - 1);
         for (uint32_t i = 0; i < setups.size(); ++i) {
             const TriangleSetup& t = setups[i];
-            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax;
+                 ++b)
                 bandTris[bandFill[size_t(b)]++] = i;
         }
         std::atomic<int> next{0};
@@ -308,8 +340,12 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 windows.clear();
                 auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
                     switch (d.action) {
-                        case TileAction::Shade: ws.tilesShaded += count; break;
-                        case TileAction::Fill: ws.tilesFilled += count; break;
+                        case TileAction::Shade:
+                            ws.tilesShaded += count;
+                            break;
+                        case TileAction::Fill:
+                            ws.tilesFilled += count;
+                            break;
                         case TileAction::Copy:
                             ws.tilesCopied += count;
                             if (copiesSave) copiesSaving.fetch_add(count, std::memory_order_relaxed);
@@ -374,8 +410,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     const TriangleSetup& s = setups[i];
                     if (isAligned[i]) {
                         if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
-                        if (floatDraw) floatGroup[grouped] = &floatTris[i];
-                        else group[grouped] = &alignedTris[i];
+                        if (floatDraw)
+                            floatGroup[grouped] = &floatTris[i];
+                        else
+                            group[grouped] = &alignedTris[i];
                         groupSetups[grouped++] = &s;
                         continue;
                     }
@@ -411,8 +449,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         const uint64_t copied = stats.tilesCopied - tilesBefore.tilesCopied;
         const uint64_t copiesSaved =
             std::min(copied, copiesSaving.load() + copiedDirect.load() / uint64_t(kBandRows * kSkipTileColumns));
-        const uint64_t saved = stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled -
-                               tilesBefore.tilesSkipped + copiesSaved;
+        const uint64_t saved =
+            stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled - tilesBefore.tilesSkipped + copiesSaved;
         history.paid = saved * 4 >= shaded + copied + saved - copiesSaved;
         history.since = 0;
     }
