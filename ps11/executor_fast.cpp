@@ -348,11 +348,15 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
             }
             commitPair(ops, idx, bank, nv);
         }
-        // A whole chunk is a fixed-size copy (vector moves, not a variable-length rep movs).
-        if (n == kChunk)
-            for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * kChunk);
-        else
-            for (int c = 0; c < 4; ++c) std::memcpy(r0[c] + off, bank.reg[kSlotR][c], sizeof(int16_t) * size_t(n));
+        // Fixed-size copies of 16 lanes (vector moves: a variable-length memcpy becomes a rep movs,
+        // whose start-up dominated the short spans of sprites), then the last lanes one by one.
+        const int n16 = n & ~15;
+        for (int c = 0; c < 4; ++c) {
+            const int16_t* src = bank.reg[kSlotR][c];
+            int16_t* dst = r0[c] + off;
+            for (int k = 0; k < n16; k += 16) std::memcpy(dst + k, src + k, sizeof(int16_t) * 16);
+            for (int k = n16; k < n; ++k) dst[k] = src[k];
+        }
     }
 }
 
