@@ -177,57 +177,40 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         }
         stats.trianglesDrawn += setups.size();
         isAligned.assign(setups.size(), 0);
-        if (alignedDraw) {
-            // Tables for the chunk's triangles, in order, while their columns fit the budget.
-            alignedTris.resize(setups.size());
+        // Tables for the chunk's triangles, in order, while their columns fit the budget (the same
+        // for both row paths: a float table holds 12 bytes a column per tap, an fx8 one 16), a
+        // quad's two halves over the same columns so they share tables and H rows (pairColumns).
+        auto prepareTables = [&](auto& rowTris, auto prepare) {
+            rowTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
             bool paired = false;  // the triangle before was paired with the one before it
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
-                isAligned[i] = prepareAlignedTriangle(aligned, setups[i], alignedTris[i]);
-                // A quad's two halves over the same columns, so they share tables and H rows.
+                auto& t = rowTris[i];
+                isAligned[i] = prepare(setups[i], t, nullptr);
                 std::pair<int, int> both;
                 const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
-                                  pairColumns(alignedTris[i - 1].x0, alignedTris[i - 1].x1, alignedTris[i].x0,
-                                              alignedTris[i].x1, clip, both);
-                if (pair && (alignedTris[i - 1].x0 != both.first || alignedTris[i - 1].x1 != both.second ||
-                             alignedTris[i].x0 != both.first || alignedTris[i].x1 != both.second)) {
-                    columns -= alignedTris[i - 1].x1 - alignedTris[i - 1].x0;
-                    isAligned[i - 1] = prepareAlignedTriangle(aligned, setups[i - 1], alignedTris[i - 1], &both);
-                    isAligned[i] =
-                        isAligned[i - 1] && prepareAlignedTriangle(aligned, setups[i], alignedTris[i], &both);
-                    if (isAligned[i - 1]) columns += alignedTris[i - 1].x1 - alignedTris[i - 1].x0;
+                                  pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
+                auto& p = rowTris[i - (pair ? 1 : 0)];
+                if (pair && (p.x0 != both.first || p.x1 != both.second || t.x0 != both.first || t.x1 != both.second)) {
+                    columns -= p.x1 - p.x0;
+                    isAligned[i - 1] = prepare(setups[i - 1], p, &both);
+                    isAligned[i] = isAligned[i - 1] && prepare(setups[i], t, &both);
+                    if (isAligned[i - 1]) columns += p.x1 - p.x0;
                 }
                 paired = pair;
-                if (isAligned[i]) columns += alignedTris[i].x1 - alignedTris[i].x0;
+                if (isAligned[i]) columns += t.x1 - t.x0;
                 if (columns > budget) isAligned[i] = 0;
             }
-        }
+        };
+        if (alignedDraw)
+            prepareTables(alignedTris, [&](const TriangleSetup& s, AlignedTriangle& t, const std::pair<int, int>* c) {
+                return prepareAlignedTriangle(aligned, s, t, c);
+            });
         if (floatDraw) {
-            // The same budget (a float table holds 12 bytes a column per tap).
-            floatTris.resize(setups.size());
-            const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
-            int64_t columns = 0;
-            bool paired = false;  // the triangle before was paired with the one before it
-            for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
-                isAligned[i] = prepareFloatRowTriangle(floatRows, setups[i], floatTris[i]);
-                // A quad's two halves over the same columns, so they share tables and H rows.
-                std::pair<int, int> both;
-                const bool pair =
-                    isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
-                    pairColumns(floatTris[i - 1].x0, floatTris[i - 1].x1, floatTris[i].x0, floatTris[i].x1, clip, both);
-                if (pair && (floatTris[i - 1].x0 != both.first || floatTris[i - 1].x1 != both.second ||
-                             floatTris[i].x0 != both.first || floatTris[i].x1 != both.second)) {
-                    columns -= floatTris[i - 1].x1 - floatTris[i - 1].x0;
-                    isAligned[i - 1] = prepareFloatRowTriangle(floatRows, setups[i - 1], floatTris[i - 1], &both);
-                    isAligned[i] =
-                        isAligned[i - 1] && prepareFloatRowTriangle(floatRows, setups[i], floatTris[i], &both);
-                    if (isAligned[i - 1]) columns += floatTris[i - 1].x1 - floatTris[i - 1].x0;
-                }
-                paired = pair;
-                if (isAligned[i]) columns += floatTris[i].x1 - floatTris[i].x0;
-                if (columns > budget) isAligned[i] = 0;
-            }
+            prepareTables(floatTris, [&](const TriangleSetup& s, FloatRowTriangle& t, const std::pair<int, int>* c) {
+                return prepareFloatRowTriangle(floatRows, s, t, c);
+            });
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
         }
         if (setups.empty()) continue;

@@ -35,9 +35,7 @@ constexpr auto kBitsSet = [] {
 }();
 
 // The weighted sum luminance() divides by 255.
-float luminanceSum(uint32_t r, uint32_t g, uint32_t b) {
-    return 0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b);
-}
+float luminanceSum(uint32_t r, uint32_t g, uint32_t b) { return 0.30f * float(r) + 0.59f * float(g) + 0.11f * float(b); }
 
 }  // namespace
 
@@ -85,12 +83,11 @@ namespace {
 // calling thread taking the first; `work(first, last, band)`. Callers join per-band results in
 // band order, so the sprites and every sum are those of one pass in raster order.
 void rowBands(uint32_t rows, uint32_t rowsPerItem, const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
-    const unsigned threads = std::max(
-        1u, std::min({std::thread::hardware_concurrency(), 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
+    const unsigned threads =
+        std::max(1u, std::min({std::thread::hardware_concurrency(), 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < threads; ++t)
-        pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads),
-                          t);
+        pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads), t);
     work(0, uint32_t(uint64_t(rows) / threads), 0);
     for (std::thread& th : pool) th.join();
 }
@@ -210,7 +207,7 @@ std::vector<float> glareImage(uint32_t size, int streaks) {
             for (int k = 0; k < streaks; ++k) {
                 const double ak = kPi * double(k) / double(streaks) + 0.3;
                 double d = std::fmod(std::abs(a - ak), kPi);
-                d = std::min(d, kPi - d);                        // a ray and its opposite
+                d = std::min(d, kPi - d);  // a ray and its opposite
                 const double across = d * r * double(size) / 2;  // distance to the ray in texels
                 v += 0.6 * std::exp(-across * across / (0.6 + 2 * r)) * fade * fade;
             }
@@ -237,62 +234,19 @@ public:
     }
     const std::vector<ParamInfo>& params() const override {
         static const std::vector<ParamInfo> p = {
-            {"threshold",
-             "",
-             "a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold",
-             0,
-             1,
-             {0.8, 0.8, 0.8, 0.8},
-             {},
+            {"threshold", "", "a sensor fires where luminance (0.30, 0.59, 0.11) >= threshold", 0, 1, {0.8, 0.8, 0.8, 0.8},
+             {}, false},
+            {"group", "pixels", "N: N x N pixels share one sprite (1 = a sensor per pixel, as the paper's base method)",
+             1, 8, {4, 2, 1, 1}, {}, true},
+            {"clusters", "", "8x8 blocks >= 90 % bright become one cluster sprite", 0, 1, {1, 1, 1, 1}, {"off", "on"},
              false},
-            {"group",
-             "pixels",
-             "N: N x N pixels share one sprite (1 = a sensor per pixel, as the paper's base method)",
-             1,
-             8,
-             {4, 2, 1, 1},
-             {},
+            {"radius", "of height", "sprite radius as a fraction of the frame height", 0.005, 0.5,
+             {0.04, 0.06, 0.08, 0.06}, {}, false},
+            {"streaks", "", "radial streaks of the glare image (each a ray and its opposite)", 0, 16, {3, 4, 6, 4}, {},
              true},
-            {"clusters",
-             "",
-             "8x8 blocks >= 90 % bright become one cluster sprite",
-             0,
-             1,
-             {1, 1, 1, 1},
-             {"off", "on"},
-             false},
-            {"radius",
-             "of height",
-             "sprite radius as a fraction of the frame height",
-             0.005,
-             0.5,
-             {0.04, 0.06, 0.08, 0.06},
-             {},
-             false},
-            {"streaks",
-             "",
-             "radial streaks of the glare image (each a ray and its opposite)",
-             0,
-             16,
-             {3, 4, 6, 4},
-             {},
-             true},
-            {"strength",
-             "",
-             "the glare image's peak per unit of pixel colour",
-             0,
-             1,
-             {0.25, 0.25, 0.25, 0.25},
-             {},
-             false},
-            {"shrink",
-             "",
-             "shrink sprites whose outer ring is below 0.5/255 (texture coordinates follow)",
-             0,
-             1,
-             {1, 1, 1, 1},
-             {"off", "on"},
-             false},
+            {"strength", "", "the glare image's peak per unit of pixel colour", 0, 1, {0.25, 0.25, 0.25, 0.25}, {}, false},
+            {"shrink", "", "shrink sprites whose outer ring is below 0.5/255 (texture coordinates follow)", 0, 1,
+             {1, 1, 1, 1}, {"off", "on"}, false},
         };
         return p;
     }
@@ -312,98 +266,95 @@ public:
 
         const TextureId image = g.create("glare image", {imageSize, imageSize, D3DFMT_A8R8G8B8});
         const auto glare = std::make_shared<const std::vector<float>>(glareImage(imageSize, streaks));
-        g.addPass(
-            PassInfo{"glare_image", PassKind::DeviceSide, "",
-                     "the precomputed glare image (streaks + halo), computed on the CPU and uploaded each frame"},
-            [&](PassBuilder& b) { b.write(image); },
-            [=](PassContext& c) {
-                const std::vector<float>& img = *glare;
-                emu::SurfacePixels px{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
-                px.bytes.resize(img.size() * 4);
-                for (size_t i = 0; i < img.size(); ++i) {
-                    const uint8_t v = uint8_t(std::lround(img[i] * 255));
-                    px.bytes[i * 4 + 0] = px.bytes[i * 4 + 1] = px.bytes[i * 4 + 2] = v;
-                    px.bytes[i * 4 + 3] = 255;
-                }
-                return emu::writeSurface(c.device, c.surface(image), px, c.error);
-            });
+        g.addPass(PassInfo{"glare_image", PassKind::DeviceSide, "",
+                           "the precomputed glare image (streaks + halo), computed on the CPU and uploaded each frame"},
+                  [&](PassBuilder& b) { b.write(image); },
+                  [=](PassContext& c) {
+                      const std::vector<float>& img = *glare;
+                      emu::SurfacePixels px{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
+                      px.bytes.resize(img.size() * 4);
+                      for (size_t i = 0; i < img.size(); ++i) {
+                          const uint8_t v = uint8_t(std::lround(img[i] * 255));
+                          px.bytes[i * 4 + 0] = px.bytes[i * 4 + 1] = px.bytes[i * 4 + 2] = v;
+                          px.bytes[i * 4 + 3] = 255;
+                      }
+                      return emu::writeSurface(c.device, c.surface(image), px, c.error);
+                  });
 
         auto sprites = std::make_shared<std::vector<Sprite>>();
         const TextureId list = g.createData("sprite list");
         const TextureId scene = fb.scene;
         Runner* runner = &fb.runner;
-        g.addPass(
-            PassInfo{
-                "sensors", PassKind::DeviceSide, "",
-                "sensors need vertex texture fetch (vs_3_0), not 1.1: the frame is read back and sensed on the CPU"},
-            [&](PassBuilder& b) {
-                b.read(scene);
-                b.write(list);
-            },
-            [=](PassContext& c) {
-                // With reuse, a frame whose scene has the generation the last sensing read,
-                // under the same settings, has the same sprites: no read-back, no sensing.
-                struct Kept {
-                    emu::Handle texture{};
-                    uint64_t generation = 0;
-                    SensorSettings settings;
-                    std::vector<Sprite> sprites;
-                    bool valid = false;
-                };
-                Kept& kept = runner->kept<Kept>("sprites: sensors");
-                const emu::Handle sceneTexture = c.texture(scene);
-                const uint64_t generation = c.device.contentGeneration(sceneTexture);
-                if (runner->reuses() && kept.valid && kept.texture == sceneTexture && kept.generation == generation &&
-                    kept.settings == ss) {
-                    *sprites = kept.sprites;
-                    c.stats.reused = true;
-                    return true;
-                }
-                kept.valid = false;
-                auto keep = [&] {
-                    kept = Kept{sceneTexture, generation, ss, *sprites, true};
-                    return true;
-                };
-                // 8-bit frames are sensed where the read-back left them; float frames
-                // (ideal) through the runner's 8-bit conversion.
-                D3DSURFACE_DESC desc{};
-                if (!c.check(c.device.GetLevelDesc(c.texture(scene), 0, &desc))) return false;
-                if (desc.Format == D3DFMT_A8R8G8B8 || desc.Format == D3DFMT_X8R8G8B8)
-                    return runner->readPixels(
-                        c.texture(scene),
-                        [&](const Runner::Pixels& px) {
-                            *sprites = senseSprites(SensorFrame{px.data, px.width, px.height, px.pitch, true}, ss);
-                            c.stats.pixels += uint64_t(px.width) * px.height;
-                            return keep();
-                        },
-                        c.error);
-                if (desc.Format == D3DFMT_A32B32G32R32F)
-                    return runner->readPixels(
-                        c.texture(scene),
-                        [&](const Runner::Pixels& px) {
-                            // The 8-bit frame readTexture would give, converted row by row
-                            // into a buffer the thread keeps (no fresh 8 MB every frame).
-                            static thread_local std::vector<uint8_t> frame8buf;
-                            std::vector<uint8_t>* frame8 = &frame8buf;
-                            frame8->resize(size_t(px.width) * px.height * 4);
-                            rowBands(px.height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
-                                for (uint32_t y = y0; y < y1; ++y) {
-                                    const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
-                                    uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
-                                    frameBytes(in, size_t(px.width) * 4, out);
-                                }
-                            });
-                            *sprites = senseSprites(frame8->data(), px.width, px.height, ss);
-                            c.stats.pixels += uint64_t(px.width) * px.height;
-                            return keep();
-                        },
-                        c.error);
-                std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
-                if (!img) return false;
-                *sprites = senseSprites(img->rgba.data(), img->width, img->height, ss);
-                c.stats.pixels += uint64_t(img->width) * img->height;
-                return keep();
-            });
+        g.addPass(PassInfo{"sensors", PassKind::DeviceSide, "",
+                           "sensors need vertex texture fetch (vs_3_0), not 1.1: the frame is read back and sensed on the CPU"},
+                  [&](PassBuilder& b) {
+                      b.read(scene);
+                      b.write(list);
+                  },
+                  [=](PassContext& c) {
+                      // With reuse, a frame whose scene has the generation the last sensing read,
+                      // under the same settings, has the same sprites: no read-back, no sensing.
+                      struct Kept {
+                          emu::Handle texture{};
+                          uint64_t generation = 0;
+                          SensorSettings settings;
+                          std::vector<Sprite> sprites;
+                          bool valid = false;
+                      };
+                      Kept& kept = runner->kept<Kept>("sprites: sensors");
+                      const emu::Handle sceneTexture = c.texture(scene);
+                      const uint64_t generation = c.device.contentGeneration(sceneTexture);
+                      if (runner->reuses() && kept.valid && kept.texture == sceneTexture && kept.generation == generation &&
+                          kept.settings == ss) {
+                          *sprites = kept.sprites;
+                          c.stats.reused = true;
+                          return true;
+                      }
+                      kept.valid = false;
+                      auto keep = [&] {
+                          kept = Kept{sceneTexture, generation, ss, *sprites, true};
+                          return true;
+                      };
+                      // 8-bit frames are sensed where the read-back left them; float frames
+                      // (ideal) through the runner's 8-bit conversion.
+                      D3DSURFACE_DESC desc{};
+                      if (!c.check(c.device.GetLevelDesc(c.texture(scene), 0, &desc))) return false;
+                      if (desc.Format == D3DFMT_A8R8G8B8 || desc.Format == D3DFMT_X8R8G8B8)
+                          return runner->readPixels(
+                              c.texture(scene),
+                              [&](const Runner::Pixels& px) {
+                                  *sprites = senseSprites(SensorFrame{px.data, px.width, px.height, px.pitch, true}, ss);
+                                  c.stats.pixels += uint64_t(px.width) * px.height;
+                                  return keep();
+                              },
+                              c.error);
+                      if (desc.Format == D3DFMT_A32B32G32R32F)
+                          return runner->readPixels(
+                              c.texture(scene),
+                              [&](const Runner::Pixels& px) {
+                                  // The 8-bit frame readTexture would give, converted row by row
+                                  // into a buffer the thread keeps (no fresh 8 MB every frame).
+                                  static thread_local std::vector<uint8_t> frame8buf;
+                                  std::vector<uint8_t>* frame8 = &frame8buf;
+                                  frame8->resize(size_t(px.width) * px.height * 4);
+                                  rowBands(px.height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
+                                      for (uint32_t y = y0; y < y1; ++y) {
+                                          const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
+                                          uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
+                                          frameBytes(in, size_t(px.width) * 4, out);
+                                      }
+                                  });
+                                  *sprites = senseSprites(frame8->data(), px.width, px.height, ss);
+                                  c.stats.pixels += uint64_t(px.width) * px.height;
+                                  return keep();
+                              },
+                              c.error);
+                      std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
+                      if (!img) return false;
+                      *sprites = senseSprites(img->rgba.data(), img->width, img->height, ss);
+                      c.stats.pixels += uint64_t(img->width) * img->height;
+                      return keep();
+                  });
 
         const TextureId buffer = g.create("glare buffer", {sd.width, sd.height, fb.format});
         // The radial maximum of the glare image, for shrinking.
@@ -420,68 +371,66 @@ public:
             for (size_t i = imageSize - 1; i-- > 0;) m[i] = std::max(m[i], m[i + 1]);  // max beyond r
             return m;
         }();
-        g.addPass(
-            PassInfo{"draw_sprites", PassKind::FixedFunction, "",
-                     "one textured quad per sprite, glare image × vertex colour, additive (ONE, ONE)"},
-            [&](PassBuilder& b) {
-                b.read(list);
-                b.read(image);
-                b.write(buffer);
-            },
-            [=](PassContext& c) {
-                emu::Device& d = c.device;
-                if (!c.clear(buffer, 0) || !setBlend(c, Blend::Add) || !c.check(d.SetPixelShader(emu::Handle::Null)) ||
-                    !bindTap(c, 0, Tap{image, {}, D3DTEXF_LINEAR}) ||
-                    !c.check(d.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_MODULATE)) ||
-                    !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_TEXTURE)) ||
-                    !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_DIFFUSE)) ||
-                    !c.check(d.SetTextureStageState(1, D3DTSS_COLOROP, D3DTOP_DISABLE)) ||
-                    !c.check(d.SetFVF(emu::kQuadFvf)))
-                    return false;
-                std::vector<emu::QuadVertex> v;
-                const float half = float(imageSize) / 2;
-                for (const Sprite& s : *sprites) {
-                    // A cluster sprite is twice the size (four times the area): its colour is a quarter.
-                    const float area = s.cluster ? 4.0f : 1.0f;
-                    const float peak = std::max({s.energy[0], s.energy[1], s.energy[2]}) / area;
-                    // Colour above 1 does not fit a vertex colour: the sprite is drawn in layers.
-                    const int layers = std::max(1, int(std::ceil(peak - 1e-6f)));
-                    float rad = s.radius, uvHalf = 0.5f;
-                    if (shrink) {
-                        // The outermost texel ring still visible: peak·G(r) >= 0.5/255 per layer.
-                        const float layerPeak = peak / float(layers);
-                        size_t keep = 0;
-                        for (size_t r = 0; r < radial.size(); ++r)
-                            if (layerPeak * radial[r] >= 0.5f / 255.0f) keep = r + 1;
-                        const float frac = std::min(1.0f, (float(keep) + 1.0f) / half);
-                        rad *= frac;
-                        uvHalf *= frac;
-                    }
-                    if (rad <= 0.0f) continue;
-                    DWORD colour = 0xff000000;
-                    for (int ch = 0; ch < 3; ++ch) {
-                        const float e = s.energy[ch] / float(layers) / area;
-                        colour |= DWORD(std::lround(std::clamp(e, 0.0f, 1.0f) * 255)) << (16 - 8 * ch);
-                    }
-                    const emu::QuadCoords uv{0.5f - uvHalf, 0.5f - uvHalf, 0.5f + uvHalf, 0.5f + uvHalf};
-                    const auto q = emu::halfPixelQuad(s.x + 0.5f - rad, s.y + 0.5f - rad, s.x + 0.5f + rad,
-                                                      s.y + 0.5f + rad, {uv, uv, uv, uv}, colour);
-                    for (int l = 0; l < layers; ++l)
-                        for (int i : {0, 1, 2, 2, 1, 3}) v.push_back(q[size_t(i)]);
-                }
-                bool ok = true;
-                // One DrawPrimitiveUP per 4096 sprites' layers.
-                for (size_t first = 0; ok && first < v.size(); first += 6 * 4096) {
-                    const size_t count = std::min<size_t>(v.size() - first, 6 * 4096);
-                    ok = c.draw(D3DPT_TRIANGLELIST, UINT(count / 3), &v[first], sizeof(emu::QuadVertex));
-                }
-                return ok;
-            });
+        g.addPass(PassInfo{"draw_sprites", PassKind::FixedFunction, "",
+                           "one textured quad per sprite, glare image × vertex colour, additive (ONE, ONE)"},
+                  [&](PassBuilder& b) {
+                      b.read(list);
+                      b.read(image);
+                      b.write(buffer);
+                  },
+                  [=](PassContext& c) {
+                      emu::Device& d = c.device;
+                      if (!c.clear(buffer, 0) || !setBlend(c, Blend::Add) || !c.check(d.SetPixelShader(emu::Handle::Null)) ||
+                          !bindTap(c, 0, Tap{image, {}, D3DTEXF_LINEAR}) ||
+                          !c.check(d.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_MODULATE)) ||
+                          !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_TEXTURE)) ||
+                          !c.check(d.SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_DIFFUSE)) ||
+                          !c.check(d.SetTextureStageState(1, D3DTSS_COLOROP, D3DTOP_DISABLE)) ||
+                          !c.check(d.SetFVF(emu::kQuadFvf)))
+                          return false;
+                      std::vector<emu::QuadVertex> v;
+                      const float half = float(imageSize) / 2;
+                      for (const Sprite& s : *sprites) {
+                          // A cluster sprite is twice the size (four times the area): its colour is a quarter.
+                          const float area = s.cluster ? 4.0f : 1.0f;
+                          const float peak = std::max({s.energy[0], s.energy[1], s.energy[2]}) / area;
+                          // Colour above 1 does not fit a vertex colour: the sprite is drawn in layers.
+                          const int layers = std::max(1, int(std::ceil(peak - 1e-6f)));
+                          float rad = s.radius, uvHalf = 0.5f;
+                          if (shrink) {
+                              // The outermost texel ring still visible: peak·G(r) >= 0.5/255 per layer.
+                              const float layerPeak = peak / float(layers);
+                              size_t keep = 0;
+                              for (size_t r = 0; r < radial.size(); ++r)
+                                  if (layerPeak * radial[r] >= 0.5f / 255.0f) keep = r + 1;
+                              const float frac = std::min(1.0f, (float(keep) + 1.0f) / half);
+                              rad *= frac;
+                              uvHalf *= frac;
+                          }
+                          if (rad <= 0.0f) continue;
+                          DWORD colour = 0xff000000;
+                          for (int ch = 0; ch < 3; ++ch) {
+                              const float e = s.energy[ch] / float(layers) / area;
+                              colour |= DWORD(std::lround(std::clamp(e, 0.0f, 1.0f) * 255)) << (16 - 8 * ch);
+                          }
+                          const emu::QuadCoords uv{0.5f - uvHalf, 0.5f - uvHalf, 0.5f + uvHalf, 0.5f + uvHalf};
+                          const auto q = emu::halfPixelQuad(s.x + 0.5f - rad, s.y + 0.5f - rad, s.x + 0.5f + rad,
+                                                            s.y + 0.5f + rad, {uv, uv, uv, uv}, colour);
+                          for (int l = 0; l < layers; ++l)
+                              for (int i : {0, 1, 2, 2, 1, 3}) v.push_back(q[size_t(i)]);
+                      }
+                      bool ok = true;
+                      // One DrawPrimitiveUP per 4096 sprites' layers.
+                      for (size_t first = 0; ok && first < v.size(); first += 6 * 4096) {
+                          const size_t count = std::min<size_t>(v.size() - first, 6 * 4096);
+                          ok = c.draw(D3DPT_TRIANGLELIST, UINT(count / 3), &v[first], sizeof(emu::QuadVertex));
+                      }
+                      return ok;
+                  });
         addStretchPass(fb, "copy_scene", fb.scene, fb.output, D3DTEXF_POINT);
-        addQuadPass(
-            fb, "composite", "additive blend (ONE, ONE) of the glare buffer",
-            QuadPass{
-                "scale.psh", fb.output, {texelTap(fb, buffer, 0, 0, D3DTEXF_POINT)}, {{0, {1, 1, 1, 0}}}, Blend::Add});
+        addQuadPass(fb, "composite", "additive blend (ONE, ONE) of the glare buffer",
+                    QuadPass{"scale.psh", fb.output, {texelTap(fb, buffer, 0, 0, D3DTEXF_POINT)}, {{0, {1, 1, 1, 0}}},
+                             Blend::Add});
     }
 };
 

@@ -340,8 +340,8 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
     for (int i = 0; i < 300; ++i) {
         // Float, half and signed textures with random bits (NaN and infinities included).
         Case c = randomCase(rng, true);
-        // Every third case into a float target (ideal's and float's intermediate textures), with
-        // any bits in it, blended with constant factors or per pixel.
+        // Every third case into a float target (ideal's and float's intermediate textures),
+        // blended with constant factors or per pixel.
         // A float target shows a NaN's sign and payload, and which of two NaN operands a sum or
         // product passes on depends on the order the compiler gave them (it commutes them freely,
         // differently in the two paths' code): those cases read and blend over no NaN. Infinities
