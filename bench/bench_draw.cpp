@@ -36,8 +36,10 @@ struct QuadVertex {
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
 // Sprites: 400 quads of 64x64 pixels at sub-pixel positions over a 1080p target, each a 32x32
 // texture magnified 2x and scaled by c0, added ONE/ONE (the sprites technique's draw).
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites };
-constexpr int kPasses = 8;
+// Tiny: the blur on a 1×1 target from a 1×1 texture (a glare technique's adaptation step): what a
+// draw costs besides its pixels.
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny };
+constexpr int kPasses = 9;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -52,6 +54,7 @@ struct Scene {
         if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         if (pass == Pass::Down2) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4) w = kW / 4, h = kH / 4;
+        if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down4;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : w, th = down ? kH : pass == Pass::Sprites ? 32 : h;
@@ -71,7 +74,7 @@ struct Scene {
             for (UINT x = 0; x < tw; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
-        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small;
+        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small || pass == Pass::Tiny;
         const int stages = fourTaps ? 4 : 1;
         const DWORD filter = pass == Pass::CopyPoint ? D3DTEXF_POINT : D3DTEXF_LINEAR;
         for (int s = 0; s < stages; ++s) {
@@ -246,6 +249,11 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->UseRealTime();
 
 BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, blur4_1x1_fx8, Pass::Tiny)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)

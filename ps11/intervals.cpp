@@ -342,6 +342,16 @@ std::optional<IntervalEvaluator> IntervalEvaluator::create(const Program& progra
         }
     }
     e.m_vRead = d.vUsed;
+    // The slots an op names (sources, destination; a texture op any t#, as matrix rows read the
+    // rows before), and r0: what run() must set before the first op.
+    e.m_slotsNamed = 1u << exec::kSlotR;
+    for (const exec::DOp& op : e.m_ops) {
+        e.m_slotsNamed |= 1u << op.dstSlot;
+        for (const exec::DSrc& src : op.src)
+            if (src.kind == exec::SrcKind::Reg) e.m_slotsNamed |= 1u << src.slot;
+        if (op.texture)
+            for (int t = 0; t < exec::kNumRegT; ++t) e.m_slotsNamed |= 1u << (exec::kSlotT + t);
+    }
     return e;
 }
 
@@ -362,8 +372,11 @@ void IntervalEvaluator::run(const IntervalInputs& inputs, IntervalResult& result
     State st{p, inputs};
     // Registers a validated program reads only after writing them: the whole range. r0 starts at
     // 0 (the executor zeroes it).
-    for (auto& slot : st.regs.reg)
-        for (AV& a : slot) a = wholeRange(p);
+    // (Slots no op names are never read: left as they are.)
+    const AV whole = wholeRange(p);
+    for (int r = 0; r < exec::kNumSlots; ++r)
+        if ((m_slotsNamed >> r) & 1)
+            for (AV& a : st.regs.reg[r]) a = whole;
     for (AV& a : st.regs.reg[exec::kSlotR]) a = AV{}, a.f = fPoint(0.0f);
     // v# saturated to [0, 1] (NaN and −0.0 to +0.0) and, in fx, rounded to the grid (loadColors).
     for (int v = 0; v < exec::kNumRegV; ++v) {

@@ -174,6 +174,7 @@ private:
     uint8_t m_tcRead = 0;  // texture coordinate sets read as values (texcoord, texcrd, texkill, matrix rows)
     uint8_t m_vRead = 0;   // v0, v1 read
     uint32_t m_plainStages = 0, m_dependentStages = 0;
+    uint32_t m_slotsNamed = 0;  // bit per register slot (ps11/decoded_program.h) some op reads or writes
 };
 
 }  // namespace ps11

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "ps11/texture.h"
 
@@ -43,65 +44,106 @@ void prepareTexelTiles(const Texture& tex, TexelTiles& out) {
 
 namespace {
 
-// Byte minima and maxima of texels [x0, x1) of one Unorm8 row, b g r a per lane group.
-void unorm8Row(const uint8_t* row, uint32_t x0, uint32_t x1, __m128i& mn, __m128i& mx, uint8_t (&smn)[4],
-               uint8_t (&smx)[4]) {
+// Per-byte minima and maxima of texels [x0, x1) of one Unorm8 row, folded into `mn`/`mx` with the
+// texels' four bytes b g r a in every 4-byte group (a tail under four texels fills a vector
+// with repeats of its first texel).
+inline void unorm8Row(const uint8_t* row, uint32_t x0, uint32_t x1, __m128i& mn, __m128i& mx) {
     uint32_t x = x0;
-    for (; x + 4 <= x1; x += 4) {
+    for (; x + 8 <= x1; x += 8) {
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + size_t(x) * 4));
+        const __m128i u = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + size_t(x) * 4 + 16));
+        mn = _mm_min_epu8(mn, _mm_min_epu8(v, u));
+        mx = _mm_max_epu8(mx, _mm_max_epu8(v, u));
+    }
+    if (x + 4 <= x1) {
         const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + size_t(x) * 4));
         mn = _mm_min_epu8(mn, v);
         mx = _mm_max_epu8(mx, v);
+        x += 4;
     }
-    for (; x < x1; ++x)
-        for (int b = 0; b < 4; ++b) {
-            smn[b] = std::min(smn[b], row[size_t(x) * 4 + size_t(b)]);
-            smx[b] = std::max(smx[b], row[size_t(x) * 4 + size_t(b)]);
+    if (x < x1) {
+        int32_t t[4];
+        for (uint32_t k = 0; k < 4; ++k) std::memcpy(&t[k], row + size_t(x + std::min(k, x1 - 1 - x)) * 4, 4);
+        const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(t));
+        mn = _mm_min_epu8(mn, v);
+        mx = _mm_max_epu8(mx, v);
+    }
+}
+
+// The four texels' bytes of a 16-byte group folded into its low four bytes.
+inline uint32_t fold4(__m128i v, bool max) {
+    if (max) {
+        v = _mm_max_epu8(v, _mm_srli_si128(v, 8));
+        v = _mm_max_epu8(v, _mm_srli_si128(v, 4));
+    } else {
+        v = _mm_min_epu8(v, _mm_srli_si128(v, 8));
+        v = _mm_min_epu8(v, _mm_srli_si128(v, 4));
+    }
+    return uint32_t(_mm_cvtsi128_si32(v));
+}
+
+void scanUnorm8Tile(const Texture& tex, uint32_t w, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                    TexelRange& r) {
+    __m128i mn = _mm_set1_epi8(char(0xff)), mx = _mm_setzero_si128();
+    for (uint32_t y = y0; y < y1; ++y) unorm8Row(tex.unorm8() + size_t(y) * w * 4, x0, x1, mn, mx);
+    const uint32_t lo = fold4(mn, false), hi = fold4(mx, true);
+    const float* v = Texture::unorm8Values();
+    for (int c = 0; c < 4; ++c) {
+        const int shift = 8 * kUnorm8Byte[c];
+        r.lo[size_t(c)] = v[(lo >> shift) & 0xff];
+        r.hi[size_t(c)] = v[(hi >> shift) & 0xff];
+    }
+}
+
+// r g b a floats: minima and maxima of the non-NaN values, NaN channels, −0.0 channels.
+void scanDecodedTile(const Texture& tex, uint32_t w, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
+                     TexelRange& r) {
+    const float inf = std::numeric_limits<float>::infinity();
+    __m128 lo = _mm_set1_ps(inf), hi = _mm_set1_ps(-inf);
+    __m128i nan = _mm_setzero_si128(), negZero = _mm_setzero_si128();
+    const __m128i negZeroBits = _mm_set1_epi32(int32_t(0x80000000u));
+    const float* values = tex.values();
+    for (uint32_t y = y0; y < y1; ++y) {
+        const float* t = values + (size_t(y) * w + x0) * 4;
+        for (uint32_t x = x0; x < x1; ++x, t += 4) {
+            const __m128 v = _mm_loadu_ps(t);
+            // minps/maxps give their second operand where either is NaN: the NaN is passed over.
+            lo = _mm_min_ps(v, lo);
+            hi = _mm_max_ps(v, hi);
+            nan = _mm_or_si128(nan, _mm_castps_si128(_mm_cmpunord_ps(v, v)));
+            // −0.0: the sign bit alone.
+            negZero = _mm_or_si128(negZero, _mm_cmpeq_epi32(_mm_castps_si128(v), negZeroBits));
         }
+    }
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    const int nanBits = _mm_movemask_ps(_mm_castsi128_ps(nan)), negBits = _mm_movemask_ps(_mm_castsi128_ps(negZero));
+    for (int c = 0; c < 4; ++c) {
+        // A channel of NaNs only keeps the empty range (lo > hi), as TexelRange{} says.
+        if (l[c] > h[c]) continue;
+        r.lo[size_t(c)] = l[c];
+        r.hi[size_t(c)] = h[c];
+    }
+    r.nan = uint8_t(nanBits);
+    r.negZero = uint8_t(negBits);
 }
 
 }  // namespace
 
 void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t ty1) {
     const uint32_t w = out.width, h = out.height;
+    const bool unorm8 = tex.storage() == TexelStorage::Unorm8;
     for (uint32_t ty = ty0; ty < ty1 && ty < out.tilesY; ++ty) {
         const uint32_t y0 = ty * out.side, y1 = std::min(h, y0 + out.side);
         for (uint32_t tx = 0; tx < out.tilesX; ++tx) {
             const uint32_t x0 = tx * out.side, x1 = std::min(w, x0 + out.side);
             TexelRange& r = out.tiles[size_t(ty) * out.tilesX + tx];
             r = TexelRange{};
-            if (tex.storage() == TexelStorage::Unorm8) {
-                __m128i mn = _mm_set1_epi8(char(0xff)), mx = _mm_setzero_si128();
-                uint8_t smn[4] = {255, 255, 255, 255}, smx[4] = {0, 0, 0, 0};
-                for (uint32_t y = y0; y < y1; ++y) unorm8Row(tex.unorm8() + size_t(y) * w * 4, x0, x1, mn, mx, smn, smx);
-                alignas(16) uint8_t vmn[16], vmx[16];
-                _mm_store_si128(reinterpret_cast<__m128i*>(vmn), mn);
-                _mm_store_si128(reinterpret_cast<__m128i*>(vmx), mx);
-                for (int k = 0; k < 16; ++k) {
-                    smn[k % 4] = std::min(smn[k % 4], vmn[k]);
-                    smx[k % 4] = std::max(smx[k % 4], vmx[k]);
-                }
-                const float* v = Texture::unorm8Values();
-                for (int c = 0; c < 4; ++c) {
-                    r.lo[size_t(c)] = v[smn[kUnorm8Byte[c]]];
-                    r.hi[size_t(c)] = v[smx[kUnorm8Byte[c]]];
-                }
-                continue;
-            }
-            const float* values = tex.values();
-            for (uint32_t y = y0; y < y1; ++y)
-                for (uint32_t x = x0; x < x1; ++x) {
-                    const float* t = values + (size_t(y) * w + x) * 4;
-                    for (int c = 0; c < 4; ++c) {
-                        const float f = t[c];
-                        if (std::isnan(f)) {
-                            r.nan |= uint8_t(1u << c);
-                            continue;
-                        }
-                        if (f == 0 && std::signbit(f)) r.negZero |= uint8_t(1u << c);
-                        r.lo[size_t(c)] = std::min(r.lo[size_t(c)], f);
-                        r.hi[size_t(c)] = std::max(r.hi[size_t(c)], f);
-                    }
-                }
+            if (unorm8)
+                scanUnorm8Tile(tex, w, x0, x1, y0, y1, r);
+            else
+                scanDecodedTile(tex, w, x0, x1, y0, y1, r);
         }
     }
 }

@@ -6,18 +6,23 @@
 // ranges (ends, zeros of both signs, NaN and infinities where a range admits them) run through
 // ps11::Executor in fx8, fx12, float and ideal: every output lies in its interval, every claimed
 // constant is the output bit for bit, every claimed copy is the lookup bit for bit, texkill and
-// depth keep their bounds. Precision: the glare shaders' common cases give the constants and
+// depth keep their bounds. The texel tiles (ps11/texture_tiles.h) those ranges come from are the
+// exact ranges of their texels. Precision: the glare shaders' common cases give the constants and
 // copies the renderer skips with.
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <sstream>
 
 #include "executor_random_programs.h"
 #include "ps11/executor.h"
 #include "ps11/intervals.h"
+#include "ps11/texture.h"
+#include "ps11/texture_tiles.h"
 #include "runner/random_program.h"
 
 using namespace ps11;
@@ -770,5 +775,70 @@ TEST_CASE("intervals: dependent reads need a range for any coordinates; texkill 
         CHECK(r.writesDepth);
         CHECK(r.depth.lo >= 0);
         CHECK(r.depth.hi <= 1);
+    }
+}
+
+TEST_CASE("texel tiles: each tile's facts are the exact ranges, NaN and -0 of its texels", "[intervals][tiles]") {
+    std::mt19937_64 rng(0x7117e5);
+    constexpr float kInf = std::numeric_limits<float>::infinity();
+    const float specials[] = {0.0f, -0.0f, std::numeric_limits<float>::quiet_NaN(), kInf, -kInf, -3.5f, 1e30f, 0.25f};
+    for (int iter = 0; iter < 60; ++iter) {
+        const bool unorm8 = iter % 2 == 0;
+        const uint32_t w = 1 + uint32_t(rng() % (iter < 20 ? 40 : 300)), h = 1 + uint32_t(rng() % (iter < 20 ? 40 : 300));
+        const int flavour = int(rng() % 3);  // 0: random, 1: mostly one value, 2: specials often
+        std::vector<uint8_t> bytes;
+        std::vector<float> floats;
+        if (unorm8) {
+            bytes.resize(size_t(w) * h * 4);
+            const uint8_t base = uint8_t(rng());
+            for (uint8_t& b : bytes) b = flavour == 1 && rng() % 64 ? base : uint8_t(rng());
+        } else {
+            floats.resize(size_t(w) * h * 4);
+            for (float& f : floats)
+                f = flavour == 1 && rng() % 64   ? 0.5f
+                    : flavour == 2 && rng() % 4 == 0 ? specials[rng() % 8]
+                                                     : float(std::ldexp(double(int64_t(rng() % 2001) - 1000), -8));
+        }
+        TextureLevelBytes level;
+        level.width = w, level.height = h;
+        level.data = unorm8 ? bytes.data() : reinterpret_cast<const uint8_t*>(floats.data());
+        level.rowPitch = size_t(w) * (unorm8 ? 4 : 16);
+        std::string error;
+        std::optional<Texture> t = Texture::fromLevels(unorm8 ? TexFormat::A8R8G8B8 : TexFormat::A32B32G32R32F, false,
+                                                       &level, 1, SignedDecode::Snorm, error);
+        REQUIRE(t);
+        TexelTiles tiles;
+        prepareTexelTiles(*t, tiles);
+        // In two halves, as workers scan them.
+        scanTexelTiles(*t, tiles, 0, tiles.tilesY / 2);
+        scanTexelTiles(*t, tiles, tiles.tilesY / 2, tiles.tilesY);
+        for (uint32_t ty = 0; ty < tiles.tilesY; ++ty)
+            for (uint32_t tx = 0; tx < tiles.tilesX; ++tx) {
+                float lo[4] = {kInf, kInf, kInf, kInf}, hi[4] = {-kInf, -kInf, -kInf, -kInf};
+                uint8_t nan = 0, negZero = 0;
+                for (uint32_t y = ty * tiles.side; y < std::min(h, (ty + 1) * tiles.side); ++y)
+                    for (uint32_t x = tx * tiles.side; x < std::min(w, (tx + 1) * tiles.side); ++x)
+                        for (int c = 0; c < 4; ++c) {
+                            const float f = t->texelValue(0, x, y)[size_t(c)];
+                            if (std::isnan(f)) {
+                                nan |= uint8_t(1 << c);
+                                continue;
+                            }
+                            if (f == 0 && std::signbit(f)) negZero |= uint8_t(1 << c);
+                            lo[c] = std::min(lo[c], f), hi[c] = std::max(hi[c], f);
+                        }
+                const TexelRange& r = tiles.tiles[size_t(ty) * tiles.tilesX + tx];
+                INFO((unorm8 ? "A8R8G8B8 " : "A32B32G32R32F ") << w << "x" << h << " tile " << tx << "," << ty);
+                CHECK(r.nan == nan);
+                CHECK(r.negZero == negZero);
+                for (int c = 0; c < 4; ++c) {
+                    if (lo[c] > hi[c]) {  // only NaNs: the empty range
+                        CHECK(r.lo[size_t(c)] > r.hi[size_t(c)]);
+                        continue;
+                    }
+                    CHECK(r.lo[size_t(c)] == lo[c]);
+                    CHECK(r.hi[size_t(c)] == hi[c]);
+                }
+            }
     }
 }
