@@ -1,5 +1,6 @@
 // The output merger alone (emu::mergePixels): ns per pixel over a 256x256 target in spans of
-// 256 pixels (one row per call, as a rasteriser hands rows over), per configuration.
+// 256 pixels (one row per call, as a rasteriser hands rows over, or as a row path's run: *_row),
+// per configuration.
 #include <benchmark/benchmark.h>
 
 #include <cstring>
@@ -44,7 +45,9 @@ struct Inputs {
     }
 };
 
-void run(benchmark::State& bs, const MergeState& st, D3DFORMAT colorFormat, D3DFORMAT depthFormat) {
+// `row`: each span is a row path's run (MergeInputs::row).
+void run(benchmark::State& bs, const MergeState& st, D3DFORMAT colorFormat, D3DFORMAT depthFormat,
+         bool row = false) {
     static const Inputs in;
     Image color = makeImage(colorFormat);
     Image depth = depthFormat == D3DFMT_UNKNOWN ? Image{} : makeImage(depthFormat);
@@ -52,6 +55,7 @@ void run(benchmark::State& bs, const MergeState& st, D3DFORMAT colorFormat, D3DF
     MergeInputs mi;
     mi.count = kSide;
     mi.x = in.x.data();
+    mi.row = row;
     const bool fx = ps11::isFixedPoint(st.precision);
     for (int c = 0; c < 4; ++c) mi.color[c] = in.color[c].data(), mi.grid[c] = fx ? in.grid[c].data() : nullptr;
     mi.fog = in.fog.data(), mi.z = in.z.data();
@@ -96,6 +100,9 @@ void BM_alpha_fx12(benchmark::State& s) {
 void BM_alpha_float(benchmark::State& s) {
     run(s, blended(Precision::Float, D3DBLEND_SRCALPHA, D3DBLEND_INVSRCALPHA), D3DFMT_A8R8G8B8, D3DFMT_UNKNOWN);
 }
+void BM_add_float_row(benchmark::State& s) {
+    run(s, blended(Precision::Float, D3DBLEND_ONE, D3DBLEND_ONE), D3DFMT_A8R8G8B8, D3DFMT_UNKNOWN, true);
+}
 void BM_add_float_half(benchmark::State& s) {
     run(s, blended(Precision::Float, D3DBLEND_ONE, D3DBLEND_ONE), D3DFMT_A16B16G16R16F, D3DFMT_UNKNOWN);
 }
@@ -123,6 +130,7 @@ BENCHMARK(BM_add_fx8);
 BENCHMARK(BM_alpha_fx8);
 BENCHMARK(BM_alpha_fx12);
 BENCHMARK(BM_alpha_float);
+BENCHMARK(BM_add_float_row);
 BENCHMARK(BM_add_float_half);
 BENCHMARK(BM_depth_fx8_d24s8);
 BENCHMARK(BM_fog_alphatest_fx8);

@@ -855,8 +855,10 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
         if (lanes.inside(0, x, y) && x + uint32_t(count) <= p.boundW) run = cs.at(x, y);
         assert(run && in.x[count - 1] == in.x[0] + count - 1 && in.y[count - 1] == in.y[0]);
     }
+    // A run's destination words are read where they are (a copy first cost as much as the blend).
+    const uint8_t* dst = reinterpret_cast<const uint8_t*>(old);
     if (run) {
-        std::memcpy(old, run, 4 * size_t(count));
+        dst = run;
     } else {
         for (int i = 0; i < count; ++i) {
             uint32_t x, y;
@@ -877,12 +879,12 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
         for (; i + 4 <= count; i += 4) {
             const __m128 v = _mm_loadu_ps(src + i);
             const __m128 sv = _mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_min_ps(v, one));
-            const __m128i w = _mm_load_si128(reinterpret_cast<const __m128i*>(old + i));
+            const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(dst + 4 * i));
             const __m128 d = _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, kShift[c]), byte)), k255);
             _mm_store_ps(out + i, _mm_add_ps(sv, d));
         }
 #endif
-        for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(old[i] >> kShift[c]) & 0xffu];
+        for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(load32(dst + 4 * i) >> kShift[c]) & 0xffu];
     }
     alignas(32) uint32_t words[ps11::kMaxSpan];
     const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
@@ -890,7 +892,7 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     mergerKernels(ps11::simdLevel()).unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
     if (run) {
         if (mask != 0xffffffffu)
-            for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (old[i] & ~mask);
+            for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (load32(dst + 4 * i) & ~mask);
         std::memcpy(run, words, 4 * size_t(count));
         n.written += uint64_t(count);
         return;
