@@ -109,6 +109,9 @@ public:
     }
     // Whether passes are reused from frame to frame (RunnerOptions::skip and reuse).
     bool reuses() const { return m_options.skip && m_options.reuse; }
+    // The CPU threads the frame's own CPU work (the sprites' sensors) may take: the software
+    // renderer's count (DeviceOptions, 0 = the machine's), whichever renderer draws.
+    int cpuThreads() const { return m_options.device.software.threads; }
     TexturePool& pool() { return *m_pool; }
 
 private:

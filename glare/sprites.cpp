@@ -79,12 +79,13 @@ void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeas
 
 namespace {
 
-// Workers over `rows` items of `rowsPerItem` pixel rows: bands of at least 64 pixel rows, the
-// calling thread taking the first; `work(first, last, band)`. Callers join per-band results in
+// `workers` threads (0: the machine's; SensorFrame::threads) over `rows` items of `rowsPerItem`
+// pixel rows: bands of at least 64 pixel rows, the calling thread taking the first; `work(first, last, band)`. Callers join per-band results in
 // band order, so the sprites and every sum are those of one pass in raster order.
-void rowBands(uint32_t rows, uint32_t rowsPerItem, const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
-    const unsigned threads =
-        std::max(1u, std::min({std::thread::hardware_concurrency(), 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
+void rowBands(uint32_t rows, uint32_t rowsPerItem, int workers,
+              const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
+    const unsigned wanted = workers > 0 ? unsigned(workers) : std::thread::hardware_concurrency();
+    const unsigned threads = std::max(1u, std::min({wanted, 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < threads; ++t)
         pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads), t);
@@ -104,7 +105,10 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
     const int rs = f.bgra ? 16 : 0, bs = f.bgra ? 0 : 16;  // bit shifts of r and b in a pixel's word
     auto pixel = [&](uint32_t x, uint32_t y) { return f.data + size_t(y) * f.pitch + size_t(x) * 4; };
     auto lum = [&](const uint8_t* p) { return luminance(p[rs / 8], p[1], p[bs / 8]); };
-    const auto inBands = rowBands;
+    const auto inBands = [&](uint32_t rows, uint32_t rowsPerItem,
+                             const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
+        rowBands(rows, rowsPerItem, f.threads, work);
+    };
     // Whether each pixel's sensor fires, one bit a pixel (its luminance is taken again only where
     // it does): dark stretches of a frame are skipped 64 pixels at a time.
     const size_t wpr = (size_t(width) + 63) / 64;
@@ -316,14 +320,16 @@ public:
                           return true;
                       };
                       // 8-bit frames are sensed where the read-back left them; float frames
-                      // (ideal) through the runner's 8-bit conversion.
+                      // (ideal) through the runner's 8-bit conversion. On the renderer's threads.
+                      const int threads = runner->cpuThreads();
                       D3DSURFACE_DESC desc{};
                       if (!c.check(c.device.GetLevelDesc(c.texture(scene), 0, &desc))) return false;
                       if (desc.Format == D3DFMT_A8R8G8B8 || desc.Format == D3DFMT_X8R8G8B8)
                           return runner->readPixels(
                               c.texture(scene),
                               [&](const Runner::Pixels& px) {
-                                  *sprites = senseSprites(SensorFrame{px.data, px.width, px.height, px.pitch, true}, ss);
+                                  *sprites = senseSprites(
+                                      SensorFrame{px.data, px.width, px.height, px.pitch, true, threads}, ss);
                                   c.stats.pixels += uint64_t(px.width) * px.height;
                                   return keep();
                               },
@@ -337,21 +343,24 @@ public:
                                   static thread_local std::vector<uint8_t> frame8buf;
                                   std::vector<uint8_t>* frame8 = &frame8buf;
                                   frame8->resize(size_t(px.width) * px.height * 4);
-                                  rowBands(px.height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
+                                  rowBands(px.height, 1, threads, [&](uint32_t y0, uint32_t y1, unsigned) {
                                       for (uint32_t y = y0; y < y1; ++y) {
                                           const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
                                           uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
                                           frameBytes(in, size_t(px.width) * 4, out);
                                       }
                                   });
-                                  *sprites = senseSprites(frame8->data(), px.width, px.height, ss);
+                                  *sprites = senseSprites(SensorFrame{frame8->data(), px.width, px.height,
+                                                                      size_t(px.width) * 4, false, threads},
+                                                          ss);
                                   c.stats.pixels += uint64_t(px.width) * px.height;
                                   return keep();
                               },
                               c.error);
                       std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
                       if (!img) return false;
-                      *sprites = senseSprites(img->rgba.data(), img->width, img->height, ss);
+                      *sprites = senseSprites(
+                          SensorFrame{img->rgba.data(), img->width, img->height, size_t(img->width) * 4, false, threads}, ss);
                       c.stats.pixels += uint64_t(img->width) * img->height;
                       return keep();
                   });
