@@ -255,8 +255,10 @@ public:
         const FloatRowTap* tap = t >= 0 ? &m_draw.taps[size_t(t)] : nullptr;
         if (!tap || !tap->bound) {
             for (int c = 0; c < 4; ++c) std::fill_n(out.value[c], n, c == 3 ? 1.0f : 0.0f);
+            out.unitRange = true;
             return;
         }
+        out.unitRange = tap->unitRange;
         const RowTaps& r = m_rows[size_t(t)];
         const size_t first = size_t(m_x - m_tri->x0) + size_t(req.u[0]);  // lanes are consecutive
         if (tap->linear) {
@@ -359,6 +361,8 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         tap.nonNegative = tap.unorm8 && std::all_of(tap.border.begin(), tap.border.end(), [](float b) {
                               return b >= 0.0f && b <= std::numeric_limits<float>::max() && !std::signbit(b);
                           });
+        tap.unitRange = tap.unorm8 && std::all_of(tap.border.begin(), tap.border.end(),
+                                                  [](float b) { return b >= 0.0f && b <= 1.0f; });
     }
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;

@@ -38,6 +38,9 @@ struct FloatRowTap {
     // Every value the tap returns is finite and not negative (8-bit texels, such a border): then
     // a lerp with weight 0 is its first operand exactly.
     bool nonNegative = false;
+    // Every value it returns lies in [0, 1] or is −0.0 (8-bit texels, a border inside [0, 1]):
+    // ps11::SampleResult::unitRange.
+    bool unitRange = false;
 };
 
 struct FloatRowKernels;

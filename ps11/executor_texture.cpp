@@ -101,7 +101,7 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
     } else {
         for (int c = 0; c < 4; ++c) res.value[c] = st.bf.reg[slot][c];
         st.sampler->sample(req, res);
-        if (p.clampRange) {
+        if (p.clampRange && !(res.unitRange && p.maxValue >= 1.0f)) {
             const float m = p.maxValue;
             for (int c = 0; c < 4; ++c) {
                 float* d = st.bf.reg[slot][c];
