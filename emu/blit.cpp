@@ -12,7 +12,9 @@
 #include <emmintrin.h>
 #endif
 
+#include "emu/output_merger_kernels.h"
 #include "ps11/precision.h"
+#include "ps11/simd_dispatch.h"
 
 namespace emu {
 
@@ -162,47 +164,17 @@ void stretchImages(const StretchCall& call, RowRange rows) {
         return;
     }
     // Fast path: an unscaled copy of A32B32G32R32F into 8-bit b g r a words (the ideal
-    // profile's float frame into an 8-bit output): store()'s rounding, channel by channel.
+    // profile's float frame into an 8-bit output): store()'s rounding (ps11::unorm8OfFloat), by
+    // the merger's kernel for such rows; X8R8G8B8 gets 0xff.
     if (sw == dw && sh == fullHeight && sf.format == D3DFMT_A32B32G32R32F && df.cls == FormatClass::Unorm8 && df.bytes == 4) {
-        const bool x8 = df.format == D3DFMT_X8R8G8B8;
+        const MergerKernels& k = mergerKernels(ps11::simdLevel());
+        const uint32_t fill = df.format == D3DFMT_X8R8G8B8 ? 0xFF000000u : 0u;
+        std::vector<uint32_t> words(static_cast<size_t>(dw));
         for (int64_t j = j0; j < dh; ++j) {
             const uint8_t* in = s->texel(uint32_t(sr.x0), uint32_t(sr.y0 + j));
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
-            int64_t i = 0;
-#if defined(__SSE2__)
-            // ps11::unorm8OfFloat two channels at a time: max(v, 0) gives 0 for NaN (MAXPD returns its second
-            // operand), the conversion rounds to nearest even (the default MXCSR mode).
-            const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), k255 = _mm_set1_pd(255.0);
-            // The channels of a pixel as b g r a int32 (each in [0, 255]).
-            auto bgra = [&](const uint8_t* px) {
-                const __m128 v = _mm_loadu_ps(reinterpret_cast<const float*>(px));
-                const __m128d rg = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(v), zero), one), k255);
-                const __m128d ba = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), zero), one), k255);
-                const __m128i rgba = _mm_unpacklo_epi64(_mm_cvtpd_epi32(rg), _mm_cvtpd_epi32(ba));
-                return _mm_shuffle_epi32(rgba, _MM_SHUFFLE(3, 0, 1, 2));
-            };
-            const __m128i alpha = _mm_set1_epi32(x8 ? int32_t(0xFF000000u) : 0);
-            for (; i + 4 <= dw; i += 4, in += 64, out += 16) {  // four pixels, packed with saturation (exact here)
-                const __m128i lo = _mm_packs_epi32(bgra(in), bgra(in + 16)), hi = _mm_packs_epi32(bgra(in + 32), bgra(in + 48));
-                _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_or_si128(_mm_packus_epi16(lo, hi), alpha));
-            }
-            for (; i < dw; ++i, in += 16, out += 4) {
-                const __m128 v = _mm_loadu_ps(reinterpret_cast<const float*>(in));
-                const __m128d rg = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(v), zero), one), k255);
-                const __m128d ba = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), zero), one), k255);
-                const __m128i irg = _mm_cvtpd_epi32(rg), iba = _mm_cvtpd_epi32(ba);
-                out[0] = uint8_t(_mm_cvtsi128_si32(iba));
-                out[1] = uint8_t(_mm_cvtsi128_si32(_mm_srli_si128(irg, 4)));
-                out[2] = uint8_t(_mm_cvtsi128_si32(irg));
-                out[3] = x8 ? 0xFF : uint8_t(_mm_cvtsi128_si32(_mm_srli_si128(iba, 4)));
-            }
-#endif
-            for (; i < dw; ++i, in += 16, out += 4) {
-                float v[4];
-                std::memcpy(v, in, 16);
-                out[0] = ps11::unorm8OfFloat(v[2]), out[1] = ps11::unorm8OfFloat(v[1]), out[2] = ps11::unorm8OfFloat(v[0]);
-                out[3] = x8 ? 0xFF : ps11::unorm8OfFloat(v[3]);
-            }
+            k.unorm8WordsRgba(reinterpret_cast<const float*>(in), int(dw), fill, words.data());
+            std::memcpy(out, words.data(), 4 * size_t(dw));
         }
         return;
     }

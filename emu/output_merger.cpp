@@ -793,6 +793,33 @@ void unorm8WordsBaseline(const float* const f[4], int count, uint32_t alphaFill,
                    alphaFill;
 }
 
+void unorm8WordsRgbaBaseline(const float* rgba, int count, uint32_t alphaFill, uint32_t* words) {
+    int i = 0;
+#if defined(__SSE2__)
+    // A pixel's channels two at a time in double, as unorm8WordsBaseline; four pixels packed with
+    // saturation (exact: every value is in [0, 255]).
+    const __m128d zero = _mm_setzero_pd(), one = _mm_set1_pd(1.0), k255 = _mm_set1_pd(255.0);
+    auto bgra = [&](const float* px) {  // b g r a int32
+        const __m128 v = _mm_loadu_ps(px);
+        const __m128d rg = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(v), zero), one), k255);
+        const __m128d ba = _mm_mul_pd(_mm_min_pd(_mm_max_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), zero), one), k255);
+        return _mm_shuffle_epi32(_mm_unpacklo_epi64(_mm_cvtpd_epi32(rg), _mm_cvtpd_epi32(ba)), _MM_SHUFFLE(3, 0, 1, 2));
+    };
+    const __m128i fill = _mm_set1_epi32(int32_t(alphaFill));
+    for (; i + 4 <= count; i += 4) {
+        const float* p = rgba + 4 * size_t(i);
+        const __m128i lo = _mm_packs_epi32(bgra(p), bgra(p + 4)), hi = _mm_packs_epi32(bgra(p + 8), bgra(p + 12));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + i), _mm_or_si128(_mm_packus_epi16(lo, hi), fill));
+    }
+#endif
+    for (; i < count; ++i) {
+        const float* p = rgba + 4 * size_t(i);
+        words[i] = packArgb(ps11::unorm8OfFloat(p[0]), ps11::unorm8OfFloat(p[1]), ps11::unorm8OfFloat(p[2]),
+                            ps11::unorm8OfFloat(p[3])) |
+                   alphaFill;
+    }
+}
+
 void halvesBaseline(const float* const f[4], int count, uint16_t* out) {
     for (int i = 0; i < count; ++i)
         for (int c = 0; c < 4; ++c) out[4 * i + c] = halfOf(f[c][i]);
@@ -982,7 +1009,7 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
 
 }  // namespace
 
-const MergerKernels baseline::kMerger{&halvesBaseline, &unorm8WordsBaseline};
+const MergerKernels baseline::kMerger{&halvesBaseline, &unorm8WordsBaseline, &unorm8WordsRgbaBaseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #ifdef PS11_HAVE_AVX2

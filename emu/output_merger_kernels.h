@@ -1,5 +1,5 @@
 // The output merger's kernels, a table per SIMD level (ps11/simd_dispatch.h) that mergePixels
-// fetches once per call. Internal to emu/output_merger*.cpp (and their tests).
+// fetches once per call, as do the blits' float-to-8-bit copies. Internal to emu/ (and its tests).
 #pragma once
 
 #include <cstdint>
@@ -16,6 +16,9 @@ struct MergerKernels {
     // The A8R8G8B8 words of `count` lanes of float r g b a: each channel ps11::unorm8OfFloat
     // (clamped to [0, 1], NaN 0, round_half_even(v * 255) in double), ORed with `alphaFill`.
     void (*unorm8Words)(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words);
+    // The same words of `count` pixels of interleaved float r g b a (an A32B32G32R32F row): the
+    // ideal profile's float frame into an 8-bit target (StretchRect, GetRenderTargetData).
+    void (*unorm8WordsRgba)(const float* rgba, int count, uint32_t alphaFill, uint32_t* words);
 };
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level);

@@ -360,6 +360,51 @@ TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at ev
     CHECK(ps11::unorm8OfFloat(2.0) == 255);
 }
 
+TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::unorm8OfFloat at every level",
+          "[simd][merger]") {
+    // The A32B32G32R32F rows a StretchRect converts: ties, ends, values outside [0, 1], ±0, ±Inf,
+    // NaN, random bits, as r g b a quadruples; every length 0..40 at every offset.
+    std::vector<float> values;
+    for (int k = 0; k < 256; ++k) {
+        const float tie = float((k + 0.5) / 255.0);
+        values.insert(values.end(), {tie, std::nextafter(tie, 0.0f), std::nextafter(tie, 2.0f), float(k / 255.0)});
+    }
+    const float inf = std::numeric_limits<float>::infinity();
+    values.insert(values.end(), {0.0f, -0.0f, 1.0f, std::nextafter(1.0f, 2.0f), -1e-30f, 7.5f, -3.0f, inf, -inf,
+                                 std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN(), 0.5f});
+    std::mt19937 rng(13);
+    for (int i = 0; i < 4096; ++i) {
+        uint32_t bits = rng();
+        float f;
+        std::memcpy(&f, &bits, 4);
+        values.push_back(i % 2 ? f : float(rng() % 100000) / 90000.0f);
+    }
+    int64_t bad = 0, checked = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::MergerKernels& k = emu::mergerKernels(level);
+        for (size_t at = 0; at + 4 * 41 <= values.size(); at += 13) {
+            const int count = int(at % 41);
+            const float* rgba = &values[at];
+            for (uint32_t fill : {0u, 0xff000000u}) {
+                std::vector<uint32_t> got(size_t(count) + 1, 0xdeadbeefu);
+                k.unorm8WordsRgba(rgba, count, fill, got.data());
+                for (int i = 0; i < count; ++i) {
+                    const float* p = rgba + 4 * i;
+                    const uint32_t want = (uint32_t(ps11::unorm8OfFloat(p[3])) << 24 | uint32_t(ps11::unorm8OfFloat(p[0])) << 16 |
+                                           uint32_t(ps11::unorm8OfFloat(p[1])) << 8 | ps11::unorm8OfFloat(p[2])) |
+                                          fill;
+                    bad += got[size_t(i)] != want;
+                    ++checked;
+                }
+                bad += got[size_t(count)] != 0xdeadbeefu;  // nothing past the span
+            }
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+    CHECK(checked > 10000);
+}
+
 TEST_CASE("simd dispatch: mergePixels stores the same A16B16G16R16F bytes at every level", "[simd][merger]") {
     std::mt19937 rng(17);
     std::uniform_real_distribution<float> u(-70000.0f, 70000.0f), small(-1.0f, 1.0f);
