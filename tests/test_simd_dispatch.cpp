@@ -310,9 +310,11 @@ TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at 
     }
 }
 
-TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at every level", "[simd][merger]") {
-    // Every tie k + 1/2 over 255 and its float neighbours, the ends of [0, 1], values outside it,
-    // ±0, ±Inf and NaN, then random bits; spans of every length 0..40 at every offset mod 8.
+namespace {
+
+// Probes of the 8-bit rounding: every tie k + 1/2 over 255 and its float neighbours, the ends of
+// [0, 1], values outside it, ±0, ±Inf and NaN, then random bits.
+std::vector<float> unorm8Probes() {
     std::vector<float> values;
     for (int k = 0; k < 256; ++k) {
         const float tie = float((k + 0.5) / 255.0);
@@ -328,6 +330,21 @@ TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at ev
         std::memcpy(&f, &bits, 4);
         values.push_back(i % 2 ? f : float(rng() % 100000) / 90000.0f);
     }
+    return values;
+}
+
+// The A8R8G8B8 word of r g b a by ps11::unorm8OfFloat, ORed with `fill`.
+uint32_t unorm8WordOf(float r, float g, float b, float a, uint32_t fill) {
+    return (uint32_t(ps11::unorm8OfFloat(a)) << 24 | uint32_t(ps11::unorm8OfFloat(r)) << 16 |
+            uint32_t(ps11::unorm8OfFloat(g)) << 8 | ps11::unorm8OfFloat(b)) |
+           fill;
+}
+
+}  // namespace
+
+TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at every level", "[simd][merger]") {
+    // Spans of every length 0..40 at every offset mod 8.
+    const std::vector<float> values = unorm8Probes();
     int64_t bad = 0, checked = 0;
     for (SimdLevel level : ps11::runnableSimdLevels()) {
         const emu::MergerKernels& k = emu::mergerKernels(level);
@@ -338,10 +355,7 @@ TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at ev
                 std::vector<uint32_t> got(size_t(count) + 1, 0xdeadbeefu);
                 k.unorm8Words(f, count, fill, got.data());
                 for (int i = 0; i < count; ++i) {
-                    const uint32_t want = (uint32_t(ps11::unorm8OfFloat(f[3][i])) << 24 |
-                                           uint32_t(ps11::unorm8OfFloat(f[0][i])) << 16 |
-                                           uint32_t(ps11::unorm8OfFloat(f[1][i])) << 8 | ps11::unorm8OfFloat(f[2][i])) |
-                                          fill;
+                    const uint32_t want = unorm8WordOf(f[0][i], f[1][i], f[2][i], f[3][i], fill);
                     bad += got[size_t(i)] != want;
                     ++checked;
                 }
@@ -362,23 +376,9 @@ TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at ev
 
 TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::unorm8OfFloat at every level",
           "[simd][merger]") {
-    // The A32B32G32R32F rows a StretchRect converts: ties, ends, values outside [0, 1], ±0, ±Inf,
-    // NaN, random bits, as r g b a quadruples; every length 0..40 at every offset.
-    std::vector<float> values;
-    for (int k = 0; k < 256; ++k) {
-        const float tie = float((k + 0.5) / 255.0);
-        values.insert(values.end(), {tie, std::nextafter(tie, 0.0f), std::nextafter(tie, 2.0f), float(k / 255.0)});
-    }
-    const float inf = std::numeric_limits<float>::infinity();
-    values.insert(values.end(), {0.0f, -0.0f, 1.0f, std::nextafter(1.0f, 2.0f), -1e-30f, 7.5f, -3.0f, inf, -inf,
-                                 std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN(), 0.5f});
-    std::mt19937 rng(13);
-    for (int i = 0; i < 4096; ++i) {
-        uint32_t bits = rng();
-        float f;
-        std::memcpy(&f, &bits, 4);
-        values.push_back(i % 2 ? f : float(rng() % 100000) / 90000.0f);
-    }
+    // The A32B32G32R32F rows a StretchRect converts, as r g b a quadruples of the probes; every
+    // length 0..40 at every offset.
+    const std::vector<float> values = unorm8Probes();
     int64_t bad = 0, checked = 0;
     for (SimdLevel level : ps11::runnableSimdLevels()) {
         const emu::MergerKernels& k = emu::mergerKernels(level);
@@ -390,10 +390,7 @@ TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::
                 k.unorm8WordsRgba(rgba, count, fill, got.data());
                 for (int i = 0; i < count; ++i) {
                     const float* p = rgba + 4 * i;
-                    const uint32_t want = (uint32_t(ps11::unorm8OfFloat(p[3])) << 24 | uint32_t(ps11::unorm8OfFloat(p[0])) << 16 |
-                                           uint32_t(ps11::unorm8OfFloat(p[1])) << 8 | ps11::unorm8OfFloat(p[2])) |
-                                          fill;
-                    bad += got[size_t(i)] != want;
+                    bad += got[size_t(i)] != unorm8WordOf(p[0], p[1], p[2], p[3], fill);
                     ++checked;
                 }
                 bad += got[size_t(count)] != 0xdeadbeefu;  // nothing past the span
