@@ -17,7 +17,7 @@ struct MergerKernels {
     // (clamped to [0, 1], NaN 0, round_half_even(v * 255) in double), ORed with `alphaFill`.
     void (*unorm8Words)(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words);
     // The same words of `count` pixels of interleaved float r g b a (an A32B32G32R32F row): the
-    // ideal profile's float frame into an 8-bit target (StretchRect, GetRenderTargetData).
+    // ideal profile's float frame into an 8-bit target (StretchRect).
     void (*unorm8WordsRgba)(const float* rgba, int count, uint32_t alphaFill, uint32_t* words);
 };
 

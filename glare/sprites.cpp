@@ -80,7 +80,8 @@ void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeas
 namespace {
 
 // `workers` threads (0: the machine's; SensorFrame::threads) over `rows` items of `rowsPerItem`
-// pixel rows: bands of at least 64 pixel rows, the calling thread taking the first; `work(first, last, band)`. Callers join per-band results in
+// pixel rows: bands of at least 64 pixel rows, the calling thread taking the first;
+// `work(first, last, band)`. Callers join per-band results in
 // band order, so the sprites and every sum are those of one pass in raster order.
 void rowBands(uint32_t rows, uint32_t rowsPerItem, int workers,
               const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
