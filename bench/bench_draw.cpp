@@ -38,8 +38,10 @@ struct QuadVertex {
 // texture magnified 2x and scaled by c0, added ONE/ONE (the sprites technique's draw).
 // Tiny: the blur on a 1×1 target from a 1×1 texture (a glare technique's adaptation step): what a
 // draw costs besides its pixels.
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny };
-constexpr int kPasses = 9;
+// Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
+// texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite };
+constexpr int kPasses = 10;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -74,18 +76,32 @@ struct Scene {
             for (UINT x = 0; x < tw; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
+        Handle glare{};
+        if (pass == Pass::Composite) {
+            if (dev->CreateTexture(w / 8, h / 8, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &glare) != D3D_OK) return;
+            if (dev->LockRect(glare, 0, &lr, nullptr, 0) != D3D_OK) return;
+            for (UINT y = 0; y < h / 8; ++y) {
+                auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
+                for (UINT x = 0; x < w / 8; ++x) row[x] = rng();
+            }
+            dev->UnlockRect(glare, 0);
+        }
         const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small || pass == Pass::Tiny;
-        const int stages = fourTaps ? 4 : 1;
-        const DWORD filter = pass == Pass::CopyPoint ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+        const int stages = fourTaps ? 4 : pass == Pass::Composite ? 2 : 1;
         for (int s = 0; s < stages; ++s) {
-            dev->SetTexture(DWORD(s), tex);
+            const DWORD filter =
+                pass == Pass::CopyPoint || (pass == Pass::Composite && s == 0) ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+            dev->SetTexture(DWORD(s), pass == Pass::Composite && s == 1 ? glare : tex);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MINFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
         }
         const char* const kSprite = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
-        if (dev->CreatePixelShaderFromText(fourTaps ? kBlur4 : pass == Pass::Sprites ? kSprite : kCopy, &ps) != D3D_OK)
+        const char* const kScreen = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n";
+        if (dev->CreatePixelShaderFromText(
+                fourTaps ? kBlur4 : pass == Pass::Sprites ? kSprite : pass == Pass::Composite ? kScreen : kCopy, &ps) !=
+            D3D_OK)
             return;
         dev->SetPixelShader(ps);
         const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
@@ -262,6 +278,12 @@ BENCHMARK_CAPTURE(BM_Draw, blur4_240x135_fx8, Pass::Blur4Small)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+BENCHMARK_CAPTURE(BM_Draw, composite_screen_1080p_x8_fx8, Pass::Composite)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_1080p_fx8, Pass::Blur4)
