@@ -90,6 +90,18 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
     }
 }
 
+// Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
+// vector kernel, then the last pixels one by one.
+void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
+    int done = 0;
+    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
+    const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
+    if (draw.directAdd)
+        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
+    else
+        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
+}
+
 // A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
 // zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
 // ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
@@ -193,6 +205,11 @@ constexpr int kMinDirectColumns = 8;
 
 // Filters pixels [first, first + count) of a row of one tap into out[c][0 .. count); vector runs
 // (only where the draw has kernels) with `kernels`.
+// GCC's SLP vectoriser would read out[] two pointers per 16-byte load, and the caller writes them
+// one by one: a load the store buffer cannot forward, a stall on every call (6 % of a composite).
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-slp-vectorize")))
+#endif
 void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
                const TapRow& row, int colBase, int first, int count, int16_t* const out[4]) {
     if (!tap.bound) {
@@ -289,7 +306,9 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
         return cache.keys[i] == h && sl.row == row && k.texels == key.texels && k.wx == key.wx && k.step == key.step &&
                k.phase == key.phase && k.jlo == key.jlo && k.jhi == key.jhi && k.tableId == tableId;
     };
-    uint32_t& hint = cache.hint[size_t(h >> 8) & 255];
+    // The product's top bits: they depend on every bit of the key (its low bits only on the key's
+    // low bits, the same for a row's configurations).
+    uint32_t& hint = cache.hint[size_t(h >> 56)];
     size_t found = hint > 0 && hint <= n && same(hint - 1) ? hint - 1 : n;
     for (size_t i = 0; found == n && i < n; ++i)
         if (same(i)) found = i;
@@ -663,16 +682,29 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     std::array<TapRow, 8> rows{};
     // The executor asks for each tap's lanes chunk by chunk and they are filtered straight into
     // its registers.
+    // r0 comes back chunk by chunk: stored to the target row at once where the store is direct
+    // (`out`: the row's first pixel), else kept in sc.r0 for the output merger.
     struct FillCtx {
         const AlignedDraw* draw;
         const AlignedTriangle* tri;
         const std::array<TapRow, 8>* rows;
         int x;
-    } ctx{&draw, nullptr, &rows, 0};
+        uint8_t* out;
+        uint32_t orMask;
+        int16_t* const* r0;
+    } ctx{&draw, nullptr, &rows, 0, nullptr, orMask, r0};
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)],
                   f.tri->x0, f.x + first, count, dst);
+    };
+    const ps11::ResultSink sink = [](void* p, int first, int count, const int16_t* const lanes[4]) {
+        const FillCtx& f = *static_cast<const FillCtx*>(p);
+        if (f.out) {
+            storeLanes(*f.draw, lanes, count, f.orMask, f.out + 4 * first);
+            return;
+        }
+        for (int c = 0; c < 4; ++c) std::memcpy(f.r0[c] + first, lanes[c], sizeof(int16_t) * size_t(count));
     };
     HRowCache& cache = sc.hrows;
     if (cache.serial != draw.serial) {
@@ -757,7 +789,14 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
-                        ps11::runPresampled(exec, in, fill, &ctx, r0, &stats.exec);
+                        const bool direct = draw.directStore || draw.directAdd;
+                        ctx.out = direct ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
+                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
+                        if (direct) {
+                            stats.pixels += uint64_t(n);
+                            stats.written += uint64_t(n);
+                            continue;
+                        }
                     } else if (mode == RowMode::Copy) {
                         if ((draw.directStore || draw.directAdd) &&
                             copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
@@ -777,13 +816,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     stats.pixels += uint64_t(n);
                     uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
                     if (draw.directStore || draw.directAdd) {
-                        int done = 0;
-                        if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r0c, n, orMask, row);
-                        const int16_t* const rest[4] = {r0c[0] + done, r0c[1] + done, r0c[2] + done, r0c[3] + done};
-                        if (draw.directAdd)
-                            storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
-                        else
-                            storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
+                        storeLanes(draw, r0c, n, orMask, row);
                         stats.written += uint64_t(n);
                         continue;
                     }

@@ -83,7 +83,7 @@ public:
     // ps11/executor_presampled_internal.h
     bool tapPlan(TapPlan& plan) const;
     bool plainTaps(TapPlan& plan) const;
-    void runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
+    void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                        ExecutorStats* stats) const;
 
 private:
@@ -213,10 +213,10 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
     return true;
 }
 
-void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
+void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, ctx, r0);
+    runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx);
     countRun(stats, count);
 }
 
@@ -512,9 +512,9 @@ bool plainTaps(const Executor& executor, TapPlan& plan) {
     return static_cast<const exec::ExecutorImpl&>(executor).plainTaps(plan);
 }
 
-void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, void* ctx,
-                   int16_t* const r0[4], ExecutorStats* stats) {
-    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, ctx, r0, stats);
+void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
+                   ExecutorStats* stats) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats);
 }
 
 }  // namespace ps11

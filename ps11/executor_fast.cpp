@@ -306,9 +306,17 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
     }
 }
 
+// Texel lanes clamped to ±m. Out of line: inlined, its hoisted broadcast of m (a 16-bit store
+// read back as 32 bits, which the store buffer cannot forward) stalled every call.
+[[gnu::noinline]] static void clampLanes(int16_t* const dst[4], int n, int16_t m) {
+    const int16_t lo = int16_t(-m);
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < n; ++i) dst[c][i] = std::min<int16_t>(std::max<int16_t>(dst[c][i], lo), m);
+}
+
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, void* ctx, int16_t* const r0[4]) {
+                       TapFill fill, ResultSink sink, void* ctx) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
@@ -337,26 +345,16 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
                 int16_t* const dst[4] = {bank.reg[op.dstSlot][0], bank.reg[op.dstSlot][1], bank.reg[op.dstSlot][2],
                                          bank.reg[op.dstSlot][3]};
                 fill(ctx, tap, off, n, dst);
-                if (m < 255) {
-                    const int16_t lo = int16_t(-m);
-                    for (int c = 0; c < 4; ++c)
-                        for (int i = 0; i < n; ++i) dst[c][i] = std::min<int16_t>(std::max<int16_t>(dst[c][i], lo), m);
-                }
+                if (m < 255) clampLanes(dst, n, m);
                 ++tap;
             } else {
                 arithStep(kern, ops2[idx], bank, nv);
             }
             commitPair(ops, idx, bank, nv);
         }
-        // Fixed-size copies of 16 lanes (vector moves: a variable-length memcpy becomes a rep movs,
-        // whose start-up dominated the short spans of sprites), then the last lanes one by one.
-        const int n16 = n & ~15;
-        for (int c = 0; c < 4; ++c) {
-            const int16_t* src = bank.reg[kSlotR][c];
-            int16_t* dst = r0[c] + off;
-            for (int k = 0; k < n16; k += 16) std::memcpy(dst + k, src + k, sizeof(int16_t) * 16);
-            for (int k = n16; k < n; ++k) dst[k] = src[k];
-        }
+        const int16_t* const r0[4] = {bank.reg[kSlotR][0], bank.reg[kSlotR][1], bank.reg[kSlotR][2],
+                                      bank.reg[kSlotR][3]};
+        sink(ctx, off, n, r0);
     }
 }
 

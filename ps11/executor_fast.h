@@ -119,12 +119,13 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
              bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
 // runPresampled (ps11/executor_presampled_internal.h) on the fast path (the kernels of
-// simdLevel()): texture instructions (plain reads, tapPlan) have `fill` write tap i's lanes straight into their register (then clamped to ±nMax as
-// sampled texels are) instead of sampling; r0's int16 lanes are the output.
+// simdLevel()): texture instructions (plain reads, tapPlan) have `fill` write tap i's lanes
+// straight into their register (then clamped to ±nMax as sampled texels are) instead of
+// sampling; r0's int16 lanes go to `sink` chunk by chunk, straight from the register bank.
 // `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, void* ctx, int16_t* const r0[4]);
+                       TapFill fill, ResultSink sink, void* ctx);
 
 // fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
 // 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.

@@ -33,11 +33,15 @@ bool plainTaps(const Executor& executor, TapPlan& plan);
 // into dst[c][0 .. n) (c = r g b a): 8-bit texels, values in [0, 255] (the executor relies on
 // that, and clamps them to ±round(M·G) when that is smaller, as it does sampled texels).
 using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);
+// sink(ctx, first, n, r0) takes r0's grid integers of lanes [first, first + n): r0[c][0 .. n)
+// (c = r g b a), valid during the call only. It is called once per chunk of lanes, in order, as
+// soon as the chunk is computed (the caller stores it while it is in cache).
+using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* const r0[4]);
 // Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from `fill`
-// instead of a sampler. v0/v1 come from inputs.color. r0[c][lane] receives r0's grid integers.
-// Same results as Executor::run() with a sampler returning those texels. Only valid after
-// tapPlan() returned true.
-void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, void* ctx, int16_t* const r0[4],
+// instead of a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as
+// Executor::run() with a sampler returning those texels. Only valid after tapPlan() returned
+// true. `ctx` is handed to both callbacks.
+void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                    ExecutorStats* stats = nullptr);
 
 }  // namespace ps11
