@@ -36,12 +36,6 @@ inline void deinterleave16(const uint8_t* p, uint16_t* const out[4], int k) {
     storeu(out[3] + k, _mm256_cvtepu8_epi16(_mm256_extracti128_si256(ra, 1)));
 }
 
-// round_half_even(t / 65536) of 32-bit lanes.
-inline __m256i roundBlend8(__m256i t) {
-    const __m256i odd = _mm256_and_si256(_mm256_srli_epi32(t, 16), _mm256_set1_epi32(1));
-    return _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(t, _mm256_set1_epi32(0x7fff)), odd), 16);
-}
-
 // round_half_even(v / 2^s) of unsigned 16-bit lanes, v + 2^(s-1) < 2^16.
 template <int S>
 inline __m256i roundShift(__m256i v) {
@@ -198,6 +192,29 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
     }
 }
 
+// General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768), m = t − 32768·256;
+// kind S is widened to h = 128·s first (Up = 7). round_half_even(t / 65536) is then
+// (m + 32768·256 + 0x7fff + odd) >> 16 with odd = bit 16 of t, which is bit 16 of m (32768·256 is a
+// multiple of 2^17): one constant add instead of two.
+template <int Up>
+void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
+                     int16_t* const out[4]) {
+    const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
+    const __m256i flip = _mm256_set1_epi16(int16_t(0x8000)), bias = _mm256_set1_epi32(32768 * 256 + 0x7fff);
+    const __m256i one = _mm256_set1_epi32(1);
+    auto round = [&](__m256i m) {
+        const __m256i odd = _mm256_and_si256(_mm256_srli_epi32(m, 16), one);
+        return _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(m, bias), odd), 16);
+    };
+    verticalGroups(count, lane, out, [&](int c, int k) {
+        const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), Up), flip);
+        const __m256i s1 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h1[c] + k), Up), flip);
+        const __m256i lo = round(_mm256_madd_epi16(_mm256_unpacklo_epi16(s0, s1), wv));
+        const __m256i hi = round(_mm256_madd_epi16(_mm256_unpackhi_epi16(s0, s1), wv));
+        return _mm256_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
+    });
+}
+
 void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                          int lane, int16_t* const out[4]) {
     if (wy == 0) {
@@ -233,18 +250,10 @@ void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t
         });
         return;
     }
-    // General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768): t = madd +
-    // 32768·256; kind S is widened to h = 128·s first.
-    const int up = kind == HKind::S ? 7 : 0;
-    const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
-    const __m256i flip = _mm256_set1_epi16(int16_t(0x8000)), bias = _mm256_set1_epi32(32768 * 256);
-    verticalGroups(count, lane, out, [&](int c, int k) {
-        const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), up), flip);
-        const __m256i s1 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h1[c] + k), up), flip);
-        const __m256i lo = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpacklo_epi16(s0, s1), wv), bias));
-        const __m256i hi = roundBlend8(_mm256_add_epi32(_mm256_madd_epi16(_mm256_unpackhi_epi16(s0, s1), wv), bias));
-        return _mm256_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
-    });
+    if (kind == HKind::S)
+        verticalGeneral<7>(h0, h1, wy, count, lane, out);
+    else
+        verticalGeneral<0>(h0, h1, wy, count, lane, out);
 }
 
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
