@@ -33,12 +33,19 @@ PixelBox meet(const PixelBox& a, const PixelBox& b) {
 
 }  // namespace
 
-void clearImages(const ClearCall& call) {
+void clearImages(const ClearCall& call, RowRange rows) {
+    // A box's part within the image and the rows asked for.
+    auto within = [&](const PixelBox& b, const Image& image) {
+        PixelBox c = meet(b, PixelBox{0, 0, image.width, image.height});
+        c.y0 = std::max(c.y0, rows.first);
+        c.y1 = std::min(c.y1, rows.last);
+        return c;
+    };
     if (call.color.valid()) {
         Image* target = call.color.image;
         const FormatInfo& f = *target->format;
         for (const PixelBox& b : call.boxes) {
-            const PixelBox c = meet(b, PixelBox{0, 0, target->width, target->height});
+            const PixelBox c = within(b, *target);
             if (c.empty()) continue;
             // Fill the first row, then copy it to the others.
             for (int64_t x = c.x0; x < c.x1; ++x)
@@ -53,7 +60,7 @@ void clearImages(const ClearCall& call) {
         Image* depth = call.depth.image;
         const FormatInfo& f = *depth->format;
         for (const PixelBox& b : call.boxes) {
-            const PixelBox c = meet(b, PixelBox{0, 0, depth->width, depth->height});
+            const PixelBox c = within(b, *depth);
             for (int64_t y = c.y0; y < c.y1; ++y) {
                 uint8_t* p = c.x0 < c.x1 ? depth->texel(uint32_t(c.x0), uint32_t(y)) : nullptr;
                 for (int64_t x = c.x0; x < c.x1; ++x, p += f.bytes) {

@@ -20,15 +20,17 @@ struct StretchTap {
 // The taps of every destination column (`horizontal`) or row, by the texel-centre mapping.
 std::vector<StretchTap> stretchTaps(const StretchCall& call, bool horizontal);
 
-// Fills the call's boxes of call.color.image and call.depth.image (when valid).
-void clearImages(const ClearCall& call);
-// Copies call.sourceRect of call.source.image to call.destRect of call.dest.image, scaling with
-// POINT or LINEAR filtering (texel-centre mapping; 8-bit weights in fx profiles, rounded once).
-// `rows` limits the work to destination rows [first, last) of the rect (relative to its top), so
-// that workers can share one call; the default is every row.
+// Rows [first, last) of a call's work, so that workers can share one call.
 struct RowRange {
     int64_t first = 0, last = INT64_MAX;
 };
+// Fills the call's boxes of call.color.image and call.depth.image (when valid); `rows` limits the
+// work to image rows [first, last) (the default is every row).
+void clearImages(const ClearCall& call, RowRange rows = {});
+// Copies call.sourceRect of call.source.image to call.destRect of call.dest.image, scaling with
+// POINT or LINEAR filtering (texel-centre mapping; 8-bit weights in fx profiles, rounded once).
+// `rows` limits the work to destination rows [first, last) of the rect (relative to its top);
+// the default is every row.
 void stretchImages(const StretchCall& call, RowRange rows = {});
 
 }  // namespace emu

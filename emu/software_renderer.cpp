@@ -20,8 +20,9 @@ namespace {
 
 // Rows per band handed to a worker: even (quads) and small enough to balance two threads.
 constexpr int kBandRows = 16;
-// A StretchRect shares its rows among the workers from this many texels read per worker.
-constexpr int64_t kMinStretchTexelsPerWorker = 16384;
+// A StretchRect or Clear shares its rows among the workers from this many texels read or
+// written per worker.
+constexpr int64_t kMinBlitTexelsPerWorker = 16384;
 // Executors kept per renderer (cleared when full).
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
@@ -71,7 +72,15 @@ SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_o
 SoftwareRenderer::~SoftwareRenderer() = default;
 
 bool SoftwareRenderer::clear(const ClearCall& call) {
-    clearImages(call);
+    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+    // Image rows in bands over the workers, as stretchRect's (each row is written by one of them).
+    int64_t rows = 0, texels = 0;
+    for (const SurfaceDesc* ref : {&call.color, &call.depth})
+        if (ref->valid()) rows = std::max<int64_t>(rows, ref->image->height);
+    for (const PixelBox& b : call.boxes) texels += std::max<int64_t>(b.x1 - b.x0, 0) * std::max<int64_t>(b.y1 - b.y0, 0);
+    const int workers = int(std::clamp<int64_t>(texels / kMinBlitTexelsPerWorker, 1, m_context->pool.size()));
+    m_context->pool.run(workers,
+                        [&](int w) { clearImages(call, RowRange{rows * w / workers, rows * (w + 1) / workers}); });
     return true;
 }
 
@@ -82,7 +91,7 @@ bool SoftwareRenderer::stretchRect(const StretchCall& call) {
     // The work is the texels read: four a pixel for LINEAR, whose scattered reads of a reduction
     // wait on memory.
     const int64_t texels = rows * (call.destRect.x1 - call.destRect.x0) * (call.linear ? 4 : 1);
-    const int workers = int(std::clamp<int64_t>(texels / kMinStretchTexelsPerWorker, 1, m_context->pool.size()));
+    const int workers = int(std::clamp<int64_t>(texels / kMinBlitTexelsPerWorker, 1, m_context->pool.size()));
     m_context->pool.run(workers, [&](int w) {
         stretchImages(call, RowRange{rows * w / workers, rows * (w + 1) / workers});
     });

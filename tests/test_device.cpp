@@ -756,6 +756,27 @@ TEST_CASE("device: Clear honours viewport, scissor and rects", "[device]") {
     REQUIRE(dev.UnlockRect(rt) == D3D_OK);
 }
 
+TEST_CASE("device: Clear shared by worker threads writes exactly its rects", "[device]") {
+    // 320×240: enough texels for up to 4 workers, whose row bands cut through the rects.
+    for (int threads : {1, 2, 3, 4}) {
+        DeviceOptions o;
+        o.software.threads = threads;
+        Device dev(o);
+        Handle rt = makeTarget(dev, 320, 240, [](UINT x, UINT y) { return 0xFF000000u | (y << 9) | x; });
+        REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+        const D3DRECT rects[3] = {{0, 0, 320, 61}, {17, 50, 300, 239}, {5, 119, 6, 121}};
+        REQUIRE(dev.Clear(3, rects, D3DCLEAR_TARGET, 0x80402010u, 1.0f, 0) == D3D_OK);
+        int wrong = 0;
+        for (UINT y = 0; y < 240; ++y)
+            for (UINT x = 0; x < 320; ++x) {
+                bool in = false;
+                for (const D3DRECT& r : rects) in = in || (LONG(x) >= r.x1 && LONG(x) < r.x2 && LONG(y) >= r.y1 && LONG(y) < r.y2);
+                wrong += readPixel(dev, rt, x, y) != (in ? 0x80402010u : 0xFF000000u | (y << 9) | x);
+            }
+        CHECK(wrong == 0);
+    }
+}
+
 TEST_CASE("device: Clear converts the colour, depth and stencil to the surface formats", "[device]") {
     Device dev;
     Handle f32{}, f16{}, x8{};
