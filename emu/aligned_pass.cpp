@@ -91,10 +91,24 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 }
 
 // Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
-// vector kernel, then the last pixels one by one.
+// vector kernel over whole groups of 16, the last pixels through a group of its own (the lanes and
+// the target's bytes padded to 16 pixels, the pixels that are the row's written back), or one by
+// one without kernels.
 void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
     int done = 0;
     if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
+    if (draw.kernels && n > done) {
+        const int left = n - done;
+        alignas(32) int16_t lanes[4][16] = {};
+        alignas(32) uint8_t bytes[64] = {};
+        for (int c = 0; c < 4; ++c) std::memcpy(lanes[c], r[c] + done, sizeof(int16_t) * size_t(left));
+        if (draw.directAdd) std::memcpy(bytes, row + 4 * done, 4 * size_t(left));
+        const int16_t* const group[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
+        if (draw.kernels->storeRow(draw.directAdd, group, 16, orMask, bytes) == 16) {
+            std::memcpy(row + 4 * done, bytes, 4 * size_t(left));
+            return;
+        }
+    }
     const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
     if (draw.directAdd)
         storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
@@ -288,9 +302,10 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
     }
 }
 
-// Finds the slot for (row, key) or takes one for it: the least recently used slot used on neither
-// the current pixel row (so every pointer handed out for a row stays valid until the next row) nor
-// the one before, or a new one. `fresh` tells whether it must be filled.
+// Finds the slot for (row, key) or takes one for it: the next slot, round the slots from the last
+// one taken, used on neither the current pixel row (so every pointer handed out for a row stays
+// valid until the next row) nor the one before, or a new one. `fresh` tells whether it must be
+// filled.
 HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
     // A cheap key over the fields that identify the row (never 0: 0 marks an empty slot); slots
     // with the key are then compared field by field.
@@ -319,10 +334,18 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
         return *cache.slots[found];
     }
     // Not one used on this pixel row or the one before (the rows a magnified tap's next pixel row
-    // most likely reads again): the oldest of the others, or a new slot.
+    // most likely reads again): the first other from the clock hand (slots are taken in turn, so
+    // the one taken is the longest filled; a scan for the least recently used cost more than the
+    // misses it saved), or a new slot.
     size_t victim = n;
-    for (size_t i = 0; i < n; ++i)
-        if (cache.stamps[i] + 1 < cache.stamp && (victim == n || cache.stamps[i] < cache.stamps[victim])) victim = i;
+    for (size_t k = 0; k < n; ++k) {
+        const size_t i = (cache.hand + k) % n;
+        if (cache.stamps[i] + 1 < cache.stamp) {
+            victim = i;
+            break;
+        }
+    }
+    cache.hand = victim + 1;
     if (victim == n) {
         cache.slots.push_back(std::make_unique<HRowCache::Slot>());
         cache.keys.push_back(0);

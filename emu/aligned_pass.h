@@ -155,6 +155,7 @@ struct HRowCache {
     std::array<uint32_t, 256> hint{};
     uint64_t serial = 0;  // the draw the slots belong to
     uint64_t stamp = 0;
+    size_t hand = 0;  // where the search for a slot to take starts
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)
 };
 
