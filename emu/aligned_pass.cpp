@@ -91,24 +91,11 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 }
 
 // Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
-// vector kernel over whole groups of 16, the last pixels through a group of its own (the lanes and
-// the target's bytes padded to 16 pixels, the pixels that are the row's written back), or one by
-// one without kernels.
+// vector kernel (which reads the planes in whole groups of 16 lanes: theirs are kChunk or kMaxSpan
+// long), then whatever it left one by one.
 void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
     int done = 0;
     if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
-    if (draw.kernels && n > done) {
-        const int left = n - done;
-        alignas(32) int16_t lanes[4][16] = {};
-        alignas(32) uint8_t bytes[64] = {};
-        for (int c = 0; c < 4; ++c) std::memcpy(lanes[c], r[c] + done, sizeof(int16_t) * size_t(left));
-        if (draw.directAdd) std::memcpy(bytes, row + 4 * done, 4 * size_t(left));
-        const int16_t* const group[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
-        if (draw.kernels->storeRow(draw.directAdd, group, 16, orMask, bytes) == 16) {
-            std::memcpy(row + 4 * done, bytes, 4 * size_t(left));
-            return;
-        }
-    }
     const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
     if (draw.directAdd)
         storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);

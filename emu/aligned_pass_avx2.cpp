@@ -177,19 +177,29 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t*
     }
 }
 
+// Dword lanes [0, t) all ones, the others 0 (a mask for maskload / maskstore).
+inline __m256i firstDwords(int t) {
+    return _mm256_cmpgt_epi32(_mm256_set1_epi32(t), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+}
+
+// The first t (< 16) int16 lanes of v to dst: masked dwords, then the odd last lane.
+inline void storeFirstLanes(int16_t* dst, __m256i v, int t) {
+    _mm256_maskstore_epi32(reinterpret_cast<int*>(dst), firstDwords(t >> 1), v);
+    if (t & 1) {
+        alignas(32) int16_t lanes[16];
+        storeu(lanes, v);
+        dst[t - 1] = lanes[t - 1];
+    }
+}
+
 // One group of 16 lanes of every channel: f(c, k) gives the vector of channel c at element k.
 template <typename F>
 inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
     int k = 0;
     for (; k + 16 <= count; k += 16)
         for (int c = 0; c < 4; ++c) storeu(out[c] + lane + k, f(c, k));
-    if (k < count) {
-        alignas(32) int16_t tmp[16];
-        for (int c = 0; c < 4; ++c) {
-            storeu(tmp, f(c, k));
-            std::memcpy(out[c] + lane + k, tmp, sizeof(int16_t) * size_t(count - k));
-        }
-    }
+    if (k < count)
+        for (int c = 0; c < 4; ++c) storeFirstLanes(out[c] + lane + k, f(c, k), count - k);
 }
 
 // General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768), m = t − 32768·256;
@@ -260,9 +270,8 @@ void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
 int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
-    int i = 0;
     const __m256i om = _mm256_set1_epi32(int32_t(orMask));
-    for (; i + 16 <= count; i += 16) {
+    for (int i = 0; i < count; i += 16) {
         auto ld = [&](int c) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i)); };
         // packus: int16 -> uint8 with saturation to [0, 255], per 128-bit lane.
         const __m256i bg = _mm256_packus_epi16(ld(2), ld(1));  // lane0: b0-7 g0-7, lane1: b8-15 g8-15
@@ -275,6 +284,18 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
         __m256i second = _mm256_permute2x128_si256(w0, w1, 0x31);                   // px 8-15
         __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
         __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
+        if (count - i < 16) {  // the last pixels: masked loads and stores of their words alone
+            int* w0 = reinterpret_cast<int*>(d0);
+            int* w1 = reinterpret_cast<int*>(d1);
+            const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
+            if constexpr (Additive) {
+                first = _mm256_adds_epu8(first, _mm256_maskload_epi32(w0, m0));
+                second = _mm256_adds_epu8(second, _mm256_maskload_epi32(w1, m1));
+            }
+            _mm256_maskstore_epi32(w0, m0, first);
+            _mm256_maskstore_epi32(w1, m1, second);
+            break;
+        }
         if constexpr (Additive) {
             first = _mm256_adds_epu8(first, _mm256_loadu_si256(d0));
             second = _mm256_adds_epu8(second, _mm256_loadu_si256(d1));
@@ -282,7 +303,7 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
         _mm256_storeu_si256(d0, first);
         _mm256_storeu_si256(d1, second);
     }
-    return i;
+    return count;
 }
 
 int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {

@@ -53,9 +53,10 @@ struct AlignedKernels {
     void (*vertical)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                      int lane, int16_t* const out[4]);
 
-    // Stores the first pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words
-    // at dst, or-ing orMask (additive: a saturating byte add onto what dst holds), in whole
-    // groups of 16; returns how many it stored (the caller stores the rest).
+    // Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
+    // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
+    // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes
+    // (the lanes past `count` are ignored); dst is never touched past its `count` words.
     int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
 };
 
