@@ -15,8 +15,9 @@
 namespace ps11::exec {
 
 // Lanes processed at once inside run(): a span is cut into chunks of this size so the working
-// set (registers + scratch) stays in L1.
-constexpr int kChunk = 128;
+// set (registers + scratch) stays in L1 or L2. A whole span (kMaxSpan) at once: the per-chunk
+// work of the row paths (a fill per tap, an op dispatch per instruction) is paid once a span.
+constexpr int kChunk = 256;
 
 // Register storage of one chunk. Only one of the int / float banks is used per profile.
 template <class T>
