@@ -27,8 +27,11 @@ constexpr int64_t kMinBlitTexelsPerWorker = 16384;
 constexpr size_t kMaxCachedExecutors = 64;
 // Triangles processed per chunk (vertex processing, setup, rasterisation).
 constexpr uint32_t kChunkTriangles = 1024;
-// A program whose tiles did not pay to decide is decided again this many draws later.
-constexpr uint32_t kTileRetryDraws = 4;
+// A program whose tiles did not pay to decide is decided again this many draws later; each
+// further decision that does not pay doubles the wait, up to kMaxTileRetryDraws (a program that
+// never pays, such as a composite over a bright scene, then decides one draw in 32; one that
+// starts to pay is noticed within as many draws).
+constexpr uint32_t kTileRetryDraws = 4, kMaxTileRetryDraws = 32;
 
 // Executor outputs and the merged live mask of one span.
 struct Lanes {
@@ -59,10 +62,12 @@ struct SoftwareDrawContext {
     // Executors by DrawProgram::key (a program's identity for the device's lifetime).
     std::unordered_map<uint64_t, std::unique_ptr<ps11::Executor>> executors;
     // By DrawProgram::key: whether deciding tiles paid on the program's last decided draw (a
-    // quarter of its tiles or more filled, copied or skipped), and its draws since.
+    // quarter of its tiles or more filled, copied or skipped), its draws since, and how many
+    // draws it waits before deciding again.
     struct TileHistory {
         bool paid = true;
         uint32_t since = 0;
+        uint32_t wait = kTileRetryDraws;
     };
     std::unordered_map<uint64_t, TileHistory> tileHistory;
 };
@@ -166,7 +171,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
     if (m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles &&
-        (history.paid || ++history.since >= kTileRetryDraws))
+        (history.paid || ++history.since >= history.wait))
         skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t> isAligned;
@@ -443,7 +448,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             std::min(copied, copiesSaving.load() + copiedDirect.load() / uint64_t(kBandRows * kSkipTileColumns));
         const uint64_t saved =
             stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled - tilesBefore.tilesSkipped + copiesSaved;
-        history.paid = saved * 4 >= shaded + copied + saved - copiesSaved;
+        const bool paid = saved * 4 >= shaded + copied + saved - copiesSaved;
+        // The first miss after paying waits kTileRetryDraws; each miss after a miss doubles it.
+        history.wait = paid || history.paid ? kTileRetryDraws : std::min(2 * history.wait, kMaxTileRetryDraws);
+        history.paid = paid;
         history.since = 0;
     }
     return true;
