@@ -22,10 +22,27 @@ void TexelRange::add(const TexelRange& o) {
 }
 
 TexelRange TexelTiles::over(uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) const {
+    // add() over the tiles with the four channels at once: minps(o, r) is std::min(r, o) and
+    // maxps(o, r) std::max(r, o), NaN and signed zeros included (each returns its second operand
+    // unless the first compares below, or above, it).
     TexelRange r;
-    for (uint32_t ty = y0 / side; ty <= y1 / side && ty < tilesY; ++ty)
-        for (uint32_t tx = x0 / side; tx <= x1 / side && tx < tilesX; ++tx)
-            r.add(tiles[size_t(ty) * tilesX + tx]);
+    if (tilesX == 0 || tilesY == 0) return r;
+    const uint32_t tx0 = x0 / side, tx1 = std::min(x1 / side, tilesX - 1);
+    const uint32_t ty0 = y0 / side, ty1 = std::min(y1 / side, tilesY - 1);
+    __m128 lo = _mm_loadu_ps(r.lo.data()), hi = _mm_loadu_ps(r.hi.data());
+    uint8_t nan = 0, negZero = 0;
+    for (uint32_t ty = ty0; ty <= ty1 && tx0 <= tx1; ++ty) {
+        const TexelRange* t = &tiles[size_t(ty) * tilesX + tx0];
+        for (uint32_t tx = tx0; tx <= tx1; ++tx, ++t) {
+            lo = _mm_min_ps(_mm_loadu_ps(t->lo.data()), lo);
+            hi = _mm_max_ps(_mm_loadu_ps(t->hi.data()), hi);
+            nan = uint8_t(nan | t->nan);
+            negZero = uint8_t(negZero | t->negZero);
+        }
+    }
+    _mm_storeu_ps(r.lo.data(), lo);
+    _mm_storeu_ps(r.hi.data(), hi);
+    r.nan = nan, r.negZero = negZero;
     return r;
 }
 
