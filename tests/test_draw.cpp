@@ -121,61 +121,53 @@ TEST_CASE("draw: mov r0, v0 fills exactly the quad's pixels with the diffuse col
     CHECK(st.trianglesDrawn == 2);
 }
 
+// A 130×40 quad squaring a random texture, drawn again and again: which draws decided tiles.
+struct RepeatedDraw {
+    static constexpr UINT W = 130, H = 40;
+    Device dev;
+    Handle tex{};
+    std::vector<QuadVertex> v = quad(W, H, 0xffffffff);
+    RepeatedDraw() {
+        (void)target(dev, W, H);
+        std::vector<uint32_t> texels;
+        tex = randomTexture(dev, W, H, texels, 11);
+        REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+        shader(dev, "ps_1_1\ntex t0\nmul r0, t0, t0\n");
+        REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+    }
+    // Draws numbered [first, last); returns those whose tiles were decided.
+    std::vector<int> decided(int first, int last) {
+        std::vector<int> out;
+        for (int i = first; i < last; ++i) {
+            REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
+            const DrawStats& st = dev.lastDrawStats();
+            CHECK(st.pixelsCovered == W * H);
+            if (st.tilesShaded + st.tilesFilled + st.tilesCopied + st.tilesSkipped) out.push_back(i);
+        }
+        return out;
+    }
+};
+
 TEST_CASE("draw: tiles of a program that needed shading are decided again after 4, 8, 16, 32 draws", "[draw][skip]") {
     // Deciding a tile costs about a microsecond: a program whose tiles mostly needed shading is
     // shaded without deciding, and tried again on its fourth draw after, then after twice as many
     // each time it still did not pay, up to 32 (docs/device.md "Tile skipping"). The bytes are
     // the same either way.
-    Device dev;
-    const UINT W = 130, H = 40;
-    Handle rt = target(dev, W, H);
-    (void)rt;
-    std::vector<uint32_t> texels;
-    Handle tex = randomTexture(dev, W, H, texels, 11);
-    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
-    shader(dev, "ps_1_1\ntex t0\nmul r0, t0, t0\n");
-    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
-    auto v = quad(W, H, 0xffffffff);
-    std::vector<int> decided;
-    for (int i = 0; i < 100; ++i) {
-        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
-        const DrawStats& st = dev.lastDrawStats();
-        if (st.tilesShaded + st.tilesFilled + st.tilesCopied + st.tilesSkipped) decided.push_back(i);
-        CHECK(st.pixelsCovered == W * H);
-    }
-    CHECK(decided == std::vector<int>{0, 4, 12, 28, 60, 92});
+    RepeatedDraw r;
+    CHECK(r.decided(0, 100) == std::vector<int>{0, 4, 12, 28, 60, 92});
 }
 
 TEST_CASE("draw: a program whose tiles start to pay is decided on every draw again", "[draw][skip]") {
     // Tiles of a random texture need shading; once the texture is black every tile is filled,
     // and the draw after the next decision decides again (the wait is reset).
-    Device dev;
-    const UINT W = 130, H = 40;
-    Handle rt = target(dev, W, H);
-    (void)rt;
-    std::vector<uint32_t> texels;
-    Handle tex = randomTexture(dev, W, H, texels, 11);
-    REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
-    shader(dev, "ps_1_1\ntex t0\nmul r0, t0, t0\n");
-    REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
-    auto v = quad(W, H, 0xffffffff);
-    auto draw = [&] {
-        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
-        const DrawStats& st = dev.lastDrawStats();
-        return st.tilesShaded + st.tilesFilled + st.tilesCopied + st.tilesSkipped > 0;
-    };
-    std::vector<int> decided;
-    for (int i = 0; i < 13; ++i)
-        if (draw()) decided.push_back(i);
-    CHECK(decided == std::vector<int>{0, 4, 12});  // waiting 16 draws now
+    RepeatedDraw r;
+    CHECK(r.decided(0, 13) == std::vector<int>{0, 4, 12});  // waiting 16 draws now
     D3DLOCKED_RECT lr;
-    REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
-    for (UINT y = 0; y < H; ++y) std::memset(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), 0, 4 * W);
-    REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
-    decided.clear();
-    for (int i = 13; i < 33; ++i)
-        if (draw()) decided.push_back(i);
-    CHECK(decided == std::vector<int>{28, 29, 30, 31, 32});
+    REQUIRE(r.dev.LockRect(r.tex, 0, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < RepeatedDraw::H; ++y)
+        std::memset(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), 0, 4 * RepeatedDraw::W);
+    REQUIRE(r.dev.UnlockRect(r.tex, 0) == D3D_OK);
+    CHECK(r.decided(13, 33) == std::vector<int>{28, 29, 30, 31, 32});
 }
 
 TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
