@@ -240,6 +240,37 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
     }
 }
 
+// Chains of products run as one (FastKernels::chain): a small non-negative mul into R, followed
+// by small non-negative mads of the same channels whose third source is R as it stands (plain,
+// unswizzled) and whose factors never read R, all arithmetic ops next to each other (the
+// weighted sums of the blurs: mul r0, t0, c0; mad r0, t1, c1, r0; ...). Only in programs without
+// co-issued pairs (presampledOps' sign analysis).
+static void markChains(const std::vector<DOp>& ops, std::vector<FastOp>& out) {
+    auto product = [&](size_t i, FastKind kind) {
+        const FastOp& f = out[i];
+        return !ops[i].texture && ops[i].op != Opcode::Phase && f.kind == kind && f.small && f.nonNegative &&
+               f.complement == 0 && !f.hold;
+    };
+    for (size_t head = 0; head < ops.size(); ++head) {
+        if (!product(head, FastKind::Mul)) continue;
+        const FastOp& h = out[head];
+        if (h.src[0].slot == h.dst || h.src[1].slot == h.dst) continue;
+        size_t end = head + 1;
+        while (end < ops.size() && end - head < size_t(kMaxFastChain) && product(end, FastKind::Mad)) {
+            const FastOp& m = out[end];
+            const FastSrc& r = m.src[2];
+            const bool addsR = r.slot == h.dst && r.a == 2 && r.b == 0 && r.sw == std::array<uint8_t, 4>{0, 1, 2, 3};
+            if (!addsR || m.dst != h.dst || m.mask != h.mask || m.src[0].slot == h.dst || m.src[1].slot == h.dst)
+                break;
+            ++end;
+        }
+        if (end - head < 2) continue;
+        out[head].chain = uint8_t(end - head);
+        for (size_t k = head + 1; k < end; ++k) out[k].inChain = true;
+        head = end - 1;
+    }
+}
+
 void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out) {
     out = fp.ops;
     if (!fp.ready) return;
@@ -303,6 +334,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
             if (f.lo >= 0) result = kMaskAll;
             pos[f.dst] = uint8_t((pos[f.dst] & ~f.mask) | (result & f.mask));
         }
+        markChains(ops, out);
     }
 }
 
@@ -347,7 +379,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
                 fill(ctx, tap, off, n, dst);
                 if (m < 255) clampLanes(dst, n, m);
                 ++tap;
-            } else {
+            } else if (ops2[idx].chain) {
+                kern.chain(&ops2[idx], ops2[idx].chain, bank, nv);
+            } else if (!ops2[idx].inChain) {
                 arithStep(kern, ops2[idx], bank, nv);
             }
             commitPair(ops, idx, bank, nv);

@@ -48,6 +48,10 @@ struct FastOp {
     int16_t lo = -255, hi = 255;  // _sat and range clamp, as the generic path computes them
     uint8_t numSrc = 0;
     std::array<FastSrc, 3> src{};
+    // Pre-sampled runs (presampledOps): this op heads a chain of `chain` consecutive products run
+    // as one (FastKernels::chain), and the ops after it in the chain have `inChain` set.
+    uint8_t chain = 0;
+    bool inChain = false;
 };
 
 struct FastBank {
@@ -58,6 +62,12 @@ struct FastBank {
 
 // Runs one arithmetic op over lanes [0, nv) (nv a multiple of 16, <= kChunk).
 using FastArithFn = void (*)(const FastOp& op, FastBank& bank, int nv);
+// Runs a chain of `count` ops (FastOp::chain) over lanes [0, nv): a small non-negative mul into
+// register R, then small non-negative mads each adding R as it stands; each op's result rounded
+// and clamped as arith() would, R kept in a vector register between them and stored once.
+using FastChainFn = void (*)(const FastOp* ops, int count, FastBank& bank, int nv);
+// The longest chain.
+constexpr int kMaxFastChain = 8;
 
 // Test hooks: the rounding steps of the kernels on their own, count lanes (a multiple of 16).
 // Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
@@ -76,6 +86,7 @@ using FastStoreFn = void (*)(const int16_t* r, float* color, int32_t* grid, int 
 struct FastKernels {
     const char* name;  // what Executor::pathName() says: "fast-sse2" or "fast-avx2"
     FastArithFn arith;
+    FastChainFn chain;
     FastLoadColorFn loadColor;
     FastStoreFn store;
     FastNarrowFn narrow;
