@@ -2,8 +2,38 @@
 #include "emu/thread_pool.h"
 
 #include <algorithm>
+#include <chrono>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
 
 namespace emu {
+
+namespace {
+
+inline void relax() {
+#if defined(__x86_64__) || defined(__i386__)
+    _mm_pause();
+#else
+    std::this_thread::yield();
+#endif
+}
+
+// Polls `done` for up to ThreadPool::kSpin; true when it held before the time ran out.
+template <typename Done>
+bool spinUntil(Done done) {
+    const auto until = std::chrono::steady_clock::now() + ThreadPool::kSpin;
+    for (;;) {
+        for (int i = 0; i < 64; ++i) {
+            if (done()) return true;
+            relax();
+        }
+        if (std::chrono::steady_clock::now() >= until) return done();
+    }
+}
+
+}  // namespace
 
 ThreadPool::ThreadPool(int threads) {
     if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -15,6 +45,7 @@ ThreadPool::~ThreadPool() {
     {
         std::lock_guard<std::mutex> lock(m_mutex);
         m_stop = true;
+        m_stopping.store(true, std::memory_order_release);
     }
     m_start.notify_all();
     for (std::thread& t : m_threads) t.join();
@@ -30,13 +61,14 @@ void ThreadPool::run(int n, const std::function<void(int)>& f) {
         std::lock_guard<std::mutex> lock(m_mutex);
         m_job = &f;
         m_jobWorkers = n;
-        m_pending = n - 1;
-        ++m_generation;
+        m_pending.store(n - 1, std::memory_order_relaxed);
+        m_generation.fetch_add(1, std::memory_order_release);
     }
     m_start.notify_all();
     f(0);
+    spinUntil([this] { return m_pending.load(std::memory_order_acquire) == 0; });
     std::unique_lock<std::mutex> lock(m_mutex);
-    m_done.wait(lock, [this] { return m_pending == 0; });
+    m_done.wait(lock, [this] { return m_pending.load(std::memory_order_relaxed) == 0; });
     m_job = nullptr;
 }
 
@@ -44,18 +76,22 @@ void ThreadPool::workerLoop(int index) {
     uint64_t seen = 0;
     for (;;) {
         const std::function<void(int)>* job = nullptr;
+        spinUntil([&] {
+            return m_stopping.load(std::memory_order_acquire) ||
+                   m_generation.load(std::memory_order_acquire) != seen;
+        });
         {
             std::unique_lock<std::mutex> lock(m_mutex);
-            m_start.wait(lock, [&] { return m_stop || m_generation != seen; });
+            m_start.wait(lock, [&] { return m_stop || m_generation.load(std::memory_order_relaxed) != seen; });
             if (m_stop) return;
-            seen = m_generation;
+            seen = m_generation.load(std::memory_order_relaxed);
             if (index >= m_jobWorkers) continue;
             job = m_job;
         }
         (*job)(index);
         {
             std::lock_guard<std::mutex> lock(m_mutex);
-            if (--m_pending == 0) m_done.notify_one();
+            if (m_pending.fetch_sub(1, std::memory_order_acq_rel) == 1) m_done.notify_one();
         }
     }
 }
