@@ -20,17 +20,16 @@ inline void relax() {
 #endif
 }
 
-// Polls `done` for up to ThreadPool::kSpin; true when it held before the time ran out.
+// Polls `done` until it holds or ThreadPool::kSpin has passed (the caller then waits under the mutex).
 template <typename Done>
-bool spinUntil(Done done) {
+void spinUntil(Done done) {
     const auto until = std::chrono::steady_clock::now() + ThreadPool::kSpin;
-    for (;;) {
+    do {
         for (int i = 0; i < 64; ++i) {
-            if (done()) return true;
+            if (done()) return;
             relax();
         }
-        if (std::chrono::steady_clock::now() >= until) return done();
-    }
+    } while (std::chrono::steady_clock::now() < until);
 }
 
 }  // namespace
@@ -44,8 +43,7 @@ ThreadPool::ThreadPool(int threads) {
 ThreadPool::~ThreadPool() {
     {
         std::lock_guard<std::mutex> lock(m_mutex);
-        m_stop = true;
-        m_stopping.store(true, std::memory_order_release);
+        m_stop.store(true, std::memory_order_release);
     }
     m_start.notify_all();
     for (std::thread& t : m_threads) t.join();
@@ -77,13 +75,15 @@ void ThreadPool::workerLoop(int index) {
     for (;;) {
         const std::function<void(int)>* job = nullptr;
         spinUntil([&] {
-            return m_stopping.load(std::memory_order_acquire) ||
+            return m_stop.load(std::memory_order_acquire) ||
                    m_generation.load(std::memory_order_acquire) != seen;
         });
         {
             std::unique_lock<std::mutex> lock(m_mutex);
-            m_start.wait(lock, [&] { return m_stop || m_generation.load(std::memory_order_relaxed) != seen; });
-            if (m_stop) return;
+            m_start.wait(lock, [&] {
+                return m_stop.load(std::memory_order_relaxed) || m_generation.load(std::memory_order_relaxed) != seen;
+            });
+            if (m_stop.load(std::memory_order_relaxed)) return;
             seen = m_generation.load(std::memory_order_relaxed);
             if (index >= m_jobWorkers) continue;
             job = m_job;

@@ -45,8 +45,7 @@ private:
     // Written under m_mutex; read without it only by the polls (which then take the mutex).
     std::atomic<uint64_t> m_generation{0};
     std::atomic<int> m_pending{0};
-    bool m_stop = false;
-    std::atomic<bool> m_stopping{false};
+    std::atomic<bool> m_stop{false};
 };
 
 }  // namespace emu
