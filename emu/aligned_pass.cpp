@@ -139,19 +139,28 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
             set |= uint32_t(std::clamp<int32_t>(window.grid[size_t(c)], 0, 255)) << shift;
         }
     const uint8_t* src = row.row0 + o;
-    if (!additive) {
+    if (!additive && keep == ~0u && set == 0) {
         std::memcpy(dst, src, size_t(n) * 4);
-        if (keep != ~0u || set != 0)
-            for (int i = 0; i < n; ++i) {
-                uint32_t w = load32(dst + 4 * i);
-                w = (w & keep) | set;
-                std::memcpy(dst + 4 * i, &w, 4);
-            }
         return true;
     }
     int i = 0;
 #if defined(__SSE2__)
     const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
+    // (One pass: the masked words are never read back from a copy just made, which the store
+    // buffer cannot forward from a string move.)
+    if (!additive)
+        for (; i + 4 <= n; i += 4)
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i),
+                             _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv));
+#endif
+    if (!additive) {
+        for (; i < n; ++i) {
+            const uint32_t w = (load32(src + 4 * i) & keep) | set;
+            std::memcpy(dst + 4 * i, &w, 4);
+        }
+        return true;
+    }
+#if defined(__SSE2__)
     for (; i + 4 <= n; i += 4) {
         const __m128i w =
             _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);

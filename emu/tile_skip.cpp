@@ -127,6 +127,17 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
         st.texture->keepTexelTiles(tiles);
         st.tiles = std::move(tiles);
     }
+    // The whole texture's lookup ranges (TileSkipper::widenedCopy): every texel, and the border
+    // colour wherever an axis may reach it.
+    sk->m_widens = eval->colorsRead() == 0;
+    for (int s = 0; s < 8 && sk->m_widens; ++s) {
+        Stage& st = sk->m_stages[size_t(s)];
+        if (!st.read || !st.texture) continue;
+        const bool border = st.sampler.addressU == ps11::TextureAddress::Border ||
+                            st.sampler.addressV == ps11::TextureAddress::Border;
+        sk->m_widens = st.tiles->width > 0 && st.tiles->height > 0 &&
+                       sk->lookupRanges(st, st.tiles->whole(), border, st.whole);
+    }
     const uint8_t v = eval->colorsRead();
     for (int k = 0; k < 2; ++k)
         if ((v >> k) & 1)
@@ -151,6 +162,32 @@ bool sameRange(const ps11::ValueRange& a, const ps11::ValueRange& b) {
 }
 
 }  // namespace
+
+bool TileSkipper::lookupRanges(const Stage& st, ps11::TexelRange r, bool border, ps11::ValueRange4& out) const {
+    if (border) {
+        // fx samplers take the border colour to the grid: within one step of it.
+        const float e = m_fx ? float(1.0 / m_grid) : 0.0f;
+        ps11::TexelRange b;
+        for (int c = 0; c < 4; ++c) {
+            const float x = st.sampler.border[size_t(c)];
+            if (std::isnan(x)) b.nan |= uint8_t(1u << c);
+            if (x == 0 && std::signbit(x)) b.negZero |= uint8_t(1u << c);
+            b.lo[size_t(c)] = m_fx ? std::max(0.0f, x - e) : x;
+            b.hi[size_t(c)] = x + e;
+        }
+        r.add(b);
+    }
+    for (int c = 0; c < 4; ++c) {
+        const bool nan = (r.nan >> c) & 1;
+        if (r.lo[size_t(c)] > r.hi[size_t(c)]) {  // no value but NaN, or nothing known
+            if (!nan) return false;
+            out[size_t(c)] = ps11::ValueRange::any();
+            continue;
+        }
+        out[size_t(c)] = lookupRange(r.lo[size_t(c)], r.hi[size_t(c)], nan, (r.negZero >> c) & 1, m_fx);
+    }
+    return true;
+}
 
 TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1,
                                  TileMemo& memo) const {
@@ -195,28 +232,7 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
         addressAxis(st.sampler.addressV, j0, j1, H, b0, b1, border);
         ps11::TexelRange r;
         if (a0 <= a1 && b0 <= b1) r = tiles.over(uint32_t(a0), uint32_t(b0), uint32_t(a1), uint32_t(b1));
-        if (border) {
-            // fx samplers take the border colour to the grid: within one step of it.
-            const float e = m_fx ? float(1.0 / m_grid) : 0.0f;
-            ps11::TexelRange b;
-            for (int c = 0; c < 4; ++c) {
-                const float x = st.sampler.border[size_t(c)];
-                if (std::isnan(x)) b.nan |= uint8_t(1u << c);
-                if (x == 0 && std::signbit(x)) b.negZero |= uint8_t(1u << c);
-                b.lo[size_t(c)] = m_fx ? std::max(0.0f, x - e) : x;
-                b.hi[size_t(c)] = x + e;
-            }
-            r.add(b);
-        }
-        for (int c = 0; c < 4; ++c) {
-            const bool nan = (r.nan >> c) & 1;
-            if (r.lo[size_t(c)] > r.hi[size_t(c)]) {  // no value but NaN, or nothing known
-                if (!nan) return shade;
-                out[size_t(c)] = ps11::ValueRange::any();
-                continue;
-            }
-            out[size_t(c)] = lookupRange(r.lo[size_t(c)], r.hi[size_t(c)], nan, (r.negZero >> c) & 1, m_fx);
-        }
+        if (!lookupRanges(st, r, border, out)) return shade;
     }
     // Colours: constant on a triangle, or affine (extremes at the tile's corners, widened for
     // the float rounding of the interpolation).
@@ -258,10 +274,65 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
     for (int k = 0; k < 2 && same; ++k)
         for (int c = 0; c < 4 && same; ++c) same = sameRange(in.color[size_t(k)][size_t(c)], memo.last.color[size_t(k)][size_t(c)]);
     if (same) return memo.decision;
+    if (m_widens) {
+        const std::optional<TileDecision> copy = widenedCopy(in, memo);
+        if (copy) return *copy;
+    }
     memo.decision = evaluate(in);
     memo.last = in;
     memo.valid = true;
     return memo.decision;
+}
+
+std::optional<TileDecision> TileSkipper::widenedCopy(const ps11::IntervalInputs& in, TileMemo& memo) const {
+    // The tile's inputs with every stage whose range is not one value widened to the whole
+    // texture's: a claim over the wider ranges holds over the tile's (the evaluator's claims hold
+    // for every input inside its ranges), and tiles that differ only in the widened stages share
+    // one evaluation (a composite's scene tiles over a zero glare).
+    ps11::IntervalInputs& wide = memo.wide;
+    uint8_t widened = 0;
+    for (int s = 0; s < 8; ++s) {
+        const Stage& st = m_stages[size_t(s)];
+        if (!st.read) continue;
+        const ps11::ValueRange4& v = in.stages[size_t(s)].value;
+        bool point = true;
+        for (const ps11::ValueRange& c : v) point = point && !c.nan && c.lo == c.hi;
+        wide.stages[size_t(s)].value = point || !st.texture ? v : st.whole;
+        if (!point && st.texture) widened |= uint8_t(1u << s);
+    }
+    if (!widened) return std::nullopt;  // the tile's own evaluation is the same
+    TileMemo::Widened* hit = nullptr;
+    for (TileMemo::Widened& w : memo.widened) {
+        if (!w.valid || w.stages != widened) continue;
+        bool same = true;
+        for (int s = 0; s < 8 && same; ++s)
+            if (m_stages[size_t(s)].read)
+                for (int c = 0; c < 4 && same; ++c)
+                    same = sameRange(wide.stages[size_t(s)].value[size_t(c)], w.in.stages[size_t(s)].value[size_t(c)]);
+        if (same) hit = &w;
+    }
+    if (!hit) {
+        hit = &memo.widened[memo.nextWidened];
+        memo.nextWidened = (memo.nextWidened + 1) % memo.widened.size();
+        hit->valid = true;
+        hit->stages = widened;
+        hit->in = wide;
+        hit->decision = evaluate(wide);
+    }
+    const TileDecision& d = hit->decision;
+    if (d.action != TileAction::Copy) return std::nullopt;  // the tile's own ranges may say more
+    // Taken only where a copied channel varies in the tile: there the tile's own evaluation can
+    // claim no constant (the channel is a copy of a lookup that takes two values), so it would
+    // not have filled or skipped the tile.
+    int stage = -1;
+    for (int s = 0; s < 8; ++s)
+        if (m_stages[size_t(s)].read && m_stages[size_t(s)].tap == d.copyTap) stage = s;
+    if (stage < 0) return std::nullopt;
+    for (int c = 0; c < 4; ++c) {
+        const ps11::ValueRange& v = in.stages[size_t(stage)].value[size_t(c)];
+        if ((d.copyMask >> c) & 1 && !v.nan && v.lo < v.hi) return d;
+    }
+    return std::nullopt;
 }
 
 TileDecision TileSkipper::evaluate(const ps11::IntervalInputs& in) const {

@@ -55,6 +55,16 @@ struct TileMemo {
     bool valid = false;
     ps11::IntervalInputs in, last;
     TileDecision decision;
+    // The last evaluations over widened inputs (TileSkipper::widenedCopy), taken round robin.
+    struct Widened {
+        bool valid = false;
+        uint8_t stages = 0;  // bit per stage widened to the whole texture's range
+        ps11::IntervalInputs in;
+        TileDecision decision;
+    };
+    std::array<Widened, 4> widened{};
+    size_t nextWidened = 0;
+    ps11::IntervalInputs wide;  // scratch
 };
 
 class TileSkipper {
@@ -72,7 +82,14 @@ public:
                         TileMemo& memo) const;
 
 private:
+    struct Stage;
     TileDecision evaluate(const ps11::IntervalInputs& in) const;
+    // A copy decided over the tile's inputs with the varying stages widened to their whole
+    // texture's range, where that holds and is what the tile's own evaluation would give.
+    std::optional<TileDecision> widenedCopy(const ps11::IntervalInputs& in, TileMemo& memo) const;
+    // A stage's lookup ranges from its texels' range (and the border colour): false when nothing
+    // is known of a channel.
+    bool lookupRanges(const Stage& st, ps11::TexelRange r, bool border, ps11::ValueRange4& out) const;
     struct Stage {
         bool read = false;
         std::shared_ptr<const ps11::Texture> texture;  // null: unbound, (0, 0, 0, 1)
@@ -80,6 +97,7 @@ private:
         ps11::SamplerState sampler;
         int coordSet = 0;
         int tap = -1;  // the plan's tap of this stage (−1 when none or several)
+        ps11::ValueRange4 whole{};  // the lookups' range over the whole texture (m_widens)
     };
     uint64_t m_id = 0;  // unique per TileSkipper (memos of an earlier draw never match)
     std::optional<ps11::IntervalEvaluator> m_eval;
@@ -89,6 +107,7 @@ private:
     double m_grid = 255;          // fx: the grid scale G
     bool m_zeroAddIsNoOp = false;  // the merge of a zero r0 leaves every target byte as it is
     bool m_writesNothing = false;
+    bool m_widens = false;  // widenedCopy applies: no colour inputs, every texture's range known
 };
 
 }  // namespace emu
