@@ -20,7 +20,10 @@ inline void relax() {
 #endif
 }
 
-// Polls `done` until it holds or ThreadPool::kSpin has passed (the caller then waits under the mutex).
+// Polls `done` until it holds or ThreadPool::kSpin has passed (the caller then waits under the
+// mutex). Every 64 polls it yields the core: where more threads are runnable than there are cores
+// (another device's workers, the GL renderer's), the thread polled for would otherwise wait behind
+// the poll.
 template <typename Done>
 void spinUntil(Done done) {
     const auto until = std::chrono::steady_clock::now() + ThreadPool::kSpin;
@@ -29,6 +32,7 @@ void spinUntil(Done done) {
             if (done()) return;
             relax();
         }
+        std::this_thread::yield();
     } while (std::chrono::steady_clock::now() < until);
 }
 
