@@ -219,6 +219,19 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
     return c;
 }
 
+// The half-pixel quad over the whole target, every set's coordinates 0..1 (a 1:1 pass when the
+// textures have the target's size).
+void fullTargetQuad(Case& c) {
+    c.verts.clear();
+    const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
+        for (int s = 0; s < 4; ++s) q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+        c.verts.push_back(q);
+    }
+}
+
 std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     Handle rt{};
     REQUIRE(dev.CreateRenderTarget(c.w, c.h, c.rtFormat, 1, &rt) == D3D_OK);
@@ -935,15 +948,7 @@ TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain a
         c.program = programs[size_t(i) % std::size(programs)];
         for (int k = 0; k < 4; ++k) c.consts[0][k] = k < 3 ? 1.0f : 0.0f;
         c.consts[1][3] = float(uni(0, 4)) * 0.25f;
-        c.verts.clear();
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
-            for (int s = 0; s < 4; ++s)
-                q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
-            c.verts.push_back(q);
-        }
+        fullTargetQuad(c);
         c.blend = DWORD(i % 2);  // plain, ONE/ONE
         c.alphaTest = false, c.writeMask = 0xf, c.scissor = uni(0, 5) == 0;
         DeviceOptions quadOpt, rowOpt;
@@ -997,15 +1002,7 @@ TEST_CASE("tile skipping: tiles over different constants of one texture are deci
                     }
         }
         c.program = i & 2 ? "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n" : "ps_1_1\ntex t0\ntex t1\nadd r0, t1, t0\n";
-        c.verts.clear();
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
-            for (int s = 0; s < 4; ++s)
-                q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
-            c.verts.push_back(q);
-        }
+        fullTargetQuad(c);
         c.blend = DWORD(i >> 2);  // plain, ONE/ONE
         c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
         DeviceOptions rowOpt;
