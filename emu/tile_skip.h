@@ -85,7 +85,8 @@ private:
     struct Stage;
     TileDecision evaluate(const ps11::IntervalInputs& in) const;
     // A copy decided over the tile's inputs with the varying stages widened to their whole
-    // texture's range, where that holds and is what the tile's own evaluation would give.
+    // texture's range, where a copied channel varies in the tile (so the tile's own evaluation
+    // could not have filled or skipped it).
     std::optional<TileDecision> widenedCopy(const ps11::IntervalInputs& in, TileMemo& memo) const;
     // A stage's lookup ranges from its texels' range (and the border colour): false when nothing
     // is known of a channel.
