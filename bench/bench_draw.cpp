@@ -38,10 +38,12 @@ struct QuadVertex {
 // texture magnified 2x and scaled by c0, added ONE/ONE (the sprites technique's draw).
 // Tiny: the blur on a 1×1 target from a 1×1 texture (a glare technique's adaptation step): what a
 // draw costs besides its pixels.
+// Weighted4: the glow's blur passes (glare/shaders/weighted4.psh) at 480×270 — four POINT taps at
+// whole-texel horizontal offsets −2…+1 with weights c0..c3, added ONE/ONE onto the target.
 // Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite };
-constexpr int kPasses = 10;
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4 };
+constexpr int kPasses = 11;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -55,7 +57,7 @@ struct Scene {
     Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         if (pass == Pass::Down2) w = kW / 2, h = kH / 2;
-        if (pass == Pass::Down4) w = kW / 4, h = kH / 4;
+        if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down4;
@@ -86,11 +88,13 @@ struct Scene {
             }
             dev->UnlockRect(glare, 0);
         }
-        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small || pass == Pass::Tiny;
+        const bool weighted = pass == Pass::Weighted4;
+        const bool fourTaps =
+            pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small || pass == Pass::Tiny || weighted;
         const int stages = fourTaps ? 4 : pass == Pass::Composite ? 2 : 1;
         for (int s = 0; s < stages; ++s) {
             const DWORD filter =
-                pass == Pass::CopyPoint || (pass == Pass::Composite && s == 0) ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+                pass == Pass::CopyPoint || weighted || (pass == Pass::Composite && s == 0) ? D3DTEXF_POINT : D3DTEXF_LINEAR;
             dev->SetTexture(DWORD(s), pass == Pass::Composite && s == 1 ? glare : tex);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MINFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
@@ -99,18 +103,35 @@ struct Scene {
         }
         const char* const kSprite = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
         const char* const kScreen = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n";
-        if (dev->CreatePixelShaderFromText(
-                fourTaps ? kBlur4 : pass == Pass::Sprites ? kSprite : pass == Pass::Composite ? kScreen : kCopy, &ps) !=
-            D3D_OK)
+        const char* const kWeighted4 =
+            "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
+            "mad r0, t3, c3, r0\n";
+        if (dev->CreatePixelShaderFromText(weighted   ? kWeighted4
+                                           : fourTaps ? kBlur4
+                                           : pass == Pass::Sprites   ? kSprite
+                                           : pass == Pass::Composite ? kScreen
+                                                                     : kCopy,
+                                           &ps) != D3D_OK)
             return;
         dev->SetPixelShader(ps);
         const float c0[4] = {0.25f, 0.25f, 0.25f, 0.25f};
         dev->SetPixelShaderConstantF(0, c0, 1);
+        if (weighted) {
+            const float cs[4][4] = {{0.12f, 0.12f, 0.12f, 0.12f},
+                                    {0.2f, 0.2f, 0.2f, 0.2f},
+                                    {0.2f, 0.2f, 0.2f, 0.2f},
+                                    {0.12f, 0.12f, 0.12f, 0.12f}};
+            dev->SetPixelShaderConstantF(0, cs[0], 4);
+            dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
+            dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
+            dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
+        }
         dev->SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4);
         // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
         // averages a 2×2 block), the copy at the texel centres; Down4's taps at ±1 texel.
         const float k = pass == Pass::Down4 ? 1.0f : 0.5f;
         const float off[4][2] = {{-k, -k}, {k, -k}, {-k, k}, {k, k}};
+        const float wOff[4][2] = {{-2, 0}, {-1, 0}, {0, 0}, {1, 0}};
         const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
         if (pass == Pass::Sprites) {
@@ -133,8 +154,9 @@ struct Scene {
         for (int c : {0, 1, 2, 0, 2, 3}) {
             QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
             for (int s = 0; s < 4; ++s) {
-                q.uv[s][0] = us[c] + (fourTaps ? off[s][0] / float(tw) : 0.0f);
-                q.uv[s][1] = vs[c] + (fourTaps ? off[s][1] / float(th) : 0.0f);
+                const float(*o)[2] = weighted ? wOff : off;
+                q.uv[s][0] = us[c] + (fourTaps ? o[s][0] / float(tw) : 0.0f);
+                q.uv[s][1] = vs[c] + (fourTaps ? o[s][1] / float(th) : 0.0f);
             }
             quad.push_back(q);
         }
@@ -279,6 +301,17 @@ BENCHMARK_CAPTURE(BM_Draw, blur4_240x135_fx8, Pass::Blur4Small)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
+
+BENCHMARK_CAPTURE(BM_Draw, weighted4_480x270_fx8, Pass::Weighted4)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, weighted4_480x270_fx8, Pass::Weighted4)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
 
 BENCHMARK_CAPTURE(BM_Draw, composite_screen_1080p_x8_fx8, Pass::Composite)
     ->Arg(1)

@@ -428,11 +428,16 @@ void columnStretches(FloatRowTriangle::Columns& cols, int n) {
 
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
                              const std::pair<int, int>* columns) {
-    if (!screenAligned(draw.plan, s)) return false;
-    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    if (!rowPathColumns(draw.plan, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
+    fillFloatRowTables(draw, s, out);
+    return true;
+}
+
+void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     const int n = out.x1 - out.x0;
-    std::vector<float> u(static_cast<size_t>(n));
+    thread_local std::vector<float> u;
+    u.resize(static_cast<size_t>(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {
         const FloatRowTap& tap = draw.taps[size_t(i)];
         FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
@@ -445,7 +450,6 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
                             cols.i1.data(), cols.f.data());
         columnStretches(cols, n);
     }
-    return true;
 }
 
 void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count) {

@@ -98,6 +98,8 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
 // `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
                              const std::pair<int, int>* columns = nullptr);
+// Its second half: the tables over out.x0 .. out.x1 (as fillAlignedTables).
+void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out);
 
 // Per-worker buffers, allocated once and kept by the worker.
 struct FloatRowScratch {

@@ -497,9 +497,14 @@ bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {
 
 void columnU(const TriangleSetup& s, int set, int x0, int n, float* u) {
     const int k = attrTex(set, 0);
-    for (int x = 0; x < n; ++x)
-        u[x] = (s.constMask >> k) & 1 ? s.constValue[size_t(k)]
-                                      : planeValue(s.attr[size_t(k)], s.ox, s.oy, x0 + x, s.yMin);
+    if ((s.constMask >> k) & 1) {
+        std::fill_n(u, n, s.constValue[size_t(k)]);
+        return;
+    }
+    // planeValue's sum with its row base taken once (u does not depend on the row).
+    const Plane& p = s.attr[size_t(k)];
+    const float base = float(planeRowBase(p, s.ox, s.oy, s.yMin)), fdx = float(p.dx);
+    for (int x = 0; x < n; ++x) u[x] = base + fdx * float(x0 + x);
 }
 
 float rowV(const TriangleSetup& s, int set, int y) {
@@ -520,6 +525,11 @@ bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
     return true;
 }
 
+bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1) {
+    // (covering nothing: the quad path finds that too)
+    return screenAligned(plan, s) && tableColumns(s, x0, x1);
+}
+
 bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair<int, int>& out) {
     const int width = clip.x1 - clip.x0;
     const bool narrow = a1 - a0 < width && b1 - b0 < width;
@@ -531,12 +541,17 @@ bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns) {
     // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
-    if (!screenAligned(draw.plan, s)) return false;
-    if (!tableColumns(s, out.x0, out.x1)) return false;  // covers nothing: the quad path finds that too
+    if (!rowPathColumns(draw.plan, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
+    fillAlignedTables(draw, s, out);
+    return true;
+}
+
+void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     out.configs.clear();
     const int n = out.x1 - out.x0;
-    std::vector<float> u(size_t(std::max(n, 0)));
+    thread_local std::vector<float> u;
+    u.resize(size_t(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {
         const AlignedTap& tap = draw.taps[size_t(i)];
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
@@ -666,7 +681,6 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
         for (AlignedTriangle::Run& r : cols.runs) r.j0 -= out.configs[size_t(cols.configs[size_t(r.config)])].jlo;
     }
-    return true;
 }
 
 RowWindows rowWindows(const RowWindow* windows, size_t count) {

@@ -114,11 +114,17 @@ struct AlignedTriangle {
 // `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns = nullptr);
+// The second half of prepareAlignedTriangle: fills the tables of a qualifying triangle over
+// out.x0 .. out.x1 (rowPathColumns' or pairColumns'). Triangles' tables are independent, so
+// the renderer fills those of a chunk on its workers.
+void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out);
 
 // The columns [x0, x1) a row path's tables of the triangle span: the clip rect's, or for a
 // triangle covering less than half of them (a sprite) its own. Triangles of one full-screen quad
 // thus have equal tables and share their H rows. False when it covers no pixel.
 bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
+// Both row paths' per-triangle condition: screenAligned and tableColumns.
+bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1);
 
 // The columns two consecutive triangles' tables should share (their union), when both have
 // narrow tables that overlap: the two halves of a sprite's quad cover column ranges a pixel apart

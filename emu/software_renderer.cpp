@@ -194,37 +194,45 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // Tables for the chunk's triangles, in order, while their columns fit the budget (the same
         // for both row paths: a float table holds 12 bytes a column per tap, an fx8 one 16), a
         // quad's two halves over the same columns so they share tables and H rows (pairColumns).
-        auto prepareTables = [&](auto& rowTris, auto prepare) {
-            rowTris.resize(setups.size());
+        // Which triangles and columns is decided here; the tables are filled on the workers
+        // (independent per triangle: a full-screen quad's two halves fill at once).
+        auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto fill) {
+            if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
             bool paired = false;  // the triangle before was paired with the one before it
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 auto& t = rowTris[i];
-                isAligned[i] = prepare(setups[i], t, nullptr);
+                isAligned[i] = rowPathColumns(plan, setups[i], t.x0, t.x1);
                 std::pair<int, int> both;
                 const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
                                   pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
-                auto& p = rowTris[i - (pair ? 1 : 0)];
-                if (pair && (p.x0 != both.first || p.x1 != both.second || t.x0 != both.first || t.x1 != both.second)) {
+                if (pair) {
+                    auto& p = rowTris[i - 1];
                     columns -= p.x1 - p.x0;
-                    isAligned[i - 1] = prepare(setups[i - 1], p, &both);
-                    isAligned[i] = isAligned[i - 1] && prepare(setups[i], t, &both);
-                    if (isAligned[i - 1]) columns += p.x1 - p.x0;
+                    p.x0 = t.x0 = both.first;
+                    p.x1 = t.x1 = both.second;
+                    columns += p.x1 - p.x0;
                 }
                 paired = pair;
                 if (isAligned[i]) columns += t.x1 - t.x0;
                 if (columns > budget) isAligned[i] = 0;
             }
+            // About a microsecond per 64 columns of one tap: the workers share from 1024.
+            const int64_t work = columns * std::max(taps, 1);
+            const int workers = int(std::clamp<int64_t>(work / 1024, 1, dc.pool.size()));
+            std::atomic<size_t> nextTri{0};
+            dc.pool.run(workers, [&](int) {
+                for (size_t i; (i = nextTri.fetch_add(1, std::memory_order_relaxed)) < setups.size();)
+                    if (isAligned[i]) fill(setups[i], rowTris[i]);
+            });
         };
         if (alignedDraw)
-            prepareTables(alignedTris, [&](const TriangleSetup& s, AlignedTriangle& t, const std::pair<int, int>* c) {
-                return prepareAlignedTriangle(aligned, s, t, c);
-            });
+            prepareTables(alignedTris, aligned.plan, aligned.plan.count,
+                          [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
         if (floatDraw) {
-            prepareTables(floatTris, [&](const TriangleSetup& s, FloatRowTriangle& t, const std::pair<int, int>* c) {
-                return prepareFloatRowTriangle(floatRows, s, t, c);
-            });
+            prepareTables(floatTris, floatRows.plan, floatRows.plan.count,
+                          [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
         }
         if (setups.empty()) continue;
