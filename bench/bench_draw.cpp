@@ -40,10 +40,12 @@ struct QuadVertex {
 // draw costs besides its pixels.
 // Weighted4: the glow's blur passes (glare/shaders/weighted4.psh) at 480×270 — four POINT taps at
 // whole-texel horizontal offsets −2…+1 with weights c0..c3, added ONE/ONE onto the target.
+// CompositeAdd: the last pass of glow, quarter, pyramid and sprites (glare/shaders/scale.psh) —
+// a 480×270 glare magnified 4× (bilinear) × c0, added ONE/ONE onto the 1080p target.
 // Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4 };
-constexpr int kPasses = 11;
+enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4, CompositeAdd };
+constexpr int kPasses = 12;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -61,7 +63,9 @@ struct Scene {
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down4;
-        const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : w, th = down ? kH : pass == Pass::Sprites ? 32 : h;
+        const bool addGlare = pass == Pass::CompositeAdd;
+        const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : addGlare ? w / 4 : w;
+        const UINT th = down ? kH : pass == Pass::Sprites ? 32 : addGlare ? h / 4 : h;
         DeviceOptions o;
         o.software.threads = threads;
         o.software.alignedPasses = aligned;
@@ -106,7 +110,9 @@ struct Scene {
         const char* const kWeighted4 =
             "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
             "mad r0, t3, c3, r0\n";
+        const char* const kScale = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
         if (dev->CreatePixelShaderFromText(weighted   ? kWeighted4
+                                           : addGlare ? kScale
                                            : fourTaps ? kBlur4
                                            : pass == Pass::Sprites   ? kSprite
                                            : pass == Pass::Composite ? kScreen
@@ -122,6 +128,12 @@ struct Scene {
                                     {0.2f, 0.2f, 0.2f, 0.2f},
                                     {0.12f, 0.12f, 0.12f, 0.12f}};
             dev->SetPixelShaderConstantF(0, cs[0], 4);
+        }
+        if (addGlare) {
+            const float strength[4] = {0.8f, 0.8f, 0.8f, 0.8f};
+            dev->SetPixelShaderConstantF(0, strength, 1);
+        }
+        if (weighted || addGlare) {
             dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
             dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
             dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
@@ -313,6 +325,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, weighted4_480x270_fx8, Pass::Weighted4)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 
+BENCHMARK_CAPTURE(BM_Draw, composite_add_1080p_x4_fx8, Pass::CompositeAdd)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, composite_screen_1080p_x8_fx8, Pass::Composite)
     ->Arg(1)
     ->Arg(2)

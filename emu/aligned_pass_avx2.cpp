@@ -204,18 +204,17 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
 
 // General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768), m = t − 32768·256;
 // kind S is widened to h = 128·s first (Up = 7). round_half_even(t / 65536) is then
-// (m + 32768·256 + 0x7fff + odd) >> 16 with odd = bit 16 of t, which is bit 16 of m (32768·256 is a
-// multiple of 2^17): one constant add instead of two.
+// m·2⁻¹⁶ + 128 in one FMA, converted with the default rounding (to nearest, ties to even):
+// |m| < 2²³ converts exactly, and the sum, at most 256 with 16 fraction bits, is exact too
+// (checked for every t in [0, 65280·256] when this was written; the row-path tests compare
+// every result with the quad path's integer rounding).
 template <int Up>
 void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
                      int16_t* const out[4]) {
     const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
-    const __m256i flip = _mm256_set1_epi16(int16_t(0x8000)), bias = _mm256_set1_epi32(32768 * 256 + 0x7fff);
-    const __m256i one = _mm256_set1_epi32(1);
-    auto round = [&](__m256i m) {
-        const __m256i odd = _mm256_and_si256(_mm256_srli_epi32(m, 16), one);
-        return _mm256_srli_epi32(_mm256_add_epi32(_mm256_add_epi32(m, bias), odd), 16);
-    };
+    const __m256i flip = _mm256_set1_epi16(int16_t(0x8000));
+    const __m256 scale = _mm256_set1_ps(1.0f / 65536.0f), c128 = _mm256_set1_ps(128.0f);
+    auto round = [&](__m256i m) { return _mm256_cvtps_epi32(_mm256_fmadd_ps(_mm256_cvtepi32_ps(m), scale, c128)); };
     verticalGroups(count, lane, out, [&](int c, int k) {
         const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), Up), flip);
         const __m256i s1 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h1[c] + k), Up), flip);
