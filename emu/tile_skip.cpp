@@ -129,14 +129,17 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
     }
     // The whole texture's lookup ranges (TileSkipper::widenedCopy): every texel, and the border
     // colour wherever an axis may reach it.
+    // (Stages reading one texture, as a blur's taps do, take its whole range once.)
     sk->m_widens = eval->colorsRead() == 0;
+    const ps11::TexelTiles* wholeOf = nullptr;
+    ps11::TexelRange whole;
     for (int s = 0; s < 8 && sk->m_widens; ++s) {
         Stage& st = sk->m_stages[size_t(s)];
         if (!st.read || !st.texture) continue;
         const bool border = st.sampler.addressU == ps11::TextureAddress::Border ||
                             st.sampler.addressV == ps11::TextureAddress::Border;
-        sk->m_widens = st.tiles->width > 0 && st.tiles->height > 0 &&
-                       sk->lookupRanges(st, st.tiles->whole(), border, st.whole);
+        if (st.tiles.get() != wholeOf) wholeOf = st.tiles.get(), whole = st.tiles->whole();
+        sk->m_widens = st.tiles->width > 0 && st.tiles->height > 0 && sk->lookupRanges(st, whole, border, st.whole);
     }
     const uint8_t v = eval->colorsRead();
     for (int k = 0; k < 2; ++k)

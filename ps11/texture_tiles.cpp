@@ -29,17 +29,31 @@ TexelRange TexelTiles::over(uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) 
     if (tilesX == 0 || tilesY == 0) return r;
     const uint32_t tx0 = x0 / side, tx1 = std::min(x1 / side, tilesX - 1);
     const uint32_t ty0 = y0 / side, ty1 = std::min(y1 / side, tilesY - 1);
+    // Two accumulators (even and odd tiles of a row), folded at the end: minima and maxima are
+    // order-free but for which of +0.0 and −0.0 stays, which `negZero` records on its own.
     __m128 lo = _mm_loadu_ps(r.lo.data()), hi = _mm_loadu_ps(r.hi.data());
+    __m128 lo2 = lo, hi2 = hi;
     uint8_t nan = 0, negZero = 0;
     for (uint32_t ty = ty0; ty <= ty1 && tx0 <= tx1; ++ty) {
         const TexelRange* t = &tiles[size_t(ty) * tilesX + tx0];
-        for (uint32_t tx = tx0; tx <= tx1; ++tx, ++t) {
+        uint32_t tx = tx0;
+        for (; tx + 1 <= tx1; tx += 2, t += 2) {
+            lo = _mm_min_ps(_mm_loadu_ps(t[0].lo.data()), lo);
+            hi = _mm_max_ps(_mm_loadu_ps(t[0].hi.data()), hi);
+            lo2 = _mm_min_ps(_mm_loadu_ps(t[1].lo.data()), lo2);
+            hi2 = _mm_max_ps(_mm_loadu_ps(t[1].hi.data()), hi2);
+            nan = uint8_t(nan | t[0].nan | t[1].nan);
+            negZero = uint8_t(negZero | t[0].negZero | t[1].negZero);
+        }
+        if (tx <= tx1) {
             lo = _mm_min_ps(_mm_loadu_ps(t->lo.data()), lo);
             hi = _mm_max_ps(_mm_loadu_ps(t->hi.data()), hi);
             nan = uint8_t(nan | t->nan);
             negZero = uint8_t(negZero | t->negZero);
         }
     }
+    lo = _mm_min_ps(lo2, lo);
+    hi = _mm_max_ps(hi2, hi);
     _mm_storeu_ps(r.lo.data(), lo);
     _mm_storeu_ps(r.hi.data(), hi);
     r.nan = nan, r.negZero = negZero;
@@ -99,16 +113,33 @@ inline uint32_t fold4(__m128i v, bool max) {
     return uint32_t(_mm_cvtsi128_si32(v));
 }
 
-void scanUnorm8Tile(const Texture& tex, uint32_t w, uint32_t x0, uint32_t x1, uint32_t y0, uint32_t y1,
-                    TexelRange& r) {
-    __m128i mn = _mm_set1_epi8(char(0xff)), mx = _mm_setzero_si128();
-    for (uint32_t y = y0; y < y1; ++y) unorm8Row(tex.unorm8() + size_t(y) * w * 4, x0, x1, mn, mx);
-    const uint32_t lo = fold4(mn, false), hi = fold4(mx, true);
+// One band of Unorm8 tiles (tile row `ty`): every texel row of the band once, folded into the
+// tiles' accumulators side by side (a small texture's tiles are 4 texels wide: one vector per
+// tile and row, so the rows' loop, not a call per tile and row, is what runs).
+// Tiles [t0, t1) of the band, at most kTexelTilesPerSide of them.
+void scanUnorm8Band(const Texture& tex, TexelTiles& out, uint32_t ty, uint32_t t0, uint32_t t1) {
+    const uint32_t w = out.width, y0 = ty * out.side, y1 = std::min(out.height, y0 + out.side);
+    __m128i mn[kTexelTilesPerSide], mx[kTexelTilesPerSide];
+    const uint32_t n = t1 - t0;
+    for (uint32_t k = 0; k < n; ++k) mn[k] = _mm_set1_epi8(char(0xff)), mx[k] = _mm_setzero_si128();
+    const uint8_t* texels = tex.unorm8();
+    for (uint32_t y = y0; y < y1; ++y) {
+        const uint8_t* row = texels + size_t(y) * w * 4;
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t x0 = (t0 + k) * out.side, x1 = std::min(w, x0 + out.side);
+            unorm8Row(row, x0, x1, mn[k], mx[k]);
+        }
+    }
     const float* v = Texture::unorm8Values();
-    for (int c = 0; c < 4; ++c) {
-        const int shift = 8 * kUnorm8Byte[c];
-        r.lo[size_t(c)] = v[(lo >> shift) & 0xff];
-        r.hi[size_t(c)] = v[(hi >> shift) & 0xff];
+    for (uint32_t k = 0; k < n; ++k) {
+        TexelRange& r = out.tiles[size_t(ty) * out.tilesX + t0 + k];
+        r = TexelRange{};
+        const uint32_t lo = fold4(mn[k], false), hi = fold4(mx[k], true);
+        for (int c = 0; c < 4; ++c) {
+            const int shift = 8 * kUnorm8Byte[c];
+            r.lo[size_t(c)] = v[(lo >> shift) & 0xff];
+            r.hi[size_t(c)] = v[(hi >> shift) & 0xff];
+        }
     }
 }
 
@@ -152,15 +183,17 @@ void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t 
     const uint32_t w = out.width, h = out.height;
     const bool unorm8 = tex.storage() == TexelStorage::Unorm8;
     for (uint32_t ty = ty0; ty < ty1 && ty < out.tilesY; ++ty) {
+        if (unorm8) {
+            for (uint32_t t0 = 0; t0 < out.tilesX; t0 += kTexelTilesPerSide)
+                scanUnorm8Band(tex, out, ty, t0, std::min(out.tilesX, t0 + kTexelTilesPerSide));
+            continue;
+        }
         const uint32_t y0 = ty * out.side, y1 = std::min(h, y0 + out.side);
         for (uint32_t tx = 0; tx < out.tilesX; ++tx) {
             const uint32_t x0 = tx * out.side, x1 = std::min(w, x0 + out.side);
             TexelRange& r = out.tiles[size_t(ty) * out.tilesX + tx];
             r = TexelRange{};
-            if (unorm8)
-                scanUnorm8Tile(tex, w, x0, x1, y0, y1, r);
-            else
-                scanDecodedTile(tex, w, x0, x1, y0, y1, r);
+            scanDecodedTile(tex, w, x0, x1, y0, y1, r);
         }
     }
 }
