@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <unordered_map>
 
 #include "emu/aligned_float.h"
@@ -32,6 +33,11 @@ constexpr uint32_t kChunkTriangles = 1024;
 // never pays, such as a composite over a bright scene, then decides one draw in 32; one that
 // starts to pay is noticed within as many draws).
 constexpr uint32_t kTileRetryDraws = 4, kMaxTileRetryDraws = 32;
+// Where the renderer times its draws (SoftwareRendererOptions::timeTiles): a program that pays
+// is drawn without deciding on every kTileProbeDraws-th draw, so that both of its times stay
+// current; the times are moving averages with this weight for the newest draw.
+constexpr uint32_t kTileProbeDraws = 16;
+constexpr double kTileTimeWeight = 0.5;
 
 // Executor outputs and the merged live mask of one span.
 struct Lanes {
@@ -61,13 +67,16 @@ struct SoftwareDrawContext {
     std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
     // Executors by DrawProgram::key (a program's identity for the device's lifetime).
     std::unordered_map<uint64_t, std::unique_ptr<ps11::Executor>> executors;
-    // By DrawProgram::key: whether deciding tiles paid on the program's last decided draw (a
-    // quarter of its tiles or more filled, copied or skipped), its draws since, and how many
-    // draws it waits before deciding again.
+    // By DrawProgram::key and target size: whether deciding tiles paid on the program's last
+    // decided draw, its draws since, and how many draws it waits before deciding again; where
+    // draws are timed, the wall time per covered pixel of its decided and undecided draws
+    // (moving averages, 0 until measured) and its decided draws since the last undecided one.
     struct TileHistory {
         bool paid = true;
         uint32_t since = 0;
         uint32_t wait = kTileRetryDraws;
+        double tiledNs = 0, plainNs = 0;
+        uint32_t decidedInARow = 0;
     };
     std::unordered_map<uint64_t, TileHistory> tileHistory;
 };
@@ -155,10 +164,11 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle> floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
-    // Deciding costs about a microsecond a tile: a program of which fewer than a quarter of the
-    // tiles saved work last time (filled, skipped, or copied where that saves) is shaded without
-    // deciding, and decided again on its kTileRetryDraws-th draw after
-    // (which tiles are decided never changes a byte, only the time).
+    // Deciding costs 0.5–3 µs a tile, and the first read of a texture scans its facts: a program
+    // whose last decided draw did not pay (timed: took longer per pixel than its undecided
+    // draws; untimed: fewer than a quarter of its tiles saved work — filled, skipped, or copied
+    // where that saves) is shaded without deciding, and decided again on its kTileRetryDraws-th
+    // draw after (which tiles are decided never changes a byte, only the time).
     std::unique_ptr<TileSkipper> skipper;
     // A copied tile saves work where the program reads more than that one tap, where the program
     // is the float executor's, or where its texels went straight to an 8-bit target (no filter, no
@@ -168,11 +178,23 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     const bool copiesSave = tapCount > 1 || floatDraw;
     std::atomic<uint64_t> copiesSaving{0}, copiedDirect{0};
     if (dc.tileHistory.size() > kMaxCachedExecutors) dc.tileHistory.clear();
-    SoftwareDrawContext::TileHistory& history = dc.tileHistory[prog.key];
+    // (One program drawn at several sizes, as a blur pyramid's levels, has a history per size:
+    // a small draw's fixed costs weigh more.)
+    const uint64_t historyKey = prog.key ^ (uint64_t(uint32_t(clip.x1 - clip.x0)) << 40) ^
+                                (uint64_t(uint32_t(clip.y1 - clip.y0)) << 20);
+    SoftwareDrawContext::TileHistory& history = dc.tileHistory[historyKey];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
-    if (m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles &&
-        (history.paid || ++history.since >= history.wait))
-        skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
+    const bool tileable =
+        m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles;
+    bool decide = tileable && (history.paid || ++history.since >= history.wait);
+    // Timed: a program that pays is drawn undecided once after its first decided draw, then on
+    // every kTileProbeDraws-th.
+    if (decide && m_options.timeTiles && history.paid && history.tiledNs > 0 &&
+        (history.plainNs == 0 || history.decidedInARow >= kTileProbeDraws))
+        decide = false;
+    const auto drawStart = std::chrono::steady_clock::now();
+    const uint64_t coveredBefore = stats.pixelsCovered;
+    if (decide) skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t> isAligned;
     std::vector<uint32_t> bandStart, bandFill, bandTris;
@@ -449,6 +471,14 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             stats.tilesSkipped += ws.tilesSkipped;
         }
     }
+    // The draw's time per covered pixel, into the history of how it was drawn.
+    if (m_options.timeTiles && tileable && stats.pixelsCovered > coveredBefore) {
+        const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - drawStart).count();
+        const double nsPerPixel = ns / double(stats.pixelsCovered - coveredBefore);
+        double& avg = skipper ? history.tiledNs : history.plainNs;
+        avg = avg == 0 ? nsPerPixel : (1 - kTileTimeWeight) * avg + kTileTimeWeight * nsPerPixel;
+        history.decidedInARow = skipper ? history.decidedInARow + 1 : 0;
+    }
     if (skipper) {
         const uint64_t shaded = stats.tilesShaded - tilesBefore.tilesShaded;
         const uint64_t copied = stats.tilesCopied - tilesBefore.tilesCopied;
@@ -456,7 +486,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             std::min(copied, copiesSaving.load() + copiedDirect.load() / uint64_t(kBandRows * kSkipTileColumns));
         const uint64_t saved =
             stats.tilesFilled + stats.tilesSkipped - tilesBefore.tilesFilled - tilesBefore.tilesSkipped + copiesSaved;
-        const bool paid = saved * 4 >= shaded + copied + saved - copiesSaved;
+        // Timed: it paid where decided draws took less time per pixel than undecided ones;
+        // until an undecided draw is timed, and untimed: a quarter of the tiles or more saved.
+        const bool paid = m_options.timeTiles && history.plainNs > 0 ? history.tiledNs < history.plainNs
+                                                                     : saved * 4 >= shaded + copied + saved - copiesSaved;
         // The first miss after paying waits kTileRetryDraws; each miss after a miss doubles it.
         history.wait = paid || history.paid ? kTileRetryDraws : std::min(2 * history.wait, kMaxTileRetryDraws);
         history.paid = paid;

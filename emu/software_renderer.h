@@ -19,6 +19,11 @@ struct SoftwareRendererOptions {
     // Tiles of row-path draws whose result the interval evaluator decides are filled, copied or
     // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile shaded.
     bool skipTiles = true;
+    // Whether deciding a program's tiles pays is judged by the wall time per pixel of its
+    // decided draws against its undecided ones (the draws' own times, so it varies from run to
+    // run; never a byte). Off: by the share of tiles saved alone (deterministic: tests that count
+    // decided tiles turn timing off).
+    bool timeTiles = true;
 };
 
 struct SoftwareDrawContext;  // the worker pool and the executor cache (software_renderer.cpp)

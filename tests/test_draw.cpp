@@ -122,12 +122,18 @@ TEST_CASE("draw: mov r0, v0 fills exactly the quad's pixels with the diffuse col
 }
 
 // A 130×40 quad squaring a random texture, drawn again and again: which draws decided tiles.
+// Untimed (SoftwareRendererOptions::timeTiles): the schedule follows the share of tiles saved.
 struct RepeatedDraw {
     static constexpr UINT W = 130, H = 40;
+    static DeviceOptions untimed() {
+        DeviceOptions o;
+        o.software.timeTiles = false;
+        return o;
+    }
     Device dev;
     Handle tex{};
     std::vector<QuadVertex> v = quad(W, H, 0xffffffff);
-    RepeatedDraw() {
+    explicit RepeatedDraw(const DeviceOptions& o = untimed()) : dev(o) {
         (void)target(dev, W, H);
         std::vector<uint32_t> texels;
         tex = randomTexture(dev, W, H, texels, 11);
@@ -168,6 +174,21 @@ TEST_CASE("draw: a program whose tiles start to pay is decided on every draw aga
         std::memset(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), 0, 4 * RepeatedDraw::W);
     REQUIRE(r.dev.UnlockRect(r.tex, 0) == D3D_OK);
     CHECK(r.decided(13, 33) == std::vector<int>{28, 29, 30, 31, 32});
+}
+
+TEST_CASE("draw: timed, a program whose tiles pay is drawn undecided once after its first decided draw",
+          "[draw][skip]") {
+    // Timing needs both times: the first draw decides (every tile of a black texture fills: it
+    // pays by the share of tiles), the second is timed undecided; which draws decide after that
+    // follows the two times.
+    RepeatedDraw r(DeviceOptions{});
+    REQUIRE(r.dev.options().software.timeTiles);
+    D3DLOCKED_RECT lr;
+    REQUIRE(r.dev.LockRect(r.tex, 0, &lr, nullptr, 0) == D3D_OK);
+    for (UINT y = 0; y < RepeatedDraw::H; ++y)
+        std::memset(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), 0, 4 * RepeatedDraw::W);
+    REQUIRE(r.dev.UnlockRect(r.tex, 0) == D3D_OK);
+    CHECK(r.decided(0, 2) == std::vector<int>{0});
 }
 
 TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
