@@ -182,6 +182,8 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
 }  // namespace
 
 void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]) {
+    // (Called per span: most post-processing programs read no colour.)
+    if (!(colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular)))) return;
     for (int k = 0; k < 8; ++k) {
         const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
         if (!((colorAttrs >> attr) & 1)) continue;

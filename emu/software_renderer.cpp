@@ -77,6 +77,7 @@ struct SoftwareDrawContext {
         uint32_t wait = kTileRetryDraws;
         double tiledNs = 0, plainNs = 0;
         uint32_t decidedInARow = 0;
+        bool warm = false;  // a decided draw was seen: the first, which scans its textures' facts, is not timed
     };
     std::unordered_map<uint64_t, TileHistory> tileHistory;
 };
@@ -187,7 +188,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     const bool tileable =
         m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
-    // Timed: a program that pays is drawn undecided once after its first decided draw, then on
+    // Timed: a program that pays is drawn undecided once after its second decided draw (the
+    // first one's time, with the first reads of textures that may stay, is not taken), then on
     // every kTileProbeDraws-th.
     if (decide && m_options.timeTiles && history.paid && history.tiledNs > 0 &&
         (history.plainNs == 0 || history.decidedInARow >= kTileProbeDraws))
@@ -476,7 +478,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - drawStart).count();
         const double nsPerPixel = ns / double(stats.pixelsCovered - coveredBefore);
         double& avg = skipper ? history.tiledNs : history.plainNs;
-        avg = avg == 0 ? nsPerPixel : (1 - kTileTimeWeight) * avg + kTileTimeWeight * nsPerPixel;
+        if (!skipper || history.warm)
+            avg = avg == 0 ? nsPerPixel : (1 - kTileTimeWeight) * avg + kTileTimeWeight * nsPerPixel;
+        history.warm = history.warm || skipper;
         history.decidedInARow = skipper ? history.decidedInARow + 1 : 0;
     }
     if (skipper) {
