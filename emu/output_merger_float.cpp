@@ -153,6 +153,25 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     }
 }
 
+// The Baseline level's sum of a saturated source and a destination byte (emu/output_merger_kernels.h).
+void satAddUnorm8Baseline(const float* src, const uint8_t* words, int shift, int count, float* out) {
+    int i = 0;
+#if defined(__SSE2__)
+    // sat: v > 0 selects min(v, 1), else 0 (NaN included); d = float(byte) / 255, as kUnitOfByte.
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f);
+    const __m128i byte = _mm_set1_epi32(0xff);
+    const __m128i count128 = _mm_cvtsi32_si128(shift);
+    for (; i + 4 <= count; i += 4) {
+        const __m128 v = _mm_loadu_ps(src + i);
+        const __m128 sv = _mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_min_ps(v, one));
+        const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(words + 4 * i));
+        const __m128 d = _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srl_epi32(w, count128), byte)), k255);
+        _mm_storeu_ps(out + i, _mm_add_ps(sv, d));
+    }
+#endif
+    for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(load32(words + 4 * i) >> shift) & 0xffu];
+}
+
 // The Baseline level's half conversion (emu/output_merger_kernels.h).
 void unorm8WordsBaseline(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
     int i = 0;
@@ -282,28 +301,12 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
     }
     alignas(32) float sum[4][ps11::kMaxSpan];
     constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
-    for (int c = 0; c < 4; ++c) {
-        const float* src = f[c];
-        float* out = sum[c];
-        int i = 0;
-#if defined(__SSE2__)
-        // sat: v > 0 selects min(v, 1), else 0 (NaN included); d = float(byte) / 255, as kUnitOfByte.
-        const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f);
-        const __m128i byte = _mm_set1_epi32(0xff);
-        for (; i + 4 <= count; i += 4) {
-            const __m128 v = _mm_loadu_ps(src + i);
-            const __m128 sv = _mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_min_ps(v, one));
-            const __m128i w = _mm_loadu_si128(reinterpret_cast<const __m128i*>(dst + 4 * i));
-            const __m128 d = _mm_div_ps(_mm_cvtepi32_ps(_mm_and_si128(_mm_srli_epi32(w, kShift[c]), byte)), k255);
-            _mm_store_ps(out + i, _mm_add_ps(sv, d));
-        }
-#endif
-        for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(load32(dst + 4 * i) >> kShift[c]) & 0xffu];
-    }
+    const MergerKernels& kernels = mergerKernels(ps11::simdLevel());
+    for (int c = 0; c < 4; ++c) kernels.satAddUnorm8(f[c], dst, kShift[c], count, sum[c]);
     alignas(32) uint32_t words[ps11::kMaxSpan];
     const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
     // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both.
-    mergerKernels(ps11::simdLevel()).unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
+    kernels.unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
     if (run) {
         if (mask != 0xffffffffu)
             for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (load32(dst + 4 * i) & ~mask);
@@ -395,7 +398,7 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
 }  // namespace merger
 
 const MergerKernels baseline::kMerger{&merger::halvesBaseline, &merger::unorm8WordsBaseline,
-                                      &merger::unorm8WordsRgbaBaseline};
+                                      &merger::unorm8WordsRgbaBaseline, &merger::satAddUnorm8Baseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #ifdef PS11_HAVE_AVX2
