@@ -61,19 +61,17 @@ void lerpRowAvx2(const float* a, const float* b, float f, int n, float* out) {
 }
 
 void decodeAvx2(const uint8_t* row, int n, float* out, size_t stride) {
-    // Division is correctly rounded at every width: float(b) / 255 is unorm8Values()[b].
+    // float(b) / 255 is unorm8Values()[b] (unitOfByte).
     const __m256i byte = _mm256_set1_epi32(0xff);
-    const __m256 k255 = _mm256_set1_ps(255.0f);
     constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
     int i = 0;
     for (; i + 8 <= n; i += 8) {
         const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row + 4 * i));
-        _mm256_storeu_ps(out + i,
-                         _mm256_div_ps(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 16), byte)), k255));
+        _mm256_storeu_ps(out + i, unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 16), byte))));
         _mm256_storeu_ps(out + stride + i,
-                         _mm256_div_ps(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 8), byte)), k255));
-        _mm256_storeu_ps(out + 2 * stride + i, _mm256_div_ps(_mm256_cvtepi32_ps(_mm256_and_si256(w, byte)), k255));
-        _mm256_storeu_ps(out + 3 * stride + i, _mm256_div_ps(_mm256_cvtepi32_ps(_mm256_srli_epi32(w, 24)), k255));
+                         unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 8), byte))));
+        _mm256_storeu_ps(out + 2 * stride + i, unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(w, byte))));
+        _mm256_storeu_ps(out + 3 * stride + i, unitOfByte(_mm256_cvtepi32_ps(_mm256_srli_epi32(w, 24))));
     }
     const float* unit = ps11::Texture::unorm8Values();
     for (; i < n; ++i) {

@@ -1,9 +1,9 @@
 // The vector kernels of the float row path (emu/aligned_float.h): a table per SIMD level
 // (ps11/simd_dispatch.h), fetched once per draw (FloatRowDraw::kernels). Every kernel performs
 // the reference sampler's float operations in its order, one lane at a time as far as the
-// result is concerned (IEEE single precision, no fused multiply-add: the Avx2 file is built with
-// -ffp-contract=off), so both levels give the same floats bit for bit. Internal to
-// emu/aligned_float*.cpp.
+// result is concerned (IEEE single precision, no fused multiply-add in the lerps: the Avx2 file
+// is built with -ffp-contract=off; the decode's quotient by 255 is exact either way), so both
+// levels give the same floats bit for bit. Internal to emu/aligned_float*.cpp.
 #pragma once
 
 #include <cstddef>

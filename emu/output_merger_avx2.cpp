@@ -7,6 +7,7 @@
 #endif
 #include <immintrin.h>
 
+#include "emu/lanes_avx2.h"
 #include "emu/output_merger_kernels.h"
 
 namespace emu {
@@ -80,11 +81,9 @@ void unorm8WordsRgbaAvx2(const float* rgba, int count, uint32_t alphaFill, uint3
     if (i < count) baseline::kMerger.unorm8WordsRgba(rgba + 4 * size_t(i), count - i, alphaFill, words + i);
 }
 
-// Eight lanes at a time. float(d) / 255 correctly rounded without dividing: q = d·(1/255), then
-// one Newton step with the exact residual d − 255·q (an FMA) — the quotient for every byte d.
+// Eight lanes at a time, the byte's value without dividing (unitOfByte).
 void satAddUnorm8Avx2(const float* src, const uint8_t* words, int shift, int count, float* out) {
-    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), k255 = _mm256_set1_ps(255.0f);
-    const __m256 inv = _mm256_set1_ps(1.0f / 255.0f);
+    const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
     const __m256i byte = _mm256_set1_epi32(0xff);
     const __m128i by = _mm_cvtsi32_si128(shift);
     int i = 0;
@@ -92,9 +91,7 @@ void satAddUnorm8Avx2(const float* src, const uint8_t* words, int shift, int cou
         const __m256 v = _mm256_loadu_ps(src + i);
         const __m256 sv = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_min_ps(v, one));
         const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(words + 4 * i));
-        const __m256 b = _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srl_epi32(w, by), byte));
-        const __m256 q = _mm256_mul_ps(b, inv);
-        const __m256 d = _mm256_fmadd_ps(_mm256_fnmadd_ps(q, k255, b), inv, q);
+        const __m256 d = unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srl_epi32(w, by), byte)));
         _mm256_storeu_ps(out + i, _mm256_add_ps(sv, d));
     }
     if (i < count) baseline::kMerger.satAddUnorm8(src + i, words + 4 * size_t(i), shift, count - i, out + i);

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "emu/aligned_float_kernels.h"
 #include "emu/aligned_pass_kernels.h"
 #include "emu/format.h"
 #include "emu/output_merger.h"
@@ -412,6 +413,38 @@ TEST_CASE("simd dispatch: ONE/ONE sums into 8-bit targets are sat(s) + byte / 25
         CHECK(bad == 0);
     }
     CHECK(checked > 5000);
+}
+
+TEST_CASE("simd dispatch: the float row path decodes every byte to the texture's value at every level",
+          "[simd][aligned]") {
+    // A row of 300 texels holding every byte in every channel (b g r a), decoded from every
+    // offset 0..7 and to every length 0..300 - offset in steps: planar floats equal to
+    // unorm8Values()[byte] bit for bit.
+    const float* unit = ps11::Texture::unorm8Values();
+    std::vector<uint8_t> row(300 * 4);
+    for (size_t i = 0; i < row.size(); ++i) row[i] = uint8_t(i * 37 + i / 4);
+    int64_t bad = 0, checked = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::FloatRowKernels& k = emu::floatRowKernels(level);
+        for (int offset = 0; offset < 8; ++offset)
+            for (int n = 0; n + offset <= 300; n += 23) {
+                const size_t stride = size_t(n) + 3;
+                std::vector<float> out(4 * stride, -5.0f);
+                k.decode(row.data() + 4 * offset, n, out.data(), stride);
+                constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a in b g r a
+                for (int c = 0; c < 4; ++c) {
+                    for (int i = 0; i < n; ++i) {
+                        const float want = unit[row[size_t(4 * (offset + i) + kByte[c])]];
+                        bad += std::memcmp(&out[size_t(c) * stride + size_t(i)], &want, 4) != 0;
+                        ++checked;
+                    }
+                    bad += out[size_t(c) * stride + size_t(n)] != -5.0f;  // nothing past the row
+                }
+            }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+    CHECK(checked > 50000);
 }
 
 TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::unorm8OfFloat at every level",
