@@ -7,6 +7,7 @@
 // path (no helper lanes shaded).
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cstring>
 #include <random>
 #include <string>
@@ -192,6 +193,14 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
         // Mostly stage 0's columns with other rows (a vertical blur).
         if ((c.oneTexture || sameShape) && s > 0 && uni(0, 3) != 0) u[s][0] = u[0][0], u[s][1] = u[0][1];
     }
+    // Or pairs of taps on the same rows, columns a whole or part of a texel apart (the half-texel
+    // blur's taps at (±½, ±½)): one tap's vertical blends serve the other's (VerticalMemo).
+    if (c.oneTexture && uni(0, 2) == 0)
+        for (int s = 1; s < 4; s += 2) {
+            const float d = float(std::array<int, 6>{8, -8, 16, 4, 1, 0}[size_t(uni(0, 5))]) * 0.125f / float(c.tex[0].w);
+            v[s][0] = v[s - 1][0], v[s][1] = v[s - 1][1];
+            u[s][0] = u[s - 1][0] + d, u[s][1] = u[s - 1][1] + d;
+        }
     DWORD dif[4];
     const bool gradient = uni(0, 1);
     for (DWORD& d : dif) d = gradient ? DWORD(rng()) : 0;
