@@ -795,6 +795,70 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
     CHECK(aligned * 10 >= cases * 9);
 }
 
+TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel blur) equal the quad path",
+          "[draw][aligned]") {
+    // Four taps of one texture at (−½, −½), (+½, −½), (−½, +½), (+½, +½) texels plus a common
+    // offset in eighths (weights ½ or any, vertical weight ½ or any), 1:1 or a 2:1 reduction,
+    // point or linear, every address mode, over rows wider than a span (whole spans inside the
+    // taps' runs, as in a 1080p blur; a scissor now and then starts and ends spans anywhere).
+    std::mt19937 rng(20261128);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 48; ++i) {
+        Case c;
+        c.w = UINT(uni(260, 700));
+        c.h = UINT(uni(2, 9));
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const UINT scale = uni(0, 3) ? 1 : 2;
+        Case::Tex t;
+        t.w = c.w * scale, t.h = c.h * scale;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 5) ? rng() : 255);
+        t.filter = uni(0, 5) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        t.addressU = DWORD(uni(1, 5));
+        t.addressV = DWORD(uni(1, 5));
+        t.border = DWORD(rng());
+        c.tex.assign(4, t);
+        c.oneTexture = true;
+        c.program = uni(0, 1) ? kPrograms[1]  // the blur (c0), or its weighted form (c0..c3)
+                              : "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\n"
+                                "mad r0, t2, c2, r0\nmad r0, t3, c3, r0\n";
+        for (auto& k : c.consts)
+            for (float& v : k) v = float(uni(0, 8)) / 16.0f;
+        const float ox = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f, oy = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f;
+        const float dx[4] = {-0.5f, 0.5f, -0.5f, 0.5f}, dy[4] = {-0.5f, -0.5f, 0.5f, 0.5f};
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
+            for (int s = 0; s < 4; ++s) {
+                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (dx[s] + ox) / float(t.w);
+                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (dy[s] + oy) / float(t.h);
+            }
+            c.verts.push_back(q);
+        }
+        c.blend = DWORD(uni(0, 1));
+        // A scissor rectangle now and then: spans that start and end anywhere.
+        c.scissor = uni(0, 2) == 0;
+        c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", scale " << scale << ", offset " << ox << ", " << oy
+                     << (c.scissor ? ", scissor" : ""));
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);  // the row path drew it
+        });
+    }
+}
+
 TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][aligned]") {
     // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with vector kernels (the Avx2 level), all
     // columns but a few at the edges (clamped pairs) belong to runs of the tabulated configuration
