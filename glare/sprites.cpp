@@ -17,6 +17,7 @@
 #include "emu/fullscreen.h"
 #include "glare/passes.h"
 #include "glare/runner.h"
+#include "glare/sensors_kernels.h"
 
 namespace glare {
 
@@ -50,11 +51,9 @@ float sensorSumThreshold(float threshold) {
 
 namespace {
 
-// Sets bit x of `fires` where luminance(pixel x of the row) >= threshold, given as sensorSumThreshold(),
-// over one row of `width` pixels, each a 32-bit word whose bytes at bit shifts rs, 8 and bs are r,
-// g and b. The same float operations in the same order as luminanceSum(), four pixels at a time
-// where SSE2 is there (every x86-64). `fires` holds (width + 63) / 64 words, zero on entry.
-void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeast, uint64_t* fires) {
+// The Baseline level's sensor row (glare/sensors_kernels.h): four pixels at a time where SSE2 is
+// there (every x86-64), the rest one by one with luminanceSum().
+void fireRowBaseline(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeast, uint64_t* fires) {
     uint32_t x = 0;
 #if defined(__SSE2__)
     const __m128i m = _mm_set1_epi32(0xff);
@@ -76,6 +75,17 @@ void fireRow(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeas
     }
 }
 }  // namespace
+
+const SensorKernels baseline::kSensors{&fireRowBaseline};
+
+const SensorKernels& sensorKernels(ps11::SimdLevel level) {
+#ifdef PS11_HAVE_AVX2
+    return *ps11::simdTable(level, &baseline::kSensors, &avx2::kSensors);
+#else
+    (void)level;
+    return baseline::kSensors;
+#endif
+}
 
 namespace {
 
@@ -117,7 +127,8 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
     auto fired = [&](uint32_t x, uint32_t y) { return (fires[size_t(y) * wpr + x / 64] >> (x % 64)) & 1; };
     const float sumAtLeast = sensorSumThreshold(s.threshold);
     inBands(height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
-        for (uint32_t y = y0; y < y1; ++y) fireRow(pixel(0, y), width, rs, bs, sumAtLeast, &fires[size_t(y) * wpr]);
+        const SensorKernels& k = sensorKernels(ps11::simdLevel());
+        for (uint32_t y = y0; y < y1; ++y) k.fireRow(pixel(0, y), width, rs, bs, sumAtLeast, &fires[size_t(y) * wpr]);
     });
     // Cluster blocks first: 8x8 blocks at least 90 % bright.
     const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;

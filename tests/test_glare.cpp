@@ -23,6 +23,7 @@
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
 #include "runner/gl_backend.h"
+#include "simd_levels.h"
 
 using namespace glare;
 
@@ -784,20 +785,23 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
                 uint8_t* q = &bgra[y * pitch + size_t(x) * 4];
                 q[0] = p[2], q[1] = p[1], q[2] = p[0], q[3] = p[3];
             }
-        // On the machine's threads and on 1, 3 and 8 (the frame's bands split differently).
-        for (const std::vector<Sprite>& fast :
-             {senseSprites(img.data(), w, h, s), senseSprites(SensorFrame{bgra.data(), w, h, pitch, true}, s),
-              senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 1}, s),
-              senseSprites(SensorFrame{img.data(), w, h, size_t(w) * 4, false, 3}, s),
-              senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 8}, s)}) {
-            REQUIRE(fast.size() == ref.size());
-            for (size_t i = 0; i < ref.size(); ++i) {
-                CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
-                CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
-                CHECK(fast[i].radius == ref[i].radius);
-                CHECK(fast[i].cluster == ref[i].cluster);
+        // On the machine's threads and on 1, 3 and 8 (the frame's bands split differently), at
+        // every SIMD level (the sensor row's kernels).
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            for (const std::vector<Sprite>& fast :
+                 {senseSprites(img.data(), w, h, s), senseSprites(SensorFrame{bgra.data(), w, h, pitch, true}, s),
+                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 1}, s),
+                  senseSprites(SensorFrame{img.data(), w, h, size_t(w) * 4, false, 3}, s),
+                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 8}, s)}) {
+                REQUIRE(fast.size() == ref.size());
+                for (size_t i = 0; i < ref.size(); ++i) {
+                    CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
+                    CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
+                    CHECK(fast[i].radius == ref[i].radius);
+                    CHECK(fast[i].cluster == ref[i].cluster);
+                }
             }
-        }
+        });
     }
 }
 
