@@ -509,9 +509,10 @@ int runGlare(const GlareOptions& o) {
                     s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0, "ran", tileText.c_str());
     }
     std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
-                " reused: its inputs were last frame's, its outputs kept, nothing ran; tiles: 16x64-pixel tiles of the\n"
-                " software renderer's full-screen draws, shaded, filled with a constant, copied from one texture or\n"
-                " skipped, as the interval evaluator decided; --no-skip runs every pass and shades every tile)\n");
+                " reused: its inputs were last frame's, its outputs kept, nothing ran; tiles: tiles of 16 rows by 64\n"
+                " pixels of the software renderer's full-screen draws, shaded, filled with a constant, copied from one\n"
+                " texture or skipped, as the interval evaluator decided; -: none decided (no such draw, or deciding\n"
+                " did not pay on the program's recent draws); --no-skip runs every pass and shades every tile)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
