@@ -165,7 +165,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle> floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
-    // Deciding costs 0.5–3 µs a tile, and the first read of a texture scans its facts: a program
+    // Deciding costs 0.4–3 µs a tile, and the first read of a texture scans its facts: a program
     // whose last decided draw did not pay (timed: took longer per pixel than its undecided
     // draws; untimed: fewer than a quarter of its tiles saved work — filled, skipped, or copied
     // where that saves) is shaded without deciding, and decided again on its kTileRetryDraws-th
@@ -221,7 +221,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // Which triangles and columns is decided here; the tables are filled on the workers
         // (independent per triangle: a full-screen quad's two halves fill at once).
         auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto fill) {
-            if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
+            rowTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
             bool paired = false;  // the triangle before was paired with the one before it
