@@ -503,6 +503,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them: a full-screen quad's two triangles
     // share their tables, so each texel row is filtered once, not once per triangle).
+    const bool prefetch = prefetchesRows(*draw.target.color);
     for (int y = y0; y < y1; ++y) {
         sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
         for (size_t ti = 0; ti < count; ++ti) {
@@ -510,6 +511,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             const TriangleSetup& s = *setups[ti];
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
+            if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri);
             for (int t = 0; t < taps; ++t) {
                 const FloatRowTap& tap = draw.taps[size_t(t)];

@@ -777,6 +777,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     }
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them).
+    const bool prefetch = prefetchesRows(target);
     for (int y = y0; y < y1; ++y) {
         ++cache.stamp;
         for (size_t ti = 0; ti < count; ++ti) {
@@ -784,6 +785,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             const TriangleSetup& s = *setups[ti];
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
+            if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
