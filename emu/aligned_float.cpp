@@ -441,7 +441,10 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
     for (int i = 0; i < draw.plan.count; ++i) {
         const FloatRowTap& tap = draw.taps[size_t(i)];
         FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
-        if (!tap.bound) continue;
+        if (!tap.bound) {  // no table (the triangle may be a previous chunk's or draw's)
+            cols.i0.clear(), cols.i1.clear(), cols.f.clear(), cols.stretches.clear();
+            continue;
+        }
         columnU(s, tap.coordSet, out.x0, n, u.data());
         cols.i0.resize(size_t(n));
         cols.i1.resize(size_t(n));

@@ -559,7 +559,10 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
         cols.runs.clear();
         cols.configCount = 0;
-        if (!tap.bound) continue;
+        if (!tap.bound) {  // no table (the triangle may be a previous chunk's or draw's)
+            cols.off0.clear(), cols.off1.clear(), cols.w.clear(), cols.run.clear();
+            continue;
+        }
         columnU(s, tap.coordSet, out.x0, n, u.data());
         cols.off0.resize(size_t(n));
         cols.off1.resize(size_t(n));

@@ -80,6 +80,18 @@ struct SoftwareDrawContext {
         bool warm = false;  // a decided draw was seen: the first, which scans its textures' facts, is not timed
     };
     std::unordered_map<uint64_t, TileHistory> tileHistory;
+    // A chunk's triangles, setups, row-path tables and bands, kept between draws: a draw of
+    // sprites allocated and first touched about 2 MB of them every time (page faults, then the
+    // tables' own vectors), a tenth of its time. Tables are filled anew per chunk and keep their
+    // memory (grown, never shrunk below a chunk's count).
+    struct Chunk {
+        std::vector<ScreenTriangle> tris;
+        std::vector<TriangleSetup> setups;
+        std::vector<AlignedTriangle> alignedTris;
+        std::vector<FloatRowTriangle> floatTris;
+        std::vector<uint8_t> isAligned;
+        std::vector<uint32_t> bandStart, bandFill, bandTris;
+    } chunk;
 };
 
 SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_options(options) {}
@@ -150,20 +162,20 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
 
     // Triangles go through in chunks (memory stays bounded for any count); chunks run one after
     // the other, so primitive order holds across them.
-    std::vector<ScreenTriangle> tris;
-    std::vector<TriangleSetup> setups;
+    std::vector<ScreenTriangle>& tris = dc.chunk.tris;
+    std::vector<TriangleSetup>& setups = dc.chunk.setups;
     // Screen-aligned passes: rows without quads (emu/aligned_pass.h), decided per triangle.
     AlignedDraw aligned;
     const bool alignedDraw =
         m_options.alignedPasses &&
         prepareAlignedDraw(executor, precision, call.textures, call.samplers, merge, mtarget, wantZ, used, aligned);
-    std::vector<AlignedTriangle> alignedTris;
+    std::vector<AlignedTriangle>& alignedTris = dc.chunk.alignedTris;
     // The float profiles' row path (emu/aligned_float.h), the same per-triangle decision.
     FloatRowDraw floatRows;
     const bool floatDraw = m_options.alignedPasses && !alignedDraw &&
                            prepareFloatRowDraw(executor, precision, call.hardware.weightBits, kills, call.textures,
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
-    std::vector<FloatRowTriangle> floatTris;
+    std::vector<FloatRowTriangle>& floatTris = dc.chunk.floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
     // Deciding costs 0.4–3 µs a tile, and the first read of a texture scans its facts: a program
     // whose last decided draw did not pay (timed: took longer per pixel than its undecided
@@ -198,8 +210,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     const uint64_t coveredBefore = stats.pixelsCovered;
     if (decide) skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     const DrawStats tilesBefore = stats;
-    std::vector<uint8_t> isAligned;
-    std::vector<uint32_t> bandStart, bandFill, bandTris;
+    std::vector<uint8_t>& isAligned = dc.chunk.isAligned;
+    std::vector<uint32_t>& bandStart = dc.chunk.bandStart;
+    std::vector<uint32_t>& bandFill = dc.chunk.bandFill;
+    std::vector<uint32_t>& bandTris = dc.chunk.bandTris;
     for (uint32_t first = 0; first < call.primitiveCount; first += kChunkTriangles) {
         const uint32_t chunk = std::min(kChunkTriangles, call.primitiveCount - first);
         tris.clear();
@@ -207,11 +221,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         call.assemble(first, chunk, tris);
         int yLo = clip.y1, yHi = clip.y0;
         for (const ScreenTriangle& t : tris) {
-            TriangleSetup s;
-            if (!setupTriangle(t, used, clip, s)) continue;
+            TriangleSetup& s = setups.emplace_back();
+            if (!setupTriangle(t, used, clip, s)) {
+                setups.pop_back();
+                continue;
+            }
             yLo = std::min(yLo, s.yMin);
             yHi = std::max(yHi, s.yMax);
-            setups.push_back(s);
         }
         stats.trianglesDrawn += setups.size();
         isAligned.assign(setups.size(), 0);
@@ -221,7 +237,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // Which triangles and columns is decided here; the tables are filled on the workers
         // (independent per triangle: a full-screen quad's two halves fill at once).
         auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto fill) {
-            rowTris.resize(setups.size());
+            if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
             bool paired = false;  // the triangle before was paired with the one before it

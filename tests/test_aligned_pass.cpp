@@ -275,6 +275,10 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
     REQUIRE(dev.SetPixelShaderConstantF(0, &c.consts[0][0], 4) == D3D_OK);
     REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+    // Every state the cases vary is set, on or off: a device may have drawn another case before.
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, c.blend ? 1 : 0) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_ALPHATESTENABLE, c.alphaTest ? 1 : 0) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_SCISSORTESTENABLE, c.scissor ? 1 : 0) == D3D_OK);
     if (c.blend) {
         REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
         const DWORD src = c.blend == 1 ? D3DBLEND_ONE : c.blend == 3 ? D3DBLEND_BLENDFACTOR : D3DBLEND_SRCALPHA;
@@ -1094,45 +1098,52 @@ TEST_CASE("tile skipping: tiles over different constants of one texture are deci
     }
 }
 
-TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path byte for byte", "[draw][aligned]") {
-    // Hundreds of overlapping axis-aligned quads at sub-pixel positions, magnified or minified,
-    // blended ONE/ONE or not, some partly outside the target: groups of 16 triangles per band, tables
-    // of each triangle's own columns, H rows built without the cache.
-    std::mt19937 rng(20261127);
+// Overlapping axis-aligned quads at sub-pixel positions over a random target, a random texture
+// per stage magnified or minified, blended ONE/ONE or not, some partly outside the target.
+Case spriteCase(std::mt19937& rng, int quads, bool twoTaps) {
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    Case c = randomCase(rng);
+    c.w = UINT(uni(64, 300)), c.h = UINT(uni(16, 60));
+    c.rtInit.resize(size_t(c.w) * c.h * 4);
+    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    for (Case::Tex& t : c.tex) {
+        t.w = UINT(uni(4, 40)), t.h = UINT(uni(4, 40));
+        t.format = D3DFMT_A8R8G8B8;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        t.bound = true;
+    }
+    c.program = twoTaps ? "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n" : "ps_1_1\ntex t0\nmul r0, t0, c0\n";
+    c.blend = DWORD(uni(0, 2) ? 1 : 0);
+    c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+    c.verts.clear();
+    for (int q = 0; q < quads; ++q) {
+        const float size = real(2.0f, 40.0f);
+        const float x0 = real(-10.0f, float(c.w)), y0 = real(-10.0f, float(c.h));
+        const float xs[4] = {x0, x0 + size, x0 + size, x0}, ys[4] = {y0, y0, y0 + size, y0 + size};
+        const DWORD colour = DWORD(rng());
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, colour, {}};
+            for (int s = 0; s < 4; ++s)
+                v.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            c.verts.push_back(v);
+        }
+    }
+    return c;
+}
+
+TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path byte for byte", "[draw][aligned]") {
+    // Groups of 16 triangles per band, tables of each triangle's own columns, H rows built without
+    // the cache.
+    std::mt19937 rng(20261127);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     uint64_t rowShaded = 0, quadShaded = 0;
     // Cases 24 on: float and ideal (groups of 16 triangles row by row, as in fx8).
     for (int i = 0; i < 40; ++i) {
         const bool floatCase = i >= 24;
-        Case c = randomCase(rng);
-        c.w = UINT(uni(64, 300)), c.h = UINT(uni(16, 60));
-        c.rtInit.resize(size_t(c.w) * c.h * 4);
-        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
-        for (Case::Tex& t : c.tex) {
-            t.w = UINT(uni(4, 40)), t.h = UINT(uni(4, 40));
-            t.format = D3DFMT_A8R8G8B8;
-            t.bytes.resize(size_t(t.w) * t.h * 4);
-            for (uint8_t& b : t.bytes) b = uint8_t(rng());
-            t.bound = true;
-        }
-        c.program = i % 2 ? "ps_1_1\ntex t0\nmul r0, t0, c0\n" : "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n";
-        c.blend = DWORD(uni(0, 2) ? 1 : 0);
-        c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
-        c.verts.clear();
         const int quads = floatCase && i % 2 ? uni(2, 8) : uni(20, 300);
-        for (int q = 0; q < quads; ++q) {
-            const float size = real(2.0f, 40.0f);
-            const float x0 = real(-10.0f, float(c.w)), y0 = real(-10.0f, float(c.h));
-            const float xs[4] = {x0, x0 + size, x0 + size, x0}, ys[4] = {y0, y0, y0 + size, y0 + size};
-            const DWORD colour = DWORD(rng());
-            for (int k : {0, 1, 2, 0, 2, 3}) {
-                Vtx v{xs[k], ys[k], 0.5f, 1.0f, colour, {}};
-                for (int s = 0; s < 4; ++s)
-                    v.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
-                c.verts.push_back(v);
-            }
-        }
+        const Case c = spriteCase(rng, quads, i % 2 == 0);
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
@@ -1150,4 +1161,35 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
     // The row path shades no helper lanes: fewer pixels than the quad path's 2x2 quads.
     INFO("shaded: row path " << rowShaded << ", quad path " << quadShaded);
     CHECK(rowShaded * 10 < quadShaded * 9);
+}
+
+TEST_CASE("aligned pass: one device keeps its row tables between draws (sprites, full-screen passes, chunks)",
+          "[draw][aligned]") {
+    // The renderer keeps a chunk's setups and tables between draws and fills them anew: a draw of
+    // fewer triangles or taps after one of more must read none of the earlier draw's. One device
+    // per profile draws random full-screen passes and sprite draws in turn, some of more triangles
+    // than a chunk (1024), each against a fresh quad-path device.
+    std::mt19937 rng(20261129);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal}) {
+        DeviceOptions rowOpt;
+        rowOpt.precision = precision;
+        rowOpt.software.threads = 2;
+        Device rowDev(rowOpt);
+        for (int i = 0; i < 24; ++i) {
+            const int kind = uni(0, 2);  // 0: a full-screen pass, 1: a few sprites, 2: more than a chunk of them
+            Case c = kind == 0 ? randomCase(rng) : spriteCase(rng, kind == 1 ? uni(1, 6) : uni(520, 700), uni(0, 1) == 1);
+            if (kind == 0 && c.program.rfind("ps_1_4", 0) == 0) continue;  // the 1.4-class card: another device
+            DeviceOptions quadOpt = rowOpt;
+            quadOpt.software.alignedPasses = false;
+            Device quadDev(quadOpt);
+            DrawStats qs, rs;
+            INFO("precision " << int(precision) << ", draw " << i << ": " << c.verts.size() / 3 << " triangles, "
+                              << c.w << "x" << c.h << ", program:\n"
+                              << c.program);
+            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            if (kind == 1) CHECK(rs.pixelsShaded == rs.pixelsCovered);  // every triangle took the row path
+        }
+    }
 }
