@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cstring>
 #include <limits>
 
@@ -532,6 +533,36 @@ bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, 
     return screenAligned(plan, s) && tableColumns(s, x0, x1);
 }
 
+namespace {
+
+// Whether attribute k takes the same value in both triangles at every pixel of row y, as the
+// row paths compute it (planeValue: float row base plus float step times the column).
+bool sameOnRow(const TriangleSetup& a, const TriangleSetup& b, int k, int y) {
+    const bool ca = (a.constMask >> k) & 1, cb = (b.constMask >> k) & 1;
+    if (ca != cb) return false;
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    if (ca) return bits(a.constValue[size_t(k)]) == bits(b.constValue[size_t(k)]);
+    const Plane &pa = a.attr[size_t(k)], &pb = b.attr[size_t(k)];
+    return bits(float(pa.dx)) == bits(float(pb.dx)) &&
+           bits(float(planeRowBase(pa, a.ox, a.oy, y))) == bits(float(planeRowBase(pb, b.ox, b.oy, y)));
+}
+
+}  // namespace
+
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapPlan& plan, uint64_t colorAttrs, int y,
+             const RowWindow* windows, size_t count, int& xl, int& xr) {
+    int nl = 0, nr = 0;
+    if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
+    for (int i = 0; i < plan.count; ++i) {
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0);
+        if (!sameOnRow(s, next, ku, y) || !sameOnRow(s, next, ku + 1, y)) return false;
+    }
+    for (int k = 0; k < kAttrCount; ++k)
+        if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y)) return false;
+    xl = std::min(xl, nl), xr = std::max(xr, nr);
+    return true;
+}
+
 bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair<int, int>& out) {
     const int width = clip.x1 - clip.x0;
     const bool narrow = a1 - a0 < width && b1 - b0 < width;
@@ -788,6 +819,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             const TriangleSetup& s = *setups[ti];
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
+            // The quad's other half, when its run of this row continues this one's (joinRow).
+            const bool joined = ti + 1 < count && tris[ti + 1]->x0 == tri.x0 && tris[ti + 1]->x1 == tri.x1 &&
+                                joinRow(s, *setups[ti + 1], draw.plan, draw.colorAttrs, y, windows, windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
             for (int t = 0; t < taps; ++t) {
@@ -880,6 +914,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     stats.written += ms.written;
                 }
             }
+            if (joined) ++ti;  // its pixels of this row were drawn
         }
     }
 }

@@ -248,6 +248,16 @@ inline void prefetchRow(const Image& target, int x0, int x1, int y) {
     for (const uint8_t* p = reinterpret_cast<const uint8_t*>(first); p < end; p += 64) __builtin_prefetch(p, 1, 3);
 }
 
+// Joins the next triangle's run of pixel row y to [xl, xr) (this triangle's, rowSpan's) when
+// the two are adjacent and give every pixel of the row the same attributes the row paths read:
+// each tap's u and v and the colours `colorAttrs` names, bit for bit (the same float row base
+// and step per column, or the same constant). The caller has checked that their tables cover
+// the same columns (they are then equal). A quad's two halves split every row at the diagonal;
+// joined, each row is one run: half the runs of a sprite, and full-width spans for a
+// full-screen pass. True when joined (the next triangle's pixels of the row are then this run's).
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapPlan& plan, uint64_t colorAttrs, int y,
+             const RowWindow* windows, size_t count, int& xl, int& xr);
+
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is

@@ -1193,3 +1193,50 @@ TEST_CASE("aligned pass: one device keeps its row tables between draws (sprites,
         }
     }
 }
+
+TEST_CASE("aligned pass: triangles of one mapping join on a row only where their runs meet", "[draw][aligned]") {
+    // Every triangle maps pixels to texels by the same planes (u = x / 64, v = y / 32, exact in
+    // binary), so consecutive triangles pass joinRow's attribute test; added ONE/ONE, any pixel
+    // of a run joined across a gap or over an overlap (the same triangle twice in a row) would be
+    // drawn the wrong number of times. Against the quad path, in fx8 and ideal.
+    std::mt19937 rng(20261129);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 12; ++i) {
+        Case c = randomCase(rng);
+        c.w = 64, c.h = 32;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        for (uint8_t& b : c.rtInit) b = uint8_t(uni(0, 40));
+        for (Case::Tex& t : c.tex) {
+            t.w = 16, t.h = 8, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = i % 2 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 60));
+        }
+        c.program = "ps_1_1\ntex t0\nmov r0, t0\n";
+        c.blend = 1, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        auto vertex = [&](int x, int y) {
+            Vtx v{float(x), float(y), 0.5f, 1.0f, 0xffffffff, {}};
+            for (auto& uv : v.uv) uv[0] = float(x) / 64.0f, uv[1] = float(y) / 32.0f;
+            return v;
+        };
+        for (int t = 0; t < 60; ++t) {
+            // Wide triangles (tables over the whole target: equal for all of them), some twice.
+            const Vtx a = vertex(uni(-8, 72), uni(-8, 40)), b = vertex(uni(-8, 72), uni(-8, 40)),
+                      d = vertex(uni(-8, 72), uni(-8, 40));
+            for (int k = uni(0, 3) == 0 ? 2 : 1; k > 0; --k) c.verts.insert(c.verts.end(), {a, b, d});
+        }
+        for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Ideal}) {
+            DeviceOptions quadOpt, rowOpt;
+            quadOpt.software.alignedPasses = false;
+            quadOpt.precision = rowOpt.precision = precision;
+            rowOpt.software.skipTiles = false;
+            Device quadDev(quadOpt), rowDev(rowOpt);
+            DrawStats qs, rs;
+            INFO("case " << i << ", precision " << int(precision));
+            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);  // the row path drew them
+        }
+    }
+}
