@@ -455,20 +455,23 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
     }
 }
 
-void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count) {
+void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared,
+                         const uint32_t* tableOf, size_t count) {
     static std::atomic<uint64_t> ids{0};
     // Two taps' H rows are equal when they filter the same texels (texture, border) with the same
     // columns, texel pairs and weights (compared by bits; an unbound tap's table is empty).
+    // Triangles are compared by the tables that serve them.
     auto sameRows = [&](size_t i, int t, size_t j, int u) {
         const FloatRowTap &a = draw.taps[size_t(t)], &b = draw.taps[size_t(u)];
-        const FloatRowTriangle::Columns &c = tris[i].taps[size_t(t)], &o = tris[j].taps[size_t(u)];
+        const FloatRowTriangle &ti = tris[tableOf[i]], &tj = tris[tableOf[j]];
+        const FloatRowTriangle::Columns &c = ti.taps[size_t(t)], &o = tj.taps[size_t(u)];
         return a.bound == b.bound && a.unorm8 == b.unorm8 && a.bytes == b.bytes && a.values == b.values &&
-               a.width == b.width && a.border == b.border && tris[j].x0 == tris[i].x0 && tris[j].x1 == tris[i].x1 &&
-               o.i0 == c.i0 && o.i1 == c.i1 && o.f.size() == c.f.size() &&
+               a.width == b.width && a.border == b.border && tj.x0 == ti.x0 && tj.x1 == ti.x1 && o.i0 == c.i0 &&
+               o.i1 == c.i1 && o.f.size() == c.f.size() &&
                (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0);
     };
     for (size_t i = 0; i < count; ++i) {
-        if (!prepared[i]) continue;
+        if (!prepared[i] || tableOf[i] != i) continue;  // served by another's tables: its ids
         for (int t = 0; t < draw.plan.count; ++t) {
             FloatRowTriangle::Columns& c = tris[i].taps[size_t(t)];
             c.tableId = 0;
@@ -476,7 +479,7 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
             // many triangles compares each with a few, not all.
             for (size_t j = i > 0 ? i - 1 : 0; j <= i && !c.tableId; ++j)
                 for (int u = 0; u < (j < i ? draw.plan.count : t) && !c.tableId; ++u)
-                    if (prepared[j] && sameRows(i, t, j, u)) c.tableId = tris[j].taps[size_t(u)].tableId;
+                    if (prepared[j] && sameRows(i, t, j, u)) c.tableId = tris[tableOf[j]].taps[size_t(u)].tableId;
             if (!c.tableId) c.tableId = ++ids;
         }
     }

@@ -91,7 +91,10 @@ struct FloatRowTriangle {
 // Gives each tap's table of tris[0 .. count) an id, the same to taps of the triangle or the one before whose H
 // rows are equal (same texels, border, columns, texel pairs and weights), so drawFloatRows
 // builds their H rows once.
-void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared, size_t count);
+// `tableOf[i]`: the triangle whose tables serve triangle i (i, or its quad's first half, whose ids
+// it then has).
+void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared,
+                         const uint32_t* tableOf, size_t count);
 
 // True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
 // colours constant or affine), and then fills its tables.

@@ -535,19 +535,27 @@ bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, 
 
 namespace {
 
-// Whether attribute k takes the same value in both triangles at every pixel of row y, as the
-// row paths compute it (planeValue: float row base plus float step times the column).
-bool sameOnRow(const TriangleSetup& a, const TriangleSetup& b, int k, int y) {
+// Whether attribute k takes the same value at every pixel of row ya in triangle a as of row yb
+// in triangle b, as the row paths compute it (planeValue: float row base plus float step times
+// the column).
+bool sameOnRow(const TriangleSetup& a, const TriangleSetup& b, int k, int ya, int yb) {
     const bool ca = (a.constMask >> k) & 1, cb = (b.constMask >> k) & 1;
     if (ca != cb) return false;
     auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
     if (ca) return bits(a.constValue[size_t(k)]) == bits(b.constValue[size_t(k)]);
     const Plane &pa = a.attr[size_t(k)], &pb = b.attr[size_t(k)];
     return bits(float(pa.dx)) == bits(float(pb.dx)) &&
-           bits(float(planeRowBase(pa, a.ox, a.oy, y))) == bits(float(planeRowBase(pb, b.ox, b.oy, y)));
+           bits(float(planeRowBase(pa, a.ox, a.oy, ya))) == bits(float(planeRowBase(pb, b.ox, b.oy, yb)));
 }
 
 }  // namespace
+
+bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11::TapPlan& plan) {
+    // (u has no dy on the row paths: its row base is that of any row, yMin's as columnU takes it)
+    for (int i = 0; i < plan.count; ++i)
+        if (!sameOnRow(a, b, attrTex(plan.coordSet[size_t(i)], 0), a.yMin, b.yMin)) return false;
+    return true;
+}
 
 bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapPlan& plan, uint64_t colorAttrs, int y,
              const RowWindow* windows, size_t count, int& xl, int& xr) {
@@ -555,10 +563,10 @@ bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapP
     if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
     for (int i = 0; i < plan.count; ++i) {
         const int ku = attrTex(plan.coordSet[size_t(i)], 0);
-        if (!sameOnRow(s, next, ku, y) || !sameOnRow(s, next, ku + 1, y)) return false;
+        if (!sameOnRow(s, next, ku, y, y) || !sameOnRow(s, next, ku + 1, y, y)) return false;
     }
     for (int k = 0; k < kAttrCount; ++k)
-        if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y)) return false;
+        if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y, y)) return false;
     xl = std::min(xl, nl), xr = std::max(xr, nr);
     return true;
 }

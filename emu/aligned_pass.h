@@ -248,6 +248,12 @@ inline void prefetchRow(const Image& target, int x0, int x1, int y) {
     for (const uint8_t* p = reinterpret_cast<const uint8_t*>(first); p < end; p += 64) __builtin_prefetch(p, 1, 3);
 }
 
+// Whether the row paths' tables of triangles a and b over the same columns are equal: every tap's
+// u gives each column the same float (the same constant, or the same float row base and step;
+// a table depends on nothing else of its triangle). A quad's second half then takes the first
+// one's tables instead of filling its own (the renderer's prepareTables).
+bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11::TapPlan& plan);
+
 // Joins the next triangle's run of pixel row y to [xl, xr) (this triangle's, rowSpan's) when
 // the two are adjacent and give every pixel of the row the same attributes the row paths read:
 // each tap's u and v and the colours `colorAttrs` names, bit for bit (the same float row base

@@ -90,6 +90,9 @@ struct SoftwareDrawContext {
         std::vector<AlignedTriangle> alignedTris;
         std::vector<FloatRowTriangle> floatTris;
         std::vector<uint8_t> isAligned;
+        // The triangle whose row tables serve each one: itself, or the first half of its quad
+        // where the tables would be equal (sameColumnTables: the second half fills none).
+        std::vector<uint32_t> tableOf;
         std::vector<uint32_t> bandStart, bandFill, bandTris;
     } chunk;
 };
@@ -211,6 +214,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     if (decide) skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t>& isAligned = dc.chunk.isAligned;
+    std::vector<uint32_t>& tableOf = dc.chunk.tableOf;
     std::vector<uint32_t>& bandStart = dc.chunk.bandStart;
     std::vector<uint32_t>& bandFill = dc.chunk.bandFill;
     std::vector<uint32_t>& bandTris = dc.chunk.bandTris;
@@ -238,11 +242,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // (independent per triangle: a full-screen quad's two halves fill at once).
         auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto fill) {
             if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
+            tableOf.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
             int64_t columns = 0;
             bool paired = false;  // the triangle before was paired with the one before it
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 auto& t = rowTris[i];
+                tableOf[i] = uint32_t(i);
                 isAligned[i] = rowPathColumns(plan, setups[i], t.x0, t.x1);
                 std::pair<int, int> both;
                 const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
@@ -254,6 +260,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     p.x1 = t.x1 = both.second;
                     columns += p.x1 - p.x0;
                 }
+                if (isAligned[i] && i > 0 && isAligned[i - 1] && tableOf[i - 1] == i - 1 && t.x0 == rowTris[i - 1].x0 &&
+                    t.x1 == rowTris[i - 1].x1 && sameColumnTables(setups[i - 1], setups[i], plan))
+                    tableOf[i] = uint32_t(i - 1);
                 paired = pair;
                 if (isAligned[i]) columns += t.x1 - t.x0;
                 if (columns > budget) isAligned[i] = 0;
@@ -264,7 +273,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             std::atomic<size_t> nextTri{0};
             dc.pool.run(workers, [&](int) {
                 for (size_t i; (i = nextTri.fetch_add(1, std::memory_order_relaxed)) < setups.size();)
-                    if (isAligned[i]) fill(setups[i], rowTris[i]);
+                    if (isAligned[i] && tableOf[i] == i) fill(setups[i], rowTris[i]);
             });
         };
         if (alignedDraw)
@@ -273,7 +282,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         if (floatDraw) {
             prepareTables(floatTris, floatRows.plan, floatRows.plan.count,
                           [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
-            shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), setups.size());
+            shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
         }
         if (setups.empty()) continue;
         const bool tiles = skipper && setups.size() <= kMaxAlignedTriangles &&
@@ -366,8 +375,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1] && n < kMaxAlignedTriangles; ++k) {
                     const uint32_t i = bandTris[k];
                     bt[n] = &setups[i];
-                    ft[n] = floatDraw ? &floatTris[i] : nullptr;
-                    at[n++] = floatDraw ? nullptr : &alignedTris[i];
+                    ft[n] = floatDraw ? &floatTris[tableOf[i]] : nullptr;
+                    at[n++] = floatDraw ? nullptr : &alignedTris[tableOf[i]];
                     ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
                     ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
                 }
@@ -456,9 +465,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if (isAligned[i]) {
                         if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
                         if (floatDraw)
-                            floatGroup[grouped] = &floatTris[i];
+                            floatGroup[grouped] = &floatTris[tableOf[i]];
                         else
-                            group[grouped] = &alignedTris[i];
+                            group[grouped] = &alignedTris[tableOf[i]];
                         groupSetups[grouped++] = &s;
                         continue;
                     }

@@ -699,7 +699,8 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
             FloatRowTriangle ft[2];
             for (int t = 0; t < 2; ++t) REQUIRE(prepareFloatRowTriangle(d, setups[t], ft[t]));
             const uint8_t prepared[2] = {1, 1};
-            shareFloatRowTables(d, ft, prepared, 2);
+            const uint32_t tableOf[2] = {0, 1};
+            shareFloatRowTables(d, ft, prepared, tableOf, 2);
             const FloatRowTriangle* tp[2] = {&ft[0], &ft[1]};
             const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
             AlignedStats stats;
