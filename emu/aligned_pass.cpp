@@ -389,6 +389,38 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
         return;
     }
+    if (config.step == 4 && config.wx == 128 && (config.phase == 0 || config.phase == 2) &&
+        4 * config.jhi <= config.rowTexels) {
+        // A 4:1 reduction's pair sums straight from the texel row, both phases at once (the other
+        // one into its own slot, where the draw's other taps on this texture most likely look).
+        HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
+        if (fresh) {
+            HConfig partner = config;
+            partner.phase = 2 - config.phase;
+            bool partnerFresh = false;
+            HRowCache::Slot& p = slotFor(cache, row, partner, tableId, partnerFresh);
+            const int n = config.jhi - config.jlo;
+            uint16_t *mine[4], *other[4];
+            slotPlanes(h, n, kHRowPad, mine);
+            if (partnerFresh) {
+                slotPlanes(p, n, kHRowPad, other);
+            } else {
+                thread_local std::vector<uint16_t> spare;
+                spare.resize(size_t((n + kHRowPad + 15) & ~15) * 4);
+                for (int c = 0; c < 4; ++c) other[c] = spare.data() + size_t(c) * (spare.size() / 4);
+            }
+            const uint8_t* texels = row + size_t(16) * size_t(config.jlo);
+            if (config.phase == 0)
+                kernels.pairSums4(texels, n, mine, other);
+            else
+                kernels.pairSums4(texels, n, other, mine);
+            cache.built += partnerFresh ? 2 : 1;
+        } else {
+            ++cache.hits;
+        }
+        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        return;
+    }
     const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
     HRowCache::Slot& staged = slotFor(cache, row, stageKey, stageKey.tableId, fresh);
     const int first = config.step * config.jlo + config.phase - config.stageLo;  // staged element of jlo
@@ -638,6 +670,7 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
             }
             if (ci < 0) {
                 out.configs.push_back(HConfig{tap.texels, wx, step, phase, j0, j0 + (e - x), 0, 0});
+                out.configs.back().rowTexels = int32_t(tap.width);
                 ci = int(out.configs.size()) - 1;
             }
             HConfig& h = out.configs[size_t(ci)];

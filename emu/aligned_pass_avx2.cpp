@@ -11,6 +11,7 @@
 
 #include "emu/aligned_pass_kernels.h"
 #include "emu/lanes_avx2.h"
+#include "ps11/texture.h"
 
 namespace emu {
 
@@ -50,6 +51,50 @@ void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[
         alignas(32) uint8_t last[64] = {};
         std::memcpy(last, row + 4 * k, size_t(4 * (count - k)));
         deinterleave16(last, out, k);
+    }
+}
+
+void alignedPairSums4Avx2(const uint8_t* row, int n, uint16_t* const even[4], uint16_t* const odd[4]) {
+    const __m256i gather = _mm256_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15, 0, 4, 8, 12, 1, 5, 9,
+                                            13, 2, 6, 10, 14, 3, 7, 11, 15);
+    const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+    const __m256i ones = _mm256_set1_epi8(1), low = _mm256_set1_epi32(0xffff);
+    int j = 0;
+    for (; j + 16 <= n; j += 16) {
+        // Four groups of 16 texels (four blocks of 4): per group, the channel bytes in texel order
+        // (b0-15 | g0-15, r0-15 | a0-15, as the deinterleave takes them), then the sums of byte
+        // pairs: words b(4i)+b(4i+1), b(4i+2)+b(4i+3), … — a block's even and odd sums, side by side.
+        __m256i bg[4], ra[4];
+        for (int g = 0; g < 4; ++g) {
+            const uint8_t* p = row + 64 * (j / 4 + g);
+            const __m256i x = _mm256_shuffle_epi8(loadu(p), gather), y = _mm256_shuffle_epi8(loadu(p + 32), gather);
+            bg[g] = _mm256_maddubs_epi16(_mm256_permutevar8x32_epi32(_mm256_unpacklo_epi32(x, y), order), ones);
+            ra[g] = _mm256_maddubs_epi16(_mm256_permutevar8x32_epi32(_mm256_unpackhi_epi32(x, y), order), ones);
+        }
+        // A channel's 16 blocks as dwords (even sum in the low word, odd in the high one), in two
+        // registers of 8; then each half packed into 16 words in block order.
+        auto store = [&](__m256i a, __m256i b, uint16_t* e, uint16_t* o) {
+            storeu(e + j, _mm256_permute4x64_epi64(
+                              _mm256_packus_epi32(_mm256_and_si256(a, low), _mm256_and_si256(b, low)), 0xD8));
+            storeu(o + j, _mm256_permute4x64_epi64(_mm256_packus_epi32(_mm256_srli_epi32(a, 16), _mm256_srli_epi32(b, 16)),
+                                                   0xD8));
+        };
+        store(_mm256_permute2x128_si256(bg[0], bg[1], 0x20), _mm256_permute2x128_si256(bg[2], bg[3], 0x20), even[2],
+              odd[2]);
+        store(_mm256_permute2x128_si256(bg[0], bg[1], 0x31), _mm256_permute2x128_si256(bg[2], bg[3], 0x31), even[1],
+              odd[1]);
+        store(_mm256_permute2x128_si256(ra[0], ra[1], 0x20), _mm256_permute2x128_si256(ra[2], ra[3], 0x20), even[0],
+              odd[0]);
+        store(_mm256_permute2x128_si256(ra[0], ra[1], 0x31), _mm256_permute2x128_si256(ra[2], ra[3], 0x31), even[3],
+              odd[3]);
+    }
+    for (; j < n; ++j) {
+        const uint8_t* t = row + 16 * j;
+        for (int c = 0; c < 4; ++c) {
+            const int b = ps11::kUnorm8Byte[c];
+            even[c][j] = uint16_t(t[b] + t[4 + b]);
+            odd[c][j] = uint16_t(t[8 + b] + t[12 + b]);
+        }
     }
 }
 
@@ -311,7 +356,7 @@ int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uin
 
 }  // namespace
 
-const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2, &alignedCombineAvx2, &alignedBuildTabulatedAvx2,
-                                    &alignedVerticalAvx2, &alignedStoreRowAvx2};
+const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2, &alignedPairSums4Avx2,
+                                    &alignedBuildTabulatedAvx2, &alignedVerticalAvx2, &alignedStoreRowAvx2};
 
 }  // namespace emu

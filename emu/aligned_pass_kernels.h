@@ -42,6 +42,12 @@ struct AlignedKernels {
     // the last one read.
     void (*combine)(const uint16_t* const t[4], int n, int step, int32_t wx, uint16_t* const out[4]);
 
+    // The two weight-½ H rows of a 4:1 reduction straight from a b g r a texel row, with no
+    // staged planes: for j in [0, n), even[c][j] = the sum of channel c of texels 4j and 4j + 1,
+    // odd[c][j] = that of texels 4j + 2 and 4j + 3 (combine's step 4, kind S, phases 0 and 2).
+    // Reads texels [0, 4n) only; writes the planes up to the next multiple of 16.
+    void (*pairSums4)(const uint8_t* row, int n, uint16_t* const even[4], uint16_t* const odd[4]);
+
     // Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b
     // the channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets within
     // the row's `rowTexels` words; negative offsets read texel 0: such elements are never used).

@@ -1241,3 +1241,94 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
         }
     }
 }
+
+TEST_CASE("aligned pass: a 4:1 reduction's pair sums straight from the texel row equal the staged combine",
+          "[draw][aligned]") {
+    // pairSums4 against the rule (channel sums of texels 4j, 4j + 1 and 4j + 2, 4j + 3, planes
+    // r g b a) and against deinterleave + combine (step 4, weight ½, phases 0 and 2), for lengths
+    // around whole groups of 16 and random bytes; nothing past texel 4n is read (the row ends
+    // there, in a buffer of its own).
+    const ps11::ScopedSimdLevel level(ps11::SimdLevel::Avx2);
+    const AlignedKernels* k = alignedKernels(level.level());
+    if (!k) return;
+    std::mt19937 rng(20261129);
+    for (const int n : {1, 5, 15, 16, 17, 31, 32, 48, 63, 64, 100, 480}) {
+        std::vector<uint8_t> row(size_t(16) * size_t(n));
+        for (uint8_t& b : row) b = uint8_t(rng());
+        const size_t stride = size_t((n + kHRowPad + 15) & ~15);
+        std::vector<uint16_t> even(stride * 4), odd(stride * 4);
+        uint16_t* const e[4] = {&even[0], &even[stride], &even[2 * stride], &even[3 * stride]};
+        uint16_t* const o[4] = {&odd[0], &odd[stride], &odd[2 * stride], &odd[3 * stride]};
+        k->pairSums4(row.data(), n, e, o);
+        // The staged way: 4n texels deinterleaved (with the padding combine reads), then combined.
+        const size_t sstride = size_t(4 * n + kStagePad + 16);
+        std::vector<uint16_t> staged(sstride * 4);
+        uint16_t* const s[4] = {&staged[0], &staged[sstride], &staged[2 * sstride], &staged[3 * sstride]};
+        k->deinterleave(row.data(), 4 * n, s);
+        std::vector<uint16_t> ce(stride * 4), co(stride * 4);
+        uint16_t* const cev[4] = {&ce[0], &ce[stride], &ce[2 * stride], &ce[3 * stride]};
+        uint16_t* const cov[4] = {&co[0], &co[stride], &co[2 * stride], &co[3 * stride]};
+        const uint16_t* const s0[4] = {s[0], s[1], s[2], s[3]};
+        const uint16_t* const s2[4] = {s[0] + 2, s[1] + 2, s[2] + 2, s[3] + 2};
+        k->combine(s0, n, 4, 128, cev);
+        k->combine(s2, n, 4, 128, cov);
+        for (int c = 0; c < 4; ++c)
+            for (int j = 0; j < n; ++j) {
+                const int b = ps11::kUnorm8Byte[c];
+                INFO("n " << n << ", channel " << c << ", element " << j);
+                REQUIRE(e[c][j] == row[size_t(16 * j + b)] + row[size_t(16 * j + 4 + b)]);
+                REQUIRE(o[c][j] == row[size_t(16 * j + 8 + b)] + row[size_t(16 * j + 12 + b)]);
+                REQUIRE(e[c][j] == cev[c][j]);
+                REQUIRE(o[c][j] == cov[c][j]);
+            }
+    }
+}
+
+TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equal the quad path", "[draw][aligned]") {
+    // The glow's first pass: four bilinear taps one texel either side of each 4x4 block's centre
+    // (H rows of pair sums from the texel row, both phases at once), random texels, a target of
+    // several groups of 16 and a ragged end, in fx8, plain and ONE/ONE.
+    std::mt19937 rng(20261130);
+    for (int i = 0; i < 8; ++i) {
+        Case c = randomCase(rng);
+        c.w = UINT(std::uniform_int_distribution<int>(20, 90)(rng)), c.h = 6;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        for (Case::Tex& t : c.tex) {
+            t.w = 4 * c.w, t.h = 4 * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = D3DTEXF_LINEAR, t.addressU = t.addressV = D3DTADDRESS_CLAMP;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        }
+        c.oneTexture = true;
+        c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                    "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
+        c.blend = DWORD(i % 2), c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        const float off[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+            for (int s = 0; s < 4; ++s) {
+                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(4 * c.w);
+                v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(4 * c.h);
+            }
+            c.verts.push_back(v);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        rowOpt.software.skipTiles = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);
+        });
+    }
+}
