@@ -142,7 +142,9 @@ const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_
 #if defined(__SSE2__)
         // Four texels at a time: a 4×4 transpose, NaNs noted by an unordered compare.
         __m128 unordered = _mm_setzero_ps();
+        const bool ahead = 16 * tw >= kPrefetchRowBytes;
         for (; i + 4 <= tw; i += 4) {
+            if (ahead) _mm_prefetch(reinterpret_cast<const char*>(v + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
             __m128 t0 = _mm_loadu_ps(v + 4 * i), t1 = _mm_loadu_ps(v + 4 * i + 4), t2 = _mm_loadu_ps(v + 4 * i + 8),
                    t3 = _mm_loadu_ps(v + 4 * i + 12);
             unordered = _mm_or_ps(unordered, _mm_or_ps(_mm_cmpunord_ps(t0, t1), _mm_cmpunord_ps(t2, t3)));

@@ -65,7 +65,9 @@ void decodeAvx2(const uint8_t* row, int n, float* out, size_t stride) {
     const __m256i byte = _mm256_set1_epi32(0xff);
     constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
     int i = 0;
+    const bool ahead = 4 * n >= kPrefetchRowBytes;
     for (; i + 8 <= n; i += 8) {
+        if (ahead) _mm_prefetch(reinterpret_cast<const char*>(row + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
         const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(row + 4 * i));
         _mm256_storeu_ps(out + i, unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, 16), byte))));
         _mm256_storeu_ps(out + stride + i,

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "emu/prefetch.h"
 #include "ps11/simd_dispatch.h"
 
 namespace emu {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "emu/output_merger.h"
+#include "emu/prefetch.h"
 #include "emu/raster.h"
 #include "ps11/executor.h"
 #include "ps11/executor_presampled_internal.h"
@@ -233,14 +234,8 @@ inline bool rowSpan(const TriangleSetup& s, int y, const RowWindow* windows, siz
     return xl < xr;
 }
 
-// Both row paths ask for the target's bytes of pixels [x0, x1) of the next row ahead of their read
-// (a ONE/ONE sum, a blend) or write (the line is fetched before it is written): a row's time hides
-// their latency, which otherwise stalls the store of every span (three quarters of a 1080p
-// composite's store time; bench_draw's 1080p composites 6–11 % faster). Only for targets larger
-// than the second-level cache: a 480×270 blur's target stays there, and asking cost it 1–2 %.
-// Asking ahead for texel rows the same way did not pay (the reductions' deinterleaves are
-// compute-bound, and the small blurs got 5–15 % slower).
-inline bool prefetchesRows(const Image& target) { return target.bytes.size() >= (size_t(1) << 20); }
+// Both row paths ask for the target's bytes of pixels [x0, x1) of the next row ahead (emu/prefetch.h).
+inline bool prefetchesRows(const Image& target) { return target.bytes.size() >= kPrefetchTargetBytes; }
 inline void prefetchRow(const Image& target, int x0, int x1, int y) {
     if (x1 <= x0) return;
     const uintptr_t first = reinterpret_cast<uintptr_t>(target.texel(uint32_t(x0), uint32_t(y))) & ~uintptr_t(63);

@@ -46,7 +46,10 @@ inline __m256i roundShift(__m256i v) {
 
 void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]) {
     int k = 0;
-    for (; k + 16 <= count; k += 16) deinterleave16(row + 4 * k, out, k);
+    for (; k + 16 <= count; k += 16) {
+        _mm_prefetch(reinterpret_cast<const char*>(row + 4 * k) + kPrefetchAhead, _MM_HINT_T0);
+        deinterleave16(row + 4 * k, out, k);
+    }
     if (k < count) {
         alignas(32) uint8_t last[64] = {};
         std::memcpy(last, row + 4 * k, size_t(4 * (count - k)));
@@ -67,6 +70,7 @@ void alignedPairSums4Avx2(const uint8_t* row, int n, uint16_t* const even[4], ui
         __m256i bg[4], ra[4];
         for (int g = 0; g < 4; ++g) {
             const uint8_t* p = row + 64 * (j / 4 + g);
+            _mm_prefetch(reinterpret_cast<const char*>(p) + kPrefetchAhead, _MM_HINT_T0);
             const __m256i x = _mm256_shuffle_epi8(loadu(p), gather), y = _mm256_shuffle_epi8(loadu(p + 32), gather);
             bg[g] = _mm256_maddubs_epi16(_mm256_permutevar8x32_epi32(_mm256_unpacklo_epi32(x, y), order), ones);
             ra[g] = _mm256_maddubs_epi16(_mm256_permutevar8x32_epi32(_mm256_unpackhi_epi32(x, y), order), ones);

@@ -16,6 +16,7 @@
 
 #include <cstdint>
 
+#include "emu/prefetch.h"
 #include "ps11/simd_dispatch.h"
 
 namespace emu {
