@@ -7,6 +7,7 @@
 // path (no helper lanes shaded).
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <random>
@@ -1330,5 +1331,56 @@ TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equ
             REQUIRE(drawCase(rowDev, c, rs) == expected);
             CHECK(rs.pixelsShaded == rs.pixelsCovered);
         });
+    }
+}
+
+TEST_CASE("aligned pass: chains of products that pass the range's top are clamped after each op", "[draw][aligned]") {
+    // The weighted blur's mul and three mads (one kernel for the chain: exec::FastKernels::chain)
+    // with weights whose sum passes 1, over bright random texels: the running sum meets hi and
+    // is clamped after each op, as the quad path's per-op arithmetic does. POINT taps at whole
+    // texels (direct runs) and bilinear ones between texels.
+    std::mt19937 rng(20261131);
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    for (int i = 0; i < 8; ++i) {
+        Case c = randomCase(rng);
+        c.w = 70, c.h = 5;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        for (Case::Tex& t : c.tex) {
+            t.w = c.w, t.h = c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = i % 2 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.addressU = t.addressV = D3DTADDRESS_CLAMP;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(std::uniform_int_distribution<int>(100, 255)(rng));
+        }
+        c.oneTexture = true;
+        // (The sub after the chain shows its clamp: the store would clamp an unclamped sum anyway.)
+        c.program = "ps_1_1\ndef c4, 0.5, 0.5, 0.5, 0.5\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                    "mad r0, t1, c1, r0\nmad r0, t2, c2, r0\nmad r0, t3, c3, r0\nsub r0, r0, c4\n";
+        for (auto& k : c.consts)
+            for (float& v : k) v = real(0.2f, 1.0f);
+        c.blend = 0, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        const float shift = i % 2 ? 0.5f : 1.0f;
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+            for (int s = 0; s < 4; ++s) {
+                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (float(s) - 1.5f) * shift / float(c.w);
+                v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            }
+            c.verts.push_back(v);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        rowOpt.software.skipTiles = false;
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsShaded == rs.pixelsCovered);
+        // The clamp mattered: the sum reached 1, less 0.5 (the byte 127 or 128).
+        CHECK(std::count_if(expected.begin(), expected.end(), [](uint8_t b) { return b == 127 || b == 128; }) > 100);
     }
 }
