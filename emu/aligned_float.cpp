@@ -521,7 +521,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
             const bool joined = ti + 1 < count && tris[ti + 1]->x0 == tri.x0 && tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1], draw.plan, draw.colorAttrs, y, windows, windowCount, xl, xr);
+                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y, windows,
+                                        windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri);
             for (int t = 0; t < taps; ++t) {

@@ -201,9 +201,9 @@ void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, in
 
 namespace {
 
-// Sets the texel rows and vertical weight of `r` (its H-row planes are the caller's to set).
-void setTapRow(TapRow& r, const AlignedTap& tap, const TriangleSetup& s, int y) {
-    const float v = rowV(s, tap.coordSet, y);
+// Sets the texel rows and vertical weight of `r` for the row's v (its H-row planes are the
+// caller's to set).
+void setTapRow(TapRow& r, const AlignedTap& tap, float v) {
     int32_t j0 = 0, j1 = 0, w = 0;
     ps11::fastpath::axisTable(tap.addressV, tap.linear, 1, &v, tap.height, &j0, &j1, &w);
     const size_t pitch = size_t(tap.width) * 4;
@@ -589,13 +589,13 @@ bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11
     return true;
 }
 
-bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapPlan& plan, uint64_t colorAttrs, int y,
-             const RowWindow* windows, size_t count, int& xl, int& xr) {
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
+             uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr) {
     int nl = 0, nr = 0;
     if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
     for (int i = 0; i < plan.count; ++i) {
         const int ku = attrTex(plan.coordSet[size_t(i)], 0);
-        if (!sameOnRow(s, next, ku, y, y) || !sameOnRow(s, next, ku + 1, y, y)) return false;
+        if ((!sharedTables && !sameOnRow(s, next, ku, y, y)) || !sameOnRow(s, next, ku + 1, y, y)) return false;
     }
     for (int k = 0; k < kAttrCount; ++k)
         if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y, y)) return false;
@@ -825,6 +825,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         cache.serial = draw.serial;
     }
     std::array<const uint16_t*, 4> planes{};
+    float tapV[8] = {};  // each tap's v on the current pixel row
     // Tabulated configurations: a triangle whose table equals an earlier one's over the same
     // columns takes that one's id, so their H rows are shared (a full-screen quad's two halves).
     // (Only the entries of existing configurations are set and read.)
@@ -862,14 +863,29 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
             const bool joined = ti + 1 < count && tris[ti + 1]->x0 == tri.x0 && tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1], draw.plan, draw.colorAttrs, y, windows, windowCount, xl, xr);
+                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y, windows,
+                                        windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
                 if (!tap.bound || !((neededTaps >> t) & 1)) continue;
                 TapRow& r = rows[size_t(t)];
-                setTapRow(r, tap, s, y);
+                // Taps at the same v of the same texture (a horizontal blur's) read the same rows.
+                tapV[t] = rowV(s, tap.coordSet, y);
+                int same = -1;
+                for (int u = 0; u < t && same < 0; ++u) {
+                    const AlignedTap& o = draw.taps[size_t(u)];
+                    if (o.bound && ((neededTaps >> u) & 1) && o.texels == tap.texels && o.height == tap.height &&
+                        o.addressV == tap.addressV && o.linear == tap.linear &&
+                        std::bit_cast<uint32_t>(tapV[u]) == std::bit_cast<uint32_t>(tapV[t]))
+                        same = u;
+                }
+                if (same >= 0) {
+                    r.row0 = rows[size_t(same)].row0, r.row1 = rows[size_t(same)].row1, r.wy = rows[size_t(same)].wy;
+                } else {
+                    setTapRow(r, tap, tapV[t]);
+                }
                 // The H rows of the tap's long runs (built on first use, shared by taps and rows).
                 const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
                 const bool rowsOk = r.row0 && (r.row1 || r.wy == 0);

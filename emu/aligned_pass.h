@@ -252,12 +252,13 @@ bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11
 // Joins the next triangle's run of pixel row y to [xl, xr) (this triangle's, rowSpan's) when
 // the two are adjacent and give every pixel of the row the same attributes the row paths read:
 // each tap's u and v and the colours `colorAttrs` names, bit for bit (the same float row base
-// and step per column, or the same constant). The caller has checked that their tables cover
+// and step per column, or the same constant; u is not compared where the two share their tables,
+// `sharedTables`: sameColumnTables compared it). The caller has checked that their tables cover
 // the same columns (they are then equal). A quad's two halves split every row at the diagonal;
 // joined, each row is one run: half the runs of a sprite, and full-width spans for a
 // full-screen pass. True when joined (the next triangle's pixels of the row are then this run's).
-bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const ps11::TapPlan& plan, uint64_t colorAttrs, int y,
-             const RowWindow* windows, size_t count, int& xl, int& xr);
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
+             uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr);
 
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
