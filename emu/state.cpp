@@ -192,49 +192,6 @@ float DeviceState::stageStateFloat(int stage, D3DTEXTURESTAGESTATETYPE s) const 
     return bitsFloat(stageStates[size_t(stage)][s]);
 }
 
-void DeviceState::forEachWord(const std::function<void(uint32_t)>& f, uint32_t parts) const {
-    if (parts & RenderStates)
-        for (DWORD v : renderStates) f(v);
-    if (parts & StageStates)
-        for (const auto& st : stageStates)
-            for (DWORD v : st) f(v);
-    if (parts & SamplerStates)
-        for (const auto& st : samplerStates)
-            for (DWORD v : st) f(v);
-    if (parts & Textures)
-        for (Handle h : textures) f(uint32_t(h));
-    if (parts & Bindings) {
-        f(uint32_t(renderTarget));
-        f(uint32_t(depthStencil));
-        f(uint32_t(pixelShader));
-    }
-    if (parts & Transforms) {
-        auto matrix = [&f](const D3DMATRIX& m) {
-            for (const auto& row : m.m)
-                for (float x : row) f(floatBits(x));
-        };
-        matrix(world);
-        matrix(view);
-        matrix(projection);
-        for (const D3DMATRIX& m : texture) matrix(m);
-    }
-    if (parts & ViewportScissor) {
-        f(viewport.X), f(viewport.Y), f(viewport.Width), f(viewport.Height);
-        f(floatBits(viewport.MinZ)), f(floatBits(viewport.MaxZ));
-        f(uint32_t(scissor.left)), f(uint32_t(scissor.top)), f(uint32_t(scissor.right)), f(uint32_t(scissor.bottom));
-    }
-    if (parts & PsConstants)
-        for (const auto& c : psConstants)
-            for (float x : c) f(floatBits(x));
-    if (parts & Fvf) f(fvf);
-    if (parts & BoundTextures) {
-        uint32_t bound = 0;
-        for (size_t i = 0; i < textures.size(); ++i)
-            if (textures[i] != Handle::Null) bound |= 1u << i;
-        f(bound);
-    }
-}
-
 size_t DeviceState::hash(uint32_t parts) const {
     // FNV-1a over the words' bytes, 64-bit.
     uint64_t h = 1469598103934665603ull;
