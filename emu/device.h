@@ -186,6 +186,13 @@ public:
     std::shared_ptr<const ps11::Texture> sampledTexture(Handle texture);
     // The decoded, validated program of a pixel shader; nullptr for a bad handle.
     const ps11::Program* pixelShaderProgram(Handle shader) const;
+    // A surface's newest bytes where the front keeps them, for reading: D3D9 reads a render
+    // target through GetRenderTargetData into a SYSTEMMEM copy, which for a 1080p frame moves
+    // 8 MB (32 MB in float) only to look at it. `read` gets the level's pitch and bits; while it
+    // runs the level counts as locked, so nothing may write it (a write fails with E4106) and the
+    // bytes cannot move. Any surface, lockable or not; refused while fingerprinting (E4125) and
+    // for a level already locked (E4106).
+    HRESULT readSurface(Handle surface, const std::function<void(const D3DLOCKED_RECT&)>& read);
 
 private:
     HRESULT fail(HRESULT hr, const char* code, std::string message);

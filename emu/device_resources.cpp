@@ -504,6 +504,36 @@ HRESULT Device::UnlockRect(Handle surface) {
     return unlockLevel("UnlockRect", *r, ref.level);
 }
 
+HRESULT Device::readSurface(Handle surface, const std::function<void(const D3DLOCKED_RECT&)>& read) {
+    ok();
+    if (m_fingerprint.active) return fingerprintRefuse("readSurface");
+    Resource* r = nullptr;
+    SurfaceRef ref;
+    const Image* im = surfaceImage(surface, "readSurface", "surface", &r, &ref);
+    if (!im) return m_error.hr;
+    if (r->locked[ref.level])
+        return fail(D3DERR_INVALIDCALL, "E4106",
+                    "readSurface: level " + num(ref.level) + " of " + handleText(surface) + " is locked");
+    syncLevel(*r, ref.level);  // the bytes read are the newest contents
+    // Read-only: no prepareWrite (the sampler's view and a shared store stay valid).
+    // Unlocked afterwards by handle: `read` may have released the resource.
+    struct Hold {
+        Device& d;
+        Handle owner;
+        uint32_t level;
+        ~Hold() {
+            if (Resource* h = d.findResource(owner)) h->locked[level] = 0;
+        }
+    } hold{*this, r->handle, ref.level};
+    r->locked[ref.level] = 1;
+    r->lockedReadOnly[ref.level] = 1;
+    D3DLOCKED_RECT lr{};
+    lr.Pitch = int32_t(im->rowPitch);
+    lr.pBits = const_cast<uint8_t*>(im->texel(0, 0));
+    read(lr);
+    return D3D_OK;
+}
+
 HRESULT Device::LockBox(Handle volumeTexture, UINT level, D3DLOCKED_BOX* locked, const D3DBOX* box, DWORD flags) {
     ok();
     if (m_fingerprint.active) return fingerprintRefuse("LockBox");

@@ -162,25 +162,14 @@ bool Runner::readPixels(Handle texture, const std::function<bool(const Pixels&)>
     emu::Device& d = *m_device;
     Handle surface{};
     D3DSURFACE_DESC desc{};
-    auto failed = [&] {
+    bool ok = false;
+    if (d.GetSurfaceLevel(texture, 0, &surface) != D3D_OK || d.GetDesc(surface, &desc) != D3D_OK ||
+        d.readSurface(surface, [&](const D3DLOCKED_RECT& lr) {
+            ok = use(Pixels{static_cast<const uint8_t*>(lr.pBits), desc.Width, desc.Height, size_t(lr.Pitch), desc.Format});
+        }) != D3D_OK) {
         error = d.lastError().message;
         return false;
-    };
-    if (d.GetSurfaceLevel(texture, 0, &surface) != D3D_OK || d.GetDesc(surface, &desc) != D3D_OK) return failed();
-    if (m_readBack == Handle::Null || m_readBackDesc.Width != desc.Width || m_readBackDesc.Height != desc.Height ||
-        m_readBackDesc.Format != desc.Format) {
-        if (m_readBack != Handle::Null) d.Release(m_readBack);
-        m_readBack = Handle::Null;
-        if (d.CreateOffscreenPlainSurface(desc.Width, desc.Height, desc.Format, D3DPOOL_SYSTEMMEM, &m_readBack) != D3D_OK)
-            return failed();
-        m_readBackDesc = desc;
     }
-    D3DLOCKED_RECT lr{};
-    if (d.GetRenderTargetData(surface, m_readBack) != D3D_OK ||
-        d.LockRect(m_readBack, &lr, nullptr, D3DLOCK_READONLY) != D3D_OK)
-        return failed();
-    const bool ok = use(Pixels{static_cast<const uint8_t*>(lr.pBits), desc.Width, desc.Height, size_t(lr.Pitch), desc.Format});
-    d.UnlockRect(m_readBack);
     return ok;
 }
 

@@ -82,10 +82,9 @@ public:
     emu::Handle outputTexture() const { return m_output; }
     std::optional<emu::RgbaImage> readOutput(std::string& error);
     std::optional<emu::RgbaImage> readTexture(emu::Handle texture, std::string& error);
-    // Level 0 of a render-target texture as the application sees it: GetRenderTargetData into a
-    // SYSTEMMEM surface the runner keeps (one per size and format), locked read-only while `use`
-    // looks at it (D3D's layout, `pitch` bytes a row). False with `error` if a call fails or `use`
-    // returns false.
+    // Level 0 of a render-target texture as the application sees it, read where the device keeps
+    // it (`Device::readSurface`: no copy) while `use` looks at it (D3D's layout, `pitch` bytes a
+    // row). False with `error` if a call fails or `use` returns false.
     struct Pixels {
         const uint8_t* data = nullptr;
         uint32_t width = 0, height = 0;
@@ -124,8 +123,6 @@ private:
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
     std::string m_persistentError;
-    emu::Handle m_readBack{};  // readPixels' SYSTEMMEM surface
-    D3DSURFACE_DESC m_readBackDesc{};
     std::string m_lastGraphviz;
 };
 

@@ -1096,6 +1096,61 @@ TEST_CASE("device: GetRenderTargetData copies into SYSTEMMEM", "[device]") {
     CHECK(dev.GetRenderTargetData(rt, Handle::Null) == D3DERR_INVALIDCALL);
 }
 
+TEST_CASE("device: readSurface hands the newest bytes in place, and nothing writes them meanwhile", "[device]") {
+    Device dev;
+    Handle rt{}, tex{}, level{};
+    REQUIRE(dev.CreateRenderTarget(3, 2, D3DFMT_A8R8G8B8, 0, &rt) == D3D_OK);  // not lockable
+    REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+    const D3DRECT r{1, 0, 3, 1};
+    REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xFF000080u, 1.0f, 0) == D3D_OK);
+    REQUIRE(dev.Clear(1, &r, D3DCLEAR_TARGET, 0x80FF0000u, 1.0f, 0) == D3D_OK);
+    int calls = 0;
+    const auto pixel = [](const D3DLOCKED_RECT& lr, UINT x, UINT y) {
+        uint32_t c;
+        std::memcpy(&c, static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch + x * 4, 4);
+        return c;
+    };
+    REQUIRE(dev.readSurface(rt, [&](const D3DLOCKED_RECT& lr) {
+        ++calls;
+        CHECK(lr.Pitch >= 12);
+        CHECK(pixel(lr, 0, 0) == 0xFF000080u);
+        CHECK(pixel(lr, 2, 0) == 0x80FF0000u);
+        CHECK(pixel(lr, 2, 1) == 0xFF000080u);
+        // Held like a lock: a write to it is refused while `read` runs.
+        CHECK(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0u, 1.0f, 0) == D3DERR_INVALIDCALL);
+        CHECK(dev.lastError().code == "E4106");
+        CHECK(dev.readSurface(rt, [](const D3DLOCKED_RECT&) {}) == D3DERR_INVALIDCALL);
+    }) == D3D_OK);
+    CHECK(calls == 1);
+    // Released afterwards: writes go through and the next read sees them.
+    REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x01020304u, 1.0f, 0) == D3D_OK);
+    REQUIRE(dev.readSurface(rt, [&](const D3DLOCKED_RECT& lr) { CHECK(pixel(lr, 1, 1) == 0x01020304u); }) == D3D_OK);
+    // A texture's level, and a level locked by LockRect (refused, the callback never runs).
+    REQUIRE(dev.CreateTexture(2, 2, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+    REQUIRE(dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK);
+    D3DLOCKED_RECT lr{};
+    REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
+    std::memcpy(lr.pBits, "\x11\x22\x33\x44", 4);
+    calls = 0;
+    CHECK(dev.readSurface(level, [&](const D3DLOCKED_RECT&) { ++calls; }) == D3DERR_INVALIDCALL);
+    CHECK(contains(dev.lastError().message, "is locked"));
+    REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+    REQUIRE(dev.readSurface(level, [&](const D3DLOCKED_RECT& l) {
+        ++calls;
+        CHECK(pixel(l, 0, 0) == 0x44332211u);
+    }) == D3D_OK);
+    CHECK(calls == 1);
+    // A handle that is no surface, and a fingerprint (which cannot hand contents back).
+    CHECK(dev.readSurface(Handle(4242), [](const D3DLOCKED_RECT&) {}) == D3DERR_INVALIDCALL);
+    CHECK(contains(dev.lastError().message, "readSurface"));
+    dev.beginFingerprint();
+    CHECK(dev.readSurface(rt, [](const D3DLOCKED_RECT&) {}) == D3DERR_INVALIDCALL);
+    CHECK(dev.lastError().code == "E4125");
+    CHECK_FALSE(dev.endFingerprint().complete);
+    // The callback may release the surface's owner: the hold is dropped by handle.
+    REQUIRE(dev.readSurface(level, [&](const D3DLOCKED_RECT&) { CHECK(dev.Release(tex) == D3D_OK); }) == D3D_OK);
+}
+
 TEST_CASE("device: automatic mip generation", "[device]") {
     Device dev;
     Handle tex{};

@@ -143,9 +143,17 @@ TEST_CASE("gl renderer: surfaces stay on the GL side until the front asks, and t
         const TransferStats t0 = dev.transfers();
         CHECK(t0.readBacks == 0);
         CHECK(t0.uploads <= 2);  // each surface's first contents, at most
-        // The front asks: one read-back, the drawn colour.
+        // readSurface of the texture cleared on the GL side (not lockable): one read-back, the
+        // cleared colour; a second read of unchanged contents crosses nothing.
+        for (int pass = 0; pass < 2; ++pass) {
+            uint32_t cleared = 0;
+            REQUIRE(dev.readSurface(level, [&](const D3DLOCKED_RECT& lr) { std::memcpy(&cleared, lr.pBits, 4); }) == D3D_OK);
+            CHECK(cleared == 0xff336699u);
+            CHECK(dev.transfers().readBacks == 1);
+        }
+        // The front asks for the render target: one read-back more, the drawn colour.
         const std::vector<uint8_t> px = lockedBytes(dev, rt);
-        CHECK(dev.transfers().readBacks == 1);
+        CHECK(dev.transfers().readBacks == 2);
         CHECK(px[0] == 0x99);
         CHECK(px[1] == 0x66);
         CHECK(px[2] == 0x33);
