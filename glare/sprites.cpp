@@ -239,6 +239,21 @@ std::vector<float> glareImage(uint32_t size, int streaks) {
 
 namespace {
 
+// The largest value of a size×size image at each distance from its centre and beyond (index:
+// the distance in texels, rounded down).
+std::vector<float> radialMaximum(const std::vector<float>& img, uint32_t size) {
+    std::vector<float> m(size, 0);
+    const float cc = (float(size) - 1) / 2;
+    for (uint32_t y = 0; y < size; ++y)
+        for (uint32_t x = 0; x < size; ++x) {
+            const float r = std::hypot(float(x) - cc, float(y) - cc);
+            const size_t ri = std::min<size_t>(size_t(r), size - 1);
+            m[ri] = std::max(m[ri], img[size_t(y) * size + x]);
+        }
+    for (size_t i = size - 1; i-- > 0;) m[i] = std::max(m[i], m[i + 1]);  // max beyond r
+    return m;
+}
+
 class Sprites final : public Technique {
 public:
     std::string_view name() const override { return "sprites"; }
@@ -281,20 +296,51 @@ public:
         const uint32_t imageSize = 128;
 
         const TextureId image = g.create("glare image", {imageSize, imageSize, D3DFMT_A8R8G8B8});
-        const auto glare = std::make_shared<const std::vector<float>>(glareImage(imageSize, streaks));
+        // The glare image and its radial maximum depend on the streaks only: made when they
+        // change, kept on the runner (a few hundred thousand exp and atan2 a frame otherwise).
+        struct GlareKept {
+            int streaks = -1;
+            std::vector<float> image;
+            std::vector<float> radial;  // the radial maximum of the glare image, for shrinking
+            emu::SurfacePixels pixels;  // the image as uploaded (8-bit grey, alpha 255)
+            // With reuse: the texture the last upload wrote and the generation it left.
+            emu::Handle uploaded{};
+            uint64_t generation = 0;
+        };
+        GlareKept& kept = fb.runner.kept<GlareKept>("sprites: glare image");
+        if (kept.streaks != streaks) {
+            kept.image = glareImage(imageSize, streaks);
+            kept.radial = radialMaximum(kept.image, imageSize);
+            kept.pixels = emu::SurfacePixels{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
+            kept.pixels.bytes.resize(kept.image.size() * 4);
+            for (size_t i = 0; i < kept.image.size(); ++i) {
+                const uint8_t v = uint8_t(std::lround(kept.image[i] * 255));
+                kept.pixels.bytes[i * 4 + 0] = kept.pixels.bytes[i * 4 + 1] = kept.pixels.bytes[i * 4 + 2] = v;
+                kept.pixels.bytes[i * 4 + 3] = 255;
+            }
+            kept.uploaded = emu::Handle::Null;
+            kept.streaks = streaks;
+        }
+        GlareKept* const glare = &kept;  // on the runner, which outlives the frame
+        const std::vector<float>& radial = kept.radial;
+        Runner* const owner = &fb.runner;
         g.addPass(PassInfo{"glare_image", PassKind::DeviceSide, "",
-                           "the precomputed glare image (streaks + halo), computed on the CPU and uploaded each frame"},
+                           "the precomputed glare image (streaks + halo), computed on the CPU once and uploaded"},
                   [&](PassBuilder& b) { b.write(image); },
                   [=](PassContext& c) {
-                      const std::vector<float>& img = *glare;
-                      emu::SurfacePixels px{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
-                      px.bytes.resize(img.size() * 4);
-                      for (size_t i = 0; i < img.size(); ++i) {
-                          const uint8_t v = uint8_t(std::lround(img[i] * 255));
-                          px.bytes[i * 4 + 0] = px.bytes[i * 4 + 1] = px.bytes[i * 4 + 2] = v;
-                          px.bytes[i * 4 + 3] = 255;
+                      // With reuse, a texture still holding the last upload (same texture, the
+                      // generation it left) is not written again.
+                      const emu::Handle texture = c.texture(image);
+                      if (owner->reuses() && glare->uploaded == texture &&
+                          c.device.contentGeneration(texture) == glare->generation) {
+                          c.stats.reused = true;
+                          return true;
                       }
-                      return emu::writeSurface(c.device, c.surface(image), px, c.error);
+                      glare->uploaded = emu::Handle::Null;
+                      if (!emu::writeSurface(c.device, c.surface(image), glare->pixels, c.error)) return false;
+                      glare->uploaded = texture;
+                      glare->generation = c.device.contentGeneration(texture);
+                      return true;
                   });
 
         auto sprites = std::make_shared<std::vector<Sprite>>();
@@ -378,20 +424,6 @@ public:
                   });
 
         const TextureId buffer = g.create("glare buffer", {sd.width, sd.height, fb.format});
-        // The radial maximum of the glare image, for shrinking.
-        const std::vector<float> radial = [&] {
-            const std::vector<float>& img = *glare;
-            std::vector<float> m(imageSize, 0);
-            const float cc = (float(imageSize) - 1) / 2;
-            for (uint32_t y = 0; y < imageSize; ++y)
-                for (uint32_t x = 0; x < imageSize; ++x) {
-                    const float r = std::hypot(float(x) - cc, float(y) - cc);
-                    const size_t ri = std::min<size_t>(size_t(r), imageSize - 1);
-                    m[ri] = std::max(m[ri], img[size_t(y) * imageSize + x]);
-                }
-            for (size_t i = imageSize - 1; i-- > 0;) m[i] = std::max(m[i], m[i + 1]);  // max beyond r
-            return m;
-        }();
         g.addPass(PassInfo{"draw_sprites", PassKind::FixedFunction, "",
                            "one textured quad per sprite, glare image × vertex colour, additive (ONE, ONE)"},
                   [&](PassBuilder& b) {

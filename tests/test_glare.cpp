@@ -926,8 +926,7 @@ void checkReuse(const emu::DeviceOptions& device) {
         // Held still, passes are reused in every technique, on both renderers (not all: a
         // read-back step, what writes CPU data, and passes whose outputs later passes of the frame
         // blend onto run every frame; docs/glare/README.md "Reuse"); after the image changed,
-        // fewer. On GL the sprites' glare image, uploaded every frame, and the adaptation's 1×1
-        // state are read by their bytes (docs/device.md "Fingerprints").
+        // fewer. On GL the adaptation's 1×1 state is read by its bytes (docs/device.md "Fingerprints").
         CHECK(reusedWhileStill >= 2);
         CHECK(reusedWhileStill <= passesWhileStill);
         CHECK(reusedAfterChange * 2 < reusedWhileStill + 2);
@@ -995,6 +994,49 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
     }
     INFO("tiles filled, copied or skipped: " << decided);
     CHECK(decided > 1000);
+}
+
+TEST_CASE("sprites: the glare image is uploaded again only when its texture or the streaks change", "[glare][reuse]") {
+    // One runner with reuse on against one with skipping off, the image held still: the glare
+    // image's upload is reused while its texture holds it; changing the streaks mid-run (the
+    // image kept on the runner is rebuilt) uploads it again, and every frame's output equals the
+    // skip-off runner's.
+    const glare::Technique* t = glare::findTechnique("sprites");
+    REQUIRE(t);
+    glare::Settings settings = *glare::presetSettings(*t, "published");
+    glare::RunnerOptions on, off;
+    on.width = off.width = 160;
+    on.height = off.height = 96;
+    off.skip = false;
+    glare::Runner a(on), b(off);
+    std::string err;
+    std::unique_ptr<glare::Scene> scene = glare::makeScene(t->scene(), err);
+    REQUIRE(scene);
+    double ms = 0;
+    REQUIRE(a.renderScene(*scene, 0, 1, ms, err));
+    const std::optional<emu::RgbaImage> still = a.readTexture(a.sceneTexture(), err);
+    REQUIRE(still);
+    REQUIRE(a.setImage(*still, err));
+    REQUIRE(b.setImage(*still, err));
+    const auto imagePass = [](const glare::FrameResult& r) {
+        for (const glare::PassStats& st : r.passes)
+            if (st.pass == "glare_image") return st;
+        FAIL("no glare_image pass");
+        return glare::PassStats{};
+    };
+    for (int f = 0; f < 6; ++f) {
+        INFO("frame " << f);
+        if (f == 3) settings["streaks"] = settings["streaks"] + 2;
+        glare::FrameResult ra, rb;
+        REQUIRE(a.runFrame(*t, settings, f, 6, ra, err));
+        REQUIRE(b.runFrame(*t, settings, f, 6, rb, err));
+        const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
+        REQUIRE(oa);
+        REQUIRE(ob);
+        REQUIRE(oa->rgba == ob->rgba);
+        CHECK_FALSE(imagePass(rb).reused);
+        CHECK(imagePass(ra).reused == (f != 0 && f != 3));
+    }
 }
 
 TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
