@@ -112,8 +112,10 @@ void Runner::buildFrame(const Technique& technique, const Settings& settings, in
 bool Runner::runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
                       FrameResult& result, std::string& error, const PassGraph::Hook& hook,
                       const std::function<void(PassGraph&)>& built, bool hookObserves) {
+    const auto start = std::chrono::steady_clock::now();
     PassGraph graph;
     buildFrame(technique, settings, frame, frameCount, graph);
+    result.buildMilliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!m_persistentError.empty()) {
         error = m_persistentError;
         return false;
@@ -122,10 +124,10 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     result.passes.clear();
     const bool ok = graph.run(*m_pool, result.passes, error, hook, reuses() ? &m_memo : nullptr, hookObserves);
     // The passes' own time: what the hooks (dumps, captures) take is not the technique's.
-    result.milliseconds = 0;
+    result.milliseconds = result.buildMilliseconds;
     for (const PassStats& s : result.passes) result.milliseconds += s.milliseconds;
     if (ok && built) built(graph);  // again, with the aliasing filled in
-    if (ok) m_lastGraphviz = graph.graphviz(std::string(technique.name()));
+    if (ok && m_options.graphviz) m_lastGraphviz = graph.graphviz(std::string(technique.name()));
     return ok;
 }
 

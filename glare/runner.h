@@ -29,12 +29,17 @@ struct RunnerOptions {
     // With skip: whether passes are reused from frame to frame (off: every pass runs every frame and
     // only the tiles are decided, what a moving scene gets; benchmarks time whole frames so).
     bool reuse = true;
+    // Keep the Graphviz of each frame's graph as it ran (lastGraphviz; --graph).
+    bool graphviz = false;
 };
 
 // One frame's result.
 struct FrameResult {
     std::vector<PassStats> passes;
-    double milliseconds = 0;  // the sum of the passes' times (not the scene, not the hooks)
+    // The frame's time: its graph built and compiled (the technique's CPU set-up, every frame)
+    // and the passes' times; not the scene, not the hooks.
+    double milliseconds = 0;
+    double buildMilliseconds = 0;  // the graph's part of it
     double sceneMilliseconds = 0;
 };
 
@@ -76,7 +81,8 @@ public:
     // Builds (and compiles) without running: for reports and --graph.
     void buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
 
-    // The Graphviz of the last frame's graph as it ran (with the aliasing it got).
+    // The Graphviz of the last frame's graph as it ran (with the aliasing it got); empty unless
+    // RunnerOptions::graphviz.
     const std::string& lastGraphviz() const { return m_lastGraphviz; }
     emu::Handle sceneTexture() const { return m_scene; }
     emu::Handle outputTexture() const { return m_output; }

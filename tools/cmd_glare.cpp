@@ -223,6 +223,7 @@ int runGlare(const GlareOptions& o) {
         ro.device.hardware = o.hardware;
         ro.device.precision = o.precision;
         ro.skip = !o.noSkip;
+        ro.graphviz = !o.graph.empty();
         if (gl) {
             ro.device.renderer = ps11test::glRendererFactory(o.glKind, err, o.glNative);
             if (!ro.device.renderer) return nullptr;
@@ -286,6 +287,7 @@ int runGlare(const GlareOptions& o) {
         if (s) s->setGlowFog(fogStart, fogEnd);
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
+    double lastBuildMs = 0;  // the last frame's graph, built and compiled
     std::vector<double> frameMs;
     emu::TransferStats lastTransfers;  // the last frame's, with its output's read-back
     std::vector<glare::PassAgreement> agreement;
@@ -367,6 +369,7 @@ int runGlare(const GlareOptions& o) {
             return cli::kUserError;
         }
         lastStats = result.passes;
+        lastBuildMs = result.buildMilliseconds;
         frameMs.push_back(result.milliseconds);
         if (!o.out.empty()) {
             std::optional<emu::RgbaImage> img = main->readOutput(err);
@@ -479,6 +482,7 @@ int runGlare(const GlareOptions& o) {
                                 {"copied", s.tilesCopied},
                                 {"skipped", s.tilesSkipped}}}});
         j["passes"] = std::move(passes);
+        j["graph_ms"] = json::rounded(lastBuildMs, "%.3f");
         j["renderer"] = main->device().rendererName();
         j["frame_uploads"] = lastTransfers.uploads;
         j["frame_readbacks"] = lastTransfers.readBacks;
@@ -508,6 +512,8 @@ int runGlare(const GlareOptions& o) {
                     (unsigned long long)s.readBacks, double(s.bytes) / 1e6,
                     s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0, "ran", tileText.c_str());
     }
+    std::printf("%-22s %9.3f  (the technique's graph, built and compiled on the CPU; part of the frame's time)\n",
+                "(frame graph)", lastBuildMs);
     std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
                 " reused: its inputs were last frame's, its outputs kept, nothing ran; tiles: tiles of 16 rows by 64\n"
                 " pixels of the software renderer's full-screen draws, shaded, filled with a constant, copied from one\n"
