@@ -302,45 +302,51 @@ public:
             int streaks = -1;
             std::vector<float> image;
             std::vector<float> radial;  // the radial maximum of the glare image, for shrinking
-            emu::SurfacePixels pixels;  // the image as uploaded (8-bit grey, alpha 255)
-            // With reuse: the texture the last upload wrote and the generation it left.
-            emu::Handle uploaded{};
-            uint64_t generation = 0;
+            // The image as uploaded (8-bit grey, alpha 255), in a surface of the runner's device
+            // that each frame's upload copies from (a 64 KB StretchRect, which a fingerprint
+            // covers: with reuse, the upload is reused while the surface and texture are as
+            // they were).
+            emu::Handle staging{};
+            std::string error;  // why the surface could not be made
         };
         GlareKept& kept = fb.runner.kept<GlareKept>("sprites: glare image");
         if (kept.streaks != streaks) {
             kept.image = glareImage(imageSize, streaks);
             kept.radial = radialMaximum(kept.image, imageSize);
-            kept.pixels = emu::SurfacePixels{imageSize, imageSize, D3DFMT_A8R8G8B8, 4, {}};
-            kept.pixels.bytes.resize(kept.image.size() * 4);
-            for (size_t i = 0; i < kept.image.size(); ++i) {
-                const uint8_t v = uint8_t(std::lround(kept.image[i] * 255));
-                kept.pixels.bytes[i * 4 + 0] = kept.pixels.bytes[i * 4 + 1] = kept.pixels.bytes[i * 4 + 2] = v;
-                kept.pixels.bytes[i * 4 + 3] = 255;
-            }
-            kept.uploaded = emu::Handle::Null;
             kept.streaks = streaks;
+            kept.error.clear();
+            emu::Device& d = fb.runner.device();
+            if (kept.staging != emu::Handle::Null) d.Release(kept.staging);
+            kept.staging = emu::Handle::Null;
+            D3DLOCKED_RECT lr{};
+            if (d.CreateOffscreenPlainSurface(imageSize, imageSize, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &kept.staging) !=
+                    D3D_OK ||
+                d.LockRect(kept.staging, &lr, nullptr, 0) != D3D_OK) {
+                kept.error = d.lastError().message;
+                kept.streaks = -1;  // made again next frame
+            } else {
+                for (uint32_t y = 0; y < imageSize; ++y)
+                    for (uint32_t x = 0; x < imageSize; ++x) {
+                        const uint8_t v = uint8_t(std::lround(kept.image[size_t(y) * imageSize + x] * 255));
+                        uint8_t* p = static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch) + size_t(x) * 4;
+                        p[0] = p[1] = p[2] = v;
+                        p[3] = 255;
+                    }
+                d.UnlockRect(kept.staging);
+            }
         }
-        GlareKept* const glare = &kept;  // on the runner, which outlives the frame
+        const emu::Handle staging = kept.staging;
+        const std::string stagingError = kept.error;
         const std::vector<float>& radial = kept.radial;
-        Runner* const owner = &fb.runner;
         g.addPass(PassInfo{"glare_image", PassKind::DeviceSide, "",
                            "the precomputed glare image (streaks + halo), computed on the CPU once and uploaded"},
                   [&](PassBuilder& b) { b.write(image); },
                   [=](PassContext& c) {
-                      // With reuse, a texture still holding the last upload (same texture, the
-                      // generation it left) is not written again.
-                      const emu::Handle texture = c.texture(image);
-                      if (owner->reuses() && glare->uploaded == texture &&
-                          c.device.contentGeneration(texture) == glare->generation) {
-                          c.stats.reused = true;
-                          return true;
+                      if (staging == emu::Handle::Null) {
+                          c.error = "glare image: its surface could not be made: " + stagingError;
+                          return false;
                       }
-                      glare->uploaded = emu::Handle::Null;
-                      if (!emu::writeSurface(c.device, c.surface(image), glare->pixels, c.error)) return false;
-                      glare->uploaded = texture;
-                      glare->generation = c.device.contentGeneration(texture);
-                      return true;
+                      return c.check(c.device.StretchRect(staging, nullptr, c.surface(image), nullptr, D3DTEXF_POINT));
                   });
 
         auto sprites = std::make_shared<std::vector<Sprite>>();
