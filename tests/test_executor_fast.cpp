@@ -21,6 +21,7 @@
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
 #include "ps11/executor_fast.h"
+#include "ps11/executor_presampled_internal.h"
 #include "ps11/testfile.h"
 #include "ps11/testfile_textures.h"
 #include "ps11/texture_sampler.h"
@@ -477,6 +478,119 @@ TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem
     for (const char* text : programs)
         for (int span : {256, 64, 37, 1}) bad += diffPaths(text, 0, l, span, sampler, &consts);
     CHECK(bad == 0);
+}
+
+namespace {
+
+// A sampler for pre-sampled comparisons: stage s returns texels[s] at lane u (u is the lane's
+// index), so run() sees the texels runPresampled's fill hands over.
+struct LaneSampler final : ps11::Sampler {
+    const std::vector<std::array<uint8_t, 4>>* texels[8] = {};
+    void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
+        for (int i = 0; i < req.count; ++i) {
+            const auto& t = (*texels[req.stage])[size_t(req.u[i])];
+            for (int c = 0; c < 4; ++c) out.grid[c][i] = t[size_t(c)];
+        }
+    }
+    bool hasTexture(int) const override { return true; }
+};
+
+}  // namespace
+
+TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
+    // runPresampled (the row paths' way in: presampledOps' sign analysis, product chains, the
+    // complement factor) against run() with a sampler handing over the same 8-bit texels. Each
+    // program runs pre-sampled (registers first poisoned by another program on the same thread)
+    // under constants whose channels are 0 two times in five.
+    using namespace ps11;
+    const char* programs[] = {
+        "ps_1_1\ntex t0\nmul r0, t0, c0\n",
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
+        "mad r0, t3, c3, r0\n",
+        "ps_1_1\ntex t0\nmad r0, t0, c0, c1\n",
+        "ps_1_1\ntex t0\nmul r0, t0, c0\nadd r0.a, r0.a, t0.a\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0\ncnd r0, r0.a, t1, t0\n",
+        "ps_1_1\ntex t0\ntex t1\ndp3 r0.rgb, t0, c0\n+mul r0.a, t1.a, c1.a\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r1, t0, c0\nmad r0, t1, c1, r1\n",
+        "ps_1_1\ntex t0\ntex t1\nlrp r0, c0, t0, t1\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, 1-t0, c0\nmad r0, t1, c1, r0\n",
+        "ps_1_1\ntex t0\nmul r0.rgb, t0, c0\n",
+        "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmul r0, r0, c0\nmad r0, r1, c1, r0\n",
+        "ps_1_4\ntexld r2, t0\nmul r0, r2, c0\n",
+    };
+    auto poison = make("ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nadd r0, t0, t1\nadd r0, r0, t2\nadd r0, r0, t3\n",
+                       Precision::Fx8, 0, ExecPath::Auto);
+    TapPlan poisonPlan;
+    REQUIRE(tapPlan(*poison, poisonPlan));
+    std::mt19937 rng(4242);
+    const int count = 200;
+    std::vector<std::array<uint8_t, 4>> texels[8];
+    for (auto& t : texels) t.resize(count);
+    Lanes l(count);
+    for (int i = 0; i < count; ++i)
+        for (int t = 0; t < 8; ++t) l.tc[t][0][size_t(i)] = float(i);
+    LaneSampler sampler;
+    for (int s = 0; s < 8; ++s) sampler.texels[s] = &texels[s];
+    struct Ctx {
+        const std::vector<std::array<uint8_t, 4>>* texels;
+        const TapPlan* plan;
+        int base;
+        std::vector<int32_t>* got;
+    };
+    const TapFill fill = [](void* p, int tap, int first, int n, int16_t* const dst[4]) {
+        Ctx& x = *static_cast<Ctx*>(p);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < n; ++i) dst[c][i] = x.texels[x.plan->stage[size_t(tap)]][size_t(x.base + first + i)][size_t(c)];
+    };
+    const ResultSink sink = [](void* p, int first, int n, const int16_t* const r0[4]) {
+        Ctx& x = *static_cast<Ctx*>(p);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < n; ++i) x.got[c][size_t(x.base + first + i)] = r0[c][i];
+    };
+    const TapFill poisonFill = [](void*, int, int, int n, int16_t* const dst[4]) {
+        for (int c = 0; c < 4; ++c) std::fill_n(dst[c], n, int16_t(201));
+    };
+    const ResultSink ignore = [](void*, int, int, const int16_t* const[4]) {};
+    int64_t bad = 0;
+    int runs = 0;
+    for (const char* text : programs) {
+        INFO(text);
+        auto gen = make(text, Precision::Fx8, 0, ExecPath::Generic);
+        auto fast = make(text, Precision::Fx8, 0, ExecPath::Auto);
+        TapPlan plan;
+        REQUIRE(tapPlan(*fast, plan));
+        for (int trial = 0; trial < 40; ++trial) {
+            for (int i = 0; i < 8; ++i) {
+                std::array<float, 4> v;
+                for (float& f : v) f = rng() % 5 < 2 ? 0.0f : float(int(rng() % 511) - 255) / 255.0f;
+                gen->setConstant(i, v);
+                fast->setConstant(i, v);
+            }
+            for (auto& t : texels)
+                for (auto& px : t)
+                    for (uint8_t& b : px) b = uint8_t(rng());
+            Out want(count);
+            runAll(*gen, l, want, sampler, 256);
+            std::vector<int32_t> got[4];
+            for (auto& g : got) g.assign(count, -9999);
+            for (int off = 0; off < count; off += 64) {
+                const int n = std::min(64, count - off);
+                PixelInputs pin = l.inputs(off, n);
+                runPresampled(*poison, pin, poisonFill, ignore, nullptr);
+                Ctx ctx{texels, &plan, off, got};
+                runPresampled(*fast, pin, fill, sink, &ctx);
+            }
+            ++runs;
+            for (int c = 0; c < 4; ++c)
+                for (int i = 0; i < count; ++i)
+                    if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
+                        FAIL_CHECK("trial " << trial << " lane " << i << " channel " << c << ": pre-sampled "
+                                            << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
+        }
+    }
+    INFO(runs << " runs");
+    CHECK(bad == 0);
+    CHECK(runs == 40 * int(std::size(programs)));
 }
 
 TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
