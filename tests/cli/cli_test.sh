@@ -509,6 +509,8 @@ expect_in "$work/out" "$work/photos/A.hdr" "bench --in DIR has rows of the first
 expect_in "$work/out" "$work/photos/b.png" "bench --in DIR has rows of the second image"
 expect_rc 0 "glare --graph without -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p.dot"
 expect_in "$work/p.dot" 'digraph "pyramid"' "glare --graph writes Graphviz"
+expect_rc 0 "glare --graph with -o" "$ps11" glare --technique pyramid --scene sky --size 64x36 --graph "$work/p2.dot" -o "$work/p2.png"
+expect_in "$work/p2.dot" 'device texture #0' "glare --graph with -o writes the graph as it ran (device textures)"
 expect_rc 0 "glare --json" "$ps11" glare --technique glow --scene neon --size 64x36 --set path=ffp -o "$work/f.png" --json
 expect_in "$work/out" '"pass": "blur_h_0"' "glare --json lists the passes"
 expect_rc 2 "glare unknown technique" "$ps11" glare --technique bloom --scene box -o "$work/x.png"
