@@ -11,6 +11,7 @@
 
 #include "emu/aligned_pass_kernels.h"
 #include "emu/lanes_avx2.h"
+#include "emu/prefetch.h"
 #include "ps11/texture.h"
 
 namespace emu {
@@ -332,6 +333,7 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
         __m256i second = _mm256_permute2x128_si256(w0, w1, 0x31);                   // px 8-15
         __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
         __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
+        _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
         if (count - i < 16) {  // the last pixels: masked loads and stores of their words alone
             int* w0 = reinterpret_cast<int*>(d0);
             int* w1 = reinterpret_cast<int*>(d1);
