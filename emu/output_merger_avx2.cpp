@@ -9,6 +9,7 @@
 
 #include "emu/lanes_avx2.h"
 #include "emu/output_merger_kernels.h"
+#include "emu/prefetch.h"
 
 namespace emu {
 
@@ -90,6 +91,8 @@ void satAddUnorm8Avx2(const float* src, const uint8_t* words, int shift, int cou
     for (; i + 8 <= count; i += 8) {
         const __m256 v = _mm256_loadu_ps(src + i);
         const __m256 sv = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_min_ps(v, one));
+        // The target's line ahead: the first channel's pass over a row waits on each line else.
+        _mm_prefetch(reinterpret_cast<const char*>(words + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
         const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(words + 4 * i));
         const __m256 d = unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srl_epi32(w, by), byte)));
         _mm256_storeu_ps(out + i, _mm256_add_ps(sv, d));
