@@ -225,6 +225,11 @@ void stretchImages(const StretchCall& call, RowRange rows) {
             uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
             int64_t i = 0;
 #if defined(__SSE2__)
+            // The next row's texels are asked for while this row's are combined: a minification
+            // (a 1080p frame to 128×128) reads a line or two per pixel, each from memory.
+            const bool ahead = j + 1 < dh;
+            const uint8_t* n0 = ahead ? s->texel(0, uint32_t(tapY[size_t(j + 1)].i0)) : r0;
+            const uint8_t* n1 = ahead ? s->texel(0, uint32_t(tapY[size_t(j + 1)].i1)) : r1;
             // The same sum in float, one pixel's four channels at a time: every product and partial
             // sum is an integer below 2^24 (S <= 65536 * 255), so exact; S / 65536 is exact too, and
             // the conversion rounds to nearest even (the default MXCSR mode).
@@ -239,6 +244,8 @@ void stretchImages(const StretchCall& call, RowRange rows) {
             for (; i < dw; ++i, out += 4) {
                 const __m128 xb = _mm_set1_ps(float(kx[size_t(i)])), xa = _mm_set1_ps(float(256 - kx[size_t(i)]));
                 const size_t o0 = size_t(x0[size_t(i)]), o1 = size_t(x1[size_t(i)]);
+                _mm_prefetch(reinterpret_cast<const char*>(n0 + o0), _MM_HINT_T0);
+                _mm_prefetch(reinterpret_cast<const char*>(n1 + o0), _MM_HINT_T0);
                 const __m128 top = _mm_add_ps(_mm_mul_ps(channels(r0 + o0), xa), _mm_mul_ps(channels(r0 + o1), xb));
                 const __m128 bottom = _mm_add_ps(_mm_mul_ps(channels(r1 + o0), xa), _mm_mul_ps(channels(r1 + o1), xb));
                 const __m128i q = _mm_cvtps_epi32(_mm_mul_ps(_mm_add_ps(_mm_mul_ps(top, ya), _mm_mul_ps(bottom, yb)), scale));
