@@ -186,6 +186,8 @@ public:
     std::shared_ptr<const ps11::Texture> sampledTexture(Handle texture);
     // The decoded, validated program of a pixel shader; nullptr for a bad handle.
     const ps11::Program* pixelShaderProgram(Handle shader) const;
+    // The renderer's worker threads for CPU work between calls (Renderer::workers), or null.
+    ThreadPool* rendererWorkers() { return m_renderer->workers(); }
     // A surface's newest bytes where the front keeps them, for reading: D3D9 reads a render
     // target through GetRenderTargetData into a SYSTEMMEM copy, which for a 1080p frame moves
     // 8 MB (32 MB in float) only to look at it. `read` gets the level's pitch and bits; while it

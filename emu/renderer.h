@@ -28,6 +28,8 @@
 
 namespace emu {
 
+class ThreadPool;
+
 // Counts of one draw (Device::lastDrawStats) or of all draws so far (Device::totalDrawStats).
 struct DrawStats {
     uint64_t draws = 0;           // DrawPrimitiveUP calls that succeeded
@@ -170,6 +172,9 @@ public:
     virtual TransferStats transfers() const { return {}; }
     // "software" (the name `ps11 test --stats` and the docs use).
     virtual const char* name() const = 0;
+    // The renderer's worker threads, for CPU work between its calls (the glare sprites' sensors),
+    // or null if it has none. Not while a call of the renderer runs.
+    virtual ThreadPool* workers() { return nullptr; }
 };
 
 }  // namespace emu

@@ -114,6 +114,11 @@ bool SoftwareRenderer::clear(const ClearCall& call) {
     return true;
 }
 
+ThreadPool* SoftwareRenderer::workers() {
+    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+    return &m_context->pool;
+}
+
 bool SoftwareRenderer::stretchRect(const StretchCall& call) {
     if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
     // Destination rows in bands over the workers (each row is written by one of them).

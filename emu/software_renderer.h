@@ -37,6 +37,7 @@ public:
     bool clear(const ClearCall& call) override;
     bool stretchRect(const StretchCall& call) override;
     const char* name() const override { return "software"; }
+    ThreadPool* workers() override;
     const SoftwareRendererOptions& options() const { return m_options; }
 
 private:

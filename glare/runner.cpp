@@ -160,6 +160,12 @@ std::optional<emu::RgbaImage> Runner::readTexture(Handle texture, std::string& e
     return img;
 }
 
+emu::ThreadPool& Runner::cpuPool() {
+    if (emu::ThreadPool* w = m_device->rendererWorkers()) return *w;
+    if (!m_cpuPool) m_cpuPool = std::make_unique<emu::ThreadPool>(cpuThreads());
+    return *m_cpuPool;
+}
+
 bool Runner::readPixels(Handle texture, const std::function<bool(const Pixels&)>& use, std::string& error) {
     emu::Device& d = *m_device;
     Handle surface{};

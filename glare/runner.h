@@ -11,6 +11,7 @@
 
 #include "emu/device.h"
 #include "emu/image_file.h"
+#include "emu/thread_pool.h"
 #include "glare/pass_graph.h"
 #include "glare/technique.h"
 
@@ -117,6 +118,9 @@ public:
     // The CPU threads the frame's own CPU work (the sprites' sensors) may take: the software
     // renderer's count (DeviceOptions, 0 = the machine's), whichever renderer draws.
     int cpuThreads() const { return m_options.device.software.threads; }
+    // Those threads: the renderer's workers (the software renderer's), else a pool of
+    // cpuThreads() the runner starts on first use. No thread is started per frame.
+    emu::ThreadPool& cpuPool();
     TexturePool& pool() { return *m_pool; }
 
 private:
@@ -125,6 +129,7 @@ private:
     std::unique_ptr<TexturePool> m_pool;
     PassMemo m_memo;  // with RunnerOptions::skip: what runFrame keeps between frames
     std::map<std::string, std::shared_ptr<void>> m_kept;  // kept()
+    std::unique_ptr<emu::ThreadPool> m_cpuPool;             // cpuPool() where the renderer has no workers
     emu::Handle m_scene{}, m_output{};
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;

@@ -7,7 +7,6 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <thread>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -15,6 +14,7 @@
 
 #include "emu/format.h"
 #include "emu/fullscreen.h"
+#include "emu/thread_pool.h"
 #include "glare/passes.h"
 #include "glare/runner.h"
 #include "glare/sensors_kernels.h"
@@ -89,19 +89,22 @@ const SensorKernels& sensorKernels(ps11::SimdLevel level) {
 
 namespace {
 
-// `workers` threads (0: the machine's; SensorFrame::threads) over `rows` items of `rowsPerItem`
-// pixel rows: bands of at least 64 pixel rows, the calling thread taking the first;
-// `work(first, last, band)`. Callers join per-band results in
-// band order, so the sprites and every sum are those of one pass in raster order.
-void rowBands(uint32_t rows, uint32_t rowsPerItem, int workers,
+// The workers of `pool` (null: the calling thread alone) over `rows` items of `rowsPerItem`
+// pixel rows: bands of at least 64 pixel rows, at most 8, the calling thread taking the first;
+// `work(first, last, band)`. Callers join per-band results in band order, so the sprites and
+// every sum are those of one pass in raster order.
+void rowBands(uint32_t rows, uint32_t rowsPerItem, emu::ThreadPool* pool,
               const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
-    const unsigned wanted = workers > 0 ? unsigned(workers) : std::thread::hardware_concurrency();
-    const unsigned threads = std::max(1u, std::min({wanted, 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t)
-        pool.emplace_back(work, uint32_t(uint64_t(rows) * t / threads), uint32_t(uint64_t(rows) * (t + 1) / threads), t);
-    work(0, uint32_t(uint64_t(rows) / threads), 0);
-    for (std::thread& th : pool) th.join();
+    const unsigned wanted = pool ? unsigned(pool->size()) : 1u;
+    const unsigned bands = std::max(1u, std::min({wanted, 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
+    if (bands == 1) {
+        work(0, rows, 0);
+        return;
+    }
+    pool->run(int(bands), [&](int t) {
+        work(uint32_t(uint64_t(rows) * unsigned(t) / bands), uint32_t(uint64_t(rows) * unsigned(t + 1) / bands),
+             unsigned(t));
+    });
 }
 
 }  // namespace
@@ -118,7 +121,7 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
     auto lum = [&](const uint8_t* p) { return luminance(p[rs / 8], p[1], p[bs / 8]); };
     const auto inBands = [&](uint32_t rows, uint32_t rowsPerItem,
                              const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
-        rowBands(rows, rowsPerItem, f.threads, work);
+        rowBands(rows, rowsPerItem, f.pool, work);
     };
     // Whether each pixel's sensor fires, one bit a pixel (its luminance is taken again only where
     // it does): dark stretches of a frame are skipped 64 pixels at a time.
@@ -383,9 +386,9 @@ public:
                           kept = Kept{sceneTexture, generation, ss, *sprites, true};
                           return true;
                       };
-                      // 8-bit frames are sensed where the read-back left them; float frames
-                      // (ideal) through the runner's 8-bit conversion. On the renderer's threads.
-                      const int threads = runner->cpuThreads();
+                      // 8-bit frames are sensed where they lie; float frames (ideal) through the
+                      // runner's 8-bit conversion. On the renderer's workers (Runner::cpuPool).
+                      emu::ThreadPool* const threads = &runner->cpuPool();
                       D3DSURFACE_DESC desc{};
                       if (!c.check(c.device.GetLevelDesc(c.texture(scene), 0, &desc))) return false;
                       if (desc.Format == D3DFMT_A8R8G8B8 || desc.Format == D3DFMT_X8R8G8B8)

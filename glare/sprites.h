@@ -7,6 +7,10 @@
 #include <cstdint>
 #include <vector>
 
+namespace emu {
+class ThreadPool;
+}
+
 namespace glare {
 
 struct Sprite {
@@ -32,9 +36,9 @@ struct SensorFrame {
     uint32_t width = 0, height = 0;
     size_t pitch = 0;
     bool bgra = false;
-    // Worker threads (the caller's included) for the frame's bands; 0: the machine's. At most 8,
-    // and never more than bands of 64 rows; the sprites do not depend on it.
-    int threads = 0;
+    // The workers for the frame's bands (null: the calling thread alone). At most 8 bands, and
+    // never more than bands of 64 rows; the sprites do not depend on it.
+    emu::ThreadPool* pool = nullptr;
 };
 
 // The least float s with s / 255.0f >= threshold (a float division): a sensor's luminance, the

@@ -18,6 +18,7 @@
 #include "glare/runner.h"
 #include "glare/scene.h"
 #include "glare/shader_library.h"
+#include "emu/thread_pool.h"
 #include "glare/sprites.h"
 #include "glare/stress.h"
 #include "ps11/assembler.h"
@@ -759,6 +760,7 @@ std::vector<Sprite> senseSpritesReference(const uint8_t* rgba, uint32_t width, u
 }  // namespace
 
 TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites exactly", "[glare]") {
+    emu::ThreadPool one(1), three(3), eight(8);
     std::mt19937 rng(7);
     for (int round = 0; round < 24; ++round) {
         const uint32_t w = 1 + rng() % 300, h = 1 + rng() % 260;
@@ -785,14 +787,14 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
                 uint8_t* q = &bgra[y * pitch + size_t(x) * 4];
                 q[0] = p[2], q[1] = p[1], q[2] = p[0], q[3] = p[3];
             }
-        // On the machine's threads and on 1, 3 and 8 (the frame's bands split differently), at
-        // every SIMD level (the sensor row's kernels).
+        // On the calling thread and on pools of 1, 3 and 8 (the frame's bands split differently),
+        // at every SIMD level (the sensor row's kernels).
         testutil::forEachSimdLevel([&](ps11::SimdLevel) {
             for (const std::vector<Sprite>& fast :
                  {senseSprites(img.data(), w, h, s), senseSprites(SensorFrame{bgra.data(), w, h, pitch, true}, s),
-                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 1}, s),
-                  senseSprites(SensorFrame{img.data(), w, h, size_t(w) * 4, false, 3}, s),
-                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, 8}, s)}) {
+                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, &one}, s),
+                  senseSprites(SensorFrame{img.data(), w, h, size_t(w) * 4, false, &three}, s),
+                  senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, &eight}, s)}) {
                 REQUIRE(fast.size() == ref.size());
                 for (size_t i = 0; i < ref.size(); ++i) {
                     CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
