@@ -4,6 +4,7 @@
 #include "emu/device.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "ps11/assembler.h"
 #include "ps11/decoder.h"
@@ -40,7 +41,8 @@ HRESULT Device::fail(HRESULT hr, const char* code, std::string message) {
 }
 
 HRESULT Device::ok() {
-    m_error = DeviceError{};
+    // Every call starts here: only an error left by the last call is cleared.
+    if (m_error.hr != D3D_OK || !m_error.code.empty() || !m_error.message.empty()) m_error = DeviceError{};
     return D3D_OK;
 }
 
@@ -310,11 +312,17 @@ HRESULT Device::applyState(const DeviceState& s) {
         m_state.renderTarget = Handle::Null;
         m_state.viewport = s.viewport;
     }
-    failed = failed || refused(SetScissorRect(&s.scissor), "scissor rect") ||
-             refused(SetDepthStencilSurface(s.depthStencil), "depth stencil surface") ||
-             refused(SetPixelShader(s.pixelShader), "pixel shader");
+    // A value equal to the current one is not set again: every setter below only validates and
+    // stores, and a current handle is a live one (Release unbinds it). A pass graph puts its
+    // state back around every pass, so this is most of a still frame's work.
+    auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+    failed = failed || (!same(s.scissor, m_state.scissor) && refused(SetScissorRect(&s.scissor), "scissor rect")) ||
+             (s.depthStencil != m_state.depthStencil &&
+              refused(SetDepthStencilSurface(s.depthStencil), "depth stencil surface")) ||
+             (s.pixelShader != m_state.pixelShader && refused(SetPixelShader(s.pixelShader), "pixel shader"));
     for (DWORD stage = 0; !failed && stage < DWORD(kMaxSamplers); ++stage)
-        failed = refused(SetTexture(stage, s.textures[stage]), "texture of stage " + num(stage));
+        if (s.textures[stage] != m_state.textures[stage])
+            failed = refused(SetTexture(stage, s.textures[stage]), "texture of stage " + num(stage));
     for (DWORD i = 0; !failed && i < DWORD(kRenderStateLimit); ++i)
         if (s.renderStates[i] != m_state.renderStates[i])
             failed = refused(SetRenderState(D3DRENDERSTATETYPE(i), s.renderStates[i]), "");
@@ -330,12 +338,16 @@ HRESULT Device::applyState(const DeviceState& s) {
                                  "sampler " + num(sampler));
     const std::pair<D3DTRANSFORMSTATETYPE, const D3DMATRIX*> transforms[] = {
         {D3DTS_WORLD, &s.world}, {D3DTS_VIEW, &s.view}, {D3DTS_PROJECTION, &s.projection}};
-    for (const auto& [type, matrix] : transforms) failed = failed || refused(SetTransform(type, matrix), "");
+    const D3DMATRIX* current[] = {&m_state.world, &m_state.view, &m_state.projection};
+    for (size_t k = 0; k < 3; ++k)
+        failed = failed || (!same(*transforms[k].second, *current[k]) && refused(SetTransform(transforms[k].first, transforms[k].second), ""));
     for (DWORD t = 0; !failed && t < DWORD(s.texture.size()); ++t)
-        failed = refused(SetTransform(D3DTRANSFORMSTATETYPE(D3DTS_TEXTURE0 + t), &s.texture[t]), "");
+        if (!same(s.texture[t], m_state.texture[t]))
+            failed = refused(SetTransform(D3DTRANSFORMSTATETYPE(D3DTS_TEXTURE0 + t), &s.texture[t]), "");
     for (UINT c = 0; !failed && c < UINT(kMaxPsConstants); ++c)
-        failed = refused(SetPixelShaderConstantF(c, s.psConstants[c].data(), 1), "");
-    failed = failed || refused(SetFVF(s.fvf), "");
+        if (!same(s.psConstants[c], m_state.psConstants[c]))
+            failed = refused(SetPixelShaderConstantF(c, s.psConstants[c].data(), 1), "");
+    failed = failed || (s.fvf != m_state.fvf && refused(SetFVF(s.fvf), ""));
     if (!failed) return ok();
     // Atomic, as every call is: a refused block changes nothing.
     const DeviceError error = m_error;
