@@ -290,10 +290,10 @@ HRESULT Device::SetFVF(DWORD fvf) {
 
 // ---- state blocks ----
 
-// Every field goes through its Set* call, so a block is checked exactly as the calls are; the
-// arrays of states only where they differ from the device's (a slot with no D3D9 state then
-// reaches its Set* call, which refuses it). The render target comes first: SetRenderTarget
-// resets the viewport and scissor rect, which follow.
+// Every field that differs from the device's goes through its Set* call, so a block is checked
+// exactly as the calls are (a slot with no D3D9 state then reaches its Set* call, which refuses
+// it; an equal value would pass and change nothing). The render target comes first:
+// SetRenderTarget resets the viewport and scissor rect, which follow.
 HRESULT Device::applyState(const DeviceState& s) {
     const DeviceState before = m_state;
     std::string field;  // which field of the block the refused call was setting
