@@ -323,19 +323,23 @@ HRESULT Device::applyState(const DeviceState& s) {
     for (DWORD stage = 0; !failed && stage < DWORD(kMaxSamplers); ++stage)
         if (s.textures[stage] != m_state.textures[stage])
             failed = refused(SetTexture(stage, s.textures[stage]), "texture of stage " + num(stage));
-    for (DWORD i = 0; !failed && i < DWORD(kRenderStateLimit); ++i)
-        if (s.renderStates[i] != m_state.renderStates[i])
-            failed = refused(SetRenderState(D3DRENDERSTATETYPE(i), s.renderStates[i]), "");
+    // The state arrays slot by slot only where they differ at all (a pass changes a few slots).
+    if (!failed && !same(s.renderStates, m_state.renderStates))
+        for (DWORD i = 0; !failed && i < DWORD(kRenderStateLimit); ++i)
+            if (s.renderStates[i] != m_state.renderStates[i])
+                failed = refused(SetRenderState(D3DRENDERSTATETYPE(i), s.renderStates[i]), "");
     for (DWORD stage = 0; !failed && stage < DWORD(kMaxStages); ++stage)
-        for (DWORD i = 0; !failed && i < DWORD(kStageStateLimit); ++i)
-            if (s.stageStates[stage][i] != m_state.stageStates[stage][i])
-                failed = refused(SetTextureStageState(stage, D3DTEXTURESTAGESTATETYPE(i), s.stageStates[stage][i]),
-                                 "stage " + num(stage));
+        if (!same(s.stageStates[stage], m_state.stageStates[stage]))
+            for (DWORD i = 0; !failed && i < DWORD(kStageStateLimit); ++i)
+                if (s.stageStates[stage][i] != m_state.stageStates[stage][i])
+                    failed = refused(SetTextureStageState(stage, D3DTEXTURESTAGESTATETYPE(i), s.stageStates[stage][i]),
+                                     "stage " + num(stage));
     for (DWORD sampler = 0; !failed && sampler < DWORD(kMaxSamplers); ++sampler)
-        for (DWORD i = 0; !failed && i < DWORD(kSamplerStateLimit); ++i)
-            if (s.samplerStates[sampler][i] != m_state.samplerStates[sampler][i])
-                failed = refused(SetSamplerState(sampler, D3DSAMPLERSTATETYPE(i), s.samplerStates[sampler][i]),
-                                 "sampler " + num(sampler));
+        if (!same(s.samplerStates[sampler], m_state.samplerStates[sampler]))
+            for (DWORD i = 0; !failed && i < DWORD(kSamplerStateLimit); ++i)
+                if (s.samplerStates[sampler][i] != m_state.samplerStates[sampler][i])
+                    failed = refused(SetSamplerState(sampler, D3DSAMPLERSTATETYPE(i), s.samplerStates[sampler][i]),
+                                     "sampler " + num(sampler));
     const std::pair<D3DTRANSFORMSTATETYPE, const D3DMATRIX*> transforms[] = {
         {D3DTS_WORLD, &s.world}, {D3DTS_VIEW, &s.view}, {D3DTS_PROJECTION, &s.projection}};
     const D3DMATRIX* current[] = {&m_state.world, &m_state.view, &m_state.projection};
