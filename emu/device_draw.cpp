@@ -503,7 +503,14 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         const uint32_t words[] = {0x44524157u, uint32_t(type), primitiveCount, stride};  // "DRAW"
         fingerprintWords(words, sizeof words);
         fingerprintWords(vertexData, size_t(vertexCount) * stride);
-        m_state.forEachWord([this](uint32_t w) { m_fingerprint.print.words.push_back(w); });
+        // The whole state, written in place (the count folds to a constant).
+        std::vector<uint32_t>& print = m_fingerprint.print.words;
+        size_t stateWords = 0;
+        m_state.forEachWord([&stateWords](uint32_t) { ++stateWords; });
+        const size_t at = print.size();
+        print.resize(at + stateWords);
+        uint32_t* out = print.data() + at;
+        m_state.forEachWord([&out](uint32_t w) { *out++ = w; });
         for (Handle t : m_state.textures) fingerprintRead(ownerOf(t));
         const bool depthTest = d.ds && m_state.renderStates[D3DRS_ZENABLE];
         if (depthTest) fingerprintRead(d.dsRef.owner);
