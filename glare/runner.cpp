@@ -13,6 +13,7 @@
 
 #include "emu/format.h"
 #include "emu/fullscreen.h"
+#include "emu/thread_pool.h"
 #include "glare/scene.h"
 #include "glare/shader_library.h"
 

@@ -11,9 +11,12 @@
 
 #include "emu/device.h"
 #include "emu/image_file.h"
-#include "emu/thread_pool.h"
 #include "glare/pass_graph.h"
 #include "glare/technique.h"
+
+namespace emu {
+class ThreadPool;  // emu/thread_pool.h (internal)
+}
 
 namespace glare {
 
