@@ -344,7 +344,8 @@ HRESULT Device::applyState(const DeviceState& s) {
         {D3DTS_WORLD, &s.world}, {D3DTS_VIEW, &s.view}, {D3DTS_PROJECTION, &s.projection}};
     const D3DMATRIX* current[] = {&m_state.world, &m_state.view, &m_state.projection};
     for (size_t k = 0; k < 3; ++k)
-        failed = failed || (!same(*transforms[k].second, *current[k]) && refused(SetTransform(transforms[k].first, transforms[k].second), ""));
+        failed = failed || (!same(*transforms[k].second, *current[k]) &&
+                            refused(SetTransform(transforms[k].first, transforms[k].second), ""));
     for (DWORD t = 0; !failed && t < DWORD(s.texture.size()); ++t)
         if (!same(s.texture[t], m_state.texture[t]))
             failed = refused(SetTransform(D3DTRANSFORMSTATETYPE(D3DTS_TEXTURE0 + t), &s.texture[t]), "");

@@ -505,10 +505,8 @@ HRESULT Device::DrawPrimitiveUP(D3DPRIMITIVETYPE type, UINT primitiveCount, cons
         fingerprintWords(vertexData, size_t(vertexCount) * stride);
         // The whole state, written in place (the count folds to a constant).
         std::vector<uint32_t>& print = m_fingerprint.print.words;
-        size_t stateWords = 0;
-        m_state.forEachWord([&stateWords](uint32_t) { ++stateWords; });
         const size_t at = print.size();
-        print.resize(at + stateWords);
+        print.resize(at + m_state.wordCount());
         uint32_t* out = print.data() + at;
         m_state.forEachWord([&out](uint32_t w) { *out++ = w; });
         for (Handle t : m_state.textures) fingerprintRead(ownerOf(t));

@@ -12,9 +12,7 @@ void Device::beginFingerprint() {
     m_fingerprint.active = true;
     m_fingerprint.print.complete = true;
     // Room for a pass's draw or two (each takes the whole state): one allocation, not a dozen.
-    size_t stateWords = 0;
-    m_state.forEachWord([&stateWords](uint32_t) { ++stateWords; });
-    m_fingerprint.print.words.reserve(2 * stateWords + 256);
+    m_fingerprint.print.words.reserve(2 * m_state.wordCount() + 256);
 }
 
 Device::Fingerprint Device::endFingerprint() {

@@ -85,6 +85,12 @@ struct DeviceState {
     // A template: a call per word through std::function was a tenth of a still frame.
     template <typename F>
     void forEachWord(F&& f, uint32_t parts = AllFields) const;
+    // How many words forEachWord gives for every part (a constant: the arrays are fixed).
+    size_t wordCount() const {
+        size_t n = 0;
+        forEachWord([&n](uint32_t) { ++n; });
+        return n;
+    }
 };
 
 template <typename F>
