@@ -18,6 +18,15 @@ struct RgbaImage {
     std::vector<uint8_t> rgba;
 };
 
+// Every pixel's alpha set to 255 (frames written as opaque pictures); `opaque` on a copy.
+inline void makeOpaque(RgbaImage& image) {
+    for (size_t i = 3; i < image.rgba.size(); i += 4) image.rgba[i] = 255;
+}
+inline RgbaImage opaque(RgbaImage image) {
+    makeOpaque(image);
+    return image;
+}
+
 // The largest image read or written: a side, and the bytes of its RGBA8 pixels. Checked against a
 // file's header before any pixel memory is allocated. 16384 a side is exactly 1 GiB of RGBA8, so the
 // byte limit binds only if the side limit is raised.

@@ -133,32 +133,54 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
 }
 
 std::optional<emu::RgbaImage> Runner::readTexture(Handle texture, std::string& error) {
-    Handle surface{};
-    if (m_device->GetSurfaceLevel(texture, 0, &surface) != D3D_OK) {
-        error = m_device->lastError().message;
-        return std::nullopt;
-    }
-    std::optional<emu::SurfacePixels> px = emu::readSurface(*m_device, surface, error);
-    if (!px) return std::nullopt;
     emu::RgbaImage img;
-    img.width = px->width;
-    img.height = px->height;
-    img.rgba.resize(size_t(px->width) * px->height * 4);
-    const emu::FormatInfo& info = *emu::formatInfo(px->format);
-    for (size_t i = 0; i < size_t(px->width) * px->height; ++i) {
-        const uint8_t* p = &px->bytes[i * px->bytesPerPixel];
-        if (px->format == D3DFMT_A8R8G8B8) {  // b g r a
-            uint8_t* d = &img.rgba[i * 4];
-            d[0] = p[2], d[1] = p[1], d[2] = p[0], d[3] = p[3];
-        } else if (info.cls == emu::FormatClass::Unorm8) {
-            const auto rgba = emu::decodeUnorm8(info, p);
-            std::memcpy(&img.rgba[i * 4], rgba.data(), 4);
-        } else {
-            const auto v = emu::decodeTexel(info, p, ps11::SignedDecode{});
-            for (int c = 0; c < 4; ++c) img.rgba[i * 4 + size_t(c)] = frameByte(v[size_t(c)]);
-        }
-    }
+    if (!readTexture(texture, img, error)) return std::nullopt;
     return img;
+}
+
+bool Runner::readTexture(Handle texture, emu::RgbaImage& img, std::string& error) {
+    return readPixels(
+        texture,
+        [&](const Pixels& px) {
+            const emu::FormatInfo* info = emu::formatInfo(px.format);
+            if (!info) {
+                error = std::string("readTexture: the texture's format ") + emu::formatName(px.format) + " is unknown";
+                return false;
+            }
+            img.width = px.width;
+            img.height = px.height;
+            img.rgba.resize(size_t(px.width) * px.height * 4);  // keeps the buffer of an image read before
+            const bool floats = px.format == D3DFMT_A32B32G32R32F;  // four floats r g b a (ps11/formats.cpp)
+            std::vector<float> v(floats ? size_t(px.width) * 4 : 0);   // a row (its bytes need not be aligned)
+            for (uint32_t y = 0; y < px.height; ++y) {
+                const uint8_t* row = px.data + size_t(y) * px.pitch;
+                uint8_t* d = &img.rgba[size_t(y) * px.width * 4];
+                if (px.format == D3DFMT_A8R8G8B8) {  // b g r a words: swap bytes 0 and 2
+                    for (uint32_t x = 0; x < px.width; ++x) {
+                        uint32_t w;
+                        std::memcpy(&w, row + 4 * size_t(x), 4);
+                        w = (w & 0xff00ff00u) | ((w >> 16) & 0xffu) | ((w & 0xffu) << 16);
+                        std::memcpy(d + 4 * size_t(x), &w, 4);
+                    }
+                } else if (floats) {
+                    std::memcpy(v.data(), row, v.size() * sizeof(float));
+                    frameBytes(v.data(), v.size(), d);
+                } else {
+                    for (uint32_t x = 0; x < px.width; ++x) {
+                        const uint8_t* p = row + size_t(x) * info->bytes;
+                        if (info->cls == emu::FormatClass::Unorm8) {
+                            const auto rgba = emu::decodeUnorm8(*info, p);
+                            std::memcpy(d + 4 * size_t(x), rgba.data(), 4);
+                        } else {
+                            const auto v = emu::decodeTexel(*info, p, ps11::SignedDecode{});
+                            for (int c = 0; c < 4; ++c) d[4 * size_t(x) + size_t(c)] = frameByte(v[size_t(c)]);
+                        }
+                    }
+                }
+            }
+            return true;
+        },
+        error);
 }
 
 emu::ThreadPool& Runner::cpuPool() {
@@ -183,6 +205,7 @@ bool Runner::readPixels(Handle texture, const std::function<bool(const Pixels&)>
 }
 
 std::optional<emu::RgbaImage> Runner::readOutput(std::string& error) { return readTexture(m_output, error); }
+bool Runner::readOutput(emu::RgbaImage& image, std::string& error) { return readTexture(m_output, image, error); }
 
 Handle Runner::shader(const std::string& file, std::string& error) {
     auto it = m_shaders.find(file);

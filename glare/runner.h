@@ -90,8 +90,13 @@ public:
     const std::string& lastGraphviz() const { return m_lastGraphviz; }
     emu::Handle sceneTexture() const { return m_scene; }
     emu::Handle outputTexture() const { return m_output; }
+    // Level 0 of a texture as 8-bit r g b a (float channels by frameByte), read where the device
+    // keeps it (readPixels). The overloads taking an image reuse its buffer: a frame loop that
+    // reads every frame allocates once.
     std::optional<emu::RgbaImage> readOutput(std::string& error);
     std::optional<emu::RgbaImage> readTexture(emu::Handle texture, std::string& error);
+    bool readOutput(emu::RgbaImage& image, std::string& error);
+    bool readTexture(emu::Handle texture, emu::RgbaImage& image, std::string& error);
     // Level 0 of a render-target texture as the application sees it, read where the device keeps
     // it (`Device::readSurface`: no copy) while `use` looks at it (D3D's layout, `pitch` bytes a
     // row). False with `error` if a call fails or `use` returns false.

@@ -664,6 +664,44 @@ TEST_CASE("frameBytes is frameByte for every float", "[glare]") {
     }
 }
 
+TEST_CASE("runner: readTexture gives each texel as r g b a, into an image it reuses", "[glare]") {
+    // An odd size (rows of any length), random bytes in fx8's A8R8G8B8 and random floats (below
+    // 0, above 1, NaN) in ideal's A32B32G32R32F: the bytes read are the texels' own, the floats'
+    // frameByte; reading into an image that held something else gives the same.
+    std::mt19937 rng(11);
+    const uint32_t w = 37, h = 5;
+    emu::RgbaImage bytes{w, h, std::vector<uint8_t>(size_t(w) * h * 4)};
+    for (uint8_t& b : bytes.rgba) b = uint8_t(rng());
+    emu::FloatImage floats{w, h, std::vector<float>(size_t(w) * h * 4)};
+    for (size_t i = 0; i < floats.rgba.size(); ++i)
+        floats.rgba[i] = i == 7 ? NAN : float(int(rng() % 4000) - 1000) / 2000.0f;
+    std::vector<uint8_t> floatBytes;
+    for (float f : floats.rgba) floatBytes.push_back(glare::frameByte(f));
+    for (const bool ideal : {false, true}) {
+        INFO((ideal ? "ideal" : "fx8"));
+        glare::RunnerOptions o;
+        o.width = w;
+        o.height = h;
+        if (ideal) o.device.precision = ps11::Precision::Ideal;
+        glare::Runner run(o);
+        std::string err;
+        REQUIRE((ideal ? run.setImage(floats, err) : run.setImage(bytes, err)));
+        const std::vector<uint8_t>& want = ideal ? floatBytes : bytes.rgba;
+        const std::optional<emu::RgbaImage> once = run.readTexture(run.sceneTexture(), err);
+        REQUIRE(once);
+        CHECK(once->width == w);
+        CHECK(once->height == h);
+        CHECK(once->rgba == want);
+        emu::RgbaImage reused{3, 2, std::vector<uint8_t>(size_t(64) * 64 * 4, 0x5A)};
+        REQUIRE(run.readTexture(run.sceneTexture(), reused, err));
+        CHECK(reused.width == w);
+        CHECK(reused.height == h);
+        CHECK(reused.rgba == want);
+        CHECK_FALSE(run.readTexture(emu::Handle{}, reused, err));
+        CHECK_FALSE(err.empty());
+    }
+}
+
 TEST_CASE("sprites: grouping keeps the total glare energy", "[glare]") {
     // Scattered bright pixels (some adjacent) on black.
     const uint32_t w = 64, h = 48;

@@ -66,11 +66,6 @@ struct GlareOptions {
     bool noSkip = false;  // --no-skip: every pass runs every frame
 };
 
-emu::RgbaImage opaque(emu::RgbaImage img) {
-    for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
-    return img;
-}
-
 std::string numbered(const std::string& path, int frame, int frames) {
     if (frames <= 1) return path;
     const std::filesystem::path p(path);
@@ -288,6 +283,7 @@ int runGlare(const GlareOptions& o) {
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
     double lastBuildMs = 0;  // the last frame's graph, built and compiled
+    emu::RgbaImage frameImage;  // -o: each frame's output, read into one buffer
     std::vector<double> frameMs;
     emu::TransferStats lastTransfers;  // the last frame's, with its output's read-back
     std::vector<glare::PassAgreement> agreement;
@@ -334,8 +330,8 @@ int runGlare(const GlareOptions& o) {
                     std::snprintf(prefix, sizeof prefix, "%02u_", pass);
                     const std::string path = o.dumpDir + "/" + prefix + safeName(n.info.name) + "-" +
                                              safeName(g.texture(id).name) + ".png";
-                    if (!emu::writePng(path, opaque(*img), e)) return false;
-                    sheet.push_back(opaque(*img));
+                    if (!emu::writePng(path, emu::opaque(*img), e)) return false;
+                    sheet.push_back(emu::opaque(*img));
                 }
             return true;
         };
@@ -372,8 +368,13 @@ int runGlare(const GlareOptions& o) {
         lastBuildMs = result.buildMilliseconds;
         frameMs.push_back(result.milliseconds);
         if (!o.out.empty()) {
-            std::optional<emu::RgbaImage> img = main->readOutput(err);
-            if (!img || !emu::writePng(numbered(o.out, f, o.frames), opaque(*img), err)) {
+            // One image for every frame: no 8 MB allocated and given back per 1080p frame.
+            bool written = main->readOutput(frameImage, err);
+            if (written) {
+                emu::makeOpaque(frameImage);
+                written = emu::writePng(numbered(o.out, f, o.frames), frameImage, err);
+            }
+            if (!written) {
                 std::cerr << "ps11 glare: " << err << "\n";
                 return cli::kUserError;
             }

@@ -62,11 +62,6 @@ std::string safeName(const std::string& s) {
     return out;
 }
 
-emu::RgbaImage opaque(emu::RgbaImage img) {
-    for (size_t i = 3; i < img.rgba.size(); i += 4) img.rgba[i] = 255;
-    return img;
-}
-
 // |a − b| over RGB as a heat map: black where equal, then red to yellow with the difference
 // (1 level is clearly visible, 8 and more is yellow).
 emu::RgbaImage heatMap(const emu::RgbaImage& a, const emu::RgbaImage& b) {
@@ -134,7 +129,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
     std::optional<emu::RgbaImage> input = emu.readTexture(emu.sceneTexture(), err);
     if (!input) return false;
     show.input = "img/" + name + "-input.png";
-    if (!c.png(show.input, opaque(*input))) return false;
+    if (!c.png(show.input, emu::opaque(*input))) return false;
 
     // The emulated frame, pass-isolated against GL's exact mode where there is GL, with every
     // pass's output kept for the contact sheet.
@@ -150,7 +145,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
             std::snprintf(prefix, sizeof prefix, "%02u", pass);
             PassImage pi{n.info.name, g.texture(id).name,
                          "img/" + name + "-pass" + prefix + "-" + safeName(n.info.name) + ".png"};
-            if (!emu::writePng(c.dir + "/" + pi.file, opaque(*img), e)) return false;
+            if (!emu::writePng(c.dir + "/" + pi.file, emu::opaque(*img), e)) return false;
             show.passes.push_back(pi);
         }
         return true;
@@ -174,7 +169,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
     }
     std::optional<emu::RgbaImage> out = emu.readOutput(err);
     if (!out) return false;
-    *out = opaque(*out);
+    *out = emu::opaque(*out);
     show.emulated = "img/" + name + "-emulated.png";
     if (!c.png(show.emulated, *out)) return false;
     if (exact) {
@@ -184,7 +179,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
         for (const glare::PassAgreement& a : show.agreement) differs = differs || a.exact < a.pixels;
         if (differs) {
             show.heat = "img/" + name + "-heat.png";
-            if (!c.png(show.heat, heatMap(*out, opaque(*gx)))) return false;
+            if (!c.png(show.heat, heatMap(*out, emu::opaque(*gx)))) return false;
         }
     }
 
@@ -196,7 +191,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
     std::optional<emu::RgbaImage> idealOut;
     if (!ideal.setImage(*input, err) || !ideal.runFrame(t, settings, 0, 1, r, err) || !(idealOut = ideal.readOutput(err)))
         return false;
-    *idealOut = opaque(*idealOut);
+    *idealOut = emu::opaque(*idealOut);
     show.ideal = "img/" + name + "-ideal.png";
     if (!c.png(show.ideal, *idealOut)) return false;
     show.emuError = glare::imageError(*out, *idealOut);
@@ -207,7 +202,7 @@ bool showTechnique(Ctx& c, const glare::Technique& t, uint32_t w, uint32_t h, Te
         std::optional<emu::RgbaImage> gn;
         if (!native.setImage(*input, err) || !native.runFrame(t, settings, 0, 1, r, err) || !(gn = native.readOutput(err)))
             return false;
-        *gn = opaque(*gn);
+        *gn = emu::opaque(*gn);
         show.glNative = "img/" + name + "-gl-native.png";
         if (!c.png(show.glNative, *gn)) return false;
         show.glError = glare::imageError(*gn, *idealOut);
@@ -313,11 +308,11 @@ bool showPhoto(Ctx& c, const glare::Photo& photo, PhotoShow& show) {
             std::optional<emu::RgbaImage> in = emu.readTexture(emu.sceneTexture(), err);
             if (!in) return false;
             show.input = "img/photo-" + stem + "-input.png";
-            if (!c.png(show.input, opaque(*in))) return false;
+            if (!c.png(show.input, emu::opaque(*in))) return false;
         }
         const std::string name(t->name());
         std::string emuFile = "img/photo-" + stem + "-" + name + "-emulated.png", glFile;
-        if (!c.png(emuFile, opaque(*out))) return false;
+        if (!c.png(emuFile, emu::opaque(*out))) return false;
         glare::ImageError e;
         if (c.glNative) {
             glare::RunnerOptions no = c.runnerOptions(image.width, image.height);
@@ -327,8 +322,8 @@ bool showPhoto(Ctx& c, const glare::Photo& photo, PhotoShow& show) {
             if (!native.setImage(image, err) || !native.runFrame(*t, settings, 0, 1, r, err) || !(g = native.readOutput(err)))
                 return false;
             glFile = "img/photo-" + stem + "-" + name + "-gl-native.png";
-            if (!c.png(glFile, opaque(*g))) return false;
-            e = glare::imageError(opaque(*out), opaque(*g));
+            if (!c.png(glFile, emu::opaque(*g))) return false;
+            e = glare::imageError(emu::opaque(*out), emu::opaque(*g));
         }
         show.results.emplace_back(name, emuFile, glFile, e);
     }
