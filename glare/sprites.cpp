@@ -424,11 +424,11 @@ public:
                                   return keep();
                               },
                               c.error);
-                      std::optional<emu::RgbaImage> img = runner->readTexture(c.texture(scene), c.error);
-                      if (!img) return false;
+                      static thread_local emu::RgbaImage img;  // kept: no fresh frame's worth every frame
+                      if (!runner->readTexture(c.texture(scene), img, c.error)) return false;
                       *sprites = senseSprites(
-                          SensorFrame{img->rgba.data(), img->width, img->height, size_t(img->width) * 4, false, threads}, ss);
-                      c.stats.pixels += uint64_t(img->width) * img->height;
+                          SensorFrame{img.rgba.data(), img.width, img.height, size_t(img.width) * 4, false, threads}, ss);
+                      c.stats.pixels += uint64_t(img.width) * img.height;
                       return keep();
                   });
 
