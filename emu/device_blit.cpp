@@ -145,6 +145,9 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     sc.linear = filter == D3DTEXF_LINEAR;
     sc.fixedPoint = ps11::isFixedPoint(m_hardware.precision);
     sc.decode = m_hardware.hardware->signedDecode;
+    // Not where the front compares a small destination's bytes before and after (prepareWrite):
+    // a copy put off has written none of them yet.
+    sc.mayPutOff = resourceLevelBytes(*dst) > kComparedResourceBytes;
     prepareWrite(*dst);
     if (m_renderer->stretchRect(sc)) {
         rendererWrote(*dst, dstRef.level);

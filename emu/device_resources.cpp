@@ -237,9 +237,9 @@ HRESULT Device::Release(Handle object) {
             m_surfaces.erase(uint32_t(s));
         }
     unbind(object);
+    m_renderer->release(id);  // while its images are there (a copy put off may read them)
     m_surfaces.erase(id);
     m_resources.erase(id);
-    m_renderer->release(id);
     return D3D_OK;
 }
 
@@ -364,7 +364,7 @@ void Device::markWritten(Resource& r, uint32_t level) {
 
 void Device::rendererWrote(Resource& r, uint32_t level) {
     markWritten(r, level);
-    r.rendererNewer[level] = m_renderer->keepsCopies() ? 1 : 0;
+    r.rendererNewer[level] = m_renderer->leftNewer(surfaceDesc(SurfaceRef{r.handle, level}, r)) ? 1 : 0;
 }
 
 SurfaceDesc Device::surfaceDesc(const SurfaceRef& ref, Resource& r) {
@@ -380,6 +380,7 @@ SurfaceDesc Device::surfaceDesc(const SurfaceRef& ref, Resource& r) {
 }
 
 void Device::prepareWrite(Resource& r) {
+    m_renderer->beforeWrite(uint32_t(r.handle));  // a copy put off that reads these levels, made first
     // The sampler's view is stale once the write lands. A texture reading the levels in place
     // that is still held elsewhere keeps the bytes it was made from: the levels move to a copy.
     if (r.sampled && r.sampled->readsInPlace()) r.sampled.reset();

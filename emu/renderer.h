@@ -137,6 +137,9 @@ struct StretchCall {
     bool linear = false;             // D3DTEXF_LINEAR (else POINT)
     bool fixedPoint = false;         // fx profiles: 8-bit sub-texel weights
     ps11::SignedDecode decode = ps11::SignedDecode::Snorm;
+    // The renderer may put the copy off (StretchRect: the destination then reads as newer in the
+    // renderer, Renderer::leftNewer); never where the front reads the destination unsynced.
+    bool mayPutOff = false;
 };
 
 // Counts of what crossed between the front's images and a renderer's copies.
@@ -159,11 +162,22 @@ public:
     virtual bool clear(const ClearCall& call) = 0;
     virtual bool stretchRect(const StretchCall& call) = 0;
     // Whether the renderer keeps its own copies of surfaces (then the front calls readBack
-    // before it reads or writes a level the renderer wrote, and release when a resource dies).
+    // before it reads or writes a level the renderer wrote).
     virtual bool keepsCopies() const { return false; }
-    // Writes the renderer's copy of the surface into surface.image.
+    // After a call of the renderer wrote the level: whether its newest bytes are still not in
+    // surface.image (a copy the renderer keeps, or a copy it put off); the front then calls
+    // readBack before it reads or writes the level.
+    virtual bool leftNewer(const SurfaceDesc& surface) const {
+        (void)surface;
+        return keepsCopies();
+    }
+    // Writes the renderer's newest bytes of the surface into surface.image.
     virtual void readBack(const SurfaceDesc& surface) { (void)surface; }
-    // The resource is gone: its copies can go.
+    // Before anything writes the resource's levels (the front, a lock, a call of the renderer):
+    // a copy put off that reads them is made now.
+    virtual void beforeWrite(uint32_t resource) { (void)resource; }
+    // The resource is about to go (its images still there): its copies can go, and copies put
+    // off that read it are made now.
     virtual void release(uint32_t resource) { (void)resource; }
     // Returns when every call so far has finished (for timings; the software renderer's calls
     // finish before they return).

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <optional>
+#include <functional>
 #include <unordered_map>
 
 #include "emu/aligned_float.h"
@@ -80,6 +82,8 @@ struct SoftwareDrawContext {
         bool warm = false;  // a decided draw was seen: the first, which scans its textures' facts, is not timed
     };
     std::unordered_map<uint64_t, TileHistory> tileHistory;
+    // A draw into the destination of a copy put off: which bands of its rows have been copied.
+    std::vector<uint8_t> bandCopied;
     // A chunk's triangles, setups, row-path tables and bands, kept between draws: a draw of
     // sprites allocated and first touched about 2 MB of them every time (page faults, then the
     // tables' own vectors), a tenth of its time. Tables are filled anew per chunk and keep their
@@ -101,8 +105,17 @@ SoftwareRenderer::SoftwareRenderer(const SoftwareRendererOptions& options) : m_o
 
 SoftwareRenderer::~SoftwareRenderer() = default;
 
-bool SoftwareRenderer::clear(const ClearCall& call) {
+SoftwareDrawContext& SoftwareRenderer::context() {
     if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+    return *m_context;
+}
+
+bool SoftwareRenderer::clear(const ClearCall& call) {
+    context();
+    // Copies put off that read what this clears are made first, and one into its target (a
+    // clear may cover part of it).
+    makeCopies(call.color.image, call.color.image);
+    makeCopies(nullptr, call.depth.image);
     // Image rows in bands over the workers, as stretchRect's (each row is written by one of them).
     int64_t rows = 0, texels = 0;
     for (const SurfaceDesc* ref : {&call.color, &call.depth})
@@ -114,28 +127,70 @@ bool SoftwareRenderer::clear(const ClearCall& call) {
     return true;
 }
 
-ThreadPool* SoftwareRenderer::workers() {
-    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
-    return &m_context->pool;
-}
+ThreadPool* SoftwareRenderer::workers() { return &context().pool; }
 
-bool SoftwareRenderer::stretchRect(const StretchCall& call) {
-    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
+void SoftwareRenderer::copyRows(const StretchCall& call, int64_t rows) {
     // Destination rows in bands over the workers (each row is written by one of them).
-    const int64_t rows = call.destRect.y1 - call.destRect.y0;
     // The work is the texels read: four a pixel for LINEAR, whose scattered reads of a reduction
     // wait on memory.
     const int64_t texels = rows * (call.destRect.x1 - call.destRect.x0) * (call.linear ? 4 : 1);
-    const int workers = int(std::clamp<int64_t>(texels / kMinBlitTexelsPerWorker, 1, m_context->pool.size()));
+    const int workers = int(std::clamp<int64_t>(texels / kMinBlitTexelsPerWorker, 1, context().pool.size()));
     m_context->pool.run(workers, [&](int w) {
         stretchImages(call, RowRange{rows * w / workers, rows * (w + 1) / workers});
     });
+}
+
+void SoftwareRenderer::makeCopies(const Image* into, const Image* from, uint32_t fromResource) {
+    // In call order: a copy reads what the ones before it wrote.
+    for (size_t i = 0; i < m_putOff.size();) {
+        const StretchCall& c = m_putOff[i];
+        if ((into && c.dest.image == into) || (from && c.source.image == from) ||
+            (fromResource && c.source.resource == fromResource)) {
+            const StretchCall call = c;
+            m_putOff.erase(m_putOff.begin() + std::ptrdiff_t(i));
+            makeCopies(call.source.image, nullptr);  // (none: a copy from a destination made its source first)
+            copyRows(call, call.destRect.y1 - call.destRect.y0);
+            i = 0;
+            continue;
+        }
+        ++i;
+    }
+}
+
+bool SoftwareRenderer::stretchRect(const StretchCall& call) {
+    context();
+    // The source's newest bytes, and nothing put off still reading what this overwrites.
+    makeCopies(call.source.image, call.dest.image);
+    const Image& d = *call.dest.image;
+    const bool whole = call.destRect.x0 == 0 && call.destRect.y0 == 0 && call.destRect.x1 == int64_t(d.width) &&
+                       call.destRect.y1 == int64_t(d.height) && d.depth == 1;
+    if (m_options.putOffCopies && call.mayPutOff && whole) {
+        // It writes every byte of the destination: a copy put off into it is dropped.
+        std::erase_if(m_putOff, [&](const StretchCall& c) { return c.dest.image == call.dest.image; });
+        m_putOff.push_back(call);
+        return true;
+    }
+    makeCopies(call.dest.image, nullptr);
+    copyRows(call, call.destRect.y1 - call.destRect.y0);
     return true;
 }
 
+bool SoftwareRenderer::leftNewer(const SurfaceDesc& surface) const {
+    return std::any_of(m_putOff.begin(), m_putOff.end(),
+                       [&](const StretchCall& c) { return c.dest.image == surface.image; });
+}
+
+void SoftwareRenderer::readBack(const SurfaceDesc& surface) { makeCopies(surface.image, nullptr); }
+
+void SoftwareRenderer::beforeWrite(uint32_t resource) { makeCopies(nullptr, nullptr, resource); }
+
+void SoftwareRenderer::release(uint32_t resource) {
+    makeCopies(nullptr, nullptr, resource);
+    std::erase_if(m_putOff, [&](const StretchCall& c) { return c.dest.resource == resource; });
+}
+
 bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& error) {
-    if (!m_context) m_context = std::make_unique<SoftwareDrawContext>(m_options.threads);
-    SoftwareDrawContext& dc = *m_context;
+    SoftwareDrawContext& dc = context();
     const DrawProgram& prog = call.program;
 
     // ---- the executor of the program (one per program identity) ----
@@ -155,6 +210,48 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         it = dc.executors.emplace(prog.key, std::move(e)).first;
     }
     ps11::Executor& executor = *it->second;
+
+    // Copies put off that read the targets are made first. One into the colour target is made
+    // band by band, each band's rows just before the band is drawn (so a blend reads them from
+    // cache), and the bands the draw does not reach after it; a draw of several chunks, whose
+    // bands are visited once per chunk, has it made first.
+    Image* const colorImage = call.target.color;
+    makeCopies(nullptr, colorImage);
+    makeCopies(call.target.depth, call.target.depth);
+    std::optional<StretchCall> fused;
+    if (colorImage) {
+        auto pending = std::find_if(m_putOff.begin(), m_putOff.end(),
+                                    [&](const StretchCall& c) { return c.dest.image == colorImage; });
+        if (pending != m_putOff.end() && call.primitiveCount <= kChunkTriangles) {
+            fused = *pending;
+            m_putOff.erase(pending);
+        } else if (pending != m_putOff.end()) {
+            makeCopies(colorImage, nullptr);
+        }
+    }
+    std::vector<uint8_t>& bandCopied = dc.bandCopied;
+    if (fused) bandCopied.assign((size_t(colorImage->height) + kBandRows - 1) / kBandRows, 0);
+    auto copyBand = [&](int band) {
+        stretchImages(*fused, RowRange{int64_t(band) * kBandRows, int64_t(band + 1) * kBandRows});
+        bandCopied[size_t(band)] = 1;
+    };
+    // On every way out: the bands not copied yet, over the workers.
+    struct AtExit {
+        std::function<void()> run;
+        ~AtExit() { run(); }
+    } copyRest{[&] {
+        if (!fused) return;
+        std::vector<int> rest;
+        for (size_t b = 0; b < bandCopied.size(); ++b)
+            if (!bandCopied[b]) rest.push_back(int(b));
+        const int64_t texels = int64_t(rest.size()) * kBandRows * int64_t(colorImage->width);
+        const int workers = int(std::clamp<int64_t>(texels / kMinBlitTexelsPerWorker, 1, dc.pool.size()));
+        std::atomic<size_t> nextRest{0};
+        dc.pool.run(workers, [&](int) {
+            for (size_t i; (i = nextRest.fetch_add(1, std::memory_order_relaxed)) < rest.size();) copyBand(rest[i]);
+        });
+    }};
+
     for (int i = 0; i < kMaxPsConstants; ++i) executor.setConstant(i, prog.constants[size_t(i)]);
     for (int s = 0; s < kMaxStages; ++s) executor.setStageState(s, prog.stages[size_t(s)]);
 
@@ -448,6 +545,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 if (b >= bands) break;
                 const int by0 = (firstBand + b) * kBandRows;
                 const int by1 = by0 + kBandRows;
+                if (fused) copyBand(firstBand + b);
                 // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
                 const AlignedTriangle* group[kMaxAlignedTriangles];
                 const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];

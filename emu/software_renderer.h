@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "emu/renderer.h"
 
@@ -24,6 +25,11 @@ struct SoftwareRendererOptions {
     // run; never a byte). Off: by the share of tiles saved alone (deterministic: tests that count
     // decided tiles turn timing off).
     bool timeTiles = true;
+    // A StretchRect onto a whole surface is put off until something reads or writes the
+    // destination or writes the source; a draw into the destination then copies each band of
+    // rows just before it draws them (the composite over a copied scene reads its target while
+    // the rows are in cache). Off: the copy is made by StretchRect. Either way the same bytes.
+    bool putOffCopies = true;
 };
 
 struct SoftwareDrawContext;  // the worker pool and the executor cache (software_renderer.cpp)
@@ -36,13 +42,26 @@ public:
     // In the front's images (emu/blit.h): the software renderer keeps no copies.
     bool clear(const ClearCall& call) override;
     bool stretchRect(const StretchCall& call) override;
+    // Copies put off (SoftwareRendererOptions::putOffCopies): the destination is newer here
+    // until the copy is made, which readBack, beforeWrite (of the source) and release do.
+    bool leftNewer(const SurfaceDesc& surface) const override;
+    void readBack(const SurfaceDesc& surface) override;
+    void beforeWrite(uint32_t resource) override;
+    void release(uint32_t resource) override;
     const char* name() const override { return "software"; }
     ThreadPool* workers() override;
     const SoftwareRendererOptions& options() const { return m_options; }
 
 private:
+    SoftwareDrawContext& context();
+    // Makes the copies put off that write `into` or read `from` (images; null matches none), or
+    // read the resource `fromResource` (0: none).
+    void makeCopies(const Image* into, const Image* from, uint32_t fromResource = 0);
+    void copyRows(const StretchCall& call, int64_t rows);  // the whole call over the workers
+
     SoftwareRendererOptions m_options;
     std::unique_ptr<SoftwareDrawContext> m_context;  // created by the first draw (threads start then)
+    std::vector<StretchCall> m_putOff;               // copies not made yet, in call order
 };
 
 }  // namespace emu

@@ -926,6 +926,7 @@ void checkReuse(const emu::DeviceOptions& device) {
         on.height = off.height = 96;
         on.device = off.device = device;
         off.skip = false;
+        off.device.software.putOffCopies = false;  // and every copy made at once (the float targets' are put off)
         glare::Runner a(on), b(off);
         std::string err;
         std::unique_ptr<glare::Scene> sa = glare::makeScene(t->scene(), err), sb = glare::makeScene(t->scene(), err);
@@ -986,8 +987,8 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
           "[glare][reuse]") {
     // Skipping's measuring scenes, moving, on every hardware class (fx8, fx12, float) and under
     // ideal: the software renderer fills, copies and skips tiles (docs/device.md "Tile
-    // skipping") and reuses passes; the frames must be those of every pass run and every tile
-    // shaded.
+    // skipping"), reuses passes and puts the scene's copy off into the composite's bands; the
+    // frames must be those of every pass run, every tile shaded and every copy made at once.
     uint64_t decided = 0;
     std::vector<emu::DeviceOptions> devices;
     for (const ps11::HardwareClass& h : ps11::hardwareClasses()) {
@@ -1009,6 +1010,7 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
                 on.device = off.device = device;
                 on.device.software.timeTiles = false;  // decided by the share of tiles: the count below holds
                 off.skip = false;
+                off.device.software.putOffCopies = false;  // copies made at once (docs/device.md "StretchRect")
                 glare::Runner a(on), b(off);
                 std::string err;
                 std::unique_ptr<glare::Scene> sa = glare::makeScene(sceneName, err), sb = glare::makeScene(sceneName, err);

@@ -1,0 +1,198 @@
+// StretchRect put off (SoftwareRendererOptions::putOffCopies, docs/device.md "StretchRect"): the
+// software renderer makes a whole-surface copy when something reads or writes its destination or
+// writes its source, and a draw into the destination copies each band of rows just before it
+// draws them. Every sequence here runs on a device that puts copies off and on one that makes
+// them at once, and everything read back must be byte for byte the same.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/device.h"
+#include "emu/fullscreen.h"
+
+using namespace emu;
+
+namespace {
+
+// Above kComparedResourceBytes (64 KB): the device lets the renderer put copies into it off.
+constexpr UINT kW = 160, kH = 120;
+
+struct Script {
+    Device dev;
+    Handle a{}, b{}, c{}, x{}, tex{}, texLevel{}, constant{}, sample{};
+    std::vector<std::vector<uint8_t>> seen;  // every read, in order
+
+    explicit Script(bool putOff) : dev([&] {
+        DeviceOptions o;
+        o.software.threads = 2;
+        o.software.putOffCopies = putOff;
+        return o;
+    }()) {
+        for (Handle* h : {&a, &b, &c, &x}) REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, h) == D3D_OK);
+        REQUIRE(dev.CreateTexture(kW, kH, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &tex) == D3D_OK);
+        REQUIRE(dev.GetSurfaceLevel(tex, 0, &texLevel) == D3D_OK);
+        std::mt19937 rng(3);
+        for (Handle h : {a, b, c, x}) fill(h, rng);
+        REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ndef c0, 0.2, 0.1, 0.3, 0.4\nmov r0, c0\n", &constant) == D3D_OK);
+        REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ntex t0\nmov r0, t0\n", &sample) == D3D_OK);
+    }
+    void fill(Handle h, std::mt19937& rng) {
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(h, &lr, nullptr, 0) == D3D_OK);
+        for (UINT y = 0; y < kH; ++y)
+            for (UINT i = 0; i < kW * 4; ++i) static_cast<uint8_t*>(lr.pBits)[y * UINT(lr.Pitch) + i] = uint8_t(rng());
+        REQUIRE(dev.UnlockRect(h) == D3D_OK);
+    }
+    std::vector<uint8_t> read(Handle h) {
+        std::vector<uint8_t> out;
+        REQUIRE(dev.readSurface(h, [&](const D3DLOCKED_RECT& lr) {
+            for (UINT y = 0; y < kH; ++y) {
+                const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
+                out.insert(out.end(), row, row + kW * 4);
+            }
+        }) == D3D_OK);
+        seen.push_back(out);
+        return out;
+    }
+    std::vector<uint8_t> lockRead(Handle h) {
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(h, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+        std::vector<uint8_t> out;
+        for (UINT y = 0; y < kH; ++y) {
+            const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
+            out.insert(out.end(), row, row + kW * 4);
+        }
+        REQUIRE(dev.UnlockRect(h) == D3D_OK);
+        seen.push_back(out);
+        return out;
+    }
+    void copy(Handle from, Handle to) { REQUIRE(dev.StretchRect(from, nullptr, to, nullptr, D3DTEXF_POINT) == D3D_OK); }
+    // Rows [y0, y1) of `target`: the constant, added (ONE, ONE) or replacing.
+    void drawConstant(Handle target, float y0, float y1, bool add) {
+        REQUIRE(dev.SetRenderTarget(0, target) == D3D_OK);
+        REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(constant) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, add ? 1 : 0) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+        REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
+        const auto q = halfPixelQuad(0, y0, float(kW), y1, {});
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, q.data(), sizeof(QuadVertex)) == D3D_OK);
+    }
+    // The texture drawn 1:1 into `target`.
+    void drawTexture(Handle target) {
+        REQUIRE(dev.SetRenderTarget(0, target) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(sample) == D3D_OK);
+        REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 0) == D3D_OK);
+        REQUIRE(drawFullscreenQuad(dev, {}) == D3D_OK);
+        REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
+    }
+};
+
+// Runs `steps` on both devices; everything they read must be the same.
+template <class F>
+void bothWays(F steps) {
+    Script on(true), off(false);
+    steps(on);
+    steps(off);
+    REQUIRE(on.seen.size() == off.seen.size());
+    for (size_t i = 0; i < on.seen.size(); ++i) {
+        INFO("read " << i);
+        CHECK(on.seen[i] == off.seen[i]);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("put-off copies: the destination reads as the copy, however it is read", "[device][putoff]") {
+    bothWays([](Script& s) {
+        const std::vector<uint8_t> a = s.read(s.a);
+        const uint64_t before = s.dev.contentGeneration(s.b);
+        s.copy(s.a, s.b);
+        CHECK(s.dev.contentGeneration(s.b) != before);  // a new generation at the call, as a copy made
+        CHECK(s.read(s.b) == a);                         // readSurface
+        s.copy(s.x, s.c);
+        s.lockRead(s.c);  // LockRect
+        s.copy(s.a, s.texLevel);
+        s.drawTexture(s.c);  // sampled by a draw
+        s.read(s.c);
+        Handle sys{};
+        REQUIRE(s.dev.CreateOffscreenPlainSurface(kW, kH, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &sys) == D3D_OK);
+        s.copy(s.x, s.b);
+        REQUIRE(s.dev.GetRenderTargetData(s.b, sys) == D3D_OK);  // read back
+        s.lockRead(sys);
+    });
+}
+
+TEST_CASE("put-off copies: writing the source first makes the copy of what it held", "[device][putoff]") {
+    bothWays([](Script& s) {
+        const std::vector<uint8_t> a = s.read(s.a);
+        s.copy(s.a, s.b);
+        REQUIRE(s.dev.SetRenderTarget(0, s.a) == D3D_OK);
+        REQUIRE(s.dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0xff102030, 1, 0) == D3D_OK);  // a clear of the source
+        CHECK(s.read(s.b) == a);
+        s.copy(s.b, s.c);
+        s.drawConstant(s.b, 0, float(kH), false);  // a draw into the source
+        CHECK(s.read(s.c) == a);
+        s.copy(s.c, s.x);
+        std::mt19937 rng(9);
+        s.fill(s.c, rng);  // a lock of the source
+        CHECK(s.read(s.x) == a);
+        s.copy(s.x, s.b);
+        s.copy(s.c, s.x);  // a copy into the source
+        CHECK(s.read(s.b) == a);
+        s.copy(s.x, s.b);
+        CHECK(s.dev.Release(s.x) == D3D_OK);  // the source released
+        s.read(s.b);
+    });
+}
+
+TEST_CASE("put-off copies: draws into the destination copy their bands first, and the rest after", "[device][putoff]") {
+    bothWays([](Script& s) {
+        // Added over some rows (the bands the draw reaches and the ones it does not), over all of
+        // them, replacing some, and a mesh of more triangles than a chunk (the copy made first).
+        s.copy(s.a, s.b);
+        s.drawConstant(s.b, 37, 83, true);
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        s.drawConstant(s.b, 0, float(kH), true);
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        s.drawConstant(s.b, 5, 6, false);
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        s.drawConstant(s.b, float(kH) + 10, float(kH) + 20, true);  // nothing drawn: the copy still lands
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        std::vector<QuadVertex> v;
+        for (int i = 0; i < 1500; ++i) {
+            const float x0 = float(i % 150), y0 = float((i / 150) * 11);
+            const auto q = halfPixelQuad(x0, y0, x0 + 3, y0 + 4, {});
+            v.insert(v.end(), {q[0], q[1], q[2]});
+        }
+        REQUIRE(s.dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+        REQUIRE(s.dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 1500, v.data(), sizeof(QuadVertex)) == D3D_OK);
+        s.read(s.b);
+        // A partial clear of the destination, a whole copy over a copy put off, then part of one.
+        s.copy(s.a, s.b);
+        REQUIRE(s.dev.SetRenderTarget(0, s.b) == D3D_OK);
+        const D3DRECT r{10, 20, 50, 60};
+        REQUIRE(s.dev.Clear(1, &r, D3DCLEAR_TARGET, 0xff0000ff, 1, 0) == D3D_OK);
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        s.copy(s.c, s.b);
+        s.read(s.b);
+        s.copy(s.a, s.b);
+        const RECT part{3, 4, 40, 50};
+        REQUIRE(s.dev.StretchRect(s.c, &part, s.b, &part, D3DTEXF_POINT) == D3D_OK);
+        s.read(s.b);
+        // The destination released with its copy put off.
+        s.copy(s.a, s.c);
+        CHECK(s.dev.Release(s.c) == D3D_OK);
+        s.read(s.a);
+    });
+}
