@@ -62,10 +62,11 @@ struct WorkerScratch {
 }  // namespace
 
 struct SoftwareDrawContext {
-    explicit SoftwareDrawContext(int threads) : pool(threads) {
+    explicit SoftwareDrawContext(int threads) : sharedPool(ThreadPool::shared(threads)), pool(*sharedPool) {
         for (int i = 0; i < pool.size(); ++i) scratch.push_back(std::make_unique<WorkerScratch>());
     }
-    ThreadPool pool;
+    std::shared_ptr<ThreadPool> sharedPool;  // the process's workers of this count (ThreadPool::shared)
+    ThreadPool& pool;
     std::vector<std::unique_ptr<WorkerScratch>> scratch;  // one per worker
     // Executors by DrawProgram::key (a program's identity for the device's lifetime).
     std::unordered_map<uint64_t, std::unique_ptr<ps11::Executor>> executors;

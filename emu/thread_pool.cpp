@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
@@ -53,12 +54,31 @@ ThreadPool::~ThreadPool() {
     for (std::thread& t : m_threads) t.join();
 }
 
+std::shared_ptr<ThreadPool> ThreadPool::shared(int threads) {
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    threads = std::clamp(threads, 1, 64);
+    static std::mutex mutex;
+    static std::map<int, std::weak_ptr<ThreadPool>> pools;
+    std::lock_guard<std::mutex> lock(mutex);
+    std::shared_ptr<ThreadPool> pool = pools[threads].lock();
+    if (!pool) pools[threads] = pool = std::make_shared<ThreadPool>(threads);
+    return pool;
+}
+
 void ThreadPool::run(int n, const std::function<void(int)>& f) {
     n = std::clamp(n, 1, m_size);
     if (n == 1) {
         f(0);
         return;
     }
+    if (m_busy.exchange(true, std::memory_order_acquire)) {
+        for (int w = 0; w < n; ++w) f(w);
+        return;
+    }
+    struct Release {
+        std::atomic<bool>& busy;
+        ~Release() { busy.store(false, std::memory_order_release); }
+    } release{m_busy};
     {
         std::lock_guard<std::mutex> lock(m_mutex);
         m_job = &f;

@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -23,8 +24,18 @@ public:
     ThreadPool(const ThreadPool&) = delete;
     ThreadPool& operator=(const ThreadPool&) = delete;
 
+    // The pool of `threads` workers (0 = hardware_concurrency) that every caller asking for
+    // that many shares in this process, alive while one holds it. The software devices draw on
+    // it: a process with several devices (the benchmark runs eighteen) has one set of workers
+    // instead of one per device. With a pool per device, the workers of the device that drew
+    // last polled on, and the scheduler put a waking worker of the next one on its caller's core:
+    // now and then a device drew a whole benchmark on one core, 1.5 times as long.
+    static std::shared_ptr<ThreadPool> shared(int threads);
+
     int size() const { return m_size; }
-    // Runs f(0) … f(min(n, size()) − 1) in parallel; f(0) on the calling thread. Not reentrant.
+    // Runs f(0) … f(min(n, size()) − 1) in parallel; f(0) on the calling thread. While the pool
+    // runs another call (from another thread, or from inside a job), this one calls them all on
+    // the calling thread, one after the other.
     void run(int n, const std::function<void(int)>& f);
 
     // How long a worker that finished a job, and the caller waiting for its workers, poll before
@@ -46,6 +57,7 @@ private:
     std::atomic<uint64_t> m_generation{0};
     std::atomic<int> m_pending{0};
     std::atomic<bool> m_stop{false};
+    std::atomic<bool> m_busy{false};  // a run() is using the workers
 };
 
 }  // namespace emu

@@ -185,7 +185,7 @@ bool Runner::readTexture(Handle texture, emu::RgbaImage& img, std::string& error
 
 emu::ThreadPool& Runner::cpuPool() {
     if (emu::ThreadPool* w = m_device->rendererWorkers()) return *w;
-    if (!m_cpuPool) m_cpuPool = std::make_unique<emu::ThreadPool>(cpuThreads());
+    if (!m_cpuPool) m_cpuPool = emu::ThreadPool::shared(cpuThreads());
     return *m_cpuPool;
 }
 

@@ -137,7 +137,7 @@ private:
     std::unique_ptr<TexturePool> m_pool;
     PassMemo m_memo;  // with RunnerOptions::skip: what runFrame keeps between frames
     std::map<std::string, std::shared_ptr<void>> m_kept;  // kept()
-    std::unique_ptr<emu::ThreadPool> m_cpuPool;             // cpuPool() where the renderer has no workers
+    std::shared_ptr<emu::ThreadPool> m_cpuPool;             // cpuPool() where the renderer has no workers
     emu::Handle m_scene{}, m_output{};
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
