@@ -195,6 +195,9 @@ public:
     // bytes cannot move. Any surface, lockable or not; refused while fingerprinting (E4125) and
     // for a level already locked (E4106).
     HRESULT readSurface(Handle surface, const std::function<void(const D3DLOCKED_RECT&)>& read);
+    // Whether the renderer put the last StretchRect's copy off (SoftwareRendererOptions::putOffCopies):
+    // its time then lands on the call that next reads or writes the destination.
+    bool lastStretchPutOff() const { return m_lastStretchPutOff; }
 
 private:
     HRESULT fail(HRESULT hr, const char* code, std::string message);
@@ -256,6 +259,7 @@ private:
     } m_fingerprint;
 
     DrawStats m_lastDraw, m_totalDraw;
+    bool m_lastStretchPutOff = false;
     std::shared_ptr<DrawContext> m_draw;  // created by the first draw
     std::unique_ptr<Renderer> m_renderer;  // draws what the front resolved (emu/renderer.h)
 

@@ -149,8 +149,11 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     // a copy put off has written none of them yet.
     sc.mayPutOff = resourceLevelBytes(*dst) > kComparedResourceBytes;
     prepareWrite(*dst);
+    m_lastStretchPutOff = false;
     if (m_renderer->stretchRect(sc)) {
         rendererWrote(*dst, dstRef.level);
+        // A renderer that draws into the front's images and holds the level newer put it off.
+        m_lastStretchPutOff = !m_renderer->keepsCopies() && dst->rendererNewer[dstRef.level];
         return D3D_OK;
     }
     // The renderer left it to the front: in the front's images, brought up to date first.

@@ -449,6 +449,7 @@ bool PassContext::stretch(TextureId source, TextureId dest, D3DTEXTUREFILTERTYPE
         !check(device.StretchRect(surface(source), nullptr, surface(dest), nullptr, filter)))
         return false;
     const uint64_t px = uint64_t(desc(dest).width) * desc(dest).height;
+    stats.putOff = stats.putOff || device.lastStretchPutOff();
     stats.pixels += px;
     stats.texels += px * (filter == D3DTEXF_LINEAR ? 4 : 1);
     return true;

@@ -72,6 +72,9 @@ struct PassStats {
     // Run with a PassMemo: the pass's fingerprint and outputs were last frame's, so its outputs
     // were kept and nothing ran (milliseconds is the dry run's).
     bool reused = false;
+    // A copy the renderer put off (Device::lastStretchPutOff): made by the pass that next reads
+    // or writes its destination, in whose time it is.
+    bool putOff = false;
 };
 
 // Device textures by description, kept between frames and runs: a graph takes one when a

@@ -196,3 +196,22 @@ TEST_CASE("put-off copies: draws into the destination copy their bands first, an
         s.read(s.a);
     });
 }
+
+TEST_CASE("put-off copies: the device says which copies were put off", "[device][putoff]") {
+    for (const bool putOff : {true, false}) {
+        INFO("putOffCopies " << putOff);
+        Script s(putOff);
+        s.copy(s.a, s.b);  // whole, above 64 KB
+        CHECK(s.dev.lastStretchPutOff() == putOff);
+        const RECT part{0, 0, 40, 40};
+        REQUIRE(s.dev.StretchRect(s.a, &part, s.c, &part, D3DTEXF_POINT) == D3D_OK);  // part of the destination
+        CHECK_FALSE(s.dev.lastStretchPutOff());
+        Handle small{}, small2{};
+        REQUIRE(s.dev.CreateRenderTarget(64, 64, D3DFMT_A8R8G8B8, 1, &small) == D3D_OK);  // 16 KB: compared by bytes
+        REQUIRE(s.dev.CreateRenderTarget(64, 64, D3DFMT_A8R8G8B8, 1, &small2) == D3D_OK);
+        s.copy(small, small2);
+        CHECK_FALSE(s.dev.lastStretchPutOff());
+        s.copy(s.a, s.x);
+        CHECK(s.dev.lastStretchPutOff() == putOff);
+    }
+}

@@ -477,6 +477,7 @@ int runGlare(const GlareOptions& o) {
                               {"readbacks", s.readBacks},
                               {"bytes", s.bytes},
                               {"reused", s.reused},
+                              {"put_off", s.putOff},
                               {"tiles",
                                {{"shaded", s.tilesShaded},
                                 {"filled", s.tilesFilled},
@@ -507,19 +508,24 @@ int runGlare(const GlareOptions& o) {
         const std::string tileText = tiles ? std::to_string(s.tilesShaded) + "/" + std::to_string(s.tilesFilled) + "/" +
                                                  std::to_string(s.tilesCopied) + "/" + std::to_string(s.tilesSkipped)
                                            : "-";
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7.1f  %-6s %s\n", s.pass.c_str(),
+        char gbps[16] = "-";  // a copy put off moved nothing in its own time
+        if (!s.putOff && s.milliseconds > 0) std::snprintf(gbps, sizeof gbps, "%.1f", double(s.bytes) / 1e6 / s.milliseconds);
+        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7s  %-6s %s\n", s.pass.c_str(),
                     s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                     (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
-                    (unsigned long long)s.readBacks, double(s.bytes) / 1e6,
-                    s.milliseconds > 0 ? double(s.bytes) / 1e6 / s.milliseconds : 0.0, "ran", tileText.c_str());
+                    (unsigned long long)s.readBacks, double(s.bytes) / 1e6, gbps, s.putOff ? "put off" : "ran",
+                    tileText.c_str());
     }
     std::printf("%-22s %9.3f  (the technique's graph, built and compiled on the CPU; part of the frame's time)\n",
                 "(frame graph)", lastBuildMs);
     std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
-                " reused: its inputs were last frame's, its outputs kept, nothing ran; tiles: tiles of 16 rows by 64\n"
-                " pixels of the software renderer's full-screen draws, shaded, filled with a constant, copied from one\n"
-                " texture or skipped, as the interval evaluator decided; -: none decided (no such draw, or deciding\n"
-                " did not pay on the program's recent draws); --no-skip runs every pass and shades every tile)\n");
+                " reused: its inputs were last frame's, its outputs kept, nothing ran; put off: a whole-surface copy the\n"
+                " software renderer makes in the pass that next draws into, reads or writes its destination, in whose\n"
+                " time it then is (the composite copies each band of the scene just before it blends onto it);\n"
+                " tiles: tiles of 16 rows by 64 pixels of the software renderer's full-screen draws, shaded, filled\n"
+                " with a constant, copied from one texture or skipped, as the interval evaluator decided; -: none\n"
+                " decided (no such draw, or deciding did not pay on the program's recent draws); --no-skip runs every\n"
+                " pass and shades every tile)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
