@@ -37,11 +37,17 @@ void lerpGatherAvx2(const float* d, int len, const int32_t* i0, const int32_t* i
         const __m256i r0 = _mm256_sub_epi32(k0, _mm256_set1_epi32(base));
         const __m256i r1 = _mm256_sub_epi32(k1, _mm256_set1_epi32(base));
         // Eight columns over at most eight texels from the first one's (a magnification): one
-        // load and two permutes; else two gathers.
+        // load and two permutes; over at most sixteen (nearly 1:1), two loads and four; else two
+        // gathers.
         if (base + 8 <= len && withinEight(r0, r1)) {
             const __m256 row = _mm256_loadu_ps(d + base);
             a = _mm256_permutevar8x32_ps(row, r0);
             b = _mm256_permutevar8x32_ps(row, r1);
+        } else if (base + 16 <= len && withinSixteen(r0, r1)) {
+            const __m256i lo = _mm256_castps_si256(_mm256_loadu_ps(d + base));
+            const __m256i hi = _mm256_castps_si256(_mm256_loadu_ps(d + base + 8));
+            a = _mm256_castsi256_ps(permuteSixteen(lo, hi, r0));
+            b = _mm256_castsi256_ps(permuteSixteen(lo, hi, r1));
         } else {
             a = _mm256_i32gather_ps(d, k0, 4);
             b = _mm256_i32gather_ps(d, k1, 4);

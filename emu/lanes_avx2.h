@@ -20,6 +20,20 @@ inline bool withinEight(__m256i r0, __m256i r1) {
     return _mm256_testz_si256(bad, bad);
 }
 
+// The same for [0, 15]: two loads of eight texels and two permutes each, blended (a nearly 1:1
+// mapping's eight columns reach a ninth texel, which withinEight refuses).
+inline bool withinSixteen(__m256i r0, __m256i r1) {
+    const __m256i fifteen = _mm256_set1_epi32(15);
+    const __m256i bad = _mm256_or_si256(_mm256_or_si256(_mm256_cmpgt_epi32(r0, fifteen), _mm256_cmpgt_epi32(r1, fifteen)),
+                                        _mm256_srai_epi32(_mm256_or_si256(r0, r1), 31));
+    return _mm256_testz_si256(bad, bad);
+}
+// Lane k of the sixteen dwords lo ‖ hi at index r[k] in [0, 15].
+inline __m256i permuteSixteen(__m256i lo, __m256i hi, __m256i r) {
+    const __m256i fromHi = _mm256_cmpgt_epi32(r, _mm256_set1_epi32(7));
+    return _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(lo, r), _mm256_permutevar8x32_epi32(hi, r), fromHi);
+}
+
 // float(b) / 255 correctly rounded (ps11::Texture::unorm8Values()[b]) for bytes b held as floats:
 // q = b·(1/255), then one Newton step with the exact residual b − 255·q (an FMA). The quotient for
 // every byte (tests/test_simd_dispatch.cpp checks all 256 at every level), in a third of a
