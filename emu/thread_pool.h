@@ -27,9 +27,9 @@ public:
     // The pool of `threads` workers (0 = hardware_concurrency) that every caller asking for
     // that many shares in this process, alive while one holds it. The software devices draw on
     // it: a process with several devices (the benchmark runs eighteen) has one set of workers
-    // instead of one per device. With a pool per device, the workers of the device that drew
-    // last polled on, and the scheduler put a waking worker of the next one on its caller's core:
-    // now and then a device drew a whole benchmark on one core, 1.5 times as long.
+    // instead of one per device. With a pool per device, now and then one device drew every
+    // frame of a benchmark 1.5 times as long, as if on one core (bench/README.md "One runner
+    // drawing on one core").
     static std::shared_ptr<ThreadPool> shared(int threads);
 
     int size() const { return m_size; }

@@ -62,7 +62,7 @@ public:
 
         // The glare amount, smoothed over frames in a 1x1 target by alpha blending.
         const TextureId adapted = fb.persistent("adapted glare amount", {1, 1, f}, 0);
-        const bool blend = !(fb.frame == 0 && fb.choice("start") == 0);
+        const bool blend = !(fb.frame() == 0 && fb.choice("start") == 0);
         const float a = float(fb.get("smoothing"));
         const bool dither = fb.choice("dither") == 1;
         const bool mulx4 = fb.choice("square") == 1;
@@ -73,7 +73,7 @@ public:
                         {{2, {0, 0, 0, a}}},
                         blend ? Blend::Alpha : Blend::None};
         if (dither) {
-            const float d = blend ? float(adaptationDither(fb.frame, a)) : 0.0f;
+            const float d = blend ? float(adaptationDither(fb.frame(), a)) : 0.0f;
             amount.constants.push_back({3, {d, d, d, 0}});
         }
         addQuadPass(fb, "glare_amount",

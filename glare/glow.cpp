@@ -206,8 +206,9 @@ public:
 
         addStretchPass(fb, "copy_scene", fb.scene, fb.output, D3DTEXF_POINT);
         const double ramp = fb.get("ramp"), period = fb.get("ramp_period");
-        const float s = float(fb.get("strength") *
-                              (1 - ramp + ramp * 0.5 * (1 + std::cos(2 * kPi * double(fb.frame) / period))));
+        // (Steady, the strength does not depend on the frame: the frame is not read.)
+        const double pulse = ramp == 0 ? 1.0 : 1 - ramp + ramp * 0.5 * (1 + std::cos(2 * kPi * double(fb.frame()) / period));
+        const float s = float(fb.get("strength") * pulse);
         addQuadPass(fb, "composite", "additive blend (ONE, ONE) of the bilinear-upsampled glow",
                     QuadPass{"scale.psh", fb.output, {texelTap(fb, glow, 0, 0)}, {{0, {s, s, s, 0}}}, Blend::Add});
     }

@@ -45,6 +45,9 @@ struct FrameResult {
     double milliseconds = 0;
     double buildMilliseconds = 0;  // the graph's part of it
     double sceneMilliseconds = 0;
+    // Nothing was built or run: a still input whose last frame reused every pass (Runner::runFrame);
+    // `passes` are that frame's, every one reused, with no time.
+    bool still = false;
 };
 
 // The 8-bit value a float frame's channel reads back as (Runner::readTexture): clamped to
@@ -82,8 +85,9 @@ public:
     bool runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, FrameResult& result,
                   std::string& error, const PassGraph::Hook& hook = {},
                   const std::function<void(PassGraph&)>& built = {}, bool hookObserves = false);
-    // Builds (and compiles) without running: for reports and --graph.
-    void buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
+    // Builds (and compiles) without running: for reports and --graph. True if the technique's
+    // build read the frame's index or count (FrameBuild::frame).
+    bool buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
 
     // The Graphviz of the last frame's graph as it ran (with the aliasing it got); empty unless
     // RunnerOptions::graphviz.
@@ -143,6 +147,15 @@ private:
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
     std::string m_persistentError;
     std::string m_lastGraphviz;
+    // The last frame, when it reused every pass and its build read no frame index, with what it
+    // depended on: a frame with all of it the same is skipped whole (runFrame).
+    struct StillFrame {
+        bool valid = false;
+        const Technique* technique = nullptr;
+        Settings settings;
+        uint64_t sceneGeneration = 0, outputGeneration = 0;
+        std::vector<PassStats> passes;
+    } m_still;
 };
 
 // One technique on its own built-in scene (Technique::scene, the scene's first frame), published

@@ -36,12 +36,26 @@ using Settings = std::map<std::string, double>;
 
 // What a technique's build() works with for one frame.
 struct FrameBuild {
+    FrameBuild(PassGraph& g, Runner& r, const Settings& s, TextureId sceneId, TextureId outputId, int frameIndex,
+               int frames, D3DFORMAT intermediate, ps11::Precision profile)
+        : graph(g), runner(r), settings(s), scene(sceneId), output(outputId), format(intermediate),
+          precision(profile), m_frame(frameIndex), m_frameCount(frames) {}
     PassGraph& graph;
     Runner& runner;
     const Settings& settings;
     TextureId scene;   // the frame (A8R8G8B8, or float under the ideal profile)
     TextureId output;  // the result, scene-sized A8R8G8B8
-    int frame = 0, frameCount = 1;
+    // The frame's index and count. A build that reads neither gives the same graph every frame
+    // for the same settings, which lets a still input skip the whole frame (Runner::runFrame).
+    int frame() const {
+        m_readFrame = true;
+        return m_frame;
+    }
+    int frameCount() const {
+        m_readFrame = true;
+        return m_frameCount;
+    }
+    bool readFrame() const { return m_readFrame; }
     // The format of intermediate textures: A8R8G8B8, or A32B32G32R32F under the ideal profile
     // (docs/precision.md: ideal keeps intermediates in float render targets).
     D3DFORMAT format = D3DFMT_A8R8G8B8;
@@ -52,6 +66,10 @@ struct FrameBuild {
     // A texture kept between frames, made (and cleared to `initial`) the first time it is asked
     // for; imported as an output so the passes that update it always run.
     TextureId persistent(const std::string& name, const TextureDesc& desc, D3DCOLOR initial = 0);
+
+private:
+    int m_frame = 0, m_frameCount = 1;
+    mutable bool m_readFrame = false;
 };
 
 class Technique {

@@ -1081,6 +1081,82 @@ TEST_CASE("sprites: the glare image is uploaded again only when its texture or t
     }
 }
 
+TEST_CASE("reuse: a still frame whose every pass was reused is skipped whole, until anything it depends on changes",
+          "[glare][reuse]") {
+    // Pyramid's build reads no frame index: held still, from its third frame on it is skipped
+    // whole (FrameResult::still). A setting, the image, the output's contents, the persistent
+    // textures, a hook: each makes the next frame run. Glow with its strength ramping and
+    // adaptive (its dither) read the frame index: never skipped whole. Every output equals the
+    // one of a runner that runs every pass.
+    const auto run = [](const char* name, glare::Settings settings, auto change, std::vector<int> wantStill) {
+        INFO(name);
+        const glare::Technique* t = glare::findTechnique(name);
+        REQUIRE(t);
+        glare::RunnerOptions on, off;
+        on.width = off.width = 192;
+        on.height = off.height = 108;
+        off.skip = false;
+        glare::Runner a(on), b(off);
+        std::string err;
+        std::unique_ptr<glare::Scene> scene = glare::makeScene(t->scene(), err);
+        REQUIRE(scene);
+        double ms = 0;
+        REQUIRE(a.renderScene(*scene, 0, 1, ms, err));
+        std::optional<emu::RgbaImage> image = a.readTexture(a.sceneTexture(), err);
+        REQUIRE(image);
+        REQUIRE(a.setImage(*image, err));
+        REQUIRE(b.setImage(*image, err));
+        for (int f = 0; f < int(wantStill.size()); ++f) {
+            INFO("frame " << f);
+            change(f, *t, a, b, settings, *image);
+            glare::FrameResult ra, rb;
+            REQUIRE(a.runFrame(*t, settings, f, 100, ra, err));
+            REQUIRE(b.runFrame(*t, settings, f, 100, rb, err));
+            CHECK(ra.still == (wantStill[size_t(f)] != 0));
+            CHECK_FALSE(rb.still);
+            if (ra.still)
+                for (const glare::PassStats& p : ra.passes) CHECK(p.reused);
+            const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
+            REQUIRE(oa);
+            REQUIRE(ob);
+            REQUIRE(oa->rgba == ob->rgba);
+        }
+    };
+    const auto nothing = [](int, const glare::Technique&, glare::Runner&, glare::Runner&, glare::Settings&,
+                            emu::RgbaImage&) {};
+    run("pyramid", *glare::presetSettings(*glare::findTechnique("pyramid"), "published"),
+        [](int f, const glare::Technique& t, glare::Runner& a, glare::Runner& b, glare::Settings& s,
+           emu::RgbaImage& image) {
+            std::string err;
+            if (f == 4) s["strength"] = 0.5;  // a setting
+            if (f == 7) {                     // the image
+                image.rgba[400] ^= 0x80;
+                REQUIRE(a.setImage(image, err));
+                REQUIRE(b.setImage(image, err));
+            }
+            if (f == 10) {  // the output's contents, written by the application
+                emu::Handle out{};
+                REQUIRE(a.device().GetSurfaceLevel(a.outputTexture(), 0, &out) == emu::D3D_OK);
+                REQUIRE(a.device().SetRenderTarget(0, out) == emu::D3D_OK);
+                REQUIRE(a.device().Clear(0, nullptr, D3DCLEAR_TARGET, 0xff00ff00, 1, 0) == emu::D3D_OK);
+            }
+            if (f == 13) a.resetPersistent(), b.resetPersistent();
+            if (f == 16) {  // with a hook every pass runs (reused or not), the frame is not skipped whole
+                glare::FrameResult r;
+                REQUIRE(a.runFrame(t, s, f, 100, r, err, [](uint32_t, bool, std::string&) { return true; }));
+                CHECK_FALSE(r.still);
+            }
+        },
+        // (Pyramid keeps no persistent texture: after their reset the frame reuses every pass. A
+        // hook that may write keeps each pass its own group: the next frame finds other groups.)
+        std::vector<int>{0, 0, 1, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 1, 1, 0, 0, 1, 1});
+    glare::Settings glow = *glare::presetSettings(*glare::findTechnique("glow"), "published");
+    glow["ramp"] = 0.5;
+    run("glow", glow, nothing, std::vector<int>{0, 0, 0, 0, 0});
+    run("adaptive", *glare::presetSettings(*glare::findTechnique("adaptive"), "published"), nothing,
+        std::vector<int>{0, 0, 0, 0, 0});
+}
+
 TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
     std::string error;
     emu::DeviceOptions gl;

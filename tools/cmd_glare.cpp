@@ -161,6 +161,7 @@ public:
     ~Progress() {
         if (m_shown) std::fprintf(stderr, "\n");
     }
+    bool shows() const { return m_terminal; }  // (only a terminal gets the progress line)
     void update(int frame, const std::string& pass) {
         const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
         if (!m_terminal || s < 1.0) return;
@@ -283,6 +284,7 @@ int runGlare(const GlareOptions& o) {
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
     double lastBuildMs = 0;  // the last frame's graph, built and compiled
+    bool lastStill = false;  // the last frame was skipped whole
     emu::RgbaImage frameImage;  // -o: each frame's output, read into one buffer
     std::vector<double> frameMs;
     emu::TransferStats lastTransfers;  // the last frame's, with its output's read-back
@@ -348,12 +350,15 @@ int runGlare(const GlareOptions& o) {
                          r->runFrame(*technique, *settings, f, o.frames, ir, err);
                 }
             }
-        } else {
+        } else if (dump || progress.shows()) {
             glare::PassGraph* built = nullptr;
             ok = main->runFrame(
                 *technique, *settings, f, o.frames, result, err,
                 [&](uint32_t pass, bool after, std::string& e) { return hook(*built, pass, after, e); },
                 [&](glare::PassGraph& g) { built = &g; }, true);  // progress and dumps only look
+        } else {
+            // No hook: a still input's frames after the first ones may be skipped whole (FrameResult::still).
+            ok = main->runFrame(*technique, *settings, f, o.frames, result, err);
         }
         if (!ok) {
             std::cerr << "ps11 glare: " << err << "\n";
@@ -366,6 +371,7 @@ int runGlare(const GlareOptions& o) {
         }
         lastStats = result.passes;
         lastBuildMs = result.buildMilliseconds;
+        lastStill = result.still;
         frameMs.push_back(result.milliseconds);
         if (!o.out.empty()) {
             // One image for every frame: no 8 MB allocated and given back per 1080p frame.
@@ -485,6 +491,7 @@ int runGlare(const GlareOptions& o) {
                                 {"skipped", s.tilesSkipped}}}});
         j["passes"] = std::move(passes);
         j["graph_ms"] = json::rounded(lastBuildMs, "%.3f");
+        j["still"] = lastStill;
         j["renderer"] = main->device().rendererName();
         j["frame_uploads"] = lastTransfers.uploads;
         j["frame_readbacks"] = lastTransfers.readBacks;
@@ -518,6 +525,9 @@ int runGlare(const GlareOptions& o) {
     }
     std::printf("%-22s %9.3f  (the technique's graph, built and compiled on the CPU; part of the frame's time)\n",
                 "(frame graph)", lastBuildMs);
+    if (lastStill)
+        std::printf("(the last frame was skipped whole: a still input whose frame before reused every pass; nothing was\n"
+                    " built or run)\n");
     std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
                 " reused: its inputs were last frame's, its outputs kept, nothing ran; put off: a whole-surface copy the\n"
                 " software renderer makes in the pass that next draws into, reads or writes its destination, in whose\n"
