@@ -1038,6 +1038,35 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
     CHECK(decided > 1000);
 }
 
+namespace {
+
+// A runner with reuse on and one that runs every pass (RunnerOptions::skip off), w × h, both
+// holding the first frame of the technique's own scene as an image.
+struct HeldPair {
+    std::unique_ptr<glare::Runner> on, off;
+    emu::RgbaImage image;
+};
+HeldPair heldPair(const glare::Technique& t, uint32_t w, uint32_t h) {
+    glare::RunnerOptions on, off;
+    on.width = off.width = w;
+    on.height = off.height = h;
+    off.skip = false;
+    HeldPair p{std::make_unique<glare::Runner>(on), std::make_unique<glare::Runner>(off), {}};
+    std::string err;
+    std::unique_ptr<glare::Scene> scene = glare::makeScene(t.scene(), err);
+    REQUIRE(scene);
+    double ms = 0;
+    REQUIRE(p.on->renderScene(*scene, 0, 1, ms, err));
+    std::optional<emu::RgbaImage> image = p.on->readTexture(p.on->sceneTexture(), err);
+    REQUIRE(image);
+    p.image = *image;
+    REQUIRE(p.on->setImage(p.image, err));
+    REQUIRE(p.off->setImage(p.image, err));
+    return p;
+}
+
+}  // namespace
+
 TEST_CASE("sprites: the glare image is uploaded again only when its texture or the streaks change", "[glare][reuse]") {
     // One runner with reuse on against one with skipping off, the image held still: the glare
     // image's upload is reused while its texture holds it; changing the streaks mid-run (the
@@ -1046,20 +1075,9 @@ TEST_CASE("sprites: the glare image is uploaded again only when its texture or t
     const glare::Technique* t = glare::findTechnique("sprites");
     REQUIRE(t);
     glare::Settings settings = *glare::presetSettings(*t, "published");
-    glare::RunnerOptions on, off;
-    on.width = off.width = 160;
-    on.height = off.height = 96;
-    off.skip = false;
-    glare::Runner a(on), b(off);
+    HeldPair held = heldPair(*t, 160, 96);
+    glare::Runner &a = *held.on, &b = *held.off;
     std::string err;
-    std::unique_ptr<glare::Scene> scene = glare::makeScene(t->scene(), err);
-    REQUIRE(scene);
-    double ms = 0;
-    REQUIRE(a.renderScene(*scene, 0, 1, ms, err));
-    const std::optional<emu::RgbaImage> still = a.readTexture(a.sceneTexture(), err);
-    REQUIRE(still);
-    REQUIRE(a.setImage(*still, err));
-    REQUIRE(b.setImage(*still, err));
     const auto imagePass = [](const glare::FrameResult& r) {
         for (const glare::PassStats& st : r.passes)
             if (st.pass == "glare_image") return st;
@@ -1092,23 +1110,12 @@ TEST_CASE("reuse: a still frame whose every pass was reused is skipped whole, un
         INFO(name);
         const glare::Technique* t = glare::findTechnique(name);
         REQUIRE(t);
-        glare::RunnerOptions on, off;
-        on.width = off.width = 192;
-        on.height = off.height = 108;
-        off.skip = false;
-        glare::Runner a(on), b(off);
+        HeldPair held = heldPair(*t, 192, 108);
+        glare::Runner &a = *held.on, &b = *held.off;
         std::string err;
-        std::unique_ptr<glare::Scene> scene = glare::makeScene(t->scene(), err);
-        REQUIRE(scene);
-        double ms = 0;
-        REQUIRE(a.renderScene(*scene, 0, 1, ms, err));
-        std::optional<emu::RgbaImage> image = a.readTexture(a.sceneTexture(), err);
-        REQUIRE(image);
-        REQUIRE(a.setImage(*image, err));
-        REQUIRE(b.setImage(*image, err));
         for (int f = 0; f < int(wantStill.size()); ++f) {
             INFO("frame " << f);
-            change(f, *t, a, b, settings, *image);
+            change(f, *t, a, b, settings, held.image);
             glare::FrameResult ra, rb;
             REQUIRE(a.runFrame(*t, settings, f, 100, ra, err));
             REQUIRE(b.runFrame(*t, settings, f, 100, rb, err));
