@@ -149,7 +149,9 @@ void SoftwareRenderer::makeCopies(const Image* into, const Image* from, uint32_t
             (fromResource && c.source.resource == fromResource)) {
             const StretchCall call = c;
             m_putOff.erase(m_putOff.begin() + std::ptrdiff_t(i));
-            makeCopies(call.source.image, nullptr);  // (none: a copy from a destination made its source first)
+            // (Copies into its source: none, since stretchRect made them before putting this one
+            // off and nothing puts one off into a source; kept as the rule's statement.)
+            makeCopies(call.source.image, nullptr);
             copyRows(call, call.destRect.y1 - call.destRect.y0);
             i = 0;
             continue;

@@ -121,7 +121,8 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     // textures and what the technique keeps are as that frame left them): nothing is built or
     // run. Hooks and `built` look at a frame's passes as they run, so they get a whole frame.
     const StillFrame& still = m_still;
-    if (reuses() && !hook && !built && still.valid && still.technique == &technique && still.settings == settings &&
+    if (reuses() && !hook && !built && still.valid && still.technique == &technique &&
+        still.techniqueName == technique.name() && still.settings == settings &&
         m_device->contentGeneration(m_scene) == still.sceneGeneration &&
         m_device->contentGeneration(m_output) == still.outputGeneration) {
         result.passes = still.passes;
@@ -149,7 +150,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     if (ok && m_options.graphviz) m_lastGraphviz = graph.graphviz(std::string(technique.name()));
     if (ok && reuses() && !readFrame && !result.passes.empty() &&
         std::all_of(result.passes.begin(), result.passes.end(), [](const PassStats& p) { return p.reused; })) {
-        m_still = StillFrame{true, &technique, settings, m_device->contentGeneration(m_scene),
+        m_still = StillFrame{true, &technique, std::string(technique.name()), settings, m_device->contentGeneration(m_scene),
                              m_device->contentGeneration(m_output), result.passes};
         for (PassStats& p : m_still.passes) p.milliseconds = 0;
     }

@@ -152,6 +152,7 @@ private:
     struct StillFrame {
         bool valid = false;
         const Technique* technique = nullptr;
+        std::string techniqueName;  // (an object made where another was has another name, or is the same technique)
         Settings settings;
         uint64_t sceneGeneration = 0, outputGeneration = 0;
         std::vector<PassStats> passes;
