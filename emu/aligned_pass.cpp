@@ -115,7 +115,7 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
     const int t = window.copyTap;
     const AlignedTap& tap = draw.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
-    if (!tap.bound || !row.row0 || row.wy != 0) return false;
+    if (!tap.bound || ((tri.freeTaps >> t) & 1) || !row.row0 || row.wy != 0) return false;
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
     const size_t i0 = size_t(x - tri.x0);
     const int32_t o = cols.off0[i0];
@@ -182,20 +182,62 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
 // The texel rows and vertical weight of a tap on pixel row y.
 }  // namespace
 
+namespace {
+
+// 1 / rhw at pixels x .. x + n − 1 of row y of a triangle with perspective, as the rasteriser
+// divides by it (rhw kept positive).
+void rowInverseW(const TriangleSetup& s, int x, int y, int n, float* inv) {
+    const float base = float(planeRowBase(s.rhw, s.ox, s.oy, y)), fdx = float(s.rhw.dx);
+    for (int i = 0; i < n; ++i) inv[i] = 1.0f / std::max(base + fdx * float(x + i), 1e-30f);
+}
+
+// Attribute k at pixels x .. x + n − 1 of row y, as the rasteriser interpolates it: the constant,
+// or planeValue, times `inv` (rowInverseW) on a triangle with perspective.
+void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const float* inv, float* dst) {
+    if ((s.constMask >> k) & 1) {
+        std::fill_n(dst, n, s.constValue[size_t(k)]);
+        return;
+    }
+    const Plane& p = s.attr[size_t(k)];
+    const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
+    for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+    if (s.perspective)
+        for (int i = 0; i < n; ++i) dst[i] *= inv[i];
+}
+
+// Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
+// path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
+// kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16.
+void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, int16_t* const dst[4]) {
+    const AlignedTap& tap = draw.taps[size_t(t)];
+    alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan], inv[ps11::kMaxSpan];
+    if (s.perspective) rowInverseW(s, x, y, n, inv);
+    rowAttribute(s, attrTex(tap.coordSet, 0), x, y, n, inv, u);
+    rowAttribute(s, attrTex(tap.coordSet, 1), x, y, n, inv, v);
+    ps11::fastpath::Unorm8Run run;
+    run.texels = tap.texels;
+    run.width = tap.width, run.height = tap.height;
+    run.linear = tap.linear;
+    run.addressU = tap.addressU, run.addressV = tap.addressV;
+    run.borderWord = tap.borderWord;
+    run.scale = 1;
+    alignas(32) int32_t grid[4][ps11::kMaxSpan];
+    int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
+    draw.sample(run, n, u, v, g);
+    for (int c = 0; c < 4; ++c)
+        for (int i = 0; i < n; ++i) dst[c][i] = int16_t(grid[c][i]);
+}
+
+}  // namespace
+
 void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]) {
     // (Called per span: most post-processing programs read no colour.)
     if (!(colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular)))) return;
+    alignas(32) float inv[ps11::kMaxSpan];
+    if (s.perspective) rowInverseW(s, x, y, n, inv);
     for (int k = 0; k < 8; ++k) {
         const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
-        if (!((colorAttrs >> attr) & 1)) continue;
-        float* dst = color[k];
-        if ((s.constMask >> attr) & 1) {
-            std::fill_n(dst, n, s.constValue[size_t(attr)]);
-        } else {
-            const Plane& p = s.attr[size_t(attr)];
-            const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
-            for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
-        }
+        if ((colorAttrs >> attr) & 1) rowAttribute(s, attr, x, y, n, inv, color[k]);
     }
 }
 
@@ -473,6 +515,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     d.serial = ++serials;
     d.executor = &executor;
     d.kernels = alignedKernels(ps11::simdLevel());
+    d.sample = ps11::fastpath::samplerKernels(ps11::simdLevel()).unorm8;
     for (int i = 0; i < d.plan.count; ++i) {
         const int stage = d.plan.stage[size_t(i)];
         AlignedTap& tap = d.taps[size_t(i)];
@@ -565,6 +608,24 @@ bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, 
     return screenAligned(plan, s) && tableColumns(s, x0, x1);
 }
 
+uint32_t freeTaps(const AlignedDraw& draw, const TriangleSetup& s) {
+    uint32_t mask = 0;
+    for (int i = 0; i < draw.plan.count; ++i) {
+        if (!draw.taps[size_t(i)].bound) continue;
+        const int ku = attrTex(draw.plan.coordSet[size_t(i)], 0), kv = ku + 1;
+        const bool cu = (s.constMask >> ku) & 1, cv = (s.constMask >> kv) & 1;
+        const bool free = s.perspective ? !(cu && cv)
+                                        : (!cu && s.attr[size_t(ku)].dy != 0.0) || (!cv && s.attr[size_t(kv)].dx != 0.0);
+        if (free) mask |= 1u << i;
+    }
+    return mask;
+}
+
+int alignedRowPath(const AlignedDraw& draw, const TriangleSetup& s, int& x0, int& x1) {
+    if (!tableColumns(s, x0, x1)) return 0;
+    return s.perspective || freeTaps(draw, s) ? 2 : 1;
+}
+
 namespace {
 
 // Whether attribute k takes the same value at every pixel of row ya in triangle a as of row yb
@@ -593,6 +654,14 @@ bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTable
              uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr) {
     int nl = 0, nr = 0;
     if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
+    // With perspective the attributes compared are the planes of attr·rhw: rhw must agree too.
+    if (s.perspective != next.perspective) return false;
+    if (s.perspective) {
+        auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+        if (bits(float(s.rhw.dx)) != bits(float(next.rhw.dx)) ||
+            bits(float(planeRowBase(s.rhw, s.ox, s.oy, y))) != bits(float(planeRowBase(next.rhw, next.ox, next.oy, y))))
+            return false;
+    }
     for (int i = 0; i < plan.count; ++i) {
         const int ku = attrTex(plan.coordSet[size_t(i)], 0);
         if ((!sharedTables && !sameOnRow(s, next, ku, y, y)) || !sameOnRow(s, next, ku + 1, y, y)) return false;
@@ -613,8 +682,7 @@ bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair
 
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns) {
-    // Colours: constant or affine (no perspective), evaluated per pixel with planeValue.
-    if (!rowPathColumns(draw.plan, s, out.x0, out.x1)) return false;
+    if (!alignedRowPath(draw, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
     fillAlignedTables(draw, s, out);
     return true;
@@ -622,6 +690,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 
 void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     out.configs.clear();
+    out.freeTaps = freeTaps(draw, s);
     const int n = out.x1 - out.x0;
     thread_local std::vector<float> u;
     u.resize(size_t(std::max(n, 0)));
@@ -630,7 +699,7 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
         cols.runs.clear();
         cols.configCount = 0;
-        if (!tap.bound) {  // no table (the triangle may be a previous chunk's or draw's)
+        if (!tap.bound || ((out.freeTaps >> i) & 1)) {  // no table (the triangle may be a previous chunk's or draw's)
             cols.off0.clear(), cols.off1.clear(), cols.w.clear(), cols.run.clear();
             continue;
         }
@@ -797,14 +866,19 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     struct FillCtx {
         const AlignedDraw* draw;
         const AlignedTriangle* tri;
+        const TriangleSetup* setup;
         const std::array<TapRow, 8>* rows;
-        int x;
+        int x, y;
         uint8_t* out;
         uint32_t orMask;
         int16_t* const* r0;
-    } ctx{&draw, nullptr, &rows, 0, nullptr, orMask, r0};
+    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0};
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
+        if ((f.tri->freeTaps >> tap) & 1) {
+            sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, dst);
+            return;
+        }
         filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)],
                   f.tri->x0, f.x + first, count, dst);
     };
@@ -867,16 +941,19 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                                         windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
+            ctx.setup = &s;
+            ctx.y = y;
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
-                if (!tap.bound || !((neededTaps >> t) & 1)) continue;
+                if (!tap.bound || !((neededTaps >> t) & 1) || ((tri.freeTaps >> t) & 1)) continue;
                 TapRow& r = rows[size_t(t)];
                 // Taps at the same v of the same texture (a horizontal blur's) read the same rows.
                 tapV[t] = rowV(s, tap.coordSet, y);
                 int same = -1;
                 for (int u = 0; u < t && same < 0; ++u) {
                     const AlignedTap& o = draw.taps[size_t(u)];
-                    if (o.bound && ((neededTaps >> u) & 1) && o.texels == tap.texels && o.height == tap.height &&
+                    if (o.bound && ((neededTaps >> u) & 1) && !((tri.freeTaps >> u) & 1) && o.texels == tap.texels &&
+                        o.height == tap.height &&
                         o.addressV == tap.addressV && o.linear == tap.linear &&
                         std::bit_cast<uint32_t>(tapV[u]) == std::bit_cast<uint32_t>(tapV[t]))
                         same = u;

@@ -1,10 +1,12 @@
-// The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): triangles whose
-// texture coordinates are screen-aligned (u depends on x only, v on y only, no perspective) in
-// fx8, with a program whose texture reads are plain (ps11::tapPlan,
-// ps11/executor_presampled_internal.h), are drawn row by row without quads or per-lane coordinates: each tap's texel
-// columns and weights are tabulated once per triangle and its rows once per pixel row, texels are filtered into int16
-// lanes (runs with a fixed weight and step through shared, cached H rows), the executor runs pre-sampled, and 8-bit
-// targets take plain and additive stores directly. Results are bit-identical to the quad path.
+// The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): fx8 triangles with a
+// program whose texture reads are plain (ps11::tapPlan, ps11/executor_presampled_internal.h) are
+// drawn row by row without quads. A tap whose coordinates are screen-aligned on the triangle (u
+// depends on x only, v on y only, no perspective) has its texel columns and weights tabulated once
+// per triangle and its rows once per pixel row, and its texels are filtered into int16 lanes (runs
+// with a fixed weight and step through shared, cached H rows); any other tap (a rotated or
+// perspective mapping) is sampled per pixel by the sampler's fast kernel. The executor runs
+// pre-sampled, and 8-bit targets take plain and additive stores directly. Results are
+// bit-identical to the quad path.
 #pragma once
 
 #include <algorithm>
@@ -21,6 +23,7 @@
 #include "ps11/executor_presampled_internal.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
+#include "ps11/texture_sampler_fast.h"
 
 namespace emu {
 
@@ -44,6 +47,8 @@ struct AlignedDraw {
     // The vector kernels of the SIMD level in force when the draw was prepared
     // (emu/aligned_pass_kernels.h); null: every pixel filtered and stored one at a time.
     const AlignedKernels* kernels = nullptr;
+    // The sampler's fast kernel of that level, for taps sampled per pixel (freeTaps).
+    ps11::fastpath::Unorm8Kernel sample = nullptr;
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
@@ -108,10 +113,11 @@ struct AlignedTriangle {
     };
     std::array<Columns, 8> taps;
     std::vector<HConfig> configs;
+    // Taps sampled per pixel on this triangle (bit per tap of the TapPlan; freeTaps): no tables.
+    uint32_t freeTaps = 0;
 };
 
-// True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
-// colours constant or affine) and then fills its tables.
+// True when the triangle qualifies (alignedRowPath) and then fills its tables.
 // `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns = nullptr);
@@ -124,8 +130,19 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
 // triangle covering less than half of them (a sprite) its own. Triangles of one full-screen quad
 // thus have equal tables and share their H rows. False when it covers no pixel.
 bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
-// Both row paths' per-triangle condition: screenAligned and tableColumns.
+// The float row path's per-triangle condition: screenAligned and tableColumns.
 bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1);
+
+// The taps of `plan` the fx8 row path samples per pixel on the triangle (bit per tap): a bound
+// tap whose u has a dy or whose v has a dx (a rotated, sheared or transposed mapping), and on a
+// triangle with perspective every tap whose u or v is not constant. Each such lane's u and v are
+// the quad path's (planeValue, divided by the interpolated rhw with perspective) and the sampler's
+// fast kernel filters them (ps11/texture_sampler_fast.h): no tables, no H rows.
+uint32_t freeTaps(const AlignedDraw& draw, const TriangleSetup& s);
+// The fx8 row path's per-triangle condition, for any mapping of its taps: tableColumns.
+// 0: the triangle takes quads; 1: screen-aligned (screenAligned: every tap tabulated, tile
+// skipping may decide its tiles); 2: some tap sampled per pixel (freeTaps) or perspective.
+int alignedRowPath(const AlignedDraw& draw, const TriangleSetup& s, int& x0, int& x1);
 
 // The columns two consecutive triangles' tables should share (their union), when both have
 // narrow tables that overlap: the two halves of a sprite's quad cover column ranges a pixel apart
@@ -191,8 +208,8 @@ void columnU(const TriangleSetup& s, int set, int x0, int n, float* u);
 float rowV(const TriangleSetup& s, int set, int y);
 
 // The diffuse (color[0..3]) and specular (color[4..7]) lanes of pixels x .. x + n − 1 of row y
-// that `colorAttrs` names, as the quad path interpolates them (constant or affine, no
-// perspective).
+// that `colorAttrs` names, as the quad path interpolates them (constant, affine, or with
+// perspective divided by the interpolated rhw).
 void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]);
 
 struct AlignedStats {

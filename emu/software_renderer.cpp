@@ -345,7 +345,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // quad's two halves over the same columns so they share tables and H rows (pairColumns).
         // Which triangles and columns is decided here; the tables are filled on the workers
         // (independent per triangle: a full-screen quad's two halves fill at once).
-        auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto fill) {
+        // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
+        // pixel (alignedRowPath; those never share tables, and their tiles are not decided).
+        auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto fill) {
             if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
             tableOf.resize(setups.size());
             const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
@@ -354,7 +356,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                 auto& t = rowTris[i];
                 tableOf[i] = uint32_t(i);
-                isAligned[i] = rowPathColumns(plan, setups[i], t.x0, t.x1);
+                isAligned[i] = uint8_t(rowPath(setups[i], t.x0, t.x1));
                 std::pair<int, int> both;
                 const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
                                   pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
@@ -365,7 +367,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     p.x1 = t.x1 = both.second;
                     columns += p.x1 - p.x0;
                 }
-                if (isAligned[i] && i > 0 && isAligned[i - 1] && tableOf[i - 1] == i - 1 && t.x0 == rowTris[i - 1].x0 &&
+                if (isAligned[i] == 1 && i > 0 && isAligned[i - 1] == 1 && tableOf[i - 1] == i - 1 && t.x0 == rowTris[i - 1].x0 &&
                     t.x1 == rowTris[i - 1].x1 && sameColumnTables(setups[i - 1], setups[i], plan))
                     tableOf[i] = uint32_t(i - 1);
                 paired = pair;
@@ -382,16 +384,20 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             });
         };
         if (alignedDraw)
-            prepareTables(alignedTris, aligned.plan, aligned.plan.count,
-                          [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
+            prepareTables(
+                alignedTris, aligned.plan, aligned.plan.count,
+                [&](const TriangleSetup& s, int& x0, int& x1) { return alignedRowPath(aligned, s, x0, x1); },
+                [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
         if (floatDraw) {
-            prepareTables(floatTris, floatRows.plan, floatRows.plan.count,
-                          [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
+            prepareTables(
+                floatTris, floatRows.plan, floatRows.plan.count,
+                [&](const TriangleSetup& s, int& x0, int& x1) { return int(rowPathColumns(floatRows.plan, s, x0, x1)); },
+                [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
         }
         if (setups.empty()) continue;
         const bool tiles = skipper && setups.size() <= kMaxAlignedTriangles &&
-                           std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a != 0; });
+                           std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
 
         // ---- rows in bands over the workers ----
         const int firstBand = (yLo & ~1) / kBandRows;

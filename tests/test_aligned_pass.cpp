@@ -425,13 +425,72 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
     CHECK(rowPath * 10 >= cases * 9);
 }
 
-TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path", "[draw][aligned]") {
+// The case's quad with any mapping: each vertex's position moved by up to two pixels (any
+// quadrilateral), its coordinates anywhere (rotated, sheared, mirrored), and in half the cases
+// an rhw of its own (perspective). The fx8 row path samples such taps per pixel.
+void anyMapping(Case& c, std::mt19937& rng) {
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    const bool perspective = rng() & 1;
+    // The six vertices are two triangles over four corners: each corner (by its old position)
+    // gets one new vertex, so the two triangles still share their edge.
+    std::vector<std::pair<std::array<float, 2>, Vtx>> corners;
+    for (Vtx& v : c.verts) {
+        const std::array<float, 2> at{v.x, v.y};
+        auto it = std::find_if(corners.begin(), corners.end(), [&](const auto& k) { return k.first == at; });
+        if (it == corners.end()) {
+            Vtx n = v;
+            n.x += real(-2.0f, 2.0f), n.y += real(-2.0f, 2.0f);
+            for (auto& uv : n.uv) uv[0] = real(-1.5f, 2.5f), uv[1] = real(-1.5f, 2.5f);
+            n.rhw = perspective ? real(0.25f, 2.0f) : 1.0f;
+            corners.emplace_back(at, n);
+            it = corners.end() - 1;
+        }
+        v = it->second;
+    }
+}
+
+TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the quad path byte for byte",
+          "[draw][aligned]") {
+    std::mt19937 rng(20261129);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng);
+        anyMapping(c, rng);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = (i % 3) == 0;  // such triangles' tiles are never decided
+        if (c.program.rfind("ps_1_4", 0) == 0) {
+            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
+        }
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << " rhw " << c.verts[0].rhw << " program:\n" << c.program);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsCovered == qs.pixelsCovered);
+            CHECK(rs.pixelsWritten == qs.pixelsWritten);
+            if (qs.pixelsCovered == 0) return;
+            ++cases;
+            if (rs.pixelsShaded == rs.pixelsCovered) ++rowPath;
+        });
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 9);
+}
+
+TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 keeps the quad path", "[draw][aligned]") {
     std::mt19937 rng(7);
     Case c = randomCase(rng);
     c.program = kPrograms[1];
     c.w = 40, c.h = 20;
     c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
     c.scissor = false;
+    c.blend = 0, c.alphaTest = false, c.writeMask = 0xf;
     // Full-target quad with its texture coordinates rotated by 90 degrees: u follows y.
     c.verts.clear();
     const float xs[4] = {-0.5f, 39.5f, 39.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, 19.5f, 19.5f};
@@ -440,30 +499,34 @@ TEST_CASE("aligned pass: rotated, perspective and fx12 draws keep the quad path"
         for (auto& uv : q.uv) uv[0] = k >= 2 ? 1.0f : 0.0f, uv[1] = (k == 1 || k == 2) ? 1.0f : 0.0f;
         c.verts.push_back(q);
     }
-    DrawStats a, b;
-    Device rowDev;
+    for (Case::Tex& t : c.tex) t.bound = true;
     DeviceOptions quadOpt;
     quadOpt.software.alignedPasses = false;
-    Device quadDev(quadOpt);
-    CHECK(drawCase(rowDev, c, a) == drawCase(quadDev, c, b));
-    CHECK(a.pixelsShaded == b.pixelsShaded);  // both through quads
-    CHECK(a.pixelsShaded > a.pixelsCovered);
-
-    // Perspective (rhw differs): quads.
-    for (size_t k = 0; k < c.verts.size(); ++k) c.verts[k].rhw = c.verts[k].x > 0 ? 0.5f : 1.0f;
-    Device rowDev2;
-    DrawStats p;
-    drawCase(rowDev2, c, p);
-    CHECK(p.pixelsShaded > p.pixelsCovered);
+    auto check = [&](const char* what, const DeviceOptions& opt, bool rows) {
+        INFO(what);
+        DrawStats a, b;
+        Device dev(opt), quadDev(quadOpt);
+        CHECK(drawCase(dev, c, a) == drawCase(quadDev, c, b));
+        CHECK(a.pixelsCovered == 800);
+        // The row path shades the covered pixels only; quads add helper lanes on the diagonal.
+        CHECK((a.pixelsShaded == a.pixelsCovered) == rows);
+        CHECK(b.pixelsShaded > b.pixelsCovered);
+    };
+    check("rotated", DeviceOptions{}, true);
+    // Perspective (rhw differs), colours too.
+    for (size_t k = 0; k < c.verts.size(); ++k) {
+        c.verts[k].rhw = c.verts[k].x > 0 ? 0.5f : 1.0f;
+        c.verts[k].diffuse = c.verts[k].y > 0 ? 0xff2040c0u : 0x80ff0010u;
+    }
+    c.program = "ps_1_1\ntex t0\nmul r0, t0, v0\n";
+    quadOpt.software.threads = 1;
+    check("perspective", DeviceOptions{}, true);
 
     // fx12: the row path is fx8 only.
     DeviceOptions fx12;
     fx12.precision = ps11::Precision::Fx12;
-    Device rowDev3(fx12);
-    c.program = kPrograms[0];
-    for (auto& q : c.verts) q.rhw = 1.0f;
-    drawCase(rowDev3, c, p);
-    CHECK(p.pixelsShaded > p.pixelsCovered);
+    quadOpt.precision = ps11::Precision::Fx12;
+    check("fx12", fx12, false);
 }
 
 TEST_CASE("aligned pass: one device across draws (constants change sign, textures rewritten, ping-pong)",
@@ -1203,7 +1266,11 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
     // drawn the wrong number of times. Against the quad path, in fx8 and ideal.
     std::mt19937 rng(20261129);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
-    for (int i = 0; i < 12; ++i) {
+    // Cases 12 and up give each vertex an rhw of 0.5, 1 or 2 and its coordinates divided by it:
+    // every triangle's planes of attr·rhw are still u = x / 64, v = y / 32 exactly, but their rhw
+    // planes differ (fx8 only: perspective draws take quads in the float profiles).
+    for (int i = 0; i < 24; ++i) {
+        const bool perspective = i >= 12;
         Case c = randomCase(rng);
         c.w = 64, c.h = 32;
         c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
@@ -1218,17 +1285,27 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
         c.blend = 1, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
         c.verts.clear();
         auto vertex = [&](int x, int y) {
-            Vtx v{float(x), float(y), 0.5f, 1.0f, 0xffffffff, {}};
-            for (auto& uv : v.uv) uv[0] = float(x) / 64.0f, uv[1] = float(y) / 32.0f;
+            const float rhw = perspective ? std::array<float, 3>{0.5f, 1.0f, 2.0f}[size_t(uni(0, 2))] : 1.0f;
+            Vtx v{float(x), float(y), 0.5f, rhw, 0xffffffff, {}};
+            for (auto& uv : v.uv) uv[0] = float(x) / 64.0f / rhw, uv[1] = float(y) / 32.0f / rhw;
             return v;
         };
-        for (int t = 0; t < 60; ++t) {
+        for (int t = 0; perspective && t < 20; ++t) {
+            // Rectangles split on a diagonal, each corner its own rhw: the halves' attr·rhw
+            // planes are equal and their runs meet on every row, but the rows must not join
+            // where their rhw planes differ.
+            const int x0 = uni(-8, 60), y0 = uni(-8, 30), x1 = x0 + uni(2, 40), y1 = y0 + uni(2, 20);
+            const Vtx a = vertex(x0, y0), b = vertex(x1, y0), d = vertex(x1, y1), e = vertex(x0, y1);
+            c.verts.insert(c.verts.end(), {a, b, d, a, d, e});
+        }
+        for (int t = 0; !perspective && t < 60; ++t) {
             // Wide triangles (tables over the whole target: equal for all of them), some twice.
             const Vtx a = vertex(uni(-8, 72), uni(-8, 40)), b = vertex(uni(-8, 72), uni(-8, 40)),
                       d = vertex(uni(-8, 72), uni(-8, 40));
             for (int k = uni(0, 3) == 0 ? 2 : 1; k > 0; --k) c.verts.insert(c.verts.end(), {a, b, d});
         }
         for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Ideal}) {
+            if (perspective && precision != ps11::Precision::Fx8) continue;
             DeviceOptions quadOpt, rowOpt;
             quadOpt.software.alignedPasses = false;
             quadOpt.precision = rowOpt.precision = precision;
