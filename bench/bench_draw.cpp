@@ -5,6 +5,7 @@
 // How to run and what the numbers mean: bench/README.md "bench_draw".
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <chrono>
@@ -44,8 +45,15 @@ struct QuadVertex {
 // a 480×270 glare magnified 4× (bilinear) × c0, added ONE/ONE onto the 1080p target.
 // Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
-enum class Pass { Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4, CompositeAdd };
-constexpr int kPasses = 12;
+// Rotated: the 1080p blur with its texture coordinates turned by 10 degrees about the centre (u
+// and v each follow both x and y: the fx8 row path samples such taps per pixel).
+// Perspective: the 1080p linear copy through a quad whose right edge has rhw ½ (perspective-
+// correct coordinates, divided per pixel).
+enum class Pass {
+    Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4, CompositeAdd,
+    Rotated, Perspective
+};
+constexpr int kPasses = 14;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -93,8 +101,8 @@ struct Scene {
             dev->UnlockRect(glare, 0);
         }
         const bool weighted = pass == Pass::Weighted4;
-        const bool fourTaps =
-            pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small || pass == Pass::Tiny || weighted;
+        const bool fourTaps = pass == Pass::Blur4 || pass == Pass::Down4 || pass == Pass::Blur4Small ||
+                              pass == Pass::Tiny || weighted || pass == Pass::Rotated;
         const int stages = fourTaps ? 4 : pass == Pass::Composite ? 2 : 1;
         for (int s = 0; s < stages; ++s) {
             const DWORD filter =
@@ -163,12 +171,16 @@ struct Scene {
             ok = draw();
             return;
         }
+        const float turn = pass == Pass::Rotated ? 10.0f * 3.14159265f / 180.0f : 0.0f;
         for (int c : {0, 1, 2, 0, 2, 3}) {
-            QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
+            const float rhw = pass == Pass::Perspective && (c == 1 || c == 2) ? 0.5f : 1.0f;
+            QuadVertex q{xs[c], ys[c], 0.0f, rhw, {}};
+            const float ru = 0.5f + std::cos(turn) * (us[c] - 0.5f) - std::sin(turn) * (vs[c] - 0.5f);
+            const float rv = 0.5f + std::sin(turn) * (us[c] - 0.5f) + std::cos(turn) * (vs[c] - 0.5f);
             for (int s = 0; s < 4; ++s) {
                 const float(*o)[2] = weighted ? wOff : off;
-                q.uv[s][0] = us[c] + (fourTaps ? o[s][0] / float(tw) : 0.0f);
-                q.uv[s][1] = vs[c] + (fourTaps ? o[s][1] / float(th) : 0.0f);
+                q.uv[s][0] = ru + (fourTaps ? o[s][0] / float(tw) : 0.0f);
+                q.uv[s][1] = rv + (fourTaps ? o[s][1] / float(th) : 0.0f);
             }
             quad.push_back(q);
         }
@@ -362,6 +374,16 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_240x135_fx8, Pass::CopySmall)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, down2_linear_1080p_to_960x540_fx8, Pass::Down2)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_rotated_1080p_fx8, Pass::Rotated)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_1080p_fx8, Pass::Perspective)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

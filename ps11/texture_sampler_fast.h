@@ -1,7 +1,9 @@
 // The fast sampling kernels for 8-bit (Unorm8) 2-D textures in fx profiles: point and bilinear
 // on one mip level, every address mode. They compute exactly what the reference path of
 // TextureSampler computes (docs/textures.md "Fast path"); TextureSampler decides when a span
-// (or a run of its quads) qualifies. Internal to ps11/texture_sampler*.cpp.
+// (or a run of its quads) qualifies. Internal (not installed): ps11/texture_sampler*.cpp and the
+// device's fx8 row path (emu/aligned_pass.cpp: axisTable, and the kernel for taps it samples per
+// pixel).
 #pragma once
 
 #include <cstdint>
