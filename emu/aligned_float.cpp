@@ -264,7 +264,9 @@ public:
         m_tapOf.fill(-1);
         for (int t = 0; t < draw.plan.count; ++t) m_tapOf[draw.plan.stage[size_t(t)]] = int8_t(t);
     }
-    void setTriangle(const FloatRowTriangle& tri) { m_tri = &tri; }
+    void setTriangle(const FloatRowTriangle& tri, const TriangleSetup& s, int y, ps11::Sampler* perPixel) {
+        m_tri = &tri, m_setup = &s, m_y = y, m_perPixel = perPixel;
+    }
     void setX(int x) { m_x = x; }
 
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
@@ -274,6 +276,16 @@ public:
         if (!tap || !tap->bound) {
             for (int c = 0; c < 4; ++c) std::fill_n(out.value[c], n, c == 3 ? 1.0f : 0.0f);
             out.unitRange = true;
+            return;
+        }
+        if ((m_tri->freeTaps >> t) & 1) {
+            // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
+            alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
+            rowCoords(*m_setup, tap->coordSet, m_x + int(req.u[0]), m_y, n, u, v);
+            ps11::SampleRequest full = req;
+            full.u = u, full.v = v;
+            full.quads = false;
+            m_perPixel->sample(full, out);  // (its texels are counted by that sampler)
             return;
         }
         out.unitRange = tap->unitRange;
@@ -330,6 +342,9 @@ public:
 private:
     const FloatRowDraw& m_draw;
     const FloatRowTriangle* m_tri = nullptr;
+    const TriangleSetup* m_setup = nullptr;
+    ps11::Sampler* m_perPixel = nullptr;
+    int m_y = 0;
     const std::array<RowTaps, 8>& m_rows;
     std::array<int8_t, 8> m_tapOf{};
     int m_x = 0;
@@ -430,20 +445,28 @@ void columnStretches(FloatRowTriangle::Columns& cols, int n) {
 
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
                              const std::pair<int, int>* columns) {
-    if (!rowPathColumns(draw.plan, s, out.x0, out.x1)) return false;
+    if (!rowPathKind(draw.plan, boundTaps(draw), s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
     fillFloatRowTables(draw, s, out);
     return true;
 }
 
+uint32_t boundTaps(const FloatRowDraw& draw) {
+    uint32_t mask = 0;
+    for (int i = 0; i < draw.plan.count; ++i)
+        if (draw.taps[size_t(i)].bound) mask |= 1u << i;
+    return mask;
+}
+
 void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     const int n = out.x1 - out.x0;
+    out.freeTaps = freeTaps(draw.plan, boundTaps(draw), s);
     thread_local std::vector<float> u;
     u.resize(static_cast<size_t>(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {
         const FloatRowTap& tap = draw.taps[size_t(i)];
         FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
-        if (!tap.bound) {  // no table (the triangle may be a previous chunk's or draw's)
+        if (!tap.bound || ((out.freeTaps >> i) & 1)) {  // no table (the triangle may be a previous chunk's or draw's)
             cols.i0.clear(), cols.i1.clear(), cols.f.clear(), cols.stretches.clear();
             continue;
         }
@@ -524,10 +547,14 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                                 joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y, windows,
                                         windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
-            sampler.setTriangle(tri);
+            sampler.setTriangle(tri, s, y, sc.sampler);
+            uint64_t rowTexelsPerPixel = texelsPerPixel;  // (the per-pixel sampler counts its own)
+            for (int t = 0; t < taps; ++t)
+                if (((tri.freeTaps >> t) & 1) && draw.taps[size_t(t)].bound)
+                    rowTexelsPerPixel -= draw.taps[size_t(t)].linear ? 4 : 1;
             for (int t = 0; t < taps; ++t) {
                 const FloatRowTap& tap = draw.taps[size_t(t)];
-                if (!tap.bound || !((neededTaps >> t) & 1)) continue;
+                if (!tap.bound || !((neededTaps >> t) & 1) || ((tri.freeTaps >> t) & 1)) continue;
                 const float v = rowV(s, tap.coordSet, y);
                 RowTaps& r = rows[size_t(t)];
                 ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
@@ -549,7 +576,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
                         exec.run(in, sampler, outp, &stats.exec);
-                        stats.texels += uint64_t(n) * texelsPerPixel;
+                        stats.texels += uint64_t(n) * rowTexelsPerPixel;
                     } else if (mode == RowMode::Copy) {
                         // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
                         const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];

@@ -1,12 +1,13 @@
 // The row path of the float profiles (docs/device.md "Aligned passes"): the float and ideal
-// counterpart of emu/aligned_pass.h. Triangles whose texture coordinates are screen-aligned (u
-// depends on x only, v on y only, no perspective) are drawn row by row without quads: each tap's
-// addressing (texel pair and weight, ps11::floatAxisTaps) is tabulated once per column and once
-// per row instead of per lane; a linear tap's horizontal lerps are made once per texel row ("H
-// rows", kept while the rows that need them are drawn) and each pixel takes one vertical lerp;
-// the executor runs its float program over the row with a sampler that hands out these values,
-// and the output merger merges the row. The arithmetic is the reference sampler's, operation for
-// operation, so results are bit-identical to the quad path.
+// counterpart of emu/aligned_pass.h. Triangles are drawn row by row without quads: each
+// screen-aligned tap's (u depends on x only, v on y only, no perspective) addressing (texel pair
+// and weight, ps11::floatAxisTaps) is tabulated once per column and once per row instead of per
+// lane, and any other tap is sampled per pixel by the worker's sampler; a linear tap's
+// horizontal lerps are made once per texel row ("H rows", kept while the rows that need them are
+// drawn) and each pixel takes one vertical lerp; the executor runs its float program over the row
+// with a sampler that hands out these values, and the output merger merges the row. The
+// arithmetic is the reference sampler's, operation for operation, so results are bit-identical
+// to the quad path.
 #pragma once
 
 #include <array>
@@ -86,7 +87,13 @@ struct FloatRowTriangle {
         uint64_t tableId = 0;
     };
     std::array<Columns, 8> taps;
+    // Taps sampled per pixel on this triangle (bit per tap, freeTaps): no tables; the worker's
+    // sampler (FloatRowScratch::sampler) filters them.
+    uint32_t freeTaps = 0;
 };
+
+// The bound taps of a float draw (bit per tap).
+uint32_t boundTaps(const FloatRowDraw& draw);
 
 // Gives each tap's table of tris[0 .. count) an id, the same to taps of the triangle or the one before whose H
 // rows are equal (same texels, border, columns, texel pairs and weights), so drawFloatRows
@@ -96,8 +103,7 @@ struct FloatRowTriangle {
 void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const uint8_t* prepared,
                          const uint32_t* tableOf, size_t count);
 
-// True when the triangle qualifies (screen-aligned coordinates for every tap, no perspective,
-// colours constant or affine), and then fills its tables.
+// True when the triangle qualifies (rowPathKind), and then fills its tables.
 // `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
                              const std::pair<int, int>* columns = nullptr);
@@ -106,6 +112,10 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
 
 // Per-worker buffers, allocated once and kept by the worker.
 struct FloatRowScratch {
+    // The worker's sampler, bound to the draw's textures and sampler states: it filters the taps
+    // sampled per pixel (their lanes' u and v from rowCoords, no quads: such a texture's level
+    // and filter never depend on them, levelZeroOnly). Set by the caller before drawFloatRows.
+    ps11::Sampler* sampler = nullptr;
     alignas(32) float color[8][ps11::kMaxSpan];
     alignas(32) float out[4][ps11::kMaxSpan];
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];

@@ -205,15 +205,24 @@ void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const floa
         for (int i = 0; i < n; ++i) dst[i] *= inv[i];
 }
 
+}  // namespace
+
+void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v) {
+    alignas(32) float inv[ps11::kMaxSpan];
+    if (s.perspective) rowInverseW(s, x, y, n, inv);
+    rowAttribute(s, attrTex(set, 0), x, y, n, inv, u);
+    rowAttribute(s, attrTex(set, 1), x, y, n, inv, v);
+}
+
+namespace {
+
 // Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
 // path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
 // kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16.
 void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, int16_t* const dst[4]) {
     const AlignedTap& tap = draw.taps[size_t(t)];
-    alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan], inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
-    rowAttribute(s, attrTex(tap.coordSet, 0), x, y, n, inv, u);
-    rowAttribute(s, attrTex(tap.coordSet, 1), x, y, n, inv, v);
+    alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
+    rowCoords(s, tap.coordSet, x, y, n, u, v);
     ps11::fastpath::Unorm8Run run;
     run.texels = tap.texels;
     run.width = tap.width, run.height = tap.height;
@@ -608,11 +617,11 @@ bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, 
     return screenAligned(plan, s) && tableColumns(s, x0, x1);
 }
 
-uint32_t freeTaps(const AlignedDraw& draw, const TriangleSetup& s) {
+uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s) {
     uint32_t mask = 0;
-    for (int i = 0; i < draw.plan.count; ++i) {
-        if (!draw.taps[size_t(i)].bound) continue;
-        const int ku = attrTex(draw.plan.coordSet[size_t(i)], 0), kv = ku + 1;
+    for (int i = 0; i < plan.count; ++i) {
+        if (!((bound >> i) & 1)) continue;
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
         const bool cu = (s.constMask >> ku) & 1, cv = (s.constMask >> kv) & 1;
         const bool free = s.perspective ? !(cu && cv)
                                         : (!cu && s.attr[size_t(ku)].dy != 0.0) || (!cv && s.attr[size_t(kv)].dx != 0.0);
@@ -621,9 +630,16 @@ uint32_t freeTaps(const AlignedDraw& draw, const TriangleSetup& s) {
     return mask;
 }
 
-int alignedRowPath(const AlignedDraw& draw, const TriangleSetup& s, int& x0, int& x1) {
+int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1) {
     if (!tableColumns(s, x0, x1)) return 0;
-    return s.perspective || freeTaps(draw, s) ? 2 : 1;
+    return s.perspective || freeTaps(plan, bound, s) ? 2 : 1;
+}
+
+uint32_t boundTaps(const AlignedDraw& draw) {
+    uint32_t mask = 0;
+    for (int i = 0; i < draw.plan.count; ++i)
+        if (draw.taps[size_t(i)].bound) mask |= 1u << i;
+    return mask;
 }
 
 namespace {
@@ -682,7 +698,7 @@ bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair
 
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns) {
-    if (!alignedRowPath(draw, s, out.x0, out.x1)) return false;
+    if (!rowPathKind(draw.plan, boundTaps(draw), s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
     fillAlignedTables(draw, s, out);
     return true;
@@ -690,7 +706,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 
 void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     out.configs.clear();
-    out.freeTaps = freeTaps(draw, s);
+    out.freeTaps = freeTaps(draw.plan, boundTaps(draw), s);
     const int n = out.x1 - out.x0;
     thread_local std::vector<float> u;
     u.resize(size_t(std::max(n, 0)));

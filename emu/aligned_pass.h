@@ -113,11 +113,11 @@ struct AlignedTriangle {
     };
     std::array<Columns, 8> taps;
     std::vector<HConfig> configs;
-    // Taps sampled per pixel on this triangle (bit per tap of the TapPlan; freeTaps): no tables.
+    // Taps sampled per pixel on this triangle (bit per tap of the TapPlan, freeTaps): no tables.
     uint32_t freeTaps = 0;
 };
 
-// True when the triangle qualifies (alignedRowPath) and then fills its tables.
+// True when the triangle qualifies (rowPathKind) and then fills its tables.
 // `columns`, when given, are the tables' columns instead of tableColumns' (see pairColumns).
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns = nullptr);
@@ -130,19 +130,25 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
 // triangle covering less than half of them (a sprite) its own. Triangles of one full-screen quad
 // thus have equal tables and share their H rows. False when it covers no pixel.
 bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
-// The float row path's per-triangle condition: screenAligned and tableColumns.
+// screenAligned and tableColumns.
 bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1);
 
-// The taps of `plan` the fx8 row path samples per pixel on the triangle (bit per tap): a bound
-// tap whose u has a dy or whose v has a dx (a rotated, sheared or transposed mapping), and on a
-// triangle with perspective every tap whose u or v is not constant. Each such lane's u and v are
-// the quad path's (planeValue, divided by the interpolated rhw with perspective) and the sampler's
-// fast kernel filters them (ps11/texture_sampler_fast.h): no tables, no H rows.
-uint32_t freeTaps(const AlignedDraw& draw, const TriangleSetup& s);
-// The fx8 row path's per-triangle condition, for any mapping of its taps: tableColumns.
+// The taps of `plan` among `bound` (bit per tap) that the row paths sample per pixel on the
+// triangle: a tap whose u has a dy or whose v has a dx (a rotated, sheared or transposed
+// mapping), and on a triangle with perspective every tap whose u or v is not constant. Each such
+// lane's u and v are the quad path's (rowCoords) and the sampler filters them as the quad path's
+// does: no tables, no H rows.
+uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s);
+// Both row paths' per-triangle condition, for any mapping of their taps: tableColumns.
 // 0: the triangle takes quads; 1: screen-aligned (screenAligned: every tap tabulated, tile
 // skipping may decide its tiles); 2: some tap sampled per pixel (freeTaps) or perspective.
-int alignedRowPath(const AlignedDraw& draw, const TriangleSetup& s, int& x0, int& x1);
+int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1);
+// The bound taps of an fx8 draw (bit per tap).
+uint32_t boundTaps(const AlignedDraw& draw);
+// Coordinate set `set`'s u and v at pixels x .. x + n − 1 (n <= kMaxSpan) of row y, as the
+// rasteriser interpolates them: constant, planeValue, or with perspective planeValue of u·rhw
+// times 1 / rhw (the same float operations in the same order).
+void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v);
 
 // The columns two consecutive triangles' tables should share (their union), when both have
 // narrow tables that overlap: the two halves of a sprite's quad cover column ranges a pixel apart

@@ -346,7 +346,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         // Which triangles and columns is decided here; the tables are filled on the workers
         // (independent per triangle: a full-screen quad's two halves fill at once).
         // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
-        // pixel (alignedRowPath; those never share tables, and their tiles are not decided).
+        // pixel (rowPathKind; those never share tables, and their tiles are not decided).
         auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto fill) {
             if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
             tableOf.resize(setups.size());
@@ -386,12 +386,16 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         if (alignedDraw)
             prepareTables(
                 alignedTris, aligned.plan, aligned.plan.count,
-                [&](const TriangleSetup& s, int& x0, int& x1) { return alignedRowPath(aligned, s, x0, x1); },
+                [&, bound = boundTaps(aligned)](const TriangleSetup& s, int& x0, int& x1) {
+                    return rowPathKind(aligned.plan, bound, s, x0, x1);
+                },
                 [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
         if (floatDraw) {
             prepareTables(
                 floatTris, floatRows.plan, floatRows.plan.count,
-                [&](const TriangleSetup& s, int& x0, int& x1) { return int(rowPathColumns(floatRows.plan, s, x0, x1)); },
+                [&, bound = boundTaps(floatRows)](const TriangleSetup& s, int& x0, int& x1) {
+                    return rowPathKind(floatRows.plan, bound, s, x0, x1);
+                },
                 [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
         }
@@ -432,6 +436,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);
                 if ((sampled >> s) & 1) sampler.setSamplerState(s, call.samplers[size_t(s)]);
             }
+            ws0.floatRows.sampler = &sampler;  // the float row path's taps sampled per pixel
             const uint64_t fetchedBefore = sampler.texelsFetched();
             QuadSpan* span = &ws0.span;
             Lanes* lanes = &ws0.lanes;

@@ -483,6 +483,37 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
     CHECK(rowPath * 10 >= cases * 9);
 }
 
+TEST_CASE("float row path: random rotated, sheared and perspective draws in float and ideal equal the quad path",
+          "[draw][aligned]") {
+    std::mt19937 rng(20261130);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 200; ++i) {
+        Case c = randomCase(rng, (i & 2) != 0);
+        anyMapping(c, rng);
+        for (Case::Tex& t : c.tex) withoutNaNs(t.bytes, t.format);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+        quadOpt.precision = rowOpt.precision = (i / 4) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
+        rowOpt.software.skipTiles = (i % 3) == 0;
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", rhw "
+                     << c.verts[0].rhw << ", program:\n"
+                     << c.program);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsCovered == qs.pixelsCovered);
+        CHECK(rs.pixelsWritten == qs.pixelsWritten);
+        if (qs.pixelsCovered == 0) continue;
+        ++cases;
+        if (rs.pixelsShaded == rs.pixelsCovered) ++rowPath;
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 8);
+}
+
 TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 keeps the quad path", "[draw][aligned]") {
     std::mt19937 rng(7);
     Case c = randomCase(rng);
@@ -1268,7 +1299,7 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     // Cases 12 and up give each vertex an rhw of 0.5, 1 or 2 and its coordinates divided by it:
     // every triangle's planes of attr·rhw are still u = x / 64, v = y / 32 exactly, but their rhw
-    // planes differ (fx8 only: perspective draws take quads in the float profiles).
+    // planes differ.
     for (int i = 0; i < 24; ++i) {
         const bool perspective = i >= 12;
         Case c = randomCase(rng);
@@ -1305,7 +1336,6 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
             for (int k = uni(0, 3) == 0 ? 2 : 1; k > 0; --k) c.verts.insert(c.verts.end(), {a, b, d});
         }
         for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Ideal}) {
-            if (perspective && precision != ps11::Precision::Fx8) continue;
             DeviceOptions quadOpt, rowOpt;
             quadOpt.software.alignedPasses = false;
             quadOpt.precision = rowOpt.precision = precision;
