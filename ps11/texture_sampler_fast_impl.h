@@ -247,6 +247,8 @@ bool quadContiguous(int count, const Scratch& s) {
     if (count % 4 != 0) return false;
     const int32_t x0 = s.x0[0], ya0 = s.y0[0], ya1 = s.y1[0], yb0 = s.y0[2], yb1 = s.y1[2];
     if ((x0 | ya0 | ya1 | yb0 | yb1) < 0) return false;
+    // (The first quad first: scattered lanes, the usual case when this fails, fail there.)
+    if (s.x0[1] != x0 + 1 || s.x0[2] != x0 || s.x0[3] != x0 + 1 || s.y0[1] != ya0 || s.y0[3] != yb0) return false;
     int bad = 0;
     for (int i = 0; i < count; ++i) {
         const int32_t col = x0 + 2 * (i >> 2) + (i & 1);
@@ -300,12 +302,74 @@ void blend(int count, const uint8_t* t00p, const uint8_t* t10p, const uint8_t* t
     }
 }
 
+#ifdef __AVX2__
+// Eight lanes [i, i + 8) of a bilinear fx8 run, gathered and blended in integers: the same sum as
+// blend()'s, one rounding. Lanes whose texel lies on the border take the border word (a masked
+// gather reads no memory for them). Per channel h = a·(256 − wx) + b·wx per texel row (below
+// 2^16: 16-bit products), then pmaddwd forms (h0 − 2^15)·(256 − wy) + (h1 − 2^15)·wy = sum − 2^23
+// exactly, and round_half_even(sum / 2^16) is taken with shifts. The results (bytes) are packed
+// back into b g r a words and split into the planes.
+void blendLinear8(const Unorm8Run& run, const Scratch& s, int i, int32_t* r, int32_t* g, int32_t* b, int32_t* a) {
+    auto load = [&](const int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p + i)); };
+    const __m256i x0 = load(s.x0), x1 = load(s.x1), y0 = load(s.y0), y1 = load(s.y1);
+    const __m256i wx = load(s.wx), wy = load(s.wy);
+    const __m256i width = _mm256_set1_epi32(int32_t(run.width)), none = _mm256_set1_epi32(-1);
+    const __m256i border = _mm256_set1_epi32(int32_t(run.borderWord));
+    const int* base = reinterpret_cast<const int*>(run.texels);
+    const __m256i r0 = _mm256_mullo_epi32(y0, width), r1 = _mm256_mullo_epi32(y1, width);
+    auto tap = [&](__m256i row, __m256i y, __m256i x) {
+        const __m256i inside = _mm256_cmpgt_epi32(_mm256_or_si256(x, y), none);
+        return _mm256_mask_i32gather_epi32(border, base, _mm256_add_epi32(row, x), inside, 4);
+    };
+    const __m256i t00 = tap(r0, y0, x0), t10 = tap(r0, y0, x1), t01 = tap(r1, y1, x0), t11 = tap(r1, y1, x1);
+    // Weights as 16-bit lanes, each pixel's repeated over its four channels.
+    const __m256i wxs = _mm256_or_si256(wx, _mm256_slli_epi32(wx, 16));
+    const __m256i wyp = _mm256_or_si256(_mm256_sub_epi32(_mm256_set1_epi32(256), wy), _mm256_slli_epi32(wy, 16));
+    const __m256i full = _mm256_set1_epi16(256), flip = _mm256_set1_epi16(int16_t(-32768));
+    const __m256i round = _mm256_set1_epi32((1 << 23) + 0x7fff), one = _mm256_set1_epi32(1);
+    __m256i words[2];
+    for (int half = 0; half < 2; ++half) {
+        auto bytes16 = [&](__m256i t) {
+            return _mm256_cvtepu8_epi16(half ? _mm256_extracti128_si256(t, 1) : _mm256_castsi256_si128(t));
+        };
+        const int q = 4 * half;
+        const __m256i w =
+            _mm256_permutevar8x32_epi32(wxs, _mm256_setr_epi32(q, q, q + 1, q + 1, q + 2, q + 2, q + 3, q + 3));
+        const __m256i wc = _mm256_sub_epi16(full, w);
+        const __m256i h0 = _mm256_xor_si256(
+            _mm256_add_epi16(_mm256_mullo_epi16(bytes16(t00), wc), _mm256_mullo_epi16(bytes16(t10), w)), flip);
+        const __m256i h1 = _mm256_xor_si256(
+            _mm256_add_epi16(_mm256_mullo_epi16(bytes16(t01), wc), _mm256_mullo_epi16(bytes16(t11), w)), flip);
+        // unpacklo: pixels q and q + 2 (one per 128-bit lane); unpackhi: q + 1 and q + 3.
+        const __m256i wlo = _mm256_permutevar8x32_epi32(wyp, _mm256_setr_epi32(q, q, q, q, q + 2, q + 2, q + 2, q + 2));
+        const __m256i whi =
+            _mm256_permutevar8x32_epi32(wyp, _mm256_setr_epi32(q + 1, q + 1, q + 1, q + 1, q + 3, q + 3, q + 3, q + 3));
+        auto rounded = [&](__m256i m) {  // m = sum − 2^23
+            const __m256i odd = _mm256_and_si256(_mm256_srai_epi32(m, 16), one);
+            return _mm256_srai_epi32(_mm256_add_epi32(_mm256_add_epi32(m, round), odd), 16);
+        };
+        const __m256i lo = rounded(_mm256_madd_epi16(_mm256_unpacklo_epi16(h0, h1), wlo));
+        const __m256i hi = rounded(_mm256_madd_epi16(_mm256_unpackhi_epi16(h0, h1), whi));
+        words[half] = _mm256_packus_epi32(lo, hi);  // per 128-bit lane: pixels q, q + 1 | q + 2, q + 3
+    }
+    const __m256i packed =
+        _mm256_permutevar8x32_epi32(_mm256_packus_epi16(words[0], words[1]), _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7));
+    const __m256i m8 = _mm256_set1_epi32(255);
+    auto store = [&](int32_t* p, __m256i v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + i), v); };
+    store(b, _mm256_and_si256(packed, m8));
+    store(g, _mm256_and_si256(_mm256_srli_epi32(packed, 8), m8));
+    store(r, _mm256_and_si256(_mm256_srli_epi32(packed, 16), m8));
+    store(a, _mm256_srli_epi32(packed, 24));
+}
+#endif
+
 // True when the span reads two texel rows in order: one row pair (no border) and column pairs
 // x0 + i, x0 + i + 1 (a screen-aligned pass at the texture's resolution, any fixed fraction).
 // Then the taps are read in place instead of gathered.
 bool rowContiguous(int count, const Scratch& s) {
     const int32_t x0 = s.x0[0], y0 = s.y0[0], y1 = s.y1[0];
     if ((x0 | y0 | y1) < 0) return false;
+    if (count > 1 && (s.x0[1] != x0 + 1 || s.y0[1] != y0)) return false;  // (scattered lanes fail here)
     int bad = 0;
     for (int i = 0; i < count; ++i)
         bad |= (s.x0[i] - i - x0) | (s.x1[i] - i - 1 - x0) | (s.y0[i] - y0) | (s.y1[i] - y1);
@@ -341,6 +405,23 @@ void sampleUnorm8(const Unorm8Run& run, int count, const float* u, const float* 
             const uint8_t* r1 = run.texels + size_t(s.y1[0]) * stride + size_t(s.x0[0]) * 4;
             blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
         } else {
+#ifdef __AVX2__
+            if (run.scale == 1 && !quadContiguous(count, s)) {
+                const int whole = count & ~7;
+                for (int i = 0; i < whole; i += 8) blendLinear8(run, s, i, dst[0], dst[1], dst[2], dst[3]);
+                if (whole == count) return;
+                // The last lanes: gathered and blended one by one, from the front of the scratch.
+                Scratch& t = s;
+                const int rest = count - whole;
+                for (int32_t* p : {t.x0, t.x1, t.y0, t.y1, t.wx, t.wy})
+                    std::memmove(p, p + whole, sizeof(int32_t) * size_t(rest));
+                gatherBilinear(run, rest, t);
+                auto bytes = [](const uint32_t* p) { return reinterpret_cast<const uint8_t*>(p); };
+                blend(rest, bytes(t.t00), bytes(t.t10), bytes(t.t01), bytes(t.t11), t.wx, t.wy, outScale,
+                      dst[0] + whole, dst[1] + whole, dst[2] + whole, dst[3] + whole);
+                return;
+            }
+#endif
             if (quadContiguous(count, s))
                 gatherQuads(run, count, s);
             else

@@ -14,6 +14,7 @@
 #include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
+#include "simd_levels.h"
 
 using namespace ps11;
 
@@ -588,6 +589,53 @@ TEST_CASE("sampler: the 8-bit fast path equals the general path", "[sampler]") {
                     Result a = run(fast, p, u, v), b = run(general, p, u, v);
                     for (int c = 0; c < 4; ++c) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
                 }
+    }
+}
+
+TEST_CASE("sampler: the 8-bit fast path equals the general path for scattered lanes, every address mode and level",
+          "[sampler]") {
+    // Lanes that are neither one row in order nor screen-aligned quads (a rotated or perspective
+    // mapping, a dependent read): the gathering kernels, eight lanes a step and the rest one by
+    // one, border lanes among them.
+    std::mt19937 rng(20261129);
+    for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{37, 23}, {64, 64}, {1, 9}}) {
+        TextureDesc d = makeDesc(TexFormat::A8R8G8B8, w, h, 0, {});
+        for (uint32_t i = 0; i < w * h; ++i) d.data[0].texels.push_back(word(rng()));
+        auto tex = build(d);
+        std::uniform_real_distribution<float> coord(-1.5f, 2.5f);
+        for (int count : {kMaxSpan, 1, 7, 8, 13, 100}) {
+            std::vector<float> u(static_cast<size_t>(count)), v(static_cast<size_t>(count));
+            for (int i = 0; i < count; ++i) {
+                // A rotated row: both coordinates move with the lane, with jitter.
+                u[size_t(i)] = 0.3f + 0.031f * float(i) + (i % 3 ? 0.0f : coord(rng) * 0.01f);
+                v[size_t(i)] = 0.2f + 0.017f * float(i) - (i % 5 ? 0.0f : coord(rng));
+                if (i % 11 == 4) u[size_t(i)] = coord(rng), v[size_t(i)] = coord(rng);
+                if (i % 16 == 9) u[size_t(i)] = float(int(rng() % 4096) - 1024) / 1024.0f;  // exact half-way weights
+            }
+            for (TextureAddress mu : {TextureAddress::Clamp, TextureAddress::Wrap, TextureAddress::Mirror,
+                                      TextureAddress::Border, TextureAddress::MirrorOnce})
+                for (TextureAddress mv : {TextureAddress::Clamp, TextureAddress::Border, TextureAddress::Wrap})
+                    for (Filter f : {Filter::Linear, Filter::Point})
+                        for (Precision p : {Precision::Fx8, Precision::Fx12}) {
+                            INFO(w << "x" << h << " count " << count << " modes " << int(mu) << "," << int(mv)
+                                   << " filter " << int(f) << " precision " << int(p));
+                            SamplerState st = state(f, mu);
+                            st.addressV = mv;
+                            st.border = {0.2f, 0.4f, 0.6f, 0.8f};
+                            TextureSampler general;
+                            general.setFastPath(false);
+                            general.bind(0, tex);
+                            general.setSamplerState(0, st);
+                            const Result b = run(general, p, u, v);
+                            testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                                TextureSampler fast;
+                                fast.bind(0, tex);
+                                fast.setSamplerState(0, st);
+                                const Result a = run(fast, p, u, v);
+                                for (int c = 0; c < 4; ++c) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
+                            });
+                        }
+        }
     }
 }
 
