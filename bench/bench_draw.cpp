@@ -17,6 +17,7 @@
 #include "bench/bench_shaders.h"
 #include "emu/device.h"
 #include "emu/raster.h"
+#include "ps11/hardware.h"
 
 namespace {
 
@@ -49,11 +50,27 @@ struct QuadVertex {
 // and v each follow both x and y: the fx8 row path samples such taps per pixel).
 // Perspective: the 1080p linear copy through a quad whose right edge has rhw ½ (perspective-
 // correct coordinates, divided per pixel).
+// Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
+// `texld r1, r0` (the first lookup's colour as the coordinates of the second, bilinear, same
+// texture): spans of one row.
 enum class Pass {
-    Blur4, CopyPoint, CopyLinear, CopySmall, Down2, Down4, Blur4Small, Sprites, Tiny, Composite, Weighted4, CompositeAdd,
-    Rotated, Perspective
+    Blur4,
+    CopyPoint,
+    CopyLinear,
+    CopySmall,
+    Down2,
+    Down4,
+    Blur4Small,
+    Sprites,
+    Tiny,
+    Composite,
+    Weighted4,
+    CompositeAdd,
+    Rotated,
+    Perspective,
+    Dependent
 };
-constexpr int kPasses = 14;
+constexpr int kPasses = 15;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -77,6 +94,7 @@ struct Scene {
         DeviceOptions o;
         o.software.threads = threads;
         o.software.alignedPasses = aligned;
+        if (pass == Pass::Dependent) o.hardware = &ps11::defaultHardware(4);  // a ps_1_4 class, fx8
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
@@ -119,9 +137,11 @@ struct Scene {
             "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
             "mad r0, t3, c3, r0\n";
         const char* const kScale = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
-        if (dev->CreatePixelShaderFromText(weighted   ? kWeighted4
-                                           : addGlare ? kScale
-                                           : fourTaps ? kBlur4
+        const char* const kDependent = "ps_1_4\ntexld r0, t0\nphase\ntexld r1, r0\nmov r0, r1\n";
+        if (dev->CreatePixelShaderFromText(pass == Pass::Dependent   ? kDependent
+                                           : weighted                ? kWeighted4
+                                           : addGlare                ? kScale
+                                           : fourTaps                ? kBlur4
                                            : pass == Pass::Sprites   ? kSprite
                                            : pass == Pass::Composite ? kScreen
                                                                      : kCopy,
@@ -384,6 +404,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_rotated_1080p_fx8, Pass::Rotated)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_1080p_fx8, Pass::Perspective)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, dependent_1080p_fx12, Pass::Dependent)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

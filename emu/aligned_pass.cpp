@@ -568,8 +568,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
 }
 
 bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss) {
-    return !tex.isVolume() && effectiveLinear(ss.minFilter) == effectiveLinear(ss.magFilter) &&
-           (tex.levelCount() == 1 || ss.mipFilter == ps11::Filter::None);
+    return !tex.isVolume() && ps11::lodFree(tex, ss);
 }
 
 bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {

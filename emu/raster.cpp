@@ -56,6 +56,53 @@ void fillPlane(const Plane& p, double ox, double oy, int x0, int y0, int n, floa
     }
 }
 
+// The attributes `used` (and z when `wantZ`) of a span's n lanes, their pixels set:
+// `fill(plane, out)` writes a plane's values over the lanes (fillPlane for quads, fillPlaneRow
+// for a row). With perspective the planes are of attr·rhw, divided per lane; constant attributes
+// are filled once and kept while the span's lanes still hold them.
+template <class Fill>
+void spanAttributes(const TriangleSetup& s, uint64_t used, bool wantZ, int n, QuadSpan& span, Fill&& fill) {
+    const uint64_t planes = used & ~s.constMask;
+    if (wantZ) fill(s.z, span.z);
+    if (s.perspective) {
+        // attr = (attr·rhw)/rhw per lane; helper lanes far outside may extrapolate rhw
+        // to <= 0, kept positive so no lane divides by zero.
+        alignas(32) float inv[ps11::kMaxSpan];
+        fill(s.rhw, inv);
+        for (int L = 0; L < n; ++L) inv[L] = 1.0f / std::max(inv[L], 1e-30f);
+        for (int k = 0; k < kAttrCount; ++k) {
+            if (!((planes >> k) & 1)) continue;
+            float* out = span.attr[k];
+            fill(s.attr[size_t(k)], out);
+            for (int L = 0; L < n; ++L) out[L] *= inv[L];
+        }
+    } else {
+        for (int k = 0; k < kAttrCount; ++k)
+            if ((planes >> k) & 1) fill(s.attr[size_t(k)], span.attr[k]);
+    }
+    for (int k = 0; k < kAttrCount; ++k)
+        if ((planes >> k) & 1) span.constLanes[size_t(k)] = 0;
+    const uint64_t consts = used & s.constMask;
+    for (int k = 0; k < kAttrCount; ++k) {
+        if (!((consts >> k) & 1)) continue;
+        const float value = s.constValue[size_t(k)];
+        int& have = span.constLanes[size_t(k)];
+        if (have > 0 && std::memcmp(&span.constFill[size_t(k)], &value, sizeof value) != 0) have = 0;
+        if (have < n) {
+            std::fill(span.attr[k] + have, span.attr[k] + n, value);
+            span.constFill[size_t(k)] = value;
+            have = n;
+        }
+    }
+}
+
+// A plane's values at pixels x0 .. x0 + n − 1 of row y: planeValue per lane (the same sum as
+// fillPlane's).
+void fillPlaneRow(const Plane& p, double ox, double oy, int x0, int y, int n, float* out) {
+    const float base = float(planeRowBase(p, ox, oy, y)), fdx = float(p.dx);
+    for (int i = 0; i < n; ++i) out[i] = base + fdx * float(x0 + i);
+}
+
 }  // namespace
 
 float planeValue(const Plane& p, double ox, double oy, int x, int y) {
@@ -157,7 +204,6 @@ void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool w
                    const std::function<void(QuadSpan&)>& emit) {
     const int yStart = std::max(y0, s.yMin & ~1);
     const int yEnd = std::min(y1, s.yMax);
-    const uint64_t planes = used & ~s.constMask;
     for (int py = yStart; py < yEnd; py += 2) {
         int l0 = 0, r0 = 0, l1 = 0, r1 = 0;
         const bool c0 = py >= y0 && rowCoverage(s, py, l0, r0);
@@ -198,37 +244,26 @@ void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool w
             }
             span.liveCount = liveCount;
             if (liveCount == 0) continue;
-            if (wantZ) fillPlane(s.z, s.ox, s.oy, sx, py, n, span.z);
-            if (s.perspective) {
-                // attr = (attr·rhw)/rhw per lane; helper lanes far outside may extrapolate rhw
-                // to <= 0, kept positive so no lane divides by zero.
-                alignas(32) float inv[ps11::kMaxSpan];
-                fillPlane(s.rhw, s.ox, s.oy, sx, py, n, inv);
-                for (int L = 0; L < n; ++L) inv[L] = 1.0f / std::max(inv[L], 1e-30f);
-                for (int k = 0; k < kAttrCount; ++k) {
-                    if (!((planes >> k) & 1)) continue;
-                    float* out = span.attr[k];
-                    fillPlane(s.attr[size_t(k)], s.ox, s.oy, sx, py, n, out);
-                    for (int L = 0; L < n; ++L) out[L] *= inv[L];
-                }
-            } else {
-                for (int k = 0; k < kAttrCount; ++k)
-                    if ((planes >> k) & 1) fillPlane(s.attr[size_t(k)], s.ox, s.oy, sx, py, n, span.attr[k]);
-            }
-            for (int k = 0; k < kAttrCount; ++k)
-                if ((planes >> k) & 1) span.constLanes[size_t(k)] = 0;
-            const uint64_t consts = used & s.constMask;
-            for (int k = 0; k < kAttrCount; ++k) {
-                if (!((consts >> k) & 1)) continue;
-                const float value = s.constValue[size_t(k)];
-                int& have = span.constLanes[size_t(k)];
-                if (have > 0 && std::memcmp(&span.constFill[size_t(k)], &value, sizeof value) != 0) have = 0;
-                if (have < n) {
-                    std::fill(span.attr[k] + have, span.attr[k] + n, value);
-                    span.constFill[size_t(k)] = value;
-                    have = n;
-                }
-            }
+            spanAttributes(s, used, wantZ, n, span,
+                           [&](const Plane& p, float* out) { fillPlane(p, s.ox, s.oy, sx, py, n, out); });
+            emit(span);
+        }
+    }
+}
+
+void rasterizeRowSpans(const TriangleSetup& s, int y0, int y1, uint64_t used, bool wantZ, QuadSpan& span,
+                       const std::function<void(QuadSpan&)>& emit) {
+    const int yStart = std::max(y0, s.yMin), yEnd = std::min(y1, s.yMax);
+    for (int y = yStart; y < yEnd; ++y) {
+        int xl = 0, xr = 0;
+        if (!rowCoverage(s, y, xl, xr)) continue;
+        for (int x = xl; x < xr; x += ps11::kMaxSpan) {
+            const int n = std::min(ps11::kMaxSpan, xr - x);
+            span.count = span.liveCount = n;
+            for (int L = 0; L < n; ++L) span.x[L] = x + L, span.y[L] = y;
+            std::memset(span.live, 1, size_t(n));
+            spanAttributes(s, used, wantZ, n, span,
+                           [&](const Plane& p, float* out) { fillPlaneRow(p, s.ox, s.oy, x, y, n, out); });
             emit(span);
         }
     }

@@ -78,4 +78,11 @@ struct QuadSpan {
 void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool wantZ, QuadSpan& span,
                    const std::function<void(QuadSpan&)>& emit);
 
+// Rasterises rows [y0, y1) of the triangle as spans of one row each (up to ps11::kMaxSpan
+// covered pixels, left to right, no helper lanes: PixelInputs::quads off), with the attributes
+// each pixel gets in rasterizeRows. For draws whose every lookup is the same without quads
+// (ps11::lodFree): the software renderer's spans then (docs/device.md "Rasterisation").
+void rasterizeRowSpans(const TriangleSetup& s, int y0, int y1, uint64_t used, bool wantZ, QuadSpan& span,
+                       const std::function<void(QuadSpan&)>& emit);
+
 }  // namespace emu

@@ -259,6 +259,12 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     for (int s = 0; s < kMaxStages; ++s) executor.setStageState(s, prog.stages[size_t(s)]);
 
     const uint32_t sampled = executor.sampledStages();
+    // Triangles that take neither row path are shaded in rows too, without helper lanes, when
+    // no lookup depends on quads (every sampled texture ps11::lodFree); else in 2×2 quads.
+    bool rowSpans = m_options.alignedPasses;
+    for (int s = 0; s < kMaxSamplers && rowSpans; ++s)
+        if ((sampled >> s) & 1 && call.textures[size_t(s)])
+            rowSpans = ps11::lodFree(*call.textures[size_t(s)], call.samplers[size_t(s)]);
     const MergeState& merge = call.merge;
     const MergeTarget& mtarget = call.target;
     const bool shaderDepth = executor.writesDepth();
@@ -441,7 +447,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             QuadSpan* span = &ws0.span;
             Lanes* lanes = &ws0.lanes;
             ps11::PixelInputs in;
-            in.quads = true;
+            in.quads = !rowSpans;
             for (int c = 0; c < 4; ++c) {
                 if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
                 if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
@@ -467,7 +473,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 mi.count = sp.count;
                 mi.x = sp.x;
                 mi.y = sp.y;
-                mi.live = kills ? lanes->live : sp.live;
+                // (A row span's lanes are one run of a row, every one covered.)
+                mi.live = kills ? lanes->live : rowSpans ? nullptr : sp.live;
+                mi.row = rowSpans;
                 for (int c = 0; c < 4; ++c) {
                     mi.color[c] = lanes->color[c];
                     mi.grid[c] = fx ? lanes->grid[c] : nullptr;
@@ -589,7 +597,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         continue;
                     }
                     flush();
-                    rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                    if (rowSpans)
+                        rasterizeRowSpans(s, by0, by1, used, wantZ, *span, emitFn);
+                    else
+                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                 }
                 flush();
             }

@@ -14,8 +14,10 @@ namespace emu {
 // What only the software renderer has.
 struct SoftwareRendererOptions {
     int threads = 0;  // worker threads of draws; 0 = all cores
-    // Screen-aligned fx8 passes take the row path of emu/aligned_pass.h (bit-identical images;
-    // no helper lanes, so fewer pixels shaded). Off: every draw goes through 2x2 quads.
+    // Rows instead of 2x2 quads (bit-identical images; no helper lanes, so fewer pixels shaded):
+    // the row paths of emu/aligned_pass.h (fx8) and emu/aligned_float.h (float, ideal) for plain
+    // texture reads, and spans of one row (rasterizeRowSpans) for any other triangle whose every
+    // lookup is ps11::lodFree. Off: every draw goes through 2x2 quads.
     bool alignedPasses = true;
     // Tiles of row-path draws whose result the interval evaluator decides are filled, copied or
     // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile shaded.

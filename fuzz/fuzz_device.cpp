@@ -2,13 +2,14 @@
 // files the reader accepts are set up on emu::Device and their draws and pixel probes run. The
 // device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
 // format can express; a refused call must carry a message. Sizes are capped so each input
-// stays fast (the limits themselves are tested elsewhere). In fx8, float and ideal every file is
-// also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path, and
-// with them tile skipping, which the first device does by default): after every draw both render
-// targets must be identical bit for bit (docs/device.md "Aligned passes", "Tile skipping"; `fill`
-// textures and constant regions make the tiles that are filled, copied or skipped). A third device checks fingerprints (docs/device.md "Fingerprints") at every draw: a
-// dry run of the draw writes nothing; and when the draw's fingerprint after running it equals
-// the one before, running it again must leave the target's bytes as they are (what lets a pass
+// stays fast (the limits themselves are tested elsewhere). In fx8, fx12, float and ideal every file
+// is also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path, the
+// spans of one row of draws whose lookups are lodFree, and with them tile skipping, which the
+// first device does by default): every triangle in 2×2 quads. After every draw both render
+// targets must be identical bit for bit (docs/device.md "Rasterisation", "Aligned passes", "Tile skipping"; `fill`
+// textures and constant regions make the tiles that are filled, copied or skipped). A third device checks fingerprints
+// (docs/device.md "Fingerprints") at every draw: a dry run of the draw writes nothing; and when the draw's fingerprint
+// after running it equals the one before, running it again must leave the target's bytes as they are (what lets a pass
 // graph skip a pass whose fingerprint and outputs are last frame's).
 #include <cstddef>
 #include <cstdint>
@@ -82,7 +83,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (program) ps11::validate(*program, diags);
         if (!program || diags.hasErrors()) return 0;
     }
-    for (ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal}) {
+    for (ps11::Precision p :
+         {ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float, ps11::Precision::Ideal}) {
         std::string error;
         const ps11::HardwareConfig hw = ps11::resolveHardware(file.require.hardware.value, program ? program->version.minor : 1,
                                                               p, file.require.maxValue.value);

@@ -188,6 +188,15 @@ void combineFloat(const CombineInput& in, const Src& src, const float* border, f
 
 Filter effective(Filter f) { return f == Filter::Linear ? Filter::Linear : Filter::Point; }
 
+}  // namespace
+
+bool lodFree(const Texture& tex, const SamplerState& st) {
+    return (tex.levelCount() == 1 || st.mipFilter == Filter::None) &&
+           effective(st.magFilter) == effective(st.minFilter);
+}
+
+namespace {
+
 // Level selection (docs/textures.md "Level of detail"): per 2x2 quad, the screen derivatives of
 // (u*W, v*H, w*D) at level 0 from the top-left lane; rho = the longer of the two derivative
 // vectors, LOD = log2(rho). Mag filter at LOD <= 0, else min filter; mip none: level 0; point:
@@ -201,7 +210,7 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
     // Without quads, or when every LOD gives level 0 with one filter (one level or no mip
     // filter, and MIN = MAG), no LOD is computed.
-    if (!req.quads || ((levels == 1 || st.mipFilter == Filter::None) && magLinear == minLinear)) {
+    if (!req.quads || lodFree(tex, st)) {
         for (int i = 0; i < count; ++i)
             L.level[0][i] = L.level[1][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0, L.mipF[i] = 0.0f;
         return;
@@ -442,9 +451,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 fastLanes += uint64_t(n);
             };
             const bool magLinear = effective(ss.magFilter) == Filter::Linear;
-            const bool uniformFilter = effective(ss.magFilter) == effective(ss.minFilter);
-            const bool singleLevel = tex.levelCount() == 1 || ss.mipFilter == Filter::None;
-            if (!req.quads || (uniformFilter && singleLevel)) {
+            if (!req.quads || lodFree(tex, ss)) {
                 fastRun(0, count, 0, magLinear);  // level 0, one filter (docs/textures.md "Level of detail")
             } else {
                 // Per quad level and filter, then runs of whole quads: one level -> fast kernel,

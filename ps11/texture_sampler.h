@@ -30,6 +30,12 @@ struct SamplerState {
     std::array<float, 4> border{0, 0, 0, 0};  // r g b a
 };
 
+// Whether a lookup of `tex` under `state` is the same with or without quads: one level in use (one
+// level, or mip filter none) and one filter for minification and magnification, so the level of
+// detail the quads give cannot change a texel (docs/textures.md "Level of detail"). The device
+// then shades rows instead of 2×2 quads (docs/device.md "Rasterisation").
+bool lodFree(const Texture& tex, const SamplerState& state);
+
 class TextureSampler final : public Sampler {
 public:
     // `fastPath` false forces the reference path for every lookup (tests and benchmarks compare

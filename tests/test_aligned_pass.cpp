@@ -514,7 +514,8 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
     CHECK(rowPath * 10 >= cases * 8);
 }
 
-TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 keeps the quad path", "[draw][aligned]") {
+TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 is shaded in row spans",
+          "[draw][aligned]") {
     std::mt19937 rng(7);
     Case c = randomCase(rng);
     c.program = kPrograms[1];
@@ -553,11 +554,12 @@ TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 k
     quadOpt.software.threads = 1;
     check("perspective", DeviceOptions{}, true);
 
-    // fx12: the row path is fx8 only.
+    // fx12: the row paths are fx8, float and ideal; its textures have one level, so it is shaded
+    // in spans of one row (rasterizeRowSpans), without helper lanes either.
     DeviceOptions fx12;
     fx12.precision = ps11::Precision::Fx12;
     quadOpt.precision = ps11::Precision::Fx12;
-    check("fx12", fx12, false);
+    check("fx12", fx12, true);
 }
 
 TEST_CASE("aligned pass: one device across draws (constants change sign, textures rewritten, ping-pong)",
