@@ -74,7 +74,10 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
     const int n = st.n;
     const int32_t lo = op.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
     const int32_t hi = op.sat ? (G < p.nMax ? G : p.nMax) : p.nMax;
-    constexpr int64_t kLin = 2;      // value = K / (2G) -> n = K·2^s / 2
+    // value = K / (2G) -> n = K·2^s / 2. Linear numerators (mov add sub cnd cmp: at most two
+    // terms of |k| <= 4·nMax + 2G, nMax <= kMaxGridBound = 2^24, times 2^3) stay below 2^30, so
+    // they take int32 lanes in every profile; products take W.
+    constexpr int64_t kLin = 2;
     constexpr int64_t kProd = 4 * int64_t(G);  // value = P / (4G²) -> n = P·2^s / (4G)
     const int sh = op.shift;
     auto& k = st.k;
@@ -123,9 +126,9 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
         const int32_t *s0 = k[0][c], *s1 = k[1][c], *s2 = k[2][c];
         int32_t* o = out[c];
         switch (op.op) {
-            case Opcode::Mov: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]); }, lo, hi); break;
-            case Opcode::Add: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]) + s1[i]; }, lo, hi); break;
-            case Opcode::Sub: finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i]) - s1[i]; }, lo, hi); break;
+            case Opcode::Mov: finish<int32_t, kLin>(sh, n, o, [=](int i) { return W(s0[i]); }, lo, hi); break;
+            case Opcode::Add: finish<int32_t, kLin>(sh, n, o, [=](int i) { return W(s0[i]) + s1[i]; }, lo, hi); break;
+            case Opcode::Sub: finish<int32_t, kLin>(sh, n, o, [=](int i) { return W(s0[i]) - s1[i]; }, lo, hi); break;
             case Opcode::Mul: finish<W, kProd>(sh, n, o, [=](int i) { return W(s0[i]) * s1[i]; }, lo, hi); break;
             case Opcode::Mad:
                 finish<W, kProd>(sh, n, o, [=](int i) { return W(s0[i]) * s1[i] + W(2 * G) * s2[i]; }, lo, hi);
@@ -137,10 +140,10 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
                 break;
             case Opcode::Cnd:
                 // s0 > 0.5 ⟺ k0 > G (1_1-1_3: s0 is r0.a replicated, see create()).
-                finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i] > G ? s1[i] : s2[i]); }, lo, hi);
+                finish<int32_t, kLin>(sh, n, o, [=](int i) { return W(s0[i] > G ? s1[i] : s2[i]); }, lo, hi);
                 break;
             case Opcode::Cmp:
-                finish<W, kLin>(sh, n, o, [=](int i) { return W(s0[i] >= 0 ? s1[i] : s2[i]); }, lo, hi);
+                finish<int32_t, kLin>(sh, n, o, [=](int i) { return W(s0[i] >= 0 ? s1[i] : s2[i]); }, lo, hi);
                 break;
             default: break;
         }

@@ -396,7 +396,9 @@ void differential(uint32_t seed, int minor, int programs, DiffStats& st) {
         ++st.valid;
         if (r0WrittenMask(p) == 0) continue;
         bool overrideM = g.coin(0.15);
-        float M = overrideM ? (minor == 4 ? std::array<float, 3>{1, 2, 4}[g.uni(0, 2)] : 2.0f) : ps11::defaultHardware(minor).maxValue;
+        // (4112: the largest MaxValue fx12 takes, round(M·4080) <= 2^24: the widest numerators.)
+        float M = overrideM ? (minor == 4 ? std::array<float, 4>{1, 2, 4, 4112}[g.uni(0, 3)] : 2.0f)
+                            : ps11::defaultHardware(minor).maxValue;
         for (ps11::Precision prec :
              {ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float, ps11::Precision::Ideal}) {
             if (!diffOne(p, *prog, g, prec, M, overrideM, st) && ++reported >= 10) return;
