@@ -322,7 +322,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         decide = false;
     const auto drawStart = std::chrono::steady_clock::now();
     const uint64_t coveredBefore = stats.pixelsCovered;
-    if (decide) skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
+    // The skipper is made for the first chunk whose every triangle is screen-aligned (a draw of
+    // rotated or perspective triangles scans no texture and counts as undecided).
+    bool skipperTried = false;
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t>& isAligned = dc.chunk.isAligned;
     std::vector<uint32_t>& tableOf = dc.chunk.tableOf;
@@ -406,8 +408,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
         }
         if (setups.empty()) continue;
-        const bool tiles = skipper && setups.size() <= kMaxAlignedTriangles &&
-                           std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
+        const bool tileChunk = decide && setups.size() <= kMaxAlignedTriangles &&
+                               std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
+        if (tileChunk && !skipperTried) {
+            skipperTried = true;
+            skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
+        }
+        const bool tiles = tileChunk && skipper;
 
         // ---- rows in bands over the workers ----
         const int firstBand = (yLo & ~1) / kBandRows;

@@ -75,8 +75,8 @@ void arithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChun
     const int32_t lo = op.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
     const int32_t hi = op.sat ? (G < p.nMax ? G : p.nMax) : p.nMax;
     // value = K / (2G) -> n = K·2^s / 2. Linear numerators (mov add sub cnd cmp: at most two
-    // terms of |k| <= 4·nMax + 2G, nMax <= kMaxGridBound = 2^24, times 2^3) stay below 2^30, so
-    // they take int32 lanes in every profile; products take W.
+    // terms of |k| <= 4·max(nMax, G) + 2G, nMax <= kMaxGridBound = 2^24, times 2^3: at most
+    // 2^30 + 32G) stay below 2^31, so they take int32 lanes in every profile; products take W.
     constexpr int64_t kLin = 2;
     constexpr int64_t kProd = 4 * int64_t(G);  // value = P / (4G²) -> n = P·2^s / (4G)
     const int sh = op.shift;
