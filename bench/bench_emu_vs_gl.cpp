@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstdint>
 #include <cstdlib>
@@ -45,8 +46,8 @@ constexpr const char* kComposite =
     "tex t1\n"
     "mad r0, t1, c0, t0\n";
 
-enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite };
-constexpr int kPasses = 5;
+enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated };
+constexpr int kPasses = 6;
 enum class Kind { EmuFx8, EmuIdeal, GlNative, GlExact };
 constexpr Kind kKinds[] = {Kind::EmuFx8, Kind::EmuIdeal, Kind::GlNative, Kind::GlExact};
 const char* kindName(Kind k) {
@@ -76,6 +77,7 @@ struct PassDef {
     std::vector<StageDef> stages;
     const char* shader;
     float c0;
+    float turn = 0;  // texture coordinates turned by this many degrees about the centre
 };
 
 PassDef passDef(Pass p) {
@@ -89,6 +91,15 @@ PassDef passDef(Pass p) {
         return {"down2_1080p", kW / 2, kH / 2, {{kW, kH}}, {{0, 0, 0}}, kCopy, 0};
     case Pass::Down4:  // taps at ±1 texel around the centre of each 4×4 block
         return {"down4_1080p", kW / 4, kH / 4, {{kW, kH}}, {{0, -1, -1}, {0, 1, -1}, {0, -1, 1}, {0, 1, 1}}, kBlur4, 0.25f};
+    case Pass::Blur4Rotated:  // the blur with its coordinates turned by 10°: sampled per pixel
+        return {"blur4_rotated_1080p",
+                kW,
+                kH,
+                {{kW, kH}},
+                {{0, -0.5f, -0.5f}, {0, 0.5f, -0.5f}, {0, -0.5f, 0.5f}, {0, 0.5f, 0.5f}},
+                kBlur4,
+                0.25f,
+                10.0f};
     case Pass::Magnify2Composite:  // t0 1:1 at 1080p, t1 a 960×540 texture magnified 2×
         return {"magnify2_composite_1080p", kW, kH, {{kW, kH}, {kW / 2, kH / 2}}, {{0, 0, 0}, {1, 0, 0}}, kComposite, 0.5f};
     }
@@ -175,12 +186,15 @@ void Scene::setup(Pass pass, Kind kind) {
     const float ys[4] = {-0.5f, -0.5f, float(pd.h) - 0.5f, float(pd.h) - 0.5f};
     const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
     stride = UINT(sizeof(float)) * (4 + 2 * sets);
+    const float turn = pd.turn * 3.14159265f / 180.0f;
     for (int c : {0, 1, 2, 0, 2, 3}) {
         vertices.insert(vertices.end(), {xs[c], ys[c], 0.0f, 1.0f});
+        const float u = 0.5f + std::cos(turn) * (us[c] - 0.5f) - std::sin(turn) * (vs[c] - 0.5f);
+        const float v = 0.5f + std::sin(turn) * (us[c] - 0.5f) + std::cos(turn) * (vs[c] - 0.5f);
         for (const StageDef& sd : pd.stages) {
             const auto [tw, th] = pd.textures[size_t(sd.texture)];
-            vertices.push_back(us[c] + sd.du / float(tw));
-            vertices.push_back(vs[c] + sd.dv / float(th));
+            vertices.push_back(u + sd.du / float(tw));
+            vertices.push_back(v + sd.dv / float(th));
         }
     }
     // Warm-up: the sampler's copy of the textures, the executor or the GL program and textures.
@@ -269,7 +283,7 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
 
 int main(int argc, char** argv) {
     // The four devices of each pass registered alternately.
-    for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite})
+    for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite, Pass::Blur4Rotated})
         for (Kind k : kKinds) {
             const std::string name = std::string("BM_EmuVsGl/") + passDef(p).name + "/" + kindName(k);
             benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)
