@@ -256,6 +256,39 @@ const auto kLaneIndex = [] {
     return t;
 }();
 
+// An 8-bit tap sampled per pixel (a coordinate set that is not screen-aligned): the reference
+// sampler's addressing (floatAxisTaps) and its lerps in its order, u then v (texels byte / 255;
+// no NaN can occur, so the vector lerps give the reference's floats), for lanes [0, n).
+void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const float* u, const float* v, int n,
+                      float* const out[4]) {
+    alignas(32) int32_t i0[ps11::kMaxSpan], i1[ps11::kMaxSpan], j0[ps11::kMaxSpan], j1[ps11::kMaxSpan];
+    alignas(32) float fu[ps11::kMaxSpan], fv[ps11::kMaxSpan];
+    ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u, tap.width, i0, i1, fu);
+    ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, n, v, tap.height, j0, j1, fv);
+    float t[4];
+    if (!tap.linear) {
+        for (int i = 0; i < n; ++i) {
+            texel(tap, i0[i], j0[i], t);
+            for (int c = 0; c < 4; ++c) out[c][i] = t[c];
+        }
+        return;
+    }
+    alignas(32) float q[4][4][ps11::kMaxSpan];  // [corner t00 t10 t01 t11][channel][lane]
+    for (int i = 0; i < n; ++i) {
+        const int32_t xs[4] = {i0[i], i1[i], i0[i], i1[i]}, ys[4] = {j0[i], j0[i], j1[i], j1[i]};
+        for (int k = 0; k < 4; ++k) {
+            texel(tap, xs[k], ys[k], t);
+            for (int c = 0; c < 4; ++c) q[k][c][i] = t[c];
+        }
+    }
+    alignas(32) float h0[ps11::kMaxSpan], h1[ps11::kMaxSpan];
+    for (int c = 0; c < 4; ++c) {
+        draw.kernels->lerpColumns(q[0][c], q[1][c], fu, n, h0);
+        draw.kernels->lerpColumns(q[2][c], q[3][c], fu, n, h1);
+        draw.kernels->lerpColumns(h0, h1, fv, n, out[c]);
+    }
+}
+
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
 // each stage read by one tap (prepareFloatRowDraw checks it).
 class RowSampler final : public ps11::Sampler {
@@ -282,6 +315,12 @@ public:
             // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
             alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
             rowCoords(*m_setup, tap->coordSet, m_x + int(req.u[0]), m_y, n, u, v);
+            if (tap->unorm8) {
+                sampleFreeUnorm8(m_draw, *tap, u, v, n, out.value);
+                out.unitRange = tap->unitRange;
+                m_fetched += uint64_t(n) * (tap->linear ? 4 : 1);
+                return;
+            }
             ps11::SampleRequest full = req;
             full.u = u, full.v = v;
             full.quads = false;
@@ -548,9 +587,10 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                                         windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri, s, y, sc.sampler);
-            uint64_t rowTexelsPerPixel = texelsPerPixel;  // (the per-pixel sampler counts its own)
+            // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit.)
+            uint64_t rowTexelsPerPixel = texelsPerPixel;
             for (int t = 0; t < taps; ++t)
-                if (((tri.freeTaps >> t) & 1) && draw.taps[size_t(t)].bound)
+                if (((tri.freeTaps >> t) & 1) && draw.taps[size_t(t)].bound && !draw.taps[size_t(t)].unorm8)
                     rowTexelsPerPixel -= draw.taps[size_t(t)].linear ? 4 : 1;
             for (int t = 0; t < taps; ++t) {
                 const FloatRowTap& tap = draw.taps[size_t(t)];

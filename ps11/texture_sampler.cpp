@@ -378,23 +378,36 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
 
 }  // namespace
 
+namespace {
+
+// axisPassT's per-lane rule for lanes of one level and one filter, with the weights as
+// sampleReference turns them into float weights (8-bit: w / 256).
+template <TextureAddress Mode>
+void floatAxisT(bool linear, bool weights8, int count, const float* coord, uint32_t n, int32_t* i0, int32_t* i1,
+                float* f) {
+    for (int i = 0; i < count; ++i) {
+        double fl, fr;
+        texelPosition(coord[i], n, linear, fl, fr);
+        addressPair<Mode>(fl, n, i0[i], i1[i]);
+        f[i] = !linear ? 0.0f : weights8 ? float(weight8(fr)) / 256.0f : float(fr);
+    }
+}
+
+}  // namespace
+
 void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, const float* coord, uint32_t extent,
                    int32_t* i0, int32_t* i1, float* f) {
-    // axisPass over lanes of one level and one filter, then the weights as sampleReference
-    // turns them into float weights.
-    static thread_local AxisTaps taps;
-    static thread_local uint8_t level[kMaxSpan], lin[kMaxSpan];
-    const uint32_t extents[1] = {extent};
-    std::fill_n(level, kMaxSpan, uint8_t(0));
-    std::fill_n(lin, kMaxSpan, uint8_t(linear));
-    for (int first = 0; first < count; first += kMaxSpan) {
-        const int n = std::min(kMaxSpan, count - first);
-        axisPass(mode, n, coord + first, extents, level, lin, taps);
-        for (int i = 0; i < n; ++i) {
-            i0[first + i] = taps.i0[i];
-            i1[first + i] = taps.i1[i];
-            f[first + i] = weights8 ? float(taps.w[i]) / 256.0f : taps.f[i];
-        }
+    switch (mode) {
+        case TextureAddress::Mirror:
+            return floatAxisT<TextureAddress::Mirror>(linear, weights8, count, coord, extent, i0, i1, f);
+        case TextureAddress::Clamp:
+            return floatAxisT<TextureAddress::Clamp>(linear, weights8, count, coord, extent, i0, i1, f);
+        case TextureAddress::Border:
+            return floatAxisT<TextureAddress::Border>(linear, weights8, count, coord, extent, i0, i1, f);
+        case TextureAddress::MirrorOnce:
+            return floatAxisT<TextureAddress::MirrorOnce>(linear, weights8, count, coord, extent, i0, i1, f);
+        default:  // Wrap (and an invalid value, as axisPass)
+            return floatAxisT<TextureAddress::Wrap>(linear, weights8, count, coord, extent, i0, i1, f);
     }
 }
 

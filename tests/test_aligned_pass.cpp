@@ -388,12 +388,17 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
         quadOpt.precision = rowOpt.precision = (i / 2) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
+        if (i % 8 == 1) {
+            // The D3D9 class in its own float profile: 8-bit filter weights (the row path's weights8).
+            quadOpt.hardware = rowOpt.hardware = ps11::findHardware("d3d9");
+            quadOpt.precision = rowOpt.precision = std::nullopt;
+        }
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision)
-                     << ", program:\n"
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", "
+                     << (quadOpt.precision ? ps11::precisionName(*quadOpt.precision) : "d3d9 float") << ", program:\n"
                      << c.program);
         // Every SIMD level the CPU runs (the float row kernels, emu/aligned_float_kernels.h).
         testutil::forEachSimdLevel([&](ps11::SimdLevel) {
@@ -496,11 +501,17 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
         quadOpt.precision = rowOpt.precision = (i / 4) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
+        if (i % 8 == 1) {
+            // The D3D9 class in its own float profile: 8-bit filter weights (the row path's weights8).
+            quadOpt.hardware = rowOpt.hardware = ps11::findHardware("d3d9");
+            quadOpt.precision = rowOpt.precision = std::nullopt;
+        }
         rowOpt.software.skipTiles = (i % 3) == 0;
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", rhw "
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", "
+                     << (quadOpt.precision ? ps11::precisionName(*quadOpt.precision) : "d3d9 float") << ", rhw "
                      << c.verts[0].rhw << ", program:\n"
                      << c.program);
         REQUIRE(drawCase(rowDev, c, rs) == expected);

@@ -387,11 +387,17 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
             lodFree = lodFree && (t.levels.value == 1 || st.mipFilter.value == ps11::Filter::None) &&
                       (st.minFilter.value == ps11::Filter::Linear) == (st.magFilter.value == ps11::Filter::Linear);
         }
-        for (ps11::Precision p :
-             {ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float, ps11::Precision::Ideal}) {
-            INFO("precision " << ps11::precisionName(p));
+        // The four profiles overridden (float without 8-bit weights), then the D3D9 class in its
+        // own float profile, whose filter weights are 8-bit (the float row path's weights8).
+        for (int config = 0; config < 5; ++config) {
+            const ps11::Precision p =
+                std::array<ps11::Precision, 5>{ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float,
+                                               ps11::Precision::Ideal, ps11::Precision::Float}[size_t(config)];
+            INFO("precision " << ps11::precisionName(p) << (config == 4 ? " (d3d9 class, 8-bit weights)" : ""));
             const ps11::HardwareConfig hw =
-                ps11::resolveHardware(file.require.hardware.value, program->version.minor, p, 0);
+                config == 4 ? ps11::resolveHardware(ps11::findHardware("d3d9"), program->version.minor, std::nullopt, 0)
+                            : ps11::resolveHardware(file.require.hardware.value, program->version.minor, p, 0);
+            if (config == 4) REQUIRE(hw.weightBits == 8);
             std::string error;
             auto rowRunner = ps11test::DrawRunner::create(file, "random.ps11test", &*program, hw, error);
             auto quadRunner = ps11test::DrawRunner::create(file, "random.ps11test", &*program, hw, error, false);
