@@ -378,37 +378,10 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
 
 }  // namespace
 
-namespace {
-
-// axisPassT's per-lane rule for lanes of one level and one filter, with the weights as
-// sampleReference turns them into float weights (8-bit: w / 256).
-template <TextureAddress Mode>
-void floatAxisT(bool linear, bool weights8, int count, const float* coord, uint32_t n, int32_t* i0, int32_t* i1,
-                float* f) {
-    for (int i = 0; i < count; ++i) {
-        double fl, fr;
-        texelPosition(coord[i], n, linear, fl, fr);
-        addressPair<Mode>(fl, n, i0[i], i1[i]);
-        f[i] = !linear ? 0.0f : weights8 ? float(weight8(fr)) / 256.0f : float(fr);
-    }
-}
-
-}  // namespace
-
 void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, const float* coord, uint32_t extent,
                    int32_t* i0, int32_t* i1, float* f) {
-    switch (mode) {
-        case TextureAddress::Mirror:
-            return floatAxisT<TextureAddress::Mirror>(linear, weights8, count, coord, extent, i0, i1, f);
-        case TextureAddress::Clamp:
-            return floatAxisT<TextureAddress::Clamp>(linear, weights8, count, coord, extent, i0, i1, f);
-        case TextureAddress::Border:
-            return floatAxisT<TextureAddress::Border>(linear, weights8, count, coord, extent, i0, i1, f);
-        case TextureAddress::MirrorOnce:
-            return floatAxisT<TextureAddress::MirrorOnce>(linear, weights8, count, coord, extent, i0, i1, f);
-        default:  // Wrap (and an invalid value, as axisPass)
-            return floatAxisT<TextureAddress::Wrap>(linear, weights8, count, coord, extent, i0, i1, f);
-    }
+    // axisPassT's rule for lanes of one level and one filter, vectorised per SIMD level.
+    fastpath::samplerKernels(simdLevel()).floatAxis(mode, linear, weights8, count, coord, extent, i0, i1, f);
 }
 
 void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {

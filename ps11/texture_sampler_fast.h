@@ -25,10 +25,17 @@ struct Unorm8Run {
 
 using Unorm8Kernel = void (*)(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
 
+// ps11::floatAxisTaps (texture_sampler.h) of a level: the reference sampler's per-lane axis rule
+// for the float profiles — texel pair after the address mode (-1 = border) and float weight
+// (w / 256 of the 8-bit weight when `weights8`; 0 for point) — for an axis of n texels.
+using FloatAxisKernel = void (*)(TextureAddress mode, bool linear, bool weights8, int count, const float* c, uint32_t n,
+                                 int32_t* i0, int32_t* i1, float* f);
+
 // The kernels of a SIMD level (ps11/simd_dispatch.h), one source (texture_sampler_fast_impl.h)
 // built per level; TextureSampler fetches the table once per span.
 struct SamplerKernels {
     Unorm8Kernel unorm8;
+    FloatAxisKernel floatAxis;
 };
 const SamplerKernels& samplerKernels(SimdLevel level);
 // The tables (the Avx2 one in x86-64 builds only); use samplerKernels().

@@ -437,8 +437,86 @@ void sampleUnorm8(const Unorm8Run& run, int count, const float* u, const float* 
     }
 }
 
+// The float profiles' axis rule (texelPosition, addressPair, weight8 of
+// texture_sampler_internal.h) lane by lane.
+template <TextureAddress Mode>
+void floatAxisScalar(bool linear, bool weights8, int count, const float* coord, uint32_t n, int32_t* i0, int32_t* i1,
+                     float* f) {
+    for (int i = 0; i < count; ++i) {
+        double fl, fr;
+        texelPosition(coord[i], n, linear, fl, fr);
+        addressPair<Mode>(fl, n, i0[i], i1[i]);
+        f[i] = !linear ? 0.0f : weights8 ? float(weight8(fr)) / 256.0f : float(fr);
+    }
+}
+
+#ifdef __AVX2__
+// The same rule four lanes a step in double: x = u·n − ½ (linear) or u·n, exact; fl = floor(x),
+// fr = x − fl, exact; the float weight float(fr) (the default rounding) or round_half_even(fr·256)
+// / 256; the texel pair by the integer address modes (address8, the same mapping as addressPair
+// for |fl| < 2^23). Lanes beyond that (huge, infinite, NaN) and the tail take the scalar rule.
+template <TextureAddress Mode>
+void floatAxisAvx2(bool linear, bool weights8, int count, const float* coord, uint32_t n, int32_t* i0, int32_t* i1,
+                   float* f) {
+    const __m256d scale = _mm256_set1_pd(double(n)), bias = _mm256_set1_pd(linear ? 0.5 : 0.0);
+    const __m256d range = _mm256_set1_pd(8388608.0);  // 2^23
+    const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m128i nv = _mm_set1_epi32(int32_t(n)), twoN = _mm_set1_epi32(int32_t(2 * n));
+    const __m256d inv = _mm256_set1_pd(1.0 / double(n)), inv2 = _mm256_set1_pd(0.5 / double(n));
+    int i = 0;
+    for (; i + 4 <= count; i += 4) {
+        const __m256d x = _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(_mm_loadu_ps(coord + i)), scale), bias);
+        if (_mm256_movemask_pd(_mm256_cmp_pd(_mm256_and_pd(x, absMask), range, _CMP_LT_OQ)) != 15) {
+            floatAxisScalar<Mode>(linear, weights8, 4, coord + i, n, i0 + i, i1 + i, f + i);
+            continue;
+        }
+        const __m256d fl = _mm256_floor_pd(x);
+        const __m128i k = _mm256_cvttpd_epi32(fl);
+        // address8 works on eight int32 lanes: the four here in the low half.
+        auto address = [&](__m128i kk) {
+            return _mm256_castsi256_si128(address8<Mode>(_mm256_zextsi128_si256(kk), _mm256_zextsi128_si256(nv), inv,
+                                                         _mm256_zextsi128_si256(twoN), inv2));
+        };
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(i0 + i), address(k));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(i1 + i), address(_mm_add_epi32(k, _mm_set1_epi32(1))));
+        const __m256d fr = _mm256_sub_pd(x, fl);
+        __m128 w;
+        if (!linear) {
+            w = _mm_setzero_ps();
+        } else if (weights8) {
+            const __m256d r = _mm256_round_pd(_mm256_mul_pd(fr, _mm256_set1_pd(256.0)),
+                                              _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+            w = _mm_div_ps(_mm256_cvtpd_ps(r), _mm_set1_ps(256.0f));
+        } else {
+            w = _mm256_cvtpd_ps(fr);
+        }
+        _mm_storeu_ps(f + i, w);
+    }
+    if (i < count) floatAxisScalar<Mode>(linear, weights8, count - i, coord + i, n, i0 + i, i1 + i, f + i);
+}
+#define PS11_FLOAT_AXIS floatAxisAvx2
+#else
+#define PS11_FLOAT_AXIS floatAxisScalar
+#endif
+
+void floatAxis(TextureAddress mode, bool linear, bool weights8, int count, const float* c, uint32_t n, int32_t* i0,
+               int32_t* i1, float* f) {
+    switch (mode) {
+        case TextureAddress::Mirror:
+            return PS11_FLOAT_AXIS<TextureAddress::Mirror>(linear, weights8, count, c, n, i0, i1, f);
+        case TextureAddress::Clamp:
+            return PS11_FLOAT_AXIS<TextureAddress::Clamp>(linear, weights8, count, c, n, i0, i1, f);
+        case TextureAddress::Border:
+            return PS11_FLOAT_AXIS<TextureAddress::Border>(linear, weights8, count, c, n, i0, i1, f);
+        case TextureAddress::MirrorOnce:
+            return PS11_FLOAT_AXIS<TextureAddress::MirrorOnce>(linear, weights8, count, c, n, i0, i1, f);
+        default:  // Wrap (and an invalid value, as the reference)
+            return PS11_FLOAT_AXIS<TextureAddress::Wrap>(linear, weights8, count, c, n, i0, i1, f);
+    }
+}
+
 }  // namespace
 
-const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8};
+const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis};
 
 }  // namespace ps11::fastpath

@@ -4,6 +4,7 @@
 // docs/textures.md).
 #include <catch2/catch.hpp>
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -637,6 +638,44 @@ TEST_CASE("sampler: the 8-bit fast path equals the general path for scattered la
                         }
         }
     }
+}
+
+TEST_CASE("sampler: floatAxisTaps gives the same pairs and weights at every SIMD level", "[sampler]") {
+    // The float row paths' axis rule (tabulated columns, per-pixel taps): the Avx2 kernel against
+    // the Baseline's lane-by-lane rule, over coordinates near texel edges, far outside, huge,
+    // infinite and NaN, in every address mode.
+    std::mt19937 rng(20261129);
+    std::uniform_real_distribution<float> coord(-3.0f, 4.0f);
+    std::vector<float> c(301);
+    for (size_t i = 0; i < c.size(); ++i) c[i] = coord(rng);
+    for (size_t i = 0; i < c.size(); i += 7) c[i] = float(int(rng() % 8192) - 2048) / 1024.0f;  // exact halves
+    c[3] = std::nanf(""), c[10] = std::numeric_limits<float>::infinity(), c[11] = -1e30f, c[12] = 3e9f;
+    c[13] = -0.0f, c[14] = 1e-40f;
+    for (uint32_t n : {1u, 5u, 37u, 1024u, 16384u})
+        for (TextureAddress mode : {TextureAddress::Wrap, TextureAddress::Mirror, TextureAddress::Clamp,
+                                    TextureAddress::Border, TextureAddress::MirrorOnce})
+            for (bool linear : {false, true})
+                for (bool weights8 : {false, true}) {
+                    INFO("n " << n << " mode " << int(mode) << " linear " << linear << " weights8 " << weights8);
+                    std::vector<int32_t> i0[2], i1[2];
+                    std::vector<float> f[2];
+                    int k = 0;
+                    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                        const int at = std::min(k++, 1);
+                        i0[at].assign(c.size(), -7), i1[at].assign(c.size(), -7), f[at].assign(c.size(), -7.0f);
+                        floatAxisTaps(mode, linear, weights8, int(c.size()), c.data(), n, i0[at].data(), i1[at].data(),
+                                      f[at].data());
+                    });
+                    for (size_t i = 0; i < c.size(); ++i) {
+                        CHECK(i0[0][i] >= -1);
+                        CHECK(i0[0][i] < int32_t(n));
+                    }
+                    if (k < 2) continue;  // one level on this CPU
+                    CHECK(i0[0] == i0[1]);
+                    CHECK(i1[0] == i1[1]);
+                    for (size_t i = 0; i < c.size(); ++i)
+                        CHECK(std::bit_cast<uint32_t>(f[0][i]) == std::bit_cast<uint32_t>(f[1][i]));
+                }
 }
 
 TEST_CASE("texture: an 8-bit texel's float is float(b) / 255 rounded once", "[texture]") {
