@@ -308,6 +308,35 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     return out;
 }
 
+// Case c drawn by a device with `rowOpt` must give the quad path's bytes (`expected`) and counts
+// (`qs`); a case covering pixels counts in `cases`, and in `rows` where no helper lane was shaded.
+void requireRowsEqual(const DeviceOptions& rowOpt, const Case& c, const std::vector<uint8_t>& expected,
+                      const DrawStats& qs, int& cases, int& rows) {
+    Device rowDev(rowOpt);
+    DrawStats rs;
+    REQUIRE(drawCase(rowDev, c, rs) == expected);
+    CHECK(rs.pixelsCovered == qs.pixelsCovered);
+    CHECK(rs.pixelsWritten == qs.pixelsWritten);
+    if (qs.pixelsCovered == 0) return;
+    ++cases;
+    if (rs.pixelsShaded == rs.pixelsCovered) ++rows;
+}
+
+// The float row path's profiles for case i: float or ideal (overriding the class's profile:
+// float weights), and every eighth case the D3D9 class in its own float profile, whose filter
+// weights are 8-bit (the row path's weights8).
+void floatProfile(int i, bool ideal, DeviceOptions& a, DeviceOptions& b) {
+    a.precision = b.precision = ideal ? ps11::Precision::Ideal : ps11::Precision::Float;
+    if (i % 8 == 1) {
+        a.hardware = b.hardware = ps11::findHardware("d3d9");
+        a.precision = b.precision = std::nullopt;
+    }
+}
+
+std::string profileName(const DeviceOptions& o) {
+    return o.precision ? ps11::precisionName(*o.precision) : "the class's own (d3d9: float, 8-bit weights)";
+}
+
 // Tile skipping (emu/tile_skip.h) changes no byte and no covered pixel: the case drawn by a device
 // like `rowOpt` with skipping on must give the quad path's bytes.
 void requireSkippingEqual(const DeviceOptions& rowOpt, const Case& c, const std::vector<uint8_t>& expected,
@@ -387,19 +416,12 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        quadOpt.precision = rowOpt.precision = (i / 2) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
-        if (i % 8 == 1) {
-            // The D3D9 class in its own float profile: 8-bit filter weights (the row path's weights8).
-            quadOpt.hardware = rowOpt.hardware = ps11::findHardware("d3d9");
-            quadOpt.precision = rowOpt.precision = std::nullopt;
-        }
+        floatProfile(i, (i / 2) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", "
-                     << (quadOpt.precision ? ps11::precisionName(*quadOpt.precision) : "d3d9 float") << ", program:\n"
-                     << c.program);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", program:\n" << c.program);
         // Every SIMD level the CPU runs (the float row kernels, emu/aligned_float_kernels.h).
         testutil::forEachSimdLevel([&](ps11::SimdLevel) {
             Device levelDev(rowOpt);
@@ -473,16 +495,7 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
         INFO("case " << i << ": " << c.w << "x" << c.h << " rhw " << c.verts[0].rhw << " program:\n" << c.program);
-        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-            Device rowDev(rowOpt);
-            DrawStats rs;
-            REQUIRE(drawCase(rowDev, c, rs) == expected);
-            CHECK(rs.pixelsCovered == qs.pixelsCovered);
-            CHECK(rs.pixelsWritten == qs.pixelsWritten);
-            if (qs.pixelsCovered == 0) return;
-            ++cases;
-            if (rs.pixelsShaded == rs.pixelsCovered) ++rowPath;
-        });
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) { requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath); });
     }
     INFO(rowPath << " of " << cases << " cases took the row path");
     CHECK(rowPath * 10 >= cases * 9);
@@ -500,26 +513,15 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        quadOpt.precision = rowOpt.precision = (i / 4) % 2 ? ps11::Precision::Ideal : ps11::Precision::Float;
-        if (i % 8 == 1) {
-            // The D3D9 class in its own float profile: 8-bit filter weights (the row path's weights8).
-            quadOpt.hardware = rowOpt.hardware = ps11::findHardware("d3d9");
-            quadOpt.precision = rowOpt.precision = std::nullopt;
-        }
+        floatProfile(i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 0;
-        Device quadDev(quadOpt), rowDev(rowOpt);
-        DrawStats qs, rs;
+        Device quadDev(quadOpt);
+        DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", "
-                     << (quadOpt.precision ? ps11::precisionName(*quadOpt.precision) : "d3d9 float") << ", rhw "
-                     << c.verts[0].rhw << ", program:\n"
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", rhw " << c.verts[0].rhw
+                     << ", program:\n"
                      << c.program);
-        REQUIRE(drawCase(rowDev, c, rs) == expected);
-        CHECK(rs.pixelsCovered == qs.pixelsCovered);
-        CHECK(rs.pixelsWritten == qs.pixelsWritten);
-        if (qs.pixelsCovered == 0) continue;
-        ++cases;
-        if (rs.pixelsShaded == rs.pixelsCovered) ++rowPath;
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath);
     }
     INFO(rowPath << " of " << cases << " cases took the row path");
     CHECK(rowPath * 10 >= cases * 8);
