@@ -419,6 +419,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         if (!levelZeroOnly(*tex, ss)) return false;
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
+        d.bound |= 1u << i;
         tap.unorm8 = tex->storage() == ps11::TexelStorage::Unorm8;
         if (tap.unorm8)
             tap.bytes = tex->unorm8() + li.offset * 4;
@@ -484,22 +485,15 @@ void columnStretches(FloatRowTriangle::Columns& cols, int n) {
 
 bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out,
                              const std::pair<int, int>* columns) {
-    if (!rowPathKind(draw.plan, boundTaps(draw), s, out.x0, out.x1)) return false;
+    if (!rowPathKind(draw.plan, draw.bound, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
     fillFloatRowTables(draw, s, out);
     return true;
 }
 
-uint32_t boundTaps(const FloatRowDraw& draw) {
-    uint32_t mask = 0;
-    for (int i = 0; i < draw.plan.count; ++i)
-        if (draw.taps[size_t(i)].bound) mask |= 1u << i;
-    return mask;
-}
-
 void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     const int n = out.x1 - out.x0;
-    out.freeTaps = freeTaps(draw.plan, boundTaps(draw), s);
+    out.freeTaps = freeTaps(draw.plan, draw.bound, s);
     thread_local std::vector<float> u;
     u.resize(static_cast<size_t>(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {

@@ -53,6 +53,7 @@ struct FloatRowDraw {
     const ps11::Executor* executor = nullptr;
     ps11::TapPlan plan;
     std::array<FloatRowTap, 8> taps{};
+    uint32_t bound = 0;     // the taps with a texture (bit per tap)
     bool weights8 = false;  // the float profile on a class with 8-bit filter weights
     uint64_t colorAttrs = 0;
     MergeState merge;
@@ -91,9 +92,6 @@ struct FloatRowTriangle {
     // sampler (FloatRowScratch::sampler) filters them.
     uint32_t freeTaps = 0;
 };
-
-// The bound taps of a float draw (bit per tap).
-uint32_t boundTaps(const FloatRowDraw& draw);
 
 // Gives each tap's table of tris[0 .. count) an id, the same to taps of the triangle or the one before whose H
 // rows are equal (same texels, border, columns, texel pairs and weights), so drawFloatRows

@@ -187,8 +187,8 @@ namespace {
 // 1 / rhw at pixels x .. x + n − 1 of row y of a triangle with perspective, as the rasteriser
 // divides by it (rhw kept positive).
 void rowInverseW(const TriangleSetup& s, int x, int y, int n, float* inv) {
-    const float base = float(planeRowBase(s.rhw, s.ox, s.oy, y)), fdx = float(s.rhw.dx);
-    for (int i = 0; i < n; ++i) inv[i] = 1.0f / std::max(base + fdx * float(x + i), 1e-30f);
+    fillPlaneRow(s.rhw, s.ox, s.oy, x, y, n, inv);
+    for (int i = 0; i < n; ++i) inv[i] = inverseRhw(inv[i]);
 }
 
 // Attribute k at pixels x .. x + n − 1 of row y, as the rasteriser interpolates it: the constant,
@@ -198,9 +198,7 @@ void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const floa
         std::fill_n(dst, n, s.constValue[size_t(k)]);
         return;
     }
-    const Plane& p = s.attr[size_t(k)];
-    const float base = float(planeRowBase(p, s.ox, s.oy, y)), fdx = float(p.dx);
-    for (int i = 0; i < n; ++i) dst[i] = base + fdx * float(x + i);
+    fillPlaneRow(s.attr[size_t(k)], s.ox, s.oy, x, y, n, dst);
     if (s.perspective)
         for (int i = 0; i < n; ++i) dst[i] *= inv[i];
 }
@@ -535,6 +533,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         if (!levelZeroOnly(*tex, ss) || tex->storage() != ps11::TexelStorage::Unorm8) return false;
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
+        d.bound |= 1u << i;
         tap.texels = tex->unorm8() + li.offset * 4;
         tap.width = li.width;
         tap.height = li.height;
@@ -587,10 +586,7 @@ void columnU(const TriangleSetup& s, int set, int x0, int n, float* u) {
         std::fill_n(u, n, s.constValue[size_t(k)]);
         return;
     }
-    // planeValue's sum with its row base taken once (u does not depend on the row).
-    const Plane& p = s.attr[size_t(k)];
-    const float base = float(planeRowBase(p, s.ox, s.oy, s.yMin)), fdx = float(p.dx);
-    for (int x = 0; x < n; ++x) u[x] = base + fdx * float(x0 + x);
+    fillPlaneRow(s.attr[size_t(k)], s.ox, s.oy, x0, s.yMin, n, u);  // (u does not depend on the row)
 }
 
 float rowV(const TriangleSetup& s, int set, int y) {
@@ -632,13 +628,6 @@ uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup
 int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1) {
     if (!tableColumns(s, x0, x1)) return 0;
     return s.perspective || freeTaps(plan, bound, s) ? 2 : 1;
-}
-
-uint32_t boundTaps(const AlignedDraw& draw) {
-    uint32_t mask = 0;
-    for (int i = 0; i < draw.plan.count; ++i)
-        if (draw.taps[size_t(i)].bound) mask |= 1u << i;
-    return mask;
 }
 
 namespace {
@@ -697,7 +686,7 @@ bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair
 
 bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
                             const std::pair<int, int>* columns) {
-    if (!rowPathKind(draw.plan, boundTaps(draw), s, out.x0, out.x1)) return false;
+    if (!rowPathKind(draw.plan, draw.bound, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
     fillAlignedTables(draw, s, out);
     return true;
@@ -705,7 +694,7 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
 
 void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     out.configs.clear();
-    out.freeTaps = freeTaps(draw.plan, boundTaps(draw), s);
+    out.freeTaps = freeTaps(draw.plan, draw.bound, s);
     const int n = out.x1 - out.x0;
     thread_local std::vector<float> u;
     u.resize(size_t(std::max(n, 0)));

@@ -51,6 +51,7 @@ struct AlignedDraw {
     ps11::fastpath::Unorm8Kernel sample = nullptr;
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
+    uint32_t bound = 0;       // the taps with a texture (bit per tap)
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
     MergeState merge;
     MergeTarget target;
@@ -143,8 +144,6 @@ uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup
 // 0: the triangle takes quads; 1: screen-aligned (screenAligned: every tap tabulated, tile
 // skipping may decide its tiles); 2: some tap sampled per pixel (freeTaps) or perspective.
 int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1);
-// The bound taps of an fx8 draw (bit per tap).
-uint32_t boundTaps(const AlignedDraw& draw);
 // Coordinate set `set`'s u and v at pixels x .. x + n − 1 (n <= kMaxSpan) of row y, as the
 // rasteriser interpolates them: constant, planeValue, or with perspective planeValue of u·rhw
 // times 1 / rhw (the same float operations in the same order).

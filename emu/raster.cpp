@@ -65,11 +65,10 @@ void spanAttributes(const TriangleSetup& s, uint64_t used, bool wantZ, int n, Qu
     const uint64_t planes = used & ~s.constMask;
     if (wantZ) fill(s.z, span.z);
     if (s.perspective) {
-        // attr = (attr·rhw)/rhw per lane; helper lanes far outside may extrapolate rhw
-        // to <= 0, kept positive so no lane divides by zero.
+        // attr = (attr·rhw)/rhw per lane.
         alignas(32) float inv[ps11::kMaxSpan];
         fill(s.rhw, inv);
-        for (int L = 0; L < n; ++L) inv[L] = 1.0f / std::max(inv[L], 1e-30f);
+        for (int L = 0; L < n; ++L) inv[L] = inverseRhw(inv[L]);
         for (int k = 0; k < kAttrCount; ++k) {
             if (!((planes >> k) & 1)) continue;
             float* out = span.attr[k];
@@ -96,14 +95,13 @@ void spanAttributes(const TriangleSetup& s, uint64_t used, bool wantZ, int n, Qu
     }
 }
 
-// A plane's values at pixels x0 .. x0 + n − 1 of row y: planeValue per lane (the same sum as
-// fillPlane's).
+}  // namespace
+
+// (The same sum as fillPlane's.)
 void fillPlaneRow(const Plane& p, double ox, double oy, int x0, int y, int n, float* out) {
     const float base = float(planeRowBase(p, ox, oy, y)), fdx = float(p.dx);
     for (int i = 0; i < n; ++i) out[i] = base + fdx * float(x0 + i);
 }
-
-}  // namespace
 
 float planeValue(const Plane& p, double ox, double oy, int x, int y) {
     const float base = float(planeRowBase(p, ox, oy, y));

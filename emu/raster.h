@@ -34,6 +34,11 @@ inline double planeRowBase(const Plane& p, double ox, double oy, int y) {
     return p.base + p.dx * (0.0 - ox) + p.dy * (double(y) - oy);
 }
 float planeValue(const Plane& p, double ox, double oy, int x, int y);
+// planeValue at pixels x0 .. x0 + n − 1 of row y (the row paths' lanes, rasterizeRowSpans').
+void fillPlaneRow(const Plane& p, double ox, double oy, int x0, int y, int n, float* out);
+// The factor a lane's attr·rhw planes are multiplied by under perspective: 1 / rhw, rhw kept
+// positive (helper lanes far outside a triangle may extrapolate it to <= 0).
+inline float inverseRhw(float rhw) { return 1.0f / (rhw > 1e-30f ? rhw : 1e-30f); }
 
 struct TriangleSetup {
     // Edge i: E(X, Y) = a·X + b·Y + c with X, Y in 1/256 pixel; a pixel centre is covered when

@@ -394,14 +394,14 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         if (alignedDraw)
             prepareTables(
                 alignedTris, aligned.plan, aligned.plan.count,
-                [&, bound = boundTaps(aligned)](const TriangleSetup& s, int& x0, int& x1) {
+                [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
                     return rowPathKind(aligned.plan, bound, s, x0, x1);
                 },
                 [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
         if (floatDraw) {
             prepareTables(
                 floatTris, floatRows.plan, floatRows.plan.count,
-                [&, bound = boundTaps(floatRows)](const TriangleSetup& s, int& x0, int& x1) {
+                [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
                     return rowPathKind(floatRows.plan, bound, s, x0, x1);
                 },
                 [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });

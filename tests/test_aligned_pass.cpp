@@ -732,6 +732,7 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
                                    false, used, d));
         AlignedTap& tap = d.taps[0];
         tap.bound = true;
+        d.bound = 1;
         tap.texels = texels.data();
         tap.width = w, tap.height = h;
         tap.linear = true;
@@ -800,6 +801,7 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
                                         MergeTarget{target, nullptr}, false, used, d));
             FloatRowTap& tap = d.taps[0];
             tap.bound = true;
+            d.bound = 1;
             tap.unorm8 = true;
             tap.bytes = texels.data();
             tap.width = w, tap.height = h;
@@ -1012,6 +1014,7 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
                                    MergeTarget{&target, nullptr}, false, used, d));
         AlignedTap& tap = d.taps[0];
         tap.bound = true;
+        d.bound = 1;
         tap.texels = texels.data();
         tap.width = tw, tap.height = h;
         tap.linear = true;
