@@ -1454,13 +1454,16 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
     }
 }
 
-TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the exact weighted sum, any scale and rect", "[device]") {
-    // The filter written out from the one tap mapping (emu/blit.h stretchTaps): fx weights k/256,
-    // the double sum (exact), rounded to nearest, ties to even; X8's alpha 255.
+TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the weighted sum, any scale and rect", "[device]") {
+    // The filter written out from the one tap mapping (emu/blit.h stretchTaps): fx weights k/256
+    // (the double sum exact), the float profiles' weights rem/den; rounded to nearest, ties to
+    // even; X8's alpha 255.
     std::mt19937 rng(11);
-    for (int round = 0; round < 40; ++round) {
+    for (int round = 0; round < 80; ++round) {
         DeviceOptions o;
         o.software.threads = 1 + int(rng() % 2);
+        const bool fixedPoint = round % 2 == 0;
+        o.precision = fixedPoint ? ps11::Precision::Fx8 : ps11::Precision::Float;
         Device dev(o);
         const D3DFORMAT fmt = rng() % 3 ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
         const UINT sw = 1 + rng() % 70, sh = 1 + rng() % 70, dw = 1 + rng() % 70, dh = 1 + rng() % 90;
@@ -1477,7 +1480,7 @@ TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the exact wei
         call.sourceRect = PixelBox{sr.left, sr.top, sr.right, sr.bottom};
         call.destRect = PixelBox{dr.left, dr.top, dr.right, dr.bottom};
         call.linear = true;
-        call.fixedPoint = true;
+        call.fixedPoint = fixedPoint;
         const std::vector<StretchTap> tx = stretchTaps(call, true), ty = stretchTaps(call, false);
         D3DLOCKED_RECT lr{};
         REQUIRE(dev.LockRect(dst, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
@@ -1503,6 +1506,67 @@ TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the exact wei
                 wrong += got != want;
             }
         REQUIRE(dev.UnlockRect(dst) == D3D_OK);
+        CHECK(wrong == 0);
+    }
+}
+
+TEST_CASE("device: LINEAR StretchRect between A32B32G32R32F targets is the double sum rounded to float", "[device]") {
+    // The ideal profile's reductions: the tap mapping's weights (fx ones too), the sum in double
+    // in the documented order, stored as float; values of any sign and size, infinities, NaN.
+    std::mt19937 rng(12);
+    const float specials[] = {0.0f, -0.0f, 1.0f, 1e30f, -3e38f, 1e-40f, float(INFINITY), float(NAN)};
+    for (int round = 0; round < 40; ++round) {
+        DeviceOptions o;
+        o.software.threads = 1 + int(rng() % 2);
+        const bool fixedPoint = round % 4 == 0;
+        o.precision = fixedPoint ? ps11::Precision::Fx8 : ps11::Precision::Ideal;
+        Device dev(o);
+        const UINT sw = 1 + rng() % 70, sh = 1 + rng() % 70, dw = 1 + rng() % 70, dh = 1 + rng() % 90;
+        std::vector<float> texels(size_t(sw) * sh * 4);
+        std::uniform_real_distribution<float> value(-2.0f, 2.0f);
+        for (float& t : texels) t = rng() % 16 ? value(rng) : specials[rng() % 8];
+        Handle src{}, dst{};
+        REQUIRE(dev.CreateRenderTarget(sw, sh, D3DFMT_A32B32G32R32F, 1, &src) == D3D_OK);
+        REQUIRE(dev.CreateRenderTarget(dw, dh, D3DFMT_A32B32G32R32F, 1, &dst) == D3D_OK);
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(src, &lr, nullptr, 0) == D3D_OK);
+        for (UINT y = 0; y < sh; ++y)
+            std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &texels[size_t(y) * sw * 4], size_t(sw) * 16);
+        REQUIRE(dev.UnlockRect(src) == D3D_OK);
+        RECT sr{LONG(rng() % sw), LONG(rng() % sh), 0, 0}, dr{LONG(rng() % dw), LONG(rng() % dh), 0, 0};
+        sr.right = sr.left + 1 + LONG(rng() % (sw - UINT(sr.left))),
+        sr.bottom = sr.top + 1 + LONG(rng() % (sh - UINT(sr.top)));
+        dr.right = dr.left + 1 + LONG(rng() % (dw - UINT(dr.left))),
+        dr.bottom = dr.top + 1 + LONG(rng() % (dh - UINT(dr.top)));
+        INFO("round " << round << ": " << sw << "x" << sh << " -> " << dw << "x" << dh);
+        REQUIRE(dev.StretchRect(src, &sr, dst, &dr, D3DTEXF_LINEAR) == D3D_OK);
+        StretchCall call;
+        call.sourceRect = PixelBox{sr.left, sr.top, sr.right, sr.bottom};
+        call.destRect = PixelBox{dr.left, dr.top, dr.right, dr.bottom};
+        call.linear = true;
+        call.fixedPoint = fixedPoint;
+        const std::vector<StretchTap> tx = stretchTaps(call, true), ty = stretchTaps(call, false);
+        int wrong = 0, inside = 0;
+        REQUIRE(dev.LockRect(dst, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+        for (UINT y = UINT(dr.top); y < UINT(dr.bottom); ++y)
+            for (UINT x = UINT(dr.left); x < UINT(dr.right); ++x) {
+                const StretchTap& a = tx[size_t(LONG(x) - dr.left)];
+                const StretchTap& b = ty[size_t(LONG(y) - dr.top)];
+                for (UINT k = 0; k < 4; ++k) {
+                    auto at = [&](int64_t sx, int64_t sy) {
+                        return double(texels[(size_t(sy) * sw + size_t(sx)) * 4 + k]);
+                    };
+                    const float want = float((1 - b.w1) * ((1 - a.w1) * at(a.i0, b.i0) + a.w1 * at(a.i1, b.i0)) +
+                                             b.w1 * ((1 - a.w1) * at(a.i0, b.i1) + a.w1 * at(a.i1, b.i1)));
+                    float got;
+                    std::memcpy(&got, static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch + x * 16 + 4 * k, 4);
+                    // (A NaN's payload follows the operands' order, which the compiler may swap.)
+                    wrong += std::memcmp(&got, &want, 4) != 0 && !(std::isnan(got) && std::isnan(want));
+                    ++inside;
+                }
+            }
+        REQUIRE(dev.UnlockRect(dst) == D3D_OK);
+        CHECK(inside > 0);
         CHECK(wrong == 0);
     }
 }
