@@ -135,6 +135,11 @@ struct DecodedProgram {
 // Decodes `program` for `options`; false with E40xx diagnostics when it cannot be run.
 bool decodeProgram(const Program& program, const ExecutorOptions& options, Diagnostics& diags, DecodedProgram& out);
 
+// The channels of r0 a run must set to 0 before the first instruction: those some instruction
+// reads before any writes them, and those none writes (r0 is the output). The others are
+// written before they are read, so their lanes' earlier contents are never seen.
+uint8_t r0PresetChannels(const std::vector<DOp>& ops);
+
 // A constant as the profile loads it: clamped to [-1, 1] (NaN: 0); fx: grid = round_half_even(v·G)
 // and value = grid / G; float profiles: value only (grid 0).
 void constantOf(Precision precision, float v, int32_t& grid, float& value);

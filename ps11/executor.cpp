@@ -16,7 +16,7 @@ namespace exec {
 
 const float* texcoordLanes(const RunState& st, int set, int comp) {
     const float* p = (set >= 0 && set < kMaxTexCoordSets) ? st.in->texcoord[set][comp] : nullptr;
-    return p ? p + st.offset : st.zeros;
+    return p ? p + st.offset : kZeroLanes;
 }
 
 void constantOf(Precision precision, float v, int32_t& grid, float& value) {
@@ -45,8 +45,15 @@ public:
     ExecutorImpl(const ExecutorOptions& options, Profile profile, std::vector<DOp> ops,
                  std::array<std::array<float, 4>, kNumConsts> defs, uint8_t defMask, uint32_t stagesUsed, bool depth,
                  uint8_t vUsed)
-        : m_options(options), m_p(profile), m_ops(std::move(ops)), m_defs(defs), m_defMask(defMask),
-          m_stagesUsed(stagesUsed), m_writesDepth(depth), m_vUsed(vUsed) {
+        : m_options(options),
+          m_p(profile),
+          m_ops(std::move(ops)),
+          m_defs(defs),
+          m_defMask(defMask),
+          m_stagesUsed(stagesUsed),
+          m_writesDepth(depth),
+          m_vUsed(vUsed),
+          m_r0Preset(r0PresetChannels(m_ops)) {
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < kNumConsts; ++i) refreshConstant(i);
         m_constsId = nextConstsId();
@@ -116,6 +123,7 @@ private:
     uint32_t m_stagesUsed = 0;
     bool m_writesDepth = false;
     uint8_t m_vUsed = 0;
+    uint8_t m_r0Preset = 0xF;          // r0PresetChannels(m_ops)
     FastProgram m_fast;                // not ready: the generic path runs
     std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
     uint64_t m_constsId = 0;           // names the constants (a thread's fast bank keeps them)
@@ -128,7 +136,7 @@ void ExecutorImpl::loadColors(RunState& st) const {
     for (int v = 0; v < kNumRegV; ++v) {
         if (!((m_vUsed >> v) & 1)) continue;
         for (int c = 0; c < 4; ++c) {
-            const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : st.zeros;
+            const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : kZeroLanes;
             if (fx) {
                 int32_t* d = st.bi.reg[kSlotV + v][c];
                 for (int i = 0; i < st.n; ++i) {
@@ -237,11 +245,17 @@ void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, Pixel
     const ThreadCached<RunState> st;  // no 60 KB allocation (nor zero fill) per call
     st->in = &inputs;
     st->sampler = &sampler;
-    std::memset(st->zeros, 0, sizeof st->zeros);
     const bool fx = isFixedPoint(m_p.precision);
-    // r0 is the output; validated programs write it, zero it anyway so nothing is undefined.
-    std::memset(st->bi.reg[kSlotR], 0, sizeof st->bi.reg[kSlotR]);
-    std::memset(st->bf.reg[kSlotR], 0, sizeof st->bf.reg[kSlotR]);
+    // r0 is the output: its channels read before written, or never written, are 0, in the bank
+    // the profile uses (a trace shows the whole register after each step: all of it).
+    const uint8_t preset = steps ? 0xF : m_r0Preset;
+    for (int c = 0; c < 4; ++c) {
+        if (!((preset >> c) & 1)) continue;
+        if (fx)
+            std::memset(st->bi.reg[kSlotR][c], 0, sizeof st->bi.reg[kSlotR][c]);
+        else
+            std::memset(st->bf.reg[kSlotR][c], 0, sizeof st->bf.reg[kSlotR][c]);
+    }
     const float g = float(m_p.g);
     const FloatArithKernels& floatArith = floatArithKernels(simdLevel());
     for (int off = 0; off < count; off += kChunk) {
@@ -339,6 +353,34 @@ ExecutorOptions executorOptionsFor(const HardwareConfig& hardware) {
     o.maxValue = hardware.maxValue;
     o.coissuedCnd = hardware.hardware->coissuedCnd;
     return o;
+}
+
+uint8_t exec::r0PresetChannels(const std::vector<DOp>& ops) {
+    uint8_t written = 0, preset = 0, held = 0;
+    for (const DOp& d : ops) {
+        // Reads first: a co-issued pair's second member reads before its first member's result
+        // lands (held until then).
+        uint8_t reads = 0;
+        for (int s = 0; s < d.numSrc; ++s) {
+            const DSrc& src = d.src[size_t(s)];
+            if (src.kind != SrcKind::Reg || src.slot != kSlotR) continue;
+            const uint8_t channels = componentsRead(*d.info, s, d.mask);
+            for (int c = 0; c < 4; ++c)
+                if ((channels >> c) & 1) reads = uint8_t(reads | (1u << src.sw[size_t(c)]));
+        }
+        if (d.dstSlot == kSlotR) reads = uint8_t(reads | d.info->dstReads);
+        preset = uint8_t(preset | (reads & ~written));
+        written = uint8_t(written | held);
+        held = 0;
+        if (d.dstSlot == kSlotR && d.info->writesDst) {
+            if (d.hold)
+                held = d.mask;
+            else
+                written = uint8_t(written | d.mask);
+        }
+    }
+    written = uint8_t(written | held);
+    return uint8_t((preset | ~written) & 0xF);
 }
 
 bool exec::decodeProgram(const Program& program, const ExecutorOptions& options, Diagnostics& diags,

@@ -127,11 +127,10 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram
     if (!fastKernels(SimdLevel::Baseline) || p.precision != Precision::Fx8 || p.g != 255 || p.nMax > kFastMaxGrid || p.nMax < 1) return false;
     fp.ops.resize(ops.size());
     fp.syncDstBefore.assign(ops.size(), 0);
+    fp.r0Preset = r0PresetChannels(ops);
     for (size_t i = 0; i < ops.size(); ++i) {
         const DOp& d = ops[i];
         if (d.texture) fp.syncDstBefore[i] = !textureWritesAll(d, p.minor);
-        if (d.dstSlot == kSlotR && d.info->writesDst)
-            fp.r0Written = uint8_t(fp.r0Written | d.mask);
         if (d.texture || d.op == Opcode::Phase) continue;
         FastOp& f = fp.ops[i];
         if (!fastKind(d.op, f.kind)) return false;
@@ -193,11 +192,12 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
     FastBank& bank = fs->bank;
     st.in = &inputs;
     st.sampler = &sampler;
-    std::memset(st.zeros, 0, sizeof st.zeros);
-    // r0 is the output: zero it as the generic path does. Lanes past a chunk's count (up to the
-    // next multiple of 16) are computed too and never stored; the kernels use only wrapping
-    // SIMD arithmetic, so whatever those lanes hold is harmless.
-    std::memset(bank.reg[kSlotR], 0, sizeof bank.reg[kSlotR]);
+    // r0 is the output: its channels read before written, or never written, are 0 as in the
+    // generic path. Lanes past a chunk's count (up to the next multiple of 16) are computed too
+    // and never stored; the kernels use only wrapping SIMD arithmetic, so whatever those lanes
+    // hold is harmless.
+    for (int c = 0; c < 4; ++c)
+        if ((fp.r0Preset >> c) & 1) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
     fillConstants(*fs, fp, p, constsId);
     const FastKernels& kern = *fastKernels(simdLevel());
     for (int off = 0; off < count; off += kChunk) {
@@ -211,7 +211,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
         for (int v = 0; v < kNumRegV; ++v) {
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c) {
-                const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : st.zeros;
+                const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : kZeroLanes;
                 kern.loadColor(src, bank.reg[kSlotV + v][c], n);
             }
         }
@@ -352,10 +352,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
-    alignas(64) static const float zeros[kChunk] = {};
-    // r0's channels that no instruction writes read 0 (as runFast's whole-register memset).
+    // r0's channels read before written, or never written, are 0 (as in runFast).
     for (int c = 0; c < 4; ++c)
-        if (!((fp.r0Written >> c) & 1)) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
+        if ((fp.r0Preset >> c) & 1) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
     fillConstants(*fs, fp, p, constsId);
     const FastKernels& kern = *fastKernels(simdLevel());
     const int16_t m = int16_t(p.nMax);
@@ -365,7 +364,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
         for (int v = 0; v < kNumRegV; ++v) {
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c)
-                kern.loadColor(inputs.color[v][c] ? inputs.color[v][c] + off : zeros, bank.reg[kSlotV + v][c], n);
+                kern.loadColor(inputs.color[v][c] ? inputs.color[v][c] + off : kZeroLanes, bank.reg[kSlotV + v][c], n);
         }
         int tap = 0;
         for (size_t idx = 0; idx < ops.size(); ++idx) {

@@ -114,7 +114,7 @@ struct FastProgram {
     bool ready = false;  // the fast path applies (buildFastProgram); false: the generic path runs
     std::vector<FastOp> ops;
     uint8_t constsUsed = 0;              // constants the arithmetic ops read (bit per c#)
-    uint8_t r0Written = 0;               // r0 channels some op writes (the others stay 0)
+    uint8_t r0Preset = 0xF;              // r0 channels set to 0 before a run (exec::r0PresetChannels)
     std::vector<uint8_t> syncDstBefore;  // texture ops: convert the destination to int32 first
 };
 

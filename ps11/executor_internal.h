@@ -19,6 +19,9 @@ namespace ps11::exec {
 // work of the row paths (a fill per tap, an op dispatch per instruction) is paid once a span.
 constexpr int kChunk = 256;
 
+// A chunk of 0.0f lanes: what an absent input (texture coordinate, colour) reads.
+alignas(64) inline constexpr float kZeroLanes[kChunk] = {};
+
 // Register storage of one chunk. Only one of the int / float banks is used per profile.
 template <class T>
 struct Bank {
@@ -36,7 +39,6 @@ struct RunState {
     alignas(64) int32_t k[3][4][kChunk];   // fx: fetched sources as k (value k/(2G))
     alignas(64) float x[3][4][kChunk];     // float: fetched sources
     alignas(64) float pad[2][kChunk];      // texm3x2pad / texm3x3pad dot products
-    alignas(64) float zeros[kChunk];
     alignas(64) uint8_t killed[kChunk];
     alignas(64) float depth[kChunk];
     bool depthWritten = false;

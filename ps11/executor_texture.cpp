@@ -288,7 +288,7 @@ void execTexm3x2pad(const Profile& p, const DOp& op, RunState& st) {
 void execTexm3x2tex(const Profile& p, const DOp& op, RunState& st) {
     Lanes v;
     rowDot(p, st, op.stage, op.src[0], v);
-    sampleInto(p, st, op.stage, 2, st.pad[0], v, st.zeros, op.dstSlot);
+    sampleInto(p, st, op.stage, 2, st.pad[0], v, kZeroLanes, op.dstSlot);
 }
 
 void execTexm3x2depth(const Profile& p, const DOp& op, RunState& st) {
@@ -347,7 +347,7 @@ void execTexm3x3spec(const Profile& p, const DOp& op, RunState& st) {
 void execTexdp3tex(const Profile& p, const DOp& op, RunState& st) {
     Lanes u;
     rowDot(p, st, op.stage, op.src[0], u);
-    sampleInto(p, st, op.stage, 3, u, st.zeros, st.zeros, op.dstSlot);
+    sampleInto(p, st, op.stage, 3, u, kZeroLanes, kZeroLanes, op.dstSlot);
 }
 
 void execTexdp3(const Profile& p, const DOp& op, RunState& st) {

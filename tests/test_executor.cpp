@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ps11/assembler.h"
+#include "ps11/decoded_program.h"
 #include "ps11/executor.h"
 #include "ps11/validator.h"
 
@@ -570,4 +571,57 @@ TEST_CASE("executor: E40xx diagnostics", "[executor]") {
                                                     opcodeTable().begin())];
     CHECK_FALSE(Executor::create(op, {}, diags));
     CHECK(diags.has("E4002"));
+}
+
+TEST_CASE("executor: r0's channels read before written, or never written, read 0 whatever ran before", "[executor]") {
+    // A program leaving r0 = 1 in this thread's run state runs first, then the program under test;
+    // the channels it reads before writing (or never writes) must start at 0, and only those are
+    // preset (decided once per program: exec::r0PresetChannels). The validator refuses reads of
+    // unwritten channels (D3D does too), so those programs are run unvalidated: the executor
+    // still defines them.
+    auto program = [](const std::string& text) {
+        Diagnostics diags;
+        std::optional<Program> p = parseAssembly(text, "t.psh", {}, diags);
+        REQUIRE(p.has_value());
+        return *p;
+    };
+    struct Case {
+        const char* text;
+        bool valid;
+        uint8_t preset;
+        std::array<float, 4> want;  // v0 = (0.2, 0.4, 0.6, 0.8)
+    };
+    const Case cases[] = {
+        {"ps_1_1\nmov r0, v0\n", true, 0x0, {0.2f, 0.4f, 0.6f, 0.8f}},
+        {"ps_1_1\nmov r0.rgb, v0\n", true, 0x8, {0.2f, 0.4f, 0.6f, 0}},
+        {"ps_1_4\nmov r0.rgb, v0\nadd r0.a, r0.r, v0\n", true, 0x0, {0.2f, 0.4f, 0.6f, 1.0f}},
+        {"ps_1_4\nmov r0.rg, v0\nmov r0.ba, r0.r\n", true, 0x0, {0.2f, 0.4f, 0.2f, 0.2f}},
+        {"ps_1_1\nmov r0.a, v0\nadd r0.rgb, r0, v0\n", false, 0x7, {0.2f, 0.4f, 0.6f, 0.8f}},
+        // The pair's second member reads r0.b before the first member's result lands.
+        {"ps_1_1\nmov r0.rgb, v0\n+mov r0.a, r0.b\n", false, 0x4, {0.2f, 0.4f, 0.6f, 0}},
+        {"ps_1_1\nmov r0.a, v0\n+mov r0.rgb, r0.a\n", false, 0x8, {0, 0, 0, 0.8f}},
+    };
+    for (Precision prec : {Precision::Fx8, Precision::Fx12, Precision::Float, Precision::Ideal}) {
+        for (const Case& c : cases) {
+            INFO(precisionName(prec) << "\n" << c.text);
+            const Program p = program(c.text);
+            Diagnostics diags;
+            CHECK(validate(p, diags) == c.valid);
+            ExecutorOptions opt;
+            opt.precision = prec;
+            exec::DecodedProgram d;
+            REQUIRE(exec::decodeProgram(p, opt, diags, d));
+            CHECK(exec::r0PresetChannels(d.ops) == c.preset);
+            auto ones = build("ps_1_1\ndef c0, 1, 1, 1, 1\nmov r0, c0\n", prec);
+            auto ex = Executor::create(p, opt, diags);
+            REQUIRE(ex);
+            Pixel px;
+            px.v0 = {0.2f, 0.4f, 0.6f, 0.8f};
+            const std::vector<Pixel> span(40, px);
+            NullSampler s;
+            REQUIRE(runPixels(*ones, span, s)[0].color[0] == 1.0f);
+            const Result r = runPixels(*ex, span, s)[39];
+            for (size_t ch = 0; ch < 4; ++ch) CHECK(r.color[ch] == Approx(c.want[ch]).margin(1.0 / 255));
+        }
+    }
 }
