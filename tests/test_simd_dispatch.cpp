@@ -415,6 +415,42 @@ TEST_CASE("simd dispatch: ONE/ONE sums into 8-bit targets are sat(s) + byte / 25
     CHECK(checked > 5000);
 }
 
+TEST_CASE("simd dispatch: the 8-bit words round every float next to a tie as ps11::unorm8OfFloat", "[simd][merger]") {
+    // The floats within 96 ulps of each (k + 1/2) / 255, where a product v·255 rounded to float
+    // lands on a tie that the exact product is not (a kernel must round the exact product), and
+    // every 4099th float of [0, 1]; each level's words against the rule.
+    std::vector<float> values;
+    for (int k = 0; k < 255; ++k) {
+        float v = float((k + 0.5) / 255.0);
+        for (int s = 0; s < 96; ++s) v = std::nextafter(v, 0.0f);
+        for (int s = 0; s < 192; ++s, v = std::nextafter(v, 2.0f)) values.push_back(v);
+    }
+    for (uint32_t bits = 0; bits <= 0x3f800000u; bits += 4099) {
+        float v;
+        std::memcpy(&v, &bits, 4);
+        values.push_back(v);
+    }
+    values.resize((values.size() + 3) / 4 * 4, 0.5f);
+    const size_t n = values.size() / 4;
+    int64_t bad = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::MergerKernels& k = emu::mergerKernels(level);
+        const float* f[4] = {&values[0], &values[n], &values[2 * n], &values[3 * n]};
+        std::vector<uint32_t> got(n), gotRgba(n);
+        k.unorm8Words(f, int(n), 0, got.data());
+        // The same values as interleaved pixels.
+        k.unorm8WordsRgba(values.data(), int(n), 0, gotRgba.data());
+        for (size_t i = 0; i < n; ++i) {
+            bad += got[i] != unorm8WordOf(f[0][i], f[1][i], f[2][i], f[3][i], 0);
+            const float* p = &values[4 * i];
+            bad += gotRgba[i] != unorm8WordOf(p[0], p[1], p[2], p[3], 0);
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+    CHECK(n > 50000);
+}
+
 TEST_CASE("simd dispatch: the float row path decodes every byte to the texture's value at every level",
           "[simd][aligned]") {
     // A row of 300 texels holding every byte in every channel (b g r a), decoded from every
