@@ -59,6 +59,16 @@ void lerpGatherBase(const float* d, int /*len*/, const int32_t* i0, const int32_
     for (int j = 0; j < n; ++j) out[j] = lerpf(d[i0[j]], d[i1[j]], f[j]);
 }
 
+void lerpWordsBase(const uint8_t* row, int /*len*/, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                   float* out, size_t stride) {
+    for (int j = 0; j < n; ++j) {
+        const uint8_t *a = row + 4 * size_t(i0[j]), *b = row + 4 * size_t(i1[j]);
+        for (size_t c = 0; c < 4; ++c)
+            out[c * stride + size_t(j)] =
+                lerpf(kUnorm8[a[ps11::kUnorm8Byte[c]]], kUnorm8[b[ps11::kUnorm8Byte[c]]], f[j]);
+    }
+}
+
 void lerpRowBase(const float* a, const float* b, float f, int n, float* out) {
     int j = 0;
 #if defined(__SSE2__)
@@ -88,7 +98,7 @@ void decodeBase(const uint8_t* row, int n, float* out, size_t stride) {
         for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = kUnorm8[row[4 * i + ps11::kUnorm8Byte[c]]];
 }
 
-const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpRowBase, &decodeBase};
+const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBase, &lerpRowBase, &decodeBase};
 
 }  // namespace
 
@@ -198,7 +208,30 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     // for the reference sampler's; without NaNs the vector kernels' results are the same whatever
     // the order.
     bool nan = false;
-    const float* dec = j >= 0 ? decodedRow(draw, tap, j, sc, &nan) : nullptr;
+    // An 8-bit row whose columns have no run of consecutive pairs (a minification's) is filtered
+    // from its bytes; the others from the decoded row.
+    const bool fromBytes = tap.unorm8 && j >= 0 &&
+                           std::none_of(cols.stretches.begin(), cols.stretches.end(),
+                                        [](const auto& st) { return st.kind == FloatRowTriangle::Columns::kSeq; });
+    if (fromBytes) {
+        const uint8_t* bytes = tap.bytes + size_t(j) * tap.width * 4;
+        for (const FloatRowTriangle::Columns::Stretch& st : cols.stretches) {
+            const size_t x0 = size_t(st.x0);
+            if (st.kind == FloatRowTriangle::Columns::kInside) {
+                draw.kernels->lerpWords(bytes, int(tap.width), cols.i0.data() + x0, cols.i1.data() + x0,
+                                        cols.f.data() + x0, st.x1 - st.x0, h.h.data() + x0, w);
+                continue;
+            }
+            float a[4], b[4];
+            for (size_t q = x0; q < size_t(st.x1); ++q) {
+                texel(tap, cols.i0[q], j, a);
+                texel(tap, cols.i1[q], j, b);
+                for (size_t c = 0; c < 4; ++c) h.h[c * w + q] = lerpf(a[c], b[c], cols.f[q]);
+            }
+        }
+        x = w;
+    }
+    const float* dec = j >= 0 && !fromBytes ? decodedRow(draw, tap, j, sc, &nan) : nullptr;
     if (dec && !nan) {
         // By stretches (prepareFloatRowTriangle): consecutive texel pairs with vector loads, other
         // pairs inside the row gathered, border columns one at a time; the same operations in the
@@ -348,19 +381,22 @@ public:
         }
         const int32_t* i0 = m_tri->taps[size_t(t)].i0.data() + first;
         if (r.dec) {
-            // Columns of a decoded row: runs of consecutive texels copied four at a time.
+            // Columns of a decoded row: each run of consecutive texels copied at once.
             const size_t tw = tap->width;
+            float* const dst[4] = {out.value[0], out.value[1], out.value[2], out.value[3]};
+            const float* const row[4] = {r.dec, r.dec + tw, r.dec + 2 * tw, r.dec + 3 * tw};
             int i = 0;
             while (i < n) {
                 const int32_t k = i0[i];
-                if (i + 4 <= n && k >= 0 && i0[i + 3] == k + 3 && i0[i + 1] == k + 1 && i0[i + 2] == k + 2) {
-                    for (int c = 0; c < 4; ++c) std::memcpy(out.value[c] + i, r.dec + size_t(c) * tw + size_t(k), 16);
-                    i += 4;
+                if (k < 0) {
+                    for (int c = 0; c < 4; ++c) dst[c][i] = tap->border[size_t(c)];
+                    ++i;
                     continue;
                 }
-                for (int c = 0; c < 4; ++c)
-                    out.value[c][i] = k >= 0 ? r.dec[size_t(c) * tw + size_t(k)] : tap->border[size_t(c)];
-                ++i;
+                int e = i + 1;
+                while (e < n && i0[e] == k + (e - i)) ++e;
+                for (int c = 0; c < 4; ++c) std::memcpy(dst[c] + i, row[c] + k, sizeof(float) * size_t(e - i));
+                i = e;
             }
             m_fetched += uint64_t(n);
             return;

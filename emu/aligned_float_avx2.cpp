@@ -57,6 +57,68 @@ void lerpGatherAvx2(const float* d, int len, const int32_t* i0, const int32_t* i
     for (; j < n; ++j) out[j] = lerp1(d[i0[j]], d[i1[j]], f[j]);
 }
 
+void lerpWordsAvx2(const uint8_t* row, int len, const int32_t* i0, const int32_t* i1, const float* f, int n, float* out,
+                   size_t stride) {
+    const __m256i byte = _mm256_set1_epi32(0xff);
+    const int* words = reinterpret_cast<const int*>(row);
+    int j = 0;
+    for (; j + 8 <= n; j += 8) {
+        const __m256i k0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j));
+        const __m256i k1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i1 + j));
+        const int base = i0[j];
+        const __m256i r0 = _mm256_sub_epi32(k0, _mm256_set1_epi32(base));
+        const __m256i r1 = _mm256_sub_epi32(k1, _mm256_set1_epi32(base));
+        __m256i wa, wb;
+        // Columns i0 = base + s·j, i1 = i0 + 1 (a 2:1 or 4:1 reduction's taps): the 2s·8 words
+        // loaded and their pairs taken apart by shuffles; other columns within eight texels of
+        // the first: one load and two permutes; else two gathers.
+        const __m256i stride2 = _mm256_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14), one = _mm256_set1_epi32(1);
+        const __m256i pairs = _mm256_cmpeq_epi32(r1, _mm256_add_epi32(r0, one));
+        const bool s2 =
+            base + 16 <= len && _mm256_movemask_epi8(_mm256_and_si256(pairs, _mm256_cmpeq_epi32(r0, stride2))) == -1;
+        const bool s4 = !s2 && base + 32 <= len &&
+                        _mm256_movemask_epi8(
+                            _mm256_and_si256(pairs, _mm256_cmpeq_epi32(r0, _mm256_add_epi32(stride2, stride2)))) == -1;
+        if (s2 || s4) {
+            // s = 2: the pairs are the 64-bit words 0..7 of v0 ‖ v1; s = 4: the even ones of
+            // v0 ‖ v1 ‖ v2 ‖ v3, gathered by two 64-bit unpacks (in lane order 0 2 1 3 | 4 6 5 7).
+            const __m256i* p = reinterpret_cast<const __m256i*>(words + base);
+            __m256 x = _mm256_castsi256_ps(_mm256_loadu_si256(p)), y = _mm256_castsi256_ps(_mm256_loadu_si256(p + 1));
+            __m256i order = _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7);  // a0 a1 a4 a5 | a2 a3 a6 a7 → in order
+            if (s4) {
+                const __m256i z = _mm256_loadu_si256(p + 2), u = _mm256_loadu_si256(p + 3);
+                x = _mm256_castsi256_ps(_mm256_unpacklo_epi64(_mm256_castps_si256(x), _mm256_castps_si256(y)));
+                y = _mm256_castsi256_ps(_mm256_unpacklo_epi64(z, u));
+                order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);  // a0 a2 a4 a6 | a1 a3 a5 a7 → in order
+            }
+            wa = _mm256_permutevar8x32_epi32(_mm256_castps_si256(_mm256_shuffle_ps(x, y, _MM_SHUFFLE(2, 0, 2, 0))),
+                                             order);
+            wb = _mm256_permutevar8x32_epi32(_mm256_castps_si256(_mm256_shuffle_ps(x, y, _MM_SHUFFLE(3, 1, 3, 1))),
+                                             order);
+        } else if (base + 8 <= len && withinEight(r0, r1)) {
+            const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(words + base));
+            wa = _mm256_permutevar8x32_epi32(w, r0);
+            wb = _mm256_permutevar8x32_epi32(w, r1);
+        } else {
+            wa = _mm256_i32gather_epi32(words, k0, 4);
+            wb = _mm256_i32gather_epi32(words, k1, 4);
+        }
+        const __m256 fv = _mm256_loadu_ps(f + j);
+        const auto channel = [&](__m256i w, int shift) {
+            return unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, shift), byte)));
+        };
+        constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+        for (size_t c = 0; c < 4; ++c)
+            _mm256_storeu_ps(out + c * stride + size_t(j), lerp8(channel(wa, kShift[c]), channel(wb, kShift[c]), fv));
+    }
+    const float* unit = ps11::Texture::unorm8Values();
+    for (; j < n; ++j) {
+        const uint8_t *a = row + 4 * size_t(i0[j]), *b = row + 4 * size_t(i1[j]);
+        for (size_t c = 0; c < 4; ++c)
+            out[c * stride + size_t(j)] = lerp1(unit[a[ps11::kUnorm8Byte[c]]], unit[b[ps11::kUnorm8Byte[c]]], f[j]);
+    }
+}
+
 void lerpRowAvx2(const float* a, const float* b, float f, int n, float* out) {
     const __m256 fv = _mm256_set1_ps(f), gv = _mm256_set1_ps(1.0f - f);
     int j = 0;
@@ -91,6 +153,6 @@ void decodeAvx2(const uint8_t* row, int n, float* out, size_t stride) {
 
 }  // namespace
 
-const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2, &lerpGatherAvx2, &lerpRowAvx2, &decodeAvx2};
+const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2, &lerpGatherAvx2, &lerpWordsAvx2, &lerpRowAvx2, &decodeAvx2};
 
 }  // namespace emu

@@ -22,6 +22,12 @@ struct FloatRowKernels {
     // horizontal lerps of any columns whose texels lie in the row (a magnified tap's).
     void (*lerpGather)(const float* d, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
                        float* out);
+    // The same lerps straight from an 8-bit b g r a row, all four channels: out[c·stride + j] =
+    // (1 − f[j])·v(i0[j], c) + f[j]·v(i1[j], c), v(i, c) texel i's channel c as its value (as
+    // decode), every index in [0, len). A minified tap's columns, which skip texels: a gather
+    // of words serves four channels, where the decoded row needs one per channel.
+    void (*lerpWords)(const uint8_t* row, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                      float* out, size_t stride);
     // out[j] = (1 − f)·a[j] + f·b[j] for j in [0, n): a pixel row's vertical lerp of two H rows.
     void (*lerpRow)(const float* a, const float* b, float f, int n, float* out);
     // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::

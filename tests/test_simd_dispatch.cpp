@@ -483,6 +483,54 @@ TEST_CASE("simd dispatch: the float row path decodes every byte to the texture's
     CHECK(checked > 50000);
 }
 
+TEST_CASE("simd dispatch: the float row path's lerps from 8-bit words are the decoded texels' lerps at every level",
+          "[simd][aligned]") {
+    // Columns of every kind the kernel tells apart: 2:1 and 4:1 reductions (i0 = base + s·j,
+    // i1 = i0 + 1), magnifications within eight texels, scattered pairs, repeats; spans of 0..40
+    // columns starting at every phase of those patterns, against (1 − f)·a + f·b of the texels'
+    // values (unorm8Values), channel planes at a stride, nothing written past them.
+    const float* unit = ps11::Texture::unorm8Values();
+    std::mt19937 rng(5);
+    std::vector<uint8_t> row(400 * 4);
+    for (uint8_t& b : row) b = uint8_t(rng());
+    const int len = 400;
+    int64_t bad = 0, checked = 0;
+    for (SimdLevel level : ps11::runnableSimdLevels()) {
+        const emu::FloatRowKernels& k = emu::floatRowKernels(level);
+        for (int round = 0; round < 400; ++round) {
+            const int n = round % 41, kind = round % 5, start = int(rng() % 100);
+            std::vector<int32_t> i0(static_cast<size_t>(n)), i1(static_cast<size_t>(n));
+            std::vector<float> f(static_cast<size_t>(n));
+            for (int j = 0; j < n; ++j) {
+                const int s = kind == 0 ? 2 : kind == 1 ? 4 : 0;
+                i0[size_t(j)] = s ? start + s * j : kind == 2 ? start + j / 3 : int(rng() % (len - 1));
+                i1[size_t(j)] = kind == 4 && j % 7 == 3 ? int(rng() % len) : i0[size_t(j)] + 1;
+                f[size_t(j)] = float(rng() % 257) / 256.0f;
+            }
+            if (n > 9 && kind < 3 && round % 3 == 0)
+                i0[size_t(n / 2)] += 1, i1[size_t(n / 2)] += 1;  // one column off the pattern
+            const size_t stride = size_t(n) + 5;
+            std::vector<float> out(4 * stride, -3.0f);
+            k.lerpWords(row.data(), len, i0.data(), i1.data(), f.data(), n, out.data(), stride);
+            constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a in b g r a
+            for (int c = 0; c < 4; ++c) {
+                for (int j = 0; j < n; ++j) {
+                    const float a = unit[row[size_t(4 * i0[size_t(j)] + kByte[c])]];
+                    const float b = unit[row[size_t(4 * i1[size_t(j)] + kByte[c])]];
+                    const float fj = f[size_t(j)];
+                    const float want = (1.0f - fj) * a + fj * b;
+                    bad += std::memcmp(&out[size_t(c) * stride + size_t(j)], &want, 4) != 0;
+                    ++checked;
+                }
+                for (size_t j = size_t(n); j < stride; ++j) bad += out[size_t(c) * stride + j] != -3.0f;
+            }
+        }
+        INFO("SIMD level " << ps11::simdLevelName(level));
+        CHECK(bad == 0);
+    }
+    CHECK(checked > 20000);
+}
+
 TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::unorm8OfFloat at every level",
           "[simd][merger]") {
     // The A32B32G32R32F rows a StretchRect converts, as r g b a quadruples of the probes; every
