@@ -69,6 +69,14 @@ void lerpWordsBase(const uint8_t* row, int /*len*/, const int32_t* i0, const int
     }
 }
 
+bool lerpValuesBase(const float* rgba, int /*len*/, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                    float* out, size_t stride) {
+    for (int j = 0; j < n; ++j)
+        for (size_t c = 0; c < 4; ++c)
+            out[c * stride + size_t(j)] = lerpf(rgba[4 * size_t(i0[j]) + c], rgba[4 * size_t(i1[j]) + c], f[j]);
+    return true;  // (lerpf itself: the reference's order)
+}
+
 void lerpRowBase(const float* a, const float* b, float f, int n, float* out) {
     int j = 0;
 #if defined(__SSE2__)
@@ -98,7 +106,8 @@ void decodeBase(const uint8_t* row, int n, float* out, size_t stride) {
         for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = kUnorm8[row[4 * i + ps11::kUnorm8Byte[c]]];
 }
 
-const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBase, &lerpRowBase, &decodeBase};
+const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBase,
+                                &lerpValuesBase,  &lerpRowBase,    &decodeBase};
 
 }  // namespace
 
@@ -208,20 +217,28 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     // for the reference sampler's; without NaNs the vector kernels' results are the same whatever
     // the order.
     bool nan = false;
-    // An 8-bit row whose columns have no run of consecutive pairs (a minification's) is filtered
-    // from its bytes; the others from the decoded row.
-    const bool fromBytes = tap.unorm8 && j >= 0 &&
-                           std::none_of(cols.stretches.begin(), cols.stretches.end(),
-                                        [](const auto& st) { return st.kind == FloatRowTriangle::Columns::kSeq; });
-    if (fromBytes) {
-        const uint8_t* bytes = tap.bytes + size_t(j) * tap.width * 4;
+    // A row whose columns have no run of consecutive pairs (a minification's) is filtered from
+    // the texels where they are (8-bit words, or float r g b a); the others from the decoded row.
+    const bool inPlace = j >= 0 && std::none_of(cols.stretches.begin(), cols.stretches.end(), [](const auto& st) {
+                             return st.kind == FloatRowTriangle::Columns::kSeq;
+                         });
+    if (inPlace) {
+        const size_t at = size_t(j) * tap.width * 4;
         for (const FloatRowTriangle::Columns::Stretch& st : cols.stretches) {
             const size_t x0 = size_t(st.x0);
+            const int n = st.x1 - st.x0;
+            const int32_t *i0 = cols.i0.data() + x0, *i1 = cols.i1.data() + x0;
             if (st.kind == FloatRowTriangle::Columns::kInside) {
-                draw.kernels->lerpWords(bytes, int(tap.width), cols.i0.data() + x0, cols.i1.data() + x0,
-                                        cols.f.data() + x0, st.x1 - st.x0, h.h.data() + x0, w);
-                continue;
+                if (tap.unorm8) {
+                    draw.kernels->lerpWords(tap.bytes + at, int(tap.width), i0, i1, cols.f.data() + x0, n,
+                                            h.h.data() + x0, w);
+                    continue;
+                }
+                if (draw.kernels->lerpValues(tap.values + at, int(tap.width), i0, i1, cols.f.data() + x0, n,
+                                             h.h.data() + x0, w))
+                    continue;
             }
+            // Border columns, and a run whose lerps gave a NaN: one column at a time (lerpf).
             float a[4], b[4];
             for (size_t q = x0; q < size_t(st.x1); ++q) {
                 texel(tap, cols.i0[q], j, a);
@@ -231,7 +248,7 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
         }
         x = w;
     }
-    const float* dec = j >= 0 && !fromBytes ? decodedRow(draw, tap, j, sc, &nan) : nullptr;
+    const float* dec = j >= 0 && !inPlace ? decodedRow(draw, tap, j, sc, &nan) : nullptr;
     if (dec && !nan) {
         // By stretches (prepareFloatRowTriangle): consecutive texel pairs with vector loads, other
         // pairs inside the row gathered, border columns one at a time; the same operations in the

@@ -119,6 +119,39 @@ void lerpWordsAvx2(const uint8_t* row, int len, const int32_t* i0, const int32_t
     }
 }
 
+bool lerpValuesAvx2(const float* rgba, int /*len*/, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                    float* out, size_t stride) {
+    int j = 0;
+    __m256 nan = _mm256_setzero_ps();
+    for (; j + 8 <= n; j += 8) {
+        // Columns k and k + 4 in the halves of X_k: each column's lerp of its two texels (r g b a),
+        // then the four registers transposed within their halves into r, g, b, a of columns 0..7.
+        const __m256 fv = _mm256_loadu_ps(f + j);
+        __m256 x[4];
+        for (int k = 0; k < 4; ++k) {
+            const __m256 a = _mm256_loadu2_m128(rgba + 4 * size_t(i0[j + k + 4]), rgba + 4 * size_t(i0[j + k]));
+            const __m256 b = _mm256_loadu2_m128(rgba + 4 * size_t(i1[j + k + 4]), rgba + 4 * size_t(i1[j + k]));
+            const __m256 fk = _mm256_permutevar8x32_ps(fv, _mm256_setr_epi32(k, k, k, k, k + 4, k + 4, k + 4, k + 4));
+            x[k] = lerp8(a, b, fk);
+            nan = _mm256_or_ps(nan, _mm256_cmp_ps(x[k], x[k], _CMP_UNORD_Q));
+        }
+        const __m256 t0 = _mm256_unpacklo_ps(x[0], x[1]), t1 = _mm256_unpackhi_ps(x[0], x[1]);
+        const __m256 t2 = _mm256_unpacklo_ps(x[2], x[3]), t3 = _mm256_unpackhi_ps(x[2], x[3]);
+        _mm256_storeu_ps(out + size_t(j), _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0)));
+        _mm256_storeu_ps(out + stride + size_t(j), _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2)));
+        _mm256_storeu_ps(out + 2 * stride + size_t(j), _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0)));
+        _mm256_storeu_ps(out + 3 * stride + size_t(j), _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2)));
+    }
+    if (_mm256_movemask_ps(nan)) return false;
+    for (; j < n; ++j)
+        for (size_t c = 0; c < 4; ++c) {
+            const float v = lerp1(rgba[4 * size_t(i0[j]) + c], rgba[4 * size_t(i1[j]) + c], f[j]);
+            if (v != v) return false;
+            out[c * stride + size_t(j)] = v;
+        }
+    return true;
+}
+
 void lerpRowAvx2(const float* a, const float* b, float f, int n, float* out) {
     const __m256 fv = _mm256_set1_ps(f), gv = _mm256_set1_ps(1.0f - f);
     int j = 0;
@@ -153,6 +186,7 @@ void decodeAvx2(const uint8_t* row, int n, float* out, size_t stride) {
 
 }  // namespace
 
-const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2, &lerpGatherAvx2, &lerpWordsAvx2, &lerpRowAvx2, &decodeAvx2};
+const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2, &lerpGatherAvx2, &lerpWordsAvx2,
+                                      &lerpValuesAvx2,  &lerpRowAvx2,    &decodeAvx2};
 
 }  // namespace emu

@@ -28,6 +28,12 @@ struct FloatRowKernels {
     // of words serves four channels, where the decoded row needs one per channel.
     void (*lerpWords)(const uint8_t* row, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
                       float* out, size_t stride);
+    // The same from a row of float r g b a texels (A32B32G32R32F as the sampler holds it): each
+    // column's two texels loaded whole, no gathers. False when a result is NaN: which of two NaNs a
+    // sum returns depends on the order of its operands, so the caller filters that run one column
+    // at a time as the reference sampler does (out unspecified then).
+    bool (*lerpValues)(const float* rgba, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
+                       float* out, size_t stride);
     // out[j] = (1 − f)·a[j] + f·b[j] for j in [0, n): a pixel row's vertical lerp of two H rows.
     void (*lerpRow)(const float* a, const float* b, float f, int n, float* out);
     // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::
