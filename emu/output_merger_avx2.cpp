@@ -7,6 +7,9 @@
 #endif
 #include <immintrin.h>
 
+#include <algorithm>
+#include <bit>
+
 #include "emu/lanes_avx2.h"
 #include "emu/output_merger_kernels.h"
 #include "emu/prefetch.h"
@@ -82,26 +85,56 @@ void unorm8WordsRgbaAvx2(const float* rgba, int count, uint32_t alphaFill, uint3
     if (i < count) baseline::kMerger.unorm8WordsRgba(rgba + 4 * size_t(i), count - i, alphaFill, words + i);
 }
 
-// Eight lanes at a time, the byte's value without dividing (unitOfByte).
-void satAddUnorm8Avx2(const float* src, const uint8_t* words, int shift, int count, float* out) {
+// Eight pixels per step, in runs of up to 64: where a source channel is above 0, each channel's
+// sum (the byte's value without dividing, unitOfByte, plus the saturated source), then the sums'
+// words as unorm8WordsAvx2 makes them; elsewhere the destination word as it is.
+void addUnorm8WordsAvx2(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill, uint32_t* out) {
+    constexpr int kRun = 64;
     const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
-    const __m256i byte = _mm256_set1_epi32(0xff);
-    const __m128i by = _mm_cvtsi32_si128(shift);
+    const __m256i byte = _mm256_set1_epi32(0xff), fill = _mm256_set1_epi32(int32_t(alphaFill));
+    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+    alignas(32) float sum[4][kRun];
     int i = 0;
-    for (; i + 8 <= count; i += 8) {
-        const __m256 v = _mm256_loadu_ps(src + i);
-        const __m256 sv = _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_min_ps(v, one));
-        // The target's line ahead: the first channel's pass over a row waits on each line else.
-        _mm_prefetch(reinterpret_cast<const char*>(words + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(words + 4 * i));
-        const __m256 d = unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srl_epi32(w, by), byte)));
-        _mm256_storeu_ps(out + i, _mm256_add_ps(sv, d));
+    while (i + 8 <= count) {
+        const int run = std::min(kRun, (count - i) & ~7);
+        uint32_t lit = 0;  // the run's blocks of eight with a source above 0
+        for (int b = 0; b < run; b += 8) {
+            const int at = i + b;
+            // The target's line ahead: a row's pass waits on each line else.
+            _mm_prefetch(reinterpret_cast<const char*>(words + 4 * at) + kPrefetchAhead, _MM_HINT_T0);
+            const __m256 s[4] = {_mm256_loadu_ps(src[0] + at), _mm256_loadu_ps(src[1] + at),
+                                 _mm256_loadu_ps(src[2] + at), _mm256_loadu_ps(src[3] + at)};
+            const __m256 above = _mm256_or_ps(
+                _mm256_or_ps(_mm256_cmp_ps(s[0], zero, _CMP_GT_OQ), _mm256_cmp_ps(s[1], zero, _CMP_GT_OQ)),
+                _mm256_or_ps(_mm256_cmp_ps(s[2], zero, _CMP_GT_OQ), _mm256_cmp_ps(s[3], zero, _CMP_GT_OQ)));
+            const __m256i w = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(words + 4 * at));
+            if (_mm256_testz_ps(above, above)) {
+                _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + at), _mm256_or_si256(w, fill));
+                continue;
+            }
+            lit |= 1u << (b / 8);
+            for (int c = 0; c < 4; ++c) {
+                const __m256 sv = _mm256_and_ps(_mm256_cmp_ps(s[c], zero, _CMP_GT_OQ), _mm256_min_ps(s[c], one));
+                const __m256 d =
+                    unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(w, kShift[c]), byte)));
+                _mm256_store_ps(sum[c] + b, _mm256_add_ps(sv, d));
+            }
+        }
+        for (uint32_t m = lit; m; m &= m - 1) {
+            const int b = 8 * std::countr_zero(m);
+            const float* const sums[4] = {sum[0] + b, sum[1] + b, sum[2] + b, sum[3] + b};
+            unorm8WordsAvx2(sums, 8, alphaFill, out + i + b);
+        }
+        i += run;
     }
-    if (i < count) baseline::kMerger.satAddUnorm8(src + i, words + 4 * size_t(i), shift, count - i, out + i);
+    if (i < count) {
+        const float* const rest[4] = {src[0] + i, src[1] + i, src[2] + i, src[3] + i};
+        baseline::kMerger.addUnorm8Words(rest, words + 4 * size_t(i), count - i, alphaFill, out + i);
+    }
 }
 
 }  // namespace
 
-const MergerKernels avx2::kMerger{&halvesF16c, &unorm8WordsAvx2, &unorm8WordsRgbaAvx2, &satAddUnorm8Avx2};
+const MergerKernels avx2::kMerger{&halvesF16c, &unorm8WordsAvx2, &unorm8WordsRgbaAvx2, &addUnorm8WordsAvx2};
 
 }  // namespace emu

@@ -153,8 +153,10 @@ void mergeFloat(const Plan& p, const MergeInputs& in, const FloatSource& src, Co
     }
 }
 
-// The Baseline level's sum of a saturated source and a destination byte (emu/output_merger_kernels.h).
-void satAddUnorm8Baseline(const float* src, const uint8_t* words, int shift, int count, float* out) {
+namespace {
+
+// sat(src[i]) + the byte at bit `shift` of the i-th destination word, as its value.
+void satAddUnorm8(const float* src, const uint8_t* words, int shift, int count, float* out) {
     int i = 0;
 #if defined(__SSE2__)
     // sat: v > 0 selects min(v, 1), else 0 (NaN included); d = float(byte) / 255, as kUnitOfByte.
@@ -171,6 +173,8 @@ void satAddUnorm8Baseline(const float* src, const uint8_t* words, int shift, int
 #endif
     for (; i < count; ++i) out[i] = sat(src[i]) + kUnitOfByte[(load32(words + 4 * i) >> shift) & 0xffu];
 }
+
+}  // namespace
 
 // The Baseline level's half conversion (emu/output_merger_kernels.h).
 void unorm8WordsBaseline(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
@@ -223,6 +227,21 @@ void unorm8WordsRgbaBaseline(const float* rgba, int count, uint32_t alphaFill, u
         words[i] = packArgb(ps11::unorm8OfFloat(p[0]), ps11::unorm8OfFloat(p[1]), ps11::unorm8OfFloat(p[2]),
                             ps11::unorm8OfFloat(p[3])) |
                    alphaFill;
+    }
+}
+
+// The Baseline level's ONE/ONE words (emu/output_merger_kernels.h): the sums a channel at a time,
+// then their words.
+void addUnorm8WordsBaseline(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
+                            uint32_t* out) {
+    constexpr int kStep = 64;
+    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+    alignas(16) float sum[4][kStep];
+    const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
+    for (int at = 0; at < count; at += kStep) {
+        const int n = std::min(kStep, count - at);
+        for (int c = 0; c < 4; ++c) satAddUnorm8(src[c] + at, words + 4 * size_t(at), kShift[c], n, sum[c]);
+        unorm8WordsBaseline(sums, n, alphaFill, out + at);
     }
 }
 
@@ -299,14 +318,9 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
             old[i] = stores[i] ? load32(cs.at(x, y)) : 0u;
         }
     }
-    alignas(32) float sum[4][ps11::kMaxSpan];
-    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
-    const MergerKernels& kernels = mergerKernels(ps11::simdLevel());
-    for (int c = 0; c < 4; ++c) kernels.satAddUnorm8(f[c], dst, kShift[c], count, sum[c]);
     alignas(32) uint32_t words[ps11::kMaxSpan];
-    const float* const sums[4] = {sum[0], sum[1], sum[2], sum[3]};
     // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both.
-    kernels.unorm8Words(sums, count, x8 ? 0xff000000u : 0u, words);
+    mergerKernels(ps11::simdLevel()).addUnorm8Words(f, dst, count, x8 ? 0xff000000u : 0u, words);
     if (run) {
         if (mask != 0xffffffffu)
             for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (load32(dst + 4 * i) & ~mask);
@@ -398,7 +412,7 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
 }  // namespace merger
 
 const MergerKernels baseline::kMerger{&merger::halvesBaseline, &merger::unorm8WordsBaseline,
-                                      &merger::unorm8WordsRgbaBaseline, &merger::satAddUnorm8Baseline};
+                                      &merger::unorm8WordsRgbaBaseline, &merger::addUnorm8WordsBaseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #ifdef PS11_HAVE_AVX2

@@ -19,11 +19,14 @@ struct MergerKernels {
     // The same words of `count` pixels of interleaved float r g b a (an A32B32G32R32F row): the
     // ideal profile's float frame into an 8-bit target (StretchRect).
     void (*unorm8WordsRgba)(const float* rgba, int count, uint32_t alphaFill, uint32_t* words);
-    // ONE/ONE into an 8-bit target under the float profiles, one channel of `count` lanes:
-    // out[i] = sat(src[i]) + d with d the byte at bit `shift` of the i-th 4-byte word at `words`,
-    // as its value float(d) / 255 (correctly rounded: the texture's value table). Avx2: a product
-    // and two FMAs in place of the division, the same float for every byte (checked for all 256).
-    void (*satAddUnorm8)(const float* src, const uint8_t* words, int shift, int count, float* out);
+    // ONE/ONE into an 8-bit target under the float profiles: the A8R8G8B8 words (as unorm8Words,
+    // ORed with `alphaFill`) of the float sums sat(src[c][i]) + d, d the destination word
+    // words[i]'s channel c as its value float(d) / 255 (correctly rounded: the texture's value
+    // table). Avx2: a product and two FMAs in place of the division, the same float for every byte
+    // (checked for all 256); eight pixels whose sources are all 0, negative or NaN keep their
+    // words (the sum is d, whose byte is d's), without converting.
+    void (*addUnorm8Words)(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
+                           uint32_t* out);
 };
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level);

@@ -376,38 +376,49 @@ TEST_CASE("simd dispatch: the merger's 8-bit words are ps11::unorm8OfFloat at ev
     CHECK(ps11::unorm8OfFloat(2.0) == 255);
 }
 
-TEST_CASE("simd dispatch: ONE/ONE sums into 8-bit targets are sat(s) + byte / 255 at every level",
+TEST_CASE("simd dispatch: ONE/ONE words into 8-bit targets are the bytes of sat(s) + byte / 255 at every level",
           "[simd][merger]") {
     // Every byte in every channel position, against probe sources (NaN, ±0, negatives, past 1,
-    // ties of the 8-bit rounding); every length 0..40 at every offset.
-    const std::vector<float> values = unorm8Probes();
+    // ties of the 8-bit rounding), and sources mostly not above 0 (whole blocks of eight kept as
+    // they are, others with one lane above); every length 0..40 at every offset; both fills.
+    const std::vector<float> probes = unorm8Probes();
     const float* unit = ps11::Texture::unorm8Values();
+    auto sat = [](float v) { return v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f; };
+    auto want = [&](const float* const s[4], uint32_t d, int i, uint32_t fill) {
+        return unorm8WordOf(sat(s[0][i]) + unit[(d >> 16) & 0xffu], sat(s[1][i]) + unit[(d >> 8) & 0xffu],
+                            sat(s[2][i]) + unit[d & 0xffu], sat(s[3][i]) + unit[d >> 24], fill);
+    };
+    std::vector<float> dark(probes.size());
+    const float notAbove[4] = {0.0f, -0.0f, -0.5f, std::numeric_limits<float>::quiet_NaN()};
+    for (size_t i = 0; i < dark.size(); ++i) dark[i] = i % 53 == 7 ? probes[i] : notAbove[i % 4];
     int64_t bad = 0, checked = 0;
     for (SimdLevel level : ps11::runnableSimdLevels()) {
         const emu::MergerKernels& k = emu::mergerKernels(level);
-        for (size_t at = 0; at + 41 <= values.size(); at += 29) {
-            const int count = int(at % 41);
-            for (int shift : {0, 8, 16, 24}) {
+        for (const std::vector<float>* values : {&probes, static_cast<const std::vector<float>*>(&dark)})
+            for (size_t at = 0; at + 4 * 48 <= values->size(); at += 29) {
+                const int count = int(at % 41);
+                const float* s[4] = {&(*values)[at], &(*values)[at + 48], &(*values)[at + 96], &(*values)[at + 144]};
                 std::vector<uint32_t> words(static_cast<size_t>(count));
                 for (int i = 0; i < count; ++i) words[size_t(i)] = uint32_t(at * 2654435761u + uint64_t(i) * 40503u);
-                std::vector<float> got(size_t(count) + 1, -7.0f);
-                k.satAddUnorm8(&values[at], reinterpret_cast<const uint8_t*>(words.data()), shift, count, got.data());
-                for (int i = 0; i < count; ++i) {
-                    const float v = values[at + size_t(i)];
-                    const float want = (v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f) + unit[(words[size_t(i)] >> shift) & 0xffu];
-                    bad += std::memcmp(&got[size_t(i)], &want, 4) != 0;
-                    ++checked;
+                for (uint32_t fill : {0u, 0xff000000u}) {
+                    std::vector<uint32_t> got(size_t(count) + 1, 0xdeadbeefu);
+                    k.addUnorm8Words(s, reinterpret_cast<const uint8_t*>(words.data()), count, fill, got.data());
+                    for (int i = 0; i < count; ++i) {
+                        bad += got[size_t(i)] != want(s, words[size_t(i)], i, fill);
+                        ++checked;
+                    }
+                    bad += got[size_t(count)] != 0xdeadbeefu;  // nothing past the span
                 }
-                bad += got[size_t(count)] != -7.0f;  // nothing past the span
             }
-        }
-        // Every byte once in every position of a 256-lane span.
-        std::vector<uint32_t> words(256);
-        std::vector<float> zeros(256, 0.0f), got(256);
-        for (int shift : {0, 8, 16, 24}) {
-            for (uint32_t b = 0; b < 256; ++b) words[b] = b << shift;
-            k.satAddUnorm8(zeros.data(), reinterpret_cast<const uint8_t*>(words.data()), shift, 256, got.data());
-            for (uint32_t b = 0; b < 256; ++b) bad += got[b] != unit[b], ++checked;
+        // Every byte once in every channel of a 256-lane span, over sources of 0, −0 and 1/510
+        // (half a step: the sums are ties or next to them).
+        std::vector<uint32_t> words(256), got(256);
+        for (float v : {0.0f, 1.0f / 510.0f, -0.0f}) {
+            std::vector<float> lanes(256, v);
+            const float* s[4] = {lanes.data(), lanes.data(), lanes.data(), lanes.data()};
+            for (uint32_t b = 0; b < 256; ++b) words[b] = b * 0x01010101u ^ 0x00ff00ffu;
+            k.addUnorm8Words(s, reinterpret_cast<const uint8_t*>(words.data()), 256, 0, got.data());
+            for (uint32_t b = 0; b < 256; ++b) bad += got[b] != want(s, words[b], int(b), 0), ++checked;
         }
         INFO("SIMD level " << ps11::simdLevelName(level));
         CHECK(bad == 0);
