@@ -128,7 +128,7 @@ struct RowTaps {
     float fy = 0;
     const float* h0 = nullptr;  // linear taps: H rows of j0 and j1 (planar, `width` columns)
     const float* h1 = nullptr;
-    const float* dec = nullptr;  // point taps: texel row j0 as planar floats (decodedRow)
+    const float* dec = nullptr;  // float point taps: texel row j0 as planar floats (decodedRow)
 };
 
 // Texel row j (in the texture) of a tap as planar r g b a floats: an 8-bit tap's decoded
@@ -418,6 +418,35 @@ public:
             m_fetched += uint64_t(n);
             return;
         }
+        const ptrdiff_t stride = out.value[1] - out.value[0];
+        if (tap->unorm8 && r.j0 >= 0 && stride >= n && out.value[2] - out.value[1] == stride &&
+            out.value[3] - out.value[2] == stride) {
+            // An 8-bit row's texels decoded where they lie into the lanes (the result's channel
+            // arrays one stride apart, as the executor's are): runs of consecutive texels by the
+            // decode kernel, other lanes by the value table.
+            const uint8_t* bytes = tap->bytes + size_t(r.j0) * tap->width * 4;
+            float* const dst = out.value[0];
+            int i = 0;
+            while (i < n) {
+                const int32_t k = i0[i];
+                int e = i + 1;
+                if (k >= 0)
+                    while (e < n && i0[e] == k + (e - i)) ++e;
+                if (e - i >= 8) {
+                    m_draw.kernels->decode(bytes + 4 * size_t(k), e - i, dst + i, size_t(stride));
+                    i = e;
+                    continue;
+                }
+                for (; i < e; ++i) {
+                    const int32_t q = i0[i];
+                    for (int c = 0; c < 4; ++c)
+                        dst[c * stride + i] = q >= 0 ? kUnorm8[bytes[4 * size_t(q) + size_t(ps11::kUnorm8Byte[c])]]
+                                                     : tap->border[size_t(c)];
+                }
+            }
+            m_fetched += uint64_t(n);
+            return;
+        }
         float v[4];
         for (int i = 0; i < n; ++i) {
             texel(*tap, i0[i], r.j0, v);
@@ -649,7 +678,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     r.h0 = hRow(draw, tri, t, r.j0, sc);
                     r.h1 = hRow(draw, tri, t, r.j1, sc);
                 } else {
-                    r.dec = r.j0 >= 0 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
+                    // (8-bit point taps decode the lanes' texels straight from the row.)
+                    r.dec = r.j0 >= 0 && !tap.unorm8 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
                 }
             }
             for (size_t wi = 0; wi < windowCount; ++wi) {
