@@ -1454,6 +1454,34 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
     }
 }
 
+namespace {
+
+// A random source rect of sw×sh and destination rect of dw×dh (each at least one pixel, inside),
+// and the tap mapping stretchTaps gives them (fx weights or the float profiles').
+struct RandomStretch {
+    RECT sr{}, dr{};
+    std::vector<StretchTap> tx, ty;
+};
+RandomStretch randomStretch(std::mt19937& rng, UINT sw, UINT sh, UINT dw, UINT dh, bool fixedPoint) {
+    RandomStretch r;
+    r.sr = RECT{LONG(rng() % sw), LONG(rng() % sh), 0, 0};
+    r.dr = RECT{LONG(rng() % dw), LONG(rng() % dh), 0, 0};
+    r.sr.right = r.sr.left + 1 + LONG(rng() % (sw - UINT(r.sr.left)));
+    r.sr.bottom = r.sr.top + 1 + LONG(rng() % (sh - UINT(r.sr.top)));
+    r.dr.right = r.dr.left + 1 + LONG(rng() % (dw - UINT(r.dr.left)));
+    r.dr.bottom = r.dr.top + 1 + LONG(rng() % (dh - UINT(r.dr.top)));
+    StretchCall call;
+    call.sourceRect = PixelBox{r.sr.left, r.sr.top, r.sr.right, r.sr.bottom};
+    call.destRect = PixelBox{r.dr.left, r.dr.top, r.dr.right, r.dr.bottom};
+    call.linear = true;
+    call.fixedPoint = fixedPoint;
+    r.tx = stretchTaps(call, true);
+    r.ty = stretchTaps(call, false);
+    return r;
+}
+
+}  // namespace
+
 TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the weighted sum, any scale and rect", "[device]") {
     // The filter written out from the one tap mapping (emu/blit.h stretchTaps): fx weights k/256
     // (the double sum exact), the float profiles' weights rem/den; rounded to nearest, ties to
@@ -1471,17 +1499,11 @@ TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the weighted 
         for (uint32_t& t : texels) t = rng();
         Handle src = makeTarget(dev, sw, sh, [&](UINT x, UINT y) { return texels[size_t(y) * sw + x]; }, fmt);
         Handle dst = makeTarget(dev, dw, dh, [](UINT, UINT) { return 0x12345678u; }, fmt);
-        RECT sr{LONG(rng() % sw), LONG(rng() % sh), 0, 0}, dr{LONG(rng() % dw), LONG(rng() % dh), 0, 0};
-        sr.right = sr.left + 1 + LONG(rng() % (sw - UINT(sr.left))), sr.bottom = sr.top + 1 + LONG(rng() % (sh - UINT(sr.top)));
-        dr.right = dr.left + 1 + LONG(rng() % (dw - UINT(dr.left))), dr.bottom = dr.top + 1 + LONG(rng() % (dh - UINT(dr.top)));
+        const RandomStretch rs = randomStretch(rng, sw, sh, dw, dh, fixedPoint);
+        const RECT &sr = rs.sr, &dr = rs.dr;
+        const std::vector<StretchTap>&tx = rs.tx, &ty = rs.ty;
         INFO("round " << round << ": " << sw << "x" << sh << " -> " << dw << "x" << dh);
         REQUIRE(dev.StretchRect(src, &sr, dst, &dr, D3DTEXF_LINEAR) == D3D_OK);
-        StretchCall call;
-        call.sourceRect = PixelBox{sr.left, sr.top, sr.right, sr.bottom};
-        call.destRect = PixelBox{dr.left, dr.top, dr.right, dr.bottom};
-        call.linear = true;
-        call.fixedPoint = fixedPoint;
-        const std::vector<StretchTap> tx = stretchTaps(call, true), ty = stretchTaps(call, false);
         D3DLOCKED_RECT lr{};
         REQUIRE(dev.LockRect(dst, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
         int wrong = 0;
@@ -1533,19 +1555,11 @@ TEST_CASE("device: LINEAR StretchRect between A32B32G32R32F targets is the doubl
         for (UINT y = 0; y < sh; ++y)
             std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &texels[size_t(y) * sw * 4], size_t(sw) * 16);
         REQUIRE(dev.UnlockRect(src) == D3D_OK);
-        RECT sr{LONG(rng() % sw), LONG(rng() % sh), 0, 0}, dr{LONG(rng() % dw), LONG(rng() % dh), 0, 0};
-        sr.right = sr.left + 1 + LONG(rng() % (sw - UINT(sr.left))),
-        sr.bottom = sr.top + 1 + LONG(rng() % (sh - UINT(sr.top)));
-        dr.right = dr.left + 1 + LONG(rng() % (dw - UINT(dr.left))),
-        dr.bottom = dr.top + 1 + LONG(rng() % (dh - UINT(dr.top)));
+        const RandomStretch rs = randomStretch(rng, sw, sh, dw, dh, fixedPoint);
+        const RECT &sr = rs.sr, &dr = rs.dr;
+        const std::vector<StretchTap>&tx = rs.tx, &ty = rs.ty;
         INFO("round " << round << ": " << sw << "x" << sh << " -> " << dw << "x" << dh);
         REQUIRE(dev.StretchRect(src, &sr, dst, &dr, D3DTEXF_LINEAR) == D3D_OK);
-        StretchCall call;
-        call.sourceRect = PixelBox{sr.left, sr.top, sr.right, sr.bottom};
-        call.destRect = PixelBox{dr.left, dr.top, dr.right, dr.bottom};
-        call.linear = true;
-        call.fixedPoint = fixedPoint;
-        const std::vector<StretchTap> tx = stretchTaps(call, true), ty = stretchTaps(call, false);
         int wrong = 0, inside = 0;
         REQUIRE(dev.LockRect(dst, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
         for (UINT y = UINT(dr.top); y < UINT(dr.bottom); ++y)
