@@ -77,6 +77,22 @@ bool lerpValuesBase(const float* rgba, int /*len*/, const int32_t* i0, const int
     return true;  // (lerpf itself: the reference's order)
 }
 
+void bilinearWordsBase(const uint8_t* texels, int width, const int32_t* i0, const int32_t* i1, const int32_t* j0,
+                       const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
+                       float* const out[4]) {
+    for (int j = 0; j < n; ++j) {
+        const int32_t xs[4] = {i0[j], i1[j], i0[j], i1[j]}, ys[4] = {j0[j], j0[j], j1[j], j1[j]};
+        float t[4][4];
+        for (int k = 0; k < 4; ++k)
+            for (size_t c = 0; c < 4; ++c)
+                t[k][c] = (xs[k] | ys[k]) < 0 ? border[c]
+                                              : kUnorm8[texels[(size_t(ys[k]) * size_t(width) + size_t(xs[k])) * 4 +
+                                                               size_t(ps11::kUnorm8Byte[c])]];
+        for (size_t c = 0; c < 4; ++c)
+            out[c][j] = lerpf(lerpf(t[0][c], t[1][c], fu[j]), lerpf(t[2][c], t[3][c], fu[j]), fv[j]);
+    }
+}
+
 void lerpRowBase(const float* a, const float* b, float f, int n, float* out) {
     int j = 0;
 #if defined(__SSE2__)
@@ -106,8 +122,8 @@ void decodeBase(const uint8_t* row, int n, float* out, size_t stride) {
         for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = kUnorm8[row[4 * i + ps11::kUnorm8Byte[c]]];
 }
 
-const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBase,
-                                &lerpValuesBase,  &lerpRowBase,    &decodeBase};
+const FloatRowKernels kBaseline{&lerpColumnsBase,   &lerpGatherBase, &lerpWordsBase, &lerpValuesBase,
+                                &bilinearWordsBase, &lerpRowBase,    &decodeBase};
 
 }  // namespace
 
@@ -323,20 +339,7 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
         }
         return;
     }
-    alignas(32) float q[4][4][ps11::kMaxSpan];  // [corner t00 t10 t01 t11][channel][lane]
-    for (int i = 0; i < n; ++i) {
-        const int32_t xs[4] = {i0[i], i1[i], i0[i], i1[i]}, ys[4] = {j0[i], j0[i], j1[i], j1[i]};
-        for (int k = 0; k < 4; ++k) {
-            texel(tap, xs[k], ys[k], t);
-            for (int c = 0; c < 4; ++c) q[k][c][i] = t[c];
-        }
-    }
-    alignas(32) float h0[ps11::kMaxSpan], h1[ps11::kMaxSpan];
-    for (int c = 0; c < 4; ++c) {
-        draw.kernels->lerpColumns(q[0][c], q[1][c], fu, n, h0);
-        draw.kernels->lerpColumns(q[2][c], q[3][c], fu, n, h1);
-        draw.kernels->lerpColumns(h0, h1, fv, n, out[c]);
-    }
+    draw.kernels->bilinearWords(tap.bytes, int(tap.width), i0, i1, j0, j1, fu, fv, tap.border.data(), n, out);
 }
 
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
