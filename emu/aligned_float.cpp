@@ -421,9 +421,12 @@ public:
             m_fetched += uint64_t(n);
             return;
         }
-        const ptrdiff_t stride = out.value[1] - out.value[0];
-        if (tap->unorm8 && r.j0 >= 0 && stride >= n && out.value[2] - out.value[1] == stride &&
-            out.value[3] - out.value[2] == stride) {
+        // (The channel arrays' distance as addresses: they need not be one array's parts.)
+        const auto at = [&](int c) { return reinterpret_cast<uintptr_t>(out.value[c]); };
+        const uintptr_t step = at(1) - at(0);
+        const ptrdiff_t stride = ptrdiff_t(step / sizeof(float));
+        if (tap->unorm8 && r.j0 >= 0 && at(1) > at(0) && step % sizeof(float) == 0 && stride >= n &&
+            at(2) - at(1) == step && at(3) - at(2) == step) {
             // An 8-bit row's texels decoded where they lie into the lanes (the result's channel
             // arrays one stride apart, as the executor's are): runs of consecutive texels by the
             // decode kernel, other lanes by the value table.
