@@ -111,12 +111,9 @@ void lerpWordsAvx2(const uint8_t* row, int len, const int32_t* i0, const int32_t
         for (size_t c = 0; c < 4; ++c)
             _mm256_storeu_ps(out + c * stride + size_t(j), lerp8(channel(wa, kShift[c]), channel(wb, kShift[c]), fv));
     }
-    const float* unit = ps11::Texture::unorm8Values();
-    for (; j < n; ++j) {
-        const uint8_t *a = row + 4 * size_t(i0[j]), *b = row + 4 * size_t(i1[j]);
-        for (size_t c = 0; c < 4; ++c)
-            out[c * stride + size_t(j)] = lerp1(unit[a[ps11::kUnorm8Byte[c]]], unit[b[ps11::kUnorm8Byte[c]]], f[j]);
-    }
+    if (j < n)
+        floatRowKernels(ps11::SimdLevel::Baseline)
+            .lerpWords(row, len, i0 + j, i1 + j, f + j, n - j, out + size_t(j), stride);
 }
 
 bool lerpValuesAvx2(const float* rgba, int /*len*/, const int32_t* i0, const int32_t* i1, const float* f, int n,
@@ -186,17 +183,10 @@ void bilinearWordsAvx2(const uint8_t* texels, int width, const int32_t* i0, cons
             _mm256_storeu_ps(out[c] + j, lerp8(lerp8(t[0], t[1], u), lerp8(t[2], t[3], u), v));
         }
     }
-    const float* unit = ps11::Texture::unorm8Values();
-    for (; j < n; ++j) {
-        const int32_t xs[4] = {i0[j], i1[j], i0[j], i1[j]}, ys[4] = {j0[j], j0[j], j1[j], j1[j]};
-        float t[4][4];
-        for (int k = 0; k < 4; ++k)
-            for (size_t c = 0; c < 4; ++c)
-                t[k][c] = (xs[k] | ys[k]) < 0 ? border[c]
-                                              : unit[texels[(size_t(ys[k]) * size_t(width) + size_t(xs[k])) * 4 +
-                                                            size_t(ps11::kUnorm8Byte[c])]];
-        for (size_t c = 0; c < 4; ++c)
-            out[c][j] = lerp1(lerp1(t[0][c], t[1][c], fu[j]), lerp1(t[2][c], t[3][c], fu[j]), fv[j]);
+    if (j < n) {
+        float* const rest[4] = {out[0] + j, out[1] + j, out[2] + j, out[3] + j};
+        floatRowKernels(ps11::SimdLevel::Baseline)
+            .bilinearWords(texels, width, i0 + j, i1 + j, j0 + j, j1 + j, fu + j, fv + j, border, n - j, rest);
     }
 }
 
