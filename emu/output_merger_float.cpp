@@ -176,7 +176,7 @@ void satAddUnorm8(const float* src, const uint8_t* words, int shift, int count, 
 
 }  // namespace
 
-// The Baseline level's half conversion (emu/output_merger_kernels.h).
+// The Baseline level's 8-bit words (emu/output_merger_kernels.h).
 void unorm8WordsBaseline(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
     int i = 0;
 #if defined(__SSE2__)
