@@ -113,6 +113,7 @@ struct Profile {
     int32_t nMax = 255;    // fx: round(M*G)
     float maxValue = 1;    // M
     bool wide = false;     // fx: products need 64-bit lanes
+    bool exactDouble = false;  // fx, wide: every product numerator below 2^52, formed in double
     bool clampRange = true;  // false for ideal
     std::array<std::array<int32_t, 4>, kNumConsts> constGrid{};  // fx: constants as grid integers
     std::array<std::array<float, 4>, kNumConsts> constF{};       // float: constants (fx: n/G)

@@ -112,7 +112,8 @@ private:
         stats->instructions += executed * uint64_t(count);
     }
     void loadColors(RunState& st) const;
-    void runChunk(RunState& st, const FloatArithKernels& floatArith, std::vector<TraceStep>* steps) const;
+    void runChunk(RunState& st, const FxArithKernels& fxArith, const FloatArithKernels& floatArith,
+                  std::vector<TraceStep>* steps) const;
 
     ExecutorOptions m_options;
     Profile m_p;
@@ -151,7 +152,8 @@ void ExecutorImpl::loadColors(RunState& st) const {
     }
 }
 
-void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith, std::vector<TraceStep>* steps) const {
+void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const FloatArithKernels& floatArith,
+                            std::vector<TraceStep>* steps) const {
     const bool fx = isFixedPoint(m_p.precision);
     std::memset(st.killed, 0, sizeof st.killed);
     loadColors(st);
@@ -160,7 +162,7 @@ void ExecutorImpl::runChunk(RunState& st, const FloatArithKernels& floatArith, s
         if (op.texture) {
             execTexture(m_p, op, st);
         } else if (fx) {
-            execArithFx(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
+            fxArith.arith(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
         } else {
             floatArith.arith(m_p, op, st, op.hold ? st.bf.hold : st.bf.reg[op.dstSlot]);
         }
@@ -257,12 +259,13 @@ void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, Pixel
             std::memset(st->bf.reg[kSlotR][c], 0, sizeof st->bf.reg[kSlotR][c]);
     }
     const float g = float(m_p.g);
+    const FxArithKernels& fxArith = fxArithKernels(simdLevel());
     const FloatArithKernels& floatArith = floatArithKernels(simdLevel());
     for (int off = 0; off < count; off += kChunk) {
         st->offset = off;
         st->n = std::min(kChunk, count - off);
         st->depthWritten = false;
-        runChunk(*st, floatArith, off == 0 ? steps : nullptr);
+        runChunk(*st, fxArith, floatArith, off == 0 ? steps : nullptr);
         for (int c = 0; c < 4; ++c) {
             if (fx) {
                 const int32_t* r = st->bi.reg[kSlotR][c];
@@ -417,6 +420,7 @@ bool exec::decodeProgram(const Program& program, const ExecutorOptions& options,
         double kmax = 4.0 * p.nMax + 2.0 * p.g;
         double bound = (4.0 * kmax * kmax + 4.0 * p.g * kmax) * 8.0;
         p.wide = bound >= 2147483647.0;
+        p.exactDouble = bound < 4503599627370496.0;  // 2^52 (executor_arith_fx.inc roundClampDouble)
     }
 
     std::vector<DOp> ops;

@@ -139,7 +139,7 @@ bool buildFastProgram(const Profile& p, const std::vector<DOp>& ops, FastProgram
         f.mask = d.mask;
         f.shift = d.shift;
         if (d.shift < -3 || d.shift > 3) return false;
-        // The write-step bounds exactly as executor_arith.cpp forms them.
+        // The write-step bounds exactly as executor_arith_fx.inc forms them.
         f.lo = int16_t(d.sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax);
         f.hi = int16_t(d.sat ? (255 < p.nMax ? 255 : p.nMax) : p.nMax);
         f.numSrc = d.numSrc;

@@ -2,7 +2,7 @@
 // fetched as k = a·n + b in int16, products and sums of products formed exactly in int32 by
 // pmaddwd, then the one round-half-even of docs/precision.md done with integer and float
 // operations whose exactness is proven over the whole input range (tests/test_executor_fast.cpp).
-// It gives results bit-identical to the generic int32/int64 path (executor_arith.cpp), which
+// It gives results bit-identical to the generic int32/int64 path (executor_arith_fx.inc), which
 // stays the reference and runs whatever the fast path does not cover. The kernels are compiled
 // twice (executor_fast_sse2.cpp for any x86-64, executor_fast_avx2.cpp for the Avx2 level) and
 // fetched per run from fastKernels(simdLevel()) (ps11/simd_dispatch.h). Not part of the public API.

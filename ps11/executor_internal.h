@@ -75,9 +75,20 @@ private:
 inline uint8_t fetchMask(const DOp& op, int s) { return componentsRead(*op.info, s, op.mask); }
 
 // Arithmetic instruction (mov … bem, not nop) into out (the destination or the hold buffer):
-// fx profiles (executor_arith.cpp), float profiles (executor_arith_float.inc, a table per SIMD
-// level that runGeneric fetches once per run).
-void execArithFx(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]);
+// fx profiles (executor_arith_fx.inc), float profiles (executor_arith_float.inc), each a table
+// per SIMD level that runGeneric fetches once per run.
+using FxArithFn = void (*)(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]);
+struct FxArithKernels {
+    FxArithFn arith;
+};
+const FxArithKernels& fxArithKernels(SimdLevel level);
+// The tables (the Avx2 one in x86-64 builds only); use fxArithKernels().
+namespace baseline {
+extern const FxArithKernels kFxArith;
+}
+namespace avx2 {
+extern const FxArithKernels kFxArith;
+}
 using FloatArithFn = void (*)(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]);
 struct FloatArithKernels {
     FloatArithFn arith;

@@ -1,5 +1,5 @@
 // Interval evaluator, arithmetic instructions (mov add sub mul mad dp3 dp4 lrp cnd cmp bem): the
-// bounds of the executor's fetch → op → write step (executor_arith.cpp for the fx profiles,
+// bounds of the executor's fetch → op → write step (executor_arith_fx.inc for the fx profiles,
 // executor_arith_float.inc for float and ideal), and the copy tags that pass through the exact
 // identities of each profile (docs/intervals.md).
 #include <algorithm>
@@ -131,7 +131,7 @@ KI madCorners(const Profile& p, const SV* s) {
     return r;
 }
 
-// The clamp bounds of the write step (executor_arith.cpp arithFx).
+// The clamp bounds of the write step (executor_arith_fx.inc arithFx).
 void fxClamp(const Profile& p, bool sat, int32_t& lo, int32_t& hi) {
     lo = sat ? (p.nMax < 0 ? p.nMax : 0) : -p.nMax;
     hi = sat ? (p.g < p.nMax ? p.g : p.nMax) : p.nMax;
@@ -263,7 +263,7 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4], Write
 }
 
 // bem (1_4): d.r = a.r + M00·b.r + M10·b.g, d.g = a.g + M01·b.r + M11·b.g in double, rounded
-// once with nearbyint (executor_arith.cpp). Every step is monotone in each input (the matrix
+// once with nearbyint (executor_arith_fx.inc). Every step is monotone in each input (the matrix
 // fixed), so the extremes are at the corners of the box.
 void bemFx(const Profile& p, bool stagesKnown, const DOp& op, const Regs& regs, AV out[4], WriteFindings* wf) {
     int32_t lo, hi;

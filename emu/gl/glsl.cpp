@@ -1,6 +1,6 @@
 // ps_1_x → GLSL, the program part (emu/gl/glsl.h): the triangle record, coverage and the
 // attribute planes, v# loading, and every arithmetic and texture-address instruction of the
-// executor's op list (ps11/executor_arith.cpp, ps11/executor_texture.cpp) in the profile's
+// executor's op list (ps11/executor_arith_fx.inc, ps11/executor_texture.cpp) in the profile's
 // terms. The sampling functions are in glsl_sampler.cpp, the merge in glsl_merge.cpp.
 #include "emu/gl/glsl.h"
 
@@ -297,7 +297,7 @@ struct Gen {
         }
     }
 
-    // ---- arithmetic (ps11/executor_arith.cpp) ----
+    // ---- arithmetic (ps11/executor_arith_fx.inc) ----
     // fx: source s, output channel c as k = a·n + b (k / 2G is the value).
     std::string k(const DOp& op, int s, int c) const {
         const DSrc& src = op.src[size_t(s)];
