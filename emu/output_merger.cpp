@@ -307,20 +307,39 @@ void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* co
     alignas(32) int32_t src[4][kN], dst[4][kN], sat[kN];
     alignas(32) uint32_t word[kN];
     uint8_t* addr[kN];
-    int m = 0;
-    for (int i = 0; i < in.count; ++i) {
+    // One run of a row (the row paths' spans, every lane live): its words are loaded and stored
+    // in place, in loops the compiler vectorises; otherwise the live lanes are gathered.
+    uint8_t* run = nullptr;
+    if (in.row && !in.live && in.count > 0) {
         uint32_t x, y;
-        if ((in.live && !in.live[i]) || !lanes.inside(i, x, y)) continue;
-        uint8_t* q = cs.at(x, y);
-        const uint32_t old = load32(q);
-        addr[m] = q;
-        word[m] = old;
-        for (int c = 0; c < 4; ++c) src[c][m] = std::clamp(g[c][i], 0, G);  // the 8-bit target saturates
-        dst[0][m] = int32_t((old >> 16) & 0xffu) * S;
-        dst[1][m] = int32_t((old >> 8) & 0xffu) * S;
-        dst[2][m] = int32_t(old & 0xffu) * S;
-        dst[3][m] = x8 ? G : int32_t(old >> 24) * S;  // X8R8G8B8's alpha reads 1
-        ++m;
+        if (lanes.inside(0, x, y) && x + uint32_t(in.count) <= p.boundW) {
+            assert(in.x[in.count - 1] == in.x[0] + in.count - 1 && in.y[in.count - 1] == in.y[0]);
+            run = cs.at(x, y);
+        }
+    }
+    int m = 0;
+    if (run) {
+        m = in.count;
+        for (int k = 0; k < m; ++k) word[k] = load32(run + 4 * size_t(k));
+        for (int c = 0; c < 4; ++c)
+            for (int k = 0; k < m; ++k) src[c][k] = std::clamp(g[c][k], 0, G);
+    } else {
+        for (int i = 0; i < in.count; ++i) {
+            uint32_t x, y;
+            if ((in.live && !in.live[i]) || !lanes.inside(i, x, y)) continue;
+            uint8_t* q = cs.at(x, y);
+            addr[m] = q;
+            word[m] = load32(q);
+            for (int c = 0; c < 4; ++c) src[c][m] = std::clamp(g[c][i], 0, G);  // the 8-bit target saturates
+            ++m;
+        }
+    }
+    for (int k = 0; k < m; ++k) {
+        const uint32_t old = word[k];
+        dst[0][k] = int32_t((old >> 16) & 0xffu) * S;
+        dst[1][k] = int32_t((old >> 8) & 0xffu) * S;
+        dst[2][k] = int32_t(old & 0xffu) * S;
+        dst[3][k] = x8 ? G : int32_t(old >> 24) * S;  // X8R8G8B8's alpha reads 1
     }
     for (int k = 0; k < m; ++k) sat[k] = std::min(src[3][k], G - dst[3][k]);
     // A factor as base + sign * array[k].
@@ -352,6 +371,18 @@ void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* co
         } else {
             const Term ts = term(cp.src), td = term(cp.dst);
             const int32_t ns = cp.cs < 0 ? -1 : 0, nd = cp.cd < 0 ? -1 : 0;  // SUBTRACT / REVSUBTRACT
+            if (ts.arr == kZeros && td.arr == kZeros && (ts.base == 0 || ts.base == G) &&
+                (td.base == 0 || td.base == G)) {
+                // Factors ZERO or ONE (ONE/ONE ADD, the additive passes): num = G·t with t = ±s ± d,
+                // so round_half_even(num·255/G²) = round_half_even(t·255/G), the byte of t.
+                // ±s and ±d by masks (no multiply): the term is 0 (ZERO), v or −v.
+                const int32_t ks = ts.base == 0 ? 0 : -1, kd = td.base == 0 ? 0 : -1;
+                for (int k = 0; k < m; ++k) {
+                    const int32_t t = (((sc[k] & ks) ^ ns) - ns) + (((dc[k] & kd) ^ nd) - nd);
+                    o[k] = Fx<G>::byteOf(t < 0 ? 0 : t > G ? G : t);
+                }
+                continue;
+            }
             for (int k = 0; k < m; ++k) {
                 const int32_t fs = ts.base + ((ts.arr[k] ^ ts.neg) - ts.neg);
                 const int32_t fd = td.base + ((td.arr[k] ^ td.neg) - td.neg);
@@ -371,9 +402,12 @@ void blendFxUnorm8Simple(const Plan& p, const MergeInputs& in, const int32_t* co
     const uint32_t alphaFill = x8 ? 0xff000000u : 0u;
     for (int k = 0; k < m; ++k) {
         uint32_t w = packArgb(out[0][k], out[1][k], out[2][k], out[3][k]) | alphaFill;
-        if (mask != 0xffffffffu) w = (w & mask) | (word[k] & ~mask);
-        store32(addr[k], w);
+        word[k] = (w & mask) | (word[k] & ~mask);
     }
+    if (run)
+        std::memcpy(run, word, 4 * size_t(m));
+    else
+        for (int k = 0; k < m; ++k) store32(addr[k], word[k]);
     n.written += uint64_t(m);
 }
 

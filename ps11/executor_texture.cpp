@@ -92,7 +92,7 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
     if (isFixedPoint(p.precision)) {
         for (int c = 0; c < 4; ++c) res.grid[c] = st.bi.reg[slot][c];
         st.sampler->sample(req, res);
-        if (st.deferTexelClamp) return;
+        if (st.deferTexelClamp || (res.unitRange && p.nMax >= p.g)) return;
         const int32_t m = p.nMax;
         for (int c = 0; c < 4; ++c) {
             int32_t* d = st.bi.reg[slot][c];

@@ -32,8 +32,9 @@ struct SampleResult {
     int32_t* grid[4] = {nullptr, nullptr, nullptr, nullptr};
     float* value[4] = {nullptr, nullptr, nullptr, nullptr};
     // A sampler may set it when every value it wrote lies in [0, 1] or is −0.0 (8-bit texels, a
-    // border colour inside [0, 1], and their lerps, which rounding keeps inside): the float
-    // profile's ±MaxValue clamp of the result is then skipped, as it could change nothing.
+    // border colour inside [0, 1], and their lerps, which rounding keeps inside; fx: grid values
+    // in [0, G]): the ±MaxValue clamp of the result is then skipped where M >= 1, as it could
+    // change nothing.
     bool unitRange = false;
 };
 

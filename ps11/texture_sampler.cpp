@@ -387,6 +387,7 @@ void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, c
 void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
     const int count = std::clamp(req.count, 0, kMaxSpan);
     const bool fixed = isFixedPoint(req.precision);
+    out.unitRange = false;
     // 8-bit weights in the float profile where the hardware class has them; never in ideal.
     const bool floatWeights8 = m_weightBits == 8 && req.precision == Precision::Float;
     // Outputs the caller did not ask for go to scratch, so the kernels never test pointers.
@@ -466,6 +467,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             }
             m_fetched.fetch_add(fetched, std::memory_order_relaxed);
             m_fastLanes.fetch_add(fastLanes, std::memory_order_relaxed);
+            out.unitRange = true;  // 8-bit texels, a border of bytes and their blends: [0, G]
             return;
         }
     }

@@ -56,7 +56,9 @@ public:
     };
     std::array<std::array<float, 4>, 8> texel{};
     std::vector<Call> calls;
+    bool unitRange = false;  // says so in SampleResult::unitRange (true only for texels in [0, 1])
     void sample(const SampleRequest& req, SampleResult& out) override {
+        out.unitRange = unitRange;
         Call c{req.stage, req.dims, {}, {}, {}};
         for (int i = 0; i < req.count; ++i) {
             c.u.push_back(req.u ? req.u[i] : -99.f);
@@ -288,6 +290,25 @@ TEST_CASE("executor: float and ideal arithmetic, no FMA contraction", "[executor
     CHECK(col("ps_1_4\ndef c0, 0.6, 0.6, 0.6, 0.6\ndef c1, 0.5, 0.5, 0.5, 0.5\nphase\nlrp r0, v0, c0, c1\n")[0] ==
           bv + f * (av - bv));
     CHECK(col("ps_1_1\ndp3 r0, v0, v1\n")[3] == (0.3f * 0.5f + 0.6f * 0.25f) + 0.9f * 0.125f);
+}
+
+TEST_CASE("executor: a sampled texel is clamped to ±MaxValue even when the sampler says [0, 1]", "[executor]") {
+    // unitRange skips the clamp only where it cannot change a value (M >= 1); with M = 0.5 a
+    // white texel still becomes 0.5 (fx8 128, fx12 2040, float 0.5), with M = 1 it stays 1.
+    FakeSampler s;
+    s.texel[0] = {1, 1, 0.25f, 0};
+    for (bool unit : {false, true}) {
+        s.unitRange = unit;
+        INFO("unitRange " << unit);
+        CHECK(runPixels(*build("ps_1_1\ntex t0\nmov r0, t0\n", Precision::Fx8, 0.5f), {Pixel{}}, s)[0].grid ==
+              G4{128, 128, 64, 0});
+        CHECK(runPixels(*build("ps_1_4\ntexld r0, t0\n", Precision::Fx12, 0.5f), {Pixel{}}, s)[0].grid ==
+              G4{2040, 2040, 1020, 0});
+        CHECK(runPixels(*build("ps_1_4\ntexld r0, t0\n", Precision::Fx12, 1.0f), {Pixel{}}, s)[0].grid ==
+              G4{4080, 4080, 1020, 0});
+        CHECK(runPixels(*build("ps_1_1\ntex t0\nmov r0, t0\n", Precision::Float, 0.5f), {Pixel{}}, s)[0].color ==
+              std::array<float, 4>{0.5f, 0.5f, 0.25f, 0});
+    }
 }
 
 TEST_CASE("executor: texcoord, tex with projection, texkill", "[executor]") {

@@ -277,11 +277,18 @@ bool cmpRef(D3DCMPFUNC f, T a, T b) {
 
 // Runs a blend configuration over 256 pixels with random (and extreme) source grid values and
 // destination bytes in an fx profile, and checks every stored byte against the rational model.
-void checkBlendFx(const MergeState& st, D3DFORMAT fmt, uint32_t seed) {
+// `row`: the lanes are one run of a row (MergeInputs::row, every lane live, as the row paths
+// hand them over), pixels 7 … 262 of row 1 of a 300×2 target; else a 16×16 block.
+void checkBlendFx(const MergeState& st, D3DFORMAT fmt, uint32_t seed, bool row = false) {
     const int32_t G = ps11::gridScale(st.precision);
     std::mt19937 rng(seed);
-    Image img = makeImage(fmt, 16, 16);
+    Image img = row ? makeImage(fmt, 300, 2) : makeImage(fmt, 16, 16);
     Span span(256);
+    const auto at = [&](int i) {
+        return row ? std::pair<uint32_t, uint32_t>(uint32_t(i + 7), 1u)
+                   : std::pair<uint32_t, uint32_t>(uint32_t(i % 16), uint32_t(i / 16));
+    };
+    for (int i = 0; i < 256; ++i) span.x[size_t(i)] = int32_t(at(i).first), span.y[size_t(i)] = int32_t(at(i).second);
     std::vector<std::array<uint32_t, 4>> dst(256);
     const int32_t extremes[] = {0, G, G / 2, 1, G - 1};
     for (int i = 0; i < 256; ++i) {
@@ -295,9 +302,11 @@ void checkBlendFx(const MergeState& st, D3DFORMAT fmt, uint32_t seed) {
         }
         span.setGrid(i, n, st.precision);
         for (int c = 0; c < 4; ++c) dst[size_t(i)][size_t(c)] = (rng() % 7 == 0) ? (rng() % 2) * 255 : rng() % 256;
-        setRgba(img, uint32_t(i % 16), uint32_t(i / 16), dst[size_t(i)]);
+        setRgba(img, at(i).first, at(i).second, dst[size_t(i)]);
     }
-    run(st, span, &img);
+    MergeInputs in = span.inputs(true);
+    if (row) in.row = true, in.live = nullptr;
+    mergePixels(st, in, MergeTarget{&img, nullptr}, nullptr);
     const bool x8 = fmt == D3DFMT_X8R8G8B8;
     for (int i = 0; i < 256; ++i) {
         Q s[4], d[4];
@@ -308,7 +317,7 @@ void checkBlendFx(const MergeState& st, D3DFORMAT fmt, uint32_t seed) {
         }
         if (x8) d[3] = kOneQ;  // X8R8G8B8 reads alpha as 1
         const std::array<Q, 4> r = blendRef(st, s, d);
-        const std::array<uint32_t, 4> got = rgbaAt(img, uint32_t(i % 16), uint32_t(i / 16));
+        const std::array<uint32_t, 4> got = rgbaAt(img, at(i).first, at(i).second);
         for (int c = 0; c < 4; ++c) {
             uint32_t want = byteOfQ(r[size_t(c)]);
             if (x8 && c == 3) want = 255;
@@ -375,6 +384,25 @@ TEST_CASE("merger: fx12 blending is exact on the 4080 grid and rounds once to 8 
             checkBlendFx(blendState(f, D3DBLEND_DESTALPHA, op, Precision::Fx12), D3DFMT_A8R8G8B8, seed++);
             checkBlendFx(blendState(D3DBLEND_SRCCOLOR, f, op, Precision::Fx12), D3DFMT_A8R8G8B8, seed++);
         }
+}
+
+TEST_CASE("merger: fx blending of a row run gives the formula's bytes for every factor pair", "[merger]") {
+    // The row paths' spans: words loaded and stored in place; factor pairs of ZERO and ONE take
+    // the byte of ±s ± d without products.
+    uint32_t seed = 7000;
+    for (Precision p : {Precision::Fx8, Precision::Fx12})
+        for (D3DBLENDOP op : kAllOps)
+            for (D3DBLEND fs : kAllBlends) {
+                for (D3DBLEND fd : kAllBlends) checkBlendFx(blendState(fs, fd, op, p), D3DFMT_A8R8G8B8, seed++, true);
+                // (X8R8G8B8's X byte becomes 0xff where a channel is written: never with ZERO/ONE ADD.)
+                checkBlendFx(blendState(fs, D3DBLEND_INVSRCALPHA, op, p), D3DFMT_X8R8G8B8, seed++, true);
+            }
+    // The same pairs of ZERO and ONE on a 16×16 block (gathered lanes).
+    for (Precision p : {Precision::Fx8, Precision::Fx12})
+        for (D3DBLENDOP op : kAllOps)
+            for (D3DBLEND fs : {D3DBLEND_ZERO, D3DBLEND_ONE})
+                for (D3DBLEND fd : {D3DBLEND_ZERO, D3DBLEND_ONE})
+                    checkBlendFx(blendState(fs, fd, op, p), D3DFMT_A8R8G8B8, seed++);
 }
 
 TEST_CASE("merger: blending behind a passing alpha or depth test gives the same bytes", "[merger]") {

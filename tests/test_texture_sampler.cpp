@@ -678,6 +678,37 @@ TEST_CASE("sampler: floatAxisTaps gives the same pairs and weights at every SIMD
                 }
 }
 
+TEST_CASE("sampler: says when every fx lookup lies in [0, G] (8-bit texels, a border of bytes)", "[sampler]") {
+    // SampleResult::unitRange lets the executor skip the ±MaxValue clamp of the result.
+    const auto unit = [](TextureSampler& s, Precision p) {
+        const std::vector<float> u{0.1f, 0.7f, -0.4f, 1.6f}, v{0.2f, 0.9f, 0.5f, -0.3f};
+        int32_t g[4][4];
+        SampleRequest req;
+        req.count = 4, req.dims = 2, req.u = u.data(), req.v = v.data(), req.precision = p;
+        SampleResult out;
+        for (int c = 0; c < 4; ++c) out.grid[c] = g[c];
+        out.unitRange = true;  // a stale flag is cleared
+        s.sample(req, out);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < 4 && out.unitRange; ++i) CHECK((g[c][i] >= 0 && g[c][i] <= gridScale(p)));
+        return out.unitRange;
+    };
+    for (Precision p : {Precision::Fx8, Precision::Fx12}) {
+        INFO(precisionName(p));
+        TextureSampler s;
+        s.bind(0, build(TexFormat::A8R8G8B8, 2, 2, {0xffffffff, 0x00000000, 0x80ff0010, 0x7f00ff01}));
+        s.setSamplerState(0, state(Filter::Linear, TextureAddress::Wrap));
+        CHECK(unit(s, p));
+        SamplerState border = state(Filter::Linear, TextureAddress::Border);
+        border.border = {1, 0.2f, 0, 1};  // 0.2 = 51/255: a byte on both grids
+        s.setSamplerState(0, border);
+        CHECK(unit(s, p));
+        s.bind(0, build(TexFormat::V8U8, 2, 2, {0x817f, 0x8040, 0x0000, 0x7f7f}));
+        s.setSamplerState(0, state(Filter::Linear, TextureAddress::Wrap));
+        CHECK_FALSE(unit(s, p));  // signed texels
+    }
+}
+
 TEST_CASE("texture: an 8-bit texel's float is float(b) / 255 rounded once", "[texture]") {
     // The row paths decode 8-bit texel rows with a float division per channel instead of the
     // table (emu/aligned_float.cpp, the output merger's blends): both must give the same floats.
