@@ -543,6 +543,12 @@ std::optional<CallError> mergeStateError(const DeviceState& st) {
     return std::nullopt;
 }
 
+bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target) {
+    if (!ps11::isFixedPoint(precision) || !target.color) return !ps11::isFixedPoint(precision);
+    Plan p;
+    return !resolveTarget(target, p) || (p.target != TargetKind::Argb8 && p.target != TargetKind::Xrgb8);
+}
+
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats) {
     // A colour target of another format, or a depth target of a non-depth format, is the
     // caller's programming error: asserted, and in release builds nothing is written.

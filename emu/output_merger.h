@@ -52,8 +52,9 @@ struct MergeInputs {
     // The lanes are pixels x[0] .. x[0] + count − 1 of row y[0] (the row paths' spans): the
     // merger may store them as one run (x and y must still be given and say the same).
     bool row = false;
-    // r0 from the executor: color always (real values); grid in fx profiles (value = grid / G),
-    // null otherwise. The merger uses grid when given.
+    // r0 from the executor: color (real values; may be null where mergeReadsColor says the merge
+    // never reads it, and then reads as 0); grid in fx profiles (value = grid / G), null
+    // otherwise. The merger uses grid when given.
     const float* color[4] = {};
     const int32_t* grid[4] = {};
     const float* fog = nullptr;  // fog factor per lane (1 = no fog; clamped to [0, 1]; null = 1), when MergeState::fog
@@ -71,6 +72,10 @@ struct MergeStats {
     uint64_t alphaRejected = 0;  // failed the alpha test
     uint64_t depthRejected = 0;  // failed the depth test
 };
+
+// Whether mergePixels reads MergeInputs::color: always in the float profiles; in fx profiles,
+// which merge from the grid, only into float colour targets.
+bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target);
 
 // Merges the pixels into the target. Thread-safe for calls that touch disjoint pixels.
 // Another colour format, a non-depth format as `depth`, or pixels outside the target are the

@@ -462,8 +462,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
             }
             ps11::PixelOutputs outp;
+            const bool readsColor = mergeReadsColor(precision, mtarget);
             for (int c = 0; c < 4; ++c) {
-                outp.color[c] = lanes->color[c];
+                outp.color[c] = readsColor ? lanes->color[c] : nullptr;
                 if (fx) outp.grid[c] = lanes->grid[c];
             }
             outp.killed = lanes->killed;
@@ -484,7 +485,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 mi.live = kills ? lanes->live : rowSpans ? nullptr : sp.live;
                 mi.row = rowSpans;
                 for (int c = 0; c < 4; ++c) {
-                    mi.color[c] = lanes->color[c];
+                    mi.color[c] = readsColor ? lanes->color[c] : nullptr;
                     mi.grid[c] = fx ? lanes->grid[c] : nullptr;
                 }
                 mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
