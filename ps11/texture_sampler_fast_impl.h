@@ -303,13 +303,16 @@ void blend(int count, const uint8_t* t00p, const uint8_t* t10p, const uint8_t* t
 }
 
 #ifdef __AVX2__
-// Eight lanes [i, i + 8) of a bilinear fx8 run, gathered and blended in integers: the same sum as
+// Eight lanes [i, i + 8) of a bilinear fx run, gathered and blended in integers: the same sum as
 // blend()'s, one rounding. Lanes whose texel lies on the border take the border word (a masked
 // gather reads no memory for them). Per channel h = a·(256 − wx) + b·wx per texel row (below
 // 2^16: 16-bit products), then pmaddwd forms (h0 − 2^15)·(256 − wy) + (h1 − 2^15)·wy = sum − 2^23
-// exactly, and round_half_even(sum / 2^16) is taken with shifts. The results (bytes) are packed
-// back into b g r a words and split into the planes.
+// exactly, and round_half_even(sum / 2^Shift) is taken with shifts: Shift 16 gives fx8's bytes,
+// packed back into b g r a words and split into the planes; Shift 12 gives fx12's grid values
+// (16·sum / 2^16, at most 4080), transposed from 16-bit lanes into the planes.
+template <int Shift>
 void blendLinear8(const Unorm8Run& run, const Scratch& s, int i, int32_t* r, int32_t* g, int32_t* b, int32_t* a) {
+    static_assert(Shift == 16 || Shift == 12);
     auto load = [&](const int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p + i)); };
     const __m256i x0 = load(s.x0), x1 = load(s.x1), y0 = load(s.y0), y1 = load(s.y1);
     const __m256i wx = load(s.wx), wy = load(s.wy);
@@ -326,7 +329,7 @@ void blendLinear8(const Unorm8Run& run, const Scratch& s, int i, int32_t* r, int
     const __m256i wxs = _mm256_or_si256(wx, _mm256_slli_epi32(wx, 16));
     const __m256i wyp = _mm256_or_si256(_mm256_sub_epi32(_mm256_set1_epi32(256), wy), _mm256_slli_epi32(wy, 16));
     const __m256i full = _mm256_set1_epi16(256), flip = _mm256_set1_epi16(int16_t(-32768));
-    const __m256i round = _mm256_set1_epi32((1 << 23) + 0x7fff), one = _mm256_set1_epi32(1);
+    const __m256i round = _mm256_set1_epi32((1 << 23) + (1 << (Shift - 1)) - 1), one = _mm256_set1_epi32(1);
     __m256i words[2];
     for (int half = 0; half < 2; ++half) {
         auto bytes16 = [&](__m256i t) {
@@ -344,18 +347,34 @@ void blendLinear8(const Unorm8Run& run, const Scratch& s, int i, int32_t* r, int
         const __m256i wlo = _mm256_permutevar8x32_epi32(wyp, _mm256_setr_epi32(q, q, q, q, q + 2, q + 2, q + 2, q + 2));
         const __m256i whi =
             _mm256_permutevar8x32_epi32(wyp, _mm256_setr_epi32(q + 1, q + 1, q + 1, q + 1, q + 3, q + 3, q + 3, q + 3));
-        auto rounded = [&](__m256i m) {  // m = sum − 2^23
-            const __m256i odd = _mm256_and_si256(_mm256_srai_epi32(m, 16), one);
-            return _mm256_srai_epi32(_mm256_add_epi32(_mm256_add_epi32(m, round), odd), 16);
+        auto rounded = [&](__m256i m) {  // m = sum − 2^23; 2^23 is a multiple of 2^(Shift + 1)
+            const __m256i odd = _mm256_and_si256(_mm256_srai_epi32(m, Shift), one);
+            return _mm256_srai_epi32(_mm256_add_epi32(_mm256_add_epi32(m, round), odd), Shift);
         };
         const __m256i lo = rounded(_mm256_madd_epi16(_mm256_unpacklo_epi16(h0, h1), wlo));
         const __m256i hi = rounded(_mm256_madd_epi16(_mm256_unpackhi_epi16(h0, h1), whi));
         words[half] = _mm256_packus_epi32(lo, hi);  // per 128-bit lane: pixels q, q + 1 | q + 2, q + 3
     }
+    auto store = [&](int32_t* p, __m256i v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + i), v); };
+    if constexpr (Shift == 12) {
+        // words[h]: pixels 4h … 4h + 3, each b g r a as 16-bit lanes. Within each 128-bit lane the
+        // pairs of a channel are gathered ((b0 b1) (g0 g1) (r0 r1) (a0 a1)), the lanes' pairs put
+        // side by side, then one channel's eight values are the low or high 64 bits of both words.
+        const __m256i pairs = _mm256_setr_epi8(0, 1, 8, 9, 2, 3, 10, 11, 4, 5, 12, 13, 6, 7, 14, 15, 0, 1, 8, 9, 2, 3,
+                                               10, 11, 4, 5, 12, 13, 6, 7, 14, 15);
+        const __m256i order = _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7);
+        const __m256i w0 = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(words[0], pairs), order);
+        const __m256i w1 = _mm256_permutevar8x32_epi32(_mm256_shuffle_epi8(words[1], pairs), order);
+        const __m256i br = _mm256_unpacklo_epi64(w0, w1), ga = _mm256_unpackhi_epi64(w0, w1);  // b | r, g | a
+        store(b, _mm256_cvtepu16_epi32(_mm256_castsi256_si128(br)));
+        store(r, _mm256_cvtepu16_epi32(_mm256_extracti128_si256(br, 1)));
+        store(g, _mm256_cvtepu16_epi32(_mm256_castsi256_si128(ga)));
+        store(a, _mm256_cvtepu16_epi32(_mm256_extracti128_si256(ga, 1)));
+        return;
+    }
     const __m256i packed =
         _mm256_permutevar8x32_epi32(_mm256_packus_epi16(words[0], words[1]), _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7));
     const __m256i m8 = _mm256_set1_epi32(255);
-    auto store = [&](int32_t* p, __m256i v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p + i), v); };
     store(b, _mm256_and_si256(packed, m8));
     store(g, _mm256_and_si256(_mm256_srli_epi32(packed, 8), m8));
     store(r, _mm256_and_si256(_mm256_srli_epi32(packed, 16), m8));
@@ -406,9 +425,13 @@ void sampleUnorm8(const Unorm8Run& run, int count, const float* u, const float* 
             blend(count, r0, r0 + 4, r1, r1 + 4, s.wx, s.wy, outScale, dst[0], dst[1], dst[2], dst[3]);
         } else {
 #ifdef __AVX2__
-            if (run.scale == 1 && !quadContiguous(count, s)) {
+            if ((run.scale == 1 || run.scale == 16) && !quadContiguous(count, s)) {
                 const int whole = count & ~7;
-                for (int i = 0; i < whole; i += 8) blendLinear8(run, s, i, dst[0], dst[1], dst[2], dst[3]);
+                for (int i = 0; i < whole; i += 8)
+                    if (run.scale == 1)
+                        blendLinear8<16>(run, s, i, dst[0], dst[1], dst[2], dst[3]);
+                    else
+                        blendLinear8<12>(run, s, i, dst[0], dst[1], dst[2], dst[3]);
                 if (whole == count) return;
                 // The last lanes: gathered and blended one by one, from the front of the scratch.
                 Scratch& t = s;
