@@ -27,8 +27,13 @@ namespace {
 
 bool effectiveLinear(ps11::Filter f) { return f == ps11::Filter::Linear; }
 
-// round_half_even(t / 65536) for 0 <= t < 2^24.
-inline int32_t roundBlend(uint32_t t) { return int32_t((t + 0x7fffu + ((t >> 16) & 1u)) >> 16); }
+// The filtered value of a four-texel sum t = Σ byte·weight (weights of 65536 in all, t < 2^24):
+// fx8 round_half_even(t / 65536); fx12 round_half_even(16·t / 65536) = round_half_even(t / 4096).
+template <bool Fx12>
+inline int32_t roundBlend(uint32_t t) {
+    constexpr int kShift = Fx12 ? 12 : 16;
+    return int32_t((t + ((1u << (kShift - 1)) - 1) + ((t >> kShift) & 1u)) >> kShift);
+}
 
 // Channel c (r g b a) of a b g r a word.
 inline uint32_t channel(uint32_t word, int c) { return (word >> (8 * ps11::kUnorm8Byte[c])) & 0xffu; }
@@ -57,6 +62,7 @@ struct TapRow {
 };
 
 // Any footprint, one pixel at a time: the exact four-texel sum of the reference.
+template <bool Fx12>
 void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase,
                   int first, int count, int lane, int16_t* const out[4]) {
     const int32_t wy = row.wy;
@@ -70,7 +76,7 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
         for (int ch = 0; ch < 4; ++ch) {
             const uint32_t h0 = channel(a, ch) * uint32_t(256 - wx) + channel(b, ch) * uint32_t(wx);
             const uint32_t h1 = channel(c, ch) * uint32_t(256 - wx) + channel(d, ch) * uint32_t(wx);
-            out[ch][lane + i] = int16_t(roundBlend(h0 * uint32_t(256 - wy) + h1 * uint32_t(wy)));
+            out[ch][lane + i] = int16_t(roundBlend<Fx12>(h0 * uint32_t(256 - wy) + h1 * uint32_t(wy)));
         }
     }
 }
@@ -91,10 +97,43 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
     }
 }
 
+// fx12: each channel's byte of its grid value saturated to [0, 4080]; additive (ONE/ONE ADD):
+// the byte of s + 16·d saturated, which is what the merger's exact blend rounds to (both factors
+// one: G·(s + 16·d)·255 / G² = (s + 16·d) / 16).
+// Channel by channel over the lanes (count <= kMaxSpan), in loops the compiler vectorises.
+template <bool Additive>
+void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    alignas(32) uint32_t old[ps11::kMaxSpan], out[ps11::kMaxSpan];
+    if constexpr (Additive) std::memcpy(old, dst, 4 * size_t(count));
+    for (int i = 0; i < count; ++i) out[i] = orMask;
+    for (int c = 0; c < 4; ++c) {
+        const int shift = 8 * ps11::kUnorm8Byte[c];
+        const int16_t* __restrict rc = r[c];
+        for (int i = 0; i < count; ++i) {
+            int32_t n = rc[i] < 0 ? 0 : rc[i] > 4080 ? 4080 : rc[i];
+            if constexpr (Additive) {
+                n += int32_t((old[i] >> shift) & 0xffu) * 16;
+                n = n > 4080 ? 4080 : n;
+            }
+            out[i] |= unorm8OfFx12(n) << shift;
+        }
+    }
+    std::memcpy(dst, out, 4 * size_t(count));
+}
+
 // Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
 // vector kernel (which reads the planes in whole groups of 16 lanes: theirs are kChunk or kMaxSpan
 // long), then whatever it left one by one.
 void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
+    if (draw.fx12) {
+        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, row) : 0;
+        const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
+        if (draw.directAdd)
+            storeRowScalar12<true>(rest, n - done, orMask, row + 4 * done);
+        else
+            storeRowScalar12<false>(rest, n - done, orMask, row + 4 * done);
+        return;
+    }
     int done = 0;
     if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
     const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
@@ -137,7 +176,15 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
         if (!((window.copyMask >> c) & 1)) {
             const int shift = 8 * ps11::kUnorm8Byte[c];
             keep &= ~(0xffu << shift);
-            set |= uint32_t(std::clamp<int32_t>(window.grid[size_t(c)], 0, 255)) << shift;
+            int32_t byte = std::clamp<int32_t>(window.grid[size_t(c)], 0, 255);
+            if (draw.fx12) {
+                // fx12: a texel's grid value is 16·b, whose byte is b, and 16·b + 16·d adds bytes
+                // with saturation; a constant between two bytes would round with the sum: filtered.
+                const int32_t g = std::clamp<int32_t>(window.grid[size_t(c)], 0, 4080);
+                if (additive && g % 16 != 0) return false;
+                byte = int32_t(unorm8OfFx12(g));
+            }
+            set |= uint32_t(byte) << shift;
         }
     const uint8_t* src = row.row0 + o;
     if (!additive && keep == ~0u && set == 0) {
@@ -227,7 +274,7 @@ void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, i
     run.linear = tap.linear;
     run.addressU = tap.addressU, run.addressV = tap.addressV;
     run.borderWord = tap.borderWord;
-    run.scale = 1;
+    run.scale = draw.fx12 ? 16 : 1;
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
     draw.sample(run, n, u, v, g);
@@ -272,12 +319,14 @@ constexpr int kMinDirectColumns = 8;
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-slp-vectorize")))
 #endif
-void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
+void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
                const TapRow& row, int colBase, int first, int count, int16_t* const out[4]) {
     if (!tap.bound) {
-        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? 255 : 0));
+        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? (fx12 ? 4080 : 255) : 0));
         return;
     }
+    // fx12 takes the vertical kernel that rounds 16·t / 65536 and its texels times 16.
+    const auto vertical = kernels ? (fx12 ? kernels->vertical12 : kernels->vertical) : nullptr;
     auto vectorRun = [&](int x) {
         const int32_t r = cols.run[size_t(x - colBase)];
         return r >= 0 && row.ready[size_t(cols.runs[size_t(r)].config)] ? r : -1;
@@ -305,6 +354,9 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
                     kernels->deinterleave(texels + 4 * n16, n - n16, t);
                     for (int c = 0; c < 4; ++c) std::memcpy(dst[c] + n16, tail[c], sizeof(uint16_t) * size_t(n - n16));
                 }
+                if (fx12)
+                    for (int c = 0; c < 4; ++c)
+                        for (int i = 0; i < n; ++i) dst[c][i] = uint16_t(dst[c][i] << 4);
                 x = e;
                 continue;
             }
@@ -315,7 +367,7 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
             const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
                                            row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
             const HKind kind = run.tabulated ? HKind::H : hKindOf(cols.w[size_t(x - colBase)]);
-            kernels->vertical(kind, h0, h1, row.wy, e - x, x - first, out);
+            vertical(kind, h0, h1, row.wy, e - x, x - first, out);
             x = e;
             continue;
         }
@@ -341,10 +393,13 @@ void filterTap(const AlignedKernels* kernels, const AlignedTap& tap, const Align
                     kernels->buildTabulated(row.row1, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1);
                 const uint16_t* const c0[4] = {h0[0], h0[1], h0[2], h0[3]};
                 const uint16_t* const c1[4] = {h1[0], h1[1], h1[2], h1[3]};
-                kernels->vertical(HKind::H, c0, c1, row.wy, n, x + done - first, out);
+                vertical(HKind::H, c0, c1, row.wy, n, x + done - first, out);
             }
         } else {
-            filterScalar(tap, cols, row, colBase, x, e - x, x - first, out);
+            if (fx12)
+                filterScalar<true>(tap, cols, row, colBase, x, e - x, x - first, out);
+            else
+                filterScalar<false>(tap, cols, row, colBase, x, e - x, x - first, out);
         }
         x = e;
     }
@@ -515,9 +570,11 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                         const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
-    if (precision != ps11::Precision::Fx8 || wantZ || merge.fog || !target.color) return false;
+    const bool fx12 = precision == ps11::Precision::Fx12;
+    if ((precision != ps11::Precision::Fx8 && !fx12) || wantZ || merge.fog || !target.color) return false;
     AlignedDraw d;
     if (!ps11::tapPlan(executor, d.plan)) return false;
+    d.fx12 = fx12;
     static std::atomic<uint64_t> serials{0};
     d.serial = ++serials;
     d.executor = &executor;
@@ -883,8 +940,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, dst);
             return;
         }
-        filterTap(f.draw->kernels, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)], (*f.rows)[size_t(tap)],
-                  f.tri->x0, f.x + first, count, dst);
+        filterTap(f.draw->kernels, f.draw->fx12, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)],
+                  (*f.rows)[size_t(tap)], f.tri->x0, f.x + first, count, dst);
     };
     const ps11::ResultSink sink = [](void* p, int first, int count, const int16_t* const lanes[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
@@ -1039,12 +1096,16 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     mi.x = sc.x;
                     mi.y = sc.y;
                     mi.row = true;
+                    // (The merger merges fx profiles from the grid: mergeReadsColor says where it also
+                    // reads the real values.)
+                    const bool readsColor =
+                        mergeReadsColor(draw.fx12 ? ps11::Precision::Fx12 : ps11::Precision::Fx8, draw.target);
+                    const float g = draw.fx12 ? 4080.0f : 255.0f;
                     for (int c = 0; c < 4; ++c) {
-                        for (int i = 0; i < n; ++i) {
-                            sc.grid[c][i] = sc.r0[c][i];
-                            sc.colorOut[c][i] = float(sc.r0[c][i]) / 255.0f;
-                        }
-                        mi.color[c] = sc.colorOut[c];
+                        for (int i = 0; i < n; ++i) sc.grid[c][i] = sc.r0[c][i];
+                        if (readsColor)
+                            for (int i = 0; i < n; ++i) sc.colorOut[c][i] = float(sc.r0[c][i]) / g;
+                        mi.color[c] = readsColor ? sc.colorOut[c] : nullptr;
                         mi.grid[c] = sc.grid[c];
                     }
                     MergeStats ms;

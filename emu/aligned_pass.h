@@ -1,4 +1,4 @@
-// The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): fx8 triangles with a
+// The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): fx8 and fx12 triangles with a
 // program whose texture reads are plain (ps11::tapPlan, ps11/executor_presampled_internal.h) are
 // drawn row by row without quads. A tap whose coordinates are screen-aligned on the triangle (u
 // depends on x only, v on y only, no perspective) has its texel columns and weights tabulated once
@@ -55,8 +55,9 @@ struct AlignedDraw {
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
     MergeState merge;
     MergeTarget target;
+    bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
     bool directStore = false;  // 8-bit target, no tests, fog or blending, all channels: stored here
-    bool directAdd = false;    // fx8 ONE/ONE ADD on every channel into an 8-bit target
+    bool directAdd = false;    // ONE/ONE ADD on every channel into an 8-bit target
 };
 
 // Decides whether a draw can take the aligned path (per-triangle checks come later) and fills

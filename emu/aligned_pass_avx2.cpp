@@ -273,12 +273,14 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
 // |m| < 2²³ converts exactly, and the sum, at most 256 with 16 fraction bits, is exact too
 // (checked for every t in [0, 65280·256] when this was written; the row-path tests compare
 // every result with the quad path's integer rounding).
-template <int Up>
+// Shift 12 (fx12) takes round_half_even(t / 4096) the same way: m·2⁻¹² + 2048 = t / 4096, at most
+// 4096 with 12 fraction bits, is exact too.
+template <int Up, int Shift = 16>
 void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
                      int16_t* const out[4]) {
     const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
     const __m256i flip = _mm256_set1_epi16(int16_t(0x8000));
-    const __m256 scale = _mm256_set1_ps(1.0f / 65536.0f), c128 = _mm256_set1_ps(128.0f);
+    const __m256 scale = _mm256_set1_ps(1.0f / float(1 << Shift)), c128 = _mm256_set1_ps(float(1 << (23 - Shift)));
     auto round = [&](__m256i m) { return _mm256_cvtps_epi32(_mm256_fmadd_ps(_mm256_cvtepi32_ps(m), scale, c128)); };
     verticalGroups(count, lane, out, [&](int c, int k) {
         const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), Up), flip);
@@ -330,6 +332,20 @@ void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t
         verticalGeneral<0>(h0, h1, wy, count, lane, out);
 }
 
+// 16 pixels' words (b g r a bytes, `om` or-ed in) from int16 r g b a lanes, each clamped to
+// [0, 255]: pixels 0-7 in `first`, 8-15 in `second`.
+inline void packWords(__m256i r, __m256i g, __m256i b, __m256i a, __m256i om, __m256i& first, __m256i& second) {
+    // packus: int16 -> uint8 with saturation to [0, 255], per 128-bit lane.
+    const __m256i bg = _mm256_packus_epi16(b, g);                             // lane0: b0-7 g0-7, lane1: b8-15 g8-15
+    const __m256i ra = _mm256_packus_epi16(r, a);                             // r, a likewise
+    const __m256i bgLo = _mm256_unpacklo_epi8(bg, _mm256_srli_si256(bg, 8));  // b0 g0 b1 g1 ... (lane-wise)
+    const __m256i raLo = _mm256_unpacklo_epi8(ra, _mm256_srli_si256(ra, 8));
+    const __m256i w0 = _mm256_or_si256(_mm256_unpacklo_epi16(bgLo, raLo), om);  // px 0-3 | 8-11
+    const __m256i w1 = _mm256_or_si256(_mm256_unpackhi_epi16(bgLo, raLo), om);  // px 4-7 | 12-15
+    first = _mm256_permute2x128_si256(w0, w1, 0x20);                            // px 0-7
+    second = _mm256_permute2x128_si256(w0, w1, 0x31);                           // px 8-15
+}
+
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
@@ -337,15 +353,8 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
     const __m256i om = _mm256_set1_epi32(int32_t(orMask));
     for (int i = 0; i < count; i += 16) {
         auto ld = [&](int c) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i)); };
-        // packus: int16 -> uint8 with saturation to [0, 255], per 128-bit lane.
-        const __m256i bg = _mm256_packus_epi16(ld(2), ld(1));  // lane0: b0-7 g0-7, lane1: b8-15 g8-15
-        const __m256i ra = _mm256_packus_epi16(ld(0), ld(3));  // r, a likewise
-        const __m256i bgLo = _mm256_unpacklo_epi8(bg, _mm256_srli_si256(bg, 8));  // b0 g0 b1 g1 ... (lane-wise)
-        const __m256i raLo = _mm256_unpacklo_epi8(ra, _mm256_srli_si256(ra, 8));
-        const __m256i w0 = _mm256_or_si256(_mm256_unpacklo_epi16(bgLo, raLo), om);  // px 0-3 | 8-11
-        const __m256i w1 = _mm256_or_si256(_mm256_unpackhi_epi16(bgLo, raLo), om);  // px 4-7 | 12-15
-        __m256i first = _mm256_permute2x128_si256(w0, w1, 0x20);                    // px 0-7
-        __m256i second = _mm256_permute2x128_si256(w0, w1, 0x31);                   // px 8-15
+        __m256i first, second;
+        packWords(ld(0), ld(1), ld(2), ld(3), om, first, second);
         __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
         __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
@@ -375,9 +384,80 @@ int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uin
     return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
 }
 
+// fx12: every kind through the general blend, its H values widened to h first (kind A: 256·a,
+// kind S: 128·s, both at most 65280); with wy = 0 the second row is not read (h1 may be null), h0
+// stands in for it.
+void alignedVertical12Avx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                           int lane, int16_t* const out[4]) {
+    const uint16_t* const* second = wy == 0 ? h0 : h1;
+    switch (kind) {
+        case HKind::A:
+            verticalGeneral<8, 12>(h0, second, wy, count, lane, out);
+            return;
+        case HKind::S:
+            verticalGeneral<7, 12>(h0, second, wy, count, lane, out);
+            return;
+        case HKind::H:
+            verticalGeneral<0, 12>(h0, second, wy, count, lane, out);
+            return;
+    }
+}
+
+// fx12 words: each channel's grid value n clamped to [0, 4080] (additive: n + 16·d, the target
+// byte d, clamped again), then its byte round_half_even(n / 16) = (n + 7 + (n >> 4 & 1)) >> 4,
+// all in int16 lanes (at most 8160).
+template <bool Additive>
+int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    const __m256i om = _mm256_set1_epi32(int32_t(orMask)), zero = _mm256_setzero_si256();
+    const __m256i top = _mm256_set1_epi16(4080), seven = _mm256_set1_epi16(7), one = _mm256_set1_epi16(1);
+    const __m256i m8 = _mm256_set1_epi32(0xff);
+    for (int i = 0; i < count; i += 16) {
+        __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
+        __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
+        const bool tail = count - i < 16;
+        const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
+        __m256i old0 = zero, old1 = zero;
+        if constexpr (Additive) {
+            old0 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d0), m0) : _mm256_loadu_si256(d0);
+            old1 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d1), m1) : _mm256_loadu_si256(d1);
+        }
+        __m256i ch[4];
+        for (int c = 0; c < 4; ++c) {
+            __m256i n = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i));
+            n = _mm256_min_epi16(_mm256_max_epi16(n, zero), top);
+            if constexpr (Additive) {
+                // The target's channel bytes of the 16 pixels as int16 lanes, in order.
+                const int shift = 8 * ps11::kUnorm8Byte[c];
+                const __m256i lo = _mm256_and_si256(_mm256_srl_epi32(old0, _mm_cvtsi32_si128(shift)), m8);
+                const __m256i hi = _mm256_and_si256(_mm256_srl_epi32(old1, _mm_cvtsi32_si128(shift)), m8);
+                const __m256i d = _mm256_permute4x64_epi64(_mm256_packs_epi32(lo, hi), 0xD8);
+                n = _mm256_min_epi16(_mm256_add_epi16(n, _mm256_slli_epi16(d, 4)), top);
+            }
+            const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(n, 4), one);
+            ch[c] = _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(n, seven), odd), 4);
+        }
+        __m256i first, second;
+        packWords(ch[0], ch[1], ch[2], ch[3], om, first, second);
+        _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
+        if (tail) {  // the last pixels: masked stores of their words alone
+            _mm256_maskstore_epi32(reinterpret_cast<int*>(d0), m0, first);
+            _mm256_maskstore_epi32(reinterpret_cast<int*>(d1), m1, second);
+            break;
+        }
+        _mm256_storeu_si256(d0, first);
+        _mm256_storeu_si256(d1, second);
+    }
+    return count;
+}
+
+int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    return additive ? storeRow12<true>(r, count, orMask, dst) : storeRow12<false>(r, count, orMask, dst);
+}
+
 }  // namespace
 
-const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2, &alignedPairSums4Avx2,
-                                    &alignedBuildTabulatedAvx2, &alignedVerticalAvx2, &alignedStoreRowAvx2};
+const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2,   &alignedPairSums4Avx2,
+                                    &alignedBuildTabulatedAvx2, &alignedVerticalAvx2,  &alignedVertical12Avx2,
+                                    &alignedStoreRowAvx2,       &alignedStoreRow12Avx2};
 
 }  // namespace emu

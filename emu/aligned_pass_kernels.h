@@ -59,12 +59,19 @@ struct AlignedKernels {
     // kind `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.
     void (*vertical)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                      int lane, int16_t* const out[4]);
+    // The same blend for fx12: round_half_even(16·(h0·(256 − wy) + h1·wy) / 65536), the grid
+    // integers (at most 4080) of the fx12 sampler.
+    void (*vertical12)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                       int lane, int16_t* const out[4]);
 
     // Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
     // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
     // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes
     // (the lanes past `count` are ignored); dst is never touched past its `count` words.
     int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+    // The same for fx12 lanes: each channel's byte round_half_even(n / 16) of n clamped to
+    // [0, 4080]; additive: of n + 16·(the target's byte), clamped again (the merger's ONE/ONE).
+    int (*storeRow12)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
 };
 
 // The table of a level, or null (no vector kernels at that level).

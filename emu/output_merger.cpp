@@ -199,8 +199,8 @@ struct Fx {
     static uint32_t byteOf(int32_t n) {
         if constexpr (G == 255)
             return uint32_t(n);
-        else  // n = 16q + r rounds up when r > 8, or r == 8 and q is odd
-            return uint32_t(n + 7 + ((n >> 4) & 1)) >> 4;
+        else
+            return unorm8OfFx12(n);
     }
     // round_half_even(num * 255 / G^2) for num in [-G^2, 2 G^2] clamped to [0, G^2] first
     // (fx8: num / 255; fx12: num / 65280); 2 G^2 < 2^31.

@@ -73,6 +73,10 @@ struct MergeStats {
     uint64_t depthRejected = 0;  // failed the depth test
 };
 
+// The stored byte of a saturated fx12 grid value n in [0, 4080]: round_half_even(n / 16)
+// (n = 16q + r rounds up when r > 8, or r == 8 and q is odd).
+inline uint32_t unorm8OfFx12(int32_t n) { return uint32_t(n + 7 + ((n >> 4) & 1)) >> 4; }
+
 // Whether mergePixels reads MergeInputs::color: always in the float profiles; in fx profiles,
 // which merge from the grid, only into float colour targets.
 bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target);

@@ -159,9 +159,23 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
     const bool fx = isFixedPoint(m_p.precision);
     std::memset(st.killed, 0, sizeof st.killed);
     loadColors(st);
+    int tap = 0;  // texture instructions so far (pre-sampled runs: the tap they read)
     for (const DOp& op : m_ops) {
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
-        if (op.texture) {
+        if (op.texture && st.fill) {
+            // A plain read (plainTaps): all four channels, clamped to ±M as sampled texels are.
+            alignas(64) int16_t texels[4][kChunk];
+            int16_t* const dst[4] = {texels[0], texels[1], texels[2], texels[3]};
+            const int n = st.n;
+            st.fill(st.fillCtx, tap++, st.offset, n, dst);
+            // (Texels lie in [0, G]: the clamp changes nothing where M >= 1.)
+            const int32_t hi = std::min(m_p.nMax, m_p.g);
+            for (int c = 0; c < 4; ++c) {
+                int32_t* __restrict d = st.bi.reg[op.dstSlot][c];
+                const int16_t* __restrict t = texels[c];
+                for (int i = 0; i < n; ++i) d[i] = std::min(int32_t(t[i]), hi);
+            }
+        } else if (op.texture) {
             execTexture(m_p, op, st);
         } else if (fx) {
             fxArith.arith(m_p, op, st, op.hold ? st.bi.hold : st.bi.reg[op.dstSlot]);
@@ -202,7 +216,10 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
 
 bool ExecutorImpl::tapPlan(TapPlan& plan) const {
     plan = TapPlan{};
-    return m_fast.ready && plainTaps(plan);
+    // The fast path's runs, or the generic path's in an fx profile whose register values fit the
+    // int16 lanes of TapFill and ResultSink (|n| <= round(M·G) <= 32767: fx8 to M = 128, fx12 to 8).
+    const bool generic = isFixedPoint(m_p.precision) && m_p.nMax <= INT16_MAX;
+    return (m_fast.ready || generic) && plainTaps(plan);
 }
 
 bool ExecutorImpl::plainTaps(TapPlan& plan) const {
@@ -228,7 +245,33 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                                  ExecutorStats* stats) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
-    runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx);
+    if (m_fast.ready) {
+        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx);
+        countRun(stats, count);
+        return;
+    }
+    // The generic path: runChunk with the taps from `fill`, r0 narrowed to int16 for `sink`.
+    const ThreadCached<RunState> st;
+    st->in = &inputs;
+    st->sampler = nullptr;
+    st->fill = fill;
+    st->fillCtx = ctx;
+    for (int c = 0; c < 4; ++c)
+        if ((m_r0Preset >> c) & 1) std::memset(st->bi.reg[kSlotR][c], 0, sizeof st->bi.reg[kSlotR][c]);
+    const FxArithKernels& fxArith = fxArithKernels(simdLevel());
+    const FloatArithKernels& floatArith = floatArithKernels(simdLevel());
+    alignas(64) int16_t r0[4][kChunk];
+    const int16_t* const out[4] = {r0[0], r0[1], r0[2], r0[3]};
+    for (int off = 0; off < count; off += kChunk) {
+        st->offset = off;
+        st->n = std::min(kChunk, count - off);
+        st->depthWritten = false;
+        runChunk(*st, fxArith, floatArith, nullptr);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < st->n; ++i) r0[c][i] = int16_t(st->bi.reg[kSlotR][c][i]);  // |r0| <= nMax
+        sink(ctx, off, st->n, out);
+    }
+    st->fill = nullptr;
     countRun(stats, count);
 }
 
@@ -249,6 +292,7 @@ void ExecutorImpl::runGeneric(const PixelInputs& inputs, Sampler& sampler, Pixel
     const ThreadCached<RunState> st;  // no 60 KB allocation (nor zero fill) per call
     st->in = &inputs;
     st->sampler = &sampler;
+    st->fill = nullptr;
     const bool fx = isFixedPoint(m_p.precision);
     // r0 is the output: its channels read before written, or never written, are 0, in the bank
     // the profile uses (a trace shows the whole register after each step: all of it).

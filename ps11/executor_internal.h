@@ -10,6 +10,7 @@
 
 #include "ps11/decoded_program.h"
 #include "ps11/executor.h"
+#include "ps11/executor_presampled_internal.h"
 #include "ps11/simd_dispatch.h"
 
 namespace ps11::exec {
@@ -45,6 +46,10 @@ struct RunState {
     // Set by the fx8 fast path around tex/texld: sampleInto then leaves the ±M clamp of the
     // texels to the caller, which clamps while converting to its int16 registers.
     bool deferTexelClamp = false;
+    // Pre-sampled runs on the generic path (runPresampled, fx profiles): the k-th texture
+    // instruction takes tap k's grid integers from `fill` instead of the sampler; null otherwise.
+    TapFill fill = nullptr;
+    void* fillCtx = nullptr;
 };
 
 // The calling thread's T (a run state of tens of KB), kept between calls so a span costs no

@@ -19,19 +19,21 @@ struct TapPlan {
     std::array<uint8_t, 8> coordSet{};
 };
 
-// Available when the program runs on the fx8 fast path and its only texture instructions are
-// plain reads: `tex t#` in ps_1_1–1_3 on a stage without D3DTTFF_PROJECTED (as set now by
-// setStageState), `texld r#, t#` in ps_1_4 (no _dz/_dw, .xy as written). Fills `plan` and
-// returns true, else false.
+// Available when the program runs in an fx profile whose register values fit int16 (the fx8
+// fast path, or the generic path with round(M·G) <= 32767: fx8 up to M = 128, the radeon8500
+// class's fx12 with M = 8) and its only texture instructions are plain reads: `tex t#` in
+// ps_1_1–1_3 on a stage without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#`
+// in ps_1_4 (no _dz/_dw, .xy as written). Fills `plan` and returns true, else false.
 bool tapPlan(const Executor& executor, TapPlan& plan);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
 // is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with
 // a sampler of its own).
 bool plainTaps(const Executor& executor, TapPlan& plan);
 
-// fill(ctx, i, first, n, dst) writes the fx8 grid integers of tap i for lanes [first, first + n)
-// into dst[c][0 .. n) (c = r g b a): 8-bit texels, values in [0, 255] (the executor relies on
-// that, and clamps them to ±round(M·G) when that is smaller, as it does sampled texels).
+// fill(ctx, i, first, n, dst) writes the grid integers of tap i (the profile's: fx8 or fx12) for
+// lanes [first, first + n) into dst[c][0 .. n) (c = r g b a): 8-bit texels, values in [0, G] (the
+// fx8 fast path relies on that), clamped to ±round(M·G) where that is smaller, as sampled texels
+// are.
 using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* const dst[4]);
 // sink(ctx, first, n, r0) takes r0's grid integers of lanes [first, first + n): r0[c][0 .. n)
 // (c = r g b a), valid during the call only. It is called once per chunk of lanes, in order, as

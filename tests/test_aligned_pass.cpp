@@ -334,7 +334,8 @@ void floatProfile(int i, bool ideal, DeviceOptions& a, DeviceOptions& b) {
 }
 
 std::string profileName(const DeviceOptions& o) {
-    return o.precision ? ps11::precisionName(*o.precision) : "the class's own (d3d9: float, 8-bit weights)";
+    if (o.precision) return ps11::precisionName(*o.precision);
+    return o.hardware ? "the " + std::string(o.hardware->name) + " class's own profile" : "the default class's";
 }
 
 // Tile skipping (emu/tile_skip.h) changes no byte and no covered pixel: the case drawn by a device
@@ -349,6 +350,13 @@ void requireSkippingEqual(const DeviceOptions& rowOpt, const Case& c, const std:
     CHECK(ks.pixelsCovered == qs.pixelsCovered);
 }
 
+// Both devices as the radeon8500 class: fx12 with MaxValue 8 (ps11/hardware.h).
+void radeon8500(DeviceOptions& a, DeviceOptions& b) {
+    a.hardware = b.hardware = ps11::findHardware("radeon8500");
+    REQUIRE(a.hardware);
+    a.precision = b.precision = std::nullopt;
+}
+
 }  // namespace
 
 TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte for byte", "[draw][aligned]") {
@@ -360,15 +368,17 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
-        // ps_1_4 programs run on the 1.4-class card, in fx8 (the aligned path's profile).
+        // ps_1_4 programs run on the 1.4-class card, in fx8; every third case on that card in its
+        // own fx12 (MaxValue 8: the generic executor's pre-sampled runs).
         if (c.program.rfind("ps_1_4", 0) == 0) {
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
         }
+        if (i % 3 == 2) radeon8500(quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        INFO("case " << i << ": " << c.w << "x" << c.h << " program:\n" << c.program);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", program:\n" << c.program);
         testutil::forEachSimdLevel([&](ps11::SimdLevel) {
             Device rowDev(rowOpt);
             DrawStats rs;
@@ -383,8 +393,8 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
             CHECK(rs.instructions * qs.pixelsShaded == qs.instructions * rs.pixelsShaded);
         });
     }
-    // Every case qualifies (fx8, plain texture reads, screen-aligned): all must take the row path,
-    // save those whose quads happened to be all covered.
+    // Every case qualifies (fx8 or fx12, plain texture reads, screen-aligned): all must take the
+    // row path, save those whose quads happened to be all covered.
     INFO(aligned << " of " << cases << " cases took the row path");
     CHECK(aligned * 10 >= cases * 9);
 }
@@ -491,6 +501,7 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
         }
+        if (i % 4 == 1) radeon8500(quadOpt, rowOpt);  // fx12: taps sampled per pixel at scale 16
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -527,8 +538,7 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
     CHECK(rowPath * 10 >= cases * 8);
 }
 
-TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 is shaded in row spans",
-          "[draw][aligned]") {
+TEST_CASE("aligned pass: rotated and perspective draws take the row path, in fx8 and fx12", "[draw][aligned]") {
     std::mt19937 rng(7);
     Case c = randomCase(rng);
     c.program = kPrograms[1];
@@ -567,8 +577,8 @@ TEST_CASE("aligned pass: rotated and perspective draws take the row path; fx12 i
     quadOpt.software.threads = 1;
     check("perspective", DeviceOptions{}, true);
 
-    // fx12: the row paths are fx8, float and ideal; its textures have one level, so it is shaded
-    // in spans of one row (rasterizeRowSpans), without helper lanes either.
+    // fx12 (MaxValue 1 here, the ps_1_1 default class's): the aligned path too, without helper
+    // lanes.
     DeviceOptions fx12;
     fx12.precision = ps11::Precision::Fx12;
     quadOpt.precision = ps11::Precision::Fx12;
@@ -579,9 +589,10 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
           "[draw][aligned]") {
     // What the row path may keep between spans or draws (the sign analysis of the constants,
     // filtered texel rows) must follow every change: the same calls on both devices, compared
-    // after every draw. In each profile with a row path: fx8, and float and ideal (the float row
-    // path's H rows and decoded texel rows).
-    const ps11::Precision precision = GENERATE(ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal);
+    // after every draw. In each profile with a row path: fx8 and fx12, and float and ideal (the
+    // float row path's H rows and decoded texel rows).
+    const ps11::Precision precision =
+        GENERATE(ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float, ps11::Precision::Ideal);
     INFO("precision " << ps11::precisionName(precision));
     std::mt19937 rng(4242);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
@@ -1032,9 +1043,10 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
 TEST_CASE("tile skipping: random draws over partly constant textures equal every pixel shaded",
           "[draw][aligned][skip]") {
     // Textures that are zero, one constant texel, zero with a few random blocks (a sparse glare),
-    // or stripes of different constants (tiles whose ranges are different single values); programs of glare passes (composites, bright passes, blurs) among the random ones;
-    // fx8, float and ideal; ONE/ONE blending often. Skipping on must give the bytes of skipping
-    // off (and of the quad path), and must really fill, copy and skip tiles.
+    // or stripes of different constants (tiles whose ranges are different single values); programs of glare passes
+    // (composites, bright passes, blurs) among the random ones; fx8, float, ideal and fx12; ONE/ONE blending often.
+    // Skipping on must give the bytes of skipping off (and of the quad path), and must really fill, copy and skip
+    // tiles.
     const char* const programs[] = {
         "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n",
         "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n",
@@ -1046,9 +1058,9 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
     std::mt19937 rng(20261128);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     uint64_t filled = 0, copied = 0, skipped = 0, shaded = 0;
-    for (int i = 0; i < 360; ++i) {
-        const int profile = i % 3;  // fx8, float, ideal
-        Case c = randomCase(rng, profile != 0);
+    for (int i = 0; i < 480; ++i) {
+        const int profile = i % 4;  // fx8, float, ideal, fx12 (the radeon8500 class)
+        Case c = randomCase(rng, profile == 1 || profile == 2);
         if (uni(0, 2)) c.program = programs[uni(0, int(std::size(programs)) - 1)];
         if (uni(0, 1)) c.blend = 1;  // ONE/ONE
         if (uni(0, 1)) c.rtFormat = D3DFMT_A8R8G8B8;
@@ -1088,6 +1100,7 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
         quadOpt.precision = rowOpt.precision = profile == 0   ? ps11::Precision::Fx8
                                                : profile == 1 ? ps11::Precision::Float
                                                               : ps11::Precision::Ideal;
+        if (profile == 3) radeon8500(quadOpt, rowOpt);
         DeviceOptions skipOpt = rowOpt;
         skipOpt.software.skipTiles = true;
         Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
@@ -1122,7 +1135,7 @@ TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain a
     const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n",
                                     "ps_1_1\ntex t0\nmov r0.rgb, t0\n+mov r0.a, c1.a\n"};
     uint64_t copied = 0;
-    for (int i = 0; i < 48; ++i) {
+    for (int i = 0; i < 96; ++i) {
         Case c = randomCase(rng);
         c.w = UINT(uni(1, 300)), c.h = UINT(uni(1, 40));
         c.rtFormat = uni(0, 2) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
@@ -1146,17 +1159,26 @@ TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain a
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         rowOpt.software.skipTiles = false;
+        // The second half in fx12: a texel's grid value 16·b stores b, and a constant channel
+        // between two bytes rounds with the sum, so it is not copied (c1.a = 0.5: 2040, whose
+        // sum with 16·d rounds to the even byte, into a target with alpha).
+        if (i >= 48) {
+            radeon8500(quadOpt, rowOpt);
+            if (i % 3 == 2) c.rtFormat = D3DFMT_A8R8G8B8, c.consts[1][3] = 0.5f;
+        }
         DeviceOptions skipOpt = rowOpt;
         skipOpt.software.skipTiles = true;
         Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
         DrawStats qs, rs, ks;
-        INFO("case " << i << ": " << c.w << "x" << c.h << ", blend " << c.blend << ", program:\n" << c.program);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", blend " << c.blend
+                     << ", program:\n"
+                     << c.program);
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
         REQUIRE(drawCase(rowDev, c, rs) == expected);
         REQUIRE(drawCase(skipDev, c, ks) == expected);
         copied += ks.tilesCopied;
     }
-    CHECK(copied > 48);
+    CHECK(copied > 96);
 }
 
 TEST_CASE("tile skipping: tiles over different constants of one texture are decided each for its own",

@@ -486,10 +486,11 @@ namespace {
 // index), so run() sees the texels runPresampled's fill hands over.
 struct LaneSampler final : ps11::Sampler {
     const std::vector<std::array<uint8_t, 4>>* texels[8] = {};
+    int32_t scale = 1;  // grid steps per byte: 1 (fx8) or 16 (fx12)
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
         for (int i = 0; i < req.count; ++i) {
             const auto& t = (*texels[req.stage])[size_t(req.u[i])];
-            for (int c = 0; c < 4; ++c) out.grid[c][i] = t[size_t(c)];
+            for (int c = 0; c < 4; ++c) out.grid[c][i] = t[size_t(c)] * scale;
         }
     }
     bool hasTexture(int) const override { return true; }
@@ -499,7 +500,8 @@ struct LaneSampler final : ps11::Sampler {
 
 TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
     // runPresampled (the row paths' way in: presampledOps' sign analysis, product chains, the
-    // complement factor) against run() with a sampler handing over the same 8-bit texels. Each
+    // complement factor; the generic path's runChunk with the taps filled in) against run() with
+    // a sampler handing over the same 8-bit texels. Each
     // program runs pre-sampled (registers first poisoned by another program on the same thread)
     // under constants whose channels are 0 two times in five.
     using namespace ps11;
@@ -536,11 +538,14 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
         const TapPlan* plan;
         int base;
         std::vector<int32_t>* got;
+        int scale;
     };
     const TapFill fill = [](void* p, int tap, int first, int n, int16_t* const dst[4]) {
         Ctx& x = *static_cast<Ctx*>(p);
         for (int c = 0; c < 4; ++c)
-            for (int i = 0; i < n; ++i) dst[c][i] = x.texels[x.plan->stage[size_t(tap)]][size_t(x.base + first + i)][size_t(c)];
+            for (int i = 0; i < n; ++i)
+                dst[c][i] =
+                    int16_t(x.texels[x.plan->stage[size_t(tap)]][size_t(x.base + first + i)][size_t(c)] * x.scale);
     };
     const ResultSink sink = [](void* p, int first, int n, const int16_t* const r0[4]) {
         Ctx& x = *static_cast<Ctx*>(p);
@@ -553,44 +558,58 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
     const ResultSink ignore = [](void*, int, int, const int16_t* const[4]) {};
     int64_t bad = 0;
     int runs = 0;
-    for (const char* text : programs) {
-        INFO(text);
-        auto gen = make(text, Precision::Fx8, 0, ExecPath::Generic);
-        auto fast = make(text, Precision::Fx8, 0, ExecPath::Auto);
-        TapPlan plan;
-        REQUIRE(tapPlan(*fast, plan));
-        for (int trial = 0; trial < 40; ++trial) {
-            for (int i = 0; i < 8; ++i) {
-                std::array<float, 4> v;
-                for (float& f : v) f = rng() % 5 < 2 ? 0.0f : float(int(rng() % 511) - 255) / 255.0f;
-                gen->setConstant(i, v);
-                fast->setConstant(i, v);
+    // The fast path's pre-sampled runs (fx8), and the generic path's: fx8 past the fast path's
+    // grid, fx12 with MaxValue 8 (the radeon8500 class) and 0.5 (texels above M clamped).
+    struct Config {
+        Precision precision;
+        float maxValue;
+        ExecPath path;
+    };
+    const Config configs[] = {{Precision::Fx8, 0, ExecPath::Auto},
+                              {Precision::Fx8, 16, ExecPath::Auto},
+                              {Precision::Fx12, 8, ExecPath::Auto},
+                              {Precision::Fx12, 0.5f, ExecPath::Auto}};
+    for (const Config& cfg : configs)
+        for (const char* text : programs) {
+            INFO(text << "precision " << precisionName(cfg.precision) << ", MaxValue " << cfg.maxValue);
+            const int scale = cfg.precision == Precision::Fx12 ? 16 : 1;
+            sampler.scale = scale;
+            auto gen = make(text, cfg.precision, cfg.maxValue, ExecPath::Generic);
+            auto fast = make(text, cfg.precision, cfg.maxValue, cfg.path);
+            TapPlan plan;
+            REQUIRE(tapPlan(*fast, plan));
+            for (int trial = 0; trial < 40; ++trial) {
+                for (int i = 0; i < 8; ++i) {
+                    std::array<float, 4> v;
+                    for (float& f : v) f = rng() % 5 < 2 ? 0.0f : float(int(rng() % 511) - 255) / 255.0f;
+                    gen->setConstant(i, v);
+                    fast->setConstant(i, v);
+                }
+                for (auto& t : texels)
+                    for (auto& px : t)
+                        for (uint8_t& b : px) b = uint8_t(rng());
+                Out want(count);
+                runAll(*gen, l, want, sampler, 256);
+                std::vector<int32_t> got[4];
+                for (auto& g : got) g.assign(count, -9999);
+                for (int off = 0; off < count; off += 64) {
+                    const int n = std::min(64, count - off);
+                    PixelInputs pin = l.inputs(off, n);
+                    runPresampled(*poison, pin, poisonFill, ignore, nullptr);
+                    Ctx ctx{texels, &plan, off, got, scale};
+                    runPresampled(*fast, pin, fill, sink, &ctx);
+                }
+                ++runs;
+                for (int c = 0; c < 4; ++c)
+                    for (int i = 0; i < count; ++i)
+                        if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
+                            FAIL_CHECK("trial " << trial << " lane " << i << " channel " << c << ": pre-sampled "
+                                                << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
             }
-            for (auto& t : texels)
-                for (auto& px : t)
-                    for (uint8_t& b : px) b = uint8_t(rng());
-            Out want(count);
-            runAll(*gen, l, want, sampler, 256);
-            std::vector<int32_t> got[4];
-            for (auto& g : got) g.assign(count, -9999);
-            for (int off = 0; off < count; off += 64) {
-                const int n = std::min(64, count - off);
-                PixelInputs pin = l.inputs(off, n);
-                runPresampled(*poison, pin, poisonFill, ignore, nullptr);
-                Ctx ctx{texels, &plan, off, got};
-                runPresampled(*fast, pin, fill, sink, &ctx);
-            }
-            ++runs;
-            for (int c = 0; c < 4; ++c)
-                for (int i = 0; i < count; ++i)
-                    if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
-                        FAIL_CHECK("trial " << trial << " lane " << i << " channel " << c << ": pre-sampled "
-                                            << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
         }
-    }
     INFO(runs << " runs");
     CHECK(bad == 0);
-    CHECK(runs == 40 * int(std::size(programs)));
+    CHECK(runs == 40 * int(std::size(programs) * std::size(configs)));
 }
 
 TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
