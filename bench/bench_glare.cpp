@@ -1,18 +1,18 @@
 // BM_Glare: every glare technique (published settings) on a 1920×1080 frame of its scene, run
-// four ways in one process, frames interleaved under the same machine load: the emulator
+// several ways in one process, frames interleaved under the same machine load: the emulator
 // (software renderer, 2 worker threads unless PS11_THREADS says otherwise) as the 1.1-class card
-// (fx8) and under `ideal`, and the GL renderer (Mesa llvmpipe through OSMesa, or EGL with
-// PS11_GL=egl) in native mode — the peer (PERF.md) — and in exact mode. Before timing, one frame
-// of each technique is compared pass by pass between the emulator and GL exact (glare/compare.h);
-// the counters report that agreement, the fx8-vs-ideal error and the native-vs-fx8 error. A
-// frame's time is its passes' own time (each pass ends when the renderer has finished it); for
-// native mode also with the upload of the scene and the read-back of the result (`native_io_ms`).
-// The benchmark's own time is the emulator's fx8 frame; every mode's median and the ratios to the
-// peer are counters. These runners run every pass every frame (RunnerOptions::skip off; the
+// (fx8), as the 1.4-class card (radeon8500, fx12), under `float` and under `ideal`, and the GL renderer (Mesa llvmpipe
+// through OSMesa, or EGL with PS11_GL=egl) in native mode — the peer (PERF.md) — and in exact mode. Before timing, one
+// frame of each technique is compared pass by pass between the emulator and GL exact (glare/compare.h); the counters
+// report that agreement, the fx8-vs-ideal error and the native-vs-fx8 error. A frame's time is its passes' own time
+// (each pass ends when the renderer has finished it); for native mode also with the upload of the scene and the
+// read-back of the result (`native_io_ms`). The benchmark's own time is the emulator's fx8 frame; every mode's median
+// and the ratios to the peer are counters. These runners run every pass every frame (RunnerOptions::skip off; the
 // *_tiles modes decide tiles but reuse no pass); two more
 // hold the image with reuse on and time frames after the first (`*_still_*`), and four run the
 // technique with skipping on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`; on the
-// emulator also with it off, `*_noskip_*`, and the sparse frame's tile decisions on stderr). Per-pass medians of the four go to stderr. bench/README.md "bench_glare".
+// emulator also with it off, `*_noskip_*`, and the sparse frame's tile decisions on stderr). Per-pass medians of the
+// four go to stderr. bench/README.md "bench_glare".
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -29,6 +29,7 @@
 #include "glare/compare.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
+#include "ps11/hardware.h"
 #include "runner/gl_backend.h"
 
 namespace {
@@ -37,9 +38,10 @@ constexpr uint32_t kW = 1920, kH = 1080;
 
 // The *_tiles modes: the emulator with its tiles decided (skipping on) but no pass reused from the
 // last frame (RunnerOptions::reuse off), what a moving scene gets with the default options.
-enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, EmuFloat, EmuFx8Tiles, EmuFloatTiles, kModes };
-const char* const kModeNames[kModes] = {"emu_fx8", "emu_ideal", "gl_native", "gl_exact", "emu_float", "emu_fx8_tiles",
-                                        "emu_float_tiles"};
+// EmuFx12: the radeon8500 class (fx12, MaxValue 8), the 1.4-class card.
+enum Mode { EmuFx8, EmuIdeal, GlNative, GlExact, EmuFloat, EmuFx8Tiles, EmuFloatTiles, EmuFx12, kModes };
+const char* const kModeNames[kModes] = {"emu_fx8",   "emu_ideal",     "gl_native",       "gl_exact",
+                                        "emu_float", "emu_fx8_tiles", "emu_float_tiles", "emu_fx12"};
 
 int threads() {
     const char* t = std::getenv("PS11_THREADS");
@@ -58,6 +60,7 @@ std::unique_ptr<glare::Runner> makeRunner(Mode mode, std::string& err, bool skip
     ro.device.software.threads = threads();
     if (mode == EmuIdeal) ro.device.precision = ps11::Precision::Ideal;
     if (mode == EmuFloat || mode == EmuFloatTiles) ro.device.precision = ps11::Precision::Float;
+    if (mode == EmuFx12) ro.device.hardware = ps11::findHardware("radeon8500");
     if (mode == GlNative || mode == GlExact) {
         setenv("LP_NUM_THREADS", "2", 0);  // llvmpipe reads it when its screen is made
         const char* kind = std::getenv("PS11_GL");
@@ -101,7 +104,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     glare::FrameResult r;
     if (!glare::compareFrame(*run[EmuFx8], *run[GlExact], t, s, 0, 2, agreement, r, err) ||
         !run[EmuIdeal]->runFrame(t, s, 0, 2, r, err) || !run[EmuFloat]->runFrame(t, s, 0, 2, r, err) ||
-        !run[GlNative]->runFrame(t, s, 0, 2, r, err)) {
+        !run[EmuFx12]->runFrame(t, s, 0, 2, r, err) || !run[GlNative]->runFrame(t, s, 0, 2, r, err)) {
         state.SkipWithError(err.c_str());
         return;
     }
@@ -282,6 +285,7 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["fx8_speedup_vs_native"] = med[GlNative] / med[EmuFx8];
     state.counters["ideal_speedup_vs_native"] = med[GlNative] / med[EmuIdeal];
     state.counters["float_speedup_vs_native"] = med[GlNative] / med[EmuFloat];
+    state.counters["fx12_speedup_vs_native"] = med[GlNative] / med[EmuFx12];
     state.counters["fx8_tiles_speedup_vs_native"] = med[GlNative] / med[EmuFx8Tiles];
     state.counters["float_tiles_speedup_vs_native"] = med[GlNative] / med[EmuFloatTiles];
     state.counters["exact_over_native"] = med[GlExact] / med[GlNative];
