@@ -12,7 +12,7 @@
 // hold the image with reuse on and time frames after the first (`*_still_*`), and four run the
 // technique with skipping on over the moving `sparse` and `dense` scenes (`*_sparse_*`, `*_dense_*`; on the
 // emulator also with it off, `*_noskip_*`, and the sparse frame's tile decisions on stderr). Per-pass medians of the
-// four go to stderr. bench/README.md "bench_glare".
+// timed modes go to stderr. bench/README.md "bench_glare".
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
