@@ -27,6 +27,9 @@ namespace {
 
 bool effectiveLinear(ps11::Filter f) { return f == ps11::Filter::Linear; }
 
+// fx12's grid scale: an 8-bit texel b is the grid value 16·b, 255 is kG12.
+constexpr int32_t kG12 = ps11::gridScale(ps11::Precision::Fx12);
+
 // The filtered value of a four-texel sum t = Σ byte·weight (weights of 65536 in all, t < 2^24):
 // fx8 round_half_even(t / 65536); fx12 round_half_even(16·t / 65536) = round_half_even(t / 4096).
 template <bool Fx12>
@@ -110,10 +113,10 @@ void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uin
         const int shift = 8 * ps11::kUnorm8Byte[c];
         const int16_t* __restrict rc = r[c];
         for (int i = 0; i < count; ++i) {
-            int32_t n = rc[i] < 0 ? 0 : rc[i] > 4080 ? 4080 : rc[i];
+            int32_t n = rc[i] < 0 ? 0 : rc[i] > kG12 ? kG12 : rc[i];
             if constexpr (Additive) {
                 n += int32_t((old[i] >> shift) & 0xffu) * 16;
-                n = n > 4080 ? 4080 : n;
+                n = n > kG12 ? kG12 : n;
             }
             out[i] |= unorm8OfFx12(n) << shift;
         }
@@ -180,7 +183,7 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
             if (draw.fx12) {
                 // fx12: a texel's grid value is 16·b, whose byte is b, and 16·b + 16·d adds bytes
                 // with saturation; a constant between two bytes would round with the sum: filtered.
-                const int32_t g = std::clamp<int32_t>(window.grid[size_t(c)], 0, 4080);
+                const int32_t g = std::clamp<int32_t>(window.grid[size_t(c)], 0, kG12);
                 if (additive && g % 16 != 0) return false;
                 byte = int32_t(unorm8OfFx12(g));
             }
@@ -322,7 +325,7 @@ __attribute__((optimize("no-tree-slp-vectorize")))
 void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
                const TapRow& row, int colBase, int first, int count, int16_t* const out[4]) {
     if (!tap.bound) {
-        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? (fx12 ? 4080 : 255) : 0));
+        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? (fx12 ? kG12 : 255) : 0));
         return;
     }
     // fx12 takes the vertical kernel that rounds 16·t / 65536 and its texels times 16.
@@ -1100,7 +1103,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     // reads the real values.)
                     const bool readsColor =
                         mergeReadsColor(draw.fx12 ? ps11::Precision::Fx12 : ps11::Precision::Fx8, draw.target);
-                    const float g = draw.fx12 ? 4080.0f : 255.0f;
+                    const float g = float(ps11::gridScale(draw.fx12 ? ps11::Precision::Fx12 : ps11::Precision::Fx8));
                     for (int c = 0; c < 4; ++c) {
                         for (int i = 0; i < n; ++i) sc.grid[c][i] = sc.r0[c][i];
                         if (readsColor)

@@ -409,7 +409,8 @@ void alignedVertical12Avx2(HKind kind, const uint16_t* const h0[4], const uint16
 template <bool Additive>
 int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     const __m256i om = _mm256_set1_epi32(int32_t(orMask)), zero = _mm256_setzero_si256();
-    const __m256i top = _mm256_set1_epi16(4080), seven = _mm256_set1_epi16(7), one = _mm256_set1_epi16(1);
+    const __m256i top = _mm256_set1_epi16(int16_t(ps11::gridScale(ps11::Precision::Fx12))),
+                  seven = _mm256_set1_epi16(7), one = _mm256_set1_epi16(1);
     const __m256i m8 = _mm256_set1_epi32(0xff);
     for (int i = 0; i < count; i += 16) {
         __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
