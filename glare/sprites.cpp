@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -116,8 +117,18 @@ std::vector<Sprite> senseSprites(const uint8_t* rgba, uint32_t width, uint32_t h
 std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) {
     const uint32_t width = f.width, height = f.height;
     const uint32_t n = uint32_t(std::max(s.group, 1));
-    const int rs = f.bgra ? 16 : 0, bs = f.bgra ? 0 : 16;  // bit shifts of r and b in a pixel's word
-    auto pixel = [&](uint32_t x, uint32_t y) { return f.data + size_t(y) * f.pitch + size_t(x) * 4; };
+    // A float frame: the bytes of the rows where a sensor fires, tight, r g b a (the buffer is
+    // the thread's, kept between frames: no fresh 8 MB a frame).
+    static thread_local std::vector<uint8_t> fired8;
+    const bool floats = f.values != nullptr;
+    if (floats) fired8.resize(size_t(width) * height * 4);
+    // (Workers name their own thread_local buffers: they write the rows through `kept`.)
+    uint8_t* const kept = floats ? fired8.data() : nullptr;
+    const uint8_t* const base = floats ? kept : f.data;
+    const size_t pitch = floats ? size_t(width) * 4 : f.pitch;
+    const bool bgra = !floats && f.bgra;
+    const int rs = bgra ? 16 : 0, bs = bgra ? 0 : 16;  // bit shifts of r and b in a pixel's word
+    auto pixel = [&](uint32_t x, uint32_t y) { return base + size_t(y) * pitch + size_t(x) * 4; };
     auto lum = [&](const uint8_t* p) { return luminance(p[rs / 8], p[1], p[bs / 8]); };
     const auto inBands = [&](uint32_t rows, uint32_t rowsPerItem,
                              const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
@@ -131,7 +142,21 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
     const float sumAtLeast = sensorSumThreshold(s.threshold);
     inBands(height, 1, [&](uint32_t y0, uint32_t y1, unsigned) {
         const SensorKernels& k = sensorKernels(ps11::simdLevel());
-        for (uint32_t y = y0; y < y1; ++y) k.fireRow(pixel(0, y), width, rs, bs, sumAtLeast, &fires[size_t(y) * wpr]);
+        if (!floats) {
+            for (uint32_t y = y0; y < y1; ++y)
+                k.fireRow(pixel(0, y), width, rs, bs, sumAtLeast, &fires[size_t(y) * wpr]);
+            return;
+        }
+        static thread_local std::vector<uint8_t> row;
+        row.resize(size_t(width) * 4);
+        for (uint32_t y = y0; y < y1; ++y) {
+            const float* in = reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(f.values) + y * f.pitch);
+            frameBytes(in, size_t(width) * 4, row.data());
+            uint64_t* bits = &fires[size_t(y) * wpr];
+            k.fireRow(row.data(), width, rs, bs, sumAtLeast, bits);
+            if (std::any_of(bits, bits + wpr, [](uint64_t b) { return b != 0; }))
+                std::memcpy(kept + size_t(y) * pitch, row.data(), size_t(width) * 4);
+        }
     });
     // Cluster blocks first: 8x8 blocks at least 90 % bright.
     const uint32_t cw = (width + 7) / 8, ch = (height + 7) / 8;
@@ -405,21 +430,10 @@ public:
                           return runner->readPixels(
                               c.texture(scene),
                               [&](const Runner::Pixels& px) {
-                                  // The 8-bit frame readTexture would give, converted row by row
-                                  // into a buffer the thread keeps (no fresh 8 MB every frame).
-                                  static thread_local std::vector<uint8_t> frame8buf;
-                                  std::vector<uint8_t>* frame8 = &frame8buf;
-                                  frame8->resize(size_t(px.width) * px.height * 4);
-                                  rowBands(px.height, 1, threads, [&](uint32_t y0, uint32_t y1, unsigned) {
-                                      for (uint32_t y = y0; y < y1; ++y) {
-                                          const float* in = reinterpret_cast<const float*>(px.data + y * px.pitch);
-                                          uint8_t* out = frame8->data() + size_t(y) * px.width * 4;
-                                          frameBytes(in, size_t(px.width) * 4, out);
-                                      }
-                                  });
-                                  *sprites = senseSprites(SensorFrame{frame8->data(), px.width, px.height,
-                                                                      size_t(px.width) * 4, false, threads},
-                                                          ss);
+                                  // The 8-bit frame readTexture would give, as the sensors read it.
+                                  SensorFrame sf{nullptr, px.width, px.height, px.pitch, false, threads};
+                                  sf.values = reinterpret_cast<const float*>(px.data);
+                                  *sprites = senseSprites(sf, ss);
                                   c.stats.pixels += uint64_t(px.width) * px.height;
                                   return keep();
                               },

@@ -39,6 +39,11 @@ struct SensorFrame {
     // The workers for the frame's bands (null: the calling thread alone). At most 8 bands, and
     // never more than bands of 64 rows; the sprites do not depend on it.
     emu::ThreadPool* pool = nullptr;
+    // Or a frame of floats, r g b a (a float render target; `data` and `bgra` unused): the
+    // sensors see each value as frameByte makes it a byte, the 8-bit frame readTexture gives.
+    // Each row is converted where the sensors read it, and kept only where a sensor fires (the
+    // only pixels read again), so no 8-bit copy of the frame is written.
+    const float* values = nullptr;
 };
 
 // The least float s with s / 255.0f >= threshold (a float division): a sensor's luminance, the

@@ -842,6 +842,37 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
                 }
             }
         });
+        // The same frame as floats (a float render target), in rows with padding: byte i as
+        // i/255 give or take 0.45/255, 255 as values past 1 or +inf, 0 as values below 0 or NaN.
+        // The sensors see glare::frameBytes of it (the 8-bit frame readTexture gives).
+        const size_t fpitch = (size_t(w) * 4 + 4 * (rng() % 3)) * sizeof(float);
+        std::vector<float> values(fpitch / sizeof(float) * h, -7.0f);
+        std::vector<uint8_t> seen(img.size());
+        std::uniform_real_distribution<float> jitter(-0.45f, 0.45f);
+        for (uint32_t y = 0; y < h; ++y) {
+            float* row = values.data() + y * (fpitch / sizeof(float));
+            for (size_t i = 0; i < size_t(w) * 4; ++i) {
+                const uint8_t b = img[size_t(y) * w * 4 + i];
+                float v = (float(b) + jitter(rng)) / 255.0f;
+                if (b == 255 && rng() % 2) v = rng() % 2 ? 1.5f : std::numeric_limits<float>::infinity();
+                if (b == 0 && rng() % 2) v = rng() % 2 ? -0.25f : std::numeric_limits<float>::quiet_NaN();
+                row[i] = v;
+            }
+            frameBytes(row, size_t(w) * 4, &seen[size_t(y) * w * 4]);
+        }
+        REQUIRE(seen == img);  // the values say the frame's bytes
+        for (emu::ThreadPool* pool : {static_cast<emu::ThreadPool*>(nullptr), &three}) {
+            SensorFrame sf{nullptr, w, h, fpitch, true, pool};
+            sf.values = values.data();
+            const std::vector<Sprite> fromFloats = senseSprites(sf, s);
+            REQUIRE(fromFloats.size() == ref.size());
+            for (size_t i = 0; i < ref.size(); ++i) {
+                CHECK(std::memcmp(&fromFloats[i].x, &ref[i].x, sizeof(float) * 2) == 0);
+                CHECK(std::memcmp(fromFloats[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
+                CHECK(fromFloats[i].radius == ref[i].radius);
+                CHECK(fromFloats[i].cluster == ref[i].cluster);
+            }
+        }
     }
 }
 
