@@ -795,6 +795,17 @@ std::vector<Sprite> senseSpritesReference(const uint8_t* rgba, uint32_t width, u
     return out;
 }
 
+// Bit for bit the same sprites, in the same order.
+void sameSprites(const std::vector<Sprite>& got, const std::vector<Sprite>& want) {
+    REQUIRE(got.size() == want.size());
+    for (size_t i = 0; i < want.size(); ++i) {
+        CHECK(std::memcmp(&got[i].x, &want[i].x, sizeof(float) * 2) == 0);
+        CHECK(std::memcmp(got[i].energy, want[i].energy, sizeof want[i].energy) == 0);
+        CHECK(got[i].radius == want[i].radius);
+        CHECK(got[i].cluster == want[i].cluster);
+    }
+}
+
 }  // namespace
 
 TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites exactly", "[glare]") {
@@ -833,13 +844,7 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
                   senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, &one}, s),
                   senseSprites(SensorFrame{img.data(), w, h, size_t(w) * 4, false, &three}, s),
                   senseSprites(SensorFrame{bgra.data(), w, h, pitch, true, &eight}, s)}) {
-                REQUIRE(fast.size() == ref.size());
-                for (size_t i = 0; i < ref.size(); ++i) {
-                    CHECK(std::memcmp(&fast[i].x, &ref[i].x, sizeof(float) * 2) == 0);
-                    CHECK(std::memcmp(fast[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
-                    CHECK(fast[i].radius == ref[i].radius);
-                    CHECK(fast[i].cluster == ref[i].cluster);
-                }
+                sameSprites(fast, ref);
             }
         });
         // The same frame as floats (a float render target), in rows with padding: byte i as
@@ -864,14 +869,7 @@ TEST_CASE("sprites: the threaded sensor step gives the one-pass sensors' sprites
         for (emu::ThreadPool* pool : {static_cast<emu::ThreadPool*>(nullptr), &three}) {
             SensorFrame sf{nullptr, w, h, fpitch, true, pool};
             sf.values = values.data();
-            const std::vector<Sprite> fromFloats = senseSprites(sf, s);
-            REQUIRE(fromFloats.size() == ref.size());
-            for (size_t i = 0; i < ref.size(); ++i) {
-                CHECK(std::memcmp(&fromFloats[i].x, &ref[i].x, sizeof(float) * 2) == 0);
-                CHECK(std::memcmp(fromFloats[i].energy, ref[i].energy, sizeof ref[i].energy) == 0);
-                CHECK(fromFloats[i].radius == ref[i].radius);
-                CHECK(fromFloats[i].cluster == ref[i].cluster);
-            }
+            sameSprites(senseSprites(sf, s), ref);
         }
     }
 }
