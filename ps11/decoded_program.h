@@ -112,8 +112,8 @@ struct Profile {
     int32_t g = 255;       // grid scale
     int32_t nMax = 255;    // fx: round(M*G)
     float maxValue = 1;    // M
-    bool wide = false;     // fx: product numerators may pass 2^31 (int64 lanes, or exactDouble)
-    bool exactDouble = false;  // fx, wide: every product numerator below 2^52, formed in double
+    bool wide = false;     // fx: product numerators may pass 2^31 (GL exact mode: int64_t)
+    bool exactDouble = false;  // fx: every product numerator below 2^52, formed in double (else int64)
     bool clampRange = true;  // false for ideal
     std::array<std::array<int32_t, 4>, kNumConsts> constGrid{};  // fx: constants as grid integers
     std::array<std::array<float, 4>, kNumConsts> constF{};       // float: constants (fx: n/G)

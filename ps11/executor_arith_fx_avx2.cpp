@@ -4,6 +4,10 @@
 #include <cstring>
 #include <type_traits>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "ps11/executor_internal.h"
 
 #if !defined(__AVX2__) || !defined(__FMA__)

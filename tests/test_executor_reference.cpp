@@ -26,10 +26,11 @@
 #include <string>
 #include <vector>
 
+#include "executor_random_programs.h"
 #include "ps11/assembler.h"
 #include "ps11/executor.h"
 #include "ps11/validator.h"
-#include "executor_random_programs.h"
+#include "simd_levels.h"
 
 namespace {
 
@@ -515,14 +516,19 @@ TEST_CASE("reference: random ps_1_x arithmetic programs, executor == reference b
         int programs;
     };
     const Run runs[] = {{0x5eed0101u, 1, 1500}, {0x5eed0102u, 2, 400}, {0x5eed0103u, 3, 600}, {0x5eed0104u, 4, 2000}};
-    for (const Run& r : runs) {
-        DiffStats st;
-        differential(r.seed, r.minor, r.programs, st);
-        INFO("ps_1_" << r.minor << ": " << st.generated << " generated, " << st.valid << " valid, " << st.compared
-                     << " pixel comparisons, " << st.mismatches << " mismatches");
-        CHECK(st.mismatches == 0);
-        CHECK(st.valid >= r.programs / 2);
-    }
+    // At every SIMD level this CPU runs: each has its own arithmetic kernels (exec::fxArithKernels,
+    // exec::floatArithKernels).
+    testutil::forEachSimdLevel([&](ps11::SimdLevel level) {
+        for (const Run& r : runs) {
+            DiffStats st;
+            differential(r.seed, r.minor, r.programs, st);
+            INFO(ps11::simdLevelName(level)
+                 << ", ps_1_" << r.minor << ": " << st.generated << " generated, " << st.valid << " valid, "
+                 << st.compared << " pixel comparisons, " << st.mismatches << " mismatches");
+            CHECK(st.mismatches == 0);
+            CHECK(st.valid >= r.programs / 2);
+        }
+    });
 }
 
 TEST_CASE("reference: the program generator mostly produces valid programs", "[reference]") {
