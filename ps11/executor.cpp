@@ -168,12 +168,15 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
             int16_t* const dst[4] = {texels[0], texels[1], texels[2], texels[3]};
             const int n = st.n;
             st.fill(st.fillCtx, tap++, st.offset, n, dst);
-            // (Texels lie in [0, G]: the clamp changes nothing where M >= 1.)
+            // (Texels lie in [0, G]: the clamp changes nothing where M >= 1, and is left out.)
             const int32_t hi = std::min(m_p.nMax, m_p.g);
             for (int c = 0; c < 4; ++c) {
                 int32_t* __restrict d = st.bi.reg[op.dstSlot][c];
                 const int16_t* __restrict t = texels[c];
-                for (int i = 0; i < n; ++i) d[i] = std::min(int32_t(t[i]), hi);
+                if (hi == m_p.g)
+                    for (int i = 0; i < n; ++i) d[i] = t[i];
+                else
+                    for (int i = 0; i < n; ++i) d[i] = std::min(int32_t(t[i]), hi);
             }
         } else if (op.texture) {
             execTexture(m_p, op, st);
