@@ -431,8 +431,10 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
     // low bits, the same for a row's configurations).
     uint32_t& hint = cache.hint[size_t(h >> 56)];
     size_t found = hint > 0 && hint <= n && same(hint - 1) ? hint - 1 : n;
+    // (The scan reads the keys alone, side by side; a slot is looked at only where its key matches.)
+    const uint64_t* keys = cache.keys.data();
     for (size_t i = 0; found == n && i < n; ++i)
-        if (same(i)) found = i;
+        if (keys[i] == h && same(i)) found = i;
     if (found < n) {
         cache.stamps[found] = cache.stamp;
         hint = uint32_t(found + 1);
@@ -444,8 +446,7 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
     // the one taken is the longest filled; a scan for the least recently used cost more than the
     // misses it saved), or a new slot.
     size_t victim = n;
-    for (size_t k = 0; k < n; ++k) {
-        const size_t i = (cache.hand + k) % n;
+    for (size_t k = 0, i = n ? cache.hand % n : 0; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
         if (cache.stamps[i] + 1 < cache.stamp) {
             victim = i;
             break;
