@@ -25,7 +25,13 @@ CpuFeatures query() {
     if ((lo & 6u) != 6u) return f;  // the OS keeps SSE and AVX state
     f.fma = (c >> 12) & 1u;
     f.f16c = (c >> 29) & 1u;
-    if (__get_cpuid_count(7, 0, &a, &b, &c, &d)) f.avx2 = (b >> 5) & 1u;
+    if (__get_cpuid_count(7, 0, &a, &b, &c, &d)) {
+        f.avx2 = (b >> 5) & 1u;
+        // F (bit 16), DQ (17), BW (30), VL (31); XCR0 bits 5-7: opmask, ZMM0-15 upper halves,
+        // ZMM16-31 (Intel SDM vol. 1, 15.2 "Detection of AVX-512 Foundation instructions").
+        const uint32_t need = (1u << 16) | (1u << 17) | (1u << 30) | (1u << 31);
+        f.avx512 = (b & need) == need && (lo & 0xe0u) == 0xe0u;
+    }
 #endif
     return f;
 }

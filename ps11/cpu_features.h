@@ -9,6 +9,8 @@ struct CpuFeatures {
     bool avx2 = false;  // AVX2 with the OS keeping the AVX state
     bool fma = false;   // FMA3 (the AVX2 kernels are built with it)
     bool f16c = false;  // VCVTPS2PH / VCVTPH2PS
+    // AVX-512 F, DQ, BW and VL, with the OS keeping the opmask and ZMM state
+    bool avx512 = false;
     bool avx2Fma() const { return avx2 && fma; }
 };
 

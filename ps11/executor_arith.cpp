@@ -20,7 +20,9 @@ const FxArithKernels kFxArith{&arithFxAny};
 }  // namespace baseline
 
 const FxArithKernels& fxArithKernels(SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return *simdTable(level, &baseline::kFxArith, &avx2::kFxArith, &avx512::kFxArith);
+#elif defined(PS11_HAVE_AVX2)
     return *simdTable(level, &baseline::kFxArith, &avx2::kFxArith);
 #else
     (void)level;

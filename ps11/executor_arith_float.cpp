@@ -15,7 +15,9 @@ const FloatArithKernels kFloatArith{&arithFloat};
 }  // namespace baseline
 
 const FloatArithKernels& floatArithKernels(SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return *simdTable(level, &baseline::kFloatArith, &avx2::kFloatArith, &avx512::kFloatArith);
+#elif defined(PS11_HAVE_AVX2)
     return *simdTable(level, &baseline::kFloatArith, &avx2::kFloatArith);
 #else
     (void)level;

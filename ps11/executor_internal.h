@@ -87,11 +87,14 @@ struct FxArithKernels {
     FxArithFn arith;
 };
 const FxArithKernels& fxArithKernels(SimdLevel level);
-// The tables (the Avx2 one in x86-64 builds only); use fxArithKernels().
+// The tables (the Avx2 and Avx512 ones in x86-64 builds only); use fxArithKernels().
 namespace baseline {
 extern const FxArithKernels kFxArith;
 }
 namespace avx2 {
+extern const FxArithKernels kFxArith;
+}
+namespace avx512 {
 extern const FxArithKernels kFxArith;
 }
 using FloatArithFn = void (*)(const Profile& p, const DOp& op, RunState& st, float (*out)[kChunk]);
@@ -99,11 +102,14 @@ struct FloatArithKernels {
     FloatArithFn arith;
 };
 const FloatArithKernels& floatArithKernels(SimdLevel level);
-// The tables (the Avx2 one in x86-64 builds only); use floatArithKernels().
+// The tables (the Avx2 and Avx512 ones in x86-64 builds only); use floatArithKernels().
 namespace baseline {
 extern const FloatArithKernels kFloatArith;
 }
 namespace avx2 {
+extern const FloatArithKernels kFloatArith;
+}
+namespace avx512 {
 extern const FloatArithKernels kFloatArith;
 }
 // Texture-address instruction.

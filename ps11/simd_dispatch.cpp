@@ -25,10 +25,14 @@ SimdLevel envLevel() {
 
 }  // namespace
 
-const char* simdLevelName(SimdLevel level) { return level == SimdLevel::Avx2 ? "avx2" : "baseline"; }
+constexpr SimdLevel kLevels[] = {SimdLevel::Baseline, SimdLevel::Avx2, SimdLevel::Avx512};
+
+const char* simdLevelName(SimdLevel level) {
+    return level == SimdLevel::Avx512 ? "avx512" : level == SimdLevel::Avx2 ? "avx2" : "baseline";
+}
 
 std::optional<SimdLevel> parseSimdLevel(std::string_view name) {
-    for (SimdLevel l : {SimdLevel::Baseline, SimdLevel::Avx2})
+    for (SimdLevel l : kLevels)
         if (name == simdLevelName(l)) return l;
     return std::nullopt;
 }
@@ -37,17 +41,29 @@ bool simdLevelRuns(SimdLevel level) {
     if (level == SimdLevel::Baseline) return true;
 #ifdef PS11_HAVE_AVX2
     const CpuFeatures& f = cpuFeatures();
-    return f.avx2Fma() && f.f16c;
+    const bool avx2 = f.avx2Fma() && f.f16c;
+    if (level == SimdLevel::Avx2) return avx2;
+#ifdef PS11_HAVE_AVX512
+    return avx2 && f.avx512;
+#else
+    return false;
+#endif
 #else
     return false;
 #endif
 }
 
-SimdLevel bestSimdLevel() { return simdLevelRuns(SimdLevel::Avx2) ? SimdLevel::Avx2 : SimdLevel::Baseline; }
+SimdLevel bestSimdLevel() {
+    SimdLevel best = SimdLevel::Baseline;
+    for (SimdLevel l : kLevels)
+        if (simdLevelRuns(l)) best = l;
+    return best;
+}
 
 std::vector<SimdLevel> runnableSimdLevels() {
-    std::vector<SimdLevel> levels{SimdLevel::Baseline};
-    if (simdLevelRuns(SimdLevel::Avx2)) levels.push_back(SimdLevel::Avx2);
+    std::vector<SimdLevel> levels;
+    for (SimdLevel l : kLevels)
+        if (simdLevelRuns(l)) levels.push_back(l);
     return levels;
 }
 
@@ -57,11 +73,12 @@ SimdLevel simdLevelFromEnv(const char* value, SimdLevel best, std::string& error
     const std::optional<SimdLevel> asked = parseSimdLevel(value);
     const std::string prefix = std::string("ps11: ") + kSimdEnvVar + "=" + value + ": ";
     if (!asked) {
-        error = prefix + "unknown SIMD level (expected baseline or avx2); using " + simdLevelName(best);
+        error = prefix + "unknown SIMD level (expected baseline, avx2 or avx512); using " + simdLevelName(best);
         return best;
     }
     if (*asked > best) {
-        error = prefix + "this CPU or build cannot run " + simdLevelName(*asked) + " (it needs AVX2, FMA and F16C); using " +
+        error = prefix + "this CPU or build cannot run " + simdLevelName(*asked) + " (it needs AVX2, FMA and F16C" +
+                (*asked == SimdLevel::Avx512 ? ", and AVX-512 F, DQ, BW and VL" : "") + "); using " +
                 simdLevelName(best);
         return best;
     }

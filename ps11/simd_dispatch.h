@@ -17,12 +17,14 @@ namespace ps11 {
 // Baseline: what any x86-64 CPU runs (SSE2), or portable C++ on other targets.
 // Avx2: AVX2, FMA and F16C, the instruction sets the *_avx2.cpp files are compiled for (x86-64
 // builds only; CMakeLists.txt defines PS11_HAVE_AVX2 there).
-enum class SimdLevel : uint8_t { Baseline, Avx2 };
+// Avx512: Avx2's and AVX-512 F, DQ, BW and VL, for the *_avx512.cpp files (PS11_HAVE_AVX512); a
+// family without an Avx512 table runs its Avx2 one there.
+enum class SimdLevel : uint8_t { Baseline, Avx2, Avx512 };
 
 // The environment variable that forces a level (read once, on the first simdLevel() call).
 constexpr const char* kSimdEnvVar = "PS11_SIMD";
 
-// "baseline", "avx2": the names PS11_SIMD takes.
+// "baseline", "avx2", "avx512": the names PS11_SIMD takes.
 const char* simdLevelName(SimdLevel level);
 std::optional<SimdLevel> parseSimdLevel(std::string_view name);
 
@@ -61,11 +63,14 @@ private:
 // `best` and sets `error` to the message simdLevel() prints on stderr; else `error` is cleared.
 SimdLevel simdLevelFromEnv(const char* value, SimdLevel best, std::string& error);
 
-// A family's table at `level`: `avx2` where the level is Avx2 and the build has that table
-// (non-null), else `baseline` (null where the family has no kernels at that level).
+// A family's table at `level`: the highest of its tables (non-null where the build has it) at or
+// below the level: `avx512` at Avx512, `avx2` at Avx2 and above, else `baseline` (null where the
+// family has no kernels at that level).
 template <class Kernels>
-const Kernels* simdTable(SimdLevel level, const Kernels* baseline, const Kernels* avx2) {
-    return level == SimdLevel::Avx2 && avx2 ? avx2 : baseline;
+const Kernels* simdTable(SimdLevel level, const Kernels* baseline, const Kernels* avx2,
+                         const Kernels* avx512 = nullptr) {
+    if (level >= SimdLevel::Avx512 && avx512) return avx512;
+    return level >= SimdLevel::Avx2 && avx2 ? avx2 : baseline;
 }
 
 }  // namespace ps11

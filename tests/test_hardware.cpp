@@ -125,6 +125,8 @@ TEST_CASE("cpu features: the one query agrees with the compiler's", "[cpu]") {
     __builtin_cpu_init();
     CHECK(ps11::cpuFeatures().avx2 == bool(__builtin_cpu_supports("avx2")));
     CHECK(ps11::cpuFeatures().fma == bool(__builtin_cpu_supports("fma")));
+    CHECK(ps11::cpuFeatures().avx512 == bool(__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                                             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")));
 #endif
     CHECK(&ps11::cpuFeatures() == &ps11::cpuFeatures());  // queried once
 }

@@ -44,8 +44,10 @@ bool contains(const std::string& s, const std::string& part) { return s.find(par
 TEST_CASE("simd dispatch: level names", "[simd]") {
     CHECK(std::string(ps11::simdLevelName(SimdLevel::Baseline)) == "baseline");
     CHECK(std::string(ps11::simdLevelName(SimdLevel::Avx2)) == "avx2");
+    CHECK(std::string(ps11::simdLevelName(SimdLevel::Avx512)) == "avx512");
     CHECK(ps11::parseSimdLevel("baseline") == SimdLevel::Baseline);
     CHECK(ps11::parseSimdLevel("avx2") == SimdLevel::Avx2);
+    CHECK(ps11::parseSimdLevel("avx512") == SimdLevel::Avx512);
     CHECK_FALSE(ps11::parseSimdLevel("AVX2"));
     CHECK_FALSE(ps11::parseSimdLevel("sse2"));
     CHECK_FALSE(ps11::parseSimdLevel(""));
@@ -63,10 +65,14 @@ TEST_CASE("simd dispatch: PS11_SIMD's rule, bad values and levels the CPU cannot
     CHECK(error.empty());
     CHECK(ps11::simdLevelFromEnv("avx2", SimdLevel::Avx2, error) == SimdLevel::Avx2);
     CHECK(error.empty());
+    CHECK(ps11::simdLevelFromEnv("avx512", SimdLevel::Avx512, error) == SimdLevel::Avx512);
+    CHECK(error.empty());
+    CHECK(ps11::simdLevelFromEnv("avx2", SimdLevel::Avx512, error) == SimdLevel::Avx2);
+    CHECK(error.empty());
     // An unknown value: the best level, and a message naming the variable and the value.
-    CHECK(ps11::simdLevelFromEnv("avx512", SimdLevel::Avx2, error) == SimdLevel::Avx2);
+    CHECK(ps11::simdLevelFromEnv("avx1024", SimdLevel::Avx2, error) == SimdLevel::Avx2);
     INFO(error);
-    CHECK(contains(error, "PS11_SIMD=avx512"));
+    CHECK(contains(error, "PS11_SIMD=avx1024"));
     CHECK(contains(error, "unknown SIMD level"));
     CHECK(contains(error, "using avx2"));
     CHECK(ps11::simdLevelFromEnv("Baseline", SimdLevel::Baseline, error) == SimdLevel::Baseline);
@@ -76,6 +82,11 @@ TEST_CASE("simd dispatch: PS11_SIMD's rule, bad values and levels the CPU cannot
     CHECK(contains(error, "PS11_SIMD=avx2"));
     CHECK(contains(error, "cannot run avx2"));
     CHECK(contains(error, "using baseline"));
+    // Avx512 on an Avx2 CPU: Avx2, and a message naming what it lacks.
+    CHECK(ps11::simdLevelFromEnv("avx512", SimdLevel::Avx2, error) == SimdLevel::Avx2);
+    CHECK(contains(error, "cannot run avx512"));
+    CHECK(contains(error, "AVX-512"));
+    CHECK(contains(error, "using avx2"));
 }
 
 TEST_CASE("simd dispatch: the best level follows the CPU query; the override falls back to it", "[simd]") {
@@ -85,13 +96,21 @@ TEST_CASE("simd dispatch: the best level follows the CPU query; the override fal
 #else
     const bool avx2 = false;
 #endif
+#ifdef PS11_HAVE_AVX512
+    const bool avx512 = avx2 && f.avx512;
+#else
+    const bool avx512 = false;
+#endif
     CHECK(ps11::simdLevelRuns(SimdLevel::Baseline));
     CHECK(ps11::simdLevelRuns(SimdLevel::Avx2) == avx2);
-    CHECK(ps11::bestSimdLevel() == (avx2 ? SimdLevel::Avx2 : SimdLevel::Baseline));
+    CHECK(ps11::simdLevelRuns(SimdLevel::Avx512) == avx512);
+    CHECK(ps11::bestSimdLevel() == (avx512 ? SimdLevel::Avx512 : avx2 ? SimdLevel::Avx2 : SimdLevel::Baseline));
     const std::vector<SimdLevel> levels = ps11::runnableSimdLevels();
     REQUIRE(!levels.empty());
+    CHECK(levels.size() == size_t(1 + avx2 + avx512));
     CHECK(levels.front() == SimdLevel::Baseline);
     CHECK(levels.back() == ps11::bestSimdLevel());
+    const SimdLevel avx2OrLess = avx2 ? SimdLevel::Avx2 : SimdLevel::Baseline;
 
     const SimdLevel before = ps11::simdLevel();
     {
@@ -99,15 +118,16 @@ TEST_CASE("simd dispatch: the best level follows the CPU query; the override fal
         CHECK(outer.level() == SimdLevel::Baseline);
         CHECK(ps11::simdLevel() == SimdLevel::Baseline);
         {
-            // Avx2 where the CPU runs it, else Baseline.
+            // Avx2 where the CPU runs it, else the best it runs (Baseline).
             const ps11::ScopedSimdLevel inner(SimdLevel::Avx2);
-            CHECK(inner.level() == ps11::bestSimdLevel());
+            CHECK(inner.level() == avx2OrLess);
             CHECK(ps11::simdLevel() == inner.level());
         }
         CHECK(ps11::simdLevel() == SimdLevel::Baseline);
     }
     CHECK(ps11::simdLevel() == before);
-    CHECK(ps11::setSimdLevel(SimdLevel::Avx2) == ps11::bestSimdLevel());
+    CHECK(ps11::setSimdLevel(SimdLevel::Avx2) == avx2OrLess);
+    CHECK(ps11::setSimdLevel(SimdLevel::Avx512) == ps11::bestSimdLevel());
     CHECK(ps11::setSimdLevel(SimdLevel::Baseline) == SimdLevel::Baseline);
     CHECK(ps11::simdLevel() == SimdLevel::Baseline);
     ps11::clearSimdLevel();
@@ -198,7 +218,8 @@ TEST_CASE("simd dispatch: float arithmetic gives the same bits at every level (f
     }
     CHECK(valid >= 300);
     CHECK(bad == 0);
-    if (ps11::simdLevelRuns(SimdLevel::Avx2)) CHECK(compared == 2 * valid);
+    // Both profiles at every level past Baseline.
+    CHECK(compared == 2 * valid * int(ps11::runnableSimdLevels().size() - 1));
 }
 
 TEST_CASE("simd dispatch: float mad, lrp and dp3 round each product at every level (no FMA)", "[simd][executor]") {
@@ -275,6 +296,15 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
 #endif
     // The aligned-pass path has no vector kernels at Baseline (every pixel on its own).
     CHECK(emu::alignedKernels(SimdLevel::Baseline) == nullptr);
+    // Avx512: the generic path's arithmetic has its own tables; every other family runs its Avx2 one.
+#ifdef PS11_HAVE_AVX512
+    CHECK(&exec::fxArithKernels(SimdLevel::Avx512) != &exec::fxArithKernels(SimdLevel::Avx2));
+    CHECK(&exec::floatArithKernels(SimdLevel::Avx512) != &exec::floatArithKernels(SimdLevel::Avx2));
+#endif
+    CHECK(exec::fastKernels(SimdLevel::Avx512) == exec::fastKernels(SimdLevel::Avx2));
+    CHECK(&fastpath::samplerKernels(SimdLevel::Avx512) == &fastpath::samplerKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
+    CHECK(&emu::mergerKernels(SimdLevel::Avx512) == &emu::mergerKernels(SimdLevel::Avx2));
 }
 
 TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at every level", "[simd][merger]") {

@@ -94,9 +94,10 @@ int cmdInfo(const std::vector<std::string>& args) {
         levelText += std::string(" (forced; this CPU runs ") + simdLevelName(bestSimdLevel()) + ")";
     const CpuFeatures& cpu = cpuFeatures();
     std::string cpuText;
-    for (auto [name, has] : {std::pair{"avx2", cpu.avx2}, std::pair{"fma", cpu.fma}, std::pair{"f16c", cpu.f16c}})
+    for (auto [name, has] : {std::pair{"avx2", cpu.avx2}, std::pair{"fma", cpu.fma}, std::pair{"f16c", cpu.f16c},
+                             std::pair{"avx512", cpu.avx512}})
         if (has) cpuText += cpuText.empty() ? name : std::string(" ") + name;
-    if (cpuText.empty()) cpuText = "none of avx2, fma, f16c";
+    if (cpuText.empty()) cpuText = "none of avx2, fma, f16c, avx512";
     GlReport r = probeGl(gl);
     if (json) {
         json::Json j;
@@ -104,7 +105,7 @@ int cmdInfo(const std::vector<std::string>& args) {
         j["hardware"] = hw.name;
         j["simd_level"] = simdLevelName(level);
         j["executor_kernels"] = kernelName;
-        j["cpu"] = {{"avx2", cpu.avx2}, {"fma", cpu.fma}, {"f16c", cpu.f16c}};
+        j["cpu"] = {{"avx2", cpu.avx2}, {"fma", cpu.fma}, {"f16c", cpu.f16c}, {"avx512", cpu.avx512}};
         if (r.ok)
             j["gl"] = {{"kind", r.kind},
                        {"platform", r.platform},
