@@ -168,16 +168,9 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
             int16_t* const dst[4] = {texels[0], texels[1], texels[2], texels[3]};
             const int n = st.n;
             st.fill(st.fillCtx, tap++, st.offset, n, dst);
-            // (Texels lie in [0, G]: the clamp changes nothing where M >= 1, and is left out.)
-            const int32_t hi = std::min(m_p.nMax, m_p.g);
-            for (int c = 0; c < 4; ++c) {
-                int32_t* __restrict d = st.bi.reg[op.dstSlot][c];
-                const int16_t* __restrict t = texels[c];
-                if (hi == m_p.g)
-                    for (int i = 0; i < n; ++i) d[i] = t[i];
-                else
-                    for (int i = 0; i < n; ++i) d[i] = std::min(int32_t(t[i]), hi);
-            }
+            // (Texels lie in [0, G]: the clamp to M changes nothing where M >= 1.)
+            const int32_t hi = m_p.nMax >= m_p.g ? INT16_MAX : m_p.nMax;
+            for (int c = 0; c < 4; ++c) fxArith.widen(texels[c], st.bi.reg[op.dstSlot][c], n, hi);
         } else if (op.texture) {
             execTexture(m_p, op, st);
         } else if (fx) {
@@ -270,8 +263,7 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, Result
         st->n = std::min(kChunk, count - off);
         st->depthWritten = false;
         runChunk(*st, fxArith, floatArith, nullptr);
-        for (int c = 0; c < 4; ++c)
-            for (int i = 0; i < st->n; ++i) r0[c][i] = int16_t(st->bi.reg[kSlotR][c][i]);  // |r0| <= nMax
+        for (int c = 0; c < 4; ++c) fxArith.narrow(st->bi.reg[kSlotR][c], r0[c], st->n);  // |r0| <= nMax
         sink(ctx, off, st->n, out);
     }
     st->fill = nullptr;

@@ -16,7 +16,7 @@ namespace baseline {
 namespace {
 #include "ps11/executor_arith_fx.inc"
 }  // namespace
-const FxArithKernels kFxArith{&arithFxAny};
+const FxArithKernels kFxArith{&arithFxAny, &widenTexels, &narrowLanes};
 }  // namespace baseline
 
 const FxArithKernels& fxArithKernels(SimdLevel level) {

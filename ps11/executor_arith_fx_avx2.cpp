@@ -18,5 +18,5 @@ namespace ps11::exec::avx2 {
 namespace {
 #include "ps11/executor_arith_fx.inc"
 }  // namespace
-const FxArithKernels kFxArith{&arithFxAny};
+const FxArithKernels kFxArith{&arithFxAny, &widenTexels, &narrowLanes};
 }  // namespace ps11::exec::avx2

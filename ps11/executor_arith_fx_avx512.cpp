@@ -17,5 +17,5 @@ namespace ps11::exec::avx512 {
 namespace {
 #include "ps11/executor_arith_fx.inc"
 }  // namespace
-const FxArithKernels kFxArith{&arithFxAny};
+const FxArithKernels kFxArith{&arithFxAny, &widenTexels, &narrowLanes};
 }  // namespace ps11::exec::avx512

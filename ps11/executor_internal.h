@@ -83,8 +83,14 @@ inline uint8_t fetchMask(const DOp& op, int s) { return componentsRead(*op.info,
 // fx profiles (executor_arith_fx.inc), float profiles (executor_arith_float.inc), each a table
 // per SIMD level that runGeneric fetches once per run.
 using FxArithFn = void (*)(const Profile& p, const DOp& op, RunState& st, int32_t (*out)[kChunk]);
+// Pre-sampled runs: a tap's int16 lanes (TapFill) into int32 register lanes, each at most `hi`;
+// r0's int32 lanes into the int16 lanes of ResultSink (|n| <= nMax <= 32767 there).
+using FxWidenFn = void (*)(const int16_t* src, int32_t* dst, int n, int32_t hi);
+using FxNarrowFn = void (*)(const int32_t* src, int16_t* dst, int n);
 struct FxArithKernels {
     FxArithFn arith;
+    FxWidenFn widen;
+    FxNarrowFn narrow;
 };
 const FxArithKernels& fxArithKernels(SimdLevel level);
 // The tables (the Avx2 and Avx512 ones in x86-64 builds only); use fxArithKernels().
