@@ -110,7 +110,7 @@ public:
     virtual uint32_t sampledStages() const = 0;
     virtual const ExecutorOptions& options() const = 0;
     // The implementation run() uses now: "generic", or the fast path's kernels at the current
-    // SIMD level, "fast-sse2" or "fast-avx2".
+    // SIMD level, "fast-sse2", "fast-avx2" or "fast-avx512".
     virtual const char* pathName() const = 0;
 
     // Runs the program for inputs.count pixels (<= kMaxSpan). Thread-safe for distinct

@@ -114,7 +114,9 @@ void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv)
 }  // namespace
 
 const FastKernels* fastKernels(SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return simdTable(level, &sse2::kKernels, &avx2::kKernels, &avx512::kKernels);
+#elif defined(PS11_HAVE_AVX2)
     return simdTable(level, &sse2::kKernels, &avx2::kKernels);
 #else
     (void)level;
@@ -193,7 +195,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
     st.in = &inputs;
     st.sampler = &sampler;
     // r0 is the output: its channels read before written, or never written, are 0 as in the
-    // generic path. Lanes past a chunk's count (up to the next multiple of 16) are computed too
+    // generic path. Lanes past a chunk's count (up to the next multiple of the kernels' lanes) are computed too
     // and never stored; the kernels use only wrapping SIMD arithmetic, so whatever those lanes
     // hold is harmless.
     for (int c = 0; c < 4; ++c)
@@ -205,7 +207,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
         st.n = std::min(kChunk, count - off);
         st.depthWritten = false;
         const int n = st.n;
-        const int nv = (n + 15) & ~15;
+        const int nv = (n + kern.lanes - 1) / kern.lanes * kern.lanes;
         std::memset(st.killed, 0, sizeof st.killed);
         // v# saturated and rounded once per pixel (docs/precision.md "Inputs"), as the generic path.
         for (int v = 0; v < kNumRegV; ++v) {
@@ -360,7 +362,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     const int16_t m = int16_t(p.nMax);
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
-        const int nv = (n + 15) & ~15;
+        const int nv = (n + kern.lanes - 1) / kern.lanes * kern.lanes;
         for (int v = 0; v < kNumRegV; ++v) {
             if (!((vUsed >> v) & 1)) continue;
             for (int c = 0; c < 4; ++c)

@@ -60,7 +60,7 @@ struct FastBank {
     alignas(64) int16_t tmp[4][kChunk];
 };
 
-// Runs one arithmetic op over lanes [0, nv) (nv a multiple of 16, <= kChunk).
+// Runs one arithmetic op over lanes [0, nv) (nv a multiple of FastKernels::lanes, <= kChunk).
 using FastArithFn = void (*)(const FastOp& op, FastBank& bank, int nv);
 // Runs a chain of `count` ops (FastOp::chain) over lanes [0, nv): a small non-negative mul into
 // register R, then small non-negative mads each adding R as it stands; each op's result rounded
@@ -69,7 +69,7 @@ using FastChainFn = void (*)(const FastOp* ops, int count, FastBank& bank, int n
 // The longest chain.
 constexpr int kMaxFastChain = 8;
 
-// Test hooks: the rounding steps of the kernels on their own, count lanes (a multiple of 16).
+// Test hooks: the rounding steps of the kernels on their own, over count lanes (any count).
 // Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
 // [lo, hi]. Linear: n = round_half_even(K·2^s / 2), clamped.
 using FastRoundProductFn = void (*)(const int32_t* p, int16_t* out, int count, int shift, bool half, int16_t lo,
@@ -84,7 +84,8 @@ using FastNarrowFn = void (*)(const int32_t* src, int16_t* dst, int n, int16_t m
 using FastStoreFn = void (*)(const int16_t* r, float* color, int32_t* grid, int n);
 
 struct FastKernels {
-    const char* name;  // what Executor::pathName() says: "fast-sse2" or "fast-avx2"
+    const char* name;  // what Executor::pathName() says: "fast-sse2", "fast-avx2" or "fast-avx512"
+    int lanes;         // int16 lanes a step: 16 (SSE2 pairs, AVX2) or 32 (AVX-512)
     FastArithFn arith;
     FastChainFn chain;
     FastLoadColorFn loadColor;
@@ -94,14 +95,17 @@ struct FastKernels {
     FastRoundLinearFn roundLinear;
 };
 
-// The kernels of a SIMD level: SSE2 at Baseline, AVX2 + FMA at Avx2. Null off x86-64 (no
-// kernels at any level: the generic path runs every program).
+// The kernels of a SIMD level: SSE2 at Baseline, AVX2 + FMA at Avx2, AVX-512 BW at Avx512.
+// Null off x86-64 (no kernels at any level: the generic path runs every program).
 const FastKernels* fastKernels(SimdLevel level);
-// The two tables (x86-64 builds), defined by executor_fast_kernels.inc; use fastKernels().
+// The tables (x86-64 builds), defined by executor_fast_kernels.inc; use fastKernels().
 namespace sse2 {
 extern const FastKernels kKernels;
 }
 namespace avx2 {
+extern const FastKernels kKernels;
+}
+namespace avx512 {
 extern const FastKernels kKernels;
 }
 

@@ -15,7 +15,9 @@
 namespace ps11::exec::avx2 {
 #define PS11_FAST_AVX2 1
 #define PS11_FAST_NAME "fast-avx2"
+#define PS11_FAST_AVX512 0
 #include "ps11/executor_fast_kernels.inc"
+#undef PS11_FAST_AVX512
 #undef PS11_FAST_AVX2
 #undef PS11_FAST_NAME
 }  // namespace ps11::exec::avx2

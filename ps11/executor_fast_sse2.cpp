@@ -12,7 +12,9 @@
 namespace ps11::exec::sse2 {
 #define PS11_FAST_AVX2 0
 #define PS11_FAST_NAME "fast-sse2"
+#define PS11_FAST_AVX512 0
 #include "ps11/executor_fast_kernels.inc"
+#undef PS11_FAST_AVX512
 #undef PS11_FAST_AVX2
 #undef PS11_FAST_NAME
 }  // namespace ps11::exec::sse2
