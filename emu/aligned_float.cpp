@@ -122,8 +122,28 @@ void decodeBase(const uint8_t* row, int n, float* out, size_t stride) {
         for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = kUnorm8[row[4 * i + ps11::kUnorm8Byte[c]]];
 }
 
+void transposeBase(const float* v, int n, float* out, size_t stride) {
+    int i = 0;
+#if defined(__SSE2__)
+    // Four texels a step: a 4×4 transpose (shuffles move the bits as they are).
+    const bool ahead = 16 * n >= kPrefetchRowBytes;
+    for (; i + 4 <= n; i += 4) {
+        if (ahead) _mm_prefetch(reinterpret_cast<const char*>(v + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
+        __m128 t0 = _mm_loadu_ps(v + 4 * i), t1 = _mm_loadu_ps(v + 4 * i + 4), t2 = _mm_loadu_ps(v + 4 * i + 8),
+               t3 = _mm_loadu_ps(v + 4 * i + 12);
+        _MM_TRANSPOSE4_PS(t0, t1, t2, t3);
+        _mm_storeu_ps(out + i, t0);
+        _mm_storeu_ps(out + stride + i, t1);
+        _mm_storeu_ps(out + 2 * stride + i, t2);
+        _mm_storeu_ps(out + 3 * stride + i, t3);
+    }
+#endif
+    for (; i < n; ++i)
+        for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = v[4 * size_t(i) + c];
+}
+
 const FloatRowKernels kBaseline{&lerpColumnsBase,   &lerpGatherBase, &lerpWordsBase, &lerpValuesBase,
-                                &bilinearWordsBase, &lerpRowBase,    &decodeBase};
+                                &bilinearWordsBase, &lerpRowBase,    &decodeBase,    &transposeBase};
 
 }  // namespace
 
@@ -144,7 +164,6 @@ struct RowTaps {
     float fy = 0;
     const float* h0 = nullptr;  // linear taps: H rows of j0 and j1 (planar, `width` columns)
     const float* h1 = nullptr;
-    const float* dec = nullptr;  // float point taps: texel row j0 as planar floats (decodedRow)
 };
 
 // Texel row j (in the texture) of a tap as planar r g b a floats: an 8-bit tap's decoded
@@ -342,6 +361,20 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
     draw.kernels->bilinearWords(tap.bytes, int(tap.width), i0, i1, j0, j1, fu, fv, tap.border.data(), n, out);
 }
 
+// The end of the run of lanes from i whose texels follow i0[i] one by one: the first e in
+// (i, n] with i0[e] != i0[i] + (e − i), or n. Eight lanes are compared at once while they match.
+int consecutiveEnd(const int32_t* i0, int i, int n) {
+    const int32_t base = i0[i] - i;
+    int e = i + 1;
+    for (; e + 8 <= n; e += 8) {
+        bool all = true;
+        for (int q = 0; q < 8; ++q) all &= i0[e + q] == base + e + q;
+        if (!all) break;
+    }
+    while (e < n && i0[e] == base + e) ++e;
+    return e;
+}
+
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
 // each stage read by one tap (prepareFloatRowDraw checks it).
 class RowSampler final : public ps11::Sampler {
@@ -400,33 +433,33 @@ public:
             return;
         }
         const int32_t* i0 = m_tri->taps[size_t(t)].i0.data() + first;
-        if (r.dec) {
-            // Columns of a decoded row: each run of consecutive texels copied at once.
-            const size_t tw = tap->width;
-            float* const dst[4] = {out.value[0], out.value[1], out.value[2], out.value[3]};
-            const float* const row[4] = {r.dec, r.dec + tw, r.dec + 2 * tw, r.dec + 3 * tw};
+        // (The channel arrays' distance as addresses: they need not be one array's parts.)
+        const auto at = [&](int c) { return reinterpret_cast<uintptr_t>(out.value[c]); };
+        const uintptr_t step = at(1) - at(0);
+        const ptrdiff_t stride = ptrdiff_t(step / sizeof(float));
+        const bool strided = at(1) > at(0) && step % sizeof(float) == 0 && stride >= n && at(2) - at(1) == step &&
+                             at(3) - at(2) == step;
+        if (!tap->unorm8 && r.j0 >= 0 && strided) {
+            // A float row's texels moved where they lie into the lanes, bit for bit: runs of
+            // consecutive texels by the transpose kernel, border lanes the border colour.
+            const float* values = tap->values + size_t(r.j0) * tap->width * 4;
+            float* const dst = out.value[0];
             int i = 0;
             while (i < n) {
                 const int32_t k = i0[i];
                 if (k < 0) {
-                    for (int c = 0; c < 4; ++c) dst[c][i] = tap->border[size_t(c)];
+                    for (int c = 0; c < 4; ++c) dst[c * stride + i] = tap->border[size_t(c)];
                     ++i;
                     continue;
                 }
-                int e = i + 1;
-                while (e < n && i0[e] == k + (e - i)) ++e;
-                for (int c = 0; c < 4; ++c) std::memcpy(dst[c] + i, row[c] + k, sizeof(float) * size_t(e - i));
+                const int e = consecutiveEnd(i0, i, n);
+                m_draw.kernels->transpose(values + 4 * size_t(k), e - i, dst + i, size_t(stride));
                 i = e;
             }
             m_fetched += uint64_t(n);
             return;
         }
-        // (The channel arrays' distance as addresses: they need not be one array's parts.)
-        const auto at = [&](int c) { return reinterpret_cast<uintptr_t>(out.value[c]); };
-        const uintptr_t step = at(1) - at(0);
-        const ptrdiff_t stride = ptrdiff_t(step / sizeof(float));
-        if (tap->unorm8 && r.j0 >= 0 && at(1) > at(0) && step % sizeof(float) == 0 && stride >= n &&
-            at(2) - at(1) == step && at(3) - at(2) == step) {
+        if (tap->unorm8 && r.j0 >= 0 && strided) {
             // An 8-bit row's texels decoded where they lie into the lanes (the result's channel
             // arrays one stride apart, as the executor's are): runs of consecutive texels by the
             // decode kernel, other lanes by the value table.
@@ -435,9 +468,7 @@ public:
             int i = 0;
             while (i < n) {
                 const int32_t k = i0[i];
-                int e = i + 1;
-                if (k >= 0)
-                    while (e < n && i0[e] == k + (e - i)) ++e;
+                const int e = k >= 0 ? consecutiveEnd(i0, i, n) : i + 1;
                 if (e - i >= 8) {
                     m_draw.kernels->decode(bytes + 4 * size_t(k), e - i, dst + i, size_t(stride));
                     i = e;
@@ -683,10 +714,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                 if (tap.linear) {
                     r.h0 = hRow(draw, tri, t, r.j0, sc);
                     r.h1 = hRow(draw, tri, t, r.j1, sc);
-                } else {
-                    // (8-bit point taps decode the lanes' texels straight from the row.)
-                    r.dec = r.j0 >= 0 && !tap.unorm8 ? decodedRow(draw, tap, r.j0, sc) : nullptr;
                 }
+                // (Point taps read the lanes' texels straight from the row: RowSampler::sample.)
             }
             for (size_t wi = 0; wi < windowCount; ++wi) {
                 const RowWindow* window = &windows[wi];

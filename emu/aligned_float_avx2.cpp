@@ -222,9 +222,34 @@ void decodeAvx2(const uint8_t* row, int n, float* out, size_t stride) {
     }
 }
 
+void transposeAvx2(const float* v, int n, float* out, size_t stride) {
+    int i = 0;
+    const bool ahead = 16 * n >= kPrefetchRowBytes;
+    for (; i + 8 <= n; i += 8) {
+        if (ahead) {
+            _mm_prefetch(reinterpret_cast<const char*>(v + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
+            _mm_prefetch(reinterpret_cast<const char*>(v + 4 * i + 16) + kPrefetchAhead, _MM_HINT_T0);
+        }
+        // Texels 0-1 | 4-5, 2-3 | 6-7, …: each 128-bit lane a texel; then a 4×4 transpose per
+        // lane (unpacks and 64-bit moves carry the bits as they are).
+        const __m256 a = _mm256_loadu2_m128(v + 4 * i + 16, v + 4 * i);       // t0 | t4
+        const __m256 b = _mm256_loadu2_m128(v + 4 * i + 20, v + 4 * i + 4);   // t1 | t5
+        const __m256 c = _mm256_loadu2_m128(v + 4 * i + 24, v + 4 * i + 8);   // t2 | t6
+        const __m256 d = _mm256_loadu2_m128(v + 4 * i + 28, v + 4 * i + 12);  // t3 | t7
+        const __m256 ab0 = _mm256_unpacklo_ps(a, b), ab1 = _mm256_unpackhi_ps(a, b);  // r0 r1 g0 g1 | b0 b1 a0 a1
+        const __m256 cd0 = _mm256_unpacklo_ps(c, d), cd1 = _mm256_unpackhi_ps(c, d);
+        _mm256_storeu_ps(out + i, _mm256_shuffle_ps(ab0, cd0, 0x44));  // r0 r1 r2 r3 | r4 … r7
+        _mm256_storeu_ps(out + stride + i, _mm256_shuffle_ps(ab0, cd0, 0xee));
+        _mm256_storeu_ps(out + 2 * stride + i, _mm256_shuffle_ps(ab1, cd1, 0x44));
+        _mm256_storeu_ps(out + 3 * stride + i, _mm256_shuffle_ps(ab1, cd1, 0xee));
+    }
+    for (; i < n; ++i)
+        for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = v[4 * size_t(i) + c];
+}
+
 }  // namespace
 
 const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2,   &lerpGatherAvx2, &lerpWordsAvx2, &lerpValuesAvx2,
-                                      &bilinearWordsAvx2, &lerpRowAvx2,    &decodeAvx2};
+                                      &bilinearWordsAvx2, &lerpRowAvx2,    &decodeAvx2,    &transposeAvx2};
 
 }  // namespace emu

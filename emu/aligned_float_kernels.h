@@ -46,6 +46,9 @@ struct FloatRowKernels {
     // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::
     // unorm8Values()): channel c of texel i at out[c·stride + i].
     void (*decode)(const uint8_t* row, int n, float* out, size_t stride);
+    // Texels [0, n) of a row of float r g b a texels as planar floats, bit for bit (NaNs too):
+    // channel c of texel i at out[c·stride + i].
+    void (*transpose)(const float* rgba, int n, float* out, size_t stride);
 };
 
 // The table of a level (Baseline: SSE2 on x86-64, scalar elsewhere).
