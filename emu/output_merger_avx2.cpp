@@ -133,8 +133,46 @@ void addUnorm8WordsAvx2(const float* const src[4], const uint8_t* words, int cou
     }
 }
 
+int blendRgba32FAvx2(const FloatBlendConsts& k, const float* const f[4], int i, int count, float* q) {
+    const auto both = [](const float* x) { return _mm256_broadcast_ps(reinterpret_cast<const __m128*>(x)); };
+    const auto mask = [&](const uint32_t* m) { return both(reinterpret_cast<const float*>(m)); };
+    const __m256 fs = both(k.fs), fd = both(k.fd), ks = both(k.ks), kd = both(k.kd);
+    const __m256 zs = mask(k.zs), zd = mask(k.zd), on = mask(k.on);
+    for (; i + 8 <= count; i += 8) {
+        // Planar r g b a of pixels i .. i + 7 to four registers of two interleaved pixels each.
+        const __m256 r = _mm256_loadu_ps(f[0] + i), g = _mm256_loadu_ps(f[1] + i), b = _mm256_loadu_ps(f[2] + i),
+                     a = _mm256_loadu_ps(f[3] + i);
+        const __m256d rg0 = _mm256_castps_pd(_mm256_unpacklo_ps(r, g));  // r0 g0 r1 g1 | r4 g4 r5 g5
+        const __m256d rg1 = _mm256_castps_pd(_mm256_unpackhi_ps(r, g));  // r2 g2 r3 g3 | r6 g6 r7 g7
+        const __m256d ba0 = _mm256_castps_pd(_mm256_unpacklo_ps(b, a));
+        const __m256d ba1 = _mm256_castps_pd(_mm256_unpackhi_ps(b, a));
+        const __m256 p04 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg0, ba0));  // pixel 0 | pixel 4
+        const __m256 p15 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg0, ba0));
+        const __m256 p26 = _mm256_castpd_ps(_mm256_unpacklo_pd(rg1, ba1));
+        const __m256 p37 = _mm256_castpd_ps(_mm256_unpackhi_pd(rg1, ba1));
+        const __m256 s[4] = {_mm256_permute2f128_ps(p04, p15, 0x20), _mm256_permute2f128_ps(p26, p37, 0x20),
+                             _mm256_permute2f128_ps(p04, p15, 0x31), _mm256_permute2f128_ps(p26, p37, 0x31)};
+        float* const dst = q + 4 * size_t(i);
+        const __m256 d[4] = {_mm256_loadu_ps(dst), _mm256_loadu_ps(dst + 8), _mm256_loadu_ps(dst + 16),
+                             _mm256_loadu_ps(dst + 24)};
+        __m256 nan = _mm256_setzero_ps();
+        for (int h = 0; h < 4; ++h) nan = _mm256_or_ps(nan, _mm256_cmp_ps(s[h], d[h], _CMP_UNORD_Q));
+        if (_mm256_movemask_ps(nan)) return i;  // the caller blends this group pixel by pixel
+        for (int h = 0; h < 4; ++h) {
+            const __m256 ts = _mm256_mul_ps(ks, _mm256_mul_ps(s[h], fs)),
+                         td = _mm256_mul_ps(kd, _mm256_mul_ps(d[h], fd));
+            const __m256 x = _mm256_andnot_ps(zd, td);
+            const __m256 y = _mm256_or_ps(_mm256_and_ps(zd, ts), _mm256_andnot_ps(zd, _mm256_add_ps(ts, td)));
+            const __m256 res = _mm256_or_ps(_mm256_and_ps(zs, x), _mm256_andnot_ps(zs, y));
+            _mm256_storeu_ps(dst + 8 * h, _mm256_or_ps(_mm256_and_ps(on, res), _mm256_andnot_ps(on, d[h])));
+        }
+    }
+    return i;
+}
+
 }  // namespace
 
-const MergerKernels avx2::kMerger{&halvesF16c, &unorm8WordsAvx2, &unorm8WordsRgbaAvx2, &addUnorm8WordsAvx2};
+const MergerKernels avx2::kMerger{&halvesF16c, &unorm8WordsAvx2, &unorm8WordsRgbaAvx2, &addUnorm8WordsAvx2,
+                                  &blendRgba32FAvx2};
 
 }  // namespace emu

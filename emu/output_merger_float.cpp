@@ -362,36 +362,42 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
     uint32_t x0 = 0, y0 = 0;
     if (constFactors && lanes.inside(0, x0, y0) && x0 + uint32_t(in.count) <= p.boundW) {
         assert(in.x[in.count - 1] == in.x[0] + in.count - 1 && in.y[in.count - 1] == in.y[0]);
-        alignas(16) float fs[4], fd[4], ks[4], kd[4];
-        alignas(16) uint32_t zs[4], zd[4], on[4];
+        FloatBlendConsts k;
         for (int c = 0; c < 4; ++c) {
             const ChannelPlan& cp = ch[c];
-            fs[c] = cp.src.inv ? 1.0f - v[cp.src.slot] : v[cp.src.slot];
-            fd[c] = cp.dst.inv ? 1.0f - v[cp.dst.slot] : v[cp.dst.slot];
-            ks[c] = float(cp.cs), kd[c] = float(cp.cd);
-            zs[c] = cp.src.slot == kZero && !cp.src.inv ? ~0u : 0u;
-            zd[c] = cp.dst.slot == kZero && !cp.dst.inv ? ~0u : 0u;
-            on[c] = (p.channels >> c & 1u) ? ~0u : 0u;
+            k.fs[c] = cp.src.inv ? 1.0f - v[cp.src.slot] : v[cp.src.slot];
+            k.fd[c] = cp.dst.inv ? 1.0f - v[cp.dst.slot] : v[cp.dst.slot];
+            k.ks[c] = float(cp.cs), k.kd[c] = float(cp.cd);
+            k.zs[c] = cp.src.slot == kZero && !cp.src.inv ? ~0u : 0u;
+            k.zd[c] = cp.dst.slot == kZero && !cp.dst.inv ? ~0u : 0u;
+            k.on[c] = (p.channels >> c & 1u) ? ~0u : 0u;
         }
-        const __m128 fsv = _mm_load_ps(fs), fdv = _mm_load_ps(fd), ksv = _mm_load_ps(ks), kdv = _mm_load_ps(kd);
-        const __m128 zsv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(zs)));
-        const __m128 zdv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(zd)));
-        const __m128 onv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(on)));
-        float* q = reinterpret_cast<float*>(cs.at(x0, y0));
+        const __m128 fsv = _mm_load_ps(k.fs), fdv = _mm_load_ps(k.fd), ksv = _mm_load_ps(k.ks), kdv = _mm_load_ps(k.kd);
+        const __m128 zsv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(k.zs)));
+        const __m128 zdv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(k.zd)));
+        const __m128 onv = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(k.on)));
+        float* const q0 = reinterpret_cast<float*>(cs.at(x0, y0));
         const float *f0 = f[0], *f1 = f[1], *f2 = f[2], *f3 = f[3];
-        for (int i = 0; i < in.count; ++i, q += 4) {
-            const __m128 sv = _mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), dv = _mm_loadu_ps(q);
-            if (_mm_movemask_ps(_mm_cmpunord_ps(sv, dv))) {  // a NaN: blendFloat's own order
-                float sc[4] = {f0[i], f1[i], f2[i], f3[i]};
-                blendIntoFloatTarget(p, ch, v, sc, reinterpret_cast<uint8_t*>(q));
-                continue;
+        const MergerKernels& kern = mergerKernels(ps11::simdLevel());
+        for (int i = 0; i < in.count;) {
+            // The kernel's groups, then pixel by pixel up to a group's length (a group with a
+            // NaN, or the last pixels).
+            i = kern.blendRgba32F(k, f, i, in.count, q0);
+            for (const int stop = std::min(in.count, i + 8); i < stop; ++i) {
+                float* const q = q0 + 4 * size_t(i);
+                const __m128 sv = _mm_setr_ps(f0[i], f1[i], f2[i], f3[i]), dv = _mm_loadu_ps(q);
+                if (_mm_movemask_ps(_mm_cmpunord_ps(sv, dv))) {  // a NaN: blendFloat's own order
+                    float sc[4] = {f0[i], f1[i], f2[i], f3[i]};
+                    blendIntoFloatTarget(p, ch, v, sc, reinterpret_cast<uint8_t*>(q));
+                    continue;
+                }
+                const __m128 ts = _mm_mul_ps(ksv, _mm_mul_ps(sv, fsv)), td = _mm_mul_ps(kdv, _mm_mul_ps(dv, fdv));
+                // zs: (zd ? 0 : td); else zd ? ts : ts + td.
+                const __m128 a = _mm_andnot_ps(zdv, td);
+                const __m128 b = _mm_or_ps(_mm_and_ps(zdv, ts), _mm_andnot_ps(zdv, _mm_add_ps(ts, td)));
+                const __m128 r = _mm_or_ps(_mm_and_ps(zsv, a), _mm_andnot_ps(zsv, b));
+                _mm_storeu_ps(q, _mm_or_ps(_mm_and_ps(onv, r), _mm_andnot_ps(onv, dv)));
             }
-            const __m128 ts = _mm_mul_ps(ksv, _mm_mul_ps(sv, fsv)), td = _mm_mul_ps(kdv, _mm_mul_ps(dv, fdv));
-            // zs: (zd ? 0 : td); else zd ? ts : ts + td.
-            const __m128 a = _mm_andnot_ps(zdv, td);
-            const __m128 b = _mm_or_ps(_mm_and_ps(zdv, ts), _mm_andnot_ps(zdv, _mm_add_ps(ts, td)));
-            const __m128 r = _mm_or_ps(_mm_and_ps(zsv, a), _mm_andnot_ps(zsv, b));
-            _mm_storeu_ps(q, _mm_or_ps(_mm_and_ps(onv, r), _mm_andnot_ps(onv, dv)));
         }
         n.written += uint64_t(in.count);
         return;
@@ -409,10 +415,14 @@ void blendFloatTarget(const Plan& p, const MergeInputs& in, const float* const f
     n.written += written;
 }
 
+// No vector groups at Baseline: blendFloatTarget blends every pixel on its own.
+int blendRgba32FBaseline(const FloatBlendConsts&, const float* const[4], int from, int, float*) { return from; }
+
 }  // namespace merger
 
 const MergerKernels baseline::kMerger{&merger::halvesBaseline, &merger::unorm8WordsBaseline,
-                                      &merger::unorm8WordsRgbaBaseline, &merger::addUnorm8WordsBaseline};
+                                      &merger::unorm8WordsRgbaBaseline, &merger::addUnorm8WordsBaseline,
+                                      &merger::blendRgba32FBaseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #ifdef PS11_HAVE_AVX2

@@ -8,6 +8,14 @@
 
 namespace emu {
 
+// A blend with constant factors into an A32B32G32R32F target (blendFloatTarget), per channel c:
+// t_s = ks·(s·fs), t_d = kd·(d·fd); the result is zs ? (zd ? 0 : t_d) : (zd ? t_s : t_s + t_d),
+// stored where `on` (the write mask) is set, d kept elsewhere. Masks are all ones or zeros.
+struct FloatBlendConsts {
+    alignas(16) float fs[4], fd[4], ks[4], kd[4];
+    alignas(16) uint32_t zs[4], zd[4], on[4];
+};
+
 struct MergerKernels {
     // The IEEE halves (round to nearest even) of `count` lanes of r g b a, interleaved:
     // out[4·i + c] = half(f[c][i]). Baseline: by bit manipulation; Avx2: F16C (VCVTPS2PH). The
@@ -27,6 +35,13 @@ struct MergerKernels {
     // words (the sum is d, whose byte is d's), without converting.
     void (*addUnorm8Words)(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
                            uint32_t* out);
+    // The FloatBlendConsts blend of planar sources f[c][i] onto the interleaved float pixels
+    // q[4·i + c], for i from `from` on, a group of pixels at a time while no source or
+    // destination value of the group is NaN; returns the first pixel not blended (a group with a
+    // NaN, or the last pixels short of a group: the caller blends them on its own). Baseline:
+    // none (returns `from`); Avx2: eight pixels a group, the same float operations in the same
+    // order per pixel.
+    int (*blendRgba32F)(const FloatBlendConsts& k, const float* const f[4], int from, int count, float* q);
 };
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level);
