@@ -103,6 +103,7 @@ DrawStats& DrawStats::operator+=(const DrawStats& o) {
     triangles += o.triangles;
     trianglesDrawn += o.trianglesDrawn;
     pixelsCovered += o.pixelsCovered;
+    pixelsRowPath += o.pixelsRowPath;
     pixelsShaded += o.pixelsShaded;
     pixelsWritten += o.pixelsWritten;
     texelsFetched += o.texelsFetched;

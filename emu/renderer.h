@@ -36,6 +36,7 @@ struct DrawStats {
     uint64_t triangles = 0;       // input triangles
     uint64_t trianglesDrawn = 0;  // triangles rasterised (after clipping, culling; a clipped polygon is a fan)
     uint64_t pixelsCovered = 0;   // pixels inside a triangle and the clip rect
+    uint64_t pixelsRowPath = 0;   // of those, the ones a row path drew (emu/aligned_pass.h; 0 on the GL renderer)
     uint64_t pixelsShaded = 0;    // lanes the executor ran: covered pixels plus quad helper lanes
     uint64_t pixelsWritten = 0;   // pixels that reached the colour or depth store (output merger)
     uint64_t texelsFetched = 0;   // texels read by the sampler

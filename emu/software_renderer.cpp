@@ -92,6 +92,8 @@ struct SoftwareDrawContext {
     struct Chunk {
         std::vector<ScreenTriangle> tris;
         std::vector<TriangleSetup> setups;
+        // Setups past the row-path column budget of the ones before them: the chunk's next part.
+        std::vector<TriangleSetup> rest;
         std::vector<AlignedTriangle> alignedTris;
         std::vector<FloatRowTriangle> floatTris;
         std::vector<uint8_t> isAligned;
@@ -235,6 +237,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     std::vector<uint8_t>& bandCopied = dc.bandCopied;
     if (fused) bandCopied.assign((size_t(colorImage->height) + kBandRows - 1) / kBandRows, 0);
     auto copyBand = [&](int band) {
+        if (bandCopied[size_t(band)]) return;  // (a band a chunk's earlier part reached)
         stretchImages(*fused, RowRange{int64_t(band) * kBandRows, int64_t(band + 1) * kBandRows});
         bandCopied[size_t(band)] = 1;
     };
@@ -336,303 +339,328 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
         tris.clear();
         setups.clear();
         call.assemble(first, chunk, tris);
-        int yLo = clip.y1, yHi = clip.y0;
         for (const ScreenTriangle& t : tris) {
             TriangleSetup& s = setups.emplace_back();
-            if (!setupTriangle(t, used, clip, s)) {
-                setups.pop_back();
-                continue;
-            }
-            yLo = std::min(yLo, s.yMin);
-            yHi = std::max(yHi, s.yMax);
+            if (!setupTriangle(t, used, clip, s)) setups.pop_back();
         }
         stats.trianglesDrawn += setups.size();
-        isAligned.assign(setups.size(), 0);
-        // Tables for the chunk's triangles, in order, while their columns fit the budget (the same
-        // for both row paths: a float table holds 12 bytes a column per tap, an fx8 one 16), a
-        // quad's two halves over the same columns so they share tables and H rows (pairColumns).
-        // Which triangles and columns is decided here; the tables are filled on the workers
-        // (independent per triangle: a full-screen quad's two halves fill at once).
-        // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
-        // pixel (rowPathKind; those never share tables, and their tiles are not decided).
-        auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto fill) {
-            if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
-            tableOf.resize(setups.size());
-            const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
-            int64_t columns = 0;
-            bool paired = false;  // the triangle before was paired with the one before it
-            for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
-                auto& t = rowTris[i];
-                tableOf[i] = uint32_t(i);
-                isAligned[i] = uint8_t(rowPath(setups[i], t.x0, t.x1));
-                std::pair<int, int> both;
-                const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
-                                  pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
-                if (pair) {
-                    auto& p = rowTris[i - 1];
-                    columns -= p.x1 - p.x0;
-                    p.x0 = t.x0 = both.first;
-                    p.x1 = t.x1 = both.second;
-                    columns += p.x1 - p.x0;
-                }
-                if (isAligned[i] == 1 && i > 0 && isAligned[i - 1] == 1 && tableOf[i - 1] == i - 1 && t.x0 == rowTris[i - 1].x0 &&
-                    t.x1 == rowTris[i - 1].x1 && sameColumnTables(setups[i - 1], setups[i], plan))
-                    tableOf[i] = uint32_t(i - 1);
-                paired = pair;
-                if (isAligned[i]) columns += t.x1 - t.x0;
-                if (columns > budget) isAligned[i] = 0;
+        std::vector<TriangleSetup>& rest = dc.chunk.rest;
+        rest.clear();
+        // The chunk in parts: each takes the triangles whose row-path tables fit the column
+        // budget, and the triangles after them are the next part (in primitive order, so each
+        // pixel's order holds). Draws of many sprites stay on the row path.
+        bool nextPart = false;
+        do {
+            if (nextPart) {
+                setups.swap(rest);
+                rest.clear();
             }
-            // About a microsecond per 64 columns of one tap: the workers share from 1024.
-            const int64_t work = columns * std::max(taps, 1);
-            const int workers = int(std::clamp<int64_t>(work / 1024, 1, dc.pool.size()));
-            std::atomic<size_t> nextTri{0};
-            dc.pool.run(workers, [&](int) {
-                for (size_t i; (i = nextTri.fetch_add(1, std::memory_order_relaxed)) < setups.size();)
-                    if (isAligned[i] && tableOf[i] == i) fill(setups[i], rowTris[i]);
-            });
-        };
-        if (alignedDraw)
-            prepareTables(
-                alignedTris, aligned.plan, aligned.plan.count,
-                [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
-                    return rowPathKind(aligned.plan, bound, s, x0, x1);
-                },
-                [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
-        if (floatDraw) {
-            prepareTables(
-                floatTris, floatRows.plan, floatRows.plan.count,
-                [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
-                    return rowPathKind(floatRows.plan, bound, s, x0, x1);
-                },
-                [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
-            shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
-        }
-        if (setups.empty()) continue;
-        const bool tileChunk = decide && setups.size() <= kMaxAlignedTriangles &&
-                               std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
-        if (tileChunk && !skipperTried) {
-            skipperTried = true;
-            skipper = TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
-        }
-        const bool tiles = tileChunk && skipper;
+            nextPart = true;
+            int yLo = clip.y1, yHi = clip.y0;
+            isAligned.assign(setups.size(), 0);
+            // Tables for the part's triangles, in order, while their columns fit the budget (the same
+            // for both row paths: a float table holds 12 bytes a column per tap, an fx8 one 16), a
+            // quad's two halves over the same columns so they share tables and H rows (pairColumns).
+            // Which triangles and columns is decided here, and the triangle past the budget starts
+            // the next part; the tables are filled on the workers (independent per triangle: a
+            // full-screen quad's two halves fill at once).
+            // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
+            // pixel (rowPathKind; those never share tables, and their tiles are not decided).
+            auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto fill) {
+                if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
+                tableOf.resize(setups.size());
+                const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
+                int64_t columns = 0;
+                bool paired = false;  // the triangle before was paired with the one before it
+                for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
+                    auto& t = rowTris[i];
+                    tableOf[i] = uint32_t(i);
+                    isAligned[i] = uint8_t(rowPath(setups[i], t.x0, t.x1));
+                    std::pair<int, int> both;
+                    const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
+                                      pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
+                    if (pair) {
+                        auto& p = rowTris[i - 1];
+                        columns -= p.x1 - p.x0;
+                        p.x0 = t.x0 = both.first;
+                        p.x1 = t.x1 = both.second;
+                        columns += p.x1 - p.x0;
+                    }
+                    if (isAligned[i] == 1 && i > 0 && isAligned[i - 1] == 1 && tableOf[i - 1] == i - 1 &&
+                        t.x0 == rowTris[i - 1].x0 && t.x1 == rowTris[i - 1].x1 &&
+                        sameColumnTables(setups[i - 1], setups[i], plan))
+                        tableOf[i] = uint32_t(i - 1);
+                    paired = pair;
+                    if (isAligned[i]) columns += t.x1 - t.x0;
+                    if (columns > budget) {
+                        rest.assign(setups.begin() + ptrdiff_t(i), setups.end());
+                        setups.resize(i);
+                        isAligned.resize(i);
+                        tableOf.resize(i);
+                    }
+                }
+                // About a microsecond per 64 columns of one tap: the workers share from 1024.
+                const int64_t work = columns * std::max(taps, 1);
+                const int workers = int(std::clamp<int64_t>(work / 1024, 1, dc.pool.size()));
+                std::atomic<size_t> nextTri{0};
+                dc.pool.run(workers, [&](int) {
+                    for (size_t i; (i = nextTri.fetch_add(1, std::memory_order_relaxed)) < setups.size();)
+                        if (isAligned[i] && tableOf[i] == i) fill(setups[i], rowTris[i]);
+                });
+            };
+            if (alignedDraw)
+                prepareTables(
+                    alignedTris, aligned.plan, aligned.plan.count,
+                    [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
+                        return rowPathKind(aligned.plan, bound, s, x0, x1);
+                    },
+                    [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
+            if (floatDraw) {
+                prepareTables(
+                    floatTris, floatRows.plan, floatRows.plan.count,
+                    [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
+                        return rowPathKind(floatRows.plan, bound, s, x0, x1);
+                    },
+                    [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
+                shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
+            }
+            if (setups.empty()) continue;
+            for (const TriangleSetup& t : setups) {
+                yLo = std::min(yLo, t.yMin);
+                yHi = std::max(yHi, t.yMax);
+            }
+            const bool tileChunk = decide && setups.size() <= kMaxAlignedTriangles &&
+                                   std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
+            if (tileChunk && !skipperTried) {
+                skipperTried = true;
+                skipper =
+                    TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
+            }
+            const bool tiles = tileChunk && skipper;
 
-        // ---- rows in bands over the workers ----
-        const int firstBand = (yLo & ~1) / kBandRows;
-        const int lastBand = (yHi + kBandRows - 1) / kBandRows;
-        const int bands = lastBand - firstBand;
-        // Each band's triangles in primitive order (a draw of many small triangles, such as
-        // sprites, visits each triangle only in the bands it touches).
-        bandStart.assign(size_t(bands) + 1, 0);
-        for (const TriangleSetup& t : setups)
-            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax;
-                 ++b)
-                ++bandStart[size_t(b) + 1];
-        for (int b = 0; b < bands; ++b) bandStart[size_t(b) + 1] += bandStart[size_t(b)];
-        bandTris.resize(bandStart[size_t(bands)]);
-        bandFill.assign(bandStart.begin(), bandStart.end() - 1);
-        for (uint32_t i = 0; i < setups.size(); ++i) {
-            const TriangleSetup& t = setups[i];
-            for (int b = std::max(t.yMin / kBandRows - firstBand, 0); b < bands && (firstBand + b) * kBandRows < t.yMax;
-                 ++b)
-                bandTris[bandFill[size_t(b)]++] = i;
-        }
-        std::atomic<int> next{0};
-        const int workers = std::min(dc.pool.size(), bands);
-        std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
-        const bool fx = ps11::isFixedPoint(precision);
-        dc.pool.run(workers, [&](int w) {
-            WorkerScratch& ws0 = *dc.scratch[size_t(w)];
-            ps11::TextureSampler& sampler = ws0.sampler;
-            sampler.setWeightBits(call.hardware.weightBits);
-            for (int s = 0; s < kMaxSamplers; ++s) {
-                // Stages the program does not sample are unbound (no texture kept alive).
-                sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);
-                if ((sampled >> s) & 1) sampler.setSamplerState(s, call.samplers[size_t(s)]);
+            // ---- rows in bands over the workers ----
+            const int firstBand = (yLo & ~1) / kBandRows;
+            const int lastBand = (yHi + kBandRows - 1) / kBandRows;
+            const int bands = lastBand - firstBand;
+            // Each band's triangles in primitive order (a draw of many small triangles, such as
+            // sprites, visits each triangle only in the bands it touches).
+            bandStart.assign(size_t(bands) + 1, 0);
+            for (const TriangleSetup& t : setups)
+                for (int b = std::max(t.yMin / kBandRows - firstBand, 0);
+                     b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+                    ++bandStart[size_t(b) + 1];
+            for (int b = 0; b < bands; ++b) bandStart[size_t(b) + 1] += bandStart[size_t(b)];
+            bandTris.resize(bandStart[size_t(bands)]);
+            bandFill.assign(bandStart.begin(), bandStart.end() - 1);
+            for (uint32_t i = 0; i < setups.size(); ++i) {
+                const TriangleSetup& t = setups[i];
+                for (int b = std::max(t.yMin / kBandRows - firstBand, 0);
+                     b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
+                    bandTris[bandFill[size_t(b)]++] = i;
             }
-            ws0.floatRows.sampler = &sampler;  // the float row path's taps sampled per pixel
-            const uint64_t fetchedBefore = sampler.texelsFetched();
-            QuadSpan* span = &ws0.span;
-            Lanes* lanes = &ws0.lanes;
-            ps11::PixelInputs in;
-            in.quads = !rowSpans;
-            for (int c = 0; c < 4; ++c) {
-                if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
-                if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
-                for (int t = 0; t < kMaxTexSets; ++t)
-                    if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
-            }
-            ps11::PixelOutputs outp;
-            const bool readsColor = mergeReadsColor(precision, mtarget);
-            for (int c = 0; c < 4; ++c) {
-                outp.color[c] = readsColor ? lanes->color[c] : nullptr;
-                if (fx) outp.grid[c] = lanes->grid[c];
-            }
-            outp.killed = lanes->killed;
-            outp.depth = shaderDepth ? lanes->depth : nullptr;
-            ps11::ExecutorStats es;
-            MergeStats ms;
-            DrawStats& ws = workerStats[size_t(w)];
-            auto emit = [&](QuadSpan& sp) {
-                in.count = sp.count;
-                executor.run(in, sampler, outp, &es);
-                if (kills)
-                    for (int L = 0; L < sp.count; ++L) lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
-                MergeInputs mi;
-                mi.count = sp.count;
-                mi.x = sp.x;
-                mi.y = sp.y;
-                // (A row span's lanes are one run of a row, every one covered.)
-                mi.live = kills ? lanes->live : rowSpans ? nullptr : sp.live;
-                mi.row = rowSpans;
+            std::atomic<int> next{0};
+            const int workers = std::min(dc.pool.size(), bands);
+            std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
+            const bool fx = ps11::isFixedPoint(precision);
+            dc.pool.run(workers, [&](int w) {
+                WorkerScratch& ws0 = *dc.scratch[size_t(w)];
+                ps11::TextureSampler& sampler = ws0.sampler;
+                sampler.setWeightBits(call.hardware.weightBits);
+                for (int s = 0; s < kMaxSamplers; ++s) {
+                    // Stages the program does not sample are unbound (no texture kept alive).
+                    sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);
+                    if ((sampled >> s) & 1) sampler.setSamplerState(s, call.samplers[size_t(s)]);
+                }
+                ws0.floatRows.sampler = &sampler;  // the float row path's taps sampled per pixel
+                const uint64_t fetchedBefore = sampler.texelsFetched();
+                QuadSpan* span = &ws0.span;
+                Lanes* lanes = &ws0.lanes;
+                ps11::PixelInputs in;
+                in.quads = !rowSpans;
                 for (int c = 0; c < 4; ++c) {
-                    mi.color[c] = readsColor ? lanes->color[c] : nullptr;
-                    mi.grid[c] = fx ? lanes->grid[c] : nullptr;
+                    if ((used >> (kAttrDiffuse + c)) & 1) in.color[0][c] = span->attr[kAttrDiffuse + c];
+                    if ((used >> (kAttrSpecular + c)) & 1) in.color[1][c] = span->attr[kAttrSpecular + c];
+                    for (int t = 0; t < kMaxTexSets; ++t)
+                        if ((used >> attrTex(t, c)) & 1) in.texcoord[t][c] = span->attr[attrTex(t, c)];
                 }
-                mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
-                mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
-                mergePixels(merge, mi, mtarget, &ms);
-                ws.pixelsCovered += uint64_t(sp.liveCount);
-            };
-            const std::function<void(QuadSpan&)> emitFn = emit;
-            AlignedStats as;
-            std::vector<RowWindow> windows;
-            TileMemo memo;
-            // A band of a chunk drawn wholly by a row path, tile by tile (emu/tile_skip.h).
-            auto drawBandTiles = [&](int b, int by0, int by1) {
-                const TriangleSetup* bt[kMaxAlignedTriangles];
-                const AlignedTriangle* at[kMaxAlignedTriangles];
-                const FloatRowTriangle* ft[kMaxAlignedTriangles];
-                size_t n = 0;
-                int ty0 = by1, ty1 = by0;
-                for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1] && n < kMaxAlignedTriangles; ++k) {
-                    const uint32_t i = bandTris[k];
-                    bt[n] = &setups[i];
-                    ft[n] = floatDraw ? &floatTris[tableOf[i]] : nullptr;
-                    at[n++] = floatDraw ? nullptr : &alignedTris[tableOf[i]];
-                    ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
-                    ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
+                ps11::PixelOutputs outp;
+                const bool readsColor = mergeReadsColor(precision, mtarget);
+                for (int c = 0; c < 4; ++c) {
+                    outp.color[c] = readsColor ? lanes->color[c] : nullptr;
+                    if (fx) outp.grid[c] = lanes->grid[c];
                 }
-                if (n == 0 || ty0 >= ty1) return;
-                // The columns the band's triangles cover (a small quad decides only its own tiles).
-                int tx0 = clip.x1, tx1 = clip.x0;
-                for (size_t t = 0; t < n; ++t)
-                    for (int y = std::max(ty0, bt[t]->yMin); y < std::min(ty1, bt[t]->yMax); ++y) {
-                        int xl = 0, xr = 0;
-                        if (rowCoverage(*bt[t], y, xl, xr)) tx0 = std::min(tx0, xl), tx1 = std::max(tx1, xr);
+                outp.killed = lanes->killed;
+                outp.depth = shaderDepth ? lanes->depth : nullptr;
+                ps11::ExecutorStats es;
+                MergeStats ms;
+                DrawStats& ws = workerStats[size_t(w)];
+                auto emit = [&](QuadSpan& sp) {
+                    in.count = sp.count;
+                    executor.run(in, sampler, outp, &es);
+                    if (kills)
+                        for (int L = 0; L < sp.count; ++L)
+                            lanes->live[L] = uint8_t(sp.live[L] & (lanes->killed[L] ^ 1));
+                    MergeInputs mi;
+                    mi.count = sp.count;
+                    mi.x = sp.x;
+                    mi.y = sp.y;
+                    // (A row span's lanes are one run of a row, every one covered.)
+                    mi.live = kills ? lanes->live : rowSpans ? nullptr : sp.live;
+                    mi.row = rowSpans;
+                    for (int c = 0; c < 4; ++c) {
+                        mi.color[c] = readsColor ? lanes->color[c] : nullptr;
+                        mi.grid[c] = fx ? lanes->grid[c] : nullptr;
                     }
-                if (tx0 >= tx1) return;
-                // Runs of tiles with one decision become the windows of one pass over the band's
-                // rows (each texel row the windows need is filtered once per pixel row).
-                windows.clear();
-                auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
-                    switch (d.action) {
-                        case TileAction::Shade:
-                            ws.tilesShaded += count;
-                            break;
-                        case TileAction::Fill:
-                            ws.tilesFilled += count;
-                            break;
-                        case TileAction::Copy:
-                            ws.tilesCopied += count;
-                            if (copiesSave) copiesSaving.fetch_add(count, std::memory_order_relaxed);
-                            break;
-                        case TileAction::Skip:
-                            ws.tilesSkipped += count;
-                            // Nothing is drawn; the pixels are still covered.
-                            for (int y = by0; y < by1; ++y)
-                                for (size_t t = 0; t < n; ++t) {
-                                    int xl = 0, xr = 0;
-                                    if (y >= bt[t]->yMin && y < bt[t]->yMax && rowCoverage(*bt[t], y, xl, xr))
-                                        as.pixels += uint64_t(std::max(0, std::min(xr, xb) - std::max(xl, xa)));
-                                }
-                            return;
-                    }
-                    windows.push_back(d.window(xa, xb));
+                    mi.fog = merge.fog ? sp.attr[kAttrSpecular + 3] : nullptr;
+                    mi.z = shaderDepth ? lanes->depth : (wantZ ? sp.z : nullptr);
+                    mergePixels(merge, mi, mtarget, &ms);
+                    ws.pixelsCovered += uint64_t(sp.liveCount);
                 };
-                TileDecision run;
-                int runX0 = tx0;
-                uint64_t runTiles = 0;
-                for (int x = tx0; x < tx1; x += kSkipTileColumns) {
-                    const int xe = std::min(tx1, x + kSkipTileColumns);
-                    const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1, memo);
-                    if (runTiles && !(d == run)) {
-                        addRun(run, runX0, x, runTiles);
-                        runTiles = 0;
+                const std::function<void(QuadSpan&)> emitFn = emit;
+                AlignedStats as;
+                std::vector<RowWindow> windows;
+                TileMemo memo;
+                // A band of a chunk drawn wholly by a row path, tile by tile (emu/tile_skip.h).
+                auto drawBandTiles = [&](int b, int by0, int by1) {
+                    const TriangleSetup* bt[kMaxAlignedTriangles];
+                    const AlignedTriangle* at[kMaxAlignedTriangles];
+                    const FloatRowTriangle* ft[kMaxAlignedTriangles];
+                    size_t n = 0;
+                    int ty0 = by1, ty1 = by0;
+                    for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1] && n < kMaxAlignedTriangles;
+                         ++k) {
+                        const uint32_t i = bandTris[k];
+                        bt[n] = &setups[i];
+                        ft[n] = floatDraw ? &floatTris[tableOf[i]] : nullptr;
+                        at[n++] = floatDraw ? nullptr : &alignedTris[tableOf[i]];
+                        ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
+                        ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
                     }
-                    if (!runTiles) run = d, runX0 = x;
-                    ++runTiles;
-                }
-                if (runTiles) addRun(run, runX0, tx1, runTiles);
-                if (windows.empty()) return;
-                if (floatDraw) {
-                    drawFloatRows(floatRows, ft, bt, n, by0, by1, ws0.floatRows, as, windows.data(), windows.size());
-                } else {
-                    drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
-                }
-            };
-            for (;;) {
-                const int b = next.fetch_add(1, std::memory_order_relaxed);
-                if (b >= bands) break;
-                const int by0 = (firstBand + b) * kBandRows;
-                const int by1 = by0 + kBandRows;
-                if (fused) copyBand(firstBand + b);
-                // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
-                const AlignedTriangle* group[kMaxAlignedTriangles];
-                const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
-                const TriangleSetup* groupSetups[kMaxAlignedTriangles];
-                size_t grouped = 0;
-                auto flush = [&] {
-                    if (grouped && floatDraw)
-                        drawFloatRows(floatRows, floatGroup, groupSetups, grouped, by0, by1, ws0.floatRows, as);
-                    else if (grouped)
-                        drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
-                    grouped = 0;
+                    if (n == 0 || ty0 >= ty1) return;
+                    // The columns the band's triangles cover (a small quad decides only its own tiles).
+                    int tx0 = clip.x1, tx1 = clip.x0;
+                    for (size_t t = 0; t < n; ++t)
+                        for (int y = std::max(ty0, bt[t]->yMin); y < std::min(ty1, bt[t]->yMax); ++y) {
+                            int xl = 0, xr = 0;
+                            if (rowCoverage(*bt[t], y, xl, xr)) tx0 = std::min(tx0, xl), tx1 = std::max(tx1, xr);
+                        }
+                    if (tx0 >= tx1) return;
+                    // Runs of tiles with one decision become the windows of one pass over the band's
+                    // rows (each texel row the windows need is filtered once per pixel row).
+                    windows.clear();
+                    auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
+                        switch (d.action) {
+                            case TileAction::Shade:
+                                ws.tilesShaded += count;
+                                break;
+                            case TileAction::Fill:
+                                ws.tilesFilled += count;
+                                break;
+                            case TileAction::Copy:
+                                ws.tilesCopied += count;
+                                if (copiesSave) copiesSaving.fetch_add(count, std::memory_order_relaxed);
+                                break;
+                            case TileAction::Skip:
+                                ws.tilesSkipped += count;
+                                // Nothing is drawn; the pixels are still covered.
+                                for (int y = by0; y < by1; ++y)
+                                    for (size_t t = 0; t < n; ++t) {
+                                        int xl = 0, xr = 0;
+                                        if (y >= bt[t]->yMin && y < bt[t]->yMax && rowCoverage(*bt[t], y, xl, xr))
+                                            as.pixels += uint64_t(std::max(0, std::min(xr, xb) - std::max(xl, xa)));
+                                    }
+                                return;
+                        }
+                        windows.push_back(d.window(xa, xb));
+                    };
+                    TileDecision run;
+                    int runX0 = tx0;
+                    uint64_t runTiles = 0;
+                    for (int x = tx0; x < tx1; x += kSkipTileColumns) {
+                        const int xe = std::min(tx1, x + kSkipTileColumns);
+                        const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1, memo);
+                        if (runTiles && !(d == run)) {
+                            addRun(run, runX0, x, runTiles);
+                            runTiles = 0;
+                        }
+                        if (!runTiles) run = d, runX0 = x;
+                        ++runTiles;
+                    }
+                    if (runTiles) addRun(run, runX0, tx1, runTiles);
+                    if (windows.empty()) return;
+                    if (floatDraw) {
+                        drawFloatRows(floatRows, ft, bt, n, by0, by1, ws0.floatRows, as, windows.data(),
+                                      windows.size());
+                    } else {
+                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
+                    }
                 };
-                if (tiles) {
-                    drawBandTiles(b, by0, by1);
-                    continue;
-                }
-                for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
-                    const uint32_t i = bandTris[k];
-                    const TriangleSetup& s = setups[i];
-                    if (isAligned[i]) {
-                        if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
-                        if (floatDraw)
-                            floatGroup[grouped] = &floatTris[tableOf[i]];
-                        else
-                            group[grouped] = &alignedTris[tableOf[i]];
-                        groupSetups[grouped++] = &s;
+                for (;;) {
+                    const int b = next.fetch_add(1, std::memory_order_relaxed);
+                    if (b >= bands) break;
+                    const int by0 = (firstBand + b) * kBandRows;
+                    const int by1 = by0 + kBandRows;
+                    if (fused) copyBand(firstBand + b);
+                    // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
+                    const AlignedTriangle* group[kMaxAlignedTriangles];
+                    const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
+                    const TriangleSetup* groupSetups[kMaxAlignedTriangles];
+                    size_t grouped = 0;
+                    auto flush = [&] {
+                        if (grouped && floatDraw)
+                            drawFloatRows(floatRows, floatGroup, groupSetups, grouped, by0, by1, ws0.floatRows, as);
+                        else if (grouped)
+                            drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
+                        grouped = 0;
+                    };
+                    if (tiles) {
+                        drawBandTiles(b, by0, by1);
                         continue;
                     }
+                    for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
+                        const uint32_t i = bandTris[k];
+                        const TriangleSetup& s = setups[i];
+                        if (isAligned[i]) {
+                            if (grouped == kMaxAlignedTriangles) flush();  // groups in order: each pixel's order holds
+                            if (floatDraw)
+                                floatGroup[grouped] = &floatTris[tableOf[i]];
+                            else
+                                group[grouped] = &alignedTris[tableOf[i]];
+                            groupSetups[grouped++] = &s;
+                            continue;
+                        }
+                        flush();
+                        if (rowSpans)
+                            rasterizeRowSpans(s, by0, by1, used, wantZ, *span, emitFn);
+                        else
+                            rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
+                    }
                     flush();
-                    if (rowSpans)
-                        rasterizeRowSpans(s, by0, by1, used, wantZ, *span, emitFn);
-                    else
-                        rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                 }
-                flush();
+                // The draw's textures are not kept alive past it: a texture read in place would
+                // otherwise be copied on its next write (Device::prepareWrite).
+                for (int s = 0; s < kMaxSamplers; ++s) sampler.bind(s, nullptr);
+                copiedDirect.fetch_add(as.copiedDirect, std::memory_order_relaxed);
+                ws.pixelsCovered += as.pixels;
+                ws.pixelsRowPath = as.pixels;
+                ws.pixelsShaded = es.pixels + as.exec.pixels;
+                ws.instructions = es.instructions + as.exec.instructions;
+                ws.pixelsWritten = ms.written + as.written;
+                ws.texelsFetched = sampler.texelsFetched() - fetchedBefore + as.texels;
+            });
+            for (const DrawStats& ws : workerStats) {
+                stats.pixelsCovered += ws.pixelsCovered;
+                stats.pixelsRowPath += ws.pixelsRowPath;
+                stats.pixelsShaded += ws.pixelsShaded;
+                stats.instructions += ws.instructions;
+                stats.pixelsWritten += ws.pixelsWritten;
+                stats.texelsFetched += ws.texelsFetched;
+                stats.tilesShaded += ws.tilesShaded;
+                stats.tilesFilled += ws.tilesFilled;
+                stats.tilesCopied += ws.tilesCopied;
+                stats.tilesSkipped += ws.tilesSkipped;
             }
-            // The draw's textures are not kept alive past it: a texture read in place would
-            // otherwise be copied on its next write (Device::prepareWrite).
-            for (int s = 0; s < kMaxSamplers; ++s) sampler.bind(s, nullptr);
-            copiedDirect.fetch_add(as.copiedDirect, std::memory_order_relaxed);
-            ws.pixelsCovered += as.pixels;
-            ws.pixelsShaded = es.pixels + as.exec.pixels;
-            ws.instructions = es.instructions + as.exec.instructions;
-            ws.pixelsWritten = ms.written + as.written;
-            ws.texelsFetched = sampler.texelsFetched() - fetchedBefore + as.texels;
-        });
-        for (const DrawStats& ws : workerStats) {
-            stats.pixelsCovered += ws.pixelsCovered;
-            stats.pixelsShaded += ws.pixelsShaded;
-            stats.instructions += ws.instructions;
-            stats.pixelsWritten += ws.pixelsWritten;
-            stats.texelsFetched += ws.texelsFetched;
-            stats.tilesShaded += ws.tilesShaded;
-            stats.tilesFilled += ws.tilesFilled;
-            stats.tilesCopied += ws.tilesCopied;
-            stats.tilesSkipped += ws.tilesSkipped;
-        }
+        } while (!rest.empty());
     }
     // The draw's time per covered pixel, into the history of how it was drawn.
     if (m_options.timeTiles && tileable && stats.pixelsCovered > coveredBefore) {

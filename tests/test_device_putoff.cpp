@@ -177,6 +177,17 @@ TEST_CASE("put-off copies: draws into the destination copy their bands first, an
         REQUIRE(s.dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
         REQUIRE(s.dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 1500, v.data(), sizeof(QuadVertex)) == D3D_OK);
         s.read(s.b);
+        // Fewer triangles than a chunk, whose row tables pass the column budget (64 target widths):
+        // drawn in parts, each band copied once, before the first part that reaches it.
+        s.copy(s.a, s.b);
+        std::vector<QuadVertex> w;
+        for (int i = 0; i < 480; ++i) {
+            const float x0 = float((i * 37) % 120), y0 = float((i * 53) % 110);
+            const auto q = halfPixelQuad(x0, y0, x0 + 40, y0 + 9, {});
+            for (int k : {0, 1, 2, 2, 1, 3}) w.push_back(q[size_t(k)]);
+        }
+        REQUIRE(s.dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 960, w.data(), sizeof(QuadVertex)) == D3D_OK);
+        s.read(s.b);
         // A partial clear of the destination, a whole copy over a copy put off, then part of one.
         s.copy(s.a, s.b);
         REQUIRE(s.dev.SetRenderTarget(0, s.b) == D3D_OK);
