@@ -562,7 +562,10 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
 }  // namespace
 
 const AlignedKernels* alignedKernels(ps11::SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return ps11::simdTable<AlignedKernels>(level, nullptr, &avx2::kAligned,
+                                           level >= ps11::SimdLevel::Avx512 ? &avx512::alignedTable() : nullptr);
+#elif defined(PS11_HAVE_AVX2)
     return ps11::simdTable<AlignedKernels>(level, nullptr, &avx2::kAligned);
 #else
     (void)level;

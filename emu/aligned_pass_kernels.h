@@ -1,7 +1,8 @@
 // The vector kernels of the aligned-pass path (emu/aligned_pass.h): a table per SIMD level
-// (ps11/simd_dispatch.h), fetched once per draw (AlignedDraw::kernels). Only the Avx2 level has
-// one (aligned_pass_avx2.cpp); at Baseline there is none and every pixel is filtered and stored
-// one at a time. Internal to emu/aligned_pass*.cpp.
+// (ps11/simd_dispatch.h), fetched once per draw (AlignedDraw::kernels): the Avx2 level's
+// (aligned_pass_avx2.cpp), and the Avx512 level's, which replaces its vertical blends and
+// deinterleave (aligned_pass_avx512.cpp); at Baseline there is none and every pixel is filtered
+// and stored one at a time. Internal to emu/aligned_pass*.cpp.
 //
 // Filtering is split in two passes (docs/device.md "Aligned passes"): a horizontal pass turns a
 // texel row into an "H row" once (combine, or buildTabulated), and each tap of each pixel row
@@ -25,9 +26,9 @@ enum class HKind : uint8_t { A, S, H };
 
 inline HKind hKindOf(int32_t wx) { return wx == 0 ? HKind::A : (wx == 128 ? HKind::S : HKind::H); }
 
-// Padding (elements) every plane of an H row keeps past its end: the kernels read and write whole
-// groups of 16. Staged rows keep kStagePad: the combine reads up to 16 groups of `step` past the
-// last element it needs.
+// Padding (elements) every plane of an H row keeps past its end: the kernels write whole groups of
+// 16 and read whole groups of 16 (32 at Avx512). Staged rows keep kStagePad: the combine reads up to 16 groups of
+// `step` past the last element it needs.
 constexpr int kHRowPad = 32;
 constexpr int kStagePad = 16 * 8 + 32;
 
@@ -79,6 +80,11 @@ const AlignedKernels* alignedKernels(ps11::SimdLevel level);
 // The Avx2 table (x86-64 builds only); use alignedKernels().
 namespace avx2 {
 extern const AlignedKernels kAligned;
+}
+// The Avx512 table: the Avx2 one with its own vertical blends and deinterleave (built on first
+// use, from the Avx2 table); use alignedKernels().
+namespace avx512 {
+const AlignedKernels& alignedTable();
 }
 
 }  // namespace emu

@@ -296,19 +296,24 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
 #endif
     // The aligned-pass path has no vector kernels at Baseline (every pixel on its own).
     CHECK(emu::alignedKernels(SimdLevel::Baseline) == nullptr);
-    // Avx512: the generic path's arithmetic and the fx8 fast path have their own tables; every
-    // other family runs its Avx2 one.
+    // Avx512: the generic path's arithmetic, the fx8 fast path and (in part) the aligned pass have
+    // their own tables; every other family runs its Avx2 one.
 #ifdef PS11_HAVE_AVX512
     CHECK(&exec::fxArithKernels(SimdLevel::Avx512) != &exec::fxArithKernels(SimdLevel::Avx2));
     CHECK(&exec::floatArithKernels(SimdLevel::Avx512) != &exec::floatArithKernels(SimdLevel::Avx2));
     REQUIRE(exec::fastKernels(SimdLevel::Avx512));
     CHECK(std::string(exec::fastKernels(SimdLevel::Avx512)->name) == "fast-avx512");
     CHECK(exec::fastKernels(SimdLevel::Avx512)->lanes == 32);
+    // The aligned pass's: its own vertical blends and deinterleave, the Avx2 level's other kernels.
+    REQUIRE(emu::alignedKernels(SimdLevel::Avx512));
+    CHECK(emu::alignedKernels(SimdLevel::Avx512) != emu::alignedKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx512)->vertical != emu::alignedKernels(SimdLevel::Avx2)->vertical);
+    CHECK(emu::alignedKernels(SimdLevel::Avx512)->storeRow == emu::alignedKernels(SimdLevel::Avx2)->storeRow);
 #else
     CHECK(exec::fastKernels(SimdLevel::Avx512) == exec::fastKernels(SimdLevel::Avx2));
+    CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
 #endif
     CHECK(&fastpath::samplerKernels(SimdLevel::Avx512) == &fastpath::samplerKernels(SimdLevel::Avx2));
-    CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
     CHECK(&emu::mergerKernels(SimdLevel::Avx512) == &emu::mergerKernels(SimdLevel::Avx2));
 }
 

@@ -1,0 +1,159 @@
+// The aligned-pass kernels at the Avx512 level (emu/aligned_pass_kernels.h): the vertical blend
+// and the texel rows' deinterleave 32 lanes a step; every other kernel is the Avx2 level's.
+// CMakeLists.txt builds this file with the Avx2 level's flags and AVX-512 F, DQ, BW and VL on
+// x86-64 only; alignedKernels() hands the table out only where the CPU runs that level.
+#if !defined(__AVX512BW__) || !defined(__AVX2__) || !defined(__FMA__)
+#error "aligned_pass_avx512.cpp needs the Avx512 level's flags (CMakeLists.txt)"
+#endif
+#include <immintrin.h>
+
+#include "emu/aligned_pass_kernels.h"
+#include "emu/prefetch.h"
+
+namespace emu {
+
+namespace {
+
+inline __m512i loadu(const void* p) { return _mm512_loadu_si512(p); }
+
+// 32 texels (128 bytes, b g r a) as r g b a uint16 planes at out[c] + k.
+inline void deinterleave32(const uint8_t* p, uint16_t* const out[4], int k) {
+    // Per 128-bit lane: b0-3 g0-3 r0-3 a0-3 of its four texels; then per register the channels'
+    // 16 bytes in texel order (b | g | r | a).
+    const __m512i gather = _mm512_broadcast_i32x4(_mm_setr_epi8(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15));
+    const __m512i order = _mm512_setr_epi32(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15);
+    const __m512i x = _mm512_permutexvar_epi32(order, _mm512_shuffle_epi8(loadu(p), gather));       // texels 0-15
+    const __m512i y = _mm512_permutexvar_epi32(order, _mm512_shuffle_epi8(loadu(p + 64), gather));  // 16-31
+    // b0-15 b16-31 g0-15 g16-31, and r, a likewise.
+    const __m512i bg = _mm512_permutex2var_epi64(x, _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11), y);
+    const __m512i ra = _mm512_permutex2var_epi64(x, _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15), y);
+    _mm512_storeu_si512(out[2] + k, _mm512_cvtepu8_epi16(_mm512_castsi512_si256(bg)));
+    _mm512_storeu_si512(out[1] + k, _mm512_cvtepu8_epi16(_mm512_extracti64x4_epi64(bg, 1)));
+    _mm512_storeu_si512(out[0] + k, _mm512_cvtepu8_epi16(_mm512_castsi512_si256(ra)));
+    _mm512_storeu_si512(out[3] + k, _mm512_cvtepu8_epi16(_mm512_extracti64x4_epi64(ra, 1)));
+}
+
+void alignedDeinterleaveAvx512(const uint8_t* row, int count, uint16_t* const out[4]) {
+    int k = 0;
+    for (; k + 32 <= count; k += 32) {
+        _mm_prefetch(reinterpret_cast<const char*>(row + 4 * k) + kPrefetchAhead, _MM_HINT_T0);
+        _mm_prefetch(reinterpret_cast<const char*>(row + 4 * k + 64) + kPrefetchAhead, _MM_HINT_T0);
+        deinterleave32(row + 4 * k, out, k);
+    }
+    // The last texels by the Avx2 kernel (its groups of 16, its reads within the row).
+    if (k < count) {
+        uint16_t* const rest[4] = {out[0] + k, out[1] + k, out[2] + k, out[3] + k};
+        avx2::kAligned.deinterleave(row + 4 * k, count - k, rest);
+    }
+}
+
+// round_half_even(v / 2^s) of unsigned 16-bit lanes, v + 2^(s-1) < 2^16.
+template <int S>
+inline __m512i roundShift(__m512i v) {
+    const __m512i odd = _mm512_and_si512(_mm512_srli_epi16(v, S), _mm512_set1_epi16(1));
+    return _mm512_srli_epi16(_mm512_add_epi16(_mm512_add_epi16(v, _mm512_set1_epi16((1 << (S - 1)) - 1)), odd), S);
+}
+
+// Every group of 32 lanes of every channel: f(c, k) gives the vector of channel c at element k
+// (reading up to 31 elements past the count: within the H rows' kHRowPad); the last lanes by a
+// masked store.
+template <typename F>
+inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
+    int k = 0;
+    for (; k + 32 <= count; k += 32)
+        for (int c = 0; c < 4; ++c) _mm512_storeu_si512(out[c] + lane + k, f(c, k));
+    if (k < count) {
+        const __mmask32 m = __mmask32((1u << (count - k)) - 1);
+        for (int c = 0; c < 4; ++c) _mm512_mask_storeu_epi16(out[c] + lane + k, m, f(c, k));
+    }
+}
+
+// The Avx2 level's general blend (aligned_pass_avx2.cpp, verticalGeneral), 32 lanes a step: the
+// same exact steps per lane.
+template <int Up, int Shift = 16>
+void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
+                     int16_t* const out[4]) {
+    const __m512i wv = _mm512_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
+    const __m512i flip = _mm512_set1_epi16(int16_t(0x8000));
+    const __m512 scale = _mm512_set1_ps(1.0f / float(1 << Shift)), c128 = _mm512_set1_ps(float(1 << (23 - Shift)));
+    auto round = [&](__m512i m) { return _mm512_cvtps_epi32(_mm512_fmadd_ps(_mm512_cvtepi32_ps(m), scale, c128)); };
+    verticalGroups(count, lane, out, [&](int c, int k) {
+        const __m512i s0 = _mm512_xor_si512(_mm512_slli_epi16(loadu(h0[c] + k), Up), flip);
+        const __m512i s1 = _mm512_xor_si512(_mm512_slli_epi16(loadu(h1[c] + k), Up), flip);
+        const __m512i lo = round(_mm512_madd_epi16(_mm512_unpacklo_epi16(s0, s1), wv));
+        const __m512i hi = round(_mm512_madd_epi16(_mm512_unpackhi_epi16(s0, s1), wv));
+        return _mm512_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
+    });
+}
+
+void alignedVerticalAvx512(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                           int lane, int16_t* const out[4]) {
+    if (wy == 0) {
+        switch (kind) {
+            case HKind::A:
+                verticalGroups(count, lane, out, [&](int c, int k) { return loadu(h0[c] + k); });
+                return;
+            case HKind::S:  // round(s / 2)
+                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<1>(loadu(h0[c] + k)); });
+                return;
+            case HKind::H:  // round(h / 256)
+                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<8>(loadu(h0[c] + k)); });
+                return;
+        }
+    }
+    if (kind == HKind::A && wy == 128) {  // round((a0 + a1) / 2)
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<1>(_mm512_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
+        });
+        return;
+    }
+    if (kind == HKind::S && wy == 128) {  // round((s0 + s1) / 4): the half-texel blur tap
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<2>(_mm512_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
+        });
+        return;
+    }
+    if (kind == HKind::A) {  // round((a0·(256 − wy) + a1·wy) / 256), at most 65280
+        const __m512i wa = _mm512_set1_epi16(int16_t(256 - wy)), wb = _mm512_set1_epi16(int16_t(wy));
+        verticalGroups(count, lane, out, [&](int c, int k) {
+            return roundShift<8>(
+                _mm512_add_epi16(_mm512_mullo_epi16(loadu(h0[c] + k), wa), _mm512_mullo_epi16(loadu(h1[c] + k), wb)));
+        });
+        return;
+    }
+    if (kind == HKind::S)
+        verticalGeneral<7>(h0, h1, wy, count, lane, out);
+    else
+        verticalGeneral<0>(h0, h1, wy, count, lane, out);
+}
+
+void alignedVertical12Avx512(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy,
+                             int count, int lane, int16_t* const out[4]) {
+    const uint16_t* const* second = wy == 0 ? h0 : h1;
+    switch (kind) {
+        case HKind::A:
+            verticalGeneral<8, 12>(h0, second, wy, count, lane, out);
+            return;
+        case HKind::S:
+            verticalGeneral<7, 12>(h0, second, wy, count, lane, out);
+            return;
+        case HKind::H:
+            verticalGeneral<0, 12>(h0, second, wy, count, lane, out);
+            return;
+    }
+}
+
+}  // namespace
+
+const AlignedKernels& avx512::alignedTable() {
+    static const AlignedKernels table = [] {
+        AlignedKernels k = avx2::kAligned;
+        k.deinterleave = &alignedDeinterleaveAvx512;
+        k.vertical = &alignedVerticalAvx512;
+        k.vertical12 = &alignedVertical12Avx512;
+        return k;
+    }();
+    return table;
+}
+
+}  // namespace emu
