@@ -366,11 +366,16 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
 int consecutiveEnd(const int32_t* i0, int i, int n) {
     const int32_t base = i0[i] - i;
     int e = i + 1;
+#if defined(__SSE2__)
+    const __m128i step = _mm_setr_epi32(0, 1, 2, 3), four = _mm_set1_epi32(4);
     for (; e + 8 <= n; e += 8) {
-        bool all = true;
-        for (int q = 0; q < 8; ++q) all &= i0[e + q] == base + e + q;
-        if (!all) break;
+        const __m128i want = _mm_add_epi32(_mm_set1_epi32(base + e), step);
+        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(i0 + e));
+        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(i0 + e + 4));
+        const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(a, want), _mm_cmpeq_epi32(b, _mm_add_epi32(want, four)));
+        if (_mm_movemask_epi8(same) != 0xffff) break;
     }
+#endif
     while (e < n && i0[e] == base + e) ++e;
     return e;
 }
