@@ -159,10 +159,10 @@ bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair
 // Triangles drawn row by row together (drawAlignedRows' group), and the most a chunk may have for
 // tile skipping.
 constexpr size_t kMaxAlignedTriangles = 16;
-// Columns of tables a chunk's aligned triangles may hold, in target widths (each triangle's tables
-// span the columns it covers, 16 bytes a column per tap: about 2 MB a tap at 1080p); triangles past
-// it take the quad path, so a chunk of 1024 sprite triangles 64 pixels wide takes the row path and a
-// mesh of large ones stays bounded.
+// Columns of tables a chunk's aligned triangles may hold at once, in target widths (each
+// triangle's tables span the columns it covers, 16 bytes a column per tap: about 2 MB a tap at
+// 1080p); the triangle past it starts the chunk's next part, so the tables of a mesh of large
+// triangles stay bounded and every triangle still takes the row path.
 constexpr int64_t kMaxAlignedColumnsPerTarget = 64;
 
 // Per-worker cache of texel rows, kept for the rows of one draw: staged (deinterleaved into
