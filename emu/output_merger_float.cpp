@@ -425,7 +425,10 @@ const MergerKernels baseline::kMerger{&merger::halvesBaseline, &merger::unorm8Wo
                                       &merger::blendRgba32FBaseline};
 
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return *ps11::simdTable(level, &baseline::kMerger, &avx2::kMerger,
+                            level >= ps11::SimdLevel::Avx512 ? &avx512::mergerTable() : nullptr);
+#elif defined(PS11_HAVE_AVX2)
     return *ps11::simdTable(level, &baseline::kMerger, &avx2::kMerger);
 #else
     (void)level;

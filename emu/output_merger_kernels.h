@@ -52,5 +52,10 @@ extern const MergerKernels kMerger;
 namespace avx2 {
 extern const MergerKernels kMerger;
 }
+// The Avx512 table: the Avx2 one with its own float-to-8-bit words (built on first use, from the
+// Avx2 table); use mergerKernels().
+namespace avx512 {
+const MergerKernels& mergerTable();
+}
 
 }  // namespace emu

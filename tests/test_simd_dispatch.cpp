@@ -296,8 +296,8 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
 #endif
     // The aligned-pass path has no vector kernels at Baseline (every pixel on its own).
     CHECK(emu::alignedKernels(SimdLevel::Baseline) == nullptr);
-    // Avx512: the generic path's arithmetic, the fx8 fast path and (in part) the aligned pass have
-    // their own tables; every other family runs its Avx2 one.
+    // Avx512: the generic path's arithmetic, the fx8 fast path and (in part) the aligned pass and
+    // the output merger have their own tables; every other family runs its Avx2 one.
 #ifdef PS11_HAVE_AVX512
     CHECK(&exec::fxArithKernels(SimdLevel::Avx512) != &exec::fxArithKernels(SimdLevel::Avx2));
     CHECK(&exec::floatArithKernels(SimdLevel::Avx512) != &exec::floatArithKernels(SimdLevel::Avx2));
@@ -309,12 +309,19 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
     CHECK(emu::alignedKernels(SimdLevel::Avx512) != emu::alignedKernels(SimdLevel::Avx2));
     CHECK(emu::alignedKernels(SimdLevel::Avx512)->vertical != emu::alignedKernels(SimdLevel::Avx2)->vertical);
     CHECK(emu::alignedKernels(SimdLevel::Avx512)->storeRow == emu::alignedKernels(SimdLevel::Avx2)->storeRow);
+    // The merger's: its own float-to-8-bit words, the Avx2 level's other kernels.
+    const emu::MergerKernels& m512 = emu::mergerKernels(SimdLevel::Avx512);
+    const emu::MergerKernels& m2 = emu::mergerKernels(SimdLevel::Avx2);
+    CHECK(&m512 != &m2);
+    CHECK(m512.unorm8Words != m2.unorm8Words);
+    CHECK(m512.unorm8WordsRgba != m2.unorm8WordsRgba);
+    CHECK(m512.addUnorm8Words == m2.addUnorm8Words);
 #else
     CHECK(exec::fastKernels(SimdLevel::Avx512) == exec::fastKernels(SimdLevel::Avx2));
     CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
+    CHECK(&emu::mergerKernels(SimdLevel::Avx512) == &emu::mergerKernels(SimdLevel::Avx2));
 #endif
     CHECK(&fastpath::samplerKernels(SimdLevel::Avx512) == &fastpath::samplerKernels(SimdLevel::Avx2));
-    CHECK(&emu::mergerKernels(SimdLevel::Avx512) == &emu::mergerKernels(SimdLevel::Avx2));
 }
 
 TEST_CASE("simd dispatch: the merger's half conversion gives the same halves at every level", "[simd][merger]") {

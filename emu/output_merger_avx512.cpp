@@ -1,0 +1,68 @@
+// The output merger's kernels at the Avx512 level (emu/output_merger_kernels.h): the float to
+// 8-bit words conversions eight doubles a step; every other kernel is the Avx2 level's.
+// CMakeLists.txt builds this file with the Avx2 level's flags and AVX-512 F, DQ, BW and VL (and
+// -ffp-contract=off: no product is fused into a sum) on x86-64 only; mergerKernels() hands the
+// table out only where the CPU runs that level.
+#if !defined(__AVX512F__) || !defined(__AVX512BW__) || !defined(__AVX2__)
+#error "output_merger_avx512.cpp needs the Avx512 level's flags (CMakeLists.txt)"
+#endif
+#include <immintrin.h>
+
+#include "emu/output_merger_kernels.h"
+
+namespace emu {
+
+namespace {
+
+// Eight channels as bytes, in double as the other levels: the same clamp (VMAXPD gives its second
+// operand, 0, for NaN), exact product and nearest-even conversion.
+inline __m256i bytes8(const float* p) {
+    const __m512d zero = _mm512_setzero_pd(), one = _mm512_set1_pd(1.0), k255 = _mm512_set1_pd(255.0);
+    return _mm512_cvtpd_epi32(
+        _mm512_mul_pd(_mm512_min_pd(_mm512_max_pd(_mm512_cvtps_pd(_mm256_loadu_ps(p)), zero), one), k255));
+}
+
+inline __m512i bytes16(const float* p) {
+    return _mm512_inserti64x4(_mm512_castsi256_si512(bytes8(p)), bytes8(p + 8), 1);
+}
+
+void unorm8WordsAvx512(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
+    const __m512i fill = _mm512_set1_epi32(int32_t(alphaFill));
+    int i = 0;
+    for (; i + 16 <= count; i += 16) {
+        const __m512i w = _mm512_or_si512(
+            _mm512_or_si512(_mm512_slli_epi32(bytes16(f[3] + i), 24), _mm512_slli_epi32(bytes16(f[0] + i), 16)),
+            _mm512_or_si512(_mm512_slli_epi32(bytes16(f[1] + i), 8), bytes16(f[2] + i)));
+        _mm512_storeu_si512(words + i, _mm512_or_si512(w, fill));
+    }
+    if (i < count) {
+        const float* const rest[4] = {f[0] + i, f[1] + i, f[2] + i, f[3] + i};
+        avx2::kMerger.unorm8Words(rest, count - i, alphaFill, words + i);
+    }
+}
+
+// Four pixels' r g b a a register: their bytes in order (VPMOVDB), then put in b g r a order.
+void unorm8WordsRgbaAvx512(const float* rgba, int count, uint32_t alphaFill, uint32_t* words) {
+    const __m128i toBgra = _mm_setr_epi8(2, 1, 0, 3, 6, 5, 4, 7, 10, 9, 8, 11, 14, 13, 12, 15);
+    const __m128i fill = _mm_set1_epi32(int32_t(alphaFill));
+    int i = 0;
+    for (; i + 4 <= count; i += 4) {
+        const __m128i bytes = _mm_shuffle_epi8(_mm512_cvtepi32_epi8(bytes16(rgba + 4 * size_t(i))), toBgra);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + i), _mm_or_si128(bytes, fill));
+    }
+    if (i < count) avx2::kMerger.unorm8WordsRgba(rgba + 4 * size_t(i), count - i, alphaFill, words + i);
+}
+
+}  // namespace
+
+const MergerKernels& avx512::mergerTable() {
+    static const MergerKernels table = [] {
+        MergerKernels k = avx2::kMerger;
+        k.unorm8Words = &unorm8WordsAvx512;
+        k.unorm8WordsRgba = &unorm8WordsRgbaAvx512;
+        return k;
+    }();
+    return table;
+}
+
+}  // namespace emu
