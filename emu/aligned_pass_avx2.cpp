@@ -38,13 +38,6 @@ inline void deinterleave16(const uint8_t* p, uint16_t* const out[4], int k) {
     storeu(out[3] + k, _mm256_cvtepu8_epi16(_mm256_extracti128_si256(ra, 1)));
 }
 
-// round_half_even(v / 2^s) of unsigned 16-bit lanes, v + 2^(s-1) < 2^16.
-template <int S>
-inline __m256i roundShift(__m256i v) {
-    const __m256i odd = _mm256_and_si256(_mm256_srli_epi16(v, S), _mm256_set1_epi16(1));
-    return _mm256_srli_epi16(_mm256_add_epi16(_mm256_add_epi16(v, _mm256_set1_epi16((1 << (S - 1)) - 1)), odd), S);
-}
-
 void alignedDeinterleaveAvx2(const uint8_t* row, int count, uint16_t* const out[4]) {
     int k = 0;
     for (; k + 16 <= count; k += 16) {
@@ -267,70 +260,33 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
         for (int c = 0; c < 4; ++c) storeFirstLanes(out[c] + lane + k, f(c, k), count - k);
 }
 
-// General: t = h0·(256 − wy) + h1·wy in 32 bits by pmaddwd on (h − 32768), m = t − 32768·256;
-// kind S is widened to h = 128·s first (Up = 7). round_half_even(t / 65536) is then
-// m·2⁻¹⁶ + 128 in one FMA, converted with the default rounding (to nearest, ties to even):
-// |m| < 2²³ converts exactly, and the sum, at most 256 with 16 fraction bits, is exact too
-// (checked for every t in [0, 65280·256] when this was written; the row-path tests compare
-// every result with the quad path's integer rounding).
-// Shift 12 (fx12) takes round_half_even(t / 4096) the same way: m·2⁻¹² + 2048 = t / 4096, at most
-// 4096 with 12 fraction bits, is exact too.
-template <int Up, int Shift = 16>
-void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
-                     int16_t* const out[4]) {
-    const __m256i wv = _mm256_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
-    const __m256i flip = _mm256_set1_epi16(int16_t(0x8000));
-    const __m256 scale = _mm256_set1_ps(1.0f / float(1 << Shift)), c128 = _mm256_set1_ps(float(1 << (23 - Shift)));
-    auto round = [&](__m256i m) { return _mm256_cvtps_epi32(_mm256_fmadd_ps(_mm256_cvtepi32_ps(m), scale, c128)); };
-    verticalGroups(count, lane, out, [&](int c, int k) {
-        const __m256i s0 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h0[c] + k), Up), flip);
-        const __m256i s1 = _mm256_xor_si256(_mm256_slli_epi16(loadu(h1[c] + k), Up), flip);
-        const __m256i lo = round(_mm256_madd_epi16(_mm256_unpacklo_epi16(s0, s1), wv));
-        const __m256i hi = round(_mm256_madd_epi16(_mm256_unpackhi_epi16(s0, s1), wv));
-        return _mm256_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
-    });
+// The 16-bit lanes the vertical blends are written over (emu/aligned_vertical.inc).
+using VI = __m256i;
+using VF = __m256;
+inline VI add16(VI a, VI b) { return _mm256_add_epi16(a, b); }
+inline VI and_(VI a, VI b) { return _mm256_and_si256(a, b); }
+inline VI xor_(VI a, VI b) { return _mm256_xor_si256(a, b); }
+inline VI mullo16(VI a, VI b) { return _mm256_mullo_epi16(a, b); }
+inline VI madd16(VI a, VI b) { return _mm256_madd_epi16(a, b); }
+inline VI packs32(VI a, VI b) { return _mm256_packs_epi32(a, b); }
+inline VI unpacklo16(VI a, VI b) { return _mm256_unpacklo_epi16(a, b); }
+inline VI unpackhi16(VI a, VI b) { return _mm256_unpackhi_epi16(a, b); }
+inline VI set16(int16_t x) { return _mm256_set1_epi16(x); }
+inline VI set32(int32_t x) { return _mm256_set1_epi32(x); }
+inline VF setf(float x) { return _mm256_set1_ps(x); }
+template <int S>
+inline VI slli16(VI v) {
+    return _mm256_slli_epi16(v, S);
 }
+template <int S>
+inline VI srli16(VI v) {
+    return _mm256_srli_epi16(v, S);
+}
+inline VI roundToInt(VF v) { return _mm256_cvtps_epi32(v); }
+inline VF cvtf(VI v) { return _mm256_cvtepi32_ps(v); }
+inline VF fmaddf(VF a, VF b, VF c) { return _mm256_fmadd_ps(a, b, c); }
 
-void alignedVerticalAvx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
-                         int lane, int16_t* const out[4]) {
-    if (wy == 0) {
-        switch (kind) {
-            case HKind::A:
-                verticalGroups(count, lane, out, [&](int c, int k) { return loadu(h0[c] + k); });
-                return;
-            case HKind::S:  // round(s / 2)
-                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<1>(loadu(h0[c] + k)); });
-                return;
-            case HKind::H:  // round(h / 256)
-                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<8>(loadu(h0[c] + k)); });
-                return;
-        }
-    }
-    if (kind == HKind::A && wy == 128) {  // round((a0 + a1) / 2)
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<1>(_mm256_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
-        });
-        return;
-    }
-    if (kind == HKind::S && wy == 128) {  // round((s0 + s1) / 4): the half-texel blur tap
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<2>(_mm256_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
-        });
-        return;
-    }
-    if (kind == HKind::A) {  // round((a0·(256 − wy) + a1·wy) / 256), at most 65280
-        const __m256i wa = _mm256_set1_epi16(int16_t(256 - wy)), wb = _mm256_set1_epi16(int16_t(wy));
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<8>(
-                _mm256_add_epi16(_mm256_mullo_epi16(loadu(h0[c] + k), wa), _mm256_mullo_epi16(loadu(h1[c] + k), wb)));
-        });
-        return;
-    }
-    if (kind == HKind::S)
-        verticalGeneral<7>(h0, h1, wy, count, lane, out);
-    else
-        verticalGeneral<0>(h0, h1, wy, count, lane, out);
-}
+#include "emu/aligned_vertical.inc"
 
 // 16 pixels' words (b g r a bytes, `om` or-ed in) from int16 r g b a lanes, each clamped to
 // [0, 255]: pixels 0-7 in `first`, 8-15 in `second`.
@@ -382,25 +338,6 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
 
 int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
-}
-
-// fx12: every kind through the general blend, its H values widened to h first (kind A: 256·a,
-// kind S: 128·s, both at most 65280); with wy = 0 the second row is not read (h1 may be null), h0
-// stands in for it.
-void alignedVertical12Avx2(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
-                           int lane, int16_t* const out[4]) {
-    const uint16_t* const* second = wy == 0 ? h0 : h1;
-    switch (kind) {
-        case HKind::A:
-            verticalGeneral<8, 12>(h0, second, wy, count, lane, out);
-            return;
-        case HKind::S:
-            verticalGeneral<7, 12>(h0, second, wy, count, lane, out);
-            return;
-        case HKind::H:
-            verticalGeneral<0, 12>(h0, second, wy, count, lane, out);
-            return;
-    }
 }
 
 // fx12 words: each channel's grid value n clamped to [0, 4080] (additive: n + 16·d, the target
@@ -458,7 +395,7 @@ int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, u
 }  // namespace
 
 const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2,   &alignedPairSums4Avx2,
-                                    &alignedBuildTabulatedAvx2, &alignedVerticalAvx2,  &alignedVertical12Avx2,
+                                    &alignedBuildTabulatedAvx2, &verticalBlend,        &verticalBlend12,
                                     &alignedStoreRowAvx2,       &alignedStoreRow12Avx2};
 
 }  // namespace emu

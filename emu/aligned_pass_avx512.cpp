@@ -47,13 +47,6 @@ void alignedDeinterleaveAvx512(const uint8_t* row, int count, uint16_t* const ou
     }
 }
 
-// round_half_even(v / 2^s) of unsigned 16-bit lanes, v + 2^(s-1) < 2^16.
-template <int S>
-inline __m512i roundShift(__m512i v) {
-    const __m512i odd = _mm512_and_si512(_mm512_srli_epi16(v, S), _mm512_set1_epi16(1));
-    return _mm512_srli_epi16(_mm512_add_epi16(_mm512_add_epi16(v, _mm512_set1_epi16((1 << (S - 1)) - 1)), odd), S);
-}
-
 // Every group of 32 lanes of every channel: f(c, k) gives the vector of channel c at element k
 // (reading up to 31 elements past the count: within the H rows' kHRowPad); the last lanes by a
 // masked store.
@@ -68,80 +61,33 @@ inline void verticalGroups(int count, int lane, int16_t* const out[4], F f) {
     }
 }
 
-// The Avx2 level's general blend (aligned_pass_avx2.cpp, verticalGeneral), 32 lanes a step: the
-// same exact steps per lane.
-template <int Up, int Shift = 16>
-void verticalGeneral(const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count, int lane,
-                     int16_t* const out[4]) {
-    const __m512i wv = _mm512_set1_epi32(int32_t(uint32_t(256 - wy) | (uint32_t(wy) << 16)));
-    const __m512i flip = _mm512_set1_epi16(int16_t(0x8000));
-    const __m512 scale = _mm512_set1_ps(1.0f / float(1 << Shift)), c128 = _mm512_set1_ps(float(1 << (23 - Shift)));
-    auto round = [&](__m512i m) { return _mm512_cvtps_epi32(_mm512_fmadd_ps(_mm512_cvtepi32_ps(m), scale, c128)); };
-    verticalGroups(count, lane, out, [&](int c, int k) {
-        const __m512i s0 = _mm512_xor_si512(_mm512_slli_epi16(loadu(h0[c] + k), Up), flip);
-        const __m512i s1 = _mm512_xor_si512(_mm512_slli_epi16(loadu(h1[c] + k), Up), flip);
-        const __m512i lo = round(_mm512_madd_epi16(_mm512_unpacklo_epi16(s0, s1), wv));
-        const __m512i hi = round(_mm512_madd_epi16(_mm512_unpackhi_epi16(s0, s1), wv));
-        return _mm512_packs_epi32(lo, hi);  // per 128-bit lane: the unpacks' order undone
-    });
+// The 16-bit lanes the vertical blends are written over (emu/aligned_vertical.inc).
+using VI = __m512i;
+using VF = __m512;
+inline VI add16(VI a, VI b) { return _mm512_add_epi16(a, b); }
+inline VI and_(VI a, VI b) { return _mm512_and_si512(a, b); }
+inline VI xor_(VI a, VI b) { return _mm512_xor_si512(a, b); }
+inline VI mullo16(VI a, VI b) { return _mm512_mullo_epi16(a, b); }
+inline VI madd16(VI a, VI b) { return _mm512_madd_epi16(a, b); }
+inline VI packs32(VI a, VI b) { return _mm512_packs_epi32(a, b); }
+inline VI unpacklo16(VI a, VI b) { return _mm512_unpacklo_epi16(a, b); }
+inline VI unpackhi16(VI a, VI b) { return _mm512_unpackhi_epi16(a, b); }
+inline VI set16(int16_t x) { return _mm512_set1_epi16(x); }
+inline VI set32(int32_t x) { return _mm512_set1_epi32(x); }
+inline VF setf(float x) { return _mm512_set1_ps(x); }
+template <int S>
+inline VI slli16(VI v) {
+    return _mm512_slli_epi16(v, S);
 }
+template <int S>
+inline VI srli16(VI v) {
+    return _mm512_srli_epi16(v, S);
+}
+inline VI roundToInt(VF v) { return _mm512_cvtps_epi32(v); }
+inline VF cvtf(VI v) { return _mm512_cvtepi32_ps(v); }
+inline VF fmaddf(VF a, VF b, VF c) { return _mm512_fmadd_ps(a, b, c); }
 
-void alignedVerticalAvx512(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
-                           int lane, int16_t* const out[4]) {
-    if (wy == 0) {
-        switch (kind) {
-            case HKind::A:
-                verticalGroups(count, lane, out, [&](int c, int k) { return loadu(h0[c] + k); });
-                return;
-            case HKind::S:  // round(s / 2)
-                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<1>(loadu(h0[c] + k)); });
-                return;
-            case HKind::H:  // round(h / 256)
-                verticalGroups(count, lane, out, [&](int c, int k) { return roundShift<8>(loadu(h0[c] + k)); });
-                return;
-        }
-    }
-    if (kind == HKind::A && wy == 128) {  // round((a0 + a1) / 2)
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<1>(_mm512_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
-        });
-        return;
-    }
-    if (kind == HKind::S && wy == 128) {  // round((s0 + s1) / 4): the half-texel blur tap
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<2>(_mm512_add_epi16(loadu(h0[c] + k), loadu(h1[c] + k)));
-        });
-        return;
-    }
-    if (kind == HKind::A) {  // round((a0·(256 − wy) + a1·wy) / 256), at most 65280
-        const __m512i wa = _mm512_set1_epi16(int16_t(256 - wy)), wb = _mm512_set1_epi16(int16_t(wy));
-        verticalGroups(count, lane, out, [&](int c, int k) {
-            return roundShift<8>(
-                _mm512_add_epi16(_mm512_mullo_epi16(loadu(h0[c] + k), wa), _mm512_mullo_epi16(loadu(h1[c] + k), wb)));
-        });
-        return;
-    }
-    if (kind == HKind::S)
-        verticalGeneral<7>(h0, h1, wy, count, lane, out);
-    else
-        verticalGeneral<0>(h0, h1, wy, count, lane, out);
-}
-
-void alignedVertical12Avx512(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy,
-                             int count, int lane, int16_t* const out[4]) {
-    const uint16_t* const* second = wy == 0 ? h0 : h1;
-    switch (kind) {
-        case HKind::A:
-            verticalGeneral<8, 12>(h0, second, wy, count, lane, out);
-            return;
-        case HKind::S:
-            verticalGeneral<7, 12>(h0, second, wy, count, lane, out);
-            return;
-        case HKind::H:
-            verticalGeneral<0, 12>(h0, second, wy, count, lane, out);
-            return;
-    }
-}
+#include "emu/aligned_vertical.inc"
 
 }  // namespace
 
@@ -149,8 +95,8 @@ const AlignedKernels& avx512::alignedTable() {
     static const AlignedKernels table = [] {
         AlignedKernels k = avx2::kAligned;
         k.deinterleave = &alignedDeinterleaveAvx512;
-        k.vertical = &alignedVerticalAvx512;
-        k.vertical12 = &alignedVertical12Avx512;
+        k.vertical = &verticalBlend;
+        k.vertical12 = &verticalBlend12;
         return k;
     }();
     return table;

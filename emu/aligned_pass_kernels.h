@@ -1,7 +1,8 @@
 // The vector kernels of the aligned-pass path (emu/aligned_pass.h): a table per SIMD level
 // (ps11/simd_dispatch.h), fetched once per draw (AlignedDraw::kernels): the Avx2 level's
 // (aligned_pass_avx2.cpp), and the Avx512 level's, which replaces its vertical blends and
-// deinterleave (aligned_pass_avx512.cpp); at Baseline there is none and every pixel is filtered
+// deinterleave (aligned_pass_avx512.cpp; the vertical blends are one source for both,
+// aligned_vertical.inc); at Baseline there is none and every pixel is filtered
 // and stored one at a time. Internal to emu/aligned_pass*.cpp.
 //
 // Filtering is split in two passes (docs/device.md "Aligned passes"): a horizontal pass turns a
