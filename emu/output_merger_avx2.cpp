@@ -41,23 +41,29 @@ void halvesF16c(const float* const f[4], int count, uint16_t* out) {
     }
 }
 
-// Four lanes of a channel per step in double, as the Baseline kernel does two: the same clamp
-// (MAXPD gives 0 for NaN), exact product and nearest-even conversion.
+// Eight values as bytes: nearest even of the exact v·255 is floor(v·255 + 1/2) for every v in
+// [0, 1] (the exact product is a tie only at v = 1/2, 127.5, whose even neighbour is 128). The
+// fused sum, rounded to float and truncated, gives that floor or one more (where rounding
+// reached the next integer n); the sign of v·255 + (1/2 − n), fused again, says which. The
+// clamp is the Baseline level's (MAXPS gives its second operand, 0, for NaN). The same bytes as
+// its exact product in double, for every float (checked over all 2^32 of them).
+inline __m256i bytes8(__m256 x) {
+    const __m256 zero = _mm256_setzero_ps(), k255 = _mm256_set1_ps(255.0f), half = _mm256_set1_ps(0.5f);
+    const __m256 v = _mm256_min_ps(_mm256_max_ps(x, zero), _mm256_set1_ps(1.0f));
+    const __m256i n = _mm256_cvttps_epi32(_mm256_fmadd_ps(v, k255, half));
+    const __m256 below = _mm256_fmadd_ps(v, k255, _mm256_sub_ps(half, _mm256_cvtepi32_ps(n)));
+    return _mm256_add_epi32(n, _mm256_castps_si256(_mm256_cmp_ps(below, zero, _CMP_LT_OQ)));  // −1 there
+}
+
+// Eight lanes of a channel per step (bytes8).
 void unorm8WordsAvx2(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
-    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), k255 = _mm256_set1_pd(255.0);
-    const auto bytes8 = [&](const float* p) {
-        const __m128i lo = _mm256_cvtpd_epi32(
-            _mm256_mul_pd(_mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(_mm_loadu_ps(p)), zero), one), k255));
-        const __m128i hi = _mm256_cvtpd_epi32(
-            _mm256_mul_pd(_mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(_mm_loadu_ps(p + 4)), zero), one), k255));
-        return _mm256_setr_m128i(lo, hi);
-    };
+    const auto load = [](const float* p) { return bytes8(_mm256_loadu_ps(p)); };
     const __m256i fill = _mm256_set1_epi32(int32_t(alphaFill));
     int i = 0;
     for (; i + 8 <= count; i += 8) {
         const __m256i w = _mm256_or_si256(
-            _mm256_or_si256(_mm256_slli_epi32(bytes8(f[3] + i), 24), _mm256_slli_epi32(bytes8(f[0] + i), 16)),
-            _mm256_or_si256(_mm256_slli_epi32(bytes8(f[1] + i), 8), bytes8(f[2] + i)));
+            _mm256_or_si256(_mm256_slli_epi32(load(f[3] + i), 24), _mm256_slli_epi32(load(f[0] + i), 16)),
+            _mm256_or_si256(_mm256_slli_epi32(load(f[1] + i), 8), load(f[2] + i)));
         _mm256_storeu_si256(reinterpret_cast<__m256i*>(words + i), _mm256_or_si256(w, fill));
     }
     if (i < count) {
@@ -66,21 +72,19 @@ void unorm8WordsAvx2(const float* const f[4], int count, uint32_t alphaFill, uin
     }
 }
 
-// A pixel's four channels per step in double (the same clamp, exact product and nearest-even
-// conversion); four pixels packed, then put in b g r a order.
+// Two pixels' channels per step (bytes8); four pixels packed, then put in b g r a order.
 void unorm8WordsRgbaAvx2(const float* rgba, int count, uint32_t alphaFill, uint32_t* words) {
-    const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), k255 = _mm256_set1_pd(255.0);
-    const auto ints = [&](const float* p) {  // r g b a int32
-        return _mm256_cvtpd_epi32(_mm256_mul_pd(_mm256_min_pd(_mm256_max_pd(_mm256_cvtps_pd(_mm_loadu_ps(p)), zero), one), k255));
-    };
     const __m128i toBgra = _mm_setr_epi8(2, 1, 0, 3, 6, 5, 4, 7, 10, 9, 8, 11, 14, 13, 12, 15);
     const __m128i fill = _mm_set1_epi32(int32_t(alphaFill));
     int i = 0;
     for (; i + 4 <= count; i += 4) {
         const float* p = rgba + 4 * size_t(i);
-        const __m128i lo = _mm_packs_epi32(ints(p), ints(p + 4)), hi = _mm_packs_epi32(ints(p + 8), ints(p + 12));
-        const __m128i bytes = _mm_shuffle_epi8(_mm_packus_epi16(lo, hi), toBgra);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + i), _mm_or_si128(bytes, fill));
+        const __m256i a = bytes8(_mm256_loadu_ps(p)), b = bytes8(_mm256_loadu_ps(p + 8));  // r g b a int32
+        // As int16 within each 128-bit half: pixels 0 and 2 in the low half, 1 and 3 in the high.
+        const __m256i packed = _mm256_packs_epi32(a, b);
+        const __m128i lo = _mm256_castsi256_si128(packed), hi = _mm256_extracti128_si256(packed, 1);
+        const __m128i ordered = _mm_packus_epi16(_mm_unpacklo_epi64(lo, hi), _mm_unpackhi_epi64(lo, hi));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(words + i), _mm_or_si128(_mm_shuffle_epi8(ordered, toBgra), fill));
     }
     if (i < count) baseline::kMerger.unorm8WordsRgba(rgba + 4 * size_t(i), count - i, alphaFill, words + i);
 }
