@@ -1,5 +1,6 @@
 // The output merger's kernels at the Avx512 level (emu/output_merger_kernels.h): the float to
-// 8-bit words conversions sixteen floats a step; every other kernel is the Avx2 level's.
+// 8-bit words conversions and the ONE/ONE sums into 8-bit words sixteen floats a step; every other
+// kernel is the Avx2 level's.
 // CMakeLists.txt builds this file with the Avx2 level's flags and AVX-512 F, DQ, BW and VL (and
 // -ffp-contract=off: no product is fused into a sum) on x86-64 only; mergerKernels() hands the
 // table out only where the CPU runs that level.
@@ -9,6 +10,7 @@
 #include <immintrin.h>
 
 #include "emu/output_merger_kernels.h"
+#include "emu/prefetch.h"
 
 namespace emu {
 
@@ -20,11 +22,20 @@ namespace {
 // mode, then truncated). The clamp is the other levels' (VMAXPS gives its second operand, 0, for
 // NaN). The same bytes as the Baseline level's exact product in double, for every float (checked
 // over all 2^32 of them).
-inline __m512i bytes16(const float* p) {
-    const __m512 v = _mm512_min_ps(_mm512_max_ps(_mm512_loadu_ps(p), _mm512_setzero_ps()), _mm512_set1_ps(1.0f));
+inline __m512i bytes16(__m512 x) {
+    const __m512 v = _mm512_min_ps(_mm512_max_ps(x, _mm512_setzero_ps()), _mm512_set1_ps(1.0f));
     const __m512 sum = _mm512_fmadd_round_ps(v, _mm512_set1_ps(255.0f), _mm512_set1_ps(0.5f),
                                              _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
     return _mm512_cvtt_roundps_epi32(sum, _MM_FROUND_NO_EXC);
+}
+inline __m512i bytes16(const float* p) { return bytes16(_mm512_loadu_ps(p)); }
+
+// float(b) / 255 correctly rounded for a byte b (the texture's value table), as the Avx2 level's
+// unitOfByte: a product and two fused corrections in place of the division.
+inline __m512 unitOfByte16(__m512 b) {
+    const __m512 inv = _mm512_set1_ps(1.0f / 255.0f);
+    const __m512 q = _mm512_mul_ps(b, inv);
+    return _mm512_fmadd_ps(_mm512_fnmadd_ps(q, _mm512_set1_ps(255.0f), b), inv, q);
 }
 
 void unorm8WordsAvx512(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
@@ -54,6 +65,43 @@ void unorm8WordsRgbaAvx512(const float* rgba, int count, uint32_t alphaFill, uin
     if (i < count) avx2::kMerger.unorm8WordsRgba(rgba + 4 * size_t(i), count - i, alphaFill, words + i);
 }
 
+// Sixteen pixels a step: where a source channel is above 0, each channel's sum sat(s) + d (d the
+// byte's value, unitOfByte16) and its byte (bytes16); elsewhere the destination word as it is.
+void addUnorm8WordsAvx512(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
+                          uint32_t* out) {
+    const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
+    const __m512i byte = _mm512_set1_epi32(0xff), fill = _mm512_set1_epi32(int32_t(alphaFill));
+    constexpr unsigned kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+    int i = 0;
+    for (; i + 16 <= count; i += 16) {
+        // The target's line ahead: a row's pass waits on each line else.
+        _mm_prefetch(reinterpret_cast<const char*>(words + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
+        const __m512i w = _mm512_loadu_si512(words + 4 * size_t(i));
+        __mmask16 above[4], any = 0;
+        __m512 s[4];
+        for (int c = 0; c < 4; ++c) {
+            s[c] = _mm512_loadu_ps(src[c] + i);
+            above[c] = _mm512_cmp_ps_mask(s[c], zero, _CMP_GT_OQ);  // false for NaN
+            any |= above[c];
+        }
+        if (!any) {
+            _mm512_storeu_si512(out + i, _mm512_or_si512(w, fill));
+            continue;
+        }
+        __m512i r = fill;
+        for (int c = 0; c < 4; ++c) {
+            const __m512 sv = _mm512_maskz_min_ps(above[c], s[c], one);  // sat: min(s, 1) above 0, else 0
+            const __m512 d = unitOfByte16(_mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w, kShift[c]), byte)));
+            r = _mm512_or_si512(r, _mm512_slli_epi32(bytes16(_mm512_add_ps(sv, d)), kShift[c]));
+        }
+        _mm512_storeu_si512(out + i, r);
+    }
+    if (i < count) {
+        const float* const rest[4] = {src[0] + i, src[1] + i, src[2] + i, src[3] + i};
+        avx2::kMerger.addUnorm8Words(rest, words + 4 * size_t(i), count - i, alphaFill, out + i);
+    }
+}
+
 }  // namespace
 
 const MergerKernels& avx512::mergerTable() {
@@ -61,6 +109,7 @@ const MergerKernels& avx512::mergerTable() {
         MergerKernels k = avx2::kMerger;
         k.unorm8Words = &unorm8WordsAvx512;
         k.unorm8WordsRgba = &unorm8WordsRgbaAvx512;
+        k.addUnorm8Words = &addUnorm8WordsAvx512;
         return k;
     }();
     return table;

@@ -30,9 +30,9 @@ struct MergerKernels {
     // ONE/ONE into an 8-bit target under the float profiles: the A8R8G8B8 words (as unorm8Words,
     // ORed with `alphaFill`) of the float sums sat(src[c][i]) + d, d the destination word
     // words[i]'s channel c as its value float(d) / 255 (correctly rounded: the texture's value
-    // table). Avx2: a product and two FMAs in place of the division, the same float for every byte
-    // (checked for all 256); eight pixels whose sources are all 0, negative or NaN keep their
-    // words (the sum is d, whose byte is d's), without converting.
+    // table). Avx2 and Avx512: a product and two FMAs in place of the division, the same float for
+    // every byte (checked for all 256); eight (Avx512: sixteen) pixels whose sources are all 0, negative or NaN keep
+    // their words (the sum is d, whose byte is d's), without converting.
     void (*addUnorm8Words)(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
                            uint32_t* out);
     // The FloatBlendConsts blend of planar sources f[c][i] onto the interleaved float pixels

@@ -309,13 +309,14 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
     CHECK(emu::alignedKernels(SimdLevel::Avx512) != emu::alignedKernels(SimdLevel::Avx2));
     CHECK(emu::alignedKernels(SimdLevel::Avx512)->vertical != emu::alignedKernels(SimdLevel::Avx2)->vertical);
     CHECK(emu::alignedKernels(SimdLevel::Avx512)->storeRow == emu::alignedKernels(SimdLevel::Avx2)->storeRow);
-    // The merger's: its own float-to-8-bit words, the Avx2 level's other kernels.
+    // The merger's: its own float-to-8-bit words and ONE/ONE words, the Avx2 level's other kernels.
     const emu::MergerKernels& m512 = emu::mergerKernels(SimdLevel::Avx512);
     const emu::MergerKernels& m2 = emu::mergerKernels(SimdLevel::Avx2);
     CHECK(&m512 != &m2);
     CHECK(m512.unorm8Words != m2.unorm8Words);
     CHECK(m512.unorm8WordsRgba != m2.unorm8WordsRgba);
-    CHECK(m512.addUnorm8Words == m2.addUnorm8Words);
+    CHECK(m512.addUnorm8Words != m2.addUnorm8Words);
+    CHECK(m512.halves == m2.halves);
 #else
     CHECK(exec::fastKernels(SimdLevel::Avx512) == exec::fastKernels(SimdLevel::Avx2));
     CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
