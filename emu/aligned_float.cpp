@@ -361,25 +361,6 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
     draw.kernels->bilinearWords(tap.bytes, int(tap.width), i0, i1, j0, j1, fu, fv, tap.border.data(), n, out);
 }
 
-// The end of the run of lanes from i whose texels follow i0[i] one by one: the first e in
-// (i, n] with i0[e] != i0[i] + (e − i), or n. Eight lanes are compared at once while they match.
-int consecutiveEnd(const int32_t* i0, int i, int n) {
-    const int32_t base = i0[i] - i;
-    int e = i + 1;
-#if defined(__SSE2__)
-    const __m128i step = _mm_setr_epi32(0, 1, 2, 3), four = _mm_set1_epi32(4);
-    for (; e + 8 <= n; e += 8) {
-        const __m128i want = _mm_add_epi32(_mm_set1_epi32(base + e), step);
-        const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(i0 + e));
-        const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(i0 + e + 4));
-        const __m128i same = _mm_and_si128(_mm_cmpeq_epi32(a, want), _mm_cmpeq_epi32(b, _mm_add_epi32(want, four)));
-        if (_mm_movemask_epi8(same) != 0xffff) break;
-    }
-#endif
-    while (e < n && i0[e] == base + e) ++e;
-    return e;
-}
-
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
 // each stage read by one tap (prepareFloatRowDraw checks it).
 class RowSampler final : public ps11::Sampler {
@@ -437,7 +418,10 @@ public:
             m_fetched += uint64_t(n) * 4;
             return;
         }
-        const int32_t* i0 = m_tri->taps[size_t(t)].i0.data() + first;
+        const FloatRowTriangle::Columns& cols = m_tri->taps[size_t(t)];
+        const int32_t* i0 = cols.i0.data() + first;
+        // The end of the run of lanes from i whose texels follow i0[i] one by one (the table's).
+        const auto runEnd = [&](int i) { return std::min(n, int(cols.runEnd[first + size_t(i)] - int32_t(first))); };
         // (The channel arrays' distance as addresses: they need not be one array's parts.)
         const auto at = [&](int c) { return reinterpret_cast<uintptr_t>(out.value[c]); };
         const uintptr_t step = at(1) - at(0);
@@ -457,7 +441,7 @@ public:
                     ++i;
                     continue;
                 }
-                const int e = consecutiveEnd(i0, i, n);
+                const int e = runEnd(i);
                 m_draw.kernels->transpose(values + 4 * size_t(k), e - i, dst + i, size_t(stride));
                 i = e;
             }
@@ -473,7 +457,7 @@ public:
             int i = 0;
             while (i < n) {
                 const int32_t k = i0[i];
-                const int e = k >= 0 ? consecutiveEnd(i0, i, n) : i + 1;
+                const int e = k >= 0 ? runEnd(i) : i + 1;
                 if (e - i >= 8) {
                     m_draw.kernels->decode(bytes + 4 * size_t(k), e - i, dst + i, size_t(stride));
                     i = e;
@@ -624,7 +608,7 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
         const FloatRowTap& tap = draw.taps[size_t(i)];
         FloatRowTriangle::Columns& cols = out.taps[size_t(i)];
         if (!tap.bound || ((out.freeTaps >> i) & 1)) {  // no table (the triangle may be a previous chunk's or draw's)
-            cols.i0.clear(), cols.i1.clear(), cols.f.clear(), cols.stretches.clear();
+            cols.i0.clear(), cols.i1.clear(), cols.f.clear(), cols.stretches.clear(), cols.runEnd.clear();
             continue;
         }
         columnU(s, tap.coordSet, out.x0, n, u.data());
@@ -634,6 +618,11 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
         ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u.data(), tap.width, cols.i0.data(),
                             cols.i1.data(), cols.f.data());
         columnStretches(cols, n);
+        cols.runEnd.resize(tap.linear ? 0 : size_t(n));
+        if (!tap.linear)
+            for (int x = n - 1; x >= 0; --x)
+                cols.runEnd[size_t(x)] =
+                    x + 1 < n && cols.i0[size_t(x) + 1] == cols.i0[size_t(x)] + 1 ? cols.runEnd[size_t(x) + 1] : x + 1;
     }
 }
 

@@ -83,6 +83,9 @@ struct FloatRowTriangle {
             Kind kind;
         };
         std::vector<Stretch> stretches;
+        // A point tap's runs: runEnd[i] is the first column after i whose texel does not follow
+        // i0[i] one by one (i0[j] != i0[i] + (j − i)), or the column count (empty for linear taps).
+        std::vector<int32_t> runEnd;
         // Equal tables of one draw share their H rows (a full-screen quad's two triangles, the
         // taps of a vertical blur): shareFloatRowTables gives them the id of the first.
         uint64_t tableId = 0;
