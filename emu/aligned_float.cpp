@@ -148,7 +148,10 @@ const FloatRowKernels kBaseline{&lerpColumnsBase,   &lerpGatherBase, &lerpWordsB
 }  // namespace
 
 const FloatRowKernels& floatRowKernels(ps11::SimdLevel level) {
-#ifdef PS11_HAVE_AVX2
+#if defined(PS11_HAVE_AVX512)
+    return *ps11::simdTable<FloatRowKernels>(level, &kBaseline, &avx2::kFloatRow,
+                                             level >= ps11::SimdLevel::Avx512 ? &avx512::floatRowTable() : nullptr);
+#elif defined(PS11_HAVE_AVX2)
     return *ps11::simdTable<FloatRowKernels>(level, &kBaseline, &avx2::kFloatRow);
 #else
     (void)level;

@@ -1,9 +1,9 @@
 // The vector kernels of the float row path (emu/aligned_float.h): a table per SIMD level
 // (ps11/simd_dispatch.h), fetched once per draw (FloatRowDraw::kernels). Every kernel performs
 // the reference sampler's float operations in its order, one lane at a time as far as the
-// result is concerned (IEEE single precision, no fused multiply-add in the lerps: the Avx2 file
-// is built with -ffp-contract=off; the decode's quotient by 255 is exact either way), so both
-// levels give the same floats bit for bit. Internal to emu/aligned_float*.cpp.
+// result is concerned (IEEE single precision, no fused multiply-add in the lerps: the Avx2
+// and Avx512 files are built with -ffp-contract=off; the decode's quotient by 255 is exact either
+// way), so every level gives the same floats bit for bit. Internal to emu/aligned_float*.cpp.
 #pragma once
 
 #include <cstddef>
@@ -56,6 +56,11 @@ const FloatRowKernels& floatRowKernels(ps11::SimdLevel level);
 // The Avx2 table (x86-64 builds only); use floatRowKernels().
 namespace avx2 {
 extern const FloatRowKernels kFloatRow;
+}
+// The Avx512 table: the Avx2 one with its own decode and row and column lerps (built on first
+// use, from the Avx2 table); use floatRowKernels().
+namespace avx512 {
+const FloatRowKernels& floatRowTable();
 }
 
 }  // namespace emu

@@ -9,6 +9,7 @@
 #endif
 #include <immintrin.h>
 
+#include "emu/lanes_avx512.h"
 #include "emu/output_merger_kernels.h"
 #include "emu/prefetch.h"
 
@@ -29,14 +30,6 @@ inline __m512i bytes16(__m512 x) {
     return _mm512_cvtt_roundps_epi32(sum, _MM_FROUND_NO_EXC);
 }
 inline __m512i bytes16(const float* p) { return bytes16(_mm512_loadu_ps(p)); }
-
-// float(b) / 255 correctly rounded for a byte b (the texture's value table), as the Avx2 level's
-// unitOfByte: a product and two fused corrections in place of the division.
-inline __m512 unitOfByte16(__m512 b) {
-    const __m512 inv = _mm512_set1_ps(1.0f / 255.0f);
-    const __m512 q = _mm512_mul_ps(b, inv);
-    return _mm512_fmadd_ps(_mm512_fnmadd_ps(q, _mm512_set1_ps(255.0f), b), inv, q);
-}
 
 void unorm8WordsAvx512(const float* const f[4], int count, uint32_t alphaFill, uint32_t* words) {
     const __m512i fill = _mm512_set1_epi32(int32_t(alphaFill));
@@ -66,7 +59,7 @@ void unorm8WordsRgbaAvx512(const float* rgba, int count, uint32_t alphaFill, uin
 }
 
 // Sixteen pixels a step: where a source channel is above 0, each channel's sum sat(s) + d (d the
-// byte's value, unitOfByte16) and its byte (bytes16); elsewhere the destination word as it is.
+// byte's value, unitOfByte) and its byte (bytes16); elsewhere the destination word as it is.
 void addUnorm8WordsAvx512(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
                           uint32_t* out) {
     const __m512 zero = _mm512_setzero_ps(), one = _mm512_set1_ps(1.0f);
@@ -91,7 +84,7 @@ void addUnorm8WordsAvx512(const float* const src[4], const uint8_t* words, int c
         __m512i r = fill;
         for (int c = 0; c < 4; ++c) {
             const __m512 sv = _mm512_maskz_min_ps(above[c], s[c], one);  // sat: min(s, 1) above 0, else 0
-            const __m512 d = unitOfByte16(_mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w, kShift[c]), byte)));
+            const __m512 d = unitOfByte(_mm512_cvtepi32_ps(_mm512_and_si512(_mm512_srli_epi32(w, kShift[c]), byte)));
             r = _mm512_or_si512(r, _mm512_slli_epi32(bytes16(_mm512_add_ps(sv, d)), kShift[c]));
         }
         _mm512_storeu_si512(out + i, r);

@@ -317,6 +317,12 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
     CHECK(m512.unorm8WordsRgba != m2.unorm8WordsRgba);
     CHECK(m512.addUnorm8Words != m2.addUnorm8Words);
     CHECK(m512.halves == m2.halves);
+    // The float row path's: its own decode and row and column lerps, the Avx2 level's other kernels.
+    const emu::FloatRowKernels& f512 = emu::floatRowKernels(SimdLevel::Avx512);
+    const emu::FloatRowKernels& f2 = emu::floatRowKernels(SimdLevel::Avx2);
+    CHECK(f512.decode != f2.decode);
+    CHECK(f512.lerpRow != f2.lerpRow);
+    CHECK(f512.lerpGather == f2.lerpGather);
 #else
     CHECK(exec::fastKernels(SimdLevel::Avx512) == exec::fastKernels(SimdLevel::Avx2));
     CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
