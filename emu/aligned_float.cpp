@@ -508,7 +508,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                          const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out) {
     if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
-    if (kills || wantZ || merge.fog || !target.color || executor.writesDepth()) return false;
+    if (kills || !target.color || (wantZ && executor.writesDepth())) return false;
     FloatRowDraw d;
     if (!ps11::plainTaps(executor, d.plan)) return false;
     static std::atomic<uint64_t> serials{0};
@@ -551,6 +551,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;
     d.target = target;
+    d.wantZ = wantZ;
     out = d;
     return true;
 }
@@ -692,9 +693,11 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
-            const bool joined = ti + 1 < count && tris[ti + 1]->x0 == tri.x0 && tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y, windows,
-                                        windowCount, xl, xr);
+            // (Not under a depth test: the two halves' z planes are their own.)
+            const bool joined = !draw.wantZ && ti + 1 < count && tris[ti + 1]->x0 == tri.x0 &&
+                                tris[ti + 1]->x1 == tri.x1 &&
+                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
+                                        windows, windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri, s, y, sc.sampler);
             // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit.)
@@ -750,6 +753,9 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     mi.x = sc.x;
                     mi.y = sc.y;
                     mi.row = true;
+                    fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
+                    mi.fog = draw.merge.fog ? sc.fog : nullptr;
+                    mi.z = draw.wantZ ? sc.z : nullptr;
                     for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
                     MergeStats ms;
                     mergePixels(draw.merge, mi, draw.target, &ms);

@@ -58,11 +58,12 @@ struct FloatRowDraw {
     uint64_t colorAttrs = 0;
     MergeState merge;
     MergeTarget target;
+    bool wantZ = false;  // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
 };
 
 // Decides whether a draw can take the float row path (float or ideal precision, a program whose
 // texture reads are plain and on distinct stages, 2-D textures each read at level 0 with one
-// filter, no depth, fog or texkill) and fills `out`.
+// filter, no texkill and no depth written by the program) and fills `out`.
 bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
@@ -120,6 +121,7 @@ struct FloatRowScratch {
     alignas(32) float color[8][ps11::kMaxSpan];
     alignas(32) float out[4][ps11::kMaxSpan];
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
+    alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     // H rows: texel rows filtered horizontally over the triangle's columns, planar r g b a (4 ×
     // columns floats each), keyed by draw, column table and texel row, shared by every tap with
     // that table (a vertical blur's taps read each other's rows). Slots used by the pixel row

@@ -255,6 +255,14 @@ void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const floa
 
 }  // namespace
 
+void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int n, float* fogOut, float* zOut) {
+    if (z) fillPlaneRow(s.z, s.ox, s.oy, x, y, n, zOut);
+    if (!fog) return;
+    alignas(32) float inv[ps11::kMaxSpan];
+    if (s.perspective) rowInverseW(s, x, y, n, inv);
+    rowAttribute(s, kAttrSpecular + 3, x, y, n, inv, fogOut);
+}
+
 void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v) {
     alignas(32) float inv[ps11::kMaxSpan];
     if (s.perspective) rowInverseW(s, x, y, n, inv);
@@ -578,7 +586,8 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                         const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
     const bool fx12 = precision == ps11::Precision::Fx12;
-    if ((precision != ps11::Precision::Fx8 && !fx12) || wantZ || merge.fog || !target.color) return false;
+    if ((precision != ps11::Precision::Fx8 && !fx12) || !target.color || (wantZ && executor.writesDepth()))
+        return false;
     AlignedDraw d;
     if (!ps11::tapPlan(executor, d.plan)) return false;
     d.fx12 = fx12;
@@ -617,9 +626,11 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;
     d.target = target;
+    d.wantZ = wantZ;
     const D3DFORMAT f = target.color->format->format;
     const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
-    const bool plain = unorm && !merge.alphaTest && !merge.depthTest && !merge.depthWrite && merge.colorWrite == 0xf;
+    const bool plain =
+        unorm && !merge.alphaTest && !merge.depthTest && !merge.depthWrite && !merge.fog && merge.colorWrite == 0xf;
     d.directStore = plain && !merge.blend;
     const bool oneOne =
         merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
@@ -1004,9 +1015,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
-            const bool joined = ti + 1 < count && tris[ti + 1]->x0 == tri.x0 && tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y, windows,
-                                        windowCount, xl, xr);
+            // (Not under a depth test: the two halves' z planes are their own.)
+            const bool joined = !draw.wantZ && ti + 1 < count && tris[ti + 1]->x0 == tri.x0 &&
+                                tris[ti + 1]->x1 == tri.x1 &&
+                                joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
+                                        windows, windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
             ctx.setup = &s;
@@ -1103,6 +1116,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     mi.x = sc.x;
                     mi.y = sc.y;
                     mi.row = true;
+                    fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
+                    mi.fog = draw.merge.fog ? sc.fog : nullptr;
+                    mi.z = draw.wantZ ? sc.z : nullptr;
                     // (The merger merges fx profiles from the grid: mergeReadsColor says where it also
                     // reads the real values.)
                     const bool readsColor =

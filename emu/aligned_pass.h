@@ -52,12 +52,13 @@ struct AlignedDraw {
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
     uint32_t bound = 0;       // the taps with a texture (bit per tap)
-    uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the program reads
+    uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the draw reads (the specular alpha under fog)
     MergeState merge;
     MergeTarget target;
     bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
     bool directStore = false;  // 8-bit target, no tests, fog or blending, all channels: stored here
     bool directAdd = false;    // ONE/ONE ADD on every channel into an 8-bit target
+    bool wantZ = false;        // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
 };
 
 // Decides whether a draw can take the aligned path (per-triangle checks come later) and fills
@@ -194,6 +195,7 @@ struct AlignedScratch {
     alignas(32) int16_t r0[4][ps11::kMaxSpan];
     alignas(32) float color[8][ps11::kMaxSpan];  // diffuse r g b a, specular r g b a
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
+    alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
     HRowCache hrows;
@@ -217,6 +219,10 @@ float rowV(const TriangleSetup& s, int set, int y);
 // that `colorAttrs` names, as the quad path interpolates them (constant, affine, or with
 // perspective divided by the interpolated rhw).
 void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]);
+// The merger's other per-lane inputs for pixels x .. x + n − 1 of row y, as the spans of one row
+// interpolate them (rasterizeRowSpans): the fog factor, the specular alpha (where `fog`), and z,
+// linear on the screen (where `z`).
+void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int n, float* fogOut, float* zOut);
 
 struct AlignedStats {
     uint64_t pixels = 0, written = 0, texels = 0;

@@ -30,9 +30,10 @@ namespace {
 struct Vtx {
     float x, y, z, rhw;
     DWORD diffuse;
+    DWORD specular = 0xff000000u;  // its alpha is the vertex fog factor
     float uv[4][2];
 };
-constexpr DWORD kFvf = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_TEX4;
+constexpr DWORD kFvf = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_SPECULAR | D3DFVF_TEX4;
 
 const char* const kPrograms[] = {
     "ps_1_1\ntex t0\nmov r0, t0\n",
@@ -102,7 +103,36 @@ struct Case {
     DWORD writeMask = 0xf;
     bool scissor = false;
     RECT scissorRect{};
+    // Vertex fog toward fogColor by each vertex's specular alpha (the triangles' own planes).
+    bool fog = false;
+    DWORD fogColor = 0;
+    // A D24X8 depth buffer cleared to zClear, tested with zFunc and written where zWrite; the
+    // vertices' z differ per triangle (a quad's halves are not one plane), and `depthVerts`,
+    // drawn after with the same states, tests what the first draw wrote.
+    bool depth = false;
+    DWORD zFunc = D3DCMP_LESSEQUAL;
+    bool zWrite = true;
+    float zClear = 1.0f;
+    std::vector<Vtx> depthVerts;
 };
+
+// Depth and fog on a quarter of the cases each, from their own generator seeded by `rng`.
+void depthAndFog(std::mt19937& rng, Case& c) {
+    std::mt19937 more(rng());
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(more); };
+    c.fog = uni(0, 3) == 0;
+    c.fogColor = DWORD(more());
+    for (Vtx& v : c.verts) v.specular = DWORD(more());
+    c.depth = uni(0, 3) == 0;
+    if (!c.depth) return;
+    const DWORD funcs[6] = {D3DCMP_LESS,  D3DCMP_LESSEQUAL, D3DCMP_GREATER,
+                            D3DCMP_EQUAL, D3DCMP_NOTEQUAL,  D3DCMP_ALWAYS};
+    c.zFunc = funcs[uni(0, 5)];
+    c.zWrite = uni(0, 3) != 0;
+    c.zClear = float(uni(0, 4)) * 0.25f;
+    c.depthVerts = c.verts;
+    for (Vtx& v : c.depthVerts) v.z = float(uni(0, 1000)) / 1000.0f, v.diffuse = DWORD(more());
+}
 
 // Every NaN of float or half texels replaced by the infinity of its sign.
 void withoutNaNs(std::vector<uint8_t>& bytes, D3DFORMAT f) {
@@ -213,7 +243,7 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
     const int order[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
     const int split = uni(0, 1);
     for (int k : order[split]) {
-        Vtx q{xs[k], ys[k], real(0, 1), 1.0f, dif[k], {}};
+        Vtx q{xs[k], ys[k], real(0, 1), 1.0f, dif[k], 0xff000000u, {}};
         for (int s = 0; s < 4; ++s) {
             q.uv[s][0] = (k == 1 || k == 2) ? u[s][1] : u[s][0];
             q.uv[s][1] = (k >= 2) ? v[s][1] : v[s][0];
@@ -226,6 +256,7 @@ Case randomCase(std::mt19937& rng, bool floatFormats = false) {
     c.writeMask = uni(0, 5) == 0 ? DWORD(uni(0, 15)) : 0xf;
     c.scissor = uni(0, 5) == 0;
     c.scissorRect = RECT{uni(0, int(c.w)), uni(0, int(c.h)), uni(0, int(c.w)), uni(0, int(c.h))};
+    depthAndFog(rng, c);
     return c;
 }
 
@@ -236,7 +267,7 @@ void fullTargetQuad(Case& c) {
     const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
     const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
     for (int k : {0, 1, 2, 0, 2, 3}) {
-        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
         for (int s = 0; s < 4; ++s) q.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
         c.verts.push_back(q);
     }
@@ -298,9 +329,31 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
         REQUIRE(dev.SetScissorRect(&c.scissorRect) == D3D_OK);
         REQUIRE(dev.SetRenderState(D3DRS_SCISSORTESTENABLE, 1) == D3D_OK);
     }
+    REQUIRE(dev.SetRenderState(D3DRS_FOGENABLE, c.fog ? 1 : 0) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_FOGCOLOR, c.fogColor) == D3D_OK);
+    REQUIRE(dev.SetRenderState(D3DRS_ZENABLE, c.depth ? 1 : 0) == D3D_OK);
+    Handle ds{};
+    if (c.depth) {
+        REQUIRE(dev.CreateDepthStencilSurface(c.w, c.h, D3DFMT_D24X8, &ds) == D3D_OK);
+        REQUIRE(dev.SetDepthStencilSurface(ds) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_ZBUFFER, 0, c.zClear, 0) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ZFUNC, c.zFunc) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ZWRITEENABLE, c.zWrite ? 1 : 0) == D3D_OK);
+    }
     REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
     REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(c.verts.size() / 3), c.verts.data(), sizeof(Vtx)) == D3D_OK);
     stats = dev.lastDrawStats();
+    if (c.depth) {
+        // The second draw's pixels pass or fail against what the first wrote.
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(c.depthVerts.size() / 3), c.depthVerts.data(),
+                                    sizeof(Vtx)) == D3D_OK);
+        const DrawStats& second = dev.lastDrawStats();
+        stats.pixelsCovered += second.pixelsCovered;
+        stats.pixelsWritten += second.pixelsWritten;
+        stats.pixelsShaded += second.pixelsShaded;
+        stats.pixelsRowPath += second.pixelsRowPath;
+        REQUIRE(dev.SetDepthStencilSurface(Handle::Null) == D3D_OK);
+    }
     std::vector<uint8_t> out(rtRow * c.h);
     REQUIRE(dev.LockRect(rt, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
     for (UINT y = 0; y < c.h; ++y) std::memcpy(&out[y * rtRow], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, rtRow);
@@ -397,6 +450,64 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     // row path, save those whose quads happened to be all covered.
     INFO(aligned << " of " << cases << " cases took the row path");
     CHECK(aligned * 10 >= cases * 9);
+}
+
+TEST_CASE("aligned pass: fogged and depth-tested passes take the row paths and equal the quad path",
+          "[draw][aligned]") {
+    // Full-target quads (whose halves share every tap's planes, so their runs of a row join) and
+    // random ones, each vertex with its own fog factor (specular alpha) and z, so the two halves'
+    // fog and z planes differ: a run must take each pixel's own triangle's. fx8, fx12, float and
+    // ideal; a second draw tests what the first wrote to the depth buffer.
+    std::mt19937 rng(20261130);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    int rowPath = 0, cases = 0, fogged = 0, depthTested = 0;
+    for (int i = 0; i < 160; ++i) {
+        const int profile = i % 4;  // fx8, fx12 (the radeon8500 class), float, ideal
+        Case c = randomCase(rng, profile >= 2);
+        if (uni(0, 2)) {
+            fullTargetQuad(c);
+            for (Case::Tex& t : c.tex) {
+                t.w = c.w, t.h = c.h;
+                t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
+                for (uint8_t& b : t.bytes) b = uint8_t(rng());
+            }
+        }
+        c.fog = uni(0, 3) != 0;
+        c.depth = !c.fog || uni(0, 1);
+        c.fogColor = DWORD(rng());
+        for (Vtx& v : c.verts) v.specular = DWORD(rng()), v.z = c.depth ? float(uni(0, 1000)) / 1000.0f : v.z;
+        c.zFunc =
+            std::array<DWORD, 4>{D3DCMP_LESS, D3DCMP_LESSEQUAL, D3DCMP_GREATER, D3DCMP_NOTEQUAL}[size_t(uni(0, 3))];
+        c.zWrite = uni(0, 3) != 0;
+        c.zClear = float(uni(1, 3)) * 0.25f;
+        c.depthVerts = c.verts;
+        for (Vtx& v : c.depthVerts) v.z = float(uni(0, 1000)) / 1000.0f;
+        c.program = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n";
+        c.alphaTest = false;
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        rowOpt.software.skipTiles = uni(0, 1) == 0;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (profile == 1) radeon8500(quadOpt, rowOpt);
+        if (profile >= 2) floatProfile(i, profile == 3, quadOpt, rowOpt);
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", fog " << c.fog
+                     << ", depth " << c.depth);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsCovered == qs.pixelsCovered);
+        CHECK(rs.pixelsWritten == qs.pixelsWritten);
+        if (rs.pixelsCovered == 0) continue;
+        ++cases;
+        if (rs.pixelsRowPath == rs.pixelsCovered) ++rowPath;
+        fogged += c.fog, depthTested += c.depth;
+    }
+    INFO(rowPath << " of " << cases << " drawn by a row path; " << fogged << " fogged, " << depthTested
+                 << " depth-tested");
+    CHECK(rowPath * 10 >= cases * 9);
+    CHECK(fogged > 80);
+    CHECK(depthTested > 60);
 }
 
 TEST_CASE("float row path: random screen-aligned draws in float and ideal equal the quad path byte for byte",
@@ -550,7 +661,7 @@ TEST_CASE("aligned pass: rotated and perspective draws take the row path, in fx8
     c.verts.clear();
     const float xs[4] = {-0.5f, 39.5f, 39.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, 19.5f, 19.5f};
     for (int k : {0, 1, 2, 0, 2, 3}) {
-        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
         for (auto& uv : q.uv) uv[0] = k >= 2 ? 1.0f : 0.0f, uv[1] = (k == 1 || k == 2) ? 1.0f : 0.0f;
         c.verts.push_back(q);
     }
@@ -631,7 +742,7 @@ TEST_CASE("aligned pass: one device across draws (constants change sign, texture
     const float ys[4] = {-0.5f, -0.5f, float(h) - 0.5f, float(h) - 0.5f};
     const float off[3][2] = {{-0.5f, -0.5f}, {0.5f, 0.5f}, {0.125f, -0.375f}};
     for (int k : {0, 1, 2, 0, 2, 3}) {
-        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
         for (int s = 0; s < 3; ++s) {
             q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(w);
             q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(h);
@@ -890,7 +1001,7 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad
         const int order[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
         const DWORD dif = DWORD(rng());
         for (int k : order[uni(0, 1)]) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, dif, {}};
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, dif, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s) {
                 q.uv[s][0] = (k == 1 || k == 2) ? u[s][1] : u[s][0];
                 q.uv[s][1] = (k >= 2) ? v[s][1] : v[s][0];
@@ -958,7 +1069,7 @@ TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel b
         const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
         const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
         for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, {}};
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s) {
                 q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (dx[s] + ox) / float(t.w);
                 q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (dy[s] + oy) / float(t.h);
@@ -1061,6 +1172,7 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
     for (int i = 0; i < 480; ++i) {
         const int profile = i % 4;  // fx8, float, ideal, fx12 (the radeon8500 class)
         Case c = randomCase(rng, profile == 1 || profile == 2);
+        if (uni(0, 1)) c.fog = c.depth = false;  // (depth and fog keep a zero ONE/ONE tile from being skipped)
         if (uni(0, 2)) c.program = programs[uni(0, int(std::size(programs)) - 1)];
         if (uni(0, 1)) c.blend = 1;  // ONE/ONE
         if (uni(0, 1)) c.rtFormat = D3DFMT_A8R8G8B8;
@@ -1260,7 +1372,7 @@ Case spriteCase(std::mt19937& rng, int quads, bool twoTaps) {
         const float xs[4] = {x0, x0 + size, x0 + size, x0}, ys[4] = {y0, y0, y0 + size, y0 + size};
         const DWORD colour = DWORD(rng());
         for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx v{xs[k], ys[k], 0.5f, 1.0f, colour, {}};
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, colour, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s)
                 v.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
             c.verts.push_back(v);
@@ -1340,10 +1452,14 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     // Cases 12 and up give each vertex an rhw of 0.5, 1 or 2 and its coordinates divided by it:
     // every triangle's planes of attr·rhw are still u = x / 64, v = y / 32 exactly, but their rhw
-    // planes differ.
+    // planes differ. Every third case fogs with each vertex's own fog factor, every third after
+    // it tests depth with each vertex's own z: those planes differ between triangles too, and a
+    // run must not join across them.
     for (int i = 0; i < 24; ++i) {
         const bool perspective = i >= 12;
         Case c = randomCase(rng);
+        c.fog = i % 3 == 1, c.depth = i % 3 == 2;
+        c.zFunc = D3DCMP_LESSEQUAL, c.zWrite = true, c.zClear = 1.0f;
         c.w = 64, c.h = 32;
         c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
         for (uint8_t& b : c.rtInit) b = uint8_t(uni(0, 40));
@@ -1358,17 +1474,34 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
         c.verts.clear();
         auto vertex = [&](int x, int y) {
             const float rhw = perspective ? std::array<float, 3>{0.5f, 1.0f, 2.0f}[size_t(uni(0, 2))] : 1.0f;
-            Vtx v{float(x), float(y), 0.5f, rhw, 0xffffffff, {}};
+            Vtx v{float(x), float(y), 0.5f, rhw, 0xffffffff, 0xff000000u, {}};
             for (auto& uv : v.uv) uv[0] = float(x) / 64.0f / rhw, uv[1] = float(y) / 32.0f / rhw;
+            if (c.fog) v.specular = DWORD(uni(0, 255)) << 24;
+            if (c.depth) v.z = float(uni(0, 100)) / 100.0f;
             return v;
         };
-        for (int t = 0; perspective && t < 20; ++t) {
-            // Rectangles split on a diagonal, each corner its own rhw: the halves' attr·rhw
-            // planes are equal and their runs meet on every row, but the rows must not join
-            // where their rhw planes differ.
+        for (int t = 0; (perspective || c.fog || c.depth) && t < 20; ++t) {
+            // Rectangles split on a diagonal, each corner its own rhw (or fog factor, or z): the
+            // halves' attr·rhw planes are equal and their runs meet on every row, but the rows
+            // must not join where their rhw (fog, z) planes differ.
             const int x0 = uni(-8, 60), y0 = uni(-8, 30), x1 = x0 + uni(2, 40), y1 = y0 + uni(2, 20);
             const Vtx a = vertex(x0, y0), b = vertex(x1, y0), d = vertex(x1, y1), e = vertex(x0, y1);
-            c.verts.insert(c.verts.end(), {a, b, d, a, d, e});
+            // Either diagonal, either half first (the halves' v planes have dx +0 or −0 by the
+            // order, and runs join only where those bits agree too).
+            switch (uni(0, 3)) {
+                case 0:
+                    c.verts.insert(c.verts.end(), {a, b, d, a, d, e});
+                    break;
+                case 1:
+                    c.verts.insert(c.verts.end(), {a, d, e, a, b, d});
+                    break;
+                case 2:
+                    c.verts.insert(c.verts.end(), {a, b, e, b, d, e});
+                    break;
+                default:
+                    c.verts.insert(c.verts.end(), {b, d, e, a, b, e});
+                    break;
+            }
         }
         for (int t = 0; !perspective && t < 60; ++t) {
             // Wide triangles (tables over the whole target: equal for all of them), some twice.
@@ -1376,6 +1509,8 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
                       d = vertex(uni(-8, 72), uni(-8, 40));
             for (int k = uni(0, 3) == 0 ? 2 : 1; k > 0; --k) c.verts.insert(c.verts.end(), {a, b, d});
         }
+        c.depthVerts = c.verts;
+        for (Vtx& v : c.depthVerts) v.z = float(uni(0, 100)) / 100.0f;
         for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Ideal}) {
             DeviceOptions quadOpt, rowOpt;
             quadOpt.software.alignedPasses = false;
@@ -1458,7 +1593,7 @@ TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equ
         const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
         const float off[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
         for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s) {
                 v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(4 * c.w);
                 v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(4 * c.h);
@@ -1506,13 +1641,13 @@ TEST_CASE("aligned pass: chains of products that pass the range's top are clampe
                     "mad r0, t1, c1, r0\nmad r0, t2, c2, r0\nmad r0, t3, c3, r0\nsub r0, r0, c4\n";
         for (auto& k : c.consts)
             for (float& v : k) v = real(0.2f, 1.0f);
-        c.blend = 0, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.blend = 0, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false, c.fog = false, c.depth = false;
         c.verts.clear();
         const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
         const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
         const float shift = i % 2 ? 0.5f : 1.0f;
         for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, {}};
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s) {
                 v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (float(s) - 1.5f) * shift / float(c.w);
                 v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;

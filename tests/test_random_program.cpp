@@ -374,7 +374,7 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
     // paths (the fx8 and float row paths, and spans of one row for everything else whose lookups
     // are ps11::lodFree) and by one shading every triangle in 2×2 quads. The targets must be
     // identical bit for bit; where every sampled texture is lodFree no helper lane is shaded.
-    int rows = 0, quads = 0;
+    int rows = 0, quads = 0, rowPathDepthFog = 0;
     for (uint64_t seed = 20000; seed < 20160; ++seed) {
         const RandomCase c = caseOf(seed, 0, 13, 7);
         INFO("seed " << seed << "\n" << c.testText);
@@ -418,6 +418,11 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
             const emu::DrawStats& qs = quadRunner->device().lastDrawStats();
             CHECK(rs.pixelsCovered == qs.pixelsCovered);
             CHECK(rs.pixelsWritten == qs.pixelsWritten);
+            CHECK(qs.pixelsRowPath == 0);
+            // Depth and fog draws the fx8, fx12 and float row paths drew wholly (not spans).
+            if (drawn && (file.renderTarget.depth.value || file.renderState.fog.value) && rs.pixelsCovered > 0 &&
+                rs.pixelsRowPath == rs.pixelsCovered)
+                ++rowPathDepthFog;
             if (!drawn || qs.pixelsShaded == qs.pixelsCovered) continue;  // (no helper lanes to tell them apart)
             if (lodFree) {
                 CHECK(rs.pixelsShaded <= rs.pixelsCovered);  // (fewer where tiles were filled or skipped)
@@ -427,10 +432,12 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
             }
         }
     }
-    // Both kinds occur: lookups free of the level of detail in rows, mip chains in quads.
-    INFO(rows << " draws in rows, " << quads << " in quads");
+    // Both kinds occur: lookups free of the level of detail in rows, mip chains in quads; and
+    // the row paths take depth-tested and fogged draws of plain reads.
+    INFO(rows << " draws in rows, " << quads << " in quads, " << rowPathDepthFog << " with depth or fog by a row path");
     CHECK(rows > 200);
     CHECK(quads > 50);
+    CHECK(rowPathDepthFog > 20);
 }
 
 TEST_CASE("random programs: the shrinker keeps a mul and little else", "[random]") {
