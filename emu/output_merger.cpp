@@ -472,6 +472,44 @@ void mergeFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[
     }
 }
 
+// Vertex fog of fx profiles into 8-bit targets for every lane at once, as mergeFxUnorm8 applies
+// it pixel by pixel: rgb = f·s + (1 − f)·FOGCOLOR on the grid of the saturated colour, rounded
+// once (every product and sum fits 32 bits: at most G² = 4080²), alpha as it is.
+template <int32_t G>
+void fogFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[4], int32_t (*out)[ps11::kMaxSpan]) {
+    using F = Fx<G>;
+    const Lanes lanes(in, p);
+    alignas(32) int32_t fq[ps11::kMaxSpan];
+    for (int i = 0; i < in.count; ++i) fq[i] = F::fogGrid(lanes.fog(i));
+    for (int c = 0; c < 3; ++c) {
+        const int32_t fogG = int32_t(p.fogByte[c]) * F::S;
+        const int32_t* src = g[c];
+        int32_t* dst = out[c];
+        for (int i = 0; i < in.count; ++i) {
+            const int32_t s = std::clamp(src[i], 0, G);
+            const uint32_t num = uint32_t(fq[i] * s + (G - fq[i]) * fogG), q = num / uint32_t(G), r = num - q * G;
+            dst[i] = int32_t(q + ((2 * r > uint32_t(G) || (2 * r == uint32_t(G) && (q & 1u))) ? 1u : 0u));
+        }
+    }
+}
+
+// The depth test (and write where it passes) of the live lanes, as the per-pixel merges make it
+// when no alpha test comes first: live[i] says which lanes go on to the colour stages. True when
+// every lane was live and passed.
+bool depthFirst(const Plan& p, const MergeInputs& in, uint8_t* live, Counts& n) {
+    const Lanes lanes(in, p);
+    const DepthCtx dc = depthCtxOf(p);
+    bool all = true;
+    for (int i = 0; i < in.count; ++i) {
+        uint32_t x, y;
+        bool go = (!in.live || in.live[i]) && lanes.inside(i, x, y);
+        if (go && !depthStage(dc, x, y, lanes.z(i))) go = false, ++n.depthRejected;
+        live[i] = uint8_t(go);
+        all = all && go;
+    }
+    return all;
+}
+
 [[maybe_unused]] bool supportedColor(const Image* img) { return img && img->format && img->format->renderTarget; }
 
 }  // namespace
@@ -554,7 +592,7 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
     // caller's programming error: asserted, and in release builds nothing is written.
     assert(!target.color || supportedColor(target.color));
     bool ok = false;
-    const Plan p = makePlan(state, target, ok);
+    Plan p = makePlan(state, target, ok);
     assert(ok);
     if (!ok || in.count <= 0 || (!p.color && !p.depth)) return;
     assert(in.count <= ps11::kMaxSpan && in.x && in.y);
@@ -580,6 +618,28 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
 
     Counts n;
     const bool unorm = p.color && (p.target == TargetKind::Argb8 || p.target == TargetKind::Xrgb8);
+    // Stages that can go first over every lane, so that the rest takes the merges without them:
+    // a depth test with no alpha test before it, and fx profiles' fog into 8-bit targets.
+    alignas(32) uint8_t passed[ps11::kMaxSpan];
+    if (p.depthTest && !p.alphaTest) {
+        // (Every lane passing keeps a row's run whole: the merges store it at once.)
+        if (!depthFirst(p, lanes, passed, n)) lanes.live = passed;
+        p.depthTest = false;
+        if (!p.color) {
+            for (int i = 0; i < count; ++i) n.written += passed[i];  // (the per-pixel merges count them so)
+            if (stats) stats->written += n.written, stats->depthRejected += n.depthRejected;
+            return;
+        }
+    }
+    alignas(32) int32_t fogged[3][ps11::kMaxSpan];
+    if (unorm && fx && p.fog) {
+        if (state.precision == Precision::Fx8)
+            fogFxUnorm8<255>(p, lanes, grid, fogged);
+        else
+            fogFxUnorm8<4080>(p, lanes, grid, fogged);
+        for (int c = 0; c < 3; ++c) grid[c] = fogged[c];
+        p.fog = false;
+    }
     // ONE/ONE ADD on every channel (additive passes); fx8's has an exact byte path.
     bool oneOneAdd = p.blend;
     for (const ChannelPlan& cp : p.ch)
