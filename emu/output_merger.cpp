@@ -500,6 +500,29 @@ bool depthFirst(const Plan& p, const MergeInputs& in, uint8_t* live, Counts& n) 
     const Lanes lanes(in, p);
     const DepthCtx dc = depthCtxOf(p);
     bool all = true;
+    uint32_t x0 = 0, y0 = 0;
+    if (dc.kind == DepthKind::D24 && in.row && !in.live && in.count > 0 && lanes.inside(0, x0, y0) &&
+        x0 + uint32_t(in.count) <= p.boundW) {
+        // One run of a row into a 24-bit depth buffer: depthStage lane by lane without its
+        // switch and branches (the code, at most 2^24 − 1, converts as an int32).
+        uint8_t* const q = dc.surf.at(x0, y0);
+        const uint32_t lt = dc.mask & 1u, eq = (dc.mask >> 1) & 1u, gt = (dc.mask >> 2) & 1u;
+        const uint32_t keep = dc.write ? 0xffu : 0xffffffffu;
+        uint32_t passed = 0;
+        for (int i = 0; i < in.count; ++i) {
+            const float zIn = in.z ? in.z[i] : 0.0f;
+            const float z = zIn > 0.0f ? (zIn < 1.0f ? zIn : 1.0f) : 0.0f;  // NaN -> 0
+            const uint32_t code = uint32_t(int32_t(ps11::roundEvenSmall(double(z) * 16777215.0)));
+            const uint32_t old = load32(q + 4 * size_t(i)), d = old >> 8;
+            const uint32_t pass = code < d ? lt : code == d ? eq : gt;
+            live[i] = uint8_t(pass);
+            passed += pass;
+            const uint32_t moved = (old & keep) | (dc.write ? code << 8 : 0u);
+            store32(q + 4 * size_t(i), pass ? moved : old);
+        }
+        n.depthRejected += uint64_t(in.count) - passed;
+        return passed == uint32_t(in.count);
+    }
     for (int i = 0; i < in.count; ++i) {
         uint32_t x, y;
         bool go = (!in.live || in.live[i]) && lanes.inside(i, x, y);
