@@ -629,14 +629,18 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     d.wantZ = wantZ;
     const D3DFORMAT f = target.color->format->format;
     const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
-    const bool plain =
-        unorm && !merge.alphaTest && !merge.depthTest && !merge.depthWrite && !merge.fog && merge.colorWrite == 0xf;
+    // (A depth write comes with a depth test: MergeState::from.)
+    const bool plain = unorm && !merge.alphaTest && !merge.fog && merge.colorWrite == 0xf &&
+                       (merge.depthTest || !merge.depthWrite) && (!merge.depthTest || target.depth);
     d.directStore = plain && !merge.blend;
     const bool oneOne =
         merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
         (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE && merge.dstBlendAlpha == D3DBLEND_ONE &&
                                   merge.blendOpAlpha == D3DBLENDOP_ADD));
     d.directAdd = plain && merge.blend && oneOne;
+    d.depthFirst = (d.directStore || d.directAdd) && merge.depthTest;
+    d.afterDepth = merge;
+    d.afterDepth.depthTest = d.afterDepth.depthWrite = false;
     out = d;
     return true;
 }
@@ -1075,10 +1079,27 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             stats.texels +=
                                 uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
                     ctx.x = x;
+                    // Stored here, or merged by `mergeState` over the lanes `live` (null: all).
+                    bool direct = draw.directStore || draw.directAdd;
+                    const MergeState* mergeState = &draw.merge;
+                    const uint8_t* live = nullptr;
+                    if (draw.depthFirst) {
+                        // The run's depth test first: stored here where every pixel passed.
+                        for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                        MergeInputs zi;
+                        zi.count = n;
+                        zi.x = sc.x;
+                        zi.y = sc.y;
+                        zi.row = true;
+                        fillRowFogDepth(s, false, true, x, y, n, nullptr, sc.z);
+                        zi.z = sc.z;
+                        direct = depthTestFirst(draw.merge, zi, draw.target, sc.passed, nullptr);
+                        mergeState = &draw.afterDepth;
+                        live = direct ? nullptr : sc.passed;
+                    }
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
-                        const bool direct = draw.directStore || draw.directAdd;
                         ctx.out = direct ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
                         if (direct) {
@@ -1087,9 +1108,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             continue;
                         }
                     } else if (mode == RowMode::Copy) {
-                        if ((draw.directStore || draw.directAdd) &&
-                            copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
-                                       target.texel(uint32_t(x), uint32_t(y)))) {
+                        if (direct && copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
+                                                 target.texel(uint32_t(x), uint32_t(y)))) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
                             stats.copiedDirect += uint64_t(n);
@@ -1104,7 +1124,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     stats.pixels += uint64_t(n);
                     uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
-                    if (draw.directStore || draw.directAdd) {
+                    if (direct) {
                         storeLanes(draw, r0c, n, orMask, row);
                         stats.written += uint64_t(n);
                         continue;
@@ -1112,13 +1132,16 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     // Anything else: the output merger over the row.
                     MergeInputs mi;
                     mi.count = n;
-                    for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
+                    if (!draw.depthFirst)
+                        for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
                     mi.x = sc.x;
                     mi.y = sc.y;
                     mi.row = true;
-                    fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
+                    mi.live = live;
+                    const bool z = draw.wantZ && !draw.depthFirst;
+                    fillRowFogDepth(s, draw.merge.fog, z, x, y, n, sc.fog, sc.z);
                     mi.fog = draw.merge.fog ? sc.fog : nullptr;
-                    mi.z = draw.wantZ ? sc.z : nullptr;
+                    mi.z = z ? sc.z : nullptr;
                     // (The merger merges fx profiles from the grid: mergeReadsColor says where it also
                     // reads the real values.)
                     const bool readsColor =
@@ -1132,7 +1155,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         mi.grid[c] = sc.grid[c];
                     }
                     MergeStats ms;
-                    mergePixels(draw.merge, mi, draw.target, &ms);
+                    mergePixels(*mergeState, mi, draw.target, &ms);
                     stats.written += ms.written;
                 }
             }

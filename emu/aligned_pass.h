@@ -56,9 +56,15 @@ struct AlignedDraw {
     MergeState merge;
     MergeTarget target;
     bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
-    bool directStore = false;  // 8-bit target, no tests, fog or blending, all channels: stored here
-    bool directAdd = false;    // ONE/ONE ADD on every channel into an 8-bit target
-    bool wantZ = false;        // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
+    // Stored here: an 8-bit target, no alpha test or fog, all channels, and no blending
+    // (directStore) or ONE/ONE ADD on every channel (directAdd); under a depth test (depthFirst)
+    // only the runs whose every pixel passed it, which is tested before they are shaded
+    // (depthTestFirst), the others merged with `afterDepth` over the pixels that passed.
+    bool directStore = false;
+    bool directAdd = false;
+    bool depthFirst = false;
+    MergeState afterDepth;  // `merge` with its depth test and write off
+    bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
 };
 
 // Decides whether a draw can take the aligned path (per-triangle checks come later) and fills
@@ -196,6 +202,7 @@ struct AlignedScratch {
     alignas(32) float color[8][ps11::kMaxSpan];  // diffuse r g b a, specular r g b a
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
+    alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
     HRowCache hrows;

@@ -610,6 +610,21 @@ bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target) {
     return !resolveTarget(target, p) || (p.target != TargetKind::Argb8 && p.target != TargetKind::Xrgb8);
 }
 
+bool depthTestFirst(const MergeState& state, const MergeInputs& in, const MergeTarget& target, uint8_t* passed,
+                    MergeStats* stats) {
+    assert(state.depthTest && !state.alphaTest && target.depth && in.count <= ps11::kMaxSpan);
+    bool ok = false;
+    const Plan p = makePlan(state, target, ok);
+    if (!ok || !p.depthTest || p.alphaTest || in.count <= 0) {
+        std::fill_n(passed, std::max(in.count, 0), uint8_t(0));
+        return false;
+    }
+    Counts n;
+    const bool all = depthFirst(p, in, passed, n);
+    if (stats) stats->depthRejected += n.depthRejected;
+    return all;
+}
+
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats) {
     // A colour target of another format, or a depth target of a non-depth format, is the
     // caller's programming error: asserted, and in release builds nothing is written.

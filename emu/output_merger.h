@@ -86,6 +86,14 @@ bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target);
 // caller's programming errors: asserted (debug), and skipped in release builds.
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats);
 
+// The depth test, and the write where it passes, of the live lanes of `in` (x, y, z, live, row),
+// as mergePixels makes it first when no alpha test comes before it; passed[i] says which lanes
+// passed. True when every lane did. A row path tests a run so before shading it: the run's colour
+// then merges by `state` with its depth test off (MergeState::depthTest, depthWrite), over the
+// lanes that passed. Requires state.depthTest, a depth target and no alpha test.
+bool depthTestFirst(const MergeState& state, const MergeInputs& in, const MergeTarget& target, uint8_t* passed,
+                    MergeStats* stats);
+
 // Draw-time check of the states the merger reads (ValidateDevice-style): nullopt when they are
 // usable, else D3DERR_INVALIDCALL, E4160, "D3DRS_SRCBLEND 99 is not a D3DBLEND value" for an
 // unknown D3DBLEND / D3DBLENDOP / D3DCMPFUNC value in a state that is in use (the caller
