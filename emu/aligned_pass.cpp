@@ -630,8 +630,8 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     const D3DFORMAT f = target.color->format->format;
     const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
     // (A depth write comes with a depth test: MergeState::from.)
-    const bool plain = unorm && !merge.alphaTest && !merge.fog && merge.colorWrite == 0xf &&
-                       (merge.depthTest || !merge.depthWrite) && (!merge.depthTest || target.depth);
+    const bool plain = unorm && !merge.alphaTest && merge.colorWrite == 0xf && (merge.depthTest || !merge.depthWrite) &&
+                       (!merge.depthTest || target.depth);
     d.directStore = plain && !merge.blend;
     const bool oneOne =
         merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
@@ -639,6 +639,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                                   merge.blendOpAlpha == D3DBLENDOP_ADD));
     d.directAdd = plain && merge.blend && oneOne;
     d.depthFirst = (d.directStore || d.directAdd) && merge.depthTest;
+    d.fogFirst = (d.directStore || d.directAdd) && merge.fog;
     d.afterDepth = merge;
     d.afterDepth.depthTest = d.afterDepth.depthWrite = false;
     out = d;
@@ -1097,19 +1098,21 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         mergeState = &draw.afterDepth;
                         live = direct ? nullptr : sc.passed;
                     }
+                    // (Fogged runs are stored once their lanes are fogged.)
+                    const bool storeAsShaded = direct && !draw.fogFirst;
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
-                        ctx.out = direct ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
+                        ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
-                        if (direct) {
+                        if (storeAsShaded) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
                             continue;
                         }
                     } else if (mode == RowMode::Copy) {
-                        if (direct && copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
-                                                 target.texel(uint32_t(x), uint32_t(y)))) {
+                        if (storeAsShaded && copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
+                                                        target.texel(uint32_t(x), uint32_t(y)))) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
                             stats.copiedDirect += uint64_t(n);
@@ -1124,6 +1127,18 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     stats.pixels += uint64_t(n);
                     uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
+                    if (direct && draw.fogFirst) {
+                        // The run's fog, as the merger applies it first, on its lanes.
+                        MergeInputs fi;
+                        fi.count = n;
+                        fillRowFogDepth(s, true, false, x, y, n, sc.fog, nullptr);
+                        fi.fog = sc.fog;
+                        for (int c = 0; c < 3; ++c)
+                            for (int i = 0; i < n; ++i) sc.grid[c][i] = sc.r0[c][i];
+                        fogGridFirst(draw.merge, fi, draw.target, sc.grid);
+                        for (int c = 0; c < 3; ++c)
+                            for (int i = 0; i < n; ++i) sc.r0[c][i] = int16_t(sc.grid[c][i]);  // (in [0, G])
+                    }
                     if (direct) {
                         storeLanes(draw, r0c, n, orMask, row);
                         stats.written += uint64_t(n);

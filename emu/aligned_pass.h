@@ -56,13 +56,15 @@ struct AlignedDraw {
     MergeState merge;
     MergeTarget target;
     bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
-    // Stored here: an 8-bit target, no alpha test or fog, all channels, and no blending
-    // (directStore) or ONE/ONE ADD on every channel (directAdd); under a depth test (depthFirst)
-    // only the runs whose every pixel passed it, which is tested before they are shaded
-    // (depthTestFirst), the others merged with `afterDepth` over the pixels that passed.
+    // Stored here: an 8-bit target, no alpha test, all channels, and no blending (directStore) or
+    // ONE/ONE ADD on every channel (directAdd); under a depth test (depthFirst) only the runs whose
+    // every pixel passed it, which is tested before they are shaded (depthTestFirst), the others
+    // merged with `afterDepth` over the pixels that passed; under fog (fogFirst) once the run's
+    // lanes are fogged as the merger fogs them (fogGridFirst).
     bool directStore = false;
     bool directAdd = false;
     bool depthFirst = false;
+    bool fogFirst = false;
     MergeState afterDepth;  // `merge` with its depth test and write off
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
 };

@@ -15,6 +15,10 @@
 #include <cstring>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "ps11/sampler.h"
 
 namespace emu {
@@ -479,13 +483,52 @@ template <int32_t G>
 void fogFxUnorm8(const Plan& p, const MergeInputs& in, const int32_t* const g[4], int32_t (*out)[ps11::kMaxSpan]) {
     using F = Fx<G>;
     const Lanes lanes(in, p);
+    int first = 0;
+#if defined(__SSE2__)
+    if constexpr (G == 255) {
+        // Eight lanes a step in 16 bits: the fog factor's byte (the exact f·255 in double,
+        // converted to nearest even), the saturated s, and num = fq·s + (255 − fq)·FOG, which is
+        // at most 255² and fits unsigned 16 bits; num / 255 as (num + 1 + (num >> 8)) >> 8
+        // (exact below 65535) and one more where the remainder passes 127 (255 is odd: no ties).
+        const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+        const __m128d k255 = _mm_set1_pd(255.0);
+        const __m128i i255 = _mm_set1_epi16(255), i127 = _mm_set1_epi16(127), i1 = _mm_set1_epi16(1),
+                      izero = _mm_setzero_si128();
+        const auto bytes4 = [&](__m128 f) {
+            const __m128 v = _mm_and_ps(_mm_cmpgt_ps(f, zero), _mm_min_ps(f, one));  // sat, NaN -> 0
+            const __m128i lo = _mm_cvtpd_epi32(_mm_mul_pd(_mm_cvtps_pd(v), k255));
+            const __m128i hi = _mm_cvtpd_epi32(_mm_mul_pd(_mm_cvtps_pd(_mm_movehl_ps(v, v)), k255));
+            return _mm_unpacklo_epi64(lo, hi);
+        };
+        for (; first + 8 <= in.count; first += 8) {
+            const int i = first;
+            const __m128 f0 = in.fog ? _mm_loadu_ps(in.fog + i) : one, f1 = in.fog ? _mm_loadu_ps(in.fog + i + 4) : one;
+            const __m128i fq = _mm_packs_epi32(bytes4(f0), bytes4(f1));
+            const __m128i rest = _mm_sub_epi16(i255, fq);
+            for (int c = 0; c < 3; ++c) {
+                const __m128i s = _mm_min_epi16(
+                    _mm_max_epi16(_mm_packs_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(g[c] + i)),
+                                                  _mm_loadu_si128(reinterpret_cast<const __m128i*>(g[c] + i + 4))),
+                                  izero),
+                    i255);
+                const __m128i num =
+                    _mm_add_epi16(_mm_mullo_epi16(fq, s), _mm_mullo_epi16(rest, _mm_set1_epi16(int16_t(p.fogByte[c]))));
+                const __m128i q = _mm_srli_epi16(_mm_add_epi16(_mm_add_epi16(num, i1), _mm_srli_epi16(num, 8)), 8);
+                const __m128i r = _mm_sub_epi16(num, _mm_mullo_epi16(q, i255));
+                const __m128i res = _mm_sub_epi16(q, _mm_cmpgt_epi16(r, i127));
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(out[c] + i), _mm_unpacklo_epi16(res, izero));
+                _mm_storeu_si128(reinterpret_cast<__m128i*>(out[c] + i + 4), _mm_unpackhi_epi16(res, izero));
+            }
+        }
+    }
+#endif
     alignas(32) int32_t fq[ps11::kMaxSpan];
-    for (int i = 0; i < in.count; ++i) fq[i] = F::fogGrid(lanes.fog(i));
+    for (int i = first; i < in.count; ++i) fq[i] = F::fogGrid(lanes.fog(i));
     for (int c = 0; c < 3; ++c) {
         const int32_t fogG = int32_t(p.fogByte[c]) * F::S;
         const int32_t* src = g[c];
         int32_t* dst = out[c];
-        for (int i = 0; i < in.count; ++i) {
+        for (int i = first; i < in.count; ++i) {
             const int32_t s = std::clamp(src[i], 0, G);
             const uint32_t num = uint32_t(fq[i] * s + (G - fq[i]) * fogG), q = num / uint32_t(G), r = num - q * G;
             dst[i] = int32_t(q + ((2 * r > uint32_t(G) || (2 * r == uint32_t(G) && (q & 1u))) ? 1u : 0u));
@@ -623,6 +666,19 @@ bool depthTestFirst(const MergeState& state, const MergeInputs& in, const MergeT
     const bool all = depthFirst(p, in, passed, n);
     if (stats) stats->depthRejected += n.depthRejected;
     return all;
+}
+
+void fogGridFirst(const MergeState& state, const MergeInputs& in, const MergeTarget& target,
+                  int32_t (*grid)[ps11::kMaxSpan]) {
+    assert(state.fog && ps11::isFixedPoint(state.precision) && in.count <= ps11::kMaxSpan);
+    bool ok = false;
+    const Plan p = makePlan(state, target, ok);
+    if (!ok || in.count <= 0) return;
+    const int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
+    if (state.precision == Precision::Fx8)
+        fogFxUnorm8<255>(p, in, g, grid);
+    else
+        fogFxUnorm8<4080>(p, in, g, grid);
 }
 
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats) {

@@ -13,6 +13,7 @@
 #include "emu/resources.h"
 #include "emu/state.h"
 #include "ps11/precision.h"
+#include "ps11/sampler.h"  // kMaxSpan
 
 namespace emu {
 
@@ -93,6 +94,13 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
 // lanes that passed. Requires state.depthTest, a depth target and no alpha test.
 bool depthTestFirst(const MergeState& state, const MergeInputs& in, const MergeTarget& target, uint8_t* passed,
                     MergeStats* stats);
+
+// Vertex fog of an fx profile into an 8-bit target over the lanes of `in` (count, fog), in place
+// in grid[0..2] (r g b on the profile's grid), as mergePixels applies it first: each becomes
+// f·s + (1 − f)·FOGCOLOR of the saturated s, rounded once. A row path fogs a run so before it
+// stores the run itself. Requires state.fog, an fx precision and an 8-bit colour target.
+void fogGridFirst(const MergeState& state, const MergeInputs& in, const MergeTarget& target,
+                  int32_t (*grid)[ps11::kMaxSpan]);
 
 // Draw-time check of the states the merger reads (ValidateDevice-style): nullopt when they are
 // usable, else D3DERR_INVALIDCALL, E4160, "D3DRS_SRCBLEND 99 is not a D3DBLEND value" for an
