@@ -1,0 +1,351 @@
+// Device stage: the aligned-pass path's set-up (emu/aligned_pass.h). Whether a draw can take a
+// row path, and per triangle which taps its rows tabulate: the column tables of texel pairs and
+// weights, their runs of a fixed step, and where one triangle's rows join the next's. The rows
+// themselves are drawn in emu/aligned_pass.cpp. Exactness: the tables hold the very texel pairs
+// and weights the TextureSampler's kernels compute for the same coordinates
+// (ps11::fastpath::axisTable), and the coordinates are the rasteriser's own formula (emu/raster.h
+// planeValue; this file is compiled without FMA contraction so that it evaluates it alike).
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+#include <limits>
+
+#include "emu/aligned_pass.h"
+#include "emu/aligned_pass_kernels.h"
+#include "ps11/texture_sampler_fast.h"
+
+namespace emu {
+
+bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
+                        const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
+                        const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
+                        const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
+    const bool fx12 = precision == ps11::Precision::Fx12;
+    if ((precision != ps11::Precision::Fx8 && !fx12) || !target.color || (wantZ && executor.writesDepth()))
+        return false;
+    AlignedDraw d;
+    if (!ps11::tapPlan(executor, d.plan)) return false;
+    d.fx12 = fx12;
+    static std::atomic<uint64_t> serials{0};
+    d.serial = ++serials;
+    d.executor = &executor;
+    d.kernels = alignedKernels(ps11::simdLevel());
+    d.sample = ps11::fastpath::samplerKernels(ps11::simdLevel()).unorm8;
+    for (int i = 0; i < d.plan.count; ++i) {
+        const int stage = d.plan.stage[size_t(i)];
+        AlignedTap& tap = d.taps[size_t(i)];
+        tap.coordSet = d.plan.coordSet[size_t(i)];
+        const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
+        if (!tex) continue;  // (0, 0, 0, 1)
+        const ps11::SamplerState& ss = samplers[size_t(stage)];
+        if (!levelZeroOnly(*tex, ss) || tex->storage() != ps11::TexelStorage::Unorm8) return false;
+        const ps11::TextureLevelInfo& li = tex->level(0);
+        tap.bound = true;
+        d.bound |= 1u << i;
+        tap.texels = tex->unorm8() + li.offset * 4;
+        tap.width = li.width;
+        tap.height = li.height;
+        tap.linear = ss.magFilter == ps11::Filter::Linear;
+        tap.addressU = ss.addressU;
+        tap.addressV = ss.addressV;
+        // The border colour's bytes (the device sets it from a D3DCOLOR: byte / 255 per channel).
+        uint32_t word = 0;
+        for (int c = 0; c < 4; ++c) {
+            const float f = ss.border[size_t(c)] * 255.0f;
+            const uint32_t b = uint32_t(std::clamp(f, 0.0f, 255.0f) + 0.5f);
+            if (float(b) / 255.0f != ss.border[size_t(c)]) return false;
+            word |= b << (8 * ps11::kUnorm8Byte[c]);
+        }
+        tap.borderWord = word;
+    }
+    d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
+    d.merge = merge;
+    d.target = target;
+    d.wantZ = wantZ;
+    const D3DFORMAT f = target.color->format->format;
+    const bool unorm = f == D3DFMT_A8R8G8B8 || f == D3DFMT_X8R8G8B8;
+    // (A depth write comes with a depth test: MergeState::from.)
+    const bool plain = unorm && !merge.alphaTest && merge.colorWrite == 0xf && (merge.depthTest || !merge.depthWrite) &&
+                       (!merge.depthTest || target.depth);
+    d.directStore = plain && !merge.blend;
+    const bool oneOne =
+        merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
+        (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE && merge.dstBlendAlpha == D3DBLEND_ONE &&
+                                  merge.blendOpAlpha == D3DBLENDOP_ADD));
+    d.directAdd = plain && merge.blend && oneOne;
+    d.depthFirst = (d.directStore || d.directAdd) && merge.depthTest;
+    d.fogFirst = (d.directStore || d.directAdd) && merge.fog;
+    d.afterDepth = merge;
+    d.afterDepth.depthTest = d.afterDepth.depthWrite = false;
+    out = d;
+    return true;
+}
+
+bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss) {
+    return !tex.isVolume() && ps11::lodFree(tex, ss);
+}
+
+bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {
+    if (s.perspective) return false;
+    for (int i = 0; i < plan.count; ++i) {
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
+        if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
+        if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
+    }
+    return true;
+}
+
+void columnU(const TriangleSetup& s, int set, int x0, int n, float* u) {
+    const int k = attrTex(set, 0);
+    if ((s.constMask >> k) & 1) {
+        std::fill_n(u, n, s.constValue[size_t(k)]);
+        return;
+    }
+    fillPlaneRow(s.attr[size_t(k)], s.ox, s.oy, x0, s.yMin, n, u);  // (u does not depend on the row)
+}
+
+float rowV(const TriangleSetup& s, int set, int y) {
+    const int k = attrTex(set, 1);
+    return (s.constMask >> k) & 1 ? s.constValue[size_t(k)] : planeValue(s.attr[size_t(k)], s.ox, s.oy, 0, y);
+}
+
+bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
+    int xlo = s.clip.x1, xhi = s.clip.x0;
+    for (int y = s.yMin; y < s.yMax; ++y) {
+        int xl = 0, xr = 0;
+        if (rowCoverage(s, y, xl, xr)) xlo = std::min(xlo, xl), xhi = std::max(xhi, xr);
+    }
+    if (xlo >= xhi) return false;
+    const bool narrow = 2 * (xhi - xlo) < s.clip.x1 - s.clip.x0;
+    x0 = narrow ? xlo : s.clip.x0;
+    x1 = narrow ? xhi : s.clip.x1;
+    return true;
+}
+
+bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1) {
+    // (covering nothing: the quad path finds that too)
+    return screenAligned(plan, s) && tableColumns(s, x0, x1);
+}
+
+uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s) {
+    uint32_t mask = 0;
+    for (int i = 0; i < plan.count; ++i) {
+        if (!((bound >> i) & 1)) continue;
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
+        const bool cu = (s.constMask >> ku) & 1, cv = (s.constMask >> kv) & 1;
+        const bool free = s.perspective ? !(cu && cv)
+                                        : (!cu && s.attr[size_t(ku)].dy != 0.0) || (!cv && s.attr[size_t(kv)].dx != 0.0);
+        if (free) mask |= 1u << i;
+    }
+    return mask;
+}
+
+int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1) {
+    if (!tableColumns(s, x0, x1)) return 0;
+    return s.perspective || freeTaps(plan, bound, s) ? 2 : 1;
+}
+
+namespace {
+
+// Whether attribute k takes the same value at every pixel of row ya in triangle a as of row yb
+// in triangle b, as the row paths compute it (planeValue: float row base plus float step times
+// the column).
+bool sameOnRow(const TriangleSetup& a, const TriangleSetup& b, int k, int ya, int yb) {
+    const bool ca = (a.constMask >> k) & 1, cb = (b.constMask >> k) & 1;
+    if (ca != cb) return false;
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    if (ca) return bits(a.constValue[size_t(k)]) == bits(b.constValue[size_t(k)]);
+    const Plane &pa = a.attr[size_t(k)], &pb = b.attr[size_t(k)];
+    return bits(float(pa.dx)) == bits(float(pb.dx)) &&
+           bits(float(planeRowBase(pa, a.ox, a.oy, ya))) == bits(float(planeRowBase(pb, b.ox, b.oy, yb)));
+}
+
+}  // namespace
+
+bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11::TapPlan& plan) {
+    // (u has no dy on the row paths: its row base is that of any row, yMin's as columnU takes it)
+    for (int i = 0; i < plan.count; ++i)
+        if (!sameOnRow(a, b, attrTex(plan.coordSet[size_t(i)], 0), a.yMin, b.yMin)) return false;
+    return true;
+}
+
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
+             uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr) {
+    int nl = 0, nr = 0;
+    if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
+    // With perspective the attributes compared are the planes of attr·rhw: rhw must agree too.
+    if (s.perspective != next.perspective) return false;
+    if (s.perspective) {
+        auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+        if (bits(float(s.rhw.dx)) != bits(float(next.rhw.dx)) ||
+            bits(float(planeRowBase(s.rhw, s.ox, s.oy, y))) != bits(float(planeRowBase(next.rhw, next.ox, next.oy, y))))
+            return false;
+    }
+    for (int i = 0; i < plan.count; ++i) {
+        const int ku = attrTex(plan.coordSet[size_t(i)], 0);
+        if ((!sharedTables && !sameOnRow(s, next, ku, y, y)) || !sameOnRow(s, next, ku + 1, y, y)) return false;
+    }
+    for (int k = 0; k < kAttrCount; ++k)
+        if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y, y)) return false;
+    xl = std::min(xl, nl), xr = std::max(xr, nr);
+    return true;
+}
+
+bool pairColumns(int a0, int a1, int b0, int b1, const ClipRect& clip, std::pair<int, int>& out) {
+    const int width = clip.x1 - clip.x0;
+    const bool narrow = a1 - a0 < width && b1 - b0 < width;
+    if (!narrow || std::max(a0, b0) >= std::min(a1, b1)) return false;
+    out = {std::min(a0, b0), std::max(a1, b1)};
+    return true;
+}
+
+bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out,
+                            const std::pair<int, int>* columns) {
+    if (!rowPathKind(draw.plan, draw.bound, s, out.x0, out.x1)) return false;
+    if (columns) out.x0 = columns->first, out.x1 = columns->second;
+    fillAlignedTables(draw, s, out);
+    return true;
+}
+
+void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
+    out.configs.clear();
+    out.freeTaps = freeTaps(draw.plan, draw.bound, s);
+    const int n = out.x1 - out.x0;
+    thread_local std::vector<float> u;
+    u.resize(size_t(std::max(n, 0)));
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const AlignedTap& tap = draw.taps[size_t(i)];
+        AlignedTriangle::Columns& cols = out.taps[size_t(i)];
+        cols.runs.clear();
+        cols.configCount = 0;
+        if (!tap.bound || ((out.freeTaps >> i) & 1)) {  // no table (the triangle may be a previous chunk's or draw's)
+            cols.off0.clear(), cols.off1.clear(), cols.w.clear(), cols.run.clear();
+            continue;
+        }
+        columnU(s, tap.coordSet, out.x0, n, u.data());
+        cols.off0.resize(size_t(n));
+        cols.off1.resize(size_t(n));
+        cols.w.resize(size_t(n));
+        ps11::fastpath::axisTable(tap.addressU, tap.linear, n, u.data(), tap.width, cols.off0.data(), cols.off1.data(),
+                                  cols.w.data());
+        // Long runs (vector kernels only): at least kMinAlignedRun columns whose first texel
+        // i0 steps by a fixed 1..kMaxAlignedStep texels with one weight, none on the border, and
+        // i1 = i0 + 1 when the weight is not 0 (the H rows read texels i0 and i0 + 1).
+        cols.run.assign(size_t(n), -1);
+        auto ok = [&](int x) {
+            const int32_t i0 = cols.off0[size_t(x)], w = cols.w[size_t(x)];
+            return i0 >= 0 && (w == 0 || cols.off1[size_t(x)] == i0 + 1);
+        };
+        for (int x = 0; draw.kernels && x < n;) {
+            int e = x + 1;
+            const int32_t step = x + 1 < n ? cols.off0[size_t(x + 1)] - cols.off0[size_t(x)] : 0;
+            if (ok(x) && step >= 1 && step <= kMaxAlignedStep)
+                while (e < n && ok(e) && cols.w[size_t(e)] == cols.w[size_t(x)] &&
+                       cols.off0[size_t(e)] - cols.off0[size_t(e - 1)] == step)
+                    ++e;
+            if (e - x < kMinAlignedRun) {
+                ++x;
+                continue;
+            }
+            // The H-row configuration: shared by every tap on this texture with the same weight,
+            // step and phase; its range grows to cover the run.
+            const int32_t i0 = cols.off0[size_t(x)], wx = cols.w[size_t(x)];
+            const int32_t phase = i0 % step, j0 = (i0 - phase) / step;
+            int ci = -1;
+            for (size_t c = 0; c < out.configs.size(); ++c) {
+                const HConfig& h = out.configs[c];
+                if (h.texels == tap.texels && h.wx == wx && h.step == step && h.phase == phase) ci = int(c);
+            }
+            if (ci < 0) {
+                out.configs.push_back(HConfig{tap.texels, wx, step, phase, j0, j0 + (e - x), 0, 0});
+                out.configs.back().rowTexels = int32_t(tap.width);
+                ci = int(out.configs.size()) - 1;
+            }
+            HConfig& h = out.configs[size_t(ci)];
+            h.jlo = std::min(h.jlo, j0);
+            h.jhi = std::max(h.jhi, j0 + (e - x));
+            int slot = -1;
+            for (int c = 0; c < cols.configCount; ++c)
+                if (cols.configs[size_t(c)] == ci) slot = c;
+            if (slot < 0 && cols.configCount < kMaxTapConfigs) {
+                slot = cols.configCount++;
+                cols.configs[size_t(slot)] = ci;
+            }
+            if (slot >= 0) {
+                cols.runs.push_back(AlignedTriangle::Run{out.x0 + x, out.x0 + e, j0, slot});
+                std::fill(cols.run.begin() + x, cols.run.begin() + e, int32_t(cols.runs.size() - 1));
+            }
+            x = e;
+        }
+        // Tabulated runs over the columns left (a magnified tap: step 0, a weight per column):
+        // at least kMinAlignedRun columns with both texels off the border (or weight 0), filtered
+        // from H rows built per column from the table; one configuration per tap.
+        auto tabOk = [&](int x) {
+            return cols.run[size_t(x)] < 0 && cols.off0[size_t(x)] >= 0 &&
+                   (cols.w[size_t(x)] == 0 || cols.off1[size_t(x)] >= 0);
+        };
+        int tabSlot = -1, tabConfig = -1;
+        for (int x = 0; draw.kernels && x < n;) {
+            if (!tabOk(x)) {
+                ++x;
+                continue;
+            }
+            int e = x + 1;
+            while (e < n && tabOk(e)) ++e;
+            if (e - x >= kMinAlignedRun && tabSlot < 0 && cols.configCount < kMaxTapConfigs) {
+                HConfig h{tap.texels, -2, 0, 0, out.x0 + x, out.x0 + e, 0, 0};
+                out.configs.push_back(h);
+                tabConfig = int(out.configs.size()) - 1;
+                tabSlot = cols.configCount++;
+                cols.configs[size_t(tabSlot)] = tabConfig;
+            }
+            if (e - x >= kMinAlignedRun && tabSlot >= 0) {
+                HConfig& h = out.configs[size_t(tabConfig)];
+                h.jlo = std::min(h.jlo, out.x0 + x);
+                h.jhi = std::max(h.jhi, out.x0 + e);
+                cols.runs.push_back(AlignedTriangle::Run{out.x0 + x, out.x0 + e, out.x0 + x, tabSlot, true});
+                std::fill(cols.run.begin() + x, cols.run.begin() + e, int32_t(cols.runs.size() - 1));
+            }
+            x = e;
+        }
+        // Texel indices to byte offsets within a row (−1 stays the border). Weight 0 reads only
+        // the first texel: its second becomes the first (the same sum, and tabulated H rows read
+        // both).
+        for (int x = 0; x < n; ++x) {
+            if (cols.off0[size_t(x)] >= 0) cols.off0[size_t(x)] *= 4;
+            if (cols.off1[size_t(x)] >= 0) cols.off1[size_t(x)] *= 4;
+            if (cols.w[size_t(x)] == 0 && cols.off0[size_t(x)] >= 0) cols.off1[size_t(x)] = cols.off0[size_t(x)];
+        }
+        if (tabConfig >= 0) {
+            HConfig& h = out.configs[size_t(tabConfig)];
+            const size_t at = size_t(h.jlo - out.x0), len = size_t(h.jhi - h.jlo);
+            h.rowTexels = int32_t(tap.width);
+            h.off0 = cols.off0.data() + at;
+            h.off1 = cols.off1.data() + at;
+            h.w = cols.w.data() + at;
+            uint64_t hash = 1469598103934665603ull;
+            for (size_t k = 0; k < len; ++k)
+                for (const int32_t v : {h.off0[k], h.off1[k], h.w[k]}) hash = (hash ^ uint32_t(v)) * 1099511628211ull;
+            h.hash = hash;
+            static std::atomic<uint64_t> tableIds{0};
+            h.tableId = ++tableIds;
+        }
+    }
+    // Each texture's staged range: the texels every configuration on it reads.
+    for (HConfig& h : out.configs) {
+        if (h.wx == -2) continue;  // tabulated: read straight from the texel rows
+        h.stageLo = h.step * h.jlo + h.phase;
+        h.stageHi = h.step * (h.jhi - 1) + h.phase + 1 + (h.wx != 0);
+    }
+    for (HConfig& h : out.configs)
+        for (const HConfig& o : out.configs)
+            if (o.texels == h.texels && h.wx != -2 && o.wx != -2)
+                h.stageLo = std::min(h.stageLo, o.stageLo), h.stageHi = std::max(h.stageHi, o.stageHi);
+    // Run starts relative to their H row's first element, now that the ranges are final.
+    for (int i = 0; i < draw.plan.count; ++i) {
+        AlignedTriangle::Columns& cols = out.taps[size_t(i)];
+        for (AlignedTriangle::Run& r : cols.runs) r.j0 -= out.configs[size_t(cols.configs[size_t(r.config)])].jlo;
+    }
+}
+
+}  // namespace emu
