@@ -34,6 +34,8 @@ struct QuadVertex {
 };
 
 // Down2: 1080p texture to a 960×540 target, one bilinear tap on the corner of each 2×2 block.
+// Down2Mip: the same from a mip-mapped 1080p texture, MIP filter POINT: every quad picks level 1
+// (960×540), read 1:1 — the row path over that level.
 // Down4: 1080p texture to 480×270, the blur program's four bilinear taps at ±1 texel around the
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
 // Sprites: 400 quads of 64x64 pixels at sub-pixel positions over a 1080p target, each a 32x32
@@ -68,9 +70,10 @@ enum class Pass {
     CompositeAdd,
     Rotated,
     Perspective,
-    Dependent
+    Dependent,
+    Down2Mip
 };
-constexpr int kPasses = 15;
+constexpr int kPasses = 16;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -83,11 +86,12 @@ struct Scene {
 
     Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
-        if (pass == Pass::Down2) w = kW / 2, h = kH / 2;
+        const bool mip = pass == Pass::Down2Mip;
+        if (pass == Pass::Down2 || mip) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
-        const bool down = pass == Pass::Down2 || pass == Pass::Down4;
+        const bool down = pass == Pass::Down2 || mip || pass == Pass::Down4;
         const bool addGlare = pass == Pass::CompositeAdd;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : addGlare ? h / 4 : h;
@@ -99,15 +103,18 @@ struct Scene {
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
         if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
-        if (dev->CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
+        if (dev->CreateTexture(tw, th, mip ? 0 : 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
         D3DLOCKED_RECT lr;
-        if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return;
         std::mt19937 rng(42);
-        for (UINT y = 0; y < th; ++y) {
-            auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
-            for (UINT x = 0; x < tw; ++x) row[x] = rng();
+        for (UINT level = 0; level < dev->GetLevelCount(tex); ++level) {
+            const UINT lw = std::max(1u, tw >> level), lh = std::max(1u, th >> level);
+            if (dev->LockRect(tex, level, &lr, nullptr, 0) != D3D_OK) return;
+            for (UINT y = 0; y < lh; ++y) {
+                auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
+                for (UINT x = 0; x < lw; ++x) row[x] = rng();
+            }
+            dev->UnlockRect(tex, level);
         }
-        dev->UnlockRect(tex, 0);
         Handle glare{};
         if (pass == Pass::Composite) {
             if (dev->CreateTexture(w / 8, h / 8, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &glare) != D3D_OK) return;
@@ -130,6 +137,7 @@ struct Scene {
             dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_MIPFILTER, mip ? D3DTEXF_POINT : D3DTEXF_NONE);
         }
         const char* const kSprite = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
         const char* const kScreen = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n";
@@ -394,6 +402,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_240x135_fx8, Pass::CopySmall)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, down2_linear_1080p_to_960x540_fx8, Pass::Down2)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, down2_mip_1080p_to_960x540_fx8, Pass::Down2Mip)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -7,6 +7,7 @@
 // planeValue; this file is compiled without FMA contraction so that it evaluates it alike).
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -15,6 +16,16 @@
 #include "ps11/texture_sampler_fast.h"
 
 namespace emu {
+
+namespace {
+
+// AlignedDraw::serial: unique per draw and per change of its taps' levels.
+uint64_t nextSerial() {
+    static std::atomic<uint64_t> serials{0};
+    return ++serials;
+}
+
+}  // namespace
 
 bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
@@ -26,8 +37,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     AlignedDraw d;
     if (!ps11::tapPlan(executor, d.plan)) return false;
     d.fx12 = fx12;
-    static std::atomic<uint64_t> serials{0};
-    d.serial = ++serials;
+    d.serial = nextSerial();
     d.executor = &executor;
     d.kernels = alignedKernels(ps11::simdLevel());
     d.sample = ps11::fastpath::samplerKernels(ps11::simdLevel()).unorm8;
@@ -38,7 +48,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        if (!levelZeroOnly(*tex, ss) || tex->storage() != ps11::TexelStorage::Unorm8) return false;
+        if (tex->isVolume() || tex->storage() != ps11::TexelStorage::Unorm8) return false;
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
         d.bound |= 1u << i;
@@ -46,6 +56,12 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         tap.width = li.width;
         tap.height = li.height;
         tap.linear = ss.magFilter == ps11::Filter::Linear;
+        if (!ps11::lodFree(*tex, ss)) {
+            // Level and filter per set of triangles (triangleLevels, setTapLevels).
+            tap.mipTexture = tex.get();
+            tap.sampler = &ss;
+            d.mipTaps |= 1u << i;
+        }
         tap.addressU = ss.addressU;
         tap.addressV = ss.addressV;
         // The border colour's bytes (the device sets it from a D3DCOLOR: byte / 255 per channel).
@@ -83,6 +99,86 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
 
 bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss) {
     return !tex.isVolume() && ps11::lodFree(tex, ss);
+}
+
+namespace {
+
+// The distinct values of `v` (at most `cap`; false past it).
+bool addDistinct(std::vector<double>& set, double v, size_t cap) {
+    if (std::find(set.begin(), set.end(), v) != set.end()) return true;
+    if (set.size() >= cap) return false;
+    set.push_back(v);
+    return true;
+}
+
+}  // namespace
+
+bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int x1, TapLevels& out) {
+    out = TapLevels{};
+    // The quads' columns and rows: pairs from even coordinates over the triangle's pixels.
+    const int cx0 = x0 & ~1, cx1 = x1 + (x1 & 1), ry0 = s.yMin & ~1, ry1 = s.yMax + (s.yMax & 1);
+    if (cx0 >= cx1 || ry0 >= ry1) return false;
+    std::vector<float> u(size_t(cx1 - cx0));
+    // A quad's squared derivative lengths at level 0 (ps11 selectLevels): with u a function of
+    // the column and v of the row (screenAligned), dx2 = ((u(x+1) − u(x))·W)² and
+    // dy2 = ((v(y+1) − v(y))·H)² exactly where the coordinates are finite (the other terms are
+    // +0), so a quad's choice is chooseLevel of its column's dx2 and its row's dy2.
+    constexpr size_t kMaxDistinct = 16;
+    std::vector<double> dx2s, dy2s;
+    for (int i = 0; i < draw.plan.count; ++i) {
+        const AlignedTap& tap = draw.taps[size_t(i)];
+        if (!((draw.mipTaps >> i) & 1)) continue;
+        const ps11::Texture& tex = *tap.mipTexture;
+        const double w = double(tex.level(0).width), h = double(tex.level(0).height);
+        dx2s.clear();
+        dy2s.clear();
+        columnU(s, tap.coordSet, cx0, cx1 - cx0, u.data());
+        for (size_t k = 0; k + 1 < u.size(); k += 2) {
+            if (!std::isfinite(u[k]) || !std::isfinite(u[k + 1])) return false;
+            const double d = double(u[k + 1]) * w - double(u[k]) * w;
+            if (!addDistinct(dx2s, d * d, kMaxDistinct)) return false;
+        }
+        for (int y = ry0; y < ry1; y += 2) {
+            const float v0 = rowV(s, tap.coordSet, y), v1 = rowV(s, tap.coordSet, y + 1);
+            if (!std::isfinite(v0) || !std::isfinite(v1)) return false;
+            const double d = double(v1) * h - double(v0) * h;
+            if (!addDistinct(dy2s, d * d, kMaxDistinct)) return false;
+        }
+        // Every quad's rho2 = max(dx2, dy2) is one of these values at or above the other axis's least.
+        const double dxLeast = *std::min_element(dx2s.begin(), dx2s.end());
+        const double dyLeast = *std::min_element(dy2s.begin(), dy2s.end());
+        bool first = true;
+        ps11::LevelChoice pick;
+        auto agree = [&](double rho2) {
+            const ps11::LevelChoice c = ps11::chooseLevel(tex, *tap.sampler, rho2, rho2, true, false);
+            if (first) pick = c, first = false;
+            return c == pick && c.slots == 1;
+        };
+        for (double a : dx2s)
+            if (a >= dyLeast && !agree(a)) return false;
+        for (double b : dy2s)
+            if (b >= dxLeast && !agree(b)) return false;
+        out.level[size_t(i)] = uint8_t(pick.level0);
+        out.linear |= uint32_t(pick.linear) << i;
+    }
+    return true;
+}
+
+void setTapLevels(AlignedDraw& draw, const TapLevels& levels) {
+    bool changed = false;
+    for (int i = 0; i < draw.plan.count; ++i) {
+        if (!((draw.mipTaps >> i) & 1)) continue;
+        AlignedTap& tap = draw.taps[size_t(i)];
+        const ps11::TextureLevelInfo& li = tap.mipTexture->level(levels.level[size_t(i)]);
+        const uint8_t* texels = tap.mipTexture->unorm8() + li.offset * 4;
+        const bool linear = (levels.linear >> i) & 1;
+        changed |= texels != tap.texels || linear != tap.linear;
+        tap.texels = texels;
+        tap.width = li.width;
+        tap.height = li.height;
+        tap.linear = linear;
+    }
+    if (changed) draw.serial = nextSerial();
 }
 
 bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {

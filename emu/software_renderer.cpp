@@ -314,8 +314,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                                 (uint64_t(uint32_t(clip.y1 - clip.y0)) << 20);
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[historyKey];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
-    const bool tileable =
-        m_options.skipTiles && (alignedDraw || floatDraw) && call.primitiveCount <= kMaxAlignedTriangles;
+    // (Nor are draws whose taps' levels the level of detail picks: the tiles' facts are level 0's.)
+    const bool tileable = m_options.skipTiles && (alignedDraw || floatDraw) && !aligned.mipTaps &&
+                          call.primitiveCount <= kMaxAlignedTriangles;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
     // Timed: a program that pays is drawn undecided once after its second decided draw (the
     // first one's time, with the first reads of textures that may stay, is not taken), then on
@@ -366,7 +367,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             // full-screen quad's two halves fill at once).
             // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
             // pixel (rowPathKind; those never share tables, and their tiles are not decided).
-            auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto fill) {
+            // `settle()` runs once the part's triangles are chosen, before their tables are filled.
+            auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto settle,
+                                     auto fill) {
                 if (rowTris.size() < setups.size()) rowTris.resize(setups.size());
                 tableOf.resize(setups.size());
                 const int64_t budget = kMaxAlignedColumnsPerTarget * std::max(clip.x1 - clip.x0, 1);
@@ -399,6 +402,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         tableOf.resize(i);
                     }
                 }
+                settle();
                 // About a microsecond per 64 columns of one tap: the workers share from 1024.
                 const int64_t work = columns * std::max(taps, 1);
                 const int workers = int(std::clamp<int64_t>(work / 1024, 1, dc.pool.size()));
@@ -408,20 +412,37 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         if (isAligned[i] && tableOf[i] == i) fill(setups[i], rowTris[i]);
                 });
             };
-            if (alignedDraw)
+            if (alignedDraw) {
+                // Taps whose level the quads' level of detail picks: a part's screen-aligned
+                // triangles take the row path where every quad of theirs picks the part's one level
+                // and filter (the first such triangle's); the others are shaded in quads.
+                TapLevels partLevels;
+                bool partHasLevels = false;
                 prepareTables(
                     alignedTris, aligned.plan, aligned.plan.count,
                     [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
-                        return rowPathKind(aligned.plan, bound, s, x0, x1);
+                        const int kind = rowPathKind(aligned.plan, bound, s, x0, x1);
+                        if (kind == 0 || !aligned.mipTaps) return kind;
+                        TapLevels levels;
+                        if (kind != 1 || !triangleLevels(aligned, s, x0, x1, levels) ||
+                            (partHasLevels && !(levels == partLevels)))
+                            return 0;
+                        partLevels = levels;
+                        partHasLevels = true;
+                        return kind;
+                    },
+                    [&] {
+                        if (partHasLevels) setTapLevels(aligned, partLevels);
                     },
                     [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
+            }
             if (floatDraw) {
                 prepareTables(
                     floatTris, floatRows.plan, floatRows.plan.count,
                     [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
                         return rowPathKind(floatRows.plan, bound, s, x0, x1);
                     },
-                    [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
+                    [] {}, [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
                 shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
             }
             if (setups.empty()) continue;

@@ -195,17 +195,50 @@ bool lodFree(const Texture& tex, const SamplerState& st) {
            effective(st.magFilter) == effective(st.minFilter);
 }
 
+// rho = the longer of the two derivative vectors, LOD = log2(rho). Mag filter at LOD <= 0, else
+// min filter; mip none: level 0; point: nearest level (ties up); linear: the two levels around
+// LOD with an 8-bit weight (fx, and the float profile's 8-bit weights).
+LevelChoice chooseLevel(const Texture& tex, const SamplerState& st, double dx2, double dy2, bool fixed, bool weights8) {
+    const int levels = tex.levelCount();
+    const double rho2 = std::max(dx2, dy2);
+    double lod = 0.5 * std::log2(rho2);  // log2(sqrt(rho2)); rho2 = 0 gives -inf (magnified)
+    if (std::isnan(lod)) lod = 0.0;
+    LevelChoice c;
+    if (lod > 0.0 && levels > 1) {
+        if (st.mipFilter == Filter::Point) {
+            const double n = std::floor(lod + 0.5);
+            c.level0 = n >= double(levels - 1) ? levels - 1 : int(n);
+        } else if (st.mipFilter == Filter::Linear) {
+            const double a = std::floor(lod);
+            if (a >= double(levels - 1)) {
+                c.level0 = levels - 1;
+            } else {
+                c.level0 = int(a);
+                c.level1 = c.level0 + 1;
+                const double frac = lod - a;
+                if (fixed || weights8) {
+                    c.mipW = weight8(frac);
+                    if (c.mipW == 256) c.level0 = c.level1;  // exactly the upper level
+                    c.slots = c.mipW == 0 || c.mipW == 256 ? 1 : 2;
+                    c.mipF = float(c.mipW) / 256.0f;
+                } else {
+                    c.mipF = float(frac);
+                    c.slots = c.mipF == 0.0f ? 1 : 2;
+                }
+            }
+        }
+    }
+    c.linear = effective(lod > 0.0 ? st.minFilter : st.magFilter) == Filter::Linear;
+    return c;
+}
+
 namespace {
 
 // Level selection (docs/textures.md "Level of detail"): per 2x2 quad, the screen derivatives of
-// (u*W, v*H, w*D) at level 0 from the top-left lane; rho = the longer of the two derivative
-// vectors, LOD = log2(rho). Mag filter at LOD <= 0, else min filter; mip none: level 0; point:
-// nearest level (ties up); linear: the two levels around LOD with an 8-bit weight (fx).
+// (u*W, v*H, w*D) at level 0 from the top-left lane, then chooseLevel.
 void selectLevels(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
                   const SamplerState& st, bool fixed, bool weights8, LaneLevels& L) {
     const bool magLinear = effective(st.magFilter) == Filter::Linear;
-    const bool minLinear = effective(st.minFilter) == Filter::Linear;
-    const int levels = tex.levelCount();
     const int axes = tex.isVolume() ? 3 : 2;
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
     // Without quads, or when every LOD gives level 0 with one filter (one level or no mip
@@ -224,44 +257,14 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
             dx2 += ddx * ddx;
             dy2 += ddy * ddy;
         }
-        const double rho2 = std::max(dx2, dy2);
-        double lod = 0.5 * std::log2(rho2);  // log2(sqrt(rho2)); rho2 = 0 gives -inf (magnified)
-        if (std::isnan(lod)) lod = 0.0;
-        int level0 = 0, level1 = 0, slots = 1;
-        int32_t mipW = 0;
-        float mipF = 0.0f;
-        if (lod > 0.0 && levels > 1) {
-            if (st.mipFilter == Filter::Point) {
-                const double n = std::floor(lod + 0.5);
-                level0 = n >= double(levels - 1) ? levels - 1 : int(n);
-            } else if (st.mipFilter == Filter::Linear) {
-                const double a = std::floor(lod);
-                if (a >= double(levels - 1)) {
-                    level0 = levels - 1;
-                } else {
-                    level0 = int(a);
-                    level1 = level0 + 1;
-                    const double frac = lod - a;
-                    if (fixed || weights8) {
-                        mipW = weight8(frac);
-                        if (mipW == 256) level0 = level1;  // exactly the upper level
-                        slots = mipW == 0 || mipW == 256 ? 1 : 2;
-                        mipF = float(mipW) / 256.0f;
-                    } else {
-                        mipF = float(frac);
-                        slots = mipF == 0.0f ? 1 : 2;
-                    }
-                }
-            }
-        }
-        const bool linear = lod > 0.0 ? minLinear : magLinear;
+        const LevelChoice c = chooseLevel(tex, st, dx2, dy2, fixed, weights8);
         for (int i = q; i < std::min(q + 4, count); ++i) {
-            L.level[0][i] = uint8_t(level0);
-            L.level[1][i] = uint8_t(level1);
-            L.slots[i] = uint8_t(slots);
-            L.linear[i] = linear;
-            L.mipW[i] = mipW;
-            L.mipF[i] = mipF;
+            L.level[0][i] = uint8_t(c.level0);
+            L.level[1][i] = uint8_t(c.level1);
+            L.slots[i] = uint8_t(c.slots);
+            L.linear[i] = c.linear;
+            L.mipW[i] = c.mipW;
+            L.mipF[i] = c.mipF;
         }
     }
 }

@@ -36,6 +36,22 @@ struct SamplerState {
 // then shades rows instead of 2×2 quads (docs/device.md "Rasterisation").
 bool lodFree(const Texture& tex, const SamplerState& state);
 
+// The level and filter of one 2×2 quad's lookup (docs/textures.md "Level of detail"), from the
+// squared lengths of its screen derivatives at level 0: dx2 = Σ (∂c/∂x · size)², dy2 likewise
+// (the sampler's own rule for quads; the device's row paths apply it to quads they tabulate).
+// `fixed`: an fx profile; `weights8`: the float profile with 8-bit weights (the mip blend's weight
+// then is 8-bit too).
+struct LevelChoice {
+    int level0 = 0, level1 = 0;
+    int slots = 1;        // 2: a mip blend of level0 and level1
+    bool linear = false;  // the filter: the min filter where minified, else the mag filter
+    int32_t mipW = 0;     // fx (and 8-bit weights): level1's weight, 0..256
+    float mipF = 0.0f;    // level1's weight
+    bool operator==(const LevelChoice&) const = default;
+};
+LevelChoice chooseLevel(const Texture& tex, const SamplerState& state, double dx2, double dy2, bool fixed,
+                        bool weights8);
+
 class TextureSampler final : public Sampler {
 public:
     // `fastPath` false forces the reference path for every lookup (tests and benchmarks compare

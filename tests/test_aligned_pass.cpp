@@ -88,6 +88,10 @@ struct Case {
         std::vector<uint8_t> bytes;
         DWORD filter = D3DTEXF_POINT, addressU = D3DTADDRESS_CLAMP, addressV = D3DTADDRESS_CLAMP, border = 0;
         bool bound = true;
+        // Levels 1.. of a mip chain (each max(1, size >> level)), the min filter where it is not
+        // `filter` (0: the same) and the MIP filter.
+        std::vector<std::vector<uint8_t>> mips;
+        DWORD minFilter = 0, mipFilter = D3DTEXF_NONE;
     };
     std::vector<Tex> tex;  // 4 stages
     // Every stage reads stage 0's texture (each with its own sampler states and coordinates):
@@ -288,15 +292,21 @@ std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stats) {
     for (DWORD s = 0; s < 4; ++s) {
         const Case::Tex& t = c.tex[s];
         Handle tex{};
-        REQUIRE(dev.CreateTexture(t.w, t.h, 1, 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
-        REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
-        const size_t row = size_t(t.w) * texelBytes(t.format);
-        for (UINT y = 0; y < t.h; ++y)
-            std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &t.bytes[y * row], row);
-        REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+        REQUIRE(dev.CreateTexture(t.w, t.h, UINT(1 + t.mips.size()), 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
+        for (UINT level = 0; level <= t.mips.size(); ++level) {
+            const UINT lw = std::max(1u, t.w >> level), lh = std::max(1u, t.h >> level);
+            const std::vector<uint8_t>& bytes = level == 0 ? t.bytes : t.mips[level - 1];
+            REQUIRE(dev.LockRect(tex, level, &lr, nullptr, 0) == D3D_OK);
+            const size_t row = size_t(lw) * texelBytes(t.format);
+            REQUIRE(bytes.size() == row * lh);
+            for (UINT y = 0; y < lh; ++y)
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &bytes[y * row], row);
+            REQUIRE(dev.UnlockRect(tex, level) == D3D_OK);
+        }
         if (s == 0) first = tex;
         REQUIRE(dev.SetTexture(s, !t.bound ? Handle::Null : c.oneTexture ? first : tex) == D3D_OK);
-        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, t.filter) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, t.minFilter ? t.minFilter : t.filter) == D3D_OK);
+        REQUIRE(dev.SetSamplerState(s, D3DSAMP_MIPFILTER, t.mipFilter) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, t.filter) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, t.addressU) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, t.addressV) == D3D_OK);
@@ -450,6 +460,101 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     // row path, save those whose quads happened to be all covered.
     INFO(aligned << " of " << cases << " cases took the row path");
     CHECK(aligned * 10 >= cases * 9);
+}
+
+TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path where every quad picks one level",
+          "[draw][aligned]") {
+    // The random cases (1:1 passes, 2:1 … 4:1 reductions, magnifications, any rectangle) with mip
+    // chains of any length, each MIP filter and a min filter that differs from the mag filter
+    // half the time: the level and filter each quad picks must be the quad path's.
+    std::mt19937 rng(20261130);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    int cases = 0, rows = 0, mipRows = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng);
+        bool chains = false;
+        for (Case::Tex& t : c.tex) {
+            int chain = 1;
+            while ((t.w >> chain) > 0 || (t.h >> chain) > 0) ++chain;
+            const int levels = uni(1, chain);
+            chains |= levels > 1;
+            for (int level = 1; level < levels; ++level) {
+                std::vector<uint8_t>& bytes = t.mips.emplace_back(size_t(std::max(1u, t.w >> level)) *
+                                                                  std::max(1u, t.h >> level) * texelBytes(t.format));
+                for (uint8_t& b : bytes) b = uint8_t(rng());
+            }
+            const DWORD mipFilters[3] = {D3DTEXF_NONE, D3DTEXF_POINT, D3DTEXF_LINEAR};
+            t.mipFilter = mipFilters[uni(0, 2)];
+            if (uni(0, 1)) t.minFilter = t.filter == D3DTEXF_LINEAR ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (c.program.rfind("ps_1_4", 0) == 0) {
+            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
+        }
+        if (i % 3 == 2) radeon8500(quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", program:\n" << c.program);
+        const int before = rows;
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
+        if (chains && rows > before) ++mipRows;
+    }
+    // Where a quad's level and filter cannot differ from its neighbours' (reductions by 2 and 4
+    // pick one level; magnifications level 0), the row path draws; the rest go to quads.
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
+    CHECK(rows * 3 >= cases);
+    CHECK(mipRows * 5 >= cases);
+}
+
+TEST_CASE("aligned pass: triangles of one draw whose quads pick different levels equal the quad path",
+          "[draw][aligned]") {
+    // Three rectangles side by side over one mip-mapped texture: 2:1, 4:1 and 1:1 across, 2:1
+    // down (levels 1, 2 and 1). The row path draws the triangles that pick the level of the
+    // first; the others must still get their own level.
+    Case c;
+    c.w = 96, c.h = 16;
+    c.rtInit.assign(size_t(c.w) * c.h * 4, 0x40);
+    c.tex.resize(4);
+    std::mt19937 rng(7);
+    for (Case::Tex& t : c.tex) {
+        t.w = 128, t.h = 32;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        for (int level = 1; level < 8; ++level) {
+            std::vector<uint8_t>& bytes =
+                t.mips.emplace_back(size_t(std::max(1u, t.w >> level)) * std::max(1u, t.h >> level) * 4);
+            for (uint8_t& b : bytes) b = uint8_t(rng());
+        }
+        t.filter = D3DTEXF_LINEAR;
+        t.mipFilter = D3DTEXF_POINT;
+        t.addressU = t.addressV = D3DTADDRESS_WRAP;
+    }
+    c.program = kPrograms[0];
+    const float spans[3][2] = {{0.0f, 0.5f}, {0.5f, 1.5f}, {1.5f, 1.75f}};
+    for (int r = 0; r < 3; ++r) {
+        const float x0 = float(32 * r) - 0.5f, x1 = x0 + 32.0f;
+        const float xs[4] = {x0, x1, x1, x0}, ys[4] = {-0.5f, -0.5f, 15.5f, 15.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
+            q.uv[0][0] = (k == 1 || k == 2) ? spans[r][1] : spans[r][0];
+            q.uv[0][1] = k >= 2 ? 1.0f : 0.0f;
+            c.verts.push_back(q);
+        }
+    }
+    DeviceOptions quadOpt, rowOpt;
+    quadOpt.software.alignedPasses = false;
+    Device quadDev(quadOpt);
+    DrawStats qs;
+    const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+    Device rowDev(rowOpt);
+    DrawStats rs;
+    REQUIRE(drawCase(rowDev, c, rs) == expected);
+    // The first and third rectangles (level 1) on the row path, the second in quads.
+    CHECK(rs.pixelsRowPath == 2 * 32 * 16);
 }
 
 TEST_CASE("aligned pass: fogged and depth-tested passes take the row paths and equal the quad path",
