@@ -511,11 +511,12 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     if (kills || !target.color || (wantZ && executor.writesDepth())) return false;
     FloatRowDraw d;
     if (!ps11::plainTaps(executor, d.plan)) return false;
-    static std::atomic<uint64_t> serials{0};
-    d.serial = ++serials;
+    d.serial = nextRowDrawSerial();
     d.kernels = &floatRowKernels(ps11::simdLevel());
     d.executor = &executor;
     d.weights8 = weightBits == 8 && precision == ps11::Precision::Float;
+    d.levelTaps.fixed = false;
+    d.levelTaps.weights8 = d.weights8;
     uint32_t stagesSeen = 0;
     for (int i = 0; i < d.plan.count; ++i) {
         const int stage = d.plan.stage[size_t(i)];
@@ -527,7 +528,8 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        if (!levelZeroOnly(*tex, ss)) return false;
+        if (tex->isVolume()) return false;
+        if (!ps11::lodFree(*tex, ss)) d.levelTaps.add(i, *tex, ss, tap.coordSet);
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
         d.bound |= 1u << i;
@@ -554,6 +556,26 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     d.wantZ = wantZ;
     out = d;
     return true;
+}
+
+void setTapLevels(FloatRowDraw& draw, const TapLevels& levels) {
+    bool changed = false;
+    for (int i = 0; i < draw.plan.count; ++i) {
+        if (!((draw.levelTaps.mask >> i) & 1)) continue;
+        FloatRowTap& tap = draw.taps[size_t(i)];
+        const ps11::Texture& tex = *draw.levelTaps.texture[size_t(i)];
+        const ps11::TextureLevelInfo& li = tex.level(levels.level[size_t(i)]);
+        const bool linear = (levels.linear >> i) & 1;
+        const uint8_t* bytes = tap.unorm8 ? tex.unorm8() + li.offset * 4 : nullptr;
+        const float* values = tap.unorm8 ? nullptr : tex.values() + li.offset * 4;
+        changed |= bytes != tap.bytes || values != tap.values || linear != tap.linear;
+        tap.bytes = bytes;
+        tap.values = values;
+        tap.width = li.width;
+        tap.height = li.height;
+        tap.linear = linear;
+    }
+    if (changed) draw.serial = nextRowDrawSerial();
 }
 
 namespace {

@@ -59,11 +59,13 @@ struct FloatRowDraw {
     MergeState merge;
     MergeTarget target;
     bool wantZ = false;  // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
+    LevelTaps levelTaps;  // the taps whose level or filter the level of detail picks
 };
 
 // Decides whether a draw can take the float row path (float or ideal precision, a program whose
-// texture reads are plain and on distinct stages, 2-D textures each read at level 0 with one
-// filter, no texkill and no depth written by the program) and fills `out`.
+// texture reads are plain and on distinct stages, 2-D textures, no texkill and no depth written
+// by the program) and fills `out`. A texture whose level or filter the level of detail picks is
+// one of levelTaps: its triangles take the row path where triangleLevels finds one level.
 bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
@@ -111,6 +113,8 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
                              const std::pair<int, int>* columns = nullptr);
 // Its second half: the tables over out.x0 .. out.x1 (as fillAlignedTables).
 void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out);
+// setTapLevels of the float row path.
+void setTapLevels(FloatRowDraw& draw, const TapLevels& levels);
 
 // Per-worker buffers, allocated once and kept by the worker.
 struct FloatRowScratch {

@@ -38,13 +38,28 @@ struct AlignedTap {
     ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;
     uint32_t borderWord = 0;  // D3DCOLOR (bytes b g r a)
     int coordSet = 0;
-    // A texture whose level or filter the quads' level of detail picks (not levelZeroOnly): the
-    // fields above are then the level and filter of the triangles being drawn (setTapLevels).
-    const ps11::Texture* mipTexture = nullptr;
-    const ps11::SamplerState* sampler = nullptr;
 };
 
-// The level and filter of each tap of AlignedDraw::mipTaps on a set of triangles.
+// A row path's taps whose level or filter the quads' level of detail picks (textures that are
+// not levelZeroOnly): their level and filter are those of the triangles being drawn
+// (triangleLevels, then setTapLevels on the draw).
+struct LevelTaps {
+    uint32_t mask = 0;  // bit per tap of the draw's TapPlan
+    bool fixed = true;  // an fx profile (ps11::chooseLevel's `fixed`)
+    bool weights8 = false;
+    std::array<const ps11::Texture*, 8> texture{};
+    std::array<const ps11::SamplerState*, 8> sampler{};
+    std::array<uint8_t, 8> coordSet{};
+    // Records tap i as one of them.
+    void add(int i, const ps11::Texture& tex, const ps11::SamplerState& ss, int set) {
+        mask |= 1u << i;
+        texture[size_t(i)] = &tex;
+        sampler[size_t(i)] = &ss;
+        coordSet[size_t(i)] = uint8_t(set);
+    }
+};
+
+// The level and filter of each of LevelTaps' taps on a set of triangles.
 struct TapLevels {
     std::array<uint8_t, 8> level{};
     uint32_t linear = 0;  // bit per tap
@@ -63,7 +78,7 @@ struct AlignedDraw {
     ps11::TapPlan plan;
     std::array<AlignedTap, 8> taps{};
     uint32_t bound = 0;       // the taps with a texture (bit per tap)
-    uint32_t mipTaps = 0;     // the taps whose level or filter the level of detail picks (AlignedTap::mipTexture)
+    LevelTaps levelTaps;      // the taps whose level or filter the level of detail picks
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the draw reads (the specular alpha under fog)
     MergeState merge;
     MergeTarget target;
@@ -227,15 +242,17 @@ struct AlignedScratch {
 // paths' per-texture condition (docs/textures.md "Level of detail").
 bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss);
 
-// For a draw with mipTaps and a screen-aligned triangle `s` whose pixels lie in columns [x0, x1):
-// the level and filter each such tap takes on every 2×2 quad the triangle's rows and columns
-// touch, by the quad path's own rule (ps11::chooseLevel over the derivatives its quads compute
-// from these coordinates). False where the quads do not all agree, where one blends two levels,
-// or where a coordinate is not finite: the triangle is then shaded in quads.
-bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int x1, TapLevels& out);
-// Points each tap of draw.mipTaps at its level and filter in `levels` (before the triangles'
-// tables are filled; a change starts a new serial, so no worker keeps H rows of another level).
+// For a screen-aligned triangle `s` whose pixels lie in columns [x0, x1): the level and filter
+// each of `taps` takes on every 2×2 quad the triangle's rows and columns touch, by the quad path's
+// own rule (ps11::chooseLevel over the derivatives its quads compute from these coordinates).
+// False where the quads do not all agree, where one blends two levels, or where a coordinate is
+// not finite: the triangle is then shaded in quads.
+bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x1, TapLevels& out);
+// Points each of draw.levelTaps at its level and filter in `levels` (before the triangles' tables
+// are filled; a change starts a new serial, so no worker keeps H rows of another level).
 void setTapLevels(AlignedDraw& draw, const TapLevels& levels);
+// AlignedDraw::serial: unique per draw and per change of its taps' levels (the float row path's too).
+uint64_t nextRowDrawSerial();
 
 // Whether every texture-coordinate set of `plan` is screen-aligned on the triangle (u constant or
 // a plane with dy = 0, v constant or a plane with dx = 0) and the triangle has no perspective:

@@ -17,15 +17,10 @@
 
 namespace emu {
 
-namespace {
-
-// AlignedDraw::serial: unique per draw and per change of its taps' levels.
-uint64_t nextSerial() {
+uint64_t nextRowDrawSerial() {
     static std::atomic<uint64_t> serials{0};
     return ++serials;
 }
-
-}  // namespace
 
 bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precision,
                         const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
@@ -37,7 +32,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     AlignedDraw d;
     if (!ps11::tapPlan(executor, d.plan)) return false;
     d.fx12 = fx12;
-    d.serial = nextSerial();
+    d.serial = nextRowDrawSerial();
     d.executor = &executor;
     d.kernels = alignedKernels(ps11::simdLevel());
     d.sample = ps11::fastpath::samplerKernels(ps11::simdLevel()).unorm8;
@@ -56,12 +51,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         tap.width = li.width;
         tap.height = li.height;
         tap.linear = ss.magFilter == ps11::Filter::Linear;
-        if (!ps11::lodFree(*tex, ss)) {
-            // Level and filter per set of triangles (triangleLevels, setTapLevels).
-            tap.mipTexture = tex.get();
-            tap.sampler = &ss;
-            d.mipTaps |= 1u << i;
-        }
+        if (!ps11::lodFree(*tex, ss)) d.levelTaps.add(i, *tex, ss, tap.coordSet);
         tap.addressU = ss.addressU;
         tap.addressV = ss.addressV;
         // The border colour's bytes (the device sets it from a D3DCOLOR: byte / 255 per channel).
@@ -113,7 +103,7 @@ bool addDistinct(std::vector<double>& set, double v, size_t cap) {
 
 }  // namespace
 
-bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int x1, TapLevels& out) {
+bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x1, TapLevels& out) {
     out = TapLevels{};
     // The quads' columns and rows: pairs from even coordinates over the triangle's pixels.
     const int cx0 = x0 & ~1, cx1 = x1 + (x1 & 1), ry0 = s.yMin & ~1, ry1 = s.yMax + (s.yMax & 1);
@@ -125,21 +115,21 @@ bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int
     // +0), so a quad's choice is chooseLevel of its column's dx2 and its row's dy2.
     constexpr size_t kMaxDistinct = 16;
     std::vector<double> dx2s, dy2s;
-    for (int i = 0; i < draw.plan.count; ++i) {
-        const AlignedTap& tap = draw.taps[size_t(i)];
-        if (!((draw.mipTaps >> i) & 1)) continue;
-        const ps11::Texture& tex = *tap.mipTexture;
+    for (int i = 0; i < 8; ++i) {
+        if (!((taps.mask >> i) & 1)) continue;
+        const ps11::Texture& tex = *taps.texture[size_t(i)];
+        const int set = taps.coordSet[size_t(i)];
         const double w = double(tex.level(0).width), h = double(tex.level(0).height);
         dx2s.clear();
         dy2s.clear();
-        columnU(s, tap.coordSet, cx0, cx1 - cx0, u.data());
+        columnU(s, set, cx0, cx1 - cx0, u.data());
         for (size_t k = 0; k + 1 < u.size(); k += 2) {
             if (!std::isfinite(u[k]) || !std::isfinite(u[k + 1])) return false;
             const double d = double(u[k + 1]) * w - double(u[k]) * w;
             if (!addDistinct(dx2s, d * d, kMaxDistinct)) return false;
         }
         for (int y = ry0; y < ry1; y += 2) {
-            const float v0 = rowV(s, tap.coordSet, y), v1 = rowV(s, tap.coordSet, y + 1);
+            const float v0 = rowV(s, set, y), v1 = rowV(s, set, y + 1);
             if (!std::isfinite(v0) || !std::isfinite(v1)) return false;
             const double d = double(v1) * h - double(v0) * h;
             if (!addDistinct(dy2s, d * d, kMaxDistinct)) return false;
@@ -150,7 +140,8 @@ bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int
         bool first = true;
         ps11::LevelChoice pick;
         auto agree = [&](double rho2) {
-            const ps11::LevelChoice c = ps11::chooseLevel(tex, *tap.sampler, rho2, rho2, true, false);
+            const ps11::LevelChoice c =
+                ps11::chooseLevel(tex, *taps.sampler[size_t(i)], rho2, rho2, taps.fixed, taps.weights8);
             if (first) pick = c, first = false;
             return c == pick && c.slots == 1;
         };
@@ -167,10 +158,11 @@ bool triangleLevels(const AlignedDraw& draw, const TriangleSetup& s, int x0, int
 void setTapLevels(AlignedDraw& draw, const TapLevels& levels) {
     bool changed = false;
     for (int i = 0; i < draw.plan.count; ++i) {
-        if (!((draw.mipTaps >> i) & 1)) continue;
+        if (!((draw.levelTaps.mask >> i) & 1)) continue;
         AlignedTap& tap = draw.taps[size_t(i)];
-        const ps11::TextureLevelInfo& li = tap.mipTexture->level(levels.level[size_t(i)]);
-        const uint8_t* texels = tap.mipTexture->unorm8() + li.offset * 4;
+        const ps11::Texture& tex = *draw.levelTaps.texture[size_t(i)];
+        const ps11::TextureLevelInfo& li = tex.level(levels.level[size_t(i)]);
+        const uint8_t* texels = tex.unorm8() + li.offset * 4;
         const bool linear = (levels.linear >> i) & 1;
         changed |= texels != tap.texels || linear != tap.linear;
         tap.texels = texels;
@@ -178,7 +170,7 @@ void setTapLevels(AlignedDraw& draw, const TapLevels& levels) {
         tap.height = li.height;
         tap.linear = linear;
     }
-    if (changed) draw.serial = nextSerial();
+    if (changed) draw.serial = nextRowDrawSerial();
 }
 
 bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {

@@ -315,8 +315,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[historyKey];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
     // (Nor are draws whose taps' levels the level of detail picks: the tiles' facts are level 0's.)
-    const bool tileable = m_options.skipTiles && (alignedDraw || floatDraw) && !aligned.mipTaps &&
-                          call.primitiveCount <= kMaxAlignedTriangles;
+    const bool tileable = m_options.skipTiles && (alignedDraw || floatDraw) && !aligned.levelTaps.mask &&
+                          !floatRows.levelTaps.mask && call.primitiveCount <= kMaxAlignedTriangles;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
     // Timed: a program that pays is drawn undecided once after its second decided draw (the
     // first one's time, with the first reads of textures that may stay, is not taken), then on
@@ -412,37 +412,42 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         if (isAligned[i] && tableOf[i] == i) fill(setups[i], rowTris[i]);
                 });
             };
-            if (alignedDraw) {
-                // Taps whose level the quads' level of detail picks: a part's screen-aligned
-                // triangles take the row path where every quad of theirs picks the part's one level
-                // and filter (the first such triangle's); the others are shaded in quads.
-                TapLevels partLevels;
-                bool partHasLevels = false;
+            // Taps whose level the quads' level of detail picks (LevelTaps): a part's screen-aligned
+            // triangles take the row path where every quad of theirs picks the part's one level and
+            // filter (the first such triangle's); the others are shaded in quads.
+            TapLevels partLevels;
+            bool partHasLevels = false;
+            auto levelKind = [&](const LevelTaps& taps, int kind, const TriangleSetup& s, int x0, int x1) {
+                if (kind == 0 || !taps.mask) return kind;
+                TapLevels levels;
+                if (kind != 1 || !triangleLevels(taps, s, x0, x1, levels) || (partHasLevels && !(levels == partLevels)))
+                    return 0;
+                partLevels = levels;
+                partHasLevels = true;
+                return kind;
+            };
+            if (alignedDraw)
                 prepareTables(
                     alignedTris, aligned.plan, aligned.plan.count,
                     [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
-                        const int kind = rowPathKind(aligned.plan, bound, s, x0, x1);
-                        if (kind == 0 || !aligned.mipTaps) return kind;
-                        TapLevels levels;
-                        if (kind != 1 || !triangleLevels(aligned, s, x0, x1, levels) ||
-                            (partHasLevels && !(levels == partLevels)))
-                            return 0;
-                        partLevels = levels;
-                        partHasLevels = true;
-                        return kind;
+                        const int kind = rowPathKind(aligned.plan, bound, s, x0, x1);  // (sets x0, x1)
+                        return levelKind(aligned.levelTaps, kind, s, x0, x1);
                     },
                     [&] {
                         if (partHasLevels) setTapLevels(aligned, partLevels);
                     },
                     [&](const TriangleSetup& s, AlignedTriangle& t) { fillAlignedTables(aligned, s, t); });
-            }
             if (floatDraw) {
                 prepareTables(
                     floatTris, floatRows.plan, floatRows.plan.count,
                     [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
-                        return rowPathKind(floatRows.plan, bound, s, x0, x1);
+                        const int kind = rowPathKind(floatRows.plan, bound, s, x0, x1);  // (sets x0, x1)
+                        return levelKind(floatRows.levelTaps, kind, s, x0, x1);
                     },
-                    [] {}, [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
+                    [&] {
+                        if (partHasLevels) setTapLevels(floatRows, partLevels);
+                    },
+                    [&](const TriangleSetup& s, FloatRowTriangle& t) { fillFloatRowTables(floatRows, s, t); });
                 shareFloatRowTables(floatRows, floatTris.data(), isAligned.data(), tableOf.data(), setups.size());
             }
             if (setups.empty()) continue;

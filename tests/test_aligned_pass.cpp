@@ -466,12 +466,15 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
           "[draw][aligned]") {
     // The random cases (1:1 passes, 2:1 … 4:1 reductions, magnifications, any rectangle) with mip
     // chains of any length, each MIP filter and a min filter that differs from the mag filter
-    // half the time: the level and filter each quad picks must be the quad path's.
+    // half the time, in fx8, fx12, float and ideal: the level and filter each quad picks must be
+    // the quad path's.
     std::mt19937 rng(20261130);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     int cases = 0, rows = 0, mipRows = 0;
-    for (int i = 0; i < 300; ++i) {
-        Case c = randomCase(rng);
+    std::array<int, 4> profileRows{};
+    for (int i = 0; i < 400; ++i) {
+        const int profile = i % 4;  // fx8, fx12 (the radeon8500 class), float, ideal
+        Case c = randomCase(rng, profile >= 2);
         bool chains = false;
         for (Case::Tex& t : c.tex) {
             int chain = 1;
@@ -494,7 +497,8 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
             quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
             quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
         }
-        if (i % 3 == 2) radeon8500(quadOpt, rowOpt);
+        if (profile == 1) radeon8500(quadOpt, rowOpt);
+        if (profile >= 2) floatProfile(i, profile == 3, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -502,12 +506,16 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
         const int before = rows;
         requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
         if (chains && rows > before) ++mipRows;
+        profileRows[size_t(profile)] += rows - before;
     }
     // Where a quad's level and filter cannot differ from its neighbours' (reductions by 2 and 4
     // pick one level; magnifications level 0), the row path draws; the rest go to quads.
-    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain; fx8 "
+              << profileRows[0] << ", fx12 " << profileRows[1] << ", float " << profileRows[2] << ", ideal "
+              << profileRows[3]);
     CHECK(rows * 3 >= cases);
     CHECK(mipRows * 5 >= cases);
+    for (int n : profileRows) CHECK(n * 20 >= cases);
 }
 
 TEST_CASE("aligned pass: triangles of one draw whose quads pick different levels equal the quad path",
