@@ -1,0 +1,805 @@
+// The row paths' own machinery against the quad path: one device across draws, H rows and texel
+// rows cached by workers (never outliving their draw), magnified and half-texel taps, tabulated
+// runs, sprites (draws of many small quads, row tables kept between draws), joined rows, 4:1
+// reductions straight from the texel row, and clamped chains of products. The random differential
+// cases are test_aligned_pass.cpp's.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/aligned_float.h"
+#include "emu/aligned_pass.h"
+#include "emu/aligned_pass_kernels.h"
+#include "emu/device.h"
+#include "emu/format.h"
+#include "ps11/assembler.h"
+#include "ps11/validator.h"
+#include "aligned_cases.h"
+#include "simd_levels.h"
+
+using namespace emu;
+
+using namespace alignedcases;
+
+TEST_CASE("aligned pass: one device across draws (constants change sign, textures rewritten, ping-pong)",
+          "[draw][aligned]") {
+    // What the row path may keep between spans or draws (the sign analysis of the constants,
+    // filtered texel rows) must follow every change: the same calls on both devices, compared
+    // after every draw. In each profile with a row path: fx8 and fx12, and float and ideal (the
+    // float row path's H rows and decoded texel rows).
+    const ps11::Precision precision =
+        GENERATE(ps11::Precision::Fx8, ps11::Precision::Fx12, ps11::Precision::Float, ps11::Precision::Ideal);
+    INFO("precision " << ps11::precisionName(precision));
+    std::mt19937 rng(4242);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const UINT w = 203, h = 19;
+    DeviceOptions quadOpt, rowOpt;
+    quadOpt.precision = rowOpt.precision = precision;
+    quadOpt.software.alignedPasses = false;
+    quadOpt.software.threads = rowOpt.software.threads = 2;
+    Device quadDev(quadOpt), rowDev(rowOpt);
+    Device* devs[2] = {&quadDev, &rowDev};
+    Handle src[2], ping[2][2], surf[2][2], ps[2];
+    for (int d = 0; d < 2; ++d) {
+        Device& dev = *devs[d];
+        REQUIRE(dev.CreateTexture(w, h, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &src[d]) == D3D_OK);
+        for (int k = 0; k < 2; ++k) {
+            REQUIRE(dev.CreateTexture(w, h, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &ping[d][k]) ==
+                    D3D_OK);
+            REQUIRE(dev.GetSurfaceLevel(ping[d][k], 0, &surf[d][k]) == D3D_OK);
+        }
+        REQUIRE(dev.CreatePixelShaderFromText(
+                    "ps_1_1\ntex t0\ntex t1\ntex t2\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad_sat r0, t2, c2, r0\n",
+                    &ps[d]) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(ps[d]) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_CULLMODE, D3DCULL_NONE) == D3D_OK);
+        REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
+        for (DWORD s = 0; s < 3; ++s) {
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP) == D3D_OK);
+        }
+    }
+    // Taps half a texel apart in both directions (the blur footprint) and one at an eighth.
+    std::vector<Vtx> quad;
+    const float xs[4] = {-0.5f, float(w) - 0.5f, float(w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(h) - 0.5f, float(h) - 0.5f};
+    const float off[3][2] = {{-0.5f, -0.5f}, {0.5f, 0.5f}, {0.125f, -0.375f}};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
+        for (int s = 0; s < 3; ++s) {
+            q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(w);
+            q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(h);
+        }
+        quad.push_back(q);
+    }
+    std::vector<uint8_t> bytes(size_t(w) * h * 4);
+    for (int iter = 0; iter < 12; ++iter) {
+        // Every third draw rewrites the source texture, every draw flips constant signs.
+        if (iter % 3 == 0)
+            for (uint8_t& b : bytes) b = uint8_t(rng());
+        float consts[3][4];
+        for (auto& c : consts)
+            for (float& v : c) v = float(uni(-4, 4)) * 0.25f;
+        std::vector<uint8_t> result[2];
+        for (int d = 0; d < 2; ++d) {
+            Device& dev = *devs[d];
+            if (iter % 3 == 0) {
+                D3DLOCKED_RECT lr;
+                REQUIRE(dev.LockRect(src[d], 0, &lr, nullptr, 0) == D3D_OK);
+                for (UINT y = 0; y < h; ++y)
+                    std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &bytes[size_t(y) * w * 4], 4 * w);
+                REQUIRE(dev.UnlockRect(src[d], 0) == D3D_OK);
+            }
+            REQUIRE(dev.SetPixelShaderConstantF(0, &consts[0][0], 3) == D3D_OK);
+            // Draw 0 of each group reads the source, the others the previous target (ping-pong).
+            const int to = iter & 1;
+            const Handle from = iter % 3 == 0 ? src[d] : ping[d][to ^ 1];
+            for (DWORD s = 0; s < 3; ++s) REQUIRE(dev.SetTexture(s, from) == D3D_OK);
+            REQUIRE(dev.SetRenderTarget(0, surf[d][to]) == D3D_OK);
+            REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(Vtx)) == D3D_OK);
+            if (d == 1) CHECK(dev.lastDrawStats().pixelsShaded == dev.lastDrawStats().pixelsCovered);
+            Handle sys{};
+            REQUIRE(dev.CreateOffscreenPlainSurface(w, h, D3DFMT_A8R8G8B8, D3DPOOL_SYSTEMMEM, &sys) == D3D_OK);
+            REQUIRE(dev.GetRenderTargetData(surf[d][to], sys) == D3D_OK);
+            D3DLOCKED_RECT lr;
+            REQUIRE(dev.LockRect(sys, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+            result[d].resize(size_t(w) * h * 4);
+            for (UINT y = 0; y < h; ++y)
+                std::memcpy(&result[d][size_t(y) * w * 4], static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, 4 * w);
+            REQUIRE(dev.UnlockRect(sys) == D3D_OK);
+            REQUIRE(dev.Release(sys) == D3D_OK);
+        }
+        INFO("draw " << iter);
+        REQUIRE(result[1] == result[0]);
+    }
+}
+
+namespace {
+
+// Below the device: a copy program (`mov r0, t0`) for the profile's executor.
+std::unique_ptr<ps11::Executor> copyExecutor(ps11::Precision precision) {
+    ps11::Diagnostics diags;
+    std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    ps11::ExecutorOptions eo;
+    eo.precision = precision;
+    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, eo, diags);
+    REQUIRE(exec);
+    return exec;
+}
+
+// The two triangles of the 1:1 quad over a w×h target, tap 0's coordinates shifted by (du, dv)
+// texels; `used` is what they interpolate.
+void quadSetups(int w, int h, float du, float dv, TriangleSetup setups[2], uint64_t& used) {
+    ScreenTriangle tris[2];
+    const double xs[4] = {-0.5, w - 0.5, w - 0.5, -0.5}, ys[4] = {-0.5, -0.5, h - 0.5, h - 0.5};
+    const int order[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int t = 0; t < 2; ++t)
+        for (int k = 0; k < 3; ++k) {
+            ScreenVertex& v = tris[t].v[size_t(k)];
+            const int c = order[t][k];
+            v.x = xs[c], v.y = ys[c], v.rhw = 1;
+            v.attr[size_t(attrTex(0, 0))] = float((c == 1 || c == 2) ? 1.0 : 0.0) + du / float(w);
+            v.attr[size_t(attrTex(0, 1))] = (c >= 2 ? 1.0f : 0.0f) + dv / float(h);
+        }
+    used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
+    for (int t = 0; t < 2; ++t) REQUIRE(setupTriangle(tris[t], used, ClipRect{0, 0, w, h}, setups[t]));
+}
+
+}  // namespace
+
+TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[draw][aligned]") {
+    // The device may place a new texture copy where a freed one was, so two draws can sample the
+    // same address with different texels. Driven below the device: the same buffer, rewritten
+    // between two draws of the same triangles, must give each draw its own texels.
+    const int w = 48, h = 6;
+    const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Fx8);
+    std::vector<uint8_t> texels(size_t(w) * h * 4);
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = w, target.height = h, target.rowPitch = 4 * w;
+    target.bytes.assign(size_t(w) * h * 4, 0);
+    // The 1:1 quad with the tap a quarter texel right (one weight along whole rows).
+    TriangleSetup setups[2];
+    uint64_t used = 0;
+    quadSetups(w, h, 0.25f, 0.0f, setups, used);
+    AlignedScratch* scratch = new AlignedScratch;  // one worker's, kept across the draws
+    std::mt19937 rng(99);
+    for (int draw = 0; draw < 2; ++draw) {
+        for (uint8_t& b : texels) b = uint8_t(rng());
+        AlignedDraw d;
+        // prepareAlignedDraw gives every draw a new serial; the taps are set by hand here.
+        std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+        std::array<ps11::SamplerState, 8> samplers{};
+        MergeState merge;
+        REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr},
+                                   false, used, d));
+        AlignedTap& tap = d.taps[0];
+        tap.bound = true;
+        d.bound = 1;
+        tap.texels = texels.data();
+        tap.width = w, tap.height = h;
+        tap.linear = true;
+        tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+        AlignedTriangle at[2];
+        for (int t = 0; t < 2; ++t) REQUIRE(prepareAlignedTriangle(d, setups[t], at[t]));
+        const AlignedTriangle* tp[2] = {&at[0], &at[1]};
+        const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
+        AlignedStats stats;
+        // The second draw covers only the row the first ended on: its cached H row has the
+        // same texel address and configuration.
+        const int y0 = draw == 0 ? 0 : h - 1;
+        drawAlignedRows(d, tp, sp, 2, y0, h, *scratch, stats);
+        CHECK(stats.pixels == uint64_t(w) * uint64_t(h - y0));
+        // Expected: round_half_even((a·192 + b·64) / 256) of texels x and x + 1 (clamped).
+        int wrong = 0;
+        for (int y = y0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int c = 0; c < 4; ++c) {
+                    const uint32_t a = texels[(size_t(y) * w + size_t(x)) * 4 + size_t(c)];
+                    const uint32_t b = texels[(size_t(y) * w + size_t(std::min(x + 1, w - 1))) * 4 + size_t(c)];
+                    const uint32_t t = a * 192 + b * 64;
+                    const uint32_t e = (t + 127 + ((t >> 8) & 1)) >> 8;
+                    wrong += target.bytes[(size_t(y) * w + size_t(x)) * 4 + size_t(c)] != e;
+                }
+        INFO("draw " << draw);
+        CHECK(wrong == 0);
+    }
+    // The vector path (where the level has one) really served the second draw from rows it built
+    // itself.
+    if (alignedKernels(ps11::simdLevel())) CHECK(scratch->hrows.built == uint64_t(h + 1));
+    delete scratch;
+}
+
+TEST_CASE("float row path: texel rows kept by a worker never outlive their draw", "[draw][aligned]") {
+    // As above for the float row path's H rows and decoded texel rows: the same buffer, rewritten
+    // between two draws, read by a worker that keeps its scratch; each draw must equal the same
+    // draw on a fresh scratch.
+    const int w = 48, h = 6;
+    const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Float);
+    std::vector<uint8_t> texels(size_t(w) * h * 4);
+    auto makeTarget = [&] {
+        Image t;
+        t.format = formatInfo(D3DFMT_A8R8G8B8);
+        t.width = w, t.height = h, t.rowPitch = 4 * w;
+        t.bytes.assign(size_t(w) * h * 4, 0);
+        return t;
+    };
+    Image kept = makeTarget(), fresh = makeTarget();
+    // The 1:1 quad with the tap a quarter texel right and a quarter texel down (each pixel row
+    // reads H rows of two texel rows).
+    TriangleSetup setups[2];
+    uint64_t used = 0;
+    quadSetups(w, h, 0.25f, 0.25f, setups, used);
+    auto scratch = std::make_unique<FloatRowScratch>();  // one worker's, kept across the draws
+    std::mt19937 rng(99);
+    for (int draw = 0; draw < 2; ++draw) {
+        for (uint8_t& b : texels) b = uint8_t(rng());
+        for (Image* target : {&kept, &fresh}) {
+            FloatRowDraw d;
+            std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+            std::array<ps11::SamplerState, 8> samplers{};
+            MergeState merge;
+            merge.precision = ps11::Precision::Float;
+            REQUIRE(prepareFloatRowDraw(*exec, ps11::Precision::Float, 0, false, none, samplers, merge,
+                                        MergeTarget{target, nullptr}, false, used, d));
+            FloatRowTap& tap = d.taps[0];
+            tap.bound = true;
+            d.bound = 1;
+            tap.unorm8 = true;
+            tap.bytes = texels.data();
+            tap.width = w, tap.height = h;
+            tap.linear = true;
+            tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+            tap.nonNegative = true;
+            FloatRowTriangle ft[2];
+            for (int t = 0; t < 2; ++t) REQUIRE(prepareFloatRowTriangle(d, setups[t], ft[t]));
+            const uint8_t prepared[2] = {1, 1};
+            const uint32_t tableOf[2] = {0, 1};
+            shareFloatRowTables(d, ft, prepared, tableOf, 2);
+            const FloatRowTriangle* tp[2] = {&ft[0], &ft[1]};
+            const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
+            AlignedStats stats;
+            // The second draw covers only the rows the first ended on: the kept scratch holds
+            // rows of the same texel addresses.
+            const int y0 = draw == 0 ? 0 : h - 2;
+            FloatRowScratch own;
+            drawFloatRows(d, tp, sp, 2, y0, h, target == &kept ? *scratch : own, stats);
+            CHECK(stats.pixels == uint64_t(w) * uint64_t(h - y0));
+        }
+        INFO("draw " << draw);
+        CHECK(std::vector<uint8_t>(kept.bytes.begin(), kept.bytes.end()) ==
+              std::vector<uint8_t>(fresh.bytes.begin(), fresh.bytes.end()));
+    }
+}
+
+TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad path byte for byte",
+          "[draw][aligned]") {
+    // A glare composite's blurred tap reads a small texture magnified: consecutive columns share
+    // their texels and the weight changes every column (tabulated H rows). Every address mode,
+    // border colours, coordinates past [0, 1] (border and wrapped texels inside a row), point
+    // and linear filters, one or two threads.
+    std::mt19937 rng(20261127);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    const float scales[] = {2.0f, 3.0f, 8.0f, 2.5f, 1.75f, 5.3f, 1.0f / 0.9f};
+    int aligned = 0, cases = 0;
+    for (int i = 0; i < 280; ++i) {
+        Case c = randomCase(rng);
+        c.w = UINT(uni(16, 420));
+        c.h = UINT(uni(2, 20));
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const float scale = scales[size_t(i) % std::size(scales)];
+        float u[4][2], v[4][2];
+        for (int s = 0; s < 4; ++s) {
+            Case::Tex& t = c.tex[size_t(s)];
+            t.w = std::max(1u, UINT(float(c.w) / scale + 0.5f));
+            t.h = std::max(1u, UINT(float(c.h) / scale + 0.5f));
+            t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : (uni(0, 1) ? 0 : 255));
+            t.filter = uni(0, 4) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.bound = uni(0, 15) != 0;
+            const int kind = uni(0, 3);
+            if (kind <= 1) {  // the whole texture over the target, maybe offset by a fraction of a texel
+                const float ox = kind ? float(uni(-8, 8)) * 0.0625f / float(t.w) : 0.0f;
+                u[s][0] = ox, u[s][1] = 1 + ox, v[s][0] = 0, v[s][1] = 1;
+            } else {  // past the edges: border, clamped, wrapped and mirrored texels inside rows
+                u[s][0] = real(-0.6f, 0.3f), u[s][1] = real(0.7f, 1.6f), v[s][0] = real(-0.4f, 0.2f),
+                v[s][1] = real(0.8f, 1.4f);
+            }
+        }
+        // One stage on a 1:1 texture (the scene tap of a composite).
+        if (uni(0, 1)) {
+            Case::Tex& t = c.tex[0];
+            t.w = c.w, t.h = c.h;
+            t.bytes.resize(size_t(t.w) * t.h * texelBytes(t.format));
+            for (uint8_t& b : t.bytes) b = uint8_t(rng());
+            u[0][0] = 0, u[0][1] = 1, v[0][0] = 0, v[0][1] = 1;
+        }
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        c.verts.clear();
+        const int order[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
+        const DWORD dif = DWORD(rng());
+        for (int k : order[uni(0, 1)]) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, dif, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                q.uv[s][0] = (k == 1 || k == 2) ? u[s][1] : u[s][0];
+                q.uv[s][1] = (k >= 2) ? v[s][1] : v[s][0];
+            }
+            c.verts.push_back(q);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;  // every pixel shaded: the row path's count below holds
+        if (c.program.rfind("ps_1_4", 0) == 0) {
+            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
+        }
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << " scale " << scale << " program:\n" << c.program);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            requireSkippingEqual(rowOpt, c, expected, qs);
+            if (qs.pixelsCovered == 0) return;
+            ++cases;
+            if (rs.pixelsShaded == rs.pixelsCovered) ++aligned;
+        });
+    }
+    INFO(aligned << " of " << cases << " cases took the row path");
+    CHECK(aligned * 10 >= cases * 9);
+}
+
+TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel blur) equal the quad path",
+          "[draw][aligned]") {
+    // Four taps of one texture at (−½, −½), (+½, −½), (−½, +½), (+½, +½) texels plus a common
+    // offset in eighths (weights ½ or any, vertical weight ½ or any), 1:1 or a 2:1 reduction,
+    // point or linear, every address mode, over rows wider than a span (whole spans inside the
+    // taps' runs, as in a 1080p blur; a scissor now and then starts and ends spans anywhere).
+    std::mt19937 rng(20261128);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 48; ++i) {
+        Case c;
+        c.w = UINT(uni(260, 700));
+        c.h = UINT(uni(2, 9));
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const UINT scale = uni(0, 3) ? 1 : 2;
+        Case::Tex t;
+        t.w = c.w * scale, t.h = c.h * scale;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 5) ? rng() : 255);
+        t.filter = uni(0, 5) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        t.addressU = DWORD(uni(1, 5));
+        t.addressV = DWORD(uni(1, 5));
+        t.border = DWORD(rng());
+        c.tex.assign(4, t);
+        c.oneTexture = true;
+        c.program = uni(0, 1) ? kPrograms[1]  // the blur (c0), or its weighted form (c0..c3)
+                              : "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\n"
+                                "mad r0, t2, c2, r0\nmad r0, t3, c3, r0\n";
+        for (auto& k : c.consts)
+            for (float& v : k) v = float(uni(0, 8)) / 16.0f;
+        const float ox = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f, oy = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f;
+        const float dx[4] = {-0.5f, 0.5f, -0.5f, 0.5f}, dy[4] = {-0.5f, -0.5f, 0.5f, 0.5f};
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (dx[s] + ox) / float(t.w);
+                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (dy[s] + oy) / float(t.h);
+            }
+            c.verts.push_back(q);
+        }
+        c.blend = DWORD(uni(0, 1));
+        // A scissor rectangle now and then: spans that start and end anywhere.
+        c.scissor = uni(0, 2) == 0;
+        c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", scale " << scale << ", offset " << ox << ", " << oy
+                     << (c.scissor ? ", scissor" : ""));
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);  // the row path drew it
+        });
+    }
+}
+
+TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][aligned]") {
+    // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with vector kernels (the Avx2 level), all
+    // columns but a few at the edges (clamped pairs) belong to runs of the tabulated configuration
+    // (weight per column).
+    const ps11::ScopedSimdLevel level(ps11::SimdLevel::Avx2);
+    if (!alignedKernels(level.level())) return;
+    ps11::Diagnostics diags;
+    std::optional<ps11::Program> program = ps11::parseAssembly("ps_1_1\ntex t0\nmov r0, t0\n", "t.psh", {}, diags);
+    REQUIRE(program);
+    REQUIRE(ps11::validate(*program, diags));
+    std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, ps11::ExecutorOptions{}, diags);
+    REQUIRE(exec);
+    const int w = 240, h = 4;
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = w, target.height = h, target.rowPitch = 4 * w;
+    target.bytes.assign(size_t(w) * h * 4, 0);
+    for (const double scale : {2.0, 3.0, 8.0, 2.5}) {
+        const uint32_t tw = uint32_t(w / scale);
+        std::vector<uint8_t> texels(size_t(tw) * h * 4, 7);
+        ScreenTriangle tri;
+        const double xs[3] = {-0.5, w - 0.5, w - 0.5}, ys[3] = {-0.5, -0.5, h - 0.5};
+        for (int k = 0; k < 3; ++k) {
+            ScreenVertex& v = tri.v[size_t(k)];
+            v.x = xs[k], v.y = ys[k], v.rhw = 1;
+            v.attr[size_t(attrTex(0, 0))] = k == 0 ? 0.0f : float(w / scale / tw);
+            v.attr[size_t(attrTex(0, 1))] = k == 2 ? 1.0f : 0.0f;
+        }
+        const uint64_t used = (uint64_t(1) << attrTex(0, 0)) | (uint64_t(1) << attrTex(0, 1));
+        TriangleSetup setup;
+        REQUIRE(setupTriangle(tri, used, ClipRect{0, 0, w, h}, setup));
+        AlignedDraw d;
+        std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+        std::array<ps11::SamplerState, 8> samplers{};
+        REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, MergeState{},
+                                   MergeTarget{&target, nullptr}, false, used, d));
+        AlignedTap& tap = d.taps[0];
+        tap.bound = true;
+        d.bound = 1;
+        tap.texels = texels.data();
+        tap.width = tw, tap.height = h;
+        tap.linear = true;
+        tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+        AlignedTriangle at;
+        REQUIRE(prepareAlignedTriangle(d, setup, at));
+        int tabulated = 0;
+        for (const AlignedTriangle::Run& r : at.taps[0].runs)
+            if (r.tabulated) tabulated += r.x1 - r.x0;
+        INFO("scale " << scale);
+        CHECK(tabulated >= w - 2 * int(scale + 1));
+    }
+}
+
+
+// Overlapping axis-aligned quads at sub-pixel positions over a random target, a random texture
+// per stage magnified or minified, blended ONE/ONE or not, some partly outside the target.
+Case spriteCase(std::mt19937& rng, int quads, bool twoTaps) {
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    Case c = randomCase(rng);
+    c.w = UINT(uni(64, 300)), c.h = UINT(uni(16, 60));
+    c.rtInit.resize(size_t(c.w) * c.h * 4);
+    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    for (Case::Tex& t : c.tex) {
+        t.w = UINT(uni(4, 40)), t.h = UINT(uni(4, 40));
+        t.format = D3DFMT_A8R8G8B8;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        t.bound = true;
+    }
+    c.program = twoTaps ? "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n" : "ps_1_1\ntex t0\nmul r0, t0, c0\n";
+    c.blend = DWORD(uni(0, 2) ? 1 : 0);
+    c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+    c.verts.clear();
+    for (int q = 0; q < quads; ++q) {
+        const float size = real(2.0f, 40.0f);
+        const float x0 = real(-10.0f, float(c.w)), y0 = real(-10.0f, float(c.h));
+        const float xs[4] = {x0, x0 + size, x0 + size, x0}, ys[4] = {y0, y0, y0 + size, y0 + size};
+        const DWORD colour = DWORD(rng());
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, colour, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s)
+                v.uv[s][0] = (k == 1 || k == 2) ? 1.0f : 0.0f, v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            c.verts.push_back(v);
+        }
+    }
+    return c;
+}
+
+TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path byte for byte", "[draw][aligned]") {
+    // Groups of 16 triangles per band, tables of each triangle's own columns, H rows built without
+    // the cache.
+    std::mt19937 rng(20261127);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    uint64_t rowShaded = 0, quadShaded = 0;
+    // Cases 24 on: float and ideal (groups of 16 triangles row by row, as in fx8).
+    for (int i = 0; i < 40; ++i) {
+        const bool floatCase = i >= 24;
+        const int quads = floatCase && i % 2 ? uni(2, 8) : uni(20, 300);
+        const Case c = spriteCase(rng, quads, i % 2 == 0);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (floatCase)
+            quadOpt.precision = rowOpt.precision = i % 4 < 2 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << quads << " quads, blend " << c.blend
+                     << (floatCase ? ", float/ideal" : ", fx8"));
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsShaded <= qs.pixelsShaded);
+        rowShaded += rs.pixelsShaded, quadShaded += qs.pixelsShaded;
+    }
+    // The row path shades no helper lanes: fewer pixels than the quad path's 2x2 quads.
+    INFO("shaded: row path " << rowShaded << ", quad path " << quadShaded);
+    CHECK(rowShaded * 10 < quadShaded * 9);
+}
+
+TEST_CASE("aligned pass: one device keeps its row tables between draws (sprites, full-screen passes, chunks)",
+          "[draw][aligned]") {
+    // The renderer keeps a chunk's setups and tables between draws and fills them anew: a draw of
+    // fewer triangles or taps after one of more must read none of the earlier draw's. One device
+    // per profile draws random full-screen passes and sprite draws in turn, some of more triangles
+    // than a chunk (1024), each against a fresh quad-path device.
+    std::mt19937 rng(20261129);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Float, ps11::Precision::Ideal}) {
+        DeviceOptions rowOpt;
+        rowOpt.precision = precision;
+        rowOpt.software.threads = 2;
+        Device rowDev(rowOpt);
+        for (int i = 0; i < 24; ++i) {
+            const int kind = uni(0, 2);  // 0: a full-screen pass, 1: a few sprites, 2: more than a chunk of them
+            Case c = kind == 0 ? randomCase(rng) : spriteCase(rng, kind == 1 ? uni(1, 6) : uni(520, 700), uni(0, 1) == 1);
+            if (kind == 0 && c.program.rfind("ps_1_4", 0) == 0) continue;  // the 1.4-class card: another device
+            DeviceOptions quadOpt = rowOpt;
+            quadOpt.software.alignedPasses = false;
+            Device quadDev(quadOpt);
+            DrawStats qs, rs;
+            INFO("precision " << int(precision) << ", draw " << i << ": " << c.verts.size() / 3 << " triangles, "
+                              << c.w << "x" << c.h << ", program:\n"
+                              << c.program);
+            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            // Every triangle took the row path (a chunk whose tables pass the column budget: in parts).
+            if (kind != 0) CHECK(rs.pixelsRowPath == rs.pixelsCovered);
+        }
+    }
+}
+
+TEST_CASE("aligned pass: triangles of one mapping join on a row only where their runs meet", "[draw][aligned]") {
+    // Every triangle maps pixels to texels by the same planes (u = x / 64, v = y / 32, exact in
+    // binary), so consecutive triangles pass joinRow's attribute test; added ONE/ONE, any pixel
+    // of a run joined across a gap or over an overlap (the same triangle twice in a row) would be
+    // drawn the wrong number of times. Against the quad path, in fx8 and ideal.
+    std::mt19937 rng(20261129);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    // Cases 12 and up give each vertex an rhw of 0.5, 1 or 2 and its coordinates divided by it:
+    // every triangle's planes of attr·rhw are still u = x / 64, v = y / 32 exactly, but their rhw
+    // planes differ. Every third case fogs with each vertex's own fog factor, every third after
+    // it tests depth with each vertex's own z: those planes differ between triangles too, and a
+    // run must not join across them.
+    for (int i = 0; i < 24; ++i) {
+        const bool perspective = i >= 12;
+        Case c = randomCase(rng);
+        c.fog = i % 3 == 1, c.depth = i % 3 == 2;
+        c.zFunc = D3DCMP_LESSEQUAL, c.zWrite = true, c.zClear = 1.0f;
+        c.w = 64, c.h = 32;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        for (uint8_t& b : c.rtInit) b = uint8_t(uni(0, 40));
+        for (Case::Tex& t : c.tex) {
+            t.w = 16, t.h = 8, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = i % 2 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 60));
+        }
+        c.program = "ps_1_1\ntex t0\nmov r0, t0\n";
+        c.blend = 1, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        auto vertex = [&](int x, int y) {
+            const float rhw = perspective ? std::array<float, 3>{0.5f, 1.0f, 2.0f}[size_t(uni(0, 2))] : 1.0f;
+            Vtx v{float(x), float(y), 0.5f, rhw, 0xffffffff, 0xff000000u, {}};
+            for (auto& uv : v.uv) uv[0] = float(x) / 64.0f / rhw, uv[1] = float(y) / 32.0f / rhw;
+            if (c.fog) v.specular = DWORD(uni(0, 255)) << 24;
+            if (c.depth) v.z = float(uni(0, 100)) / 100.0f;
+            return v;
+        };
+        for (int t = 0; (perspective || c.fog || c.depth) && t < 20; ++t) {
+            // Rectangles split on a diagonal, each corner its own rhw (or fog factor, or z): the
+            // halves' attr·rhw planes are equal and their runs meet on every row, but the rows
+            // must not join where their rhw (fog, z) planes differ.
+            const int x0 = uni(-8, 60), y0 = uni(-8, 30), x1 = x0 + uni(2, 40), y1 = y0 + uni(2, 20);
+            const Vtx a = vertex(x0, y0), b = vertex(x1, y0), d = vertex(x1, y1), e = vertex(x0, y1);
+            // Either diagonal, either half first (the halves' v planes have dx +0 or −0 by the
+            // order, and runs join only where those bits agree too).
+            switch (uni(0, 3)) {
+                case 0:
+                    c.verts.insert(c.verts.end(), {a, b, d, a, d, e});
+                    break;
+                case 1:
+                    c.verts.insert(c.verts.end(), {a, d, e, a, b, d});
+                    break;
+                case 2:
+                    c.verts.insert(c.verts.end(), {a, b, e, b, d, e});
+                    break;
+                default:
+                    c.verts.insert(c.verts.end(), {b, d, e, a, b, e});
+                    break;
+            }
+        }
+        for (int t = 0; !perspective && t < 60; ++t) {
+            // Wide triangles (tables over the whole target: equal for all of them), some twice.
+            const Vtx a = vertex(uni(-8, 72), uni(-8, 40)), b = vertex(uni(-8, 72), uni(-8, 40)),
+                      d = vertex(uni(-8, 72), uni(-8, 40));
+            for (int k = uni(0, 3) == 0 ? 2 : 1; k > 0; --k) c.verts.insert(c.verts.end(), {a, b, d});
+        }
+        c.depthVerts = c.verts;
+        for (Vtx& v : c.depthVerts) v.z = float(uni(0, 100)) / 100.0f;
+        for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Ideal}) {
+            DeviceOptions quadOpt, rowOpt;
+            quadOpt.software.alignedPasses = false;
+            quadOpt.precision = rowOpt.precision = precision;
+            rowOpt.software.skipTiles = false;
+            Device quadDev(quadOpt), rowDev(rowOpt);
+            DrawStats qs, rs;
+            INFO("case " << i << ", precision " << int(precision));
+            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);  // the row path drew them
+        }
+    }
+}
+
+TEST_CASE("aligned pass: a 4:1 reduction's pair sums straight from the texel row equal the staged combine",
+          "[draw][aligned]") {
+    // pairSums4 against the rule (channel sums of texels 4j, 4j + 1 and 4j + 2, 4j + 3, planes
+    // r g b a) and against deinterleave + combine (step 4, weight ½, phases 0 and 2), for lengths
+    // around whole groups of 16 and random bytes; nothing past texel 4n is read (the row ends
+    // there, in a buffer of its own).
+    const ps11::ScopedSimdLevel level(ps11::SimdLevel::Avx2);
+    const AlignedKernels* k = alignedKernels(level.level());
+    if (!k) return;
+    std::mt19937 rng(20261129);
+    for (const int n : {1, 5, 15, 16, 17, 31, 32, 48, 63, 64, 100, 480}) {
+        std::vector<uint8_t> row(size_t(16) * size_t(n));
+        for (uint8_t& b : row) b = uint8_t(rng());
+        const size_t stride = size_t((n + kHRowPad + 15) & ~15);
+        std::vector<uint16_t> even(stride * 4), odd(stride * 4);
+        uint16_t* const e[4] = {&even[0], &even[stride], &even[2 * stride], &even[3 * stride]};
+        uint16_t* const o[4] = {&odd[0], &odd[stride], &odd[2 * stride], &odd[3 * stride]};
+        k->pairSums4(row.data(), n, e, o);
+        // The staged way: 4n texels deinterleaved (with the padding combine reads), then combined.
+        const size_t sstride = size_t(4 * n + kStagePad + 16);
+        std::vector<uint16_t> staged(sstride * 4);
+        uint16_t* const s[4] = {&staged[0], &staged[sstride], &staged[2 * sstride], &staged[3 * sstride]};
+        k->deinterleave(row.data(), 4 * n, s);
+        std::vector<uint16_t> ce(stride * 4), co(stride * 4);
+        uint16_t* const cev[4] = {&ce[0], &ce[stride], &ce[2 * stride], &ce[3 * stride]};
+        uint16_t* const cov[4] = {&co[0], &co[stride], &co[2 * stride], &co[3 * stride]};
+        const uint16_t* const s0[4] = {s[0], s[1], s[2], s[3]};
+        const uint16_t* const s2[4] = {s[0] + 2, s[1] + 2, s[2] + 2, s[3] + 2};
+        k->combine(s0, n, 4, 128, cev);
+        k->combine(s2, n, 4, 128, cov);
+        for (int c = 0; c < 4; ++c)
+            for (int j = 0; j < n; ++j) {
+                const int b = ps11::kUnorm8Byte[c];
+                INFO("n " << n << ", channel " << c << ", element " << j);
+                REQUIRE(e[c][j] == row[size_t(16 * j + b)] + row[size_t(16 * j + 4 + b)]);
+                REQUIRE(o[c][j] == row[size_t(16 * j + 8 + b)] + row[size_t(16 * j + 12 + b)]);
+                REQUIRE(e[c][j] == cev[c][j]);
+                REQUIRE(o[c][j] == cov[c][j]);
+            }
+    }
+}
+
+TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equal the quad path", "[draw][aligned]") {
+    // The glow's first pass: four bilinear taps one texel either side of each 4x4 block's centre
+    // (H rows of pair sums from the texel row, both phases at once), random texels, a target of
+    // several groups of 16 and a ragged end, in fx8, plain and ONE/ONE.
+    std::mt19937 rng(20261130);
+    for (int i = 0; i < 8; ++i) {
+        Case c = randomCase(rng);
+        c.w = UINT(std::uniform_int_distribution<int>(20, 90)(rng)), c.h = 6;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        for (Case::Tex& t : c.tex) {
+            t.w = 4 * c.w, t.h = 4 * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = D3DTEXF_LINEAR, t.addressU = t.addressV = D3DTADDRESS_CLAMP;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        }
+        c.oneTexture = true;
+        c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                    "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
+        c.blend = DWORD(i % 2), c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        const float off[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(4 * c.w);
+                v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(4 * c.h);
+            }
+            c.verts.push_back(v);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        rowOpt.software.skipTiles = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsShaded == rs.pixelsCovered);
+        });
+    }
+}
+
+TEST_CASE("aligned pass: chains of products that pass the range's top are clamped after each op", "[draw][aligned]") {
+    // The weighted blur's mul and three mads (one kernel for the chain: exec::FastKernels::chain)
+    // with weights whose sum passes 1, over bright random texels: the running sum meets hi and
+    // is clamped after each op, as the quad path's per-op arithmetic does. POINT taps at whole
+    // texels (direct runs) and bilinear ones between texels.
+    std::mt19937 rng(20261131);
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    for (int i = 0; i < 8; ++i) {
+        Case c = randomCase(rng);
+        c.w = 70, c.h = 5;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        for (Case::Tex& t : c.tex) {
+            t.w = c.w, t.h = c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = i % 2 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.addressU = t.addressV = D3DTADDRESS_CLAMP;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(std::uniform_int_distribution<int>(100, 255)(rng));
+        }
+        c.oneTexture = true;
+        // (The sub after the chain shows its clamp: the store would clamp an unclamped sum anyway.)
+        c.program = "ps_1_1\ndef c4, 0.5, 0.5, 0.5, 0.5\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                    "mad r0, t1, c1, r0\nmad r0, t2, c2, r0\nmad r0, t3, c3, r0\nsub r0, r0, c4\n";
+        for (auto& k : c.consts)
+            for (float& v : k) v = real(0.2f, 1.0f);
+        c.blend = 0, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false, c.fog = false, c.depth = false;
+        c.verts.clear();
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        const float shift = i % 2 ? 0.5f : 1.0f;
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (float(s) - 1.5f) * shift / float(c.w);
+                v.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            }
+            c.verts.push_back(v);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        rowOpt.software.skipTiles = false;
+        Device quadDev(quadOpt), rowDev(rowOpt);
+        DrawStats qs, rs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsShaded == rs.pixelsCovered);
+        // The clamp mattered: the sum reached 1, less 0.5 (the byte 127 or 128).
+        CHECK(std::count_if(expected.begin(), expected.end(), [](uint8_t b) { return b == 127 || b == 128; }) > 100);
+    }
+}

@@ -1,0 +1,220 @@
+// Tile skipping (emu/tile_skip.h) against every pixel shaded: random draws over partly constant
+// textures, 1:1 copies stored straight from the texel row, tiles over different constants of one
+// texture.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "emu/aligned_float.h"
+#include "emu/aligned_pass.h"
+#include "emu/aligned_pass_kernels.h"
+#include "emu/device.h"
+#include "emu/format.h"
+#include "ps11/assembler.h"
+#include "ps11/validator.h"
+#include "aligned_cases.h"
+#include "simd_levels.h"
+
+using namespace emu;
+
+using namespace alignedcases;
+
+TEST_CASE("tile skipping: random draws over partly constant textures equal every pixel shaded",
+          "[draw][aligned][skip]") {
+    // Textures that are zero, one constant texel, zero with a few random blocks (a sparse glare),
+    // or stripes of different constants (tiles whose ranges are different single values); programs of glare passes
+    // (composites, bright passes, blurs) among the random ones; fx8, float, ideal and fx12; ONE/ONE blending often.
+    // Skipping on must give the bytes of skipping off (and of the quad path), and must really fill, copy and skip
+    // tiles.
+    const char* const programs[] = {
+        "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n",
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n",
+        "ps_1_1\ntex t0\nsub_sat r0, t0, c1\nmul_x4 r0, r0, c2\n",
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, "
+        "c0, r0\n",
+        "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r1, c0, r0\n",
+    };
+    std::mt19937 rng(20261128);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    uint64_t filled = 0, copied = 0, skipped = 0, shaded = 0;
+    for (int i = 0; i < 480; ++i) {
+        const int profile = i % 4;  // fx8, float, ideal, fx12 (the radeon8500 class)
+        Case c = randomCase(rng, profile == 1 || profile == 2);
+        if (uni(0, 1)) c.fog = c.depth = false;  // (depth and fog keep a zero ONE/ONE tile from being skipped)
+        if (uni(0, 2)) c.program = programs[uni(0, int(std::size(programs)) - 1)];
+        if (uni(0, 1)) c.blend = 1;  // ONE/ONE
+        if (uni(0, 1)) c.rtFormat = D3DFMT_A8R8G8B8;
+        for (Case::Tex& t : c.tex) {
+            const uint32_t tb = texelBytes(t.format);
+            const int kind = uni(0, 4);
+            if (kind == 0) continue;  // random texels
+            std::vector<uint8_t> texel(tb, 0);
+            if (kind == 2)
+                for (uint8_t& b : texel) b = uint8_t(uni(0, 1) ? rng() : 0);
+            for (size_t k = 0; k < t.bytes.size(); ++k) t.bytes[k] = texel[k % tb];
+            if (kind == 4) {  // stripes of columns, each one constant (zero or not): tiles of different constants
+                const UINT stripe = UINT(uni(8, 96));
+                for (UINT x0 = 0; x0 < t.w; x0 += stripe) {
+                    for (uint8_t& b : texel) b = uint8_t(uni(0, 2) ? rng() : 0);
+                    for (UINT y = 0; y < t.h; ++y)
+                        for (UINT x = x0; x < std::min(t.w, x0 + stripe); ++x)
+                            for (uint32_t k = 0; k < tb; ++k) t.bytes[(size_t(y) * t.w + x) * tb + k] = texel[k];
+                }
+            }
+            if (kind == 3) {  // a few random blocks on zero
+                const int blocks = uni(1, 3);
+                for (int b = 0; b < blocks; ++b) {
+                    const UINT bx = UINT(uni(0, int(t.w) - 1)), by = UINT(uni(0, int(t.h) - 1));
+                    const UINT bw = UINT(uni(1, 12)), bh = UINT(uni(1, 6));
+                    for (UINT y = by; y < std::min(t.h, by + bh); ++y)
+                        for (UINT x = bx; x < std::min(t.w, bx + bw); ++x)
+                            for (uint32_t k = 0; k < tb; ++k) t.bytes[(size_t(y) * t.w + x) * tb + k] = uint8_t(rng());
+                }
+            }
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+        quadOpt.precision = rowOpt.precision = profile == 0   ? ps11::Precision::Fx8
+                                               : profile == 1 ? ps11::Precision::Float
+                                                              : ps11::Precision::Ideal;
+        if (profile == 3) radeon8500(quadOpt, rowOpt);
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats qs, rs, ks;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << ps11::precisionName(*quadOpt.precision) << ", blend "
+                     << c.blend << ", program:\n"
+                     << c.program);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        const std::vector<uint8_t> got = drawCase(skipDev, c, ks);
+        size_t firstDiff = 0;
+        while (firstDiff < got.size() && got[firstDiff] == expected[firstDiff]) ++firstDiff;
+        INFO("first difference at pixel " << firstDiff / 4 % c.w << ", " << firstDiff / 4 / c.w << "; tiles filled "
+                                          << ks.tilesFilled << " copied " << ks.tilesCopied << " skipped "
+                                          << ks.tilesSkipped);
+        REQUIRE(firstDiff == got.size());
+        CHECK(ks.pixelsCovered == qs.pixelsCovered);
+        filled += ks.tilesFilled, copied += ks.tilesCopied, skipped += ks.tilesSkipped, shaded += ks.tilesShaded;
+    }
+    INFO("tiles shaded " << shaded << ", filled " << filled << ", copied " << copied << ", skipped " << skipped);
+    CHECK(filled > 20);
+    CHECK(copied > 20);
+    CHECK(skipped > 5);
+}
+
+TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain and ONE/ONE", "[draw][aligned][skip]") {
+    // The sprites' composite (mul r0, t0, c0 with c0 = (1, 1, 1, 0), ONE/ONE) and plain copies: every
+    // tile is a copy whatever the texels, and the copy goes from the texture's row to the target
+    // (a row copy, or a saturating byte add). Bytes must equal skipping off and the quad path.
+    std::mt19937 rng(20261127);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n",
+                                    "ps_1_1\ntex t0\nmov r0.rgb, t0\n+mov r0.a, c1.a\n"};
+    uint64_t copied = 0;
+    for (int i = 0; i < 96; ++i) {
+        Case c = randomCase(rng);
+        c.w = UINT(uni(1, 300)), c.h = UINT(uni(1, 40));
+        c.rtFormat = uni(0, 2) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        for (Case::Tex& t : c.tex) {
+            t.w = c.w, t.h = c.h;
+            t.format = uni(0, 2) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 3) ? rng() : 255);
+            t.filter = uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.bound = true;
+        }
+        c.program = programs[size_t(i) % std::size(programs)];
+        for (int k = 0; k < 4; ++k) c.consts[0][k] = k < 3 ? 1.0f : 0.0f;
+        c.consts[1][3] = float(uni(0, 4)) * 0.25f;
+        fullTargetQuad(c);
+        c.blend = DWORD(i % 2);  // plain, ONE/ONE
+        c.alphaTest = false, c.writeMask = 0xf, c.scissor = uni(0, 5) == 0;
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        // The second half in fx12: a texel's grid value 16·b stores b, and a constant channel
+        // between two bytes rounds with the sum, so it is not copied (c1.a = 0.5: 2040, whose
+        // sum with 16·d rounds to the even byte, into a target with alpha).
+        if (i >= 48) {
+            radeon8500(quadOpt, rowOpt);
+            if (i % 3 == 2) c.rtFormat = D3DFMT_A8R8G8B8, c.consts[1][3] = 0.5f;
+        }
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats qs, rs, ks;
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", blend " << c.blend
+                     << ", program:\n"
+                     << c.program);
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        copied += ks.tilesCopied;
+    }
+    CHECK(copied > 96);
+}
+
+TEST_CASE("tile skipping: tiles over different constants of one texture are decided each for its own",
+          "[draw][aligned][skip]") {
+    // add r0, t0, t1 over random scene texels t0 and a glare t1 of stripes, each stripe one
+    // constant (zero, then not): the renderer decides a tile over its stages' ranges with the
+    // varying scene widened to the whole texture's (one evaluation for every tile over a zero
+    // glare: a copy of the scene), so a tile over the non-zero stripe must not take the zero
+    // stripe's copy. Bytes must equal skipping off; both kinds of tile must occur.
+    std::mt19937 rng(20261128);
+    for (int i = 0; i < 8; ++i) {
+        Case c = randomCase(rng);
+        c.w = 1024, c.h = 48;
+        c.oneTexture = false;
+        c.rtFormat = D3DFMT_A8R8G8B8;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        c.tex.resize(4);
+        for (size_t s = 0; s < c.tex.size(); ++s) {
+            Case::Tex& t = c.tex[s];
+            t.w = c.w, t.h = c.h;
+            t.format = D3DFMT_A8R8G8B8;
+            t.filter = i & 1 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.addressU = t.addressV = D3DTADDRESS_CLAMP;  // (wrap would let every tile reach every stripe)
+            t.bound = s < 2;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (UINT y = 0; y < t.h; ++y)
+                for (UINT x = 0; x < t.w; ++x)
+                    for (int k = 0; k < 4; ++k) {
+                        // Stripes of 256 columns (two whole tiles inside each): zero, then
+                        // 40 + 20·stripe, the last one zero again.
+                        const UINT stripe = x / 256;
+                        const uint8_t glare = stripe == 0 || stripe == 3 ? 0 : uint8_t(40 + 20 * stripe);
+                        t.bytes[(size_t(y) * t.w + x) * 4 + size_t(k)] = s == 0 ? uint8_t(rng()) : glare;
+                    }
+        }
+        c.program = i & 2 ? "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n" : "ps_1_1\ntex t0\ntex t1\nadd r0, t1, t0\n";
+        fullTargetQuad(c);
+        c.blend = DWORD(i >> 2);  // plain, ONE/ONE
+        c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        DeviceOptions rowOpt;
+        rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats rs, ks;
+        INFO("case " << i << ", program:\n" << c.program);
+        const std::vector<uint8_t> expected = drawCase(rowDev, c, rs);
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        INFO("tiles shaded " << ks.tilesShaded << ", copied " << ks.tilesCopied);
+        CHECK(ks.tilesCopied > 0);
+        CHECK(ks.tilesShaded > 0);
+    }
+}
