@@ -4,7 +4,7 @@
 // and ideal profiles) and the output merger's half store. The executor's fx8 kernels, the fast
 // sampler and the aligned-pass path are compared across levels by test_executor_fast.cpp,
 // test_sampler_fast.cpp and test_aligned_pass.cpp (and the half store once more by
-// test_output_merger.cpp, against format.cpp).
+// test_output_merger_float.cpp, against format.cpp).
 #include <catch2/catch.hpp>
 
 #include <array>
