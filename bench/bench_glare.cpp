@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "emu/fullscreen.h"
+#include "emu/thread_pool.h"
 #include "glare/compare.h"
 #include "glare/runner.h"
 #include "glare/scene.h"
@@ -199,9 +200,29 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
             }
     std::vector<double> panelMs[2][3];
     uint64_t sparseBytes = 0;
+    // The host's memory speed in the same run: one 1080p RGBA8 target copied into another by the
+    // emulator's workers (each its half), timed once per iteration between the frames. Its bytes
+    // are counted as PassStats::bytes counts a pass's (read and written), so the sparse frame's
+    // floor in bytes over this speed is that floor in time on this host, today.
+    const size_t probeBytes = size_t(kW) * kH * 4;
+    std::vector<uint8_t> probeFrom(probeBytes, 1), probeTo(probeBytes, 0);
+    const std::shared_ptr<emu::ThreadPool> probePool = emu::ThreadPool::shared(threads());
+    std::vector<double> probeMs;
+    auto probe = [&] {
+        const int n = probePool->size();
+        const auto t0 = std::chrono::steady_clock::now();
+        probePool->run(n, [&](int i) {
+            const size_t a = probeBytes * size_t(i) / size_t(n) / 64 * 64, b = probeBytes * size_t(i + 1) / size_t(n) / 64 * 64;
+            std::memcpy(probeTo.data() + a, probeFrom.data() + a, (i + 1 == n ? probeBytes : b) - a);
+        });
+        probeMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    };
+    probe();  // (the pages touched once before timing)
+    probeMs.clear();
     glare::FrameResult sparseFrame;  // the last sparse frame on the emulator, for its tile counts
     int f = 1;
     for (auto _ : state) {
+        probe();
         for (int d = 0; d < 2; ++d)
             for (int k = 0; k < 3; ++k) {
                 double sceneMs = 0;
@@ -310,6 +331,10 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["fx8_dense_vs_noskip_pct"] = 100.0 * median(panelMs[1][0]) / median(panelMs[1][2]);
     state.counters["fx8_sparse_floor_mb"] = double(sparseBytes) / 1e6;
     state.counters["fx8_sparse_gbps"] = double(sparseBytes) / 1e6 / median(panelMs[0][0]);
+    const double copyGbps = 2.0 * double(probeBytes) / 1e6 / median(probeMs);
+    state.counters["copy_gbps"] = copyGbps;
+    state.counters["fx8_sparse_floor_ms"] = double(sparseBytes) / 1e6 / copyGbps;
+    state.counters["fx8_sparse_over_floor"] = median(panelMs[0][0]) / (double(sparseBytes) / 1e6 / copyGbps);
     uint64_t tiles[4] = {};
     for (const glare::PassStats& p : sparseFrame.passes) {
         tiles[0] += p.tilesShaded, tiles[1] += p.tilesFilled, tiles[2] += p.tilesCopied, tiles[3] += p.tilesSkipped;
