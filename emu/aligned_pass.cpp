@@ -374,7 +374,8 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
             const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
             const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
                                            row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
-            const HKind kind = run.tabulated ? HKind::H : hKindOf(cols.w[size_t(x - colBase)]);
+            const HKind kind = run.tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H)
+                                              : hKindOf(cols.w[size_t(x - colBase)]);
             vertical(kind, h0, h1, row.wy, e - x, x - first, out);
             x = e;
             continue;
@@ -396,9 +397,9 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
             for (int done = 0; done < e - x; done += ps11::kMaxSpan) {
                 const int n = std::min(ps11::kMaxSpan, e - x - done);
                 const size_t k = at + size_t(done);
-                kernels->buildTabulated(row.row0, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h0);
+                kernels->buildTabulated(row.row0, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h0, 0);
                 if (row.wy != 0)
-                    kernels->buildTabulated(row.row1, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1);
+                    kernels->buildTabulated(row.row1, int(tap.width), &cols.off0[k], &cols.off1[k], &cols.w[k], n, h1, 0);
                 const uint16_t* const c0[4] = {h0[0], h0[1], h0[2], h0[3]};
                 const uint16_t* const c1[4] = {h1[0], h1[1], h1[2], h1[3]};
                 vertical(HKind::H, c0, c1, row.wy, n, x + done - first, out);
@@ -494,7 +495,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
             const int n = config.jhi - config.jlo;
             uint16_t* out[4];
             slotPlanes(h, n, kHRowPad, out);
-            kernels.buildTabulated(row, config.rowTexels, config.off0, config.off1, config.w, n, out);
+            kernels.buildTabulated(row, config.rowTexels, config.off0, config.off1, config.w, n, out, config.q16 ? 4 : 0);
             ++cache.built;
         } else {
             ++cache.hits;

@@ -130,6 +130,7 @@ struct HConfig {
     const int32_t* off1 = nullptr;
     const int32_t* w = nullptr;
     int32_t rowTexels = 0;  // texels in a texel row (the texture's width)
+    bool q16 = false;       // tabulated, every weight a multiple of 16: its H rows are of kind Q
     uint64_t hash = 0;
     uint64_t tableId = 0;  // unique per prepared table (a slot that checked it needs no second look)
 };
@@ -148,6 +149,7 @@ struct AlignedTriangle {
         std::vector<Run> runs;
         std::array<int32_t, kMaxTapConfigs> configs{};  // indices into AlignedTriangle::configs
         int configCount = 0;
+        bool tabulatedQ16 = false;  // its tabulated configuration's H rows are of kind Q (HConfig::q16)
     };
     std::array<Columns, 8> taps;
     std::vector<HConfig> configs;

@@ -162,7 +162,8 @@ void alignedCombineAvx2(const uint16_t* const t[4], int n, int step, int32_t wx,
 }
 
 void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t* off0, const int32_t* off1,
-                               const int32_t* w, int n, uint16_t* const out[4]) {
+                               const int32_t* w, int n, uint16_t* const out[4], int shift) {
+    const __m128i shiftV = _mm_cvtsi32_si128(shift);
     static constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a within a b g r a word
     // Per channel: byte of a to bits 0-7 of each dword, byte of b to bits 16-23 (pmaddwd pairs).
     // Made once (a sprite's rows call this for a hundred columns: building them per call was a
@@ -223,15 +224,18 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t*
                     _mm256_or_si256(_mm256_shuffle_epi8(a, selA[c]), _mm256_shuffle_epi8(b, selB[c])), wp);
         }
         for (int c = 0; c < 4; ++c)
-            storeu(out[c] + j, _mm256_permute4x64_epi64(_mm256_packus_epi32(m[0][c], m[1][c]), 0xD8));
+            storeu(out[c] + j, _mm256_permute4x64_epi64(
+                                   _mm256_packus_epi32(_mm256_srl_epi32(m[0][c], shiftV), _mm256_srl_epi32(m[1][c], shiftV)),
+                                   0xD8));
     }
     for (; j < n; ++j) {
         uint32_t a, b;
         std::memcpy(&a, row + std::max(off0[j], 0), 4);
         std::memcpy(&b, row + std::max(off1[j], 0), 4);
         for (int c = 0; c < 4; ++c)
-            out[c][j] = uint16_t(((a >> (8 * kByte[c])) & 0xffu) * uint32_t(256 - w[j]) +
-                                 ((b >> (8 * kByte[c])) & 0xffu) * uint32_t(w[j]));
+            out[c][j] = uint16_t((((a >> (8 * kByte[c])) & 0xffu) * uint32_t(256 - w[j]) +
+                                  ((b >> (8 * kByte[c])) & 0xffu) * uint32_t(w[j])) >>
+                                 shift);
     }
 }
 

@@ -12,8 +12,11 @@
 //   kind A (wx = 0):   a           (h = 256·a)
 //   kind S (wx = 128): a + b       (h = 128·(a + b))
 //   kind H (other wx): a·(256 − wx) + b·wx = h
+//   kind Q (a tabulated row whose every weight is a multiple of 16, as a 2×, 4× or 8×
+//           magnification's are): h / 16, exact, at most 4080
 // where a, b are the channel bytes of texels i = step·j + phase and i + 1. The blend of the
-// reference sampler is round_half_even((h0·(256 − wy) + h1·wy) / 65536).
+// reference sampler is round_half_even((h0·(256 − wy) + h1·wy) / 65536); for kind Q with wy a
+// multiple of 16 that is round_half_even((q0·(16 − wy/16) + q1·wy/16) / 256) in 16 bits.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +26,7 @@
 
 namespace emu {
 
-enum class HKind : uint8_t { A, S, H };
+enum class HKind : uint8_t { A, S, H, Q };
 
 inline HKind hKindOf(int32_t wx) { return wx == 0 ? HKind::A : (wx == 128 ? HKind::S : HKind::H); }
 
@@ -51,11 +54,12 @@ struct AlignedKernels {
     // Reads texels [0, 4n) only; writes the planes up to the next multiple of 16.
     void (*pairSums4)(const uint8_t* row, int n, uint16_t* const even[4], uint16_t* const odd[4]);
 
-    // Tabulated H row j in [0, n) (kind H for every weight): (256 − w[j])·a + w[j]·b with a, b
-    // the channel bytes of the b g r a words at row + off0[j], row + off1[j] (byte offsets within
-    // the row's `rowTexels` words; negative offsets read texel 0: such elements are never used).
+    // Tabulated H row j in [0, n): ((256 − w[j])·a + w[j]·b) >> shift with a, b the channel bytes
+    // of the b g r a words at row + off0[j], row + off1[j] (byte offsets within the row's
+    // `rowTexels` words; negative offsets read texel 0: such elements are never used). Shift 0
+    // gives kind H for every weight; shift 4, where every w[j] is a multiple of 16, kind Q.
     void (*buildTabulated)(const uint8_t* row, int rowTexels, const int32_t* off0, const int32_t* off1,
-                           const int32_t* w, int n, uint16_t* const out[4]);
+                           const int32_t* w, int n, uint16_t* const out[4], int shift);
 
     // Lanes [lane, lane + count) of out[c] from H rows h0, h1 (planes, read from element 0) of
     // kind `kind` with vertical weight wy (h1 unused when wy = 0): the blended channel bytes.

@@ -306,6 +306,7 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
         AlignedTriangle::Columns& cols = out.taps[size_t(i)];
         cols.runs.clear();
         cols.configCount = 0;
+        cols.tabulatedQ16 = false;
         if (!tap.bound || ((out.freeTaps >> i) & 1)) {  // no table (the triangle may be a previous chunk's or draw's)
             cols.off0.clear(), cols.off1.clear(), cols.w.clear(), cols.run.clear();
             continue;
@@ -415,6 +416,8 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
             for (size_t k = 0; k < len; ++k)
                 for (const int32_t v : {h.off0[k], h.off1[k], h.w[k]}) hash = (hash ^ uint32_t(v)) * 1099511628211ull;
             h.hash = hash;
+            h.q16 = std::all_of(h.w, h.w + len, [](int32_t w) { return w % 16 == 0; });
+            cols.tabulatedQ16 = h.q16;
             static std::atomic<uint64_t> tableIds{0};
             h.tableId = ++tableIds;
         }

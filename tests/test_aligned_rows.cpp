@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <random>
 #include <string>
@@ -281,24 +282,32 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
     }
 }
 
-TEST_CASE("aligned pass: magnified taps (2x, 3x, 8x, non-integer) equal the quad path byte for byte",
+TEST_CASE("aligned pass: magnified taps (2x, 3x, 4x, 8x, 16x, non-integer) equal the quad path byte for byte",
           "[draw][aligned]") {
     // A glare composite's blurred tap reads a small texture magnified: consecutive columns share
-    // their texels and the weight changes every column (tabulated H rows). Every address mode,
+    // their texels and the weight changes every column (tabulated H rows; at 2x, 4x and 8x every
+    // weight is a multiple of 16, kind Q, at 16x of 8 only). Every address mode,
     // border colours, coordinates past [0, 1] (border and wrapped texels inside a row), point
     // and linear filters, one or two threads.
     std::mt19937 rng(20261127);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
-    const float scales[] = {2.0f, 3.0f, 8.0f, 2.5f, 1.75f, 5.3f, 1.0f / 0.9f};
+    const float scales[] = {2.0f, 3.0f, 8.0f, 2.5f, 1.75f, 5.3f, 1.0f / 0.9f, 4.0f, 16.0f};
     int aligned = 0, cases = 0;
     for (int i = 0; i < 280; ++i) {
         Case c = randomCase(rng);
+        const float scale = scales[size_t(i) % std::size(scales)];
         c.w = UINT(uni(16, 420));
         c.h = UINT(uni(2, 20));
+        // An integer scale over a target of whole multiples half the time: the texture spans the
+        // target exactly, so its weights are those of the scale (multiples of 256 / scale).
+        if (scale == std::floor(scale) && uni(0, 1)) {
+            const UINT k = UINT(scale);
+            c.w = std::max(k, c.w / k * k);
+            c.h = std::max(k, (c.h + k) / k * k);
+        }
         c.rtInit.resize(size_t(c.w) * c.h * 4);
         for (uint8_t& b : c.rtInit) b = uint8_t(rng());
-        const float scale = scales[size_t(i) % std::size(scales)];
         float u[4][2], v[4][2];
         for (int s = 0; s < 4; ++s) {
             Case::Tex& t = c.tex[size_t(s)];
