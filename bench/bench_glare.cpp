@@ -201,20 +201,17 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     std::vector<double> panelMs[2][3];
     uint64_t sparseBytes = 0;
     // The host's memory speed in the same run: one 1080p RGBA8 target copied into another by the
-    // emulator's workers (each its half), timed once per iteration between the frames. Its bytes
-    // are counted as PassStats::bytes counts a pass's (read and written), so the sparse frame's
-    // floor in bytes over this speed is that floor in time on this host, today.
+    // emulator's workers (emu::parallelCopy), timed once per iteration between the frames (the
+    // buffers made once). Its bytes are counted as PassStats::bytes counts a pass's (read and
+    // written), so the sparse frame's floor in bytes over this speed is that floor in time on
+    // this host, today. Runner::copySpeed's warm and cold copies, after the frames, bound it.
     const size_t probeBytes = size_t(kW) * kH * 4;
     std::vector<uint8_t> probeFrom(probeBytes, 1), probeTo(probeBytes, 0);
     const std::shared_ptr<emu::ThreadPool> probePool = emu::ThreadPool::shared(threads());
     std::vector<double> probeMs;
     auto probe = [&] {
-        const int n = probePool->size();
         const auto t0 = std::chrono::steady_clock::now();
-        probePool->run(n, [&](int i) {
-            const size_t a = probeBytes * size_t(i) / size_t(n) / 64 * 64, b = probeBytes * size_t(i + 1) / size_t(n) / 64 * 64;
-            std::memcpy(probeTo.data() + a, probeFrom.data() + a, (i + 1 == n ? probeBytes : b) - a);
-        });
+        emu::parallelCopy(*probePool, probeTo.data(), probeFrom.data(), probeBytes);
         probeMs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     };
     probe();  // (the pages touched once before timing)
@@ -333,6 +330,9 @@ void BM_Glare(benchmark::State& state, const std::string& name) {
     state.counters["fx8_sparse_gbps"] = double(sparseBytes) / 1e6 / median(panelMs[0][0]);
     const double copyGbps = 2.0 * double(probeBytes) / 1e6 / median(probeMs);
     state.counters["copy_gbps"] = copyGbps;
+    const glare::Runner::CopySpeed bounds = run[EmuFx8]->copySpeed();
+    state.counters["copy_warm_gbps"] = bounds.warm;
+    state.counters["copy_cold_gbps"] = bounds.cold;
     state.counters["fx8_sparse_floor_ms"] = double(sparseBytes) / 1e6 / copyGbps;
     state.counters["fx8_sparse_over_floor"] = median(panelMs[0][0]) / (double(sparseBytes) / 1e6 / copyGbps);
     uint64_t tiles[4] = {};

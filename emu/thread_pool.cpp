@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <map>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -118,6 +119,15 @@ void ThreadPool::workerLoop(int index) {
             if (m_pending.fetch_sub(1, std::memory_order_acq_rel) == 1) m_done.notify_one();
         }
     }
+}
+
+void parallelCopy(ThreadPool& pool, void* to, const void* from, size_t bytes) {
+    const int n = pool.size();
+    pool.run(n, [&](int i) {
+        const size_t a = bytes * size_t(i) / size_t(n) / 64 * 64;
+        const size_t b = i + 1 == n ? bytes : bytes * size_t(i + 1) / size_t(n) / 64 * 64;
+        if (b > a) std::memcpy(static_cast<uint8_t*>(to) + a, static_cast<const uint8_t*>(from) + a, b - a);
+    });
 }
 
 }  // namespace emu

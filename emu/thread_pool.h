@@ -60,4 +60,9 @@ private:
     std::atomic<bool> m_busy{false};  // a run() is using the workers
 };
 
+// `bytes` from `from` to `to` (not overlapping), each of the pool's workers copying its share (in
+// whole 64-byte lines but the last): the host's memory speed as the renderer's threads see it
+// (Runner::copySpeed, bench_glare's copy_gbps).
+void parallelCopy(ThreadPool& pool, void* to, const void* from, size_t bytes);
+
 }  // namespace emu

@@ -214,6 +214,36 @@ emu::ThreadPool& Runner::cpuPool() {
     return *m_cpuPool;
 }
 
+Runner::CopySpeed Runner::copySpeed() {
+    const size_t bytes = std::max<size_t>(size_t(m_options.width) * m_options.height * 4, 64);
+    // The cold ring: four pairs, at least 64 MiB together (a smaller frame's surfaces are copied
+    // from further into a larger ring: every copy still reads and writes `bytes`).
+    constexpr size_t kPairs = 4, kRing = size_t(64) << 20;
+    const size_t stride = std::max(bytes, kRing / (2 * kPairs));
+    std::vector<uint8_t> ring(2 * kPairs * stride, 1);  // every page touched here
+    emu::ThreadPool& pool = cpuPool();
+    auto speed = [&](auto&& pair) {
+        std::vector<double> ms;
+        for (int i = 0; i < 6; ++i) {
+            const auto [to, from] = pair(i);
+            const auto t0 = std::chrono::steady_clock::now();
+            emu::parallelCopy(pool, to, from, bytes);
+            if (i > 0)  // (the first untimed)
+                ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        }
+        std::sort(ms.begin(), ms.end());
+        const double median = ms[ms.size() / 2];
+        return median > 0 ? 2.0 * double(bytes) / 1e6 / median : 0.0;
+    };
+    CopySpeed s;
+    s.warm = speed([&](int) { return std::pair{ring.data() + stride, ring.data()}; });
+    s.cold = speed([&](int i) {
+        uint8_t* from = ring.data() + 2 * size_t(i % int(kPairs)) * stride;
+        return std::pair{from + stride, static_cast<const uint8_t*>(from)};
+    });
+    return s;
+}
+
 bool Runner::readPixels(Handle texture, const std::function<bool(const Pixels&)>& use, std::string& error) {
     emu::Device& d = *m_device;
     Handle surface{};

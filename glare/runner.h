@@ -133,6 +133,18 @@ public:
     // Those threads: the renderer's workers (the software renderer's), else a pool of
     // cpuThreads() the runner starts on first use. No thread is started per frame.
     emu::ThreadPool& cpuPool();
+    // The host's memory speed now, in GB/s: an RGBA8 surface of the frame's size copied into
+    // another by cpuPool()'s threads (emu::parallelCopy), its bytes read and written counted as
+    // PassStats::bytes counts a pass's, the median of five copies after one untimed. `warm`: the
+    // same two surfaces each time (within the last-level cache where they fit); `cold`: four pairs
+    // in turn, 64 MiB or more in all, so each copy's surfaces were last touched three copies
+    // earlier (from memory, unless the cache holds that much). A pass that moved only its bytes
+    // would run at about these speeds (ps11 glare's per-pass table; bench/README.md
+    // "bench_glare").
+    struct CopySpeed {
+        double warm = 0, cold = 0;
+    };
+    CopySpeed copySpeed();
     TexturePool& pool() { return *m_pool; }
 
 private:

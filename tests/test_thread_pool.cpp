@@ -1,8 +1,10 @@
 // emu::ThreadPool: every worker index runs once per call, however the pool is shared, called
-// from several threads at once or from inside one of its own jobs.
+// from several threads at once or from inside one of its own jobs; parallelCopy.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <thread>
 #include <vector>
 
@@ -46,4 +48,19 @@ TEST_CASE("thread pool: each index runs once, from several threads at once and f
     });
     CHECK(outer == 3);
     CHECK(inner == 12);
+}
+
+TEST_CASE("thread pool: parallelCopy copies every byte and nothing past them, on any thread count", "[threads]") {
+    // Sizes around the 64-byte lines the shares are cut at, and sizes smaller than one share each.
+    for (int threads : {1, 2, 3, 7})
+        for (size_t bytes : {size_t(0), size_t(1), size_t(63), size_t(64), size_t(65), size_t(200), size_t(4097),
+                             size_t(1) << 20}) {
+            INFO(threads << " threads, " << bytes << " bytes");
+            std::shared_ptr<emu::ThreadPool> pool = emu::ThreadPool::shared(threads);
+            std::vector<uint8_t> from(bytes), to(bytes + 64, 0xee);
+            for (size_t i = 0; i < bytes; ++i) from[i] = uint8_t(i * 131 + i / 251);
+            emu::parallelCopy(*pool, to.data(), from.data(), bytes);
+            CHECK(std::equal(from.begin(), from.end(), to.begin()));
+            CHECK(std::all_of(to.begin() + std::ptrdiff_t(bytes), to.end(), [](uint8_t b) { return b == 0xee; }));
+        }
 }

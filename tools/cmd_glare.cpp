@@ -16,6 +16,7 @@
 #include "emu/format.h"
 #include "emu/fullscreen.h"
 #include "emu/image_file.h"
+#include "emu/thread_pool.h"
 #include "glare/compare.h"
 #include "glare/photos.h"
 #include "glare/report.h"
@@ -464,6 +465,9 @@ int runGlare(const GlareOptions& o) {
         if (ideal) return cli::kOk;
         return over == 0 ? cli::kOk : cli::kUserError;
     }
+    // The host's memory speed, measured now, after the frames: what the MB column's passes would
+    // reach if moving their bytes were all they did.
+    const glare::Runner::CopySpeed copy = main->copySpeed();
     if (o.json) {
         json::Json j;
         j["technique"] = std::string(technique->name());
@@ -493,6 +497,7 @@ int runGlare(const GlareOptions& o) {
         j["graph_ms"] = json::rounded(lastBuildMs, "%.3f");
         j["still"] = lastStill;
         j["renderer"] = main->device().rendererName();
+        j["copy_gbps"] = {{"warm", json::rounded(copy.warm, "%.1f")}, {"cold", json::rounded(copy.cold, "%.1f")}};
         j["frame_uploads"] = lastTransfers.uploads;
         j["frame_readbacks"] = lastTransfers.readBacks;
         std::cout << json::dump(j, 2) << "\n";
@@ -525,6 +530,13 @@ int runGlare(const GlareOptions& o) {
     }
     std::printf("%-22s %9.3f  (the technique's graph, built and compiled on the CPU; part of the frame's time)\n",
                 "(frame graph)", lastBuildMs);
+    uint64_t frameBytes = 0;
+    for (const glare::PassStats& s : lastStats) frameBytes += s.reused ? 0 : s.bytes;
+    auto floorMs = [&](double gbps) { return gbps > 0 ? double(frameBytes) / 1e6 / gbps : 0.0; };
+    std::printf("(this host now: a %ux%u RGBA8 copy on %d thread(s) moves %.1f GB/s from the cache and %.1f from memory,\n"
+                " read and written counted as MB is: the last frame's %.2f MB would take %.3f to %.3f ms)\n",
+                width, height, main->cpuPool().size(), copy.warm, copy.cold, double(frameBytes) / 1e6,
+                floorMs(copy.warm), floorMs(copy.cold));
     if (lastStill)
         std::printf("(the last frame was skipped whole: a still input whose frame before reused every pass; nothing was\n"
                     " built or run)\n");
