@@ -3,7 +3,7 @@
 // kernel set of every SIMD level this CPU runs (SSE2, AVX2) are checked exhaustively over every
 // input that does not saturate, and sampled beyond; then whole programs are compared pixel by
 // pixel at every level: every arithmetic op over all operand pairs with each modifier, shift and
-// _sat, random valid programs (co-issue, masks, selectors, 1_4 ranges) over spans of 1..256
+// _sat, random valid programs (co-issue, masks, selectors, 1_4 ranges) over spans of 1..kMaxSpan
 // pixels, and textured programs.
 #include <algorithm>
 #include <array>
@@ -362,7 +362,7 @@ TEST_CASE("fast: every op over all operand pairs, each modifier, shift and _sat 
     CHECK(bad == 0);
 }
 
-TEST_CASE("fast: random valid programs over spans of 1..256 pixels equal the generic path", "[fast]") {
+TEST_CASE("fast: random valid programs over spans of 1..kMaxSpan pixels equal the generic path", "[fast]") {
     using namespace execrand;
     ps11::NullSampler sampler;
     struct Run {
@@ -389,7 +389,7 @@ TEST_CASE("fast: random valid programs over spans of 1..256 pixels equal the gen
             if (g.coin(0.2)) M = r.minor == 4 ? std::array<float, 4>{1, 2, 4, 16}[size_t(g.uni(0, 3))] : 2.0f;
             const bool fastExpected = M != 16.0f;
             const int count = g.coin(0.3) ? g.uni(1, 40) : g.uni(41, 700);
-            const int span = g.coin(0.5) ? 256 : g.uni(1, 256);
+            const int span = g.coin(0.5) ? ps11::kMaxSpan : g.uni(1, ps11::kMaxSpan);  // (spans of more than one chunk too)
             Lanes l(count);
             for (int i = 0; i < count; ++i) {
                 Inputs in = g.inputs();

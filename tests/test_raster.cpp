@@ -301,7 +301,7 @@ TEST_CASE("raster: spans are 2x2 quads with helper lanes", "[raster]") {
 }
 
 TEST_CASE("raster: a wide row pair is cut into spans of at most kMaxSpan lanes", "[raster]") {
-    const int W = 300;
+    const int W = ps11::kMaxSpan + ps11::kMaxSpan / 2 + 44;  // 2W lanes = 3 kMaxSpan + 88
     TriangleSetup s;
     REQUIRE(setupTriangle(tri(sv(-0.5, -0.5), sv(W - 0.5, -0.5), sv(-0.5, 1e5)), 0, rect(0, 0, W, 2), s));
     std::vector<int> counts;
@@ -311,10 +311,11 @@ TEST_CASE("raster: a wide row pair is cut into spans of at most kMaxSpan lanes",
         counts.push_back(sp.count);
         for (int L = 0; L < sp.count; ++L) live += sp.live[L];
     });
-    REQUIRE(counts.size() == 3);  // 600 lanes: 256 + 256 + 88
-    CHECK(counts[0] == 256);
-    CHECK(counts[1] == 256);
-    CHECK(counts[2] == 88);
+    REQUIRE(counts.size() == 4);
+    CHECK(counts[0] == ps11::kMaxSpan);
+    CHECK(counts[1] == ps11::kMaxSpan);
+    CHECK(counts[2] == ps11::kMaxSpan);
+    CHECK(counts[3] == 88);
     CHECK(live == 2 * W);
 }
 
