@@ -535,6 +535,27 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
         return;
     }
+    if (config.wx == 0 && config.step >= 2) {
+        // A point reduction (kind A, one texel in `step`, a bright pass's 8:1): the texels it
+        // reads, picked from the row and deinterleaved; no staged row, which would deinterleave
+        // `step` times the texels used.
+        HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
+        if (fresh) {
+            const int n = config.jhi - config.jlo;
+            uint16_t* out[4];
+            slotPlanes(h, n, kHRowPad, out);
+            thread_local std::vector<uint32_t> picked;
+            picked.resize(size_t(n));
+            const uint8_t* texel = row + 4 * (size_t(config.step) * size_t(config.jlo) + size_t(config.phase));
+            for (int j = 0; j < n; ++j, texel += 4 * size_t(config.step)) std::memcpy(&picked[size_t(j)], texel, 4);
+            kernels.deinterleave(reinterpret_cast<const uint8_t*>(picked.data()), n, out);
+            ++cache.built;
+        } else {
+            ++cache.hits;
+        }
+        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        return;
+    }
     const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
     HRowCache::Slot& staged = slotFor(cache, row, stageKey, stageKey.tableId, fresh);
     const int first = config.step * config.jlo + config.phase - config.stageLo;  // staged element of jlo

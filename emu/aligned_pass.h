@@ -118,7 +118,8 @@ struct HConfig {
     const uint8_t* texels = nullptr;
     int32_t wx = 0, step = 1, phase = 0, jlo = 0, jhi = 0;
     // Texels [stageLo, stageHi) of the row: what every configuration on this texture reads,
-    // deinterleaved once per texel row and shared by them.
+    // deinterleaved once per texel row and shared by them (not set for tabulated configurations
+    // and point reductions, wx = 0 at a step of 2 or more: their H rows read the texel row).
     int32_t stageLo = 0, stageHi = 0;
     // Tabulated configuration (step = 0, wx = −2): element j is absolute column jlo + j of one
     // tap's column table, H = (256 − w)·T[off0] + w·T[off1] with that column's pair and weight

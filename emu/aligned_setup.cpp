@@ -422,15 +422,17 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
             h.tableId = ++tableIds;
         }
     }
-    // Each texture's staged range: the texels every configuration on it reads.
+    // Each texture's staged range: the texels every configuration on it reads. (Tabulated rows and
+    // point reductions, hRow's kind A at a step of 2 or more, read straight from the texel rows.)
+    auto staged = [](const HConfig& h) { return h.wx != -2 && !(h.wx == 0 && h.step >= 2); };
     for (HConfig& h : out.configs) {
-        if (h.wx == -2) continue;  // tabulated: read straight from the texel rows
+        if (!staged(h)) continue;
         h.stageLo = h.step * h.jlo + h.phase;
         h.stageHi = h.step * (h.jhi - 1) + h.phase + 1 + (h.wx != 0);
     }
     for (HConfig& h : out.configs)
         for (const HConfig& o : out.configs)
-            if (o.texels == h.texels && h.wx != -2 && o.wx != -2)
+            if (o.texels == h.texels && staged(h) && staged(o))
                 h.stageLo = std::min(h.stageLo, o.stageLo), h.stageHi = std::max(h.stageHi, o.stageHi);
     // Run starts relative to their H row's first element, now that the ranges are final.
     for (int i = 0; i < draw.plan.count; ++i) {

@@ -762,6 +762,121 @@ TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equ
     }
 }
 
+TEST_CASE("aligned pass: point reductions by 2 to 8 (a bright pass) equal the quad path", "[draw][aligned]") {
+    // A W/s x H/s target point-sampling a texture s times its size (the adaptive glare's bright
+    // pass reads one scene texel in 8): four taps at different phases within each s x s block, in
+    // wrap and clamp, random texels, plain and ONE/ONE, fx8 and fx12. Their H rows are of kind A at
+    // a step of s, picked straight from the texel row.
+    std::mt19937 rng(20261201);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 12; ++i) {
+        const int scale = std::array<int, 6>{2, 3, 4, 5, 7, 8}[size_t(i % 6)];
+        Case c = randomCase(rng);
+        c.w = UINT(uni(20, 70)), c.h = 5;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const DWORD address = uni(0, 1) ? D3DTADDRESS_WRAP : D3DTADDRESS_CLAMP;
+        for (Case::Tex& t : c.tex) {
+            t.w = UINT(scale) * c.w, t.h = UINT(scale) * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+            t.filter = D3DTEXF_POINT, t.addressU = t.addressV = address;
+            t.bytes.resize(size_t(t.w) * t.h * 4);
+            for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        }
+        c.oneTexture = true;
+        c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                    "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
+        c.blend = DWORD(i % 2), c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+        c.verts.clear();
+        // Each tap at texel (s·x + px, s·y + py) of its block: the centre of that texel.
+        float phase[4][2];
+        for (auto& p : phase) p[0] = float(uni(0, scale - 1)), p[1] = float(uni(0, scale - 1));
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                const float tw = float(scale) * float(c.w), th = float(scale) * float(c.h);
+                const float half = 0.5f * float(scale) - 0.5f;  // the block's centre to its first texel's
+                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (phase[s][0] - half) / tw;
+                v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (phase[s][1] - half) / th;
+            }
+            c.verts.push_back(v);
+        }
+        for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Fx12}) {
+            DeviceOptions quadOpt, rowOpt;
+            quadOpt.software.alignedPasses = false;
+            rowOpt.software.skipTiles = false;
+            quadOpt.precision = rowOpt.precision = precision;
+            quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+            Device quadDev(quadOpt);
+            DrawStats qs;
+            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+            INFO("case " << i << ": " << c.w << "x" << c.h << " from " << scale << " times that, "
+                         << ps11::precisionName(precision));
+            testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                Device rowDev(rowOpt);
+                DrawStats rs;
+                REQUIRE(drawCase(rowDev, c, rs) == expected);
+                CHECK(rs.pixelsShaded == rs.pixelsCovered);
+            });
+        }
+    }
+}
+
+TEST_CASE("aligned pass: a point reduction's H rows are picked from the texel row, with no staged row",
+          "[draw][aligned]") {
+    // Below the device: `mov r0, t0` over a 40x4 target from a texture 8 times as wide and
+    // 4 times as high, point-sampled at texel (8x + 5, 4y + 1): every pixel is that texel's bytes,
+    // and the vector path built one H row per pixel row without deinterleaving a whole texel row.
+    const int w = 40, h = 4, sx = 8, sy = 4;
+    const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Fx8);
+    std::vector<uint8_t> texels(size_t(w * sx) * size_t(h * sy) * 4);
+    std::mt19937 rng(7);
+    for (uint8_t& b : texels) b = uint8_t(rng());
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = w, target.height = h, target.rowPitch = 4 * w;
+    target.bytes.assign(size_t(w) * h * 4, 0);
+    TriangleSetup setups[2];
+    uint64_t used = 0;
+    // Pixel x's u lands on texel 8x + 3.5 + du·8: du = 1.5 / 8 gives 8x + 5 (and v: 4y + 1).
+    quadSetups(w, h, 1.5f / float(sx), -0.5f / float(sy), setups, used);
+    AlignedDraw d;
+    std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+    std::array<ps11::SamplerState, 8> samplers{};
+    MergeState merge;
+    REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr}, false,
+                               used, d));
+    AlignedTap& tap = d.taps[0];
+    tap.bound = true;
+    d.bound = 1;
+    tap.texels = texels.data();
+    tap.width = w * sx, tap.height = h * sy;
+    tap.linear = false;
+    tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+    AlignedTriangle at[2];
+    for (int t = 0; t < 2; ++t) REQUIRE(prepareAlignedTriangle(d, setups[t], at[t]));
+    const AlignedTriangle* tp[2] = {&at[0], &at[1]};
+    const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
+    auto scratch = std::make_unique<AlignedScratch>();
+    AlignedStats stats;
+    drawAlignedRows(d, tp, sp, 2, 0, h, *scratch, stats);
+    int wrong = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 4; ++c)
+                wrong += target.bytes[(size_t(y) * w + size_t(x)) * 4 + size_t(c)] !=
+                         texels[((size_t(sy * y + 1) * size_t(w * sx)) + size_t(sx * x + 5)) * 4 + size_t(c)];
+    CHECK(wrong == 0);
+    if (alignedKernels(ps11::simdLevel())) {
+        REQUIRE(at[0].configs.size() == 1);
+        CHECK(at[0].configs[0].step == sx);
+        CHECK(at[0].configs[0].wx == 0);
+        CHECK(scratch->hrows.staged == 0);
+        CHECK(scratch->hrows.built == uint64_t(h));
+    }
+}
+
 TEST_CASE("aligned pass: chains of products that pass the range's top are clamped after each op", "[draw][aligned]") {
     // The weighted blur's mul and three mads (one kernel for the chain: exec::FastKernels::chain)
     // with weights whose sum passes 1, over bright random texels: the running sum meets hi and
