@@ -414,11 +414,44 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
     }
 }
 
-// Finds the slot for (row, key) or takes one for it: the next slot, round the slots from the last
-// one taken, used on neither the current pixel row (so every pointer handed out for a row stays
-// valid until the next row) nor the one before, or a new one. `fresh` tells whether it must be
-// filled.
-HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId, bool& fresh) {
+// Takes a slot for (row, key), whose hash `h` no slot has: the next slot, round the slots from
+// the last one taken, used on neither the current pixel row (so every pointer handed out for a
+// row stays valid until the next row) nor the one before, or a new one.
+[[gnu::noinline]] HRowCache::Slot& takeSlot(HRowCache& cache, const uint8_t* row, const HConfig& key, uint64_t tableId,
+                                            uint64_t h, uint32_t& hint) {
+    // Not one used on this pixel row or the one before (the rows a magnified tap's next pixel row
+    // most likely reads again): the first other from the clock hand (slots are taken in turn, so
+    // the one taken is the longest filled; a scan for the least recently used cost more than the
+    // misses it saved), or a new slot.
+    const size_t n = cache.keys.size();
+    size_t victim = n;
+    for (size_t k = 0, i = n ? cache.hand % n : 0; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
+        if (cache.stamps[i] + 1 < cache.stamp) {
+            victim = i;
+            break;
+        }
+    }
+    cache.hand = victim + 1;
+    if (victim == n) {
+        cache.slots.push_back(std::make_unique<HRowCache::Slot>());
+        cache.keys.push_back(0);
+        cache.stamps.push_back(0);
+    }
+    HRowCache::Slot& sl = *cache.slots[victim];
+    sl.row = row;
+    sl.config = key;
+    sl.config.tableId = tableId;
+    cache.keys[victim] = h;
+    cache.stamps[victim] = cache.stamp;
+    hint = uint32_t(victim + 1);
+    return sl;
+}
+
+// Finds the slot for (row, key) or takes one for it (takeSlot). `fresh` tells whether it must be
+// filled. Inlined into hRow: the keys it builds stay in registers (a key stored to the stack
+// and read back field by field stalled every lookup).
+[[gnu::always_inline]] inline HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& key,
+                                                       uint64_t tableId, bool& fresh) {
     // A cheap key over the fields that identify the row (never 0: 0 marks an empty slot); slots
     // with the key are then compared field by field.
     uint64_t h = (uint64_t(reinterpret_cast<uintptr_t>(row)) ^ (tableId * 0x9E3779B97F4A7C15ull) ^
@@ -447,32 +480,8 @@ HRowCache::Slot& slotFor(HRowCache& cache, const uint8_t* row, const HConfig& ke
         fresh = false;
         return *cache.slots[found];
     }
-    // Not one used on this pixel row or the one before (the rows a magnified tap's next pixel row
-    // most likely reads again): the first other from the clock hand (slots are taken in turn, so
-    // the one taken is the longest filled; a scan for the least recently used cost more than the
-    // misses it saved), or a new slot.
-    size_t victim = n;
-    for (size_t k = 0, i = n ? cache.hand % n : 0; k < n; ++k, i = i + 1 == n ? 0 : i + 1) {
-        if (cache.stamps[i] + 1 < cache.stamp) {
-            victim = i;
-            break;
-        }
-    }
-    cache.hand = victim + 1;
-    if (victim == n) {
-        cache.slots.push_back(std::make_unique<HRowCache::Slot>());
-        cache.keys.push_back(0);
-        cache.stamps.push_back(0);
-    }
-    HRowCache::Slot& sl = *cache.slots[victim];
-    sl.row = row;
-    sl.config = key;
-    sl.config.tableId = tableId;
-    cache.keys[victim] = h;
-    cache.stamps[victim] = cache.stamp;
-    hint = uint32_t(victim + 1);
     fresh = true;
-    return sl;
+    return takeSlot(cache, row, key, tableId, h, hint);
 }
 
 // Sizes a slot for n elements per plane (plus the kernels' padding) and returns its planes.
@@ -482,12 +491,19 @@ void slotPlanes(HRowCache::Slot& sl, int n, int pad, uint16_t* out[4]) {
     for (int c = 0; c < 4; ++c) out[c] = sl.data.data() + size_t(c) * size_t(sl.stride);
 }
 
+// An H row's four planes: data + c·stride (returned whole, not as four pointers stored one by one
+// and read back together, which the store buffer cannot forward).
+struct HRowRef {
+    const uint16_t* data = nullptr;
+    size_t stride = 0;
+};
+
 // The H row of texel row `row` for `config` (planes from element jlo), from the worker's cache.
 // Texel rows are first deinterleaved once per draw (a "staged" slot over the triangle's texel
 // range of that texture), then combined per configuration; weight 0 at step 1 is the staged row
 // itself.
 void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, const HConfig& config, uint64_t tableId,
-          std::array<const uint16_t*, 4>& planes) {
+          HRowRef& planes) {
     bool fresh = false;
     if (config.wx == -2) {  // tabulated: straight from the texel row, per column
         HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
@@ -500,7 +516,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         } else {
             ++cache.hits;
         }
-        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        planes = HRowRef{h.data.data(), size_t(h.stride)};
         return;
     }
     if (config.step == 4 && config.wx == 128 && (config.phase == 0 || config.phase == 2) &&
@@ -532,7 +548,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         } else {
             ++cache.hits;
         }
-        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        planes = HRowRef{h.data.data(), size_t(h.stride)};
         return;
     }
     if (config.wx == 0 && config.step >= 2) {
@@ -553,7 +569,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         } else {
             ++cache.hits;
         }
-        for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+        planes = HRowRef{h.data.data(), size_t(h.stride)};
         return;
     }
     const HConfig stageKey{config.texels, -1, 0, 0, config.stageLo, config.stageHi, config.stageLo, config.stageHi};
@@ -566,8 +582,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
         ++cache.staged;
     }
     if (config.step == 1 && config.wx == 0) {
-        for (int c = 0; c < 4; ++c)
-            planes[size_t(c)] = staged.data.data() + size_t(c) * size_t(staged.stride) + size_t(first);
+        planes = HRowRef{staged.data.data() + size_t(first), size_t(staged.stride)};
         return;
     }
     HRowCache::Slot& h = slotFor(cache, row, config, tableId, fresh);
@@ -583,7 +598,7 @@ void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, c
     } else {
         ++cache.hits;
     }
-    for (int c = 0; c < 4; ++c) planes[size_t(c)] = h.data.data() + size_t(c) * size_t(h.stride);
+    planes = HRowRef{h.data.data(), size_t(h.stride)};
 }
 
 }  // namespace
@@ -669,7 +684,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         std::fill(cache.stamps.begin(), cache.stamps.end(), 0);
         cache.serial = draw.serial;
     }
-    std::array<const uint16_t*, 4> planes{};
+    HRowRef planes{};
     float tapV[8] = {};  // each tap's v on the current pixel row
     // Tabulated configurations: a triangle whose table equals an earlier one's over the same
     // columns takes that one's id, so their H rows are shared (a full-screen quad's two halves).
@@ -749,10 +764,10 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     const uint64_t id =
                         ti < kMaxAlignedTriangles && ci < tabIds[ti].size() ? tabIds[ti][ci] : h.tableId;
                     hRow(*draw.kernels, cache, r.row0, h, id, planes);
-                    for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes[size_t(ch)];
+                    for (int ch = 0; ch < 4; ++ch) r.h0[size_t(c)].p[ch] = planes.data + size_t(ch) * planes.stride;
                     if (r.wy != 0) {
                         hRow(*draw.kernels, cache, r.row1, h, id, planes);
-                        for (int ch = 0; ch < 4; ++ch) r.h1[size_t(c)].p[ch] = planes[size_t(ch)];
+                        for (int ch = 0; ch < 4; ++ch) r.h1[size_t(c)].p[ch] = planes.data + size_t(ch) * planes.stride;
                     }
                 }
             }
