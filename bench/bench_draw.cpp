@@ -50,6 +50,8 @@ struct QuadVertex {
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
 // Rotated: the 1080p blur with its texture coordinates turned by 10 degrees about the centre (u
 // and v each follow both x and y: the fx8 row path samples such taps per pixel).
+// PerspectiveMip: the same from a texture with its whole mip chain, MIP filter POINT: each pixel
+// at the level its 2×2 quad picks (levels 0 and 1 across the screen).
 // Perspective: the 1080p linear copy through a quad whose right edge has rhw ½ (perspective-
 // correct coordinates, divided per pixel).
 // Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
@@ -71,9 +73,10 @@ enum class Pass {
     Rotated,
     Perspective,
     Dependent,
-    Down2Mip
+    Down2Mip,
+    PerspectiveMip
 };
-constexpr int kPasses = 16;
+constexpr int kPasses = 17;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -86,12 +89,12 @@ struct Scene {
 
     Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
-        const bool mip = pass == Pass::Down2Mip;
-        if (pass == Pass::Down2 || mip) w = kW / 2, h = kH / 2;
+        const bool mip = pass == Pass::Down2Mip || pass == Pass::PerspectiveMip;
+        if (pass == Pass::Down2 || pass == Pass::Down2Mip) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
-        const bool down = pass == Pass::Down2 || mip || pass == Pass::Down4;
+        const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4;
         const bool addGlare = pass == Pass::CompositeAdd;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : addGlare ? h / 4 : h;
@@ -201,7 +204,8 @@ struct Scene {
         }
         const float turn = pass == Pass::Rotated ? 10.0f * 3.14159265f / 180.0f : 0.0f;
         for (int c : {0, 1, 2, 0, 2, 3}) {
-            const float rhw = pass == Pass::Perspective && (c == 1 || c == 2) ? 0.5f : 1.0f;
+            const bool perspective = pass == Pass::Perspective || pass == Pass::PerspectiveMip;
+            const float rhw = perspective && (c == 1 || c == 2) ? 0.5f : 1.0f;
             QuadVertex q{xs[c], ys[c], 0.0f, rhw, {}};
             const float ru = 0.5f + std::cos(turn) * (us[c] - 0.5f) - std::sin(turn) * (vs[c] - 0.5f);
             const float rv = 0.5f + std::sin(turn) * (us[c] - 0.5f) + std::cos(turn) * (vs[c] - 0.5f);
@@ -412,6 +416,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, down2_mip_1080p_to_960x540_fx8, Pass::Down2
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_rotated_1080p_fx8, Pass::Rotated)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_mip_1080p_fx8, Pass::PerspectiveMip)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -368,7 +368,8 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
 // each stage read by one tap (prepareFloatRowDraw checks it).
 class RowSampler final : public ps11::Sampler {
 public:
-    RowSampler(const FloatRowDraw& draw, const std::array<RowTaps, 8>& rows) : m_draw(draw), m_rows(rows) {
+    RowSampler(const FloatRowDraw& draw, const std::array<RowTaps, 8>& rows, QuadLevels& quadLevels)
+        : m_draw(draw), m_rows(rows), m_quadLevels(&quadLevels) {
         m_tapOf.fill(-1);
         for (int t = 0; t < draw.plan.count; ++t) m_tapOf[draw.plan.stage[size_t(t)]] = int8_t(t);
     }
@@ -390,6 +391,33 @@ public:
             // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
             alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
             rowCoords(*m_setup, tap->coordSet, m_x + int(req.u[0]), m_y, n, u, v);
+            if (tap->unorm8 && ((m_draw.levelTaps.mask >> t) & 1)) {
+                // Each pixel at the level and filter its 2×2 quad picks (quadLevels), in runs of one.
+                const LevelTaps& lt = m_draw.levelTaps;
+                const ps11::Texture& tex = *lt.texture[size_t(t)];
+                const QuadLevels::Entry& e =
+                    quadLevels(*m_quadLevels, *m_setup, t, tap->coordSet, tex, *lt.sampler[size_t(t)], lt.fixed,
+                               lt.weights8, m_draw.target.color->width, m_x + int(req.u[0]), m_y, n);
+                FloatRowTap level = *tap;
+                const int x = m_x + int(req.u[0]);
+                for (int i = 0; i < n;) {
+                    const size_t qi = size_t((x + i) >> 1);
+                    int end = i + 1;
+                    while (end < n && e.level[size_t((x + end) >> 1)] == e.level[qi] &&
+                           e.linear[size_t((x + end) >> 1)] == e.linear[qi])
+                        ++end;
+                    const ps11::TextureLevelInfo& li = tex.level(e.level[qi]);
+                    level.bytes = tex.unorm8() + li.offset * 4;
+                    level.width = li.width, level.height = li.height;
+                    level.linear = e.linear[qi] != 0;
+                    float* const o[4] = {out.value[0] + i, out.value[1] + i, out.value[2] + i, out.value[3] + i};
+                    sampleFreeUnorm8(m_draw, level, u + i, v + i, end - i, o);
+                    m_fetched += uint64_t(end - i) * (level.linear ? 4 : 1);
+                    i = end;
+                }
+                out.unitRange = tap->unitRange;
+                return;
+            }
             if (tap->unorm8) {
                 sampleFreeUnorm8(m_draw, *tap, u, v, n, out.value);
                 out.unitRange = tap->unitRange;
@@ -496,6 +524,7 @@ private:
     ps11::Sampler* m_perPixel = nullptr;
     int m_y = 0;
     const std::array<RowTaps, 8>& m_rows;
+    QuadLevels* m_quadLevels;
     std::array<int8_t, 8> m_tapOf{};
     int m_x = 0;
     uint64_t m_fetched = 0;
@@ -691,7 +720,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     const uint32_t neededTaps = ws.taps;
     const int taps = draw.plan.count;
     std::array<RowTaps, 8> rows{};
-    RowSampler sampler(draw, rows);
+    sc.quadLevels.used = 0;  // (a quad's two rows are drawn in one call: bands start on even rows)
+    RowSampler sampler(draw, rows, sc.quadLevels);
     ps11::PixelInputs in;
     for (int c = 0; c < 4; ++c) {
         if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];

@@ -151,6 +151,7 @@ struct FloatRowScratch {
     };
     std::vector<DecodedRow> decoded;
     uint64_t stamp = 0, rowStart = 0;
+    QuadLevels quadLevels;  // per-quad levels of taps sampled per pixel (quadLevels)
 };
 
 // Draws rows [y0, y1) of prepared triangles tris[0 .. count), row by row and within a row in

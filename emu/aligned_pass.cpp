@@ -272,7 +272,8 @@ namespace {
 // Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
 // path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
 // kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16.
-void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, int16_t* const dst[4]) {
+void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, QuadLevels& cache,
+                int16_t* const dst[4]) {
     const AlignedTap& tap = draw.taps[size_t(t)];
     alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
     rowCoords(s, tap.coordSet, x, y, n, u, v);
@@ -284,8 +285,32 @@ void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, i
     run.borderWord = tap.borderWord;
     run.scale = draw.fx12 ? 16 : 1;
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
-    int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
-    draw.sample(run, n, u, v, g);
+    if (!((draw.levelTaps.mask >> t) & 1)) {
+        int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
+        draw.sample(run, n, u, v, g);
+    } else {
+        // Each pixel at the level and filter its 2×2 quad picks (quadLevels); the fast kernel
+        // over each run of one level and filter.
+        const ps11::Texture& tex = *draw.levelTaps.texture[size_t(t)];
+        const QuadLevels::Entry& e =
+            quadLevels(cache, s, t, tap.coordSet, tex, *draw.levelTaps.sampler[size_t(t)], draw.levelTaps.fixed,
+                       draw.levelTaps.weights8, draw.target.color->width, x, y, n);
+        auto same = [&](int a, int b) {
+            return e.level[size_t(a >> 1)] == e.level[size_t(b >> 1)] && e.linear[size_t(a >> 1)] == e.linear[size_t(b >> 1)];
+        };
+        for (int i = 0; i < n;) {
+            int end = i + 1;
+            while (end < n && same(x + end, x + i)) ++end;
+            const size_t qi = size_t((x + i) >> 1);
+            const ps11::TextureLevelInfo& li = tex.level(e.level[qi]);
+            run.texels = tex.unorm8() + li.offset * 4;
+            run.width = li.width, run.height = li.height;
+            run.linear = e.linear[qi] != 0;
+            int32_t* const g[4] = {grid[0] + i, grid[1] + i, grid[2] + i, grid[3] + i};
+            draw.sample(run, end - i, u + i, v + i, g);
+            i = end;
+        }
+    }
     for (int c = 0; c < 4; ++c)
         for (int i = 0; i < n; ++i) dst[c][i] = int16_t(grid[c][i]);
 }
@@ -658,11 +683,13 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         uint8_t* out;
         uint32_t orMask;
         int16_t* const* r0;
-    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0};
+        QuadLevels* quadLevels;
+    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0, &sc.quadLevels};
+    sc.quadLevels.used = 0;  // (a quad's two rows are drawn in one call: bands start on even rows)
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         if ((f.tri->freeTaps >> tap) & 1) {
-            sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, dst);
+            sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, *f.quadLevels, dst);
             return;
         }
         filterTap(f.draw->kernels, f.draw->fx12, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)],

@@ -228,6 +228,34 @@ struct HRowCache {
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)
 };
 
+// The level and filter of each 2×2 quad of a triangle's tap whose level the level of detail picks
+// and which is sampled per pixel (freeTaps, freeLevels): chosen on the quad's first row drawn and
+// kept for its other, within one drawAlignedRows call (which draws both rows of every quad: its
+// bands start on even rows). Entries per (triangle, tap), indexed by quad column (x / 2).
+struct QuadLevels {
+    struct Entry {
+        const TriangleSetup* setup = nullptr;
+        int tap = -1;
+        std::vector<uint8_t> level, linear;
+        std::vector<int32_t> stamp;  // quad row + 1 where level and linear hold that row's quad's
+    };
+    std::vector<Entry> entries;
+    size_t used = 0;  // entries [0, used) belong to the current call
+    // The entry of (setup, tap) in this call, or a fresh one for quads of a `width`-pixel target.
+    Entry& entry(const TriangleSetup* setup, int tap, uint32_t width) {
+        for (size_t i = 0; i < used; ++i)
+            if (entries[i].setup == setup && entries[i].tap == tap) return entries[i];
+        if (used == entries.size()) entries.emplace_back();
+        Entry& e = entries[used++];
+        e.setup = setup, e.tap = tap;
+        const size_t quads = size_t(width) / 2 + 1;
+        e.level.resize(quads);
+        e.linear.resize(quads);
+        e.stamp.assign(quads, 0);
+        return e;
+    }
+};
+
 // Per-worker buffers, allocated once.
 struct AlignedScratch {
     alignas(32) int16_t r0[4][ps11::kMaxSpan];
@@ -238,6 +266,7 @@ struct AlignedScratch {
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
     HRowCache hrows;
+    QuadLevels quadLevels;
 };
 
 // Whether the sampler reads level 0 with one filter at every level of detail (a 2-D texture, the
@@ -251,6 +280,19 @@ bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss);
 // False where the quads do not all agree, where one blends two levels, or where a coordinate is
 // not finite: the triangle is then shaded in quads.
 bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x1, TapLevels& out);
+// Whether a row path can sample the taps of `taps` per pixel on a triangle whose taps `free` are
+// sampled so (freeTaps): each is among them and never blends two levels (one level, or a MIP
+// filter other than LINEAR), and with `unorm8Only` each has 8-bit texels (the float row path's
+// per-pixel kernel); each pixel then takes the level and filter of its quad (quadLevels).
+bool freeLevels(const LevelTaps& taps, uint32_t free, bool unorm8Only);
+// The level and filter of every 2×2 quad whose pixels include x .. x + n − 1 (n <= kMaxSpan) of
+// row y, for tap `tap` of triangle `s` (coordinate set `coordSet`, sampled per pixel): the quad
+// path's choice (ps11::chooseLevel, `fixed` and `weights8` as its sampler takes them) from the
+// coordinates of the quad's top-left, top-right and bottom-left pixels, chosen on the quad's first
+// row drawn and kept in `cache` for its other. Quad q = x / 2 is at level[q], linear[q].
+const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
+                                    const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
+                                    uint32_t width, int x, int y, int n);
 // Points each of draw.levelTaps at its level and filter in `levels` (before the triangles' tables
 // are filled; a change starts a new serial, so no worker keeps H rows of another level).
 void setTapLevels(AlignedDraw& draw, const TapLevels& levels);

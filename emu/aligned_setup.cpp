@@ -155,6 +155,58 @@ bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x
     return true;
 }
 
+bool freeLevels(const LevelTaps& taps, uint32_t free, bool unorm8Only) {
+    if ((taps.mask & free) != taps.mask) return false;
+    for (int i = 0; i < 8; ++i) {
+        if (!((taps.mask >> i) & 1)) continue;
+        const ps11::Texture& tex = *taps.texture[size_t(i)];
+        if (tex.levelCount() > 1 && taps.sampler[size_t(i)]->mipFilter == ps11::Filter::Linear) return false;
+        if (unorm8Only && tex.storage() != ps11::TexelStorage::Unorm8) return false;
+    }
+    return true;
+}
+
+const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
+                                    const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
+                                    uint32_t width, int x, int y, int n) {
+    QuadLevels::Entry& e = cache.entry(&s, tap, width);
+    const int qy = y & ~1, q0 = x >> 1, q1 = (x + n - 1) >> 1;  // quads [q0, q1]
+    const int32_t mark = qy + 1;                                 // (stamps start at 0)
+    int lo = q0;
+    while (lo <= q1 && e.stamp[size_t(lo)] == mark) ++lo;
+    if (lo > q1) return e;
+    int hi = q1;
+    while (e.stamp[size_t(hi)] == mark) --hi;
+    // Quads [lo, hi]: the coordinates the quad path gives their top-left, top-right and
+    // bottom-left pixels (the rasteriser interpolates helper lanes from the same planes), the
+    // derivatives it takes from them (selectLevels), and its choice.
+    const double w0 = double(tex.level(0).width), h0 = double(tex.level(0).height);
+    alignas(32) float ut[ps11::kMaxSpan], vt[ps11::kMaxSpan], ub[ps11::kMaxSpan], vb[ps11::kMaxSpan];
+    for (int first = 2 * lo; first < 2 * hi + 2; first += ps11::kMaxSpan) {
+        const int len = std::min(ps11::kMaxSpan, 2 * hi + 2 - first);
+        rowCoords(s, coordSet, first, qy, len, ut, vt);
+        rowCoords(s, coordSet, first, qy + 1, len, ub, vb);
+        for (int q = 0; q < len; q += 2) {
+            double dx2 = 0, dy2 = 0;
+            for (int a = 0; a < 2; ++a) {
+                const float* top = a == 0 ? ut : vt;
+                const float* bottom = a == 0 ? ub : vb;
+                const double size = a == 0 ? w0 : h0;
+                const double c0 = double(top[q]) * size;
+                const double ddx = double(top[q + 1]) * size - c0, ddy = double(bottom[q]) * size - c0;
+                dx2 += ddx * ddx;
+                dy2 += ddy * ddy;
+            }
+            const ps11::LevelChoice c = ps11::chooseLevel(tex, ss, dx2, dy2, fixed, weights8);
+            const size_t qi = size_t((first + q) >> 1);
+            e.level[qi] = uint8_t(c.level0);
+            e.linear[qi] = uint8_t(c.linear);
+            e.stamp[qi] = mark;
+        }
+    }
+    return e;
+}
+
 void setTapLevels(AlignedDraw& draw, const TapLevels& levels) {
     bool changed = false;
     for (int i = 0; i < draw.plan.count; ++i) {

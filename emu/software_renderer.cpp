@@ -417,11 +417,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             // filter (the first such triangle's); the others are shaded in quads.
             TapLevels partLevels;
             bool partHasLevels = false;
-            auto levelKind = [&](const LevelTaps& taps, int kind, const TriangleSetup& s, int x0, int x1) {
+            // `freeOk`: a triangle whose taps are sampled per pixel (kind 2) may take the row path,
+            // each pixel at its quad's level and filter (freeLevels, quadLevels).
+            auto levelKind = [&](const LevelTaps& taps, int kind, const TriangleSetup& s, int x0, int x1, bool freeOk) {
                 if (kind == 0 || !taps.mask) return kind;
+                if (kind == 2) return freeOk ? kind : 0;
                 TapLevels levels;
-                if (kind != 1 || !triangleLevels(taps, s, x0, x1, levels) || (partHasLevels && !(levels == partLevels)))
-                    return 0;
+                if (!triangleLevels(taps, s, x0, x1, levels) || (partHasLevels && !(levels == partLevels))) return 0;
                 partLevels = levels;
                 partHasLevels = true;
                 return kind;
@@ -431,7 +433,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     alignedTris, aligned.plan, aligned.plan.count,
                     [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
                         const int kind = rowPathKind(aligned.plan, bound, s, x0, x1);  // (sets x0, x1)
-                        return levelKind(aligned.levelTaps, kind, s, x0, x1);
+                        return levelKind(aligned.levelTaps, kind, s, x0, x1,
+                                         kind == 2 &&
+                                             freeLevels(aligned.levelTaps, freeTaps(aligned.plan, bound, s), false));
                     },
                     [&] {
                         if (partHasLevels) setTapLevels(aligned, partLevels);
@@ -442,7 +446,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     floatTris, floatRows.plan, floatRows.plan.count,
                     [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
                         const int kind = rowPathKind(floatRows.plan, bound, s, x0, x1);  // (sets x0, x1)
-                        return levelKind(floatRows.levelTaps, kind, s, x0, x1);
+                        return levelKind(
+                            floatRows.levelTaps, kind, s, x0, x1,
+                            kind == 2 && freeLevels(floatRows.levelTaps, freeTaps(floatRows.plan, bound, s), true));
                     },
                     [&] {
                         if (partHasLevels) setTapLevels(floatRows, partLevels);

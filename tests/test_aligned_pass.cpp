@@ -69,6 +69,33 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     CHECK(aligned * 10 >= cases * 9);
 }
 
+namespace {
+
+// Gives each texture of `c` a mip chain of random length (random texels), a random MIP filter
+// and, half the time, a min filter other than its mag filter. True when some chain has two
+// levels or more.
+bool addMipChains(Case& c, std::mt19937& rng) {
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    bool chains = false;
+    for (Case::Tex& t : c.tex) {
+        int chain = 1;
+        while ((t.w >> chain) > 0 || (t.h >> chain) > 0) ++chain;
+        const int levels = uni(1, chain);
+        chains |= levels > 1;
+        for (int level = 1; level < levels; ++level) {
+            std::vector<uint8_t>& bytes = t.mips.emplace_back(size_t(std::max(1u, t.w >> level)) *
+                                                              std::max(1u, t.h >> level) * texelBytes(t.format));
+            for (uint8_t& b : bytes) b = uint8_t(rng());
+        }
+        const DWORD mipFilters[3] = {D3DTEXF_NONE, D3DTEXF_POINT, D3DTEXF_LINEAR};
+        t.mipFilter = mipFilters[uni(0, 2)];
+        if (uni(0, 1)) t.minFilter = t.filter == D3DTEXF_LINEAR ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+    }
+    return chains;
+}
+
+}  // namespace
+
 TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path where every quad picks one level",
           "[draw][aligned]") {
     // The random cases (1:1 passes, 2:1 … 4:1 reductions, magnifications, any rectangle) with mip
@@ -76,27 +103,12 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
     // half the time, in fx8, fx12, float and ideal: the level and filter each quad picks must be
     // the quad path's.
     std::mt19937 rng(20261130);
-    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     int cases = 0, rows = 0, mipRows = 0;
     std::array<int, 4> profileRows{};
     for (int i = 0; i < 400; ++i) {
         const int profile = i % 4;  // fx8, fx12 (the radeon8500 class), float, ideal
         Case c = randomCase(rng, profile >= 2);
-        bool chains = false;
-        for (Case::Tex& t : c.tex) {
-            int chain = 1;
-            while ((t.w >> chain) > 0 || (t.h >> chain) > 0) ++chain;
-            const int levels = uni(1, chain);
-            chains |= levels > 1;
-            for (int level = 1; level < levels; ++level) {
-                std::vector<uint8_t>& bytes = t.mips.emplace_back(size_t(std::max(1u, t.w >> level)) *
-                                                                  std::max(1u, t.h >> level) * texelBytes(t.format));
-                for (uint8_t& b : bytes) b = uint8_t(rng());
-            }
-            const DWORD mipFilters[3] = {D3DTEXF_NONE, D3DTEXF_POINT, D3DTEXF_LINEAR};
-            t.mipFilter = mipFilters[uni(0, 2)];
-            if (uni(0, 1)) t.minFilter = t.filter == D3DTEXF_LINEAR ? D3DTEXF_POINT : D3DTEXF_LINEAR;
-        }
+        const bool chains = addMipChains(c, rng);
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
@@ -343,6 +355,38 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
     CHECK(rowPath * 10 >= cases * 9);
 }
 
+TEST_CASE("aligned pass: rotated and perspective draws of mip chains pick each pixel's level as its quad does",
+          "[draw][aligned]") {
+    // The random rotated, sheared and perspective cases with mip chains, every MIP filter and
+    // MIN != MAG half the time, in fx8 and fx12: where no tap blends two levels the row path samples
+    // them per pixel, each pixel at the level and filter of its 2×2 quad.
+    std::mt19937 rng(20261201);
+    int cases = 0, rows = 0, mipRows = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng);
+        const bool chains = addMipChains(c, rng);
+        anyMapping(c, rng);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (c.program.rfind("ps_1_4", 0) == 0) {
+            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
+        }
+        if (i % 4 == 1) radeon8500(quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << " rhw " << c.verts[0].rhw << " program:\n" << c.program);
+        const int before = rows;
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
+        if (chains && rows > before) ++mipRows;
+    }
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
+    CHECK(rows * 4 >= cases);
+    CHECK(mipRows * 5 >= cases);
+}
+
 TEST_CASE("float row path: random rotated, sheared and perspective draws in float and ideal equal the quad path",
           "[draw][aligned]") {
     std::mt19937 rng(20261130);
@@ -367,6 +411,41 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
     }
     INFO(rowPath << " of " << cases << " cases took the row path");
     CHECK(rowPath * 10 >= cases * 8);
+}
+
+TEST_CASE("float row path: rotated and perspective draws of mip chains pick each pixel's level as its quad does",
+          "[draw][aligned]") {
+    // The same in float and ideal (and the D3D9 class's 8-bit weights): the float row path samples
+    // 8-bit taps whose level the level of detail picks per pixel, each at its quad's level and
+    // filter; other formats with a chain go to quads.
+    std::mt19937 rng(20261202);
+    int cases = 0, rows = 0, mipRows = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng, (i & 2) != 0);
+        const bool chains = addMipChains(c, rng);
+        anyMapping(c, rng);
+        for (Case::Tex& t : c.tex) {
+            withoutNaNs(t.bytes, t.format);
+            for (std::vector<uint8_t>& level : t.mips) withoutNaNs(level, t.format);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
+        floatProfile(i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", rhw " << c.verts[0].rhw
+                     << ", program:\n"
+                     << c.program);
+        const int before = rows;
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
+        if (chains && rows > before) ++mipRows;
+    }
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
+    CHECK(rows * 4 >= cases);
+    CHECK(mipRows * 5 >= cases);
 }
 
 TEST_CASE("aligned pass: rotated and perspective draws take the row path, in fx8 and fx12", "[draw][aligned]") {
