@@ -51,7 +51,8 @@ struct QuadVertex {
 // Rotated: the 1080p blur with its texture coordinates turned by 10 degrees about the centre (u
 // and v each follow both x and y: the fx8 row path samples such taps per pixel).
 // PerspectiveMip: the same from a texture with its whole mip chain, MIP filter POINT: each pixel
-// at the level its 2×2 quad picks (levels 0 and 1 across the screen).
+// at the level its 2×2 quad picks (levels 0 and 1 across the screen). PerspectiveTrilinear: MIP
+// filter LINEAR, each pixel a blend of two levels where its quad's level of detail is above 0.
 // Perspective: the 1080p linear copy through a quad whose right edge has rhw ½ (perspective-
 // correct coordinates, divided per pixel).
 // Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
@@ -74,9 +75,10 @@ enum class Pass {
     Perspective,
     Dependent,
     Down2Mip,
-    PerspectiveMip
+    PerspectiveMip,
+    PerspectiveTrilinear
 };
-constexpr int kPasses = 17;
+constexpr int kPasses = 18;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -89,7 +91,8 @@ struct Scene {
 
     Scene(Pass pass, int threads, bool aligned = true) {
         if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
-        const bool mip = pass == Pass::Down2Mip || pass == Pass::PerspectiveMip;
+        const bool trilinear = pass == Pass::PerspectiveTrilinear;
+        const bool mip = pass == Pass::Down2Mip || pass == Pass::PerspectiveMip || trilinear;
         if (pass == Pass::Down2 || pass == Pass::Down2Mip) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
@@ -140,7 +143,8 @@ struct Scene {
             dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
             dev->SetSamplerState(DWORD(s), D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
-            dev->SetSamplerState(DWORD(s), D3DSAMP_MIPFILTER, mip ? D3DTEXF_POINT : D3DTEXF_NONE);
+            dev->SetSamplerState(DWORD(s), D3DSAMP_MIPFILTER,
+                                 trilinear ? D3DTEXF_LINEAR : mip ? D3DTEXF_POINT : D3DTEXF_NONE);
         }
         const char* const kSprite = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
         const char* const kScreen = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n";
@@ -204,7 +208,7 @@ struct Scene {
         }
         const float turn = pass == Pass::Rotated ? 10.0f * 3.14159265f / 180.0f : 0.0f;
         for (int c : {0, 1, 2, 0, 2, 3}) {
-            const bool perspective = pass == Pass::Perspective || pass == Pass::PerspectiveMip;
+            const bool perspective = pass == Pass::Perspective || pass == Pass::PerspectiveMip || trilinear;
             const float rhw = perspective && (c == 1 || c == 2) ? 0.5f : 1.0f;
             QuadVertex q{xs[c], ys[c], 0.0f, rhw, {}};
             const float ru = 0.5f + std::cos(turn) * (us[c] - 0.5f) - std::sin(turn) * (vs[c] - 0.5f);
@@ -421,6 +425,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, blur4_rotated_1080p_fx8, Pass::Rotated)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_mip_1080p_fx8, Pass::PerspectiveMip)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_trilinear_1080p_fx8, Pass::PerspectiveTrilinear)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <xmmintrin.h>
@@ -391,28 +392,42 @@ public:
             // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
             alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
             rowCoords(*m_setup, tap->coordSet, m_x + int(req.u[0]), m_y, n, u, v);
-            if (tap->unorm8 && ((m_draw.levelTaps.mask >> t) & 1)) {
-                // Each pixel at the level and filter its 2×2 quad picks (quadLevels), in runs of one.
+            if ((m_draw.levelTaps.mask >> t) & 1) {
+                // Each pixel at the level, filter and mip blend its 2×2 quad picks (quadLevels):
+                // 8-bit texels at one level by the vector kernel, the rest (blends of two levels,
+                // other formats) by the worker's sampler at those levels.
                 const LevelTaps& lt = m_draw.levelTaps;
                 const ps11::Texture& tex = *lt.texture[size_t(t)];
-                const QuadLevels::Entry& e =
-                    quadLevels(*m_quadLevels, *m_setup, t, tap->coordSet, tex, *lt.sampler[size_t(t)], lt.fixed,
-                               lt.weights8, m_draw.target.color->width, m_x + int(req.u[0]), m_y, n);
-                FloatRowTap level = *tap;
                 const int x = m_x + int(req.u[0]);
+                const QuadLevels::Entry& e = quadLevels(*m_quadLevels, *m_setup, t, tap->coordSet, tex,
+                                                        *lt.sampler[size_t(t)], lt.fixed, lt.weights8,
+                                                        m_draw.target.color->width, x, m_y, n);
+                thread_local ps11::LevelChoice lanes[ps11::kMaxSpan];
+                FloatRowTap level = *tap;
                 for (int i = 0; i < n;) {
-                    const size_t qi = size_t((x + i) >> 1);
+                    const ps11::LevelChoice& c = e.choice[size_t((x + i) >> 1)];
                     int end = i + 1;
-                    while (end < n && e.level[size_t((x + end) >> 1)] == e.level[qi] &&
-                           e.linear[size_t((x + end) >> 1)] == e.linear[qi])
-                        ++end;
-                    const ps11::TextureLevelInfo& li = tex.level(e.level[qi]);
-                    level.bytes = tex.unorm8() + li.offset * 4;
-                    level.width = li.width, level.height = li.height;
-                    level.linear = e.linear[qi] != 0;
+                    while (end < n && e.choice[size_t((x + end) >> 1)] == c) ++end;
                     float* const o[4] = {out.value[0] + i, out.value[1] + i, out.value[2] + i, out.value[3] + i};
-                    sampleFreeUnorm8(m_draw, level, u + i, v + i, end - i, o);
-                    m_fetched += uint64_t(end - i) * (level.linear ? 4 : 1);
+                    if (tap->unorm8 && c.slots == 1) {
+                        const ps11::TextureLevelInfo& li = tex.level(c.level0);
+                        level.bytes = tex.unorm8() + li.offset * 4;
+                        level.width = li.width, level.height = li.height;
+                        level.linear = c.linear;
+                        sampleFreeUnorm8(m_draw, level, u + i, v + i, end - i, o);
+                        m_fetched += uint64_t(end - i) * (level.linear ? 4 : 1);
+                        m_levelTexels += uint64_t(end - i) * (level.linear ? 4 : 1);
+                    } else {
+                        std::fill_n(lanes, end - i, c);
+                        ps11::SampleRequest sub = req;
+                        sub.count = end - i;
+                        sub.u = u + i, sub.v = v + i;
+                        sub.quads = false;
+                        sub.levels = lanes;
+                        ps11::SampleResult part;
+                        for (int ch = 0; ch < 4; ++ch) part.value[ch] = o[ch];
+                        m_perPixel->sample(sub, part);  // (its texels are counted by that sampler)
+                    }
                     i = end;
                 }
                 out.unitRange = tap->unitRange;
@@ -516,6 +531,9 @@ public:
         return t >= 0 && m_draw.taps[size_t(t)].bound;
     }
     uint64_t texelsFetched() const override { return m_fetched; }
+    // The texels of taps at their quads' levels this sampler filtered itself since the last call
+    // (the row's count per pixel leaves such taps out; the worker's sampler counts the others).
+    uint64_t takeLevelTexels() { return std::exchange(m_levelTexels, 0); }
 
 private:
     const FloatRowDraw& m_draw;
@@ -528,6 +546,7 @@ private:
     std::array<int8_t, 8> m_tapOf{};
     int m_x = 0;
     uint64_t m_fetched = 0;
+    uint64_t m_levelTexels = 0;
 };
 
 }  // namespace
@@ -650,13 +669,14 @@ bool prepareFloatRowTriangle(const FloatRowDraw& draw, const TriangleSetup& s, F
                              const std::pair<int, int>* columns) {
     if (!rowPathKind(draw.plan, draw.bound, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
+    out.levelFree = 0;
     fillFloatRowTables(draw, s, out);
     return true;
 }
 
 void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatRowTriangle& out) {
     const int n = out.x1 - out.x0;
-    out.freeTaps = freeTaps(draw.plan, draw.bound, s);
+    out.freeTaps = freeTaps(draw.plan, draw.bound, s) | out.levelFree;
     thread_local std::vector<float> u;
     u.resize(static_cast<size_t>(std::max(n, 0)));
     for (int i = 0; i < draw.plan.count; ++i) {
@@ -745,17 +765,22 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
-            // (Not under a depth test: the two halves' z planes are their own.)
-            const bool joined = !draw.wantZ && ti + 1 < count && tris[ti + 1]->x0 == tri.x0 &&
+            // (Not under a depth test: the two halves' z planes are their own. Nor where a tap is
+            // sampled at its quads' levels: those come from the quad's two rows, and joinRow
+            // compares one.)
+            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
+                                tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
                                         windows, windowCount, xl, xr);
             if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri, s, y, sc.sampler);
-            // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit.)
+            // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit,
+            // or at their quads' levels, which the row sampler counts where it filters them.)
             uint64_t rowTexelsPerPixel = texelsPerPixel;
             for (int t = 0; t < taps; ++t)
-                if (((tri.freeTaps >> t) & 1) && draw.taps[size_t(t)].bound && !draw.taps[size_t(t)].unorm8)
+                if (((tri.freeTaps >> t) & 1) && draw.taps[size_t(t)].bound &&
+                    (!draw.taps[size_t(t)].unorm8 || ((draw.levelTaps.mask >> t) & 1)))
                     rowTexelsPerPixel -= draw.taps[size_t(t)].linear ? 4 : 1;
             for (int t = 0; t < taps; ++t) {
                 const FloatRowTap& tap = draw.taps[size_t(t)];
@@ -780,7 +805,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
                         exec.run(in, sampler, outp, &stats.exec);
-                        stats.texels += uint64_t(n) * rowTexelsPerPixel;
+                        stats.texels += uint64_t(n) * rowTexelsPerPixel + sampler.takeLevelTexels();
                     } else if (mode == RowMode::Copy) {
                         // r0 is the tap's lookup bit for bit (emu/tile_skip.h): the sampler's lanes.
                         const FloatRowTap& tap = draw.taps[size_t(window->copyTap)];

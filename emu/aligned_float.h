@@ -97,6 +97,7 @@ struct FloatRowTriangle {
     // Taps sampled per pixel on this triangle (bit per tap, freeTaps): no tables; the worker's
     // sampler (FloatRowScratch::sampler) filters them.
     uint32_t freeTaps = 0;
+    uint32_t levelFree = 0;  // as AlignedTriangle::levelFree
 };
 
 // Gives each tap's table of tris[0 .. count) an id, the same to taps of the triangle or the one before whose H

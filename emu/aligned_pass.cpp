@@ -271,45 +271,43 @@ namespace {
 
 // Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
 // path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
-// kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16.
+// kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16; a tap whose
+// level the level of detail picks through `sampler`, at its quads' levels.
 void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, QuadLevels& cache,
-                int16_t* const dst[4]) {
+                ps11::Sampler* sampler, int16_t* const dst[4]) {
     const AlignedTap& tap = draw.taps[size_t(t)];
     alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
     rowCoords(s, tap.coordSet, x, y, n, u, v);
-    ps11::fastpath::Unorm8Run run;
-    run.texels = tap.texels;
-    run.width = tap.width, run.height = tap.height;
-    run.linear = tap.linear;
-    run.addressU = tap.addressU, run.addressV = tap.addressV;
-    run.borderWord = tap.borderWord;
-    run.scale = draw.fx12 ? 16 : 1;
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     if (!((draw.levelTaps.mask >> t) & 1)) {
+        ps11::fastpath::Unorm8Run run;
+        run.texels = tap.texels;
+        run.width = tap.width, run.height = tap.height;
+        run.linear = tap.linear;
+        run.addressU = tap.addressU, run.addressV = tap.addressV;
+        run.borderWord = tap.borderWord;
+        run.scale = draw.fx12 ? 16 : 1;
         int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
         draw.sample(run, n, u, v, g);
     } else {
-        // Each pixel at the level and filter its 2×2 quad picks (quadLevels); the fast kernel
-        // over each run of one level and filter.
-        const ps11::Texture& tex = *draw.levelTaps.texture[size_t(t)];
+        // Each pixel at the level, filter and mip blend its 2×2 quad picks (quadLevels), through
+        // the worker's sampler (the fast kernel over runs of one level, the reference over
+        // blends of two, as for the quad path).
         const QuadLevels::Entry& e =
-            quadLevels(cache, s, t, tap.coordSet, tex, *draw.levelTaps.sampler[size_t(t)], draw.levelTaps.fixed,
-                       draw.levelTaps.weights8, draw.target.color->width, x, y, n);
-        auto same = [&](int a, int b) {
-            return e.level[size_t(a >> 1)] == e.level[size_t(b >> 1)] && e.linear[size_t(a >> 1)] == e.linear[size_t(b >> 1)];
-        };
-        for (int i = 0; i < n;) {
-            int end = i + 1;
-            while (end < n && same(x + end, x + i)) ++end;
-            const size_t qi = size_t((x + i) >> 1);
-            const ps11::TextureLevelInfo& li = tex.level(e.level[qi]);
-            run.texels = tex.unorm8() + li.offset * 4;
-            run.width = li.width, run.height = li.height;
-            run.linear = e.linear[qi] != 0;
-            int32_t* const g[4] = {grid[0] + i, grid[1] + i, grid[2] + i, grid[3] + i};
-            draw.sample(run, end - i, u + i, v + i, g);
-            i = end;
-        }
+            quadLevels(cache, s, t, tap.coordSet, *draw.levelTaps.texture[size_t(t)],
+                       *draw.levelTaps.sampler[size_t(t)], draw.levelTaps.fixed, draw.levelTaps.weights8,
+                       draw.target.color->width, x, y, n);
+        thread_local ps11::LevelChoice lanes[ps11::kMaxSpan];
+        for (int i = 0; i < n; ++i) lanes[i] = e.choice[size_t((x + i) >> 1)];
+        ps11::SampleRequest req;
+        req.stage = draw.plan.stage[size_t(t)];
+        req.count = n;
+        req.u = u, req.v = v;
+        req.levels = lanes;
+        req.precision = draw.fx12 ? ps11::Precision::Fx12 : ps11::Precision::Fx8;
+        ps11::SampleResult out;
+        for (int c = 0; c < 4; ++c) out.grid[c] = grid[c];
+        sampler->sample(req, out);
     }
     for (int c = 0; c < 4; ++c)
         for (int i = 0; i < n; ++i) dst[c][i] = int16_t(grid[c][i]);
@@ -684,12 +682,13 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         uint32_t orMask;
         int16_t* const* r0;
         QuadLevels* quadLevels;
-    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0, &sc.quadLevels};
+        ps11::Sampler* sampler;
+    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0, &sc.quadLevels, sc.sampler};
     sc.quadLevels.used = 0;  // (a quad's two rows are drawn in one call: bands start on even rows)
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         if ((f.tri->freeTaps >> tap) & 1) {
-            sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, *f.quadLevels, dst);
+            sampleFree(*f.draw, *f.setup, tap, f.x + first, f.y, count, *f.quadLevels, f.sampler, dst);
             return;
         }
         filterTap(f.draw->kernels, f.draw->fx12, f.draw->taps[size_t(tap)], f.tri->taps[size_t(tap)],
@@ -749,8 +748,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             int xl = 0, xr = 0;
             if (!rowSpan(s, y, windows, windowCount, xl, xr)) continue;
             // The quad's other half, when its run of this row continues this one's (joinRow).
-            // (Not under a depth test: the two halves' z planes are their own.)
-            const bool joined = !draw.wantZ && ti + 1 < count && tris[ti + 1]->x0 == tri.x0 &&
+            // (Not under a depth test: the two halves' z planes are their own. Nor where a tap is
+            // sampled at its quads' levels: those come from the quad's two rows, and joinRow
+            // compares one.)
+            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
+                                tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
                                         windows, windowCount, xl, xr);
@@ -805,7 +807,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 for (int x = wl; x < wr; x += ps11::kMaxSpan) {
                     const int n = std::min(ps11::kMaxSpan, wr - x);
                     for (int t = 0; t < taps; ++t)
-                        if (mode == RowMode::Shade || (mode == RowMode::Copy && t == window->copyTap))
+                        if ((mode == RowMode::Shade || (mode == RowMode::Copy && t == window->copyTap)) &&
+                            !(((tri.freeTaps & draw.levelTaps.mask) >> t) & 1))  // (those the sampler counts)
                             stats.texels +=
                                 uint64_t(n) * (draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0);
                     ctx.x = x;

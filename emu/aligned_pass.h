@@ -156,6 +156,11 @@ struct AlignedTriangle {
     std::vector<HConfig> configs;
     // Taps sampled per pixel on this triangle (bit per tap of the TapPlan, freeTaps): no tables.
     uint32_t freeTaps = 0;
+    // Taps the caller has sampled per pixel whatever their mapping (set before the tables are
+    // filled, or-ed into freeTaps): those whose level the level of detail picks, where the
+    // triangle's quads do not all pick the part's one level and filter (quadLevels then picks
+    // each pixel's).
+    uint32_t levelFree = 0;
 };
 
 // True when the triangle qualifies (rowPathKind) and then fills its tables.
@@ -236,8 +241,8 @@ struct QuadLevels {
     struct Entry {
         const TriangleSetup* setup = nullptr;
         int tap = -1;
-        std::vector<uint8_t> level, linear;
-        std::vector<int32_t> stamp;  // quad row + 1 where level and linear hold that row's quad's
+        std::vector<ps11::LevelChoice> choice;
+        std::vector<int32_t> stamp;  // quad row + 1 where `choice` holds that row's quad's
     };
     std::vector<Entry> entries;
     size_t used = 0;  // entries [0, used) belong to the current call
@@ -249,8 +254,7 @@ struct QuadLevels {
         Entry& e = entries[used++];
         e.setup = setup, e.tap = tap;
         const size_t quads = size_t(width) / 2 + 1;
-        e.level.resize(quads);
-        e.linear.resize(quads);
+        e.choice.resize(quads);
         e.stamp.assign(quads, 0);
         return e;
     }
@@ -263,6 +267,10 @@ struct AlignedScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
+    // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps
+    // whose level the level of detail picks on triangles where they are sampled per pixel, at
+    // their quads' levels (SampleRequest::levels). Set by the caller before drawAlignedRows.
+    ps11::Sampler* sampler = nullptr;
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
     HRowCache hrows;
@@ -280,16 +288,11 @@ bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss);
 // False where the quads do not all agree, where one blends two levels, or where a coordinate is
 // not finite: the triangle is then shaded in quads.
 bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x1, TapLevels& out);
-// Whether a row path can sample the taps of `taps` per pixel on a triangle whose taps `free` are
-// sampled so (freeTaps): each is among them and never blends two levels (one level, or a MIP
-// filter other than LINEAR), and with `unorm8Only` each has 8-bit texels (the float row path's
-// per-pixel kernel); each pixel then takes the level and filter of its quad (quadLevels).
-bool freeLevels(const LevelTaps& taps, uint32_t free, bool unorm8Only);
 // The level and filter of every 2×2 quad whose pixels include x .. x + n − 1 (n <= kMaxSpan) of
 // row y, for tap `tap` of triangle `s` (coordinate set `coordSet`, sampled per pixel): the quad
 // path's choice (ps11::chooseLevel, `fixed` and `weights8` as its sampler takes them) from the
 // coordinates of the quad's top-left, top-right and bottom-left pixels, chosen on the quad's first
-// row drawn and kept in `cache` for its other. Quad q = x / 2 is at level[q], linear[q].
+// row drawn and kept in `cache` for its other. Quad q = x / 2's is choice[q].
 const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
                                     const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
                                     uint32_t width, int x, int y, int n);

@@ -155,17 +155,6 @@ bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x
     return true;
 }
 
-bool freeLevels(const LevelTaps& taps, uint32_t free, bool unorm8Only) {
-    if ((taps.mask & free) != taps.mask) return false;
-    for (int i = 0; i < 8; ++i) {
-        if (!((taps.mask >> i) & 1)) continue;
-        const ps11::Texture& tex = *taps.texture[size_t(i)];
-        if (tex.levelCount() > 1 && taps.sampler[size_t(i)]->mipFilter == ps11::Filter::Linear) return false;
-        if (unorm8Only && tex.storage() != ps11::TexelStorage::Unorm8) return false;
-    }
-    return true;
-}
-
 const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
                                     const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
                                     uint32_t width, int x, int y, int n) {
@@ -197,10 +186,8 @@ const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, i
                 dx2 += ddx * ddx;
                 dy2 += ddy * ddy;
             }
-            const ps11::LevelChoice c = ps11::chooseLevel(tex, ss, dx2, dy2, fixed, weights8);
             const size_t qi = size_t((first + q) >> 1);
-            e.level[qi] = uint8_t(c.level0);
-            e.linear[qi] = uint8_t(c.linear);
+            e.choice[qi] = ps11::chooseLevel(tex, ss, dx2, dy2, fixed, weights8);
             e.stamp[qi] = mark;
         }
     }
@@ -343,13 +330,14 @@ bool prepareAlignedTriangle(const AlignedDraw& draw, const TriangleSetup& s, Ali
                             const std::pair<int, int>* columns) {
     if (!rowPathKind(draw.plan, draw.bound, s, out.x0, out.x1)) return false;
     if (columns) out.x0 = columns->first, out.x1 = columns->second;
+    out.levelFree = 0;
     fillAlignedTables(draw, s, out);
     return true;
 }
 
 void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedTriangle& out) {
     out.configs.clear();
-    out.freeTaps = freeTaps(draw.plan, draw.bound, s);
+    out.freeTaps = freeTaps(draw.plan, draw.bound, s) | out.levelFree;
     const int n = out.x1 - out.x0;
     thread_local std::vector<float> u;
     u.resize(size_t(std::max(n, 0)));

@@ -365,8 +365,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             // Which triangles and columns is decided here, and the triangle past the budget starts
             // the next part; the tables are filled on the workers (independent per triangle: a
             // full-screen quad's two halves fill at once).
-            // `rowPath(s, x0, x1)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
-            // pixel (rowPathKind; those never share tables, and their tiles are not decided).
+            // `rowPath(s, t)`: 0 quads, 1 screen-aligned, 2 the row path with taps sampled per
+            // pixel (rowPathKind; those never share tables, and their tiles are not decided); it
+            // sets the row triangle's columns t.x0, t.x1 and its levelFree.
             // `settle()` runs once the part's triangles are chosen, before their tables are filled.
             auto prepareTables = [&](auto& rowTris, const ps11::TapPlan& plan, int taps, auto rowPath, auto settle,
                                      auto fill) {
@@ -378,7 +379,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 for (size_t i = 0; i < setups.size() && columns <= budget; ++i) {
                     auto& t = rowTris[i];
                     tableOf[i] = uint32_t(i);
-                    isAligned[i] = uint8_t(rowPath(setups[i], t.x0, t.x1));
+                    isAligned[i] = uint8_t(rowPath(setups[i], t));
                     std::pair<int, int> both;
                     const bool pair = isAligned[i] && i > 0 && isAligned[i - 1] && !paired &&
                                       pairColumns(rowTris[i - 1].x0, rowTris[i - 1].x1, t.x0, t.x1, clip, both);
@@ -413,29 +414,31 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 });
             };
             // Taps whose level the quads' level of detail picks (LevelTaps): a part's screen-aligned
-            // triangles take the row path where every quad of theirs picks the part's one level and
-            // filter (the first such triangle's); the others are shaded in quads.
+            // triangles read them at the one level and filter every quad of theirs picks, the part's
+            // (the first such triangle's); on any other triangle they are sampled per pixel, each at
+            // its quad's level, filter and mip blend (levelFree, quadLevels).
             TapLevels partLevels;
             bool partHasLevels = false;
-            // `freeOk`: a triangle whose taps are sampled per pixel (kind 2) may take the row path,
-            // each pixel at its quad's level and filter (freeLevels, quadLevels).
-            auto levelKind = [&](const LevelTaps& taps, int kind, const TriangleSetup& s, int x0, int x1, bool freeOk) {
+            auto levelKind = [&](const LevelTaps& taps, const ps11::TapPlan& plan, uint32_t bound,
+                                 const TriangleSetup& s, auto& t) {
+                t.levelFree = 0;
+                const int kind = rowPathKind(plan, bound, s, t.x0, t.x1);  // (sets x0, x1)
                 if (kind == 0 || !taps.mask) return kind;
-                if (kind == 2) return freeOk ? kind : 0;
                 TapLevels levels;
-                if (!triangleLevels(taps, s, x0, x1, levels) || (partHasLevels && !(levels == partLevels))) return 0;
-                partLevels = levels;
-                partHasLevels = true;
-                return kind;
+                if (kind == 1 && triangleLevels(taps, s, t.x0, t.x1, levels) &&
+                    (!partHasLevels || levels == partLevels)) {
+                    partLevels = levels;
+                    partHasLevels = true;
+                    return 1;
+                }
+                t.levelFree = taps.mask & ~freeTaps(plan, bound, s);
+                return 2;
             };
             if (alignedDraw)
                 prepareTables(
                     alignedTris, aligned.plan, aligned.plan.count,
-                    [&, bound = aligned.bound](const TriangleSetup& s, int& x0, int& x1) {
-                        const int kind = rowPathKind(aligned.plan, bound, s, x0, x1);  // (sets x0, x1)
-                        return levelKind(aligned.levelTaps, kind, s, x0, x1,
-                                         kind == 2 &&
-                                             freeLevels(aligned.levelTaps, freeTaps(aligned.plan, bound, s), false));
+                    [&](const TriangleSetup& s, AlignedTriangle& t) {
+                        return levelKind(aligned.levelTaps, aligned.plan, aligned.bound, s, t);
                     },
                     [&] {
                         if (partHasLevels) setTapLevels(aligned, partLevels);
@@ -444,11 +447,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
             if (floatDraw) {
                 prepareTables(
                     floatTris, floatRows.plan, floatRows.plan.count,
-                    [&, bound = floatRows.bound](const TriangleSetup& s, int& x0, int& x1) {
-                        const int kind = rowPathKind(floatRows.plan, bound, s, x0, x1);  // (sets x0, x1)
-                        return levelKind(
-                            floatRows.levelTaps, kind, s, x0, x1,
-                            kind == 2 && freeLevels(floatRows.levelTaps, freeTaps(floatRows.plan, bound, s), true));
+                    [&](const TriangleSetup& s, FloatRowTriangle& t) {
+                        return levelKind(floatRows.levelTaps, floatRows.plan, floatRows.bound, s, t);
                     },
                     [&] {
                         if (partHasLevels) setTapLevels(floatRows, partLevels);
@@ -503,7 +503,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);
                     if ((sampled >> s) & 1) sampler.setSamplerState(s, call.samplers[size_t(s)]);
                 }
-                ws0.floatRows.sampler = &sampler;  // the float row path's taps sampled per pixel
+                ws0.floatRows.sampler = &sampler;  // the row paths' taps sampled per pixel
+                ws0.aligned.sampler = &sampler;
                 const uint64_t fetchedBefore = sampler.texelsFetched();
                 QuadSpan* span = &ws0.span;
                 Lanes* lanes = &ws0.lanes;

@@ -15,12 +15,18 @@ namespace ps11 {
 // entered) over twice the pixels took 4–6 % off the 1080p composites in bench_draw (3 alternations).
 constexpr int kMaxSpan = 512;
 
+struct LevelChoice;  // ps11/texture_sampler.h
+
 struct SampleRequest {
     int stage = 0;          // sampler stage 0..7
     int count = 0;          // lanes, <= kMaxSpan
     bool quads = false;     // lanes 4i..4i+3 form a 2x2 pixel quad (top-left, top-right,
                             // bottom-left, bottom-right): use them for the mip LOD;
                             // otherwise sample mip level 0
+    // Or, where not null, lane i's level, filter and mip blend as its quad chose them
+    // (chooseLevel, by a caller that shades rows and keeps each quad's choice): used instead of
+    // quads, with the same results as lanes of quads that chose them.
+    const LevelChoice* levels = nullptr;
     int dims = 2;           // coordinates used: 1 (u), 2 (u, v) or 3 (u, v, w)
     const float* u = nullptr;
     const float* v = nullptr;

@@ -241,6 +241,18 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     const bool magLinear = effective(st.magFilter) == Filter::Linear;
     const int axes = tex.isVolume() ? 3 : 2;
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
+    if (req.levels) {  // chosen by the caller, per lane
+        for (int i = 0; i < count; ++i) {
+            const LevelChoice& c = req.levels[i];
+            L.level[0][i] = uint8_t(c.level0);
+            L.level[1][i] = uint8_t(c.level1);
+            L.slots[i] = uint8_t(c.slots);
+            L.linear[i] = c.linear;
+            L.mipW[i] = c.mipW;
+            L.mipF[i] = c.mipF;
+        }
+        return;
+    }
     // Without quads, or when every LOD gives level 0 with one filter (one level or no mip
     // filter, and MIN = MAG), no LOD is computed.
     if (!req.quads || lodFree(tex, st)) {
@@ -441,7 +453,29 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 fastLanes += uint64_t(n);
             };
             const bool magLinear = effective(ss.magFilter) == Filter::Linear;
-            if (!req.quads || lodFree(tex, ss)) {
+            if (req.levels) {
+                // Levels given per lane: runs of one level and filter -> fast kernel, lanes of a
+                // linear mip blend -> the reference path (which takes the same levels).
+                for (int q = 0; q < count;) {
+                    const LevelChoice& c = req.levels[q];
+                    const bool two = c.slots == 2;
+                    int e = q + 1;
+                    while (e < count && (req.levels[e].slots == 2) == two &&
+                           (two || (req.levels[e].level0 == c.level0 && req.levels[e].linear == c.linear)))
+                        ++e;
+                    if (!two) {
+                        fastRun(q, e - q, c.level0, c.linear);
+                    } else {
+                        SampleRequest sub = req;
+                        sub.count = e - q;
+                        sub.levels = req.levels + q;
+                        const float* c3[3] = {coord[0] + q, coord[1] + q, coord[2] + q};
+                        int32_t* g[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
+                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst, floatWeights8);
+                    }
+                    q = e;
+                }
+            } else if (!req.quads || lodFree(tex, ss)) {
                 fastRun(0, count, 0, magLinear);  // level 0, one filter (docs/textures.md "Level of detail")
             } else {
                 // Per quad level and filter, then runs of whole quads: one level -> fast kernel,

@@ -94,6 +94,19 @@ bool addMipChains(Case& c, std::mt19937& rng) {
     return chains;
 }
 
+// Whether some texture of `c` blends two levels (a chain under MIP filter LINEAR).
+bool trilinear(const Case& c) {
+    return std::any_of(c.tex.begin(), c.tex.end(),
+                       [](const Case::Tex& t) { return t.bound && !t.mips.empty() && t.mipFilter == D3DTEXF_LINEAR; });
+}
+
+// Whether some texture of `c` with a chain is not 8-bit (texels decoded).
+bool decodedChain(const Case& c) {
+    return std::any_of(c.tex.begin(), c.tex.end(), [](const Case::Tex& t) {
+        return t.bound && !t.mips.empty() && emu::formatInfo(t.format)->cls != ps11::FormatClass::Unorm8;
+    });
+}
+
 }  // namespace
 
 TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path where every quad picks one level",
@@ -140,8 +153,8 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
 TEST_CASE("aligned pass: triangles of one draw whose quads pick different levels equal the quad path",
           "[draw][aligned]") {
     // Three rectangles side by side over one mip-mapped texture: 2:1, 4:1 and 1:1 across, 2:1
-    // down (levels 1, 2 and 1). The row path draws the triangles that pick the level of the
-    // first; the others must still get their own level.
+    // down (levels 1, 2 and 1). The row path reads the level of the first for the triangles that
+    // pick it, and samples the others' taps per pixel, each at its quad's level.
     Case c;
     c.w = 96, c.h = 16;
     c.rtInit.assign(size_t(c.w) * c.h * 4, 0x40);
@@ -180,8 +193,9 @@ TEST_CASE("aligned pass: triangles of one draw whose quads pick different levels
     Device rowDev(rowOpt);
     DrawStats rs;
     REQUIRE(drawCase(rowDev, c, rs) == expected);
-    // The first and third rectangles (level 1) on the row path, the second in quads.
-    CHECK(rs.pixelsRowPath == 2 * 32 * 16);
+    // Every rectangle on the row path (the second's tap sampled per pixel, at its quads' level).
+    CHECK(rs.pixelsRowPath == 3 * 32 * 16);
+    CHECK(rs.pixelsShaded == rs.pixelsCovered);
 }
 
 TEST_CASE("aligned pass: fogged and depth-tested passes take the row paths and equal the quad path",
@@ -358,10 +372,10 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
 TEST_CASE("aligned pass: rotated and perspective draws of mip chains pick each pixel's level as its quad does",
           "[draw][aligned]") {
     // The random rotated, sheared and perspective cases with mip chains, every MIP filter and
-    // MIN != MAG half the time, in fx8 and fx12: where no tap blends two levels the row path samples
-    // them per pixel, each pixel at the level and filter of its 2×2 quad.
+    // MIN != MAG half the time, in fx8 and fx12: the row path samples them per pixel, each pixel
+    // at the level, filter and mip blend of its 2×2 quad.
     std::mt19937 rng(20261201);
-    int cases = 0, rows = 0, mipRows = 0;
+    int cases = 0, rows = 0, mipRows = 0, trilinearRows = 0;
     for (int i = 0; i < 300; ++i) {
         Case c = randomCase(rng);
         const bool chains = addMipChains(c, rng);
@@ -381,10 +395,13 @@ TEST_CASE("aligned pass: rotated and perspective draws of mip chains pick each p
         const int before = rows;
         requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
         if (chains && rows > before) ++mipRows;
+        if (trilinear(c) && rows > before) ++trilinearRows;
     }
-    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
-    CHECK(rows * 4 >= cases);
-    CHECK(mipRows * 5 >= cases);
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain, " << trilinearRows
+              << " with a blend of two levels");
+    CHECK(rows * 4 >= cases * 3);
+    CHECK(mipRows * 4 >= cases * 3);
+    CHECK(trilinearRows * 2 >= cases);
 }
 
 TEST_CASE("float row path: random rotated, sheared and perspective draws in float and ideal equal the quad path",
@@ -415,11 +432,10 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
 
 TEST_CASE("float row path: rotated and perspective draws of mip chains pick each pixel's level as its quad does",
           "[draw][aligned]") {
-    // The same in float and ideal (and the D3D9 class's 8-bit weights): the float row path samples
-    // 8-bit taps whose level the level of detail picks per pixel, each at its quad's level and
-    // filter; other formats with a chain go to quads.
+    // The same in float and ideal (and the D3D9 class's 8-bit weights), every format: the float row
+    // path samples them per pixel, each at its quad's level, filter and mip blend.
     std::mt19937 rng(20261202);
-    int cases = 0, rows = 0, mipRows = 0;
+    int cases = 0, rows = 0, mipRows = 0, trilinearRows = 0, decodedRows = 0;
     for (int i = 0; i < 300; ++i) {
         Case c = randomCase(rng, (i & 2) != 0);
         const bool chains = addMipChains(c, rng);
@@ -442,10 +458,15 @@ TEST_CASE("float row path: rotated and perspective draws of mip chains pick each
         const int before = rows;
         requireRowsEqual(rowOpt, c, expected, qs, cases, rows);
         if (chains && rows > before) ++mipRows;
+        if (trilinear(c) && rows > before) ++trilinearRows;
+        if (decodedChain(c) && rows > before) ++decodedRows;
     }
-    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain");
-    CHECK(rows * 4 >= cases);
-    CHECK(mipRows * 5 >= cases);
+    INFO(rows << " of " << cases << " cases took the row path, " << mipRows << " with a mip chain, " << trilinearRows
+              << " with a blend of two levels, " << decodedRows << " with a chain of decoded texels");
+    CHECK(rows * 4 >= cases * 3);
+    CHECK(mipRows * 4 >= cases * 3);
+    CHECK(trilinearRows * 2 >= cases);
+    CHECK(decodedRows * 10 >= cases);
 }
 
 TEST_CASE("aligned pass: rotated and perspective draws take the row path, in fx8 and fx12", "[draw][aligned]") {
