@@ -167,27 +167,17 @@ const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, i
     int hi = q1;
     while (e.stamp[size_t(hi)] == mark) --hi;
     // Quads [lo, hi]: the coordinates the quad path gives their top-left, top-right and
-    // bottom-left pixels (the rasteriser interpolates helper lanes from the same planes), the
-    // derivatives it takes from them (selectLevels), and its choice.
-    const double w0 = double(tex.level(0).width), h0 = double(tex.level(0).height);
+    // bottom-left pixels (the rasteriser interpolates helper lanes from the same planes), and its
+    // choice from them.
     alignas(32) float ut[ps11::kMaxSpan], vt[ps11::kMaxSpan], ub[ps11::kMaxSpan], vb[ps11::kMaxSpan];
     for (int first = 2 * lo; first < 2 * hi + 2; first += ps11::kMaxSpan) {
         const int len = std::min(ps11::kMaxSpan, 2 * hi + 2 - first);
         rowCoords(s, coordSet, first, qy, len, ut, vt);
         rowCoords(s, coordSet, first, qy + 1, len, ub, vb);
         for (int q = 0; q < len; q += 2) {
-            double dx2 = 0, dy2 = 0;
-            for (int a = 0; a < 2; ++a) {
-                const float* top = a == 0 ? ut : vt;
-                const float* bottom = a == 0 ? ub : vb;
-                const double size = a == 0 ? w0 : h0;
-                const double c0 = double(top[q]) * size;
-                const double ddx = double(top[q + 1]) * size - c0, ddy = double(bottom[q]) * size - c0;
-                dx2 += ddx * ddx;
-                dy2 += ddy * ddy;
-            }
+            const float tl[3] = {ut[q], vt[q], 0.0f}, tr[3] = {ut[q + 1], vt[q + 1], 0.0f}, bl[3] = {ub[q], vb[q], 0.0f};
             const size_t qi = size_t((first + q) >> 1);
-            e.choice[qi] = ps11::chooseLevel(tex, ss, dx2, dy2, fixed, weights8);
+            e.choice[qi] = ps11::quadLevel(tex, ss, tl, tr, bl, fixed, weights8);
             e.stamp[qi] = mark;
         }
     }

@@ -232,25 +232,40 @@ LevelChoice chooseLevel(const Texture& tex, const SamplerState& st, double dx2, 
     return c;
 }
 
+LevelChoice quadLevel(const Texture& tex, const SamplerState& st, const float tl[3], const float tr[3],
+                      const float bl[3], bool fixed, bool weights8) {
+    const int axes = tex.isVolume() ? 3 : 2;
+    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
+    double dx2 = 0, dy2 = 0;
+    for (int a = 0; a < axes; ++a) {
+        const double c0 = double(tl[a]) * size[a];
+        const double ddx = double(tr[a]) * size[a] - c0, ddy = double(bl[a]) * size[a] - c0;
+        dx2 += ddx * ddx;
+        dy2 += ddy * ddy;
+    }
+    return chooseLevel(tex, st, dx2, dy2, fixed, weights8);
+}
+
 namespace {
 
+// Lane i of L takes choice c.
+inline void setLane(LaneLevels& L, int i, const LevelChoice& c) {
+    L.level[0][i] = uint8_t(c.level0);
+    L.level[1][i] = uint8_t(c.level1);
+    L.slots[i] = uint8_t(c.slots);
+    L.linear[i] = c.linear;
+    L.mipW[i] = c.mipW;
+    L.mipF[i] = c.mipF;
+}
+
 // Level selection (docs/textures.md "Level of detail"): per 2x2 quad, the screen derivatives of
-// (u*W, v*H, w*D) at level 0 from the top-left lane, then chooseLevel.
+// (u*W, v*H, w*D) at level 0 from the top-left lane, then chooseLevel (quadLevel); or the
+// caller's choice per lane (SampleRequest::levels).
 void selectLevels(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
                   const SamplerState& st, bool fixed, bool weights8, LaneLevels& L) {
     const bool magLinear = effective(st.magFilter) == Filter::Linear;
-    const int axes = tex.isVolume() ? 3 : 2;
-    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
-    if (req.levels) {  // chosen by the caller, per lane
-        for (int i = 0; i < count; ++i) {
-            const LevelChoice& c = req.levels[i];
-            L.level[0][i] = uint8_t(c.level0);
-            L.level[1][i] = uint8_t(c.level1);
-            L.slots[i] = uint8_t(c.slots);
-            L.linear[i] = c.linear;
-            L.mipW[i] = c.mipW;
-            L.mipF[i] = c.mipF;
-        }
+    if (req.levels) {
+        for (int i = 0; i < count; ++i) setLane(L, i, req.levels[i]);
         return;
     }
     // Without quads, or when every LOD gives level 0 with one filter (one level or no mip
@@ -262,22 +277,11 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     }
     for (int q = 0; q < count; q += 4) {
         const int tl = q, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
-        double dx2 = 0, dy2 = 0;
-        for (int a = 0; a < axes; ++a) {
-            const double c0 = double(coord[a][tl]) * size[a];
-            const double ddx = double(coord[a][tr]) * size[a] - c0, ddy = double(coord[a][bl]) * size[a] - c0;
-            dx2 += ddx * ddx;
-            dy2 += ddy * ddy;
-        }
-        const LevelChoice c = chooseLevel(tex, st, dx2, dy2, fixed, weights8);
-        for (int i = q; i < std::min(q + 4, count); ++i) {
-            L.level[0][i] = uint8_t(c.level0);
-            L.level[1][i] = uint8_t(c.level1);
-            L.slots[i] = uint8_t(c.slots);
-            L.linear[i] = c.linear;
-            L.mipW[i] = c.mipW;
-            L.mipF[i] = c.mipF;
-        }
+        const float ctl[3] = {coord[0][tl], coord[1][tl], coord[2][tl]};
+        const float ctr[3] = {coord[0][tr], coord[1][tr], coord[2][tr]};
+        const float cbl[3] = {coord[0][bl], coord[1][bl], coord[2][bl]};
+        const LevelChoice c = quadLevel(tex, st, ctl, ctr, cbl, fixed, weights8);
+        for (int i = q; i < std::min(q + 4, count); ++i) setLane(L, i, c);
     }
 }
 

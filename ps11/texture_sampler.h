@@ -51,6 +51,11 @@ struct LevelChoice {
 };
 LevelChoice chooseLevel(const Texture& tex, const SamplerState& state, double dx2, double dy2, bool fixed,
                         bool weights8);
+// A quad's choice from the coordinates (u, v, and w for a volume) of its top-left, top-right and
+// bottom-left lanes: the derivatives ∂c/∂x = c(tr) − c(tl) and ∂c/∂y = c(bl) − c(tl) in level-0
+// texels, computed in double, then chooseLevel (what sample() does per quad of its lanes).
+LevelChoice quadLevel(const Texture& tex, const SamplerState& state, const float tl[3], const float tr[3],
+                      const float bl[3], bool fixed, bool weights8);
 
 class TextureSampler final : public Sampler {
 public:

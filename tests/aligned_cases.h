@@ -414,4 +414,15 @@ inline void radeon8500(DeviceOptions& a, DeviceOptions& b) {
     a.precision = b.precision = std::nullopt;
 }
 
+// The fx profiles of case c on both devices: ps_1_4 programs on the 1.4-class card in fx8, and
+// with `radeon` the radeon8500 class in its own fx12 (MaxValue 8: the generic executor's
+// pre-sampled runs) instead.
+inline void fxProfile(const Case& c, bool radeon, DeviceOptions& a, DeviceOptions& b) {
+    if (c.program.rfind("ps_1_4", 0) == 0) {
+        a.hardware = b.hardware = &ps11::defaultHardware(4);
+        a.precision = b.precision = ps11::Precision::Fx8;
+    }
+    if (radeon) radeon8500(a, b);
+}
+
 }  // namespace alignedcases

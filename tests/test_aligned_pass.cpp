@@ -40,11 +40,7 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         // ps_1_4 programs run on the 1.4-class card, in fx8; every third case on that card in its
         // own fx12 (MaxValue 8: the generic executor's pre-sampled runs).
-        if (c.program.rfind("ps_1_4", 0) == 0) {
-            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
-        }
-        if (i % 3 == 2) radeon8500(quadOpt, rowOpt);
+        fxProfile(c, i % 3 == 2, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -125,11 +121,7 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (c.program.rfind("ps_1_4", 0) == 0) {
-            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
-        }
-        if (profile == 1) radeon8500(quadOpt, rowOpt);
+        fxProfile(c, profile == 1, quadOpt, rowOpt);
         if (profile >= 2) floatProfile(i, profile == 3, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
@@ -354,11 +346,7 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         rowOpt.software.skipTiles = (i % 3) == 0;  // such triangles' tiles are never decided
-        if (c.program.rfind("ps_1_4", 0) == 0) {
-            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
-        }
-        if (i % 4 == 1) radeon8500(quadOpt, rowOpt);  // fx12: taps sampled per pixel at scale 16
+        fxProfile(c, i % 4 == 1, quadOpt, rowOpt);  // radeon8500, fx12: taps sampled per pixel at scale 16
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -383,11 +371,7 @@ TEST_CASE("aligned pass: rotated and perspective draws of mip chains pick each p
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (c.program.rfind("ps_1_4", 0) == 0) {
-            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
-        }
-        if (i % 4 == 1) radeon8500(quadOpt, rowOpt);
+        fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);

@@ -137,6 +137,15 @@ std::unique_ptr<ps11::Executor> copyExecutor(ps11::Precision precision) {
     return exec;
 }
 
+// A w×h A8R8G8B8 target of zero bytes.
+Image blankTarget(int w, int h) {
+    Image target;
+    target.format = formatInfo(D3DFMT_A8R8G8B8);
+    target.width = uint32_t(w), target.height = uint32_t(h), target.rowPitch = 4 * uint32_t(w);
+    target.bytes.assign(size_t(w) * size_t(h) * 4, 0);
+    return target;
+}
+
 // The two triangles of the 1:1 quad over a w×h target, tap 0's coordinates shifted by (du, dv)
 // texels; `used` is what they interpolate.
 void quadSetups(int w, int h, float du, float dv, TriangleSetup setups[2], uint64_t& used) {
@@ -164,10 +173,7 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
     const int w = 48, h = 6;
     const std::unique_ptr<ps11::Executor> exec = copyExecutor(ps11::Precision::Fx8);
     std::vector<uint8_t> texels(size_t(w) * h * 4);
-    Image target;
-    target.format = formatInfo(D3DFMT_A8R8G8B8);
-    target.width = w, target.height = h, target.rowPitch = 4 * w;
-    target.bytes.assign(size_t(w) * h * 4, 0);
+    Image target = blankTarget(w, h);
     // The 1:1 quad with the tap a quarter texel right (one weight along whole rows).
     TriangleSetup setups[2];
     uint64_t used = 0;
@@ -351,10 +357,7 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 4x, 8x, 16x, non-integer) equal
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the row path's count below holds
-        if (c.program.rfind("ps_1_4", 0) == 0) {
-            quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-            quadOpt.precision = rowOpt.precision = ps11::Precision::Fx8;
-        }
+        fxProfile(c, false, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -450,10 +453,7 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
     std::unique_ptr<ps11::Executor> exec = ps11::Executor::create(*program, ps11::ExecutorOptions{}, diags);
     REQUIRE(exec);
     const int w = 240, h = 4;
-    Image target;
-    target.format = formatInfo(D3DFMT_A8R8G8B8);
-    target.width = w, target.height = h, target.rowPitch = 4 * w;
-    target.bytes.assign(size_t(w) * h * 4, 0);
+    Image target = blankTarget(w, h);
     for (const double scale : {2.0, 3.0, 8.0, 2.5}) {
         const uint32_t tw = uint32_t(w / scale);
         std::vector<uint8_t> texels(size_t(tw) * h * 4, 7);
@@ -713,52 +713,74 @@ TEST_CASE("aligned pass: a 4:1 reduction's pair sums straight from the texel row
     }
 }
 
+namespace {
+
+// A w x h target over four taps of one texture `scale` times its size (random texels and target
+// bytes), the blur program (weight 0.25 each), plain (blend 0) or ONE/ONE; the taps' offsets
+// (in texels of the texture, from the half-pixel quad's 1:1 mapping of the block) are
+// `offsets[s]`.
+Case reductionCase(std::mt19937& rng, UINT w, UINT h, int scale, DWORD filter, DWORD address, DWORD blend,
+                   const float (*offsets)[2]) {
+    Case c = randomCase(rng);
+    c.w = w, c.h = h;
+    c.rtInit.resize(size_t(c.w) * c.h * 4);
+    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    for (Case::Tex& t : c.tex) {
+        t.w = UINT(scale) * c.w, t.h = UINT(scale) * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
+        t.filter = filter, t.addressU = t.addressV = address;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(rng());
+    }
+    c.oneTexture = true;
+    c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+                "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
+    c.blend = blend, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
+    c.verts.clear();
+    const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
+        for (int s = 0; s < 4; ++s) {
+            v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + offsets[s][0] / float(c.tex[0].w);
+            v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + offsets[s][1] / float(c.tex[0].h);
+        }
+        c.verts.push_back(v);
+    }
+    return c;
+}
+
+// The case drawn in quads and on the row path (tiles not decided) at every SIMD level: the same
+// bytes, every covered pixel shaded in rows.
+void requireRowsAtEveryLevel(const Case& c, ps11::Precision precision, int threads) {
+    DeviceOptions quadOpt, rowOpt;
+    quadOpt.software.alignedPasses = false;
+    rowOpt.software.skipTiles = false;
+    quadOpt.precision = rowOpt.precision = precision;
+    quadOpt.software.threads = rowOpt.software.threads = threads;
+    Device quadDev(quadOpt);
+    DrawStats qs;
+    const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+        Device rowDev(rowOpt);
+        DrawStats rs;
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsShaded == rs.pixelsCovered);
+    });
+}
+
+}  // namespace
+
 TEST_CASE("aligned pass: 4:1 reductions by weight-½ taps (a glow's sources) equal the quad path", "[draw][aligned]") {
     // The glow's first pass: four bilinear taps one texel either side of each 4x4 block's centre
     // (H rows of pair sums from the texel row, both phases at once), random texels, a target of
     // several groups of 16 and a ragged end, in fx8, plain and ONE/ONE.
     std::mt19937 rng(20261130);
+    const float off[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
     for (int i = 0; i < 8; ++i) {
-        Case c = randomCase(rng);
-        c.w = UINT(std::uniform_int_distribution<int>(20, 90)(rng)), c.h = 6;
-        c.rtInit.resize(size_t(c.w) * c.h * 4);
-        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
-        for (Case::Tex& t : c.tex) {
-            t.w = 4 * c.w, t.h = 4 * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
-            t.filter = D3DTEXF_LINEAR, t.addressU = t.addressV = D3DTADDRESS_CLAMP;
-            t.bytes.resize(size_t(t.w) * t.h * 4);
-            for (uint8_t& b : t.bytes) b = uint8_t(rng());
-        }
-        c.oneTexture = true;
-        c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
-                    "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
-        c.blend = DWORD(i % 2), c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
-        c.verts.clear();
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        const float off[4][2] = {{-1, -1}, {1, -1}, {-1, 1}, {1, 1}};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
-            for (int s = 0; s < 4; ++s) {
-                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + off[s][0] / float(4 * c.w);
-                v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + off[s][1] / float(4 * c.h);
-            }
-            c.verts.push_back(v);
-        }
-        DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        rowOpt.software.skipTiles = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        Device quadDev(quadOpt);
-        DrawStats qs;
-        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        const UINT w = UINT(std::uniform_int_distribution<int>(20, 90)(rng));
+        const Case c = reductionCase(rng, w, 6, 4, D3DTEXF_LINEAR, D3DTADDRESS_CLAMP, DWORD(i % 2), off);
         INFO("case " << i << ": " << c.w << "x" << c.h);
-        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-            Device rowDev(rowOpt);
-            DrawStats rs;
-            REQUIRE(drawCase(rowDev, c, rs) == expected);
-            CHECK(rs.pixelsShaded == rs.pixelsCovered);
-        });
+        requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
     }
 }
 
@@ -771,54 +793,17 @@ TEST_CASE("aligned pass: point reductions by 2 to 8 (a bright pass) equal the qu
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     for (int i = 0; i < 12; ++i) {
         const int scale = std::array<int, 6>{2, 3, 4, 5, 7, 8}[size_t(i % 6)];
-        Case c = randomCase(rng);
-        c.w = UINT(uni(20, 70)), c.h = 5;
-        c.rtInit.resize(size_t(c.w) * c.h * 4);
-        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        // Each tap at the centre of texel (s·x + px, s·y + py) of its block.
+        float off[4][2];
+        const float half = 0.5f * float(scale) - 0.5f;  // the block's centre to its first texel's
+        for (auto& p : off) p[0] = float(uni(0, scale - 1)) - half, p[1] = float(uni(0, scale - 1)) - half;
+        const UINT w = UINT(uni(20, 70));
         const DWORD address = uni(0, 1) ? D3DTADDRESS_WRAP : D3DTADDRESS_CLAMP;
-        for (Case::Tex& t : c.tex) {
-            t.w = UINT(scale) * c.w, t.h = UINT(scale) * c.h, t.format = D3DFMT_A8R8G8B8, t.bound = true;
-            t.filter = D3DTEXF_POINT, t.addressU = t.addressV = address;
-            t.bytes.resize(size_t(t.w) * t.h * 4);
-            for (uint8_t& b : t.bytes) b = uint8_t(rng());
-        }
-        c.oneTexture = true;
-        c.program = "ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
-                    "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
-        c.blend = DWORD(i % 2), c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
-        c.verts.clear();
-        // Each tap at texel (s·x + px, s·y + py) of its block: the centre of that texel.
-        float phase[4][2];
-        for (auto& p : phase) p[0] = float(uni(0, scale - 1)), p[1] = float(uni(0, scale - 1));
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
-            for (int s = 0; s < 4; ++s) {
-                const float tw = float(scale) * float(c.w), th = float(scale) * float(c.h);
-                const float half = 0.5f * float(scale) - 0.5f;  // the block's centre to its first texel's
-                v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (phase[s][0] - half) / tw;
-                v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (phase[s][1] - half) / th;
-            }
-            c.verts.push_back(v);
-        }
+        const Case c = reductionCase(rng, w, 5, scale, D3DTEXF_POINT, address, DWORD(i % 2), off);
         for (const ps11::Precision precision : {ps11::Precision::Fx8, ps11::Precision::Fx12}) {
-            DeviceOptions quadOpt, rowOpt;
-            quadOpt.software.alignedPasses = false;
-            rowOpt.software.skipTiles = false;
-            quadOpt.precision = rowOpt.precision = precision;
-            quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-            Device quadDev(quadOpt);
-            DrawStats qs;
-            const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
             INFO("case " << i << ": " << c.w << "x" << c.h << " from " << scale << " times that, "
                          << ps11::precisionName(precision));
-            testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-                Device rowDev(rowOpt);
-                DrawStats rs;
-                REQUIRE(drawCase(rowDev, c, rs) == expected);
-                CHECK(rs.pixelsShaded == rs.pixelsCovered);
-            });
+            requireRowsAtEveryLevel(c, precision, 1 + (i & 1));
         }
     }
 }
@@ -833,10 +818,7 @@ TEST_CASE("aligned pass: a point reduction's H rows are picked from the texel ro
     std::vector<uint8_t> texels(size_t(w * sx) * size_t(h * sy) * 4);
     std::mt19937 rng(7);
     for (uint8_t& b : texels) b = uint8_t(rng());
-    Image target;
-    target.format = formatInfo(D3DFMT_A8R8G8B8);
-    target.width = w, target.height = h, target.rowPitch = 4 * w;
-    target.bytes.assign(size_t(w) * h * 4, 0);
+    Image target = blankTarget(w, h);
     TriangleSetup setups[2];
     uint64_t used = 0;
     // Pixel x's u lands on texel 8x + 3.5 + du·8: du = 1.5 / 8 gives 8x + 5 (and v: 4y + 1).
