@@ -640,6 +640,82 @@ TEST_CASE("sampler: the 8-bit fast path equals the general path for scattered la
     }
 }
 
+TEST_CASE("sampler: lanes at levels given per lane equal lanes of quads that chose them", "[sampler]") {
+    // SampleRequest::levels (what the device's row paths hand over, each quad's quadLevel kept for
+    // its two rows): random quads of coordinates over a 64x32 chain of random texels, MIP filter
+    // POINT and LINEAR, MIN != MAG, in fx8, fx12, float and ideal, through the fast path (at every
+    // SIMD level) and the general one. Each quad's lanes sampled with their quad's choice and no
+    // quads must give the bytes or floats the quads give.
+    std::mt19937 rng(20261203);
+    TextureDesc d = makeDesc(TexFormat::A8R8G8B8, 64, 32, 0, {});
+    for (uint32_t i = 0; i < 64 * 32; ++i) d.data[0].texels.push_back(word(rng()));
+    d.levels = {0, 1};  // the whole chain, generated
+    auto tex = build(d);
+    REQUIRE(tex->levelCount() == 7);
+    std::uniform_real_distribution<float> at(-0.5f, 1.5f), step(-0.2f, 0.2f);
+    const int quads = 64;
+    std::vector<float> u(4 * quads), v(4 * quads);
+    for (int q = 0; q < quads; ++q) {
+        // A quad at (u0, v0) whose x and y steps reach anything from magnified to level 6.
+        const float u0 = at(rng), v0 = at(rng), dux = step(rng), dvx = step(rng) * 0.5f, duy = step(rng) * 0.5f,
+                    dvy = step(rng);
+        for (int k = 0; k < 4; ++k) {
+            const float x = float(k & 1), y = float(k >> 1);
+            u[size_t(4 * q + k)] = u0 + x * dux + y * duy;
+            v[size_t(4 * q + k)] = v0 + x * dvx + y * dvy;
+        }
+    }
+    int blends = 0;
+    for (Filter mip : {Filter::Point, Filter::Linear})
+        for (Filter minf : {Filter::Linear, Filter::Point})
+            for (Precision p : {Precision::Fx8, Precision::Fx12, Precision::Float, Precision::Ideal})
+                for (bool fastPath : {true, false}) {
+                    SamplerState st = state(Filter::Linear, TextureAddress::Wrap, mip);
+                    st.minFilter = minf;
+                    const bool fixed = isFixedPoint(p);
+                    std::vector<LevelChoice> levels(u.size());
+                    for (int q = 0; q < quads; ++q) {
+                        const size_t i = size_t(4 * q);
+                        const float tl[3] = {u[i], v[i], 0}, tr[3] = {u[i + 1], v[i + 1], 0},
+                                    bl[3] = {u[i + 2], v[i + 2], 0};
+                        const LevelChoice c = quadLevel(*tex, st, tl, tr, bl, fixed, false);
+                        blends += c.slots == 2;
+                        for (int k = 0; k < 4; ++k) levels[i + size_t(k)] = c;
+                    }
+                    INFO("mip " << int(mip) << " min " << int(minf) << " precision " << int(p) << " fast "
+                                << fastPath);
+                    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                        TextureSampler s;
+                        s.setFastPath(fastPath);
+                        s.bind(0, tex);
+                        s.setSamplerState(0, st);
+                        const Result a = run(s, p, u, v, {}, true);
+                        Result b;
+                        SampleRequest req;
+                        req.count = int(u.size());
+                        req.u = u.data(), req.v = v.data();
+                        req.levels = levels.data();
+                        req.precision = p;
+                        SampleResult out;
+                        for (int c = 0; c < 4; ++c) {
+                            b.g[size_t(c)].assign(u.size(), -999);
+                            b.f[size_t(c)].assign(u.size(), -999.0f);
+                            out.grid[c] = b.g[size_t(c)].data();
+                            out.value[c] = b.f[size_t(c)].data();
+                        }
+                        s.sample(req, out);
+                        for (int c = 0; c < 4; ++c) {
+                            if (fixed) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
+                            if (!fixed)
+                                for (size_t i = 0; i < u.size(); ++i)
+                                    CHECK(std::bit_cast<uint32_t>(a.f[size_t(c)][i]) ==
+                                          std::bit_cast<uint32_t>(b.f[size_t(c)][i]));
+                        }
+                    });
+                }
+    CHECK(blends > 0);  // some quads blend two levels
+}
+
 TEST_CASE("sampler: floatAxisTaps gives the same pairs and weights at every SIMD level", "[sampler]") {
     // The float row paths' axis rule (tabulated columns, per-pixel taps): the Avx2 kernel against
     // the Baseline's lane-by-lane rule, over coordinates near texel edges, far outside, huge,
