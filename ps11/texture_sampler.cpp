@@ -446,62 +446,47 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
         run.scale = gridScale(req.precision) / 255;
         const bool border = ss.addressU == TextureAddress::Border || ss.addressV == TextureAddress::Border;
         if (!border || borderAsWord(borderGrid, run.scale, run.borderWord)) {
-            const fastpath::Unorm8Kernel kernel = fastpath::samplerKernels(simdLevel()).unorm8;
-            auto fastRun = [&](int first, int n, int level, bool linear) {
+            const fastpath::SamplerKernels& kernels = fastpath::samplerKernels(simdLevel());
+            auto levelRun = [&](fastpath::Unorm8Run& r, int level, bool linear) {
                 const TextureLevelInfo& li = tex.level(level);
-                run.texels = tex.unorm8() + li.offset * 4;
-                run.width = li.width, run.height = li.height, run.linear = linear;
+                r.texels = tex.unorm8() + li.offset * 4;
+                r.width = li.width, r.height = li.height, r.linear = linear;
+            };
+            auto fastRun = [&](int first, int n, int level, bool linear) {
+                levelRun(run, level, linear);
                 int32_t* dst[4] = {gridDst[0] + first, gridDst[1] + first, gridDst[2] + first, gridDst[3] + first};
-                kernel(run, n, coord[0] + first, coord[1] + first, dst);
+                kernels.unorm8(run, n, coord[0] + first, coord[1] + first, dst);
                 fetched += uint64_t(n) * (linear ? 4 : 1);
                 fastLanes += uint64_t(n);
             };
             const bool magLinear = effective(ss.magFilter) == Filter::Linear;
-            if (req.levels) {
-                // Levels given per lane: runs of one level and filter -> fast kernel, lanes of a
-                // linear mip blend -> the reference path (which takes the same levels).
-                for (int q = 0; q < count;) {
-                    const LevelChoice& c = req.levels[q];
-                    const bool two = c.slots == 2;
-                    int e = q + 1;
-                    while (e < count && (req.levels[e].slots == 2) == two &&
-                           (two || (req.levels[e].level0 == c.level0 && req.levels[e].linear == c.linear)))
-                        ++e;
-                    if (!two) {
-                        fastRun(q, e - q, c.level0, c.linear);
-                    } else {
-                        SampleRequest sub = req;
-                        sub.count = e - q;
-                        sub.levels = req.levels + q;
-                        const float* c3[3] = {coord[0] + q, coord[1] + q, coord[2] + q};
-                        int32_t* g[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
-                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst, floatWeights8);
-                    }
-                    q = e;
-                }
-            } else if (!req.quads || lodFree(tex, ss)) {
+            if (!req.levels && (!req.quads || lodFree(tex, ss))) {
                 fastRun(0, count, 0, magLinear);  // level 0, one filter (docs/textures.md "Level of detail")
             } else {
-                // Per quad level and filter, then runs of whole quads: one level -> fast kernel,
-                // a linear mip blend of two levels -> the reference path (quad-aligned, so its LOD
-                // is the same).
+                // Per quad (or per lane, where the caller gives the levels) level, filter and mip
+                // blend, then runs of whole quads (lanes) that agree: one level -> the kernel, a
+                // linear mip blend of two -> the two-level kernel, each lane at its own weight.
                 static thread_local LaneLevels lanes;
                 selectLevels(req, count, coord, tex, ss, true, false, lanes);
+                const int step = req.levels ? 1 : 4;
                 for (int q = 0; q < count;) {
                     const bool two = lanes.slots[q] == 2;
-                    int e = q + 4;
-                    while (e < count && (lanes.slots[e] == 2) == two &&
-                           (two || (lanes.level[0][e] == lanes.level[0][q] && lanes.linear[e] == lanes.linear[q])))
-                        e += 4;
+                    int e = q + step;
+                    while (e < count && (lanes.slots[e] == 2) == two && lanes.level[0][e] == lanes.level[0][q] &&
+                           lanes.linear[e] == lanes.linear[q])
+                        e += step;
                     e = std::min(e, count);
+                    const bool linear = lanes.linear[q] != 0;
                     if (!two) {
-                        fastRun(q, e - q, lanes.level[0][q], lanes.linear[q] != 0);
+                        fastRun(q, e - q, lanes.level[0][q], linear);
                     } else {
-                        SampleRequest sub = req;
-                        sub.count = e - q;
-                        const float* c3[3] = {coord[0] + q, coord[1] + q, coord[2] + q};
-                        int32_t* g[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
-                        fetched += sampleReference(sub, e - q, c3, tex, ss, borderGrid, g, valueDst, floatWeights8);
+                        fastpath::Unorm8Run upper = run;
+                        levelRun(run, lanes.level[0][q], linear);
+                        levelRun(upper, lanes.level[1][q], linear);
+                        int32_t* dst[4] = {gridDst[0] + q, gridDst[1] + q, gridDst[2] + q, gridDst[3] + q};
+                        kernels.unorm8Mip(run, upper, lanes.mipW + q, e - q, coord[0] + q, coord[1] + q, dst);
+                        fetched += 2 * uint64_t(e - q) * (linear ? 4 : 1);
+                        fastLanes += uint64_t(e - q);
                     }
                     q = e;
                 }

@@ -24,6 +24,12 @@ struct Unorm8Run {
 };
 
 using Unorm8Kernel = void (*)(const Unorm8Run& run, int count, const float* u, const float* v, int32_t* const* dst);
+// A blend of two levels (MIP filter LINEAR) in an fx profile: per lane the exact sums S = Σ w·byte
+// of its taps at level0's run and at level1's (weights of 65536 in all per level, a point tap's
+// byte times 65536), then round_half_even(((256 − m)·S0 + m·S1)·scale / 2^24) with m = mipW[i]:
+// the reference's one rounding. Both runs share the address modes, border word and scale.
+using Unorm8MipKernel = void (*)(const Unorm8Run& level0, const Unorm8Run& level1, const int32_t* mipW, int count,
+                                 const float* u, const float* v, int32_t* const* dst);
 
 // ps11::floatAxisTaps (texture_sampler.h) of a level: the reference sampler's per-lane axis rule
 // for the float profiles — texel pair after the address mode (-1 = border) and float weight
@@ -36,6 +42,7 @@ using FloatAxisKernel = void (*)(TextureAddress mode, bool linear, bool weights8
 struct SamplerKernels {
     Unorm8Kernel unorm8;
     FloatAxisKernel floatAxis;
+    Unorm8MipKernel unorm8Mip;
 };
 const SamplerKernels& samplerKernels(SimdLevel level);
 // The tables (the Avx2 one in x86-64 builds only); use samplerKernels().

@@ -10,6 +10,7 @@
 // is exact in float32 whatever the order or FMA; scaling by 2^-16 (fx8) or 2^-12 (fx12, 16
 // grid units per byte) is exact, and adding and removing 1.5 * 2^23 rounds to the nearest
 // integer, ties to even: one rounding, as the reference does in 64-bit integers.
+#include <cmath>
 #include <cstring>
 #ifdef __AVX2__
 #include <immintrin.h>
@@ -460,6 +461,56 @@ void sampleUnorm8(const Unorm8Run& run, int count, const float* u, const float* 
     }
 }
 
+// Per lane and channel (b g r a) the exact sum Σ w·byte of one level's taps (bilinear weights
+// w = wx'·wy' of 65536 in all; a point tap's byte times 65536): below 2^24, exact in float.
+void levelSums(const Unorm8Run& run, int count, const float* u, const float* v, Scratch& s,
+               float (*sum)[kMaxSpan]) {
+    if (run.linear) {
+        axisPass<true>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+        axisPass<true>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+        if (quadContiguous(count, s))
+            gatherQuads(run, count, s);
+        else
+            gatherBilinear(run, count, s);
+        for (int i = 0; i < count; ++i) {
+            const float fx = float(s.wx[i]), fy = float(s.wy[i]);
+            const float w11 = fx * fy, w10 = fx * 256.0f - w11, w01 = fy * 256.0f - w11;
+            const float w00 = 65536.0f - fx * 256.0f - w01;
+            for (int k = 0; k < 4; ++k)
+                sum[k][i] = w00 * byteOf(s.t00[i], k) + w10 * byteOf(s.t10[i], k) + w01 * byteOf(s.t01[i], k) +
+                            w11 * byteOf(s.t11[i], k);
+        }
+        return;
+    }
+    axisPass<false>(run.addressU, count, u, run.width, s.x0, s.x1, s.wx);
+    axisPass<false>(run.addressV, count, v, run.height, s.y0, s.y1, s.wy);
+    const size_t stride = size_t(run.width) * 4;
+    for (int i = 0; i < count; ++i) {
+        const int32_t x = s.x0[i], y = s.y0[i];
+        const uint32_t w = (x | y) < 0 ? run.borderWord : load32(run.texels + size_t(y) * stride + size_t(x) * 4);
+        for (int k = 0; k < 4; ++k) sum[k][i] = byteOf(w, k) * 65536.0f;
+    }
+}
+
+void sampleUnorm8Mip(const Unorm8Run& level0, const Unorm8Run& level1, const int32_t* mipW, int count, const float* u,
+                     const float* v, int32_t* const* dst) {
+    static thread_local Scratch s;
+    alignas(64) static thread_local float s0[4][kMaxSpan], s1[4][kMaxSpan];
+    levelSums(level0, count, u, v, s, s0);
+    levelSums(level1, count, u, v, s, s1);
+    // (256 − m)·S0 + m·S1 < 2^32, exact in double, as is its product with scale / 2^24 (a power of
+    // two); rounding it to an integer in the default mode is round-half-even.
+    const double k = double(level0.scale) / 16777216.0;
+    static constexpr int kPlane[4] = {2, 1, 0, 3};  // b g r a sums into the r g b a planes
+    for (int c = 0; c < 4; ++c) {
+        int32_t* out = dst[kPlane[c]];
+        for (int i = 0; i < count; ++i) {
+            const double m = double(mipW[i]);
+            out[i] = int32_t(std::nearbyint(((256.0 - m) * double(s0[c][i]) + m * double(s1[c][i])) * k));
+        }
+    }
+}
+
 // The float profiles' axis rule (texelPosition, addressPair, weight8 of
 // texture_sampler_internal.h) lane by lane.
 template <TextureAddress Mode>
@@ -540,6 +591,6 @@ void floatAxis(TextureAddress mode, bool linear, bool weights8, int count, const
 
 }  // namespace
 
-const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis};
+const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip};
 
 }  // namespace ps11::fastpath

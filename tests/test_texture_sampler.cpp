@@ -640,12 +640,14 @@ TEST_CASE("sampler: the 8-bit fast path equals the general path for scattered la
     }
 }
 
-TEST_CASE("sampler: lanes at levels given per lane equal lanes of quads that chose them", "[sampler]") {
+TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, equal the general path's quads",
+          "[sampler]") {
     // SampleRequest::levels (what the device's row paths hand over, each quad's quadLevel kept for
     // its two rows): random quads of coordinates over a 64x32 chain of random texels, MIP filter
     // POINT and LINEAR, MIN != MAG, in fx8, fx12, float and ideal, through the fast path (at every
-    // SIMD level) and the general one. Each quad's lanes sampled with their quad's choice and no
-    // quads must give the bytes or floats the quads give.
+    // SIMD level: its one- and two-level kernels) and the general one. Each quad's lanes sampled
+    // with their quad's choice and no quads, and the quads through the fast path, must give the
+    // bytes or floats the general path gives the quads.
     std::mt19937 rng(20261203);
     TextureDesc d = makeDesc(TexFormat::A8R8G8B8, 64, 32, 0, {});
     for (uint32_t i = 0; i < 64 * 32; ++i) d.data[0].texels.push_back(word(rng()));
@@ -684,12 +686,24 @@ TEST_CASE("sampler: lanes at levels given per lane equal lanes of quads that cho
                     }
                     INFO("mip " << int(mip) << " min " << int(minf) << " precision " << int(p) << " fast "
                                 << fastPath);
+                    TextureSampler general;
+                    general.setFastPath(false);
+                    general.bind(0, tex);
+                    general.setSamplerState(0, st);
+                    const Result a = run(general, p, u, v, {}, true);
                     testutil::forEachSimdLevel([&](ps11::SimdLevel) {
                         TextureSampler s;
                         s.setFastPath(fastPath);
                         s.bind(0, tex);
                         s.setSamplerState(0, st);
-                        const Result a = run(s, p, u, v, {}, true);
+                        const Result viaQuads = run(s, p, u, v, {}, true);
+                        for (int c = 0; c < 4; ++c) {
+                            if (fixed) CHECK(viaQuads.g[size_t(c)] == a.g[size_t(c)]);
+                            if (!fixed)
+                                for (size_t i = 0; i < u.size(); ++i)
+                                    CHECK(std::bit_cast<uint32_t>(viaQuads.f[size_t(c)][i]) ==
+                                          std::bit_cast<uint32_t>(a.f[size_t(c)][i]));
+                        }
                         Result b;
                         SampleRequest req;
                         req.count = int(u.size());
