@@ -75,12 +75,13 @@ struct Result {
 };
 
 Result run(TextureSampler& s, Precision p, const std::vector<float>& u, const std::vector<float>& v,
-           const std::vector<float>& w = {}, bool quads = false, int stage = 0) {
+           const std::vector<float>& w = {}, bool quads = false, int stage = 0, const LevelChoice* levels = nullptr) {
     Result r;
     SampleRequest req;
     req.stage = stage;
     req.count = int(u.size());
     req.quads = quads;
+    req.levels = levels;
     req.dims = w.empty() ? 2 : 3;
     req.u = u.data();
     req.v = v.data();
@@ -696,35 +697,17 @@ TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, eq
                         s.setFastPath(fastPath);
                         s.bind(0, tex);
                         s.setSamplerState(0, st);
-                        const Result viaQuads = run(s, p, u, v, {}, true);
-                        for (int c = 0; c < 4; ++c) {
-                            if (fixed) CHECK(viaQuads.g[size_t(c)] == a.g[size_t(c)]);
-                            if (!fixed)
-                                for (size_t i = 0; i < u.size(); ++i)
-                                    CHECK(std::bit_cast<uint32_t>(viaQuads.f[size_t(c)][i]) ==
+                        // The grid integers (fx) or the floats bit for bit.
+                        auto same = [&](const Result& b) {
+                            for (int c = 0; c < 4; ++c) {
+                                if (fixed) CHECK(b.g[size_t(c)] == a.g[size_t(c)]);
+                                for (size_t i = 0; !fixed && i < u.size(); ++i)
+                                    CHECK(std::bit_cast<uint32_t>(b.f[size_t(c)][i]) ==
                                           std::bit_cast<uint32_t>(a.f[size_t(c)][i]));
-                        }
-                        Result b;
-                        SampleRequest req;
-                        req.count = int(u.size());
-                        req.u = u.data(), req.v = v.data();
-                        req.levels = levels.data();
-                        req.precision = p;
-                        SampleResult out;
-                        for (int c = 0; c < 4; ++c) {
-                            b.g[size_t(c)].assign(u.size(), -999);
-                            b.f[size_t(c)].assign(u.size(), -999.0f);
-                            out.grid[c] = b.g[size_t(c)].data();
-                            out.value[c] = b.f[size_t(c)].data();
-                        }
-                        s.sample(req, out);
-                        for (int c = 0; c < 4; ++c) {
-                            if (fixed) CHECK(a.g[size_t(c)] == b.g[size_t(c)]);
-                            if (!fixed)
-                                for (size_t i = 0; i < u.size(); ++i)
-                                    CHECK(std::bit_cast<uint32_t>(a.f[size_t(c)][i]) ==
-                                          std::bit_cast<uint32_t>(b.f[size_t(c)][i]));
-                        }
+                            }
+                        };
+                        same(run(s, p, u, v, {}, true));
+                        same(run(s, p, u, v, {}, false, 0, levels.data()));
                     });
                 }
     CHECK(blends > 0);  // some quads blend two levels
