@@ -390,6 +390,12 @@ inline void floatProfile(int i, bool ideal, DeviceOptions& a, DeviceOptions& b) 
     }
 }
 
+// The same for case c: its ps_1_4 programs on the 1.4-class card.
+inline void floatProfile(const Case& c, int i, bool ideal, DeviceOptions& a, DeviceOptions& b) {
+    if (c.program.rfind("ps_1_4", 0) == 0) a.hardware = b.hardware = &ps11::defaultHardware(4);
+    floatProfile(i, ideal, a, b);
+}
+
 inline std::string profileName(const DeviceOptions& o) {
     if (o.precision) return ps11::precisionName(*o.precision);
     return o.hardware ? "the " + std::string(o.hardware->name) + " class's own profile" : "the default class's";

@@ -274,8 +274,7 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        floatProfile(i, (i / 2) % 2 != 0, quadOpt, rowOpt);
+        floatProfile(c, i, (i / 2) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         Device quadDev(quadOpt), rowDev(rowOpt);
         DrawStats qs, rs;
@@ -399,8 +398,7 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        floatProfile(i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 0;
         Device quadDev(quadOpt);
         DrawStats qs;
@@ -431,8 +429,7 @@ TEST_CASE("float row path: rotated and perspective draws of mip chains pick each
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
-        floatProfile(i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
         const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);

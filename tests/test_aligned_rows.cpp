@@ -146,6 +146,24 @@ Image blankTarget(int w, int h) {
     return target;
 }
 
+// A draw of `exec` (fx8) into `target` whose tap 0 reads `texels` by hand (w×h texels, clamped,
+// bilinear or point), set up below the device (prepareAlignedDraw gives it a new serial).
+void tapDraw(const ps11::Executor& exec, Image& target, uint64_t used, const std::vector<uint8_t>& texels, uint32_t w,
+             uint32_t h, bool linear, AlignedDraw& d) {
+    std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
+    std::array<ps11::SamplerState, 8> samplers{};
+    MergeState merge;
+    REQUIRE(prepareAlignedDraw(exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr}, false,
+                               used, d));
+    AlignedTap& tap = d.taps[0];
+    tap.bound = true;
+    d.bound = 1;
+    tap.texels = texels.data();
+    tap.width = w, tap.height = h;
+    tap.linear = linear;
+    tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+}
+
 // The two triangles of the 1:1 quad over a w×h target, tap 0's coordinates shifted by (du, dv)
 // texels; `used` is what they interpolate.
 void quadSetups(int w, int h, float du, float dv, TriangleSetup setups[2], uint64_t& used) {
@@ -183,20 +201,8 @@ TEST_CASE("aligned pass: H rows cached by a worker never outlive their draw", "[
     for (int draw = 0; draw < 2; ++draw) {
         for (uint8_t& b : texels) b = uint8_t(rng());
         AlignedDraw d;
-        // prepareAlignedDraw gives every draw a new serial; the taps are set by hand here.
-        std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
-        std::array<ps11::SamplerState, 8> samplers{};
-        MergeState merge;
-        REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr},
-                                   false, used, d));
-        AlignedTap& tap = d.taps[0];
-        tap.bound = true;
-        d.bound = 1;
-        tap.texels = texels.data();
-        tap.width = w, tap.height = h;
-        tap.linear = true;
-        tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
         AlignedTriangle at[2];
+        tapDraw(*exec, target, used, texels, w, h, true, d);
         for (int t = 0; t < 2; ++t) REQUIRE(prepareAlignedTriangle(d, setups[t], at[t]));
         const AlignedTriangle* tp[2] = {&at[0], &at[1]};
         const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
@@ -469,17 +475,7 @@ TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][
         TriangleSetup setup;
         REQUIRE(setupTriangle(tri, used, ClipRect{0, 0, w, h}, setup));
         AlignedDraw d;
-        std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
-        std::array<ps11::SamplerState, 8> samplers{};
-        REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, MergeState{},
-                                   MergeTarget{&target, nullptr}, false, used, d));
-        AlignedTap& tap = d.taps[0];
-        tap.bound = true;
-        d.bound = 1;
-        tap.texels = texels.data();
-        tap.width = tw, tap.height = h;
-        tap.linear = true;
-        tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
+        tapDraw(*exec, target, used, texels, tw, h, true, d);
         AlignedTriangle at;
         REQUIRE(prepareAlignedTriangle(d, setup, at));
         int tabulated = 0;
@@ -824,19 +820,8 @@ TEST_CASE("aligned pass: a point reduction's H rows are picked from the texel ro
     // Pixel x's u lands on texel 8x + 3.5 + du·8: du = 1.5 / 8 gives 8x + 5 (and v: 4y + 1).
     quadSetups(w, h, 1.5f / float(sx), -0.5f / float(sy), setups, used);
     AlignedDraw d;
-    std::array<std::shared_ptr<const ps11::Texture>, 8> none{};
-    std::array<ps11::SamplerState, 8> samplers{};
-    MergeState merge;
-    REQUIRE(prepareAlignedDraw(*exec, ps11::Precision::Fx8, none, samplers, merge, MergeTarget{&target, nullptr}, false,
-                               used, d));
-    AlignedTap& tap = d.taps[0];
-    tap.bound = true;
-    d.bound = 1;
-    tap.texels = texels.data();
-    tap.width = w * sx, tap.height = h * sy;
-    tap.linear = false;
-    tap.addressU = tap.addressV = ps11::TextureAddress::Clamp;
     AlignedTriangle at[2];
+    tapDraw(*exec, target, used, texels, uint32_t(w * sx), uint32_t(h * sy), false, d);
     for (int t = 0; t < 2; ++t) REQUIRE(prepareAlignedTriangle(d, setups[t], at[t]));
     const AlignedTriangle* tp[2] = {&at[0], &at[1]};
     const TriangleSetup* sp[2] = {&setups[0], &setups[1]};
