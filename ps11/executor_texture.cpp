@@ -160,13 +160,13 @@ void rowDot(const Profile& p, const RunState& st, int row, const DSrc& s, float*
 // 1_4 texld/texcrd coordinates: swizzled x, y and third component; _dz/_dw divide x and y
 // by the raw z/w first, a zero divisor giving 1.0 (spec §2.4, §3.1).
 void coords14(const Profile& p, const RunState& st, const DSrc& s, float* c0, float* c1, float* c2, float* c3) {
-    Lanes raw[4];
-    for (int c = 0; c < 4; ++c) srcFloat(p, st, s, c, raw[c]);
+    // Only the components asked for, each straight into its output (the divisor apart).
     float* outs[4] = {c0, c1, c2, c3};
     for (int c = 0; c < 4; ++c)
-        if (outs[c]) std::memcpy(outs[c], raw[s.sw[size_t(c)]], sizeof(float) * size_t(st.n));
+        if (outs[c]) srcFloat(p, st, s, s.sw[size_t(c)], outs[c]);
     if (s.mod == SrcMod::Dz || s.mod == SrcMod::Dw) {
-        const float* d = raw[s.mod == SrcMod::Dz ? 2 : 3];
+        Lanes d;
+        srcFloat(p, st, s, s.mod == SrcMod::Dz ? 2 : 3, d);
         for (int i = 0; i < st.n; ++i) {
             c0[i] = d[i] == 0.0f ? 1.0f : c0[i] / d[i];
             c1[i] = d[i] == 0.0f ? 1.0f : c1[i] / d[i];
