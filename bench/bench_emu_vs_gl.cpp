@@ -46,8 +46,17 @@ constexpr const char* kComposite =
     "tex t1\n"
     "mad r0, t1, c0, t0\n";
 
-enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated };
-constexpr int kPasses = 6;
+// A dependent read, ps_1_1's own: t1 sampled where t0's red and green, through stage 1's bump
+// matrix, move its coordinates (texbem). Neither row path takes it: its lookups are shaded in
+// spans of a row, each lane sampled where the program puts it.
+constexpr const char* kBump =
+    "ps_1_1\n"
+    "tex t0\n"
+    "texbem t1, t0\n"
+    "mov r0, t1\n";
+
+enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated, Bump };
+constexpr int kPasses = 7;
 enum class Kind { EmuFx8, EmuIdeal, GlNative, GlExact };
 constexpr Kind kKinds[] = {Kind::EmuFx8, Kind::EmuIdeal, Kind::GlNative, Kind::GlExact};
 const char* kindName(Kind k) {
@@ -78,6 +87,7 @@ struct PassDef {
     const char* shader;
     float c0;
     float turn = 0;  // texture coordinates turned by this many degrees about the centre
+    float bump = 0;  // stage 1's bump matrix: (bump, 0; 0, bump)
 };
 
 PassDef passDef(Pass p) {
@@ -102,6 +112,8 @@ PassDef passDef(Pass p) {
                 10.0f};
     case Pass::Magnify2Composite:  // t0 1:1 at 1080p, t1 a 960×540 texture magnified 2×
         return {"magnify2_composite_1080p", kW, kH, {{kW, kH}, {kW / 2, kH / 2}}, {{0, 0, 0}, {1, 0, 0}}, kComposite, 0.5f};
+    case Pass::Bump:  // t1 moved by up to 0.03 of its size by t0 (texbem)
+        return {"bump_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, 0, 0}, {1, 0, 0}}, kBump, 0, 0, 0.03f};
     }
     return {};
 }
@@ -173,6 +185,13 @@ void Scene::setup(Pass pass, Kind kind) {
         dev->SetSamplerState(st, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR);
         dev->SetSamplerState(st, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
         dev->SetSamplerState(st, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
+    }
+    if (pd.bump != 0) {
+        DWORD m;
+        std::memcpy(&m, &pd.bump, sizeof m);
+        if (dev->SetTextureStageState(1, D3DTSS_BUMPENVMAT00, m) != D3D_OK ||
+            dev->SetTextureStageState(1, D3DTSS_BUMPENVMAT11, m) != D3D_OK)
+            return refused("SetTextureStageState");
     }
     Handle ps{};
     if (dev->CreatePixelShaderFromText(pd.shader, &ps) != D3D_OK) return refused("CreatePixelShaderFromText");
@@ -283,7 +302,8 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
 
 int main(int argc, char** argv) {
     // The four devices of each pass registered alternately.
-    for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite, Pass::Blur4Rotated})
+    for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite, Pass::Blur4Rotated,
+                   Pass::Bump})
         for (Kind k : kKinds) {
             const std::string name = std::string("BM_EmuVsGl/") + passDef(p).name + "/" + kindName(k);
             benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)

@@ -78,22 +78,6 @@ bool lerpValuesBase(const float* rgba, int /*len*/, const int32_t* i0, const int
     return true;  // (lerpf itself: the reference's order)
 }
 
-void bilinearWordsBase(const uint8_t* texels, int width, const int32_t* i0, const int32_t* i1, const int32_t* j0,
-                       const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
-                       float* const out[4]) {
-    for (int j = 0; j < n; ++j) {
-        const int32_t xs[4] = {i0[j], i1[j], i0[j], i1[j]}, ys[4] = {j0[j], j0[j], j1[j], j1[j]};
-        float t[4][4];
-        for (int k = 0; k < 4; ++k)
-            for (size_t c = 0; c < 4; ++c)
-                t[k][c] = (xs[k] | ys[k]) < 0 ? border[c]
-                                              : kUnorm8[texels[(size_t(ys[k]) * size_t(width) + size_t(xs[k])) * 4 +
-                                                               size_t(ps11::kUnorm8Byte[c])]];
-        for (size_t c = 0; c < 4; ++c)
-            out[c][j] = lerpf(lerpf(t[0][c], t[1][c], fu[j]), lerpf(t[2][c], t[3][c], fu[j]), fv[j]);
-    }
-}
-
 void lerpRowBase(const float* a, const float* b, float f, int n, float* out) {
     int j = 0;
 #if defined(__SSE2__)
@@ -143,8 +127,8 @@ void transposeBase(const float* v, int n, float* out, size_t stride) {
         for (size_t c = 0; c < 4; ++c) out[c * stride + size_t(i)] = v[4 * size_t(i) + c];
 }
 
-const FloatRowKernels kBaseline{&lerpColumnsBase,   &lerpGatherBase, &lerpWordsBase, &lerpValuesBase,
-                                &bilinearWordsBase, &lerpRowBase,    &decodeBase,    &transposeBase};
+const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBase, &lerpValuesBase,
+                                &lerpRowBase,     &decodeBase,     &transposeBase};
 
 }  // namespace
 
@@ -345,24 +329,19 @@ const auto kLaneIndex = [] {
     return t;
 }();
 
-// An 8-bit tap sampled per pixel (a coordinate set that is not screen-aligned): the reference
-// sampler's addressing (floatAxisTaps) and its lerps in its order, u then v (texels byte / 255;
-// no NaN can occur, so the vector lerps give the reference's floats), for lanes [0, n).
+// An 8-bit tap sampled per pixel (a coordinate set that is not screen-aligned): the sampler's
+// own float kernel (ps11/texture_sampler_fast.h: the reference's addressing and lerps, u then v),
+// for lanes [0, n).
 void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const float* u, const float* v, int n,
                       float* const out[4]) {
-    alignas(32) int32_t i0[ps11::kMaxSpan], i1[ps11::kMaxSpan], j0[ps11::kMaxSpan], j1[ps11::kMaxSpan];
-    alignas(32) float fu[ps11::kMaxSpan], fv[ps11::kMaxSpan];
-    ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u, tap.width, i0, i1, fu);
-    ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, n, v, tap.height, j0, j1, fv);
-    float t[4];
-    if (!tap.linear) {
-        for (int i = 0; i < n; ++i) {
-            texel(tap, i0[i], j0[i], t);
-            for (int c = 0; c < 4; ++c) out[c][i] = t[c];
-        }
-        return;
-    }
-    draw.kernels->bilinearWords(tap.bytes, int(tap.width), i0, i1, j0, j1, fu, fv, tap.border.data(), n, out);
+    ps11::fastpath::Unorm8FloatRun run;
+    run.texels = tap.bytes;
+    run.width = tap.width, run.height = tap.height;
+    run.linear = tap.linear;
+    run.weights8 = draw.weights8;
+    run.addressU = tap.addressU, run.addressV = tap.addressV;
+    run.border = tap.border.data();
+    draw.sampler->unorm8Float(run, n, u, v, out);
 }
 
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
@@ -561,6 +540,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     if (!ps11::plainTaps(executor, d.plan)) return false;
     d.serial = nextRowDrawSerial();
     d.kernels = &floatRowKernels(ps11::simdLevel());
+    d.sampler = &ps11::fastpath::samplerKernels(ps11::simdLevel());
     d.executor = &executor;
     d.weights8 = weightBits == 8 && precision == ps11::Precision::Float;
     d.levelTaps.fixed = false;

@@ -21,6 +21,7 @@
 #include "ps11/executor.h"
 #include "ps11/executor_presampled_internal.h"
 #include "ps11/texture.h"
+#include "ps11/texture_sampler_fast.h"
 #include "ps11/texture_sampler.h"
 
 namespace emu {
@@ -50,6 +51,7 @@ struct FloatRowKernels;
 struct FloatRowDraw {
     uint64_t serial = 0;                       // unique per draw: H rows kept by workers are valid within one draw only
     const FloatRowKernels* kernels = nullptr;  // the SIMD level's (emu/aligned_float_kernels.h)
+    const ps11::fastpath::SamplerKernels* sampler = nullptr;  // the SIMD level's (ps11/texture_sampler_fast.h)
     const ps11::Executor* executor = nullptr;
     ps11::TapPlan plan;
     std::array<FloatRowTap, 8> taps{};

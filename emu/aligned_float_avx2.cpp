@@ -149,47 +149,6 @@ bool lerpValuesAvx2(const float* rgba, int /*len*/, const int32_t* i0, const int
     return true;
 }
 
-void bilinearWordsAvx2(const uint8_t* texels, int width, const int32_t* i0, const int32_t* i1, const int32_t* j0,
-                       const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
-                       float* const out[4]) {
-    const __m256i byte = _mm256_set1_epi32(0xff), w = _mm256_set1_epi32(width), none = _mm256_set1_epi32(-1);
-    const int* words = reinterpret_cast<const int*>(texels);
-    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
-    int j = 0;
-    for (; j + 8 <= n; j += 8) {
-        const __m256i x0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j));
-        const __m256i x1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i1 + j));
-        const __m256i y0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j0 + j));
-        const __m256i y1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j1 + j));
-        // Corners t00 t10 t01 t11: gathered where both indices are texels (the others' lanes
-        // masked off, never read), else the border colour.
-        const __m256i xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-        __m256i word[4];
-        __m256 inside[4];
-        for (int k = 0; k < 4; ++k) {
-            const __m256i in = _mm256_cmpgt_epi32(_mm256_or_si256(xs[k], ys[k]), none);
-            const __m256i at = _mm256_and_si256(_mm256_add_epi32(_mm256_mullo_epi32(ys[k], w), xs[k]), in);
-            inside[k] = _mm256_castsi256_ps(in);
-            word[k] = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), words, at, in, 4);
-        }
-        const __m256 u = _mm256_loadu_ps(fu + j), v = _mm256_loadu_ps(fv + j);
-        for (int c = 0; c < 4; ++c) {
-            const __m256 b = _mm256_set1_ps(border[c]);
-            __m256 t[4];
-            for (int k = 0; k < 4; ++k)
-                t[k] = _mm256_blendv_ps(
-                    b, unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(word[k], kShift[c]), byte))),
-                    inside[k]);
-            _mm256_storeu_ps(out[c] + j, lerp8(lerp8(t[0], t[1], u), lerp8(t[2], t[3], u), v));
-        }
-    }
-    if (j < n) {
-        float* const rest[4] = {out[0] + j, out[1] + j, out[2] + j, out[3] + j};
-        floatRowKernels(ps11::SimdLevel::Baseline)
-            .bilinearWords(texels, width, i0 + j, i1 + j, j0 + j, j1 + j, fu + j, fv + j, border, n - j, rest);
-    }
-}
-
 void lerpRowAvx2(const float* a, const float* b, float f, int n, float* out) {
     const __m256 fv = _mm256_set1_ps(f), gv = _mm256_set1_ps(1.0f - f);
     int j = 0;
@@ -249,7 +208,7 @@ void transposeAvx2(const float* v, int n, float* out, size_t stride) {
 
 }  // namespace
 
-const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2,   &lerpGatherAvx2, &lerpWordsAvx2, &lerpValuesAvx2,
-                                      &bilinearWordsAvx2, &lerpRowAvx2,    &decodeAvx2,    &transposeAvx2};
+const FloatRowKernels avx2::kFloatRow{&lerpColumnsAvx2, &lerpGatherAvx2, &lerpWordsAvx2, &lerpValuesAvx2,
+                                      &lerpRowAvx2,     &decodeAvx2,     &transposeAvx2};
 
 }  // namespace emu

@@ -34,13 +34,6 @@ struct FloatRowKernels {
     // at a time as the reference sampler does (out unspecified then).
     bool (*lerpValues)(const float* rgba, int len, const int32_t* i0, const int32_t* i1, const float* f, int n,
                        float* out, size_t stride);
-    // Bilinear lookups of an 8-bit b g r a texture (tight rows of `width` texels), one a lane, for
-    // taps sampled per pixel: out[c][j] = lerp(lerp(t00, t10, fu), lerp(t01, t11, fu), fv) with
-    // lerp(a, b, f) = (1 − f)·a + f·b and t_xy channel c of texel (x_j, y_j), x_j in {i0[j], i1[j]},
-    // y_j in {j0[j], j1[j]}, as its value (as decode), or border[c] where x or y is −1.
-    void (*bilinearWords)(const uint8_t* texels, int width, const int32_t* i0, const int32_t* i1, const int32_t* j0,
-                          const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
-                          float* const out[4]);
     // out[j] = (1 − f)·a[j] + f·b[j] for j in [0, n): a pixel row's vertical lerp of two H rows.
     void (*lerpRow)(const float* a, const float* b, float f, int n, float* out);
     // Texels [0, n) of a b g r a row as planar r g b a floats, byte / 255 (ps11::Texture::

@@ -8,6 +8,8 @@
 #endif
 #include <immintrin.h>
 
+#include "ps11/lanes_avx2.h"
+
 namespace emu {
 
 // Whether every lane of r0 and r1 (texel indices relative to a block's first texel) lies in
@@ -34,14 +36,7 @@ inline __m256i permuteSixteen(__m256i lo, __m256i hi, __m256i r) {
     return _mm256_blendv_epi8(_mm256_permutevar8x32_epi32(lo, r), _mm256_permutevar8x32_epi32(hi, r), fromHi);
 }
 
-// float(b) / 255 correctly rounded (ps11::Texture::unorm8Values()[b]) for bytes b held as floats:
-// q = b·(1/255), then one Newton step with the exact residual b − 255·q (an FMA). The quotient for
-// every byte (tests/test_simd_dispatch.cpp checks all 256 at every level), in a third of a
-// division's time.
-inline __m256 unitOfByte(__m256 b) {
-    const __m256 inv = _mm256_set1_ps(1.0f / 255.0f);
-    const __m256 q = _mm256_mul_ps(b, inv);
-    return _mm256_fmadd_ps(_mm256_fnmadd_ps(q, _mm256_set1_ps(255.0f), b), inv, q);
-}
+// float(b) / 255 for bytes held as floats (ps11/lanes_avx2.h).
+using ps11::unitOfByte;
 
 }  // namespace emu

@@ -497,6 +497,26 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             return;
         }
     }
+    if (m_fastPath && !fixed && !tex.isVolume() && tex.storage() == TexelStorage::Unorm8 && !req.levels &&
+        lodFree(tex, ss)) {
+        // float and ideal: level 0 with its one filter, the reference's floats eight lanes a step.
+        const TextureLevelInfo& li = tex.level(0);
+        fastpath::Unorm8FloatRun run;
+        run.texels = tex.unorm8() + li.offset * 4;
+        run.width = li.width, run.height = li.height;
+        run.linear = effective(ss.magFilter) == Filter::Linear;
+        run.weights8 = floatWeights8;
+        run.addressU = ss.addressU, run.addressV = ss.addressV;
+        run.border = ss.border.data();
+        fastpath::samplerKernels(simdLevel()).unorm8Float(run, count, coord[0], coord[1], valueDst);
+        m_fetched.fetch_add(uint64_t(count) * (run.linear ? 4 : 1), std::memory_order_relaxed);
+        m_fastLanes.fetch_add(uint64_t(count), std::memory_order_relaxed);
+        // Blends of bytes / 255 and of a border colour in [0, 1] stay in [0, 1].
+        bool unit = true;
+        for (float b : ss.border) unit = unit && b >= 0.0f && b <= 1.0f;
+        out.unitRange = unit;
+        return;
+    }
     fetched = sampleReference(req, count, coord, tex, ss, borderGrid, gridDst, valueDst, floatWeights8);
     m_fetched.fetch_add(fetched, std::memory_order_relaxed);
 }

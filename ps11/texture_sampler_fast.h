@@ -1,9 +1,10 @@
-// The fast sampling kernels for 8-bit (Unorm8) 2-D textures in fx profiles: point and bilinear
-// on one mip level, every address mode. They compute exactly what the reference path of
-// TextureSampler computes (docs/textures.md "Fast path"); TextureSampler decides when a span
-// (or a run of its quads) qualifies. Internal (not installed): ps11/texture_sampler*.cpp and the
-// device's fx8 row path (emu/aligned_pass.cpp: axisTable, and the kernel for taps it samples per
-// pixel).
+// The fast sampling kernels for 8-bit (Unorm8) 2-D textures: point and bilinear on one mip level
+// (fx: and blends of two), every address mode, in the fx profiles and in float and ideal. They
+// compute exactly what the reference path of TextureSampler computes (docs/textures.md "Fast
+// path"); TextureSampler decides when a span (or a run of its quads) qualifies. Internal (not
+// installed): ps11/texture_sampler*.cpp and the device's row paths (emu/aligned_pass.cpp:
+// axisTable, and the fx kernel for taps it samples per pixel; emu/aligned_float.cpp: the float
+// kernel for its taps sampled per pixel).
 #pragma once
 
 #include <cstdint>
@@ -37,12 +38,30 @@ using Unorm8MipKernel = void (*)(const Unorm8Run& level0, const Unorm8Run& level
 using FloatAxisKernel = void (*)(TextureAddress mode, bool linear, bool weights8, int count, const float* c, uint32_t n,
                                  int32_t* i0, int32_t* i1, float* f);
 
+// The float profiles' lanes of one level of an 8-bit 2-D texture, filtered as the reference
+// sampler's combineFloat (texture_sampler.cpp): per axis the FloatAxisKernel's pair and weight,
+// texels byte / 255 (the texture's value table), the border colour's floats where an index is −1,
+// and the lerps (1 − f)·a + f·b along u, then v (point: the texel at i0). Texels are finite, so
+// vector lerps give the reference's floats bit for bit.
+struct Unorm8FloatRun {
+    const uint8_t* texels = nullptr;  // the level's first texel: b g r a bytes, rows width * 4 apart
+    uint32_t width = 1, height = 1;
+    bool linear = false;
+    bool weights8 = false;  // the class's 8-bit weights (the float profile on such a class)
+    TextureAddress addressU = TextureAddress::Wrap, addressV = TextureAddress::Wrap;
+    const float* border = nullptr;  // r g b a
+};
+// count <= kMaxSpan; dst[c][0 .. count) for c = r g b a.
+using Unorm8FloatKernel = void (*)(const Unorm8FloatRun& run, int count, const float* u, const float* v,
+                                   float* const* dst);
+
 // The kernels of a SIMD level (ps11/simd_dispatch.h), one source (texture_sampler_fast_impl.h)
 // built per level; TextureSampler fetches the table once per span.
 struct SamplerKernels {
     Unorm8Kernel unorm8;
     FloatAxisKernel floatAxis;
     Unorm8MipKernel unorm8Mip;
+    Unorm8FloatKernel unorm8Float;
 };
 const SamplerKernels& samplerKernels(SimdLevel level);
 // The tables (the Avx2 one in x86-64 builds only); use samplerKernels().

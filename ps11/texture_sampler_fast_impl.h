@@ -14,6 +14,8 @@
 #include <cstring>
 #ifdef __AVX2__
 #include <immintrin.h>
+
+#include "ps11/lanes_avx2.h"
 #endif
 
 #include "ps11/texture.h"
@@ -589,8 +591,98 @@ void floatAxis(TextureAddress mode, bool linear, bool weights8, int count, const
     }
 }
 
+// (1 − f)·a + f·b: the reference sampler's lerp (texture_sampler.cpp lerpf), operation for
+// operation (this file is built without FMA contraction).
+inline float lerpFloat(float a, float b, float f) { return (1.0f - f) * a + f * b; }
+
+// Bilinear lanes of 8-bit texels in float: corners (i0, j0) (i1, j0) (i0, j1) (i1, j1), an index
+// −1 reading the border colour.
+void bilinearFloatScalar(const uint8_t* texels, uint32_t width, const int32_t* i0, const int32_t* i1,
+                         const int32_t* j0, const int32_t* j1, const float* fu, const float* fv, const float* border,
+                         int n, float* const* out) {
+    const float* values = Texture::unorm8Values();
+    for (int j = 0; j < n; ++j) {
+        const int32_t xs[4] = {i0[j], i1[j], i0[j], i1[j]}, ys[4] = {j0[j], j0[j], j1[j], j1[j]};
+        float t[4][4];
+        for (int k = 0; k < 4; ++k)
+            for (size_t c = 0; c < 4; ++c)
+                t[k][c] = (xs[k] | ys[k]) < 0
+                              ? border[c]
+                              : values[texels[(size_t(ys[k]) * width + size_t(xs[k])) * 4 + size_t(kUnorm8Byte[c])]];
+        for (size_t c = 0; c < 4; ++c)
+            out[c][j] = lerpFloat(lerpFloat(t[0][c], t[1][c], fu[j]), lerpFloat(t[2][c], t[3][c], fu[j]), fv[j]);
+    }
+}
+
+#ifdef __AVX2__
+inline __m256 lerpFloat8(__m256 a, __m256 b, __m256 f) {
+    return _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(1.0f), f), a), _mm256_mul_ps(f, b));
+}
+
+// Eight lanes a step: each corner's b g r a words gathered once for all four channels (the lanes
+// whose corner is the border masked off, never read), then the border colour blended in.
+void bilinearFloatAvx2(const uint8_t* texels, uint32_t width, const int32_t* i0, const int32_t* i1, const int32_t* j0,
+                       const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
+                       float* const* out) {
+    const __m256i byte = _mm256_set1_epi32(0xff), w = _mm256_set1_epi32(int32_t(width)), none = _mm256_set1_epi32(-1);
+    const int* words = reinterpret_cast<const int*>(texels);
+    constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
+    int j = 0;
+    for (; j + 8 <= n; j += 8) {
+        const __m256i x0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i0 + j));
+        const __m256i x1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(i1 + j));
+        const __m256i y0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j0 + j));
+        const __m256i y1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(j1 + j));
+        const __m256i xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+        __m256i word[4];
+        __m256 inside[4];
+        for (int k = 0; k < 4; ++k) {
+            const __m256i in = _mm256_cmpgt_epi32(_mm256_or_si256(xs[k], ys[k]), none);
+            const __m256i at = _mm256_and_si256(_mm256_add_epi32(_mm256_mullo_epi32(ys[k], w), xs[k]), in);
+            inside[k] = _mm256_castsi256_ps(in);
+            word[k] = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), words, at, in, 4);
+        }
+        const __m256 u = _mm256_loadu_ps(fu + j), v = _mm256_loadu_ps(fv + j);
+        for (int c = 0; c < 4; ++c) {
+            const __m256 b = _mm256_set1_ps(border[c]);
+            __m256 t[4];
+            for (int k = 0; k < 4; ++k)
+                t[k] = _mm256_blendv_ps(
+                    b, unitOfByte(_mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32(word[k], kShift[c]), byte))),
+                    inside[k]);
+            _mm256_storeu_ps(out[c] + j, lerpFloat8(lerpFloat8(t[0], t[1], u), lerpFloat8(t[2], t[3], u), v));
+        }
+    }
+    if (j < n) {
+        float* const rest[4] = {out[0] + j, out[1] + j, out[2] + j, out[3] + j};
+        bilinearFloatScalar(texels, width, i0 + j, i1 + j, j0 + j, j1 + j, fu + j, fv + j, border, n - j, rest);
+    }
+}
+#define PS11_BILINEAR_FLOAT bilinearFloatAvx2
+#else
+#define PS11_BILINEAR_FLOAT bilinearFloatScalar
+#endif
+
+void sampleUnorm8Float(const Unorm8FloatRun& run, int count, const float* u, const float* v, float* const* dst) {
+    alignas(32) int32_t i0[kMaxSpan], i1[kMaxSpan], j0[kMaxSpan], j1[kMaxSpan];
+    alignas(32) float fu[kMaxSpan], fv[kMaxSpan];
+    count = count < kMaxSpan ? count : kMaxSpan;
+    floatAxis(run.addressU, run.linear, run.weights8, count, u, run.width, i0, i1, fu);
+    floatAxis(run.addressV, run.linear, run.weights8, count, v, run.height, j0, j1, fv);
+    if (run.linear) {
+        PS11_BILINEAR_FLOAT(run.texels, run.width, i0, i1, j0, j1, fu, fv, run.border, count, dst);
+        return;
+    }
+    const float* values = Texture::unorm8Values();
+    for (int i = 0; i < count; ++i) {
+        const bool border = (i0[i] | j0[i]) < 0;
+        const uint8_t* t = run.texels + (border ? 0 : (size_t(j0[i]) * run.width + size_t(i0[i])) * 4);
+        for (size_t c = 0; c < 4; ++c) dst[c][i] = border ? run.border[c] : values[t[kUnorm8Byte[c]]];
+    }
+}
+
 }  // namespace
 
-const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip};
+const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip, &sampleUnorm8Float};
 
 }  // namespace ps11::fastpath

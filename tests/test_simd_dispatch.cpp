@@ -651,57 +651,6 @@ TEST_CASE("simd dispatch: the float row path's lerps from float texels are the r
     if (ps11::runnableSimdLevels().size() > 1) CHECK(refused > 0);  // the rows with a NaN or an infinity
 }
 
-TEST_CASE("simd dispatch: the float row path's per-pixel bilinear lookups of 8-bit texels at every level",
-          "[simd][aligned]") {
-    // Random texel pairs anywhere in a 37×23 texture, some of them the border (index −1 on either
-    // axis), random weights; spans of 0..40: lerp in u, then in v, of the texels' values (as
-    // unorm8Values) or the border colour, bit for bit.
-    const float* unit = ps11::Texture::unorm8Values();
-    std::mt19937 rng(8);
-    const int w = 37, h = 23;
-    std::vector<uint8_t> tex(size_t(w) * h * 4);
-    for (uint8_t& b : tex) b = uint8_t(rng());
-    const float border[4] = {0.25f, -1.5f, 3.0f, 0.0f};
-    int64_t bad = 0, checked = 0;
-    for (SimdLevel level : ps11::runnableSimdLevels()) {
-        const emu::FloatRowKernels& k = emu::floatRowKernels(level);
-        for (int round = 0; round < 300; ++round) {
-            const int n = round % 41;
-            std::vector<int32_t> i0(static_cast<size_t>(n)), i1(static_cast<size_t>(n)), j0(static_cast<size_t>(n)),
-                j1(static_cast<size_t>(n));
-            std::vector<float> fu(static_cast<size_t>(n)), fv(static_cast<size_t>(n));
-            auto index = [&](int len) { return rng() % 9 == 0 ? -1 : int32_t(rng() % uint32_t(len)); };
-            for (size_t j = 0; j < size_t(n); ++j) {
-                i0[j] = index(w), i1[j] = index(w), j0[j] = index(h), j1[j] = index(h);
-                fu[j] = float(rng() % 1000) / 999.0f, fv[j] = float(rng() % 1000) / 999.0f;
-            }
-            std::vector<float> planes(4 * (size_t(n) + 1), -7.0f);
-            float* const out[4] = {&planes[0], &planes[size_t(n) + 1], &planes[2 * (size_t(n) + 1)],
-                                   &planes[3 * (size_t(n) + 1)]};
-            k.bilinearWords(tex.data(), w, i0.data(), i1.data(), j0.data(), j1.data(), fu.data(), fv.data(), border, n,
-                            out);
-            constexpr int kByte[4] = {2, 1, 0, 3};  // r g b a in b g r a
-            for (size_t c = 0; c < 4; ++c) {
-                for (size_t j = 0; j < size_t(n); ++j) {
-                    auto t = [&](int32_t x, int32_t y) {
-                        return (x | y) < 0 ? border[c] : unit[tex[(size_t(y) * w + size_t(x)) * 4 + size_t(kByte[c])]];
-                    };
-                    const float u = fu[j], v = fv[j];
-                    const float a = (1.0f - u) * t(i0[j], j0[j]) + u * t(i1[j], j0[j]);
-                    const float b = (1.0f - u) * t(i0[j], j1[j]) + u * t(i1[j], j1[j]);
-                    const float want = (1.0f - v) * a + v * b;
-                    bad += std::memcmp(&out[c][j], &want, 4) != 0;
-                    ++checked;
-                }
-                bad += out[c][size_t(n)] != -7.0f;  // nothing past the span
-            }
-        }
-        INFO("SIMD level " << ps11::simdLevelName(level));
-        CHECK(bad == 0);
-    }
-    CHECK(checked > 20000);
-}
-
 TEST_CASE("simd dispatch: the 8-bit words of interleaved float pixels are ps11::unorm8OfFloat at every level",
           "[simd][merger]") {
     // The A32B32G32R32F rows a StretchRect converts, as r g b a quadruples of the probes; every
