@@ -55,8 +55,22 @@ constexpr const char* kBump =
     "texbem t1, t0\n"
     "mov r0, t1\n";
 
-enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated, Bump };
-constexpr int kPasses = 7;
+// texkill on stage 0's coordinates (shifted so the quad's left quarter is killed), then a read.
+constexpr const char* kKill =
+    "ps_1_1\n"
+    "texkill t0\n"
+    "tex t1\n"
+    "mov r0, t1\n";
+
+// Coordinates as a colour (texcoord: saturated u v w, 1) times a read.
+constexpr const char* kTexcoord =
+    "ps_1_1\n"
+    "texcoord t0\n"
+    "tex t1\n"
+    "mul r0, t0, t1\n";
+
+enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated, Bump, Kill, Texcoord };
+constexpr int kPasses = 9;
 enum class Kind { EmuFx8, EmuIdeal, GlNative, GlExact };
 constexpr Kind kKinds[] = {Kind::EmuFx8, Kind::EmuIdeal, Kind::GlNative, Kind::GlExact};
 const char* kindName(Kind k) {
@@ -114,6 +128,10 @@ PassDef passDef(Pass p) {
         return {"magnify2_composite_1080p", kW, kH, {{kW, kH}, {kW / 2, kH / 2}}, {{0, 0, 0}, {1, 0, 0}}, kComposite, 0.5f};
     case Pass::Bump:  // t1 moved by up to 0.03 of its size by t0 (texbem)
         return {"bump_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, 0, 0}, {1, 0, 0}}, kBump, 0, 0, 0.03f};
+    case Pass::Kill:  // stage 0's u runs from −0.25, so a quarter of the pixels are killed
+        return {"texkill_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, -480, 0}, {1, 0, 0}}, kKill, 0};
+    case Pass::Texcoord:
+        return {"texcoord_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, 0, 0}, {1, 0, 0}}, kTexcoord, 0};
     }
     return {};
 }
@@ -303,7 +321,7 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
 int main(int argc, char** argv) {
     // The four devices of each pass registered alternately.
     for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite, Pass::Blur4Rotated,
-                   Pass::Bump})
+                   Pass::Bump, Pass::Kill, Pass::Texcoord})
         for (Kind k : kKinds) {
             const std::string name = std::string("BM_EmuVsGl/") + passDef(p).name + "/" + kindName(k);
             benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)
