@@ -625,6 +625,7 @@ void bilinearFloatAvx2(const uint8_t* texels, uint32_t width, const int32_t* i0,
                        const int32_t* j1, const float* fu, const float* fv, const float* border, int n,
                        float* const* out) {
     const __m256i byte = _mm256_set1_epi32(0xff), w = _mm256_set1_epi32(int32_t(width)), none = _mm256_set1_epi32(-1);
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7), one = _mm256_set1_epi32(1);
     const int* words = reinterpret_cast<const int*>(texels);
     constexpr int kShift[4] = {16, 8, 0, 24};  // r g b a in a b g r a word
     int j = 0;
@@ -636,11 +637,25 @@ void bilinearFloatAvx2(const uint8_t* texels, uint32_t width, const int32_t* i0,
         const __m256i xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
         __m256i word[4];
         __m256 inside[4];
-        for (int k = 0; k < 4; ++k) {
-            const __m256i in = _mm256_cmpgt_epi32(_mm256_or_si256(xs[k], ys[k]), none);
-            const __m256i at = _mm256_and_si256(_mm256_add_epi32(_mm256_mullo_epi32(ys[k], w), xs[k]), in);
-            inside[k] = _mm256_castsi256_ps(in);
-            word[k] = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), words, at, in, 4);
+        // Eight columns in order on one pair of rows (a row of a plain read): plain loads.
+        const int32_t cx = i0[j], cy0 = j0[j], cy1 = j1[j];
+        const __m256i x0Run = _mm256_add_epi32(_mm256_set1_epi32(cx), iota);
+        const __m256i off = _mm256_or_si256(
+            _mm256_or_si256(_mm256_xor_si256(x0, x0Run), _mm256_xor_si256(x1, _mm256_add_epi32(x0Run, one))),
+            _mm256_or_si256(_mm256_xor_si256(y0, _mm256_set1_epi32(cy0)), _mm256_xor_si256(y1, _mm256_set1_epi32(cy1))));
+        if (_mm256_testz_si256(off, off) && (cx | cy0 | cy1) >= 0 && uint32_t(cx) + 9 <= width) {
+            const int* r0 = words + size_t(cy0) * width + size_t(cx);
+            const int* r1 = words + size_t(cy1) * width + size_t(cx);
+            auto at = [](const int* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); };
+            word[0] = at(r0), word[1] = at(r0 + 1), word[2] = at(r1), word[3] = at(r1 + 1);
+            for (__m256& in : inside) in = _mm256_castsi256_ps(none);
+        } else {
+            for (int k = 0; k < 4; ++k) {
+                const __m256i in = _mm256_cmpgt_epi32(_mm256_or_si256(xs[k], ys[k]), none);
+                const __m256i at = _mm256_and_si256(_mm256_add_epi32(_mm256_mullo_epi32(ys[k], w), xs[k]), in);
+                inside[k] = _mm256_castsi256_ps(in);
+                word[k] = _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), words, at, in, 4);
+            }
         }
         const __m256 u = _mm256_loadu_ps(fu + j), v = _mm256_loadu_ps(fv + j);
         for (int c = 0; c < 4; ++c) {

@@ -646,57 +646,66 @@ TEST_CASE("sampler: the float profiles' 8-bit fast path equals the general path 
     // Lanes as a dependent read puts them (scattered, some far outside, NaN, infinite, half-way
     // between texels), every address mode, point and bilinear, float with and without the class's
     // 8-bit weights and ideal, a border colour inside [0, 1] and one outside; spans of 1..kMaxSpan
-    // (the gathering kernel's eight lanes a step and its tail), at every SIMD level.
+    // (the gathering kernel's eight lanes a step and its tail), at every SIMD level. Half the
+    // spans are rows in order (a plain read's: consecutive columns, one row pair), which the
+    // kernel loads instead of gathering where eight columns lie inside the texture.
     std::mt19937 rng(20261130);
     for (const auto& [w, h] : {std::pair<uint32_t, uint32_t>{37, 23}, {64, 32}, {1, 5}}) {
         TextureDesc d = makeDesc(TexFormat::A8R8G8B8, w, h, 0, {});
         for (uint32_t i = 0; i < w * h; ++i) d.data[0].texels.push_back(word(rng()));
         auto tex = build(d);
         std::uniform_real_distribution<float> coord(-1.5f, 2.5f);
-        for (int count : {kMaxSpan, 1, 7, 8, 13, 100}) {
-            std::vector<float> u(static_cast<size_t>(count)), v(static_cast<size_t>(count));
-            for (int i = 0; i < count; ++i) {
-                u[size_t(i)] = coord(rng), v[size_t(i)] = coord(rng);
-                if (i % 16 == 9) u[size_t(i)] = float(int(rng() % 4096) - 1024) / 1024.0f;  // half-way weights
-                if (i % 16 == 10) v[size_t(i)] = (float(rng() % 64) + 0.5f) / float(h);    // texel centres
+        for (int count : {kMaxSpan, 1, 7, 8, 13, 100, 24, 40}) {
+            for (bool inOrder : {false, true}) {
+                std::vector<float> u(static_cast<size_t>(count)), v(static_cast<size_t>(count));
+                const float start = coord(rng), row = coord(rng), frac = float(rng() % 256) / 256.0f;
+                for (int i = 0; i < count; ++i) {
+                    if (inOrder) {
+                        u[size_t(i)] = start + (float(i) + frac) / float(w), v[size_t(i)] = row;
+                        continue;
+                    }
+                    u[size_t(i)] = coord(rng), v[size_t(i)] = coord(rng);
+                    if (i % 16 == 9) u[size_t(i)] = float(int(rng() % 4096) - 1024) / 1024.0f;  // half-way weights
+                    if (i % 16 == 10) v[size_t(i)] = (float(rng() % 64) + 0.5f) / float(h);     // texel centres
+                }
+                if (count > 20 && !inOrder) {
+                    u[3] = std::nanf(""), v[5] = std::numeric_limits<float>::infinity(), u[11] = -1e30f;
+                    v[17] = 3e9f;
+                }
+                for (TextureAddress mu : {TextureAddress::Clamp, TextureAddress::Wrap, TextureAddress::Mirror,
+                                          TextureAddress::Border, TextureAddress::MirrorOnce})
+                    for (TextureAddress mv : {TextureAddress::Clamp, TextureAddress::Border, TextureAddress::Wrap})
+                        for (Filter f : {Filter::Linear, Filter::Point})
+                            for (int profile = 0; profile < 3; ++profile) {
+                                const Precision p = profile == 2 ? Precision::Ideal : Precision::Float;
+                                const int weightBits = profile == 1 ? 8 : 0;
+                                SamplerState st = state(f, mu);
+                                st.addressV = mv;
+                                st.border = (count % 2) ? std::array<float, 4>{0.2f, 0.4f, 0.6f, 0.8f}
+                                                        : std::array<float, 4>{0.25f, -1.5f, 3.0f, 0.0f};
+                                INFO(w << "x" << h << " count " << count << " modes " << int(mu) << "," << int(mv)
+                                       << " filter " << int(f) << " profile " << profile);
+                                TextureSampler general;
+                                general.setFastPath(false);
+                                general.setWeightBits(weightBits);
+                                general.bind(0, tex);
+                                general.setSamplerState(0, st);
+                                const Result b = run(general, p, u, v);
+                                testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                                    for (bool quads : {false, true}) {
+                                        TextureSampler fast;
+                                        fast.setWeightBits(weightBits);
+                                        fast.bind(0, tex);
+                                        fast.setSamplerState(0, st);
+                                        const Result a = run(fast, p, u, v, {}, quads && count % 4 == 0);
+                                        CHECK(fast.fastLanes() == uint64_t(count));
+                                        for (int c = 0; c < 4; ++c)
+                                            CHECK(std::memcmp(a.f[size_t(c)].data(), b.f[size_t(c)].data(),
+                                                              sizeof(float) * size_t(count)) == 0);
+                                    }
+                                });
+                            }
             }
-            if (count > 20) {
-                u[3] = std::nanf(""), v[5] = std::numeric_limits<float>::infinity(), u[11] = -1e30f;
-                v[17] = 3e9f;
-            }
-            for (TextureAddress mu : {TextureAddress::Clamp, TextureAddress::Wrap, TextureAddress::Mirror,
-                                      TextureAddress::Border, TextureAddress::MirrorOnce})
-                for (TextureAddress mv : {TextureAddress::Clamp, TextureAddress::Border, TextureAddress::Wrap})
-                    for (Filter f : {Filter::Linear, Filter::Point})
-                        for (int profile = 0; profile < 3; ++profile) {
-                            const Precision p = profile == 2 ? Precision::Ideal : Precision::Float;
-                            const int weightBits = profile == 1 ? 8 : 0;
-                            SamplerState st = state(f, mu);
-                            st.addressV = mv;
-                            st.border = (count % 2) ? std::array<float, 4>{0.2f, 0.4f, 0.6f, 0.8f}
-                                                    : std::array<float, 4>{0.25f, -1.5f, 3.0f, 0.0f};
-                            INFO(w << "x" << h << " count " << count << " modes " << int(mu) << "," << int(mv)
-                                   << " filter " << int(f) << " profile " << profile);
-                            TextureSampler general;
-                            general.setFastPath(false);
-                            general.setWeightBits(weightBits);
-                            general.bind(0, tex);
-                            general.setSamplerState(0, st);
-                            const Result b = run(general, p, u, v);
-                            testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-                                for (bool quads : {false, true}) {
-                                    TextureSampler fast;
-                                    fast.setWeightBits(weightBits);
-                                    fast.bind(0, tex);
-                                    fast.setSamplerState(0, st);
-                                    const Result a = run(fast, p, u, v, {}, quads && count % 4 == 0);
-                                    CHECK(fast.fastLanes() == uint64_t(count));
-                                    for (int c = 0; c < 4; ++c)
-                                        CHECK(std::memcmp(a.f[size_t(c)].data(), b.f[size_t(c)].data(),
-                                                          sizeof(float) * size_t(count)) == 0);
-                                }
-                            });
-                        }
         }
     }
 }
