@@ -498,6 +498,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 WorkerScratch& ws0 = *dc.scratch[size_t(w)];
                 ps11::TextureSampler& sampler = ws0.sampler;
                 sampler.setWeightBits(call.hardware.weightBits);
+                sampler.setFastPath(m_options.fastSampler);
                 for (int s = 0; s < kMaxSamplers; ++s) {
                     // Stages the program does not sample are unbound (no texture kept alive).
                     sampler.bind(s, (sampled >> s) & 1 ? call.textures[size_t(s)] : nullptr);

@@ -19,6 +19,11 @@ struct SoftwareRendererOptions {
     // texture reads, and spans of one row (rasterizeRowSpans) for any other triangle whose every
     // lookup is ps11::lodFree. Off: every draw goes through 2x2 quads.
     bool alignedPasses = true;
+    // The sampler's fast kernels for 8-bit 2-D textures (ps11/texture_sampler_fast.h) on the spans
+    // and quads (TextureSampler::setFastPath; bit-identical images). Off: every lookup there by
+    // the reference path (the row paths, which only alignedPasses turns off, sample with the
+    // kernels themselves).
+    bool fastSampler = true;
     // Tiles of row-path draws whose result the interval evaluator decides are filled, copied or
     // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile shaded.
     bool skipTiles = true;

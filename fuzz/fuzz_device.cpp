@@ -5,7 +5,8 @@
 // stays fast (the limits themselves are tested elsewhere). In fx8, fx12, float and ideal every file
 // is also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path, the
 // spans of one row of draws whose lookups are lodFree, and with them tile skipping, which the
-// first device does by default): every triangle in 2×2 quads. After every draw both render
+// first device does by default) and the sampler's fast kernels off: every triangle in 2×2 quads,
+// every lookup by the reference sampler. After every draw both render
 // targets must be identical bit for bit (docs/device.md "Rasterisation", "Aligned passes", "Tile skipping"; `fill`
 // textures and constant regions make the tiles that are filled, copied or skipped). A third device checks fingerprints
 // (docs/device.md "Fingerprints") at every draw: a dry run of the draw writes nothing; and when the draw's fingerprint

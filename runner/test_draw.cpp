@@ -273,14 +273,15 @@ DrawRunner::~DrawRunner() = default;
 
 std::unique_ptr<DrawRunner> DrawRunner::create(const TestFile& file, const std::string& path, const Program* program,
                                                const HardwareConfig& hardware, std::string& error,
-                                               bool alignedPasses, const RendererFactory& renderer, bool skipTiles) {
+                                               bool fastPaths, const RendererFactory& renderer, bool skipTiles) {
     std::unique_ptr<DrawRunner> r(new DrawRunner());
     r->m_path = path;
     emu::DeviceOptions options;
     options.hardware = hardware.hardware;
     options.precision = hardware.precision;
     options.maxValue = hardware.maxValue;
-    options.software.alignedPasses = alignedPasses;
+    options.software.alignedPasses = fastPaths;
+    options.software.fastSampler = fastPaths;
     options.software.skipTiles = skipTiles;
     options.renderer = renderer;
     r->m_device = std::make_unique<Device>(options);

@@ -49,12 +49,14 @@ public:
     // Sets up the device for `file`: render target (and depth buffer), textures, sampler, stage
     // and render states, transforms, constants and the pixel shader (`program`, null = fixed
     // function) on a device of `hardware`. Returns null with `error` set ("FILE:LINE: …") when
-    // the device refuses a call. `alignedPasses` is emu::DeviceOptions::alignedPasses (the fuzzer
-    // draws both ways); `renderer` makes the device's renderer (empty: the software renderer);
+    // the device refuses a call. `fastPaths` false draws the general way: the software renderer's
+    // alignedPasses and fastSampler off, every triangle in 2×2 quads and every lookup by the
+    // reference sampler (the fuzzer and the random-program test draw both ways and compare);
+    // `renderer` makes the device's renderer (empty: the software renderer);
     // `skipTiles` is emu::DeviceOptions::software.skipTiles (`ps11 test --no-skip` turns it off).
     static std::unique_ptr<DrawRunner> create(const TestFile& file, const std::string& path, const Program* program,
                                               const HardwareConfig& hardware, std::string& error,
-                                              bool alignedPasses = true, const RendererFactory& renderer = {},
+                                              bool fastPaths = true, const RendererFactory& renderer = {},
                                               bool skipTiles = true);
     ~DrawRunner();
 
