@@ -69,8 +69,8 @@ constexpr const char* kTexcoord =
     "tex t1\n"
     "mul r0, t0, t1\n";
 
-enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated, Bump, Kill, Texcoord };
-constexpr int kPasses = 9;
+enum class Pass { Blur4, Copy, Down2, Down4, Magnify2Composite, Blur4Rotated, Bump, BumpMip, Kill, Texcoord };
+constexpr int kPasses = 10;
 enum class Kind { EmuFx8, EmuIdeal, GlNative, GlExact };
 constexpr Kind kKinds[] = {Kind::EmuFx8, Kind::EmuIdeal, Kind::GlNative, Kind::GlExact};
 const char* kindName(Kind k) {
@@ -102,6 +102,7 @@ struct PassDef {
     float c0;
     float turn = 0;  // texture coordinates turned by this many degrees about the centre
     float bump = 0;  // stage 1's bump matrix: (bump, 0; 0, bump)
+    int mipTexture = -1;  // this texture gets its whole chain (AUTOGENMIPMAP), read with MIP filter LINEAR
 };
 
 PassDef passDef(Pass p) {
@@ -128,6 +129,8 @@ PassDef passDef(Pass p) {
         return {"magnify2_composite_1080p", kW, kH, {{kW, kH}, {kW / 2, kH / 2}}, {{0, 0, 0}, {1, 0, 0}}, kComposite, 0.5f};
     case Pass::Bump:  // t1 moved by up to 0.03 of its size by t0 (texbem)
         return {"bump_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, 0, 0}, {1, 0, 0}}, kBump, 0, 0, 0.03f};
+    case Pass::BumpMip:  // the same over a mip-mapped t1: each quad's level from its moved coordinates
+        return {"bump_mip_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, 0, 0}, {1, 0, 0}}, kBump, 0, 0, 0.03f, 1};
     case Pass::Kill:  // stage 0's u runs from −0.25, so a quarter of the pixels are killed
         return {"texkill_1080p", kW, kH, {{kW, kH}, {kW, kH}}, {{0, -480, 0}, {1, 0, 0}}, kKill, 0};
     case Pass::Texcoord:
@@ -184,7 +187,9 @@ void Scene::setup(Pass pass, Kind kind) {
     for (size_t i = 0; i < pd.textures.size(); ++i) {
         const auto [tw, th] = pd.textures[i];
         Handle tex{};
-        if (dev->CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK)
+        const bool mips = int(i) == pd.mipTexture;
+        if (dev->CreateTexture(tw, th, mips ? 0 : 1, mips ? D3DUSAGE_AUTOGENMIPMAP : 0, D3DFMT_A8R8G8B8,
+                               D3DPOOL_MANAGED, &tex) != D3D_OK)
             return refused("CreateTexture");
         D3DLOCKED_RECT lr;
         if (dev->LockRect(tex, 0, &lr, nullptr, 0) != D3D_OK) return refused("LockRect");
@@ -194,6 +199,7 @@ void Scene::setup(Pass pass, Kind kind) {
             for (UINT x = 0; x < tw; ++x) row[x] = rng();
         }
         dev->UnlockRect(tex, 0);
+        if (mips && dev->GenerateMipSubLevels(tex) != D3D_OK) return refused("GenerateMipSubLevels");
         textures.push_back(tex);
     }
     for (size_t s = 0; s < pd.stages.size(); ++s) {
@@ -203,6 +209,7 @@ void Scene::setup(Pass pass, Kind kind) {
         dev->SetSamplerState(st, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR);
         dev->SetSamplerState(st, D3DSAMP_ADDRESSU, D3DTADDRESS_CLAMP);
         dev->SetSamplerState(st, D3DSAMP_ADDRESSV, D3DTADDRESS_CLAMP);
+        if (pd.stages[s].texture == pd.mipTexture) dev->SetSamplerState(st, D3DSAMP_MIPFILTER, D3DTEXF_LINEAR);
     }
     if (pd.bump != 0) {
         DWORD m;
@@ -321,7 +328,7 @@ void BM_EmuVsGl(benchmark::State& state, Pass pass, Kind kind) {
 int main(int argc, char** argv) {
     // The four devices of each pass registered alternately.
     for (Pass p : {Pass::Blur4, Pass::Copy, Pass::Down2, Pass::Down4, Pass::Magnify2Composite, Pass::Blur4Rotated,
-                   Pass::Bump, Pass::Kill, Pass::Texcoord})
+                   Pass::Bump, Pass::BumpMip, Pass::Kill, Pass::Texcoord})
         for (Kind k : kKinds) {
             const std::string name = std::string("BM_EmuVsGl/") + passDef(p).name + "/" + kindName(k);
             benchmark::RegisterBenchmark(name.c_str(), BM_EmuVsGl, p, k)

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <vector>
 
 namespace ps11 {
 
@@ -395,6 +396,77 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
     return true;
 }
 
+// sampleBySets' lanes of one set, gathered: coordinates, mip weights, the lanes they came from.
+struct SetScratch {
+    alignas(64) float u[kMaxSpan], v[kMaxSpan];
+    alignas(64) int32_t mipW[kMaxSpan];
+    alignas(64) int32_t out[4][kMaxSpan];
+    int16_t lane[kMaxSpan];
+    int16_t next[kMaxSpan];  // the next group of the same set (−1: none), by group start lane
+};
+
+// The fast kernels over the span's groups (`step` lanes each, all of one key) set by set: every
+// group of a key is gathered into one run, sampled (one level: unorm8; two: unorm8Mip), and its
+// lanes' results are written back to where they came from.
+template <class Key>
+void sampleBySets(int count, int step, const LaneLevels& lanes, const Key& key, const float* const coord[3],
+                  const Texture& tex, const fastpath::Unorm8Run& base, const fastpath::SamplerKernels& kernels,
+                  int32_t* const* gridDst, SetScratch& s, uint64_t& fetched, uint64_t& fastLanes) {
+    // Chains of groups per distinct key, in span order.
+    constexpr int kMaxKeys = 64;
+    uint32_t keys[kMaxKeys];
+    int16_t first[kMaxKeys], last[kMaxKeys];
+    int distinct = 0;
+    // Groups whose key found no slot. (Not expected: at most 16 levels, each one-level key point
+    // or linear, and blends of two adjacent levels, make fewer than 64 keys.)
+    std::vector<int> overflow;
+    for (int q = 0; q < count; q += step) {
+        const uint32_t k = key(q);
+        int slot = 0;
+        while (slot < distinct && keys[slot] != k) ++slot;
+        if (slot == distinct) {
+            if (distinct == kMaxKeys) {
+                overflow.push_back(q);
+                continue;
+            }
+            keys[distinct] = k, first[distinct] = int16_t(q), last[distinct] = int16_t(q), ++distinct;
+        } else {
+            s.next[last[slot]] = int16_t(q), last[slot] = int16_t(q);
+        }
+        s.next[q] = -1;
+    }
+    auto levelRun = [&](fastpath::Unorm8Run& r, int level, bool linear) {
+        const TextureLevelInfo& li = tex.level(level);
+        r.texels = tex.unorm8() + li.offset * 4;
+        r.width = li.width, r.height = li.height, r.linear = linear;
+    };
+    auto sampleSet = [&](int group0, bool chained) {
+        int n = 0;
+        for (int q = group0; q >= 0; q = chained ? s.next[q] : -1)
+            for (int i = q; i < q + step && i < count; ++i) {
+                s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.lane[n] = int16_t(i);
+                ++n;
+            }
+        const bool two = lanes.slots[group0] == 2, linear = lanes.linear[group0] != 0;
+        int32_t* dst[4] = {s.out[0], s.out[1], s.out[2], s.out[3]};
+        fastpath::Unorm8Run lower = base;
+        levelRun(lower, lanes.level[0][group0], linear);
+        if (two) {
+            fastpath::Unorm8Run upper = base;
+            levelRun(upper, lanes.level[1][group0], linear);
+            kernels.unorm8Mip(lower, upper, s.mipW, n, s.u, s.v, dst);
+        } else {
+            kernels.unorm8(lower, n, s.u, s.v, dst);
+        }
+        for (int c = 0; c < 4; ++c)
+            for (int j = 0; j < n; ++j) gridDst[c][s.lane[j]] = s.out[c][j];
+        fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
+        fastLanes += uint64_t(n);
+    };
+    for (int k = 0; k < distinct; ++k) sampleSet(first[k], true);
+    for (int q : overflow) sampleSet(q, false);
+}
+
 }  // namespace
 
 void floatAxisTaps(TextureAddress mode, bool linear, bool weights8, int count, const float* coord, uint32_t extent,
@@ -469,6 +541,27 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 static thread_local LaneLevels lanes;
                 selectLevels(req, count, coord, tex, ss, true, false, lanes);
                 const int step = req.levels ? 1 : 4;
+                // Groups (quads, or lanes) of one level, filter and blend are drawn together
+                // wherever they lie in the span when runs of consecutive ones are short (each
+                // quad at a level of its own, as a dependent read's often is): each such set's
+                // coordinates gathered, sampled as one run, the results put back. Every lane's
+                // result depends on its own coordinates alone, so the images are the same.
+                auto key = [&](int q) {
+                    const bool two = lanes.slots[q] == 2;
+                    return uint32_t(lanes.level[0][q]) | (two ? uint32_t(lanes.level[1][q]) << 5 | 1u << 10 : 0u) |
+                           uint32_t(lanes.linear[q] != 0) << 11;
+                };
+                int runs = 0;
+                for (int q = 0; q < count; q += step) runs += q == 0 || key(q) != key(q - step);
+                if (runs * 16 > count) {
+                    static thread_local SetScratch sets;
+                    sampleBySets(count, step, lanes, key, coord, tex, run, kernels, gridDst, sets, fetched,
+                                 fastLanes);
+                    m_fetched.fetch_add(fetched, std::memory_order_relaxed);
+                    m_fastLanes.fetch_add(fastLanes, std::memory_order_relaxed);
+                    out.unitRange = true;
+                    return;
+                }
                 for (int q = 0; q < count;) {
                     const bool two = lanes.slots[q] == 2;
                     int e = q + step;
