@@ -396,75 +396,63 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
     return true;
 }
 
-// sampleBySets' lanes of one set, gathered: coordinates, mip weights, the lanes they came from.
+// The lanes of one set (setsOf), gathered: coordinates, mip weights, the lanes they came from,
+// and room for the kernels' results.
 struct SetScratch {
     alignas(64) float u[kMaxSpan], v[kMaxSpan];
     alignas(64) int32_t mipW[kMaxSpan];
-    alignas(64) int32_t out[4][kMaxSpan];
+    alignas(64) int32_t grid[4][kMaxSpan];
+    alignas(64) float value[2][4][kMaxSpan];
     int16_t lane[kMaxSpan];
     int16_t next[kMaxSpan];  // the next group of the same set (−1: none), by group start lane
 };
 
-// The fast kernels over the span's groups (`step` lanes each, all of one key) set by set: every
-// group of a key is gathered into one run, sampled (one level: unorm8; two: unorm8Mip), and its
-// lanes' results are written back to where they came from.
-template <class Key>
-void sampleBySets(int count, int step, const LaneLevels& lanes, const Key& key, const float* const coord[3],
-                  const Texture& tex, const fastpath::Unorm8Run& base, const fastpath::SamplerKernels& kernels,
-                  int32_t* const* gridDst, SetScratch& s, uint64_t& fetched, uint64_t& fastLanes) {
-    // Chains of groups per distinct key, in span order.
+// Per lane the set it belongs to: its level, filter and blend (the key a fast kernel's run needs).
+uint32_t laneKey(const LaneLevels& lanes, int i) {
+    const bool two = lanes.slots[i] == 2;
+    return uint32_t(lanes.level[0][i]) | (two ? uint32_t(lanes.level[1][i]) << 5 | 1u << 10 : 0u) |
+           uint32_t(lanes.linear[i] != 0) << 11;
+}
+
+// The span's groups (`step` lanes each, all of one key) set by set: for each distinct key, in
+// the order of its first group, every group of that key is gathered into s (u, v, mipW, lane)
+// and visit(first group's lane, n) is called to sample the n lanes as one run and put them back.
+// Every lane's result depends on its own coordinates alone, so this gives what sampling the
+// groups one by one gives.
+template <class Visit>
+void forEachSet(int count, int step, const LaneLevels& lanes, const float* const coord[3], SetScratch& s,
+                const Visit& visit) {
+    // At most 16 levels, each one-level key point or linear, and blends of two adjacent levels:
+    // fewer than 64 keys. (A group whose key finds no slot is visited on its own.)
     constexpr int kMaxKeys = 64;
     uint32_t keys[kMaxKeys];
     int16_t first[kMaxKeys], last[kMaxKeys];
     int distinct = 0;
-    // Groups whose key found no slot. (Not expected: at most 16 levels, each one-level key point
-    // or linear, and blends of two adjacent levels, make fewer than 64 keys.)
-    std::vector<int> overflow;
-    for (int q = 0; q < count; q += step) {
-        const uint32_t k = key(q);
-        int slot = 0;
-        while (slot < distinct && keys[slot] != k) ++slot;
-        if (slot == distinct) {
-            if (distinct == kMaxKeys) {
-                overflow.push_back(q);
-                continue;
-            }
-            keys[distinct] = k, first[distinct] = int16_t(q), last[distinct] = int16_t(q), ++distinct;
-        } else {
-            s.next[last[slot]] = int16_t(q), last[slot] = int16_t(q);
-        }
-        s.next[q] = -1;
-    }
-    auto levelRun = [&](fastpath::Unorm8Run& r, int level, bool linear) {
-        const TextureLevelInfo& li = tex.level(level);
-        r.texels = tex.unorm8() + li.offset * 4;
-        r.width = li.width, r.height = li.height, r.linear = linear;
-    };
-    auto sampleSet = [&](int group0, bool chained) {
+    auto gather = [&](int group0, bool chained) {
         int n = 0;
         for (int q = group0; q >= 0; q = chained ? s.next[q] : -1)
             for (int i = q; i < q + step && i < count; ++i) {
                 s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.lane[n] = int16_t(i);
                 ++n;
             }
-        const bool two = lanes.slots[group0] == 2, linear = lanes.linear[group0] != 0;
-        int32_t* dst[4] = {s.out[0], s.out[1], s.out[2], s.out[3]};
-        fastpath::Unorm8Run lower = base;
-        levelRun(lower, lanes.level[0][group0], linear);
-        if (two) {
-            fastpath::Unorm8Run upper = base;
-            levelRun(upper, lanes.level[1][group0], linear);
-            kernels.unorm8Mip(lower, upper, s.mipW, n, s.u, s.v, dst);
-        } else {
-            kernels.unorm8(lower, n, s.u, s.v, dst);
-        }
-        for (int c = 0; c < 4; ++c)
-            for (int j = 0; j < n; ++j) gridDst[c][s.lane[j]] = s.out[c][j];
-        fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
-        fastLanes += uint64_t(n);
+        visit(group0, n);
     };
-    for (int k = 0; k < distinct; ++k) sampleSet(first[k], true);
-    for (int q : overflow) sampleSet(q, false);
+    for (int q = 0; q < count; q += step) {
+        const uint32_t k = laneKey(lanes, q);
+        int slot = 0;
+        while (slot < distinct && keys[slot] != k) ++slot;
+        s.next[q] = -1;
+        if (slot == distinct) {
+            if (distinct == kMaxKeys) {
+                gather(q, false);
+                continue;
+            }
+            keys[distinct] = k, first[distinct] = int16_t(q), last[distinct] = int16_t(q), ++distinct;
+        } else {
+            s.next[last[slot]] = int16_t(q), last[slot] = int16_t(q);
+        }
+    }
+    for (int k = 0; k < distinct; ++k) gather(first[k], true);
 }
 
 }  // namespace
@@ -543,20 +531,29 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 const int step = req.levels ? 1 : 4;
                 // Groups (quads, or lanes) of one level, filter and blend are drawn together
                 // wherever they lie in the span when runs of consecutive ones are short (each
-                // quad at a level of its own, as a dependent read's often is): each such set's
-                // coordinates gathered, sampled as one run, the results put back. Every lane's
-                // result depends on its own coordinates alone, so the images are the same.
-                auto key = [&](int q) {
-                    const bool two = lanes.slots[q] == 2;
-                    return uint32_t(lanes.level[0][q]) | (two ? uint32_t(lanes.level[1][q]) << 5 | 1u << 10 : 0u) |
-                           uint32_t(lanes.linear[q] != 0) << 11;
-                };
+                // quad at a level of its own, as a dependent read's often is): forEachSet.
                 int runs = 0;
-                for (int q = 0; q < count; q += step) runs += q == 0 || key(q) != key(q - step);
+                for (int q = 0; q < count; q += step)
+                    runs += q == 0 || laneKey(lanes, q) != laneKey(lanes, q - step);
                 if (runs * 16 > count) {
-                    static thread_local SetScratch sets;
-                    sampleBySets(count, step, lanes, key, coord, tex, run, kernels, gridDst, sets, fetched,
-                                 fastLanes);
+                    static thread_local SetScratch set;
+                    forEachSet(count, step, lanes, coord, set, [&](int g, int n) {
+                        const bool two = lanes.slots[g] == 2, linear = lanes.linear[g] != 0;
+                        int32_t* dst[4] = {set.grid[0], set.grid[1], set.grid[2], set.grid[3]};
+                        fastpath::Unorm8Run lower = run;
+                        levelRun(lower, lanes.level[0][g], linear);
+                        if (two) {
+                            fastpath::Unorm8Run upper = run;
+                            levelRun(upper, lanes.level[1][g], linear);
+                            kernels.unorm8Mip(lower, upper, set.mipW, n, set.u, set.v, dst);
+                        } else {
+                            kernels.unorm8(lower, n, set.u, set.v, dst);
+                        }
+                        for (int c = 0; c < 4; ++c)
+                            for (int j = 0; j < n; ++j) gridDst[c][set.lane[j]] = set.grid[c][j];
+                        fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
+                        fastLanes += uint64_t(n);
+                    });
                     m_fetched.fetch_add(fetched, std::memory_order_relaxed);
                     m_fastLanes.fetch_add(fastLanes, std::memory_order_relaxed);
                     out.unitRange = true;
@@ -590,19 +587,50 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             return;
         }
     }
-    if (m_fastPath && !fixed && !tex.isVolume() && tex.storage() == TexelStorage::Unorm8 && !req.levels &&
-        lodFree(tex, ss)) {
-        // float and ideal: level 0 with its one filter, the reference's floats eight lanes a step.
-        const TextureLevelInfo& li = tex.level(0);
+    if (m_fastPath && !fixed && !tex.isVolume() && tex.storage() == TexelStorage::Unorm8) {
+        // float and ideal: the reference's floats eight lanes a step (Unorm8FloatKernel).
+        const fastpath::SamplerKernels& kernels = fastpath::samplerKernels(simdLevel());
         fastpath::Unorm8FloatRun run;
-        run.texels = tex.unorm8() + li.offset * 4;
-        run.width = li.width, run.height = li.height;
-        run.linear = effective(ss.magFilter) == Filter::Linear;
         run.weights8 = floatWeights8;
         run.addressU = ss.addressU, run.addressV = ss.addressV;
         run.border = ss.border.data();
-        fastpath::samplerKernels(simdLevel()).unorm8Float(run, count, coord[0], coord[1], valueDst);
-        m_fetched.fetch_add(uint64_t(count) * (run.linear ? 4 : 1), std::memory_order_relaxed);
+        auto levelRun = [&](int level, bool linear) {
+            const TextureLevelInfo& li = tex.level(level);
+            run.texels = tex.unorm8() + li.offset * 4;
+            run.width = li.width, run.height = li.height, run.linear = linear;
+        };
+        if (!req.levels && lodFree(tex, ss)) {
+            levelRun(0, effective(ss.magFilter) == Filter::Linear);  // level 0, its one filter
+            kernels.unorm8Float(run, count, coord[0], coord[1], valueDst);
+            fetched = uint64_t(count) * (run.linear ? 4 : 1);
+        } else {
+            // Each quad's (or lane's) level, filter and mip blend as the reference chooses them,
+            // then set by set: one level, the kernel; two, the kernel at each and the reference's
+            // blend of the two (lerpf with its weight).
+            static thread_local LaneLevels lanes;
+            static thread_local SetScratch set;
+            selectLevels(req, count, coord, tex, ss, false, floatWeights8, lanes);
+            forEachSet(count, req.levels ? 1 : 4, lanes, coord, set, [&](int g, int n) {
+                const bool two = lanes.slots[g] == 2, linear = lanes.linear[g] != 0;
+                float* lower[4] = {set.value[0][0], set.value[0][1], set.value[0][2], set.value[0][3]};
+                float* upper[4] = {set.value[1][0], set.value[1][1], set.value[1][2], set.value[1][3]};
+                levelRun(lanes.level[0][g], linear);
+                kernels.unorm8Float(run, n, set.u, set.v, lower);
+                if (two) {
+                    levelRun(lanes.level[1][g], linear);
+                    kernels.unorm8Float(run, n, set.u, set.v, upper);
+                    for (int c = 0; c < 4; ++c)
+                        for (int j = 0; j < n; ++j) {
+                            valueDst[c][set.lane[j]] = lerpf(lower[c][j], upper[c][j], lanes.mipF[set.lane[j]]);
+                        }
+                } else {
+                    for (int c = 0; c < 4; ++c)
+                        for (int j = 0; j < n; ++j) valueDst[c][set.lane[j]] = lower[c][j];
+                }
+                fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
+            });
+        }
+        m_fetched.fetch_add(fetched, std::memory_order_relaxed);
         m_fastLanes.fetch_add(uint64_t(count), std::memory_order_relaxed);
         // Blends of bytes / 255 and of a border colour in [0, 1] stay in [0, 1].
         bool unit = true;

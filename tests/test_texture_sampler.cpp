@@ -714,8 +714,9 @@ TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, eq
           "[sampler]") {
     // SampleRequest::levels (what the device's row paths hand over, each quad's quadLevel kept for
     // its two rows): random quads of coordinates over a 64x32 chain of random texels, MIP filter
-    // POINT and LINEAR, MIN != MAG, in fx8, fx12, float and ideal, through the fast path (at every
-    // SIMD level: its one- and two-level kernels) and the general one. Each quad's lanes sampled
+    // POINT and LINEAR, MIN != MAG, in fx8, fx12, float (with and without 8-bit weights) and ideal,
+    // through the fast path (at every SIMD level: its one- and two-level kernels, set by set where
+    // quads change level) and the general one. Each quad's lanes sampled
     // with their quad's choice and no quads, and the quads through the fast path, must give the
     // bytes or floats the general path gives the quads.
     std::mt19937 rng(20261203);
@@ -740,8 +741,11 @@ TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, eq
     int blends = 0;
     for (Filter mip : {Filter::Point, Filter::Linear})
         for (Filter minf : {Filter::Linear, Filter::Point})
-            for (Precision p : {Precision::Fx8, Precision::Fx12, Precision::Float, Precision::Ideal})
+            for (int config = 0; config < 5; ++config)  // fx8, fx12, float, ideal, float with 8-bit weights
                 for (bool fastPath : {true, false}) {
+                    const Precision p = std::array<Precision, 5>{Precision::Fx8, Precision::Fx12, Precision::Float,
+                                                                 Precision::Ideal, Precision::Float}[size_t(config)];
+                    const int weightBits = config == 4 ? 8 : 0;
                     SamplerState st = state(Filter::Linear, TextureAddress::Wrap, mip);
                     st.minFilter = minf;
                     const bool fixed = isFixedPoint(p);
@@ -750,20 +754,22 @@ TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, eq
                         const size_t i = size_t(4 * q);
                         const float tl[3] = {u[i], v[i], 0}, tr[3] = {u[i + 1], v[i + 1], 0},
                                     bl[3] = {u[i + 2], v[i + 2], 0};
-                        const LevelChoice c = quadLevel(*tex, st, tl, tr, bl, fixed, false);
+                        const LevelChoice c = quadLevel(*tex, st, tl, tr, bl, fixed, weightBits == 8);
                         blends += c.slots == 2;
                         for (int k = 0; k < 4; ++k) levels[i + size_t(k)] = c;
                     }
-                    INFO("mip " << int(mip) << " min " << int(minf) << " precision " << int(p) << " fast "
-                                << fastPath);
+                    INFO("mip " << int(mip) << " min " << int(minf) << " precision " << int(p) << " weight bits "
+                                << weightBits << " fast " << fastPath);
                     TextureSampler general;
                     general.setFastPath(false);
+                    general.setWeightBits(weightBits);
                     general.bind(0, tex);
                     general.setSamplerState(0, st);
                     const Result a = run(general, p, u, v, {}, true);
                     testutil::forEachSimdLevel([&](ps11::SimdLevel) {
                         TextureSampler s;
                         s.setFastPath(fastPath);
+                        s.setWeightBits(weightBits);
                         s.bind(0, tex);
                         s.setSamplerState(0, st);
                         // The grid integers (fx) or the floats bit for bit.
