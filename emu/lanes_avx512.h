@@ -7,7 +7,7 @@
 namespace emu {
 
 // float(b) / 255 correctly rounded for sixteen bytes held as floats: the Avx2 level's unitOfByte
-// (emu/lanes_avx2.h), a product and one Newton step with the exact residual b − 255·q.
+// (ps11/lanes_avx2.h), a product and one Newton step with the exact residual b − 255·q.
 inline __m512 unitOfByte(__m512 b) {
     const __m512 inv = _mm512_set1_ps(1.0f / 255.0f);
     const __m512 q = _mm512_mul_ps(b, inv);
