@@ -139,12 +139,11 @@ void ExecutorImpl::loadColors(RunState& st) const {
         for (int c = 0; c < 4; ++c) {
             const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : kZeroLanes;
             if (fx) {
-                // s·G rounded half to even by adding and subtracting 1.5·2^52 (exact below 2^51).
-                constexpr double kRound = 6755399441055744.0;
+                // s·G rounded half to even (roundEvenSmall: exact below 2^51).
                 int32_t* d = st.bi.reg[kSlotV + v][c];
                 for (int i = 0; i < st.n; ++i) {
                     float s = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;  // NaN -> 0
-                    d[i] = int32_t((double(s) * double(g) + kRound) - kRound);
+                    d[i] = int32_t(roundEvenSmall(double(s) * double(g)));
                 }
             } else {
                 float* d = st.bf.reg[kSlotV + v][c];

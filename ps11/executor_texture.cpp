@@ -48,14 +48,13 @@ void writeFloat(const Profile& p, RunState& st, int slot, int comp, const float*
         const double g = p.g;
         const double lo = sat ? 0.0 : -double(p.nMax), hi = sat ? double(p.g < p.nMax ? p.g : p.nMax) : p.nMax;
         // Clamped first (lo and hi are integers and rounding is monotonic: the same result), then
-        // rounded half to even by adding and removing 1.5·2^52 (|v| <= 2^24 here), a loop the
-        // compiler vectorises where nearbyint is a call per lane. v·G is exact (24 + 12 bits).
-        constexpr double kRound = 6755399441055744.0;  // 1.5·2^52
+        // rounded half to even by roundEvenSmall (|v| <= 2^24 here), a loop the compiler
+        // vectorises where nearbyint is a call per lane. v·G is exact (24 + 12 bits).
         for (int i = 0; i < n; ++i) {
             double v = double(in[i]) * g;
             v = v > lo ? v : lo;  // NaN -> lo
             v = v < hi ? v : hi;
-            d[i] = int32_t((v + kRound) - kRound);
+            d[i] = int32_t(roundEvenSmall(v));
         }
     } else {
         float* d = st.bf.reg[slot][comp];
@@ -255,12 +254,11 @@ void execTexbeml(const Profile& p, const DOp& op, RunState& st) {
         const double m = p.nMax;
         for (int c = 0; c < 4; ++c) {
             int32_t* d = st.bi.reg[op.dstSlot][c];
-            constexpr double kRound = 6755399441055744.0;  // 1.5·2^52, as in writeFloat
             for (int i = 0; i < n; ++i) {
                 double x = double(d[i]) * double(b[i]);  // exact: 25 + 24 bits
                 x = x > -m ? x : -m;                     // NaN -> −M
                 x = x < m ? x : m;
-                d[i] = int32_t((x + kRound) - kRound);
+                d[i] = int32_t(roundEvenSmall(x));
             }
         }
     } else {

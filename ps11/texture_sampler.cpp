@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <vector>
 
 namespace ps11 {
 
@@ -396,7 +395,7 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
     return true;
 }
 
-// The lanes of one set (setsOf), gathered: coordinates, mip weights, the lanes they came from,
+// The lanes of one set (forEachSet), gathered: coordinates, mip weights, the lanes they came from,
 // and room for the kernels' results.
 struct SetScratch {
     alignas(64) float u[kMaxSpan], v[kMaxSpan];
