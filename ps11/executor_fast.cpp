@@ -333,6 +333,8 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
                 for (int c = 0; c < 4; ++c)
                     if (known(f.src[0], c)) result |= uint8_t(1u << c);
             }
+            // Every written channel's result >= 0 >= lo: the lower clamp is a no-op.
+            f.lean = f.nonNegative && (result & f.mask) == f.mask && f.lo <= 0;
             if (f.lo >= 0) result = kMaskAll;
             pos[f.dst] = uint8_t((pos[f.dst] & ~f.mask) | (result & f.mask));
         }

@@ -42,6 +42,9 @@ struct FastOp {
     bool small = false;    // mul/mad, shift 0, sources ±n, |n| <= 255: the 16-bit kernel (productSmall)
     bool nonNegative = false;  // small, and both factors unnegated and >= 0 in every lane (set per run)
     uint8_t complement = 0;    // nonNegative only: bit s, factor s is 1 − n (255 − n, n known in [0, 255])
+    // nonNegative only: the result is >= 0 in every lane and lo <= 0 (a mul, or a mad whose third
+    // source is unnegated and known >= 0), so productSmall leaves out the lower clamp.
+    bool lean = false;
     uint8_t dst = 0;
     uint8_t mask = kMaskAll;
     int8_t shift = 0;
