@@ -490,8 +490,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                      b < bands && (firstBand + b) * kBandRows < t.yMax; ++b)
                     bandTris[bandFill[size_t(b)]++] = i;
             }
-            std::atomic<int> next{0};
             const int workers = std::min(dc.pool.size(), bands);
+            // Bands in a contiguous range per worker: a worker's H rows of one band's last pixel
+            // rows are those its next band reads first (magnified and offset taps).
+            RangeQueue bandQueue(bands, workers);
             std::vector<DrawStats> workerStats(size_t(std::max(workers, 1)));
             const bool fx = ps11::isFixedPoint(precision);
             dc.pool.run(workers, [&](int w) {
@@ -630,8 +632,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     }
                 };
                 for (;;) {
-                    const int b = next.fetch_add(1, std::memory_order_relaxed);
-                    if (b >= bands) break;
+                    const int b = bandQueue.take(w);
+                    if (b < 0) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
                     if (fused) copyBand(firstBand + b);

@@ -121,6 +121,31 @@ void ThreadPool::workerLoop(int index) {
     }
 }
 
+RangeQueue::RangeQueue(int count, int workers) : m_ranges(size_t(std::max(workers, 1))) {
+    const int64_t n = int64_t(m_ranges.size()), items = std::max(count, 0);
+    for (int64_t w = 0; w < n; ++w) {
+        const uint64_t front = uint64_t(items * w / n), back = uint64_t(items * (w + 1) / n);
+        m_ranges[size_t(w)].store((front << 32) | back, std::memory_order_relaxed);
+    }
+}
+
+int RangeQueue::take(int worker) {
+    const size_t n = m_ranges.size();
+    for (size_t k = 0; k < n; ++k) {
+        const bool own = k == 0;
+        std::atomic<uint64_t>& range = m_ranges[(size_t(std::max(worker, 0)) + k) % n];
+        uint64_t v = range.load(std::memory_order_relaxed);
+        for (;;) {
+            const uint32_t front = uint32_t(v >> 32), back = uint32_t(v);
+            if (front >= back) break;
+            const uint64_t taken = own ? (uint64_t(front + 1) << 32) | back : (uint64_t(front) << 32) | (back - 1);
+            // (Relaxed: the items' data is published by ThreadPool::run, which also joins their results.)
+            if (range.compare_exchange_weak(v, taken, std::memory_order_relaxed)) return int(own ? front : back - 1);
+        }
+    }
+    return -1;
+}
+
 void parallelCopy(ThreadPool& pool, void* to, const void* from, size_t bytes) {
     const int n = pool.size();
     pool.run(n, [&](int i) {

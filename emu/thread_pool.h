@@ -1,6 +1,6 @@
 // A small persistent pool of worker threads for draws (docs/device.md "Threads"): run(n, f)
 // calls f(worker) on n workers (the calling thread is worker 0) and returns when all are done.
-// Work is split by the caller (e.g. bands of rows taken from an atomic counter), so results
+// Work is split by the caller (e.g. bands of rows taken from a RangeQueue), so results
 // never depend on the number of threads.
 #pragma once
 
@@ -58,6 +58,21 @@ private:
     std::atomic<int> m_pending{0};
     std::atomic<bool> m_stop{false};
     std::atomic<bool> m_busy{false};  // a run() is using the workers
+};
+
+// Items [0, count) in one contiguous range per worker: worker w takes its own range's items in
+// order from the front and, once that is empty, the others' from their back. Every item is
+// taken exactly once, whatever the timing, and a worker's items are mostly consecutive: what it
+// built for one (a band of a draw's rows: the H rows of the texel rows its last pixel rows read)
+// serves the next.
+class RangeQueue {
+public:
+    RangeQueue(int count, int workers);
+    // The next item for `worker` (in [0, workers)), or −1 when every item is taken.
+    int take(int worker);
+
+private:
+    std::vector<std::atomic<uint64_t>> m_ranges;  // per worker: (front << 32) | back, items left [front, back)
 };
 
 // `bytes` from `from` to `to` (not overlapping), each of the pool's workers copying its share (in

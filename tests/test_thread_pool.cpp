@@ -64,3 +64,56 @@ TEST_CASE("thread pool: parallelCopy copies every byte and nothing past them, on
             CHECK(std::all_of(to.begin() + std::ptrdiff_t(bytes), to.end(), [](uint8_t b) { return b == 0xee; }));
         }
 }
+
+TEST_CASE("range queue: each item once, a worker's own range in order, then the others' from their back",
+          "[threads]") {
+    // One caller taking for worker 1 of 3 over 10 items (ranges [0,3) [3,6) [6,10)): its own
+    // items in order, then worker 2's from the back, then worker 0's.
+    {
+        emu::RangeQueue q(10, 3);
+        std::vector<int> order;
+        for (int b; (b = q.take(1)) >= 0;) order.push_back(b);
+        CHECK(order == std::vector<int>{3, 4, 5, 9, 8, 7, 6, 2, 1, 0});
+    }
+    // Owners and a thief interleaved: nothing twice, nothing left out.
+    {
+        emu::RangeQueue q(7, 2);  // [0,3) [3,7)
+        CHECK(q.take(0) == 0);
+        CHECK(q.take(1) == 3);
+        CHECK(q.take(0) == 1);
+        CHECK(q.take(0) == 2);
+        CHECK(q.take(0) == 6);  // worker 0's range is empty: worker 1's last item
+        CHECK(q.take(1) == 4);
+        CHECK(q.take(0) == 5);
+        CHECK(q.take(1) == -1);
+        CHECK(q.take(0) == -1);
+    }
+    // No items, and more workers than items.
+    CHECK(emu::RangeQueue(0, 2).take(0) == -1);
+    {
+        emu::RangeQueue q(2, 5);
+        std::vector<int> got;
+        for (int w = 0; w < 5; ++w)
+            for (int b; (b = q.take(w)) >= 0;) got.push_back(b);
+        std::sort(got.begin(), got.end());
+        CHECK(got == std::vector<int>{0, 1});
+    }
+    // Four threads racing over many items, uneven work: every item exactly once.
+    for (int round = 0; round < 20; ++round) {
+        constexpr int kItems = 5000;
+        emu::RangeQueue q(kItems, 4);
+        std::vector<std::atomic<int>> seen(kItems);
+        std::vector<std::thread> workers;
+        for (int w = 0; w < 4; ++w)
+            workers.emplace_back([&, w] {
+                for (int b; (b = q.take(w)) >= 0;) {
+                    seen[size_t(b)].fetch_add(1);
+                    if (w == 0 && b % 7 == 0) std::this_thread::yield();  // a slow worker: the others take its items
+                }
+            });
+        for (std::thread& t : workers) t.join();
+        int wrong = 0;
+        for (const std::atomic<int>& s : seen) wrong += s.load() != 1;
+        CHECK(wrong == 0);
+    }
+}
