@@ -576,3 +576,71 @@ TEST_CASE("device: LINEAR StretchRect between A32B32G32R32F targets is the doubl
         CHECK(wrong == 0);
     }
 }
+
+TEST_CASE("band copy: writes that add onto the copy's source, then the rest copied, equal copy-then-add",
+          "[device][putoff]") {
+    // A whole copy put off into an image, made by a band's additive writes (BandCopy): random
+    // spans, overlapping and repeated, each added onto what base() says; then finish(). The
+    // result must be the copy made first with every span added onto it in the same order, and
+    // the rows outside the band must stay as they were. rowCopy takes only one-format copies of
+    // the destination's size into the whole destination.
+    const FormatInfo* f = formatInfo(D3DFMT_A8R8G8B8);
+    REQUIRE(f);
+    std::mt19937 rng(20261130);
+    auto image = [&](uint32_t w, uint32_t h) {
+        Image im;
+        im.format = f;
+        im.width = w, im.height = h;
+        im.rowPitch = w * 4 + 12;  // (a pitch past the row)
+        im.slicePitch = uint64_t(im.rowPitch) * h;
+        im.bytes.assign(size_t(im.slicePitch), 0);
+        for (size_t i = 0; i < size_t(im.slicePitch); ++i) im.bytes.data()[i] = uint8_t(rng());
+        return im;
+    };
+    for (int round = 0; round < 40; ++round) {
+        const uint32_t w = 1 + rng() % 200, h = 1 + rng() % 40;
+        Image src = image(w + 3, h + 2), dst = image(w, h);
+        Image ref = dst;
+        StretchCall call;
+        call.source.image = &src;
+        call.dest.image = &dst;
+        call.sourceRect = PixelBox{3, 2, int64_t(w) + 3, int64_t(h) + 2};  // the source's lower right part
+        call.destRect = PixelBox{0, 0, int64_t(w), int64_t(h)};
+        REQUIRE(BandCopy::rowCopy(call));
+        const int y0 = int(rng() % h), y1 = std::min<int>(int(h), y0 + 1 + int(rng() % 16));
+        // The reference: the band copied first, then each span added onto the target.
+        for (int y = y0; y < y1; ++y) std::memcpy(ref.texel(0, uint32_t(y)), src.texel(3, uint32_t(y + 2)), 4 * size_t(w));
+        BandCopy band;
+        band.begin(call, y0, y1);
+        const int spans = int(rng() % 30);
+        for (int k = 0; k < spans; ++k) {
+            const int y = y0 + int(rng() % uint32_t(y1 - y0));
+            const int x = int(rng() % w), n = 1 + int(rng() % (w - uint32_t(x)));
+            const uint8_t add = uint8_t(rng());
+            uint8_t* row = dst.texel(uint32_t(x), uint32_t(y));
+            const uint8_t* base = band.base(x, y, n, row);
+            for (int i = 0; i < 4 * n; ++i) row[i] = uint8_t(std::min(255, base[i] + add));
+            uint8_t* r = ref.texel(uint32_t(x), uint32_t(y));
+            for (int i = 0; i < 4 * n; ++i) r[i] = uint8_t(std::min(255, r[i] + add));
+        }
+        band.finish();
+        INFO("round " << round << " " << w << "x" << h << " band " << y0 << ".." << y1);
+        for (uint32_t y = 0; y < h; ++y) CHECK(std::memcmp(dst.texel(0, y), ref.texel(0, y), 4 * size_t(w)) == 0);
+    }
+    // Not such copies: another size, another format, part of the destination.
+    Image a = image(8, 8), b = image(8, 8);
+    StretchCall c;
+    c.source.image = &a;
+    c.dest.image = &b;
+    c.sourceRect = PixelBox{0, 0, 8, 8};
+    c.destRect = PixelBox{0, 0, 8, 8};
+    CHECK(BandCopy::rowCopy(c));
+    c.sourceRect = PixelBox{0, 0, 4, 8};
+    CHECK_FALSE(BandCopy::rowCopy(c));
+    c.sourceRect = PixelBox{0, 0, 8, 8};
+    c.destRect = PixelBox{0, 1, 8, 8};
+    CHECK_FALSE(BandCopy::rowCopy(c));
+    c.destRect = PixelBox{0, 0, 8, 8};
+    a.format = formatInfo(D3DFMT_X8R8G8B8);
+    CHECK_FALSE(BandCopy::rowCopy(c));
+}
