@@ -20,18 +20,6 @@ namespace {
 // Above kComparedResourceBytes (64 KB): the device lets the renderer put copies into it off.
 constexpr UINT kW = 160, kH = 120;
 
-// The surface's kW × kH pixels, row after row.
-std::vector<uint8_t> surfaceBytes(Device& dev, Handle h) {
-    std::vector<uint8_t> out;
-    REQUIRE(dev.readSurface(h, [&](const D3DLOCKED_RECT& lr) {
-        for (UINT y = 0; y < kH; ++y) {
-            const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
-            out.insert(out.end(), row, row + kW * 4);
-        }
-    }) == D3D_OK);
-    return out;
-}
-
 struct Script {
     Device dev;
     Handle a{}, b{}, c{}, x{}, tex{}, texLevel{}, constant{}, sample{};
@@ -59,8 +47,15 @@ struct Script {
         REQUIRE(dev.UnlockRect(h) == D3D_OK);
     }
     std::vector<uint8_t> read(Handle h) {
-        seen.push_back(surfaceBytes(dev, h));
-        return seen.back();
+        std::vector<uint8_t> out;
+        REQUIRE(dev.readSurface(h, [&](const D3DLOCKED_RECT& lr) {
+            for (UINT y = 0; y < kH; ++y) {
+                const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
+                out.insert(out.end(), row, row + kW * 4);
+            }
+        }) == D3D_OK);
+        seen.push_back(out);
+        return out;
     }
     std::vector<uint8_t> lockRead(Handle h) {
         D3DLOCKED_RECT lr{};
@@ -280,7 +275,14 @@ TEST_CASE("put-off copies: made by a magnified ONE/ONE composite's own writes, t
                     REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
                     REQUIRE(drawFullscreenQuad(dev, {}) == D3D_OK);
                     REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
-                    seen[putOff ? 0 : 1].push_back(surfaceBytes(dev, out));
+                    std::vector<uint8_t> bytes;
+                    REQUIRE(dev.readSurface(out, [&](const D3DLOCKED_RECT& lr) {
+                        for (UINT y = 0; y < kH; ++y) {
+                            const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
+                            bytes.insert(bytes.end(), row, row + kW * 4);
+                        }
+                    }) == D3D_OK);
+                    seen[putOff ? 0 : 1].push_back(bytes);
                 }
             }
             REQUIRE(seen[0].size() == seen[1].size());
