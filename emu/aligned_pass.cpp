@@ -82,12 +82,12 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
 }
 
 template <bool Additive>
-void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst, const uint8_t* base) {
+void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     for (int i = 0; i < count; ++i) {
         auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
         uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
         if constexpr (Additive) {
-            const uint32_t old = load32(base + 4 * i);
+            const uint32_t old = load32(dst + 4 * i);
             uint32_t s = 0;
             for (int k = 0; k < 4; ++k)
                 s |= std::min<uint32_t>(((w >> (8 * k)) & 0xff) + ((old >> (8 * k)) & 0xff), 255u) << (8 * k);
@@ -102,9 +102,9 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 // one: G·(s + 16·d)·255 / G² = (s + 16·d) / 16).
 // Channel by channel over the lanes (count <= kMaxSpan), in loops the compiler vectorises.
 template <bool Additive>
-void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst, const uint8_t* base) {
+void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     alignas(32) uint32_t old[ps11::kMaxSpan], out[ps11::kMaxSpan];
-    if constexpr (Additive) std::memcpy(old, base, 4 * size_t(count));
+    if constexpr (Additive) std::memcpy(old, dst, 4 * size_t(count));
     for (int i = 0; i < count; ++i) out[i] = orMask;
     for (int c = 0; c < 4; ++c) {
         const int shift = 8 * ps11::kUnorm8Byte[c];
@@ -121,27 +121,26 @@ void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uin
     std::memcpy(dst, out, 4 * size_t(count));
 }
 
-// Stores (or adds onto `base`'s words, directAdd) n pixels of int16 lanes to a row of the 8-bit
-// target: the level's vector kernel (which reads the planes in whole groups of 16 lanes: theirs
-// are kChunk or kMaxSpan long), then whatever it left one by one.
-void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row,
-                const uint8_t* base) {
+// Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
+// vector kernel (which reads the planes in whole groups of 16 lanes: theirs are kChunk or kMaxSpan
+// long), then whatever it left one by one.
+void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
     if (draw.fx12) {
-        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, row, base) : 0;
+        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, row) : 0;
         const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
         if (draw.directAdd)
-            storeRowScalar12<true>(rest, n - done, orMask, row + 4 * done, base + 4 * done);
+            storeRowScalar12<true>(rest, n - done, orMask, row + 4 * done);
         else
-            storeRowScalar12<false>(rest, n - done, orMask, row + 4 * done, base + 4 * done);
+            storeRowScalar12<false>(rest, n - done, orMask, row + 4 * done);
         return;
     }
     int done = 0;
-    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row, base);
+    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
     const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
     if (draw.directAdd)
-        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done, base + 4 * done);
+        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
     else
-        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done, base + 4 * done);
+        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
 }
 
 // A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
@@ -151,8 +150,7 @@ void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint3
 // additive store (ONE/ONE into an 8-bit target) adds those bytes to the target's with saturation,
 // as storeRow does. False where the columns do not qualify (the caller filters).
 bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
-                const RowWindow& window, int x, int n, uint32_t orMask, bool additive, uint8_t* dst,
-                const uint8_t* base) {
+                const RowWindow& window, int x, int n, uint32_t orMask, bool additive, uint8_t* dst) {
     const int t = window.copyTap;
     const AlignedTap& tap = draw.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
@@ -214,12 +212,12 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
     for (; i + 4 <= n; i += 4) {
         const __m128i w =
             _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i),
-                         _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(base + 4 * i)), w));
+        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
+        _mm_storeu_si128(d, _mm_adds_epu8(_mm_loadu_si128(d), w));
     }
 #endif
     for (; i < n; ++i) {
-        const uint32_t w = (load32(src + 4 * i) & keep) | set, old = load32(base + 4 * i);
+        const uint32_t w = (load32(src + 4 * i) & keep) | set, old = load32(dst + 4 * i);
         uint32_t sum = 0;
         for (int b = 0; b < 4; ++b)
             sum |= std::min<uint32_t>(((w >> (8 * b)) & 0xff) + ((old >> (8 * b)) & 0xff), 255u) << (8 * b);
@@ -653,7 +651,7 @@ RowWindows rowWindows(const RowWindow* windows, size_t count) {
 
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* windows,
-                     size_t windowCount, BandCopy* bandCopy) {
+                     size_t windowCount) {
     const RowWindows ws = rowWindows(windows, windowCount);
     windows = ws.data, windowCount = ws.count;
     const uint32_t neededTaps = ws.taps;
@@ -681,12 +679,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         const std::array<TapRow, 8>* rows;
         int x, y;
         uint8_t* out;
-        const uint8_t* base;  // what ONE/ONE stores add onto (out, or a copy's source: BandCopy)
         uint32_t orMask;
         int16_t* const* r0;
         QuadLevels* quadLevels;
         ps11::Sampler* sampler;
-    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, nullptr, orMask, r0, &sc.quadLevels, sc.sampler};
+    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0, &sc.quadLevels, sc.sampler};
     sc.quadLevels.used = 0;  // (a quad's two rows are drawn in one call: bands start on even rows)
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
@@ -700,7 +697,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     const ps11::ResultSink sink = [](void* p, int first, int count, const int16_t* const lanes[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         if (f.out) {
-            storeLanes(*f.draw, lanes, count, f.orMask, f.out + 4 * first, f.base + 4 * first);
+            storeLanes(*f.draw, lanes, count, f.orMask, f.out + 4 * first);
             return;
         }
         for (int c = 0; c < 4; ++c) std::memcpy(f.r0[c] + first, lanes[c], sizeof(int16_t) * size_t(count));
@@ -835,14 +832,10 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
-                    uint8_t* const row = target.texel(uint32_t(x), uint32_t(y));
-                    // (With a band copy every run is stored directly and adds: see drawAlignedRows.)
-                    const uint8_t* const base = bandCopy ? bandCopy->base(x, y, n, row) : row;
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
-                        ctx.out = storeAsShaded ? row : nullptr;
-                        ctx.base = base;
+                        ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
                         if (storeAsShaded) {
                             stats.pixels += uint64_t(n);
@@ -850,8 +843,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             continue;
                         }
                     } else if (mode == RowMode::Copy) {
-                        if (storeAsShaded &&
-                            copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd, row, base)) {
+                        if (storeAsShaded && copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
+                                                        target.texel(uint32_t(x), uint32_t(y)))) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
                             stats.copiedDirect += uint64_t(n);
@@ -865,6 +858,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     }
                     stats.pixels += uint64_t(n);
+                    uint8_t* row = target.texel(uint32_t(x), uint32_t(y));
                     if (direct && draw.fogFirst) {
                         // The run's fog, as the merger applies it first, on its lanes.
                         MergeInputs fi;
@@ -878,7 +872,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             for (int i = 0; i < n; ++i) sc.r0[c][i] = int16_t(sc.grid[c][i]);  // (in [0, G])
                     }
                     if (direct) {
-                        storeLanes(draw, r0c, n, orMask, row, base);
+                        storeLanes(draw, r0c, n, orMask, row);
                         stats.written += uint64_t(n);
                         continue;
                     }

@@ -16,7 +16,6 @@
 #include <utility>
 #include <vector>
 
-#include "emu/blit.h"
 #include "emu/output_merger.h"
 #include "emu/prefetch.h"
 #include "emu/raster.h"
@@ -95,8 +94,6 @@ struct AlignedDraw {
     bool fogFirst = false;
     MergeState afterDepth;  // `merge` with its depth test and write off
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
-    // Every run is added straight onto the target (drawAlignedRows' `bandCopy` may be given).
-    bool addsDirectly() const { return directAdd && !depthFirst && !fogFirst; }
 };
 
 // Decides whether a draw can take the aligned path (per-triangle checks come later) and fills
@@ -391,11 +388,9 @@ bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTable
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is
-// filtered once per pixel row for all of them. With `bandCopy` (a draw whose every write adds
-// directly onto the target, directAdd without depthFirst or fogFirst), each write adds onto what
-// bandCopy->base gives: the band of a copy put off into the target is made by the draw itself.
+// filtered once per pixel row for all of them.
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats,
-                     const RowWindow* windows = nullptr, size_t windowCount = 0, BandCopy* bandCopy = nullptr);
+                     const RowWindow* windows = nullptr, size_t windowCount = 0);
 
 }  // namespace emu

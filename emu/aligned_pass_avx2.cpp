@@ -309,34 +309,30 @@ inline void packWords(__m256i r, __m256i g, __m256i b, __m256i a, __m256i om, __
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
-int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst, const uint8_t* base) {
+int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     const __m256i om = _mm256_set1_epi32(int32_t(orMask));
-    // (ONE/ONE from the source of a copy the stores make asks for its lines ahead too.)
-    const bool fromCopy = Additive && base != dst;
     for (int i = 0; i < count; i += 16) {
         auto ld = [&](int c) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i)); };
         __m256i first, second;
         packWords(ld(0), ld(1), ld(2), ld(3), om, first, second);
         __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
         __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
-        const uint8_t* b0 = base + 4 * i;
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        if (fromCopy) _mm_prefetch(reinterpret_cast<const char*>(b0) + kPrefetchAhead, _MM_HINT_T0);
         if (count - i < 16) {  // the last pixels: masked loads and stores of their words alone
             int* w0 = reinterpret_cast<int*>(d0);
             int* w1 = reinterpret_cast<int*>(d1);
             const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
             if constexpr (Additive) {
-                first = _mm256_adds_epu8(first, _mm256_maskload_epi32(reinterpret_cast<const int*>(b0), m0));
-                second = _mm256_adds_epu8(second, _mm256_maskload_epi32(reinterpret_cast<const int*>(b0 + 32), m1));
+                first = _mm256_adds_epu8(first, _mm256_maskload_epi32(w0, m0));
+                second = _mm256_adds_epu8(second, _mm256_maskload_epi32(w1, m1));
             }
             _mm256_maskstore_epi32(w0, m0, first);
             _mm256_maskstore_epi32(w1, m1, second);
             break;
         }
         if constexpr (Additive) {
-            first = _mm256_adds_epu8(first, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b0)));
-            second = _mm256_adds_epu8(second, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b0 + 32)));
+            first = _mm256_adds_epu8(first, _mm256_loadu_si256(d0));
+            second = _mm256_adds_epu8(second, _mm256_loadu_si256(d1));
         }
         _mm256_storeu_si256(d0, first);
         _mm256_storeu_si256(d1, second);
@@ -344,16 +340,15 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
     return count;
 }
 
-int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst,
-                        const uint8_t* base) {
-    return additive ? storeRow<true>(r, count, orMask, dst, base) : storeRow<false>(r, count, orMask, dst, base);
+int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
 }
 
 // fx12 words: each channel's grid value n clamped to [0, 4080] (additive: n + 16·d, the target
 // byte d, clamped again), then its byte round_half_even(n / 16) = (n + 7 + (n >> 4 & 1)) >> 4,
 // all in int16 lanes (at most 8160).
 template <bool Additive>
-int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst, const uint8_t* base) {
+int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     const __m256i om = _mm256_set1_epi32(int32_t(orMask)), zero = _mm256_setzero_si256();
     const __m256i top = _mm256_set1_epi16(int16_t(ps11::gridScale(ps11::Precision::Fx12))),
                   seven = _mm256_set1_epi16(7), one = _mm256_set1_epi16(1);
@@ -365,10 +360,8 @@ int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* d
         const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
         __m256i old0 = zero, old1 = zero;
         if constexpr (Additive) {
-            const int* b0 = reinterpret_cast<const int*>(base + 4 * i);
-            const int* b1 = reinterpret_cast<const int*>(base + 4 * i + 32);
-            old0 = tail ? _mm256_maskload_epi32(b0, m0) : _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b0));
-            old1 = tail ? _mm256_maskload_epi32(b1, m1) : _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b1));
+            old0 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d0), m0) : _mm256_loadu_si256(d0);
+            old1 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d1), m1) : _mm256_loadu_si256(d1);
         }
         __m256i ch[4];
         for (int c = 0; c < 4; ++c) {
@@ -399,9 +392,8 @@ int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* d
     return count;
 }
 
-int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst,
-                          const uint8_t* base) {
-    return additive ? storeRow12<true>(r, count, orMask, dst, base) : storeRow12<false>(r, count, orMask, dst, base);
+int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+    return additive ? storeRow12<true>(r, count, orMask, dst) : storeRow12<false>(r, count, orMask, dst);
 }
 
 }  // namespace

@@ -71,16 +71,13 @@ struct AlignedKernels {
                        int lane, int16_t* const out[4]);
 
     // Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
-    // dst, or-ing orMask (additive: a saturating byte add onto the words at `base`: dst itself, or
-    // the source of a copy into dst that these stores make, BandCopy); returns how many it stored
-    // (the caller stores the rest). The planes are read in whole groups of 16 lanes (the lanes
-    // past `count` are ignored); dst and base are never touched past their `count` words.
-    int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst,
-                    const uint8_t* base);
+    // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
+    // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes
+    // (the lanes past `count` are ignored); dst is never touched past its `count` words.
+    int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
     // The same for fx12 lanes: each channel's byte round_half_even(n / 16) of n clamped to
-    // [0, 4080]; additive: of n + 16·(the base's byte), clamped again (the merger's ONE/ONE).
-    int (*storeRow12)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst,
-                      const uint8_t* base);
+    // [0, 4080]; additive: of n + 16·(the target's byte), clamped again (the merger's ONE/ONE).
+    int (*storeRow12)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
 };
 
 // The table of a level, or null (no vector kernels at that level).

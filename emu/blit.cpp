@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -337,83 +336,6 @@ void stretchImages(const StretchCall& call, RowRange rows) {
             store(dx, dy, v);
         }
     }
-}
-
-bool BandCopy::rowCopy(const StretchCall& call) {
-    const Image* s = call.source.image;
-    const Image* d = call.dest.image;
-    const PixelBox& sr = call.sourceRect;
-    const PixelBox& dr = call.destRect;
-    return s && d && s != d && s->format == d->format && d->depth == 1 && dr.x0 == 0 && dr.y0 == 0 &&
-           dr.x1 == int64_t(d->width) && dr.y1 == int64_t(d->height) && sr.x1 - sr.x0 == dr.x1 &&
-           sr.y1 - sr.y0 == dr.y1;
-}
-
-void BandCopy::begin(const StretchCall& call, int y0, int y1) {
-    m_call = &call;
-    const Image& d = *call.dest.image;
-    m_y0 = std::clamp(y0, 0, int(d.height));
-    m_y1 = std::clamp(y1, m_y0, int(d.height));
-    m_words = (size_t(d.width) + 63) / 64;
-    m_bytes = size_t(d.format->bytes);
-    m_bits.assign(m_words * size_t(m_y1 - m_y0), 0);
-}
-
-const uint8_t* BandCopy::source(int x, int y) const {
-    return m_call->source.image->texel(uint32_t(m_call->sourceRect.x0 + x), uint32_t(m_call->sourceRect.y0 + y));
-}
-
-namespace {
-
-// Calls f(x0, x1) for every run of clear bits in [x, end) of `bits`.
-template <class F>
-void forClearRuns(const uint64_t* bits, int x, int end, F f) {
-    while (x < end) {
-        // The next clear bit from x, then the next set bit after it.
-        while (x < end && ((bits[size_t(x) / 64] >> (x % 64)) & 1)) {
-            const uint64_t w = ~bits[size_t(x) / 64] >> (x % 64);
-            x = w ? x + std::countr_zero(w) : (x / 64 + 1) * 64;
-        }
-        if (x >= end) return;
-        int e = x;
-        while (e < end && !((bits[size_t(e) / 64] >> (e % 64)) & 1)) {
-            const uint64_t w = bits[size_t(e) / 64] >> (e % 64);
-            e = w ? e + std::countr_zero(w) : (e / 64 + 1) * 64;
-        }
-        e = std::min(e, end);
-        f(x, e);
-        x = e;
-    }
-}
-
-void setBits(uint64_t* bits, int x, int end) {
-    for (; x < end && x % 64; ++x) bits[size_t(x) / 64] |= uint64_t(1) << (x % 64);
-    for (; x + 64 <= end; x += 64) bits[size_t(x) / 64] = ~uint64_t(0);
-    for (; x < end; ++x) bits[size_t(x) / 64] |= uint64_t(1) << (x % 64);
-}
-
-}  // namespace
-
-const uint8_t* BandCopy::base(int x, int y, int n, uint8_t* dst) {
-    uint64_t* bits = &m_bits[m_words * size_t(y - m_y0)];
-    bool none = false;  // [x, x + n) is one run of clear bits
-    forClearRuns(bits, x, x + n, [&](int a, int b) { none = a == x && b == x + n; });
-    if (none) {
-        setBits(bits, x, x + n);
-        return source(x, y);
-    }
-    forClearRuns(bits, x, x + n,
-                 [&](int a, int b) { std::memcpy(dst + m_bytes * size_t(a - x), source(a, y), m_bytes * size_t(b - a)); });
-    setBits(bits, x, x + n);
-    return dst;
-}
-
-void BandCopy::finish() {
-    Image& d = *m_call->dest.image;
-    for (int y = m_y0; y < m_y1; ++y)
-        forClearRuns(&m_bits[m_words * size_t(y - m_y0)], 0, int(d.width), [&](int a, int b) {
-            std::memcpy(d.texel(uint32_t(a), uint32_t(y)), source(a, y), m_bytes * size_t(b - a));
-        });
 }
 
 }  // namespace emu

@@ -57,7 +57,6 @@ struct WorkerScratch {
     ps11::TextureSampler sampler;
     AlignedScratch aligned;
     FloatRowScratch floatRows;
-    BandCopy bandCopy;
 };
 
 }  // namespace
@@ -293,9 +292,6 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     const bool floatDraw = m_options.alignedPasses && !alignedDraw &&
                            prepareFloatRowDraw(executor, precision, call.hardware.weightBits, kills, call.textures,
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
-    // A copy put off into the target, of one format at one size, is made by this draw's writes
-    // band by band where each of them adds straight onto the target (BandCopy, emu/blit.h).
-    const bool copyByDraw = fused && alignedDraw && aligned.addsDirectly() && BandCopy::rowCopy(*fused);
     std::vector<FloatRowTriangle>& floatTris = dc.chunk.floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.
     // Deciding costs 0.4–3 µs a tile, and the first read of a texture scans its facts: a program
@@ -560,36 +556,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 AlignedStats as;
                 std::vector<RowWindow> windows;
                 TileMemo memo;
-                // Whether the row path draws band b alone (no triangle on another path).
-                auto bandAligned = [&](int b) {
-                    const uint32_t k0 = bandStart[size_t(b)], k1 = bandStart[size_t(b) + 1];
-                    if (k1 - k0 > uint32_t(kMaxAlignedTriangles)) return false;
-                    for (uint32_t k = k0; k < k1; ++k)
-                        if (!isAligned[bandTris[k]]) return false;
-                    return true;
-                };
-                // Whether band b's triangles cover its first and last rows from edge to edge.
-                auto bandCovered = [&](int b, int by0, int by1) {
-                    const uint32_t k0 = bandStart[size_t(b)], k1 = bandStart[size_t(b) + 1];
-                    for (const int y : {by0, std::min(by1, int(colorImage->height)) - 1}) {
-                        std::pair<int, int> spans[kMaxAlignedTriangles];
-                        size_t n = 0;
-                        for (uint32_t k = k0; k < k1; ++k)
-                            if (rowCoverage(setups[bandTris[k]], y, spans[n].first, spans[n].second)) ++n;
-                        std::sort(spans, spans + n);
-                        int reach = 0;  // the union of the spans, as one run from column 0
-                        for (size_t i = 0; i < n && spans[i].first <= reach; ++i) reach = std::max(reach, spans[i].second);
-                        if (reach < int(colorImage->width)) return false;
-                    }
-                    return true;
-                };
                 // A band of a chunk drawn wholly by a row path, tile by tile (emu/tile_skip.h).
-                // `mayCopyByDraw`: the band of a copy put off into the target may be made by the
-                // band's writes (BandCopy) where they cover it: no tile left as it is.
-                auto drawBandTiles = [&](int b, int by0, int by1, bool mayCopyByDraw) {
-                    auto copyFirst = [&] {
-                        if (fused) copyBand(firstBand + b);
-                    };
+                auto drawBandTiles = [&](int b, int by0, int by1) {
                     const TriangleSetup* bt[kMaxAlignedTriangles];
                     const AlignedTriangle* at[kMaxAlignedTriangles];
                     const FloatRowTriangle* ft[kMaxAlignedTriangles];
@@ -604,7 +572,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
                         ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
                     }
-                    if (n == 0 || ty0 >= ty1) return copyFirst();
+                    if (n == 0 || ty0 >= ty1) return;
                     // The columns the band's triangles cover (a small quad decides only its own tiles).
                     int tx0 = clip.x1, tx1 = clip.x0;
                     for (size_t t = 0; t < n; ++t)
@@ -612,11 +580,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                             int xl = 0, xr = 0;
                             if (rowCoverage(*bt[t], y, xl, xr)) tx0 = std::min(tx0, xl), tx1 = std::max(tx1, xr);
                         }
-                    if (tx0 >= tx1) return copyFirst();
+                    if (tx0 >= tx1) return;
                     // Runs of tiles with one decision become the windows of one pass over the band's
                     // rows (each texel row the windows need is filtered once per pixel row).
                     windows.clear();
-                    const uint64_t skippedBefore = ws.tilesSkipped;
                     auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
                         switch (d.action) {
                             case TileAction::Shade:
@@ -656,25 +623,12 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         ++runTiles;
                     }
                     if (runTiles) addRun(run, runX0, tx1, runTiles);
-                    BandCopy* bandCopy = nullptr;
-                    if (mayCopyByDraw && ws.tilesSkipped == skippedBefore && !windows.empty() && tx0 == 0 &&
-                        tx1 == int(colorImage->width) && ty0 == by0 && ty1 == std::min(by1, int(colorImage->height))) {
-                        bandCopy = &ws0.bandCopy;
-                        bandCopy->begin(*fused, by0, by1);
-                    } else {
-                        copyFirst();
-                    }
                     if (windows.empty()) return;
                     if (floatDraw) {
                         drawFloatRows(floatRows, ft, bt, n, by0, by1, ws0.floatRows, as, windows.data(),
                                       windows.size());
                     } else {
-                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size(),
-                                        bandCopy);
-                    }
-                    if (bandCopy) {
-                        bandCopy->finish();
-                        bandCopied[size_t(firstBand + b)] = 1;
+                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
                     }
                 };
                 for (;;) {
@@ -682,27 +636,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if (b < 0) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
-                    // The band of a copy put off into the target: made by the draw's own writes
-                    // (BandCopy) where every one of them adds onto the target and they cover the
-                    // band, else first (a band mostly left to copy is copied faster whole).
-                    const bool mayCopyByDraw =
-                        fused && copyByDraw && !bandCopied[size_t(firstBand + b)] && bandAligned(b);
-                    if (tiles) {
-                        drawBandTiles(b, by0, by1, mayCopyByDraw);
-                        continue;
-                    }
-                    BandCopy* bandCopy = nullptr;
-                    if (mayCopyByDraw && bandCovered(b, by0, by1)) {
-                        bandCopy = &ws0.bandCopy;
-                        bandCopy->begin(*fused, by0, by1);
-                    } else if (fused) {
-                        copyBand(firstBand + b);
-                    }
-                    auto copied = [&] {
-                        if (!bandCopy) return;
-                        bandCopy->finish();
-                        bandCopied[size_t(firstBand + b)] = 1;
-                    };
+                    if (fused) copyBand(firstBand + b);
                     // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
                     const AlignedTriangle* group[kMaxAlignedTriangles];
                     const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
@@ -712,10 +646,13 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         if (grouped && floatDraw)
                             drawFloatRows(floatRows, floatGroup, groupSetups, grouped, by0, by1, ws0.floatRows, as);
                         else if (grouped)
-                            drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as, nullptr,
-                                            0, bandCopy);
+                            drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
                         grouped = 0;
                     };
+                    if (tiles) {
+                        drawBandTiles(b, by0, by1);
+                        continue;
+                    }
                     for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {
                         const uint32_t i = bandTris[k];
                         const TriangleSetup& s = setups[i];
@@ -735,7 +672,6 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                             rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                     }
                     flush();
-                    copied();
                 }
                 // The draw's textures are not kept alive past it: a texture read in place would
                 // otherwise be copied on its next write (Device::prepareWrite).
