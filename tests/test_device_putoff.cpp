@@ -20,6 +20,18 @@ namespace {
 // Above kComparedResourceBytes (64 KB): the device lets the renderer put copies into it off.
 constexpr UINT kW = 160, kH = 120;
 
+// The surface's kW × kH pixels, row after row.
+std::vector<uint8_t> surfaceBytes(Device& dev, Handle h) {
+    std::vector<uint8_t> out;
+    REQUIRE(dev.readSurface(h, [&](const D3DLOCKED_RECT& lr) {
+        for (UINT y = 0; y < kH; ++y) {
+            const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
+            out.insert(out.end(), row, row + kW * 4);
+        }
+    }) == D3D_OK);
+    return out;
+}
+
 struct Script {
     Device dev;
     Handle a{}, b{}, c{}, x{}, tex{}, texLevel{}, constant{}, sample{};
@@ -47,15 +59,8 @@ struct Script {
         REQUIRE(dev.UnlockRect(h) == D3D_OK);
     }
     std::vector<uint8_t> read(Handle h) {
-        std::vector<uint8_t> out;
-        REQUIRE(dev.readSurface(h, [&](const D3DLOCKED_RECT& lr) {
-            for (UINT y = 0; y < kH; ++y) {
-                const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
-                out.insert(out.end(), row, row + kW * 4);
-            }
-        }) == D3D_OK);
-        seen.push_back(out);
-        return out;
+        seen.push_back(surfaceBytes(dev, h));
+        return seen.back();
     }
     std::vector<uint8_t> lockRead(Handle h) {
         D3DLOCKED_RECT lr{};
@@ -225,4 +230,63 @@ TEST_CASE("put-off copies: the device says which copies were put off", "[device]
         s.copy(s.a, s.x);
         CHECK(s.dev.lastStretchPutOff() == putOff);
     }
+}
+
+TEST_CASE("put-off copies: made by a magnified ONE/ONE composite's own writes, tiled or not, fx8 and fx12",
+          "[device][putoff]") {
+    // The glare composites' case (emu/blit.h BandCopy): the scene copied into the target, put
+    // off, then a texture a quarter of the size added over every pixel. Its top rows are black:
+    // their tiles are skipped (bands copied first), the others shaded from the copy's source; with
+    // tile skipping off every band is. Against the same on a device that makes copies at once.
+    for (const ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Fx12})
+        for (const bool skip : {true, false}) {
+            INFO(ps11::precisionName(p) << (skip ? "" : ", tiles not skipped"));
+            std::vector<std::vector<uint8_t>> seen[2];
+            for (const bool putOff : {true, false}) {
+                DeviceOptions o;
+                o.precision = p;
+                o.software.threads = 2;
+                o.software.putOffCopies = putOff;
+                o.software.skipTiles = skip;
+                o.software.timeTiles = false;
+                Device dev(o);
+                Handle scene{}, out{}, glow{}, glowLevel{}, sample{};
+                REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &scene) == D3D_OK);
+                REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &out) == D3D_OK);
+                REQUIRE(dev.CreateTexture(kW / 4, kH / 4, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &glow) == D3D_OK);
+                REQUIRE(dev.GetSurfaceLevel(glow, 0, &glowLevel) == D3D_OK);
+                REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ntex t0\nmov r0, t0\n", &sample) == D3D_OK);
+                std::mt19937 rng(11);
+                for (int frame = 0; frame < 3; ++frame) {
+                    for (const Handle h : {scene, glowLevel}) {
+                        const bool isGlow = h == glowLevel;
+                        const UINT w = isGlow ? kW / 4 : kW, hh = isGlow ? kH / 4 : kH;
+                        D3DLOCKED_RECT lr{};
+                        REQUIRE(dev.LockRect(h, &lr, nullptr, 0) == D3D_OK);
+                        for (UINT y = 0; y < hh; ++y)
+                            for (UINT i = 0; i < w * 4; ++i)
+                                static_cast<uint8_t*>(lr.pBits)[y * UINT(lr.Pitch) + i] =
+                                    isGlow && y < hh / 2 + UINT(frame) ? 0 : uint8_t(rng());
+                        REQUIRE(dev.UnlockRect(h) == D3D_OK);
+                    }
+                    REQUIRE(dev.StretchRect(scene, nullptr, out, nullptr, D3DTEXF_POINT) == D3D_OK);
+                    REQUIRE(dev.SetRenderTarget(0, out) == D3D_OK);
+                    REQUIRE(dev.SetPixelShader(sample) == D3D_OK);
+                    REQUIRE(dev.SetTexture(0, glow) == D3D_OK);
+                    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, D3DTEXF_LINEAR) == D3D_OK);
+                    REQUIRE(dev.SetSamplerState(0, D3DSAMP_MINFILTER, D3DTEXF_LINEAR) == D3D_OK);
+                    REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+                    REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+                    REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+                    REQUIRE(drawFullscreenQuad(dev, {}) == D3D_OK);
+                    REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
+                    seen[putOff ? 0 : 1].push_back(surfaceBytes(dev, out));
+                }
+            }
+            REQUIRE(seen[0].size() == seen[1].size());
+            for (size_t i = 0; i < seen[0].size(); ++i) {
+                INFO("frame " << i);
+                CHECK(seen[0][i] == seen[1][i]);
+            }
+        }
 }
