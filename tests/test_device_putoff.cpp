@@ -232,12 +232,11 @@ TEST_CASE("put-off copies: the device says which copies were put off", "[device]
     }
 }
 
-TEST_CASE("put-off copies: made by a magnified ONE/ONE composite's own writes, tiled or not, fx8 and fx12",
-          "[device][putoff]") {
-    // The glare composites' case (emu/blit.h BandCopy): the scene copied into the target, put
-    // off, then a texture a quarter of the size added over every pixel. Its top rows are black:
-    // their tiles are skipped (bands copied first), the others shaded from the copy's source; with
-    // tile skipping off every band is. Against the same on a device that makes copies at once.
+TEST_CASE("put-off copies: a magnified ONE/ONE composite over one, tiled or not, fx8 and fx12", "[device][putoff]") {
+    // The glare composites' case: the scene copied into the target, put off, then a texture a
+    // quarter of the size added over every pixel. Its top rows are black: their tiles are
+    // skipped, the others shaded; with tile skipping off every one is. Against the same on a
+    // device that makes copies at once.
     for (const ps11::Precision p : {ps11::Precision::Fx8, ps11::Precision::Fx12})
         for (const bool skip : {true, false}) {
             INFO(ps11::precisionName(p) << (skip ? "" : ", tiles not skipped"));
