@@ -9,6 +9,7 @@
 
 #include "emu/blit.h"
 #include "emu/device.h"
+#include "emu/tile_facts.h"
 #include "ps11/precision.h"
 
 namespace emu {
@@ -283,13 +284,17 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     if (m_renderer->clear(cc)) {
         if (target) rendererWrote(*rt, rtRef.level);
         if (depth) rendererWrote(*ds, dsRef.level);
-        return D3D_OK;
+    } else {
+        if (target) syncLevel(*rt, rtRef.level);
+        if (depth) syncLevel(*ds, dsRef.level);
+        clearImages(cc);
+        if (target) markWritten(*rt, rtRef.level);
+        if (depth) markWritten(*ds, dsRef.level);
     }
-    if (target) syncLevel(*rt, rtRef.level);
-    if (depth) syncLevel(*ds, dsRef.level);
-    clearImages(cc);
-    if (target) markWritten(*rt, rtRef.level);
-    if (depth) markWritten(*ds, dsRef.level);
+    // Level 0 of a texture cleared whole holds one value: its tile facts need no scan until drawn into.
+    if (target && rtRef.level == 0 && boxes.size() == 1 && boxes[0].x0 <= 0 && boxes[0].y0 <= 0 &&
+        boxes[0].x1 >= int64_t(target->width) && boxes[0].y1 >= int64_t(target->height))
+        rt->uniformStale = std::make_shared<const std::vector<uint8_t>>(uniformTileCount(*target), uint8_t(0));
     return D3D_OK;
 }
 

@@ -16,6 +16,7 @@
 #include "emu/ffp.h"
 #include "emu/output_merger.h"
 #include "emu/renderer.h"
+#include "emu/tile_facts.h"
 #include "emu/vertex.h"
 #include "ps11/executor.h"
 #include "ps11/texture_sampler.h"
@@ -477,11 +478,14 @@ std::optional<CallError> Device::submit(DrawSetup& d, DrawStats& stats) {
         call.textureView = [this](int stage) { return sampledTexture(m_state.textures[size_t(stage)]); };
     prepareWrite(*d.rt);
     if (d.depth) prepareWrite(*d.ds);
+    // A target of known tile facts keeps them, with the tiles the triangles reach marked stale.
+    std::shared_ptr<const std::vector<uint8_t>> uniform = d.rtRef.level == 0 ? d.rt->uniformStale : nullptr;
     CallError error;
     if (!m_renderer->draw(call, stats, error)) return error;
     if (stats.trianglesDrawn) {
         rendererWrote(*d.rt, d.rtRef.level);
         if (d.depth && call.merge.depthWrite) rendererWrote(*d.ds, d.dsRef.level);
+        if (uniform) d.rt->uniformStale = markDrawnTiles(call, *d.target, *uniform);
     }
     return std::nullopt;
 }

@@ -357,6 +357,7 @@ void Device::markWritten(Resource& r, uint32_t level) {
         if (same) return;  // nothing changed: the generation, the mips and the renderer's copy stand
     }
     ++r.generation;
+    if (level == 0) r.uniformStale.reset();  // (a clear or a draw that keeps it sets it again)
     r.levelGeneration[level] = r.generation;
     r.rendererNewer[level] = 0;
     if (level == 0 && r.autoGenMips()) r.mipsDirty = true;
@@ -598,6 +599,7 @@ std::shared_ptr<const ps11::Texture> Device::makeSampled(Handle texture, CallErr
         return nullptr;
     }
     r->sampledGeneration = r->generation;
+    if (r->uniformStale) r->sampled->setUniformTiles(r->uniformStale);
     return r->sampled;
 }
 

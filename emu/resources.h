@@ -105,6 +105,11 @@ struct Resource {
     std::vector<uint8_t> rendererNewer;
     uint64_t sampledGeneration = ~uint64_t(0);
     std::shared_ptr<const ps11::Texture> sampled;  // the sampler's view (see Device::sampledTexture)
+    // Level 0's tile facts known without a scan (docs/device.md "Tile facts from clears"): set
+    // when a clear wrote one value to every texel, then a byte per tile of its tile grid
+    // (ps11::texelTileSide) that draws may have written since; null after any other write.
+    // Handed to each sampled view (ps11::Texture::setUniformTiles).
+    std::shared_ptr<const std::vector<uint8_t>> uniformStale;
 
     // The one buffer all levels view (allocateLevels).
     const std::shared_ptr<uint8_t[]>& store() const { return levels.front().bytes.store(); }

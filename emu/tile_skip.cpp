@@ -110,18 +110,33 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
         st.tiles = st.texture->texelTiles();
         if (st.tiles) continue;
         // First read of this texture (of this generation): its facts, tile rows over the workers.
+        // Where the device knew them uniform (cleared whole, then drawn into in places), only
+        // the tiles drawn into since are scanned (ps11::uniformTileRange).
         auto tiles = std::make_shared<ps11::TexelTiles>();
         ps11::prepareTexelTiles(*st.texture, *tiles);
-        // Over the workers only where the scan outweighs waking them (about a megabyte of texels).
         const ps11::Texture& tex = *st.texture;
-        const uint64_t texels = uint64_t(tiles->width) * tiles->height;
+        const std::shared_ptr<const std::vector<uint8_t>> stale = tex.uniformTiles();
+        ps11::TexelRange uniform;
+        const bool known = stale && ps11::uniformTileRange(tex, *tiles, *stale, uniform);
+        uint64_t texels = uint64_t(tiles->width) * tiles->height;
+        if (known) {
+            const uint64_t perTile = uint64_t(tiles->side) * tiles->side;
+            texels = perTile * uint64_t(std::count(stale->begin(), stale->end(), uint8_t(1)));
+        }
+        auto scanRows = [&](uint32_t ty0, uint32_t ty1) {
+            if (known)
+                ps11::fillUniformTiles(tex, *tiles, *stale, uniform, ty0, ty1);
+            else
+                ps11::scanTexelTiles(tex, *tiles, ty0, ty1);
+        };
+        // Over the workers only where the scan outweighs waking them (about a megabyte of texels).
         if (texels < kParallelScanTexels) {
-            ps11::scanTexelTiles(tex, *tiles, 0, tiles->tilesY);
+            scanRows(0, tiles->tilesY);
         } else {
             const int workers = int(std::clamp<uint32_t>(tiles->tilesY / 4, 1, uint32_t(pool.size())));
             pool.run(workers, [&](int w) {
-                ps11::scanTexelTiles(tex, *tiles, tiles->tilesY * uint32_t(w) / uint32_t(workers),
-                                     tiles->tilesY * uint32_t(w + 1) / uint32_t(workers));
+                scanRows(tiles->tilesY * uint32_t(w) / uint32_t(workers),
+                         tiles->tilesY * uint32_t(w + 1) / uint32_t(workers));
             });
         }
         st.texture->keepTexelTiles(tiles);

@@ -108,6 +108,11 @@ public:
     // (null before); thread-safe. Copies of a texture share them.
     std::shared_ptr<const TexelTiles> texelTiles() const;
     void keepTexelTiles(std::shared_ptr<const TexelTiles> tiles) const;
+    // What the texture's maker knew of level 0 before any scan (ps11/texture_tiles.h
+    // "uniformTileRange"): one value in every texel but the tiles flagged stale; null when
+    // nothing is known. Thread-safe; copies of a texture share it.
+    std::shared_ptr<const std::vector<uint8_t>> uniformTiles() const;
+    void setUniformTiles(std::shared_ptr<const std::vector<uint8_t>> stale) const;
 
 private:
     friend class TextureBuilder;
@@ -136,6 +141,7 @@ private:
     struct TileCache {
         std::mutex mutex;
         std::shared_ptr<const TexelTiles> tiles;
+        std::shared_ptr<const std::vector<uint8_t>> uniformStale;
     };
     std::shared_ptr<TileCache> m_tileCache = std::make_shared<TileCache>();
 };

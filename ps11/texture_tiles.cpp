@@ -62,12 +62,17 @@ TexelRange TexelTiles::over(uint32_t x0, uint32_t y0, uint32_t x1, uint32_t y1) 
 
 bool hasTexelTiles(const Texture& tex) { return !tex.isVolume() && tex.levelCount() >= 1; }
 
+uint32_t texelTileSide(uint32_t width, uint32_t height) {
+    uint32_t side = kMinTexelTileSide;
+    while (side < kMaxTexelTileSide && std::max(width, height) > side * kTexelTilesPerSide) side *= 2;
+    return side;
+}
+
 void prepareTexelTiles(const Texture& tex, TexelTiles& out) {
     const TextureLevelInfo& l = tex.level(0);
     out.width = l.width;
     out.height = l.height;
-    out.side = kMinTexelTileSide;
-    while (out.side < kMaxTexelTileSide && std::max(l.width, l.height) > out.side * kTexelTilesPerSide) out.side *= 2;
+    out.side = texelTileSide(l.width, l.height);
     out.tilesX = (l.width + out.side - 1) / out.side;
     out.tilesY = (l.height + out.side - 1) / out.side;
     out.tiles.assign(size_t(out.tilesX) * out.tilesY, TexelRange{});
@@ -177,23 +182,55 @@ void scanDecodedTile(const Texture& tex, uint32_t w, uint32_t x0, uint32_t x1, u
     r.negZero = uint8_t(negBits);
 }
 
+// Scans tiles [t0, t1) of tile row ty.
+void scanRun(const Texture& tex, TexelTiles& out, uint32_t ty, uint32_t t0, uint32_t t1) {
+    if (tex.storage() == TexelStorage::Unorm8) {
+        for (uint32_t t = t0; t < t1; t += kTexelTilesPerSide)
+            scanUnorm8Band(tex, out, ty, t, std::min(t1, t + kTexelTilesPerSide));
+        return;
+    }
+    const uint32_t w = out.width, y0 = ty * out.side, y1 = std::min(out.height, y0 + out.side);
+    for (uint32_t tx = t0; tx < t1; ++tx) {
+        const uint32_t x0 = tx * out.side, x1 = std::min(w, x0 + out.side);
+        TexelRange& r = out.tiles[size_t(ty) * out.tilesX + tx];
+        r = TexelRange{};
+        scanDecodedTile(tex, w, x0, x1, y0, y1, r);
+    }
+}
+
 }  // namespace
 
 void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t ty1) {
-    const uint32_t w = out.width, h = out.height;
-    const bool unorm8 = tex.storage() == TexelStorage::Unorm8;
+    for (uint32_t ty = ty0; ty < ty1 && ty < out.tilesY; ++ty) scanRun(tex, out, ty, 0, out.tilesX);
+}
+
+bool uniformTileRange(const Texture& tex, TexelTiles& out, const std::vector<uint8_t>& stale, TexelRange& range) {
+    if (stale.size() != out.tiles.size()) return false;
+    for (size_t i = 0; i < stale.size(); ++i) {
+        if (stale[i]) continue;
+        const uint32_t tx = uint32_t(i % out.tilesX), ty = uint32_t(i / out.tilesX);
+        scanRun(tex, out, ty, tx, tx + 1);
+        range = out.tiles[i];
+        return true;
+    }
+    return false;
+}
+
+void fillUniformTiles(const Texture& tex, TexelTiles& out, const std::vector<uint8_t>& stale,
+                      const TexelRange& uniform, uint32_t ty0, uint32_t ty1) {
     for (uint32_t ty = ty0; ty < ty1 && ty < out.tilesY; ++ty) {
-        if (unorm8) {
-            for (uint32_t t0 = 0; t0 < out.tilesX; t0 += kTexelTilesPerSide)
-                scanUnorm8Band(tex, out, ty, t0, std::min(out.tilesX, t0 + kTexelTilesPerSide));
-            continue;
-        }
-        const uint32_t y0 = ty * out.side, y1 = std::min(h, y0 + out.side);
-        for (uint32_t tx = 0; tx < out.tilesX; ++tx) {
-            const uint32_t x0 = tx * out.side, x1 = std::min(w, x0 + out.side);
-            TexelRange& r = out.tiles[size_t(ty) * out.tilesX + tx];
-            r = TexelRange{};
-            scanDecodedTile(tex, w, x0, x1, y0, y1, r);
+        const size_t row = size_t(ty) * out.tilesX;
+        for (uint32_t tx = 0; tx < out.tilesX;) {
+            if (!stale[row + tx]) {
+                out.tiles[row + tx] = uniform;
+                ++tx;
+                continue;
+            }
+            // A run of stale tiles, scanned together.
+            uint32_t end = tx + 1;
+            while (end < out.tilesX && stale[row + end]) ++end;
+            scanRun(tex, out, ty, tx, end);
+            tx = end;
         }
     }
 }
@@ -206,6 +243,16 @@ std::shared_ptr<const TexelTiles> Texture::texelTiles() const {
 void Texture::keepTexelTiles(std::shared_ptr<const TexelTiles> tiles) const {
     std::lock_guard<std::mutex> lock(m_tileCache->mutex);
     m_tileCache->tiles = std::move(tiles);
+}
+
+std::shared_ptr<const std::vector<uint8_t>> Texture::uniformTiles() const {
+    std::lock_guard<std::mutex> lock(m_tileCache->mutex);
+    return m_tileCache->uniformStale;
+}
+
+void Texture::setUniformTiles(std::shared_ptr<const std::vector<uint8_t>> stale) const {
+    std::lock_guard<std::mutex> lock(m_tileCache->mutex);
+    m_tileCache->uniformStale = std::move(stale);
 }
 
 }  // namespace ps11

@@ -43,10 +43,24 @@ struct TexelTiles {
 // Whether texelTiles can describe the texture: a 2-D texture whose level 0 is Unorm8 or Decoded
 // (every format is).
 bool hasTexelTiles(const Texture& tex);
+// The side of the tiles of a level of width × height texels.
+uint32_t texelTileSide(uint32_t width, uint32_t height);
 // Sizes `out` for the texture's level 0 (tiles empty until scanned).
 void prepareTexelTiles(const Texture& tex, TexelTiles& out);
 // Scans tile rows [ty0, ty1) of level 0 into `out` (prepared; disjoint rows may be scanned by
 // different threads).
 void scanTexelTiles(const Texture& tex, TexelTiles& out, uint32_t ty0, uint32_t ty1);
+
+// Facts its maker knew without a scan (Texture::uniformTiles): level 0 held one value in every
+// texel, then only the tiles flagged in `stale` (one byte per tile of the prepared grid,
+// row-major) may have been written. uniformTileRange scans the first tile not stale into the
+// prepared `out`: the range every tile not stale has (false where every tile is stale, or
+// `stale` does not fit the grid).
+// fillUniformTiles gives tile rows [ty0, ty1) of `out` that range where not stale and scans the
+// stale ones: the same tiles scanTexelTiles gives (disjoint rows may be filled by different
+// threads).
+bool uniformTileRange(const Texture& tex, TexelTiles& out, const std::vector<uint8_t>& stale, TexelRange& range);
+void fillUniformTiles(const Texture& tex, TexelTiles& out, const std::vector<uint8_t>& stale,
+                      const TexelRange& uniform, uint32_t ty0, uint32_t ty1);
 
 }  // namespace ps11
