@@ -329,6 +329,8 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     // The skipper is made for the first chunk whose every triangle is screen-aligned (a draw of
     // rotated or perspective triangles scans no texture and counts as undecided).
     bool skipperTried = false;
+    bool anyDataTried = false;
+    TileDecision anyData;  // TileSkipper::anyData, once asked
     const DrawStats tilesBefore = stats;
     std::vector<uint8_t>& isAligned = dc.chunk.isAligned;
     std::vector<uint32_t>& tableOf = dc.chunk.tableOf;
@@ -461,14 +463,27 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 yLo = std::min(yLo, t.yMin);
                 yHi = std::max(yHi, t.yMax);
             }
-            const bool tileChunk = decide && setups.size() <= kMaxAlignedTriangles &&
+            const bool tileShape = tileable && setups.size() <= kMaxAlignedTriangles &&
                                    std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
+            const bool tileChunk = decide && tileShape;
             if (tileChunk && !skipperTried) {
                 skipperTried = true;
                 skipper =
                     TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
             }
             const bool tiles = tileChunk && skipper;
+            // A chunk not decided tile by tile (deciding did not pay lately, or the program cannot
+            // be) whose program makes one decision whatever its textures hold (TileSkipper::anyData:
+            // a composite of one texture scaled by 1 is a copy of it) takes that decision in every
+            // tile: no facts scanned, no tile evaluated. Asked once per draw (bench_draw: a 1×1
+            // blur's 3.9 µs did not change).
+            if (!tiles && tileShape && !anyDataTried) {
+                anyDataTried = true;
+                const std::unique_ptr<TileSkipper> sk = TileSkipper::create(
+                    *prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool, false);
+                if (sk) anyData = sk->anyData();
+            }
+            const TileDecision* fixed = !tiles && tileShape && anyData.action != TileAction::Shade ? &anyData : nullptr;
 
             // ---- rows in bands over the workers ----
             const int firstBand = (yLo & ~1) / kBandRows;
@@ -614,7 +629,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     uint64_t runTiles = 0;
                     for (int x = tx0; x < tx1; x += kSkipTileColumns) {
                         const int xe = std::min(tx1, x + kSkipTileColumns);
-                        const TileDecision d = skipper->decide(bt, n, x, xe, ty0, ty1, memo);
+                        const TileDecision d = fixed ? *fixed : skipper->decide(bt, n, x, xe, ty0, ty1, memo);
                         if (runTiles && !(d == run)) {
                             addRun(run, runX0, x, runTiles);
                             runTiles = 0;
@@ -649,7 +664,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                             drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
                         grouped = 0;
                     };
-                    if (tiles) {
+                    if (tiles || fixed) {
                         drawBandTiles(b, by0, by1);
                         continue;
                     }

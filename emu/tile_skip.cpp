@@ -75,7 +75,7 @@ RowWindow TileDecision::window(int x0, int x1) const {
 }
 
 std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, const DrawCall& call,
-                                                 const ps11::TapPlan& plan, ThreadPool& pool) {
+                                                 const ps11::TapPlan& plan, ThreadPool& pool, bool scan) {
     ps11::IntervalSetup setup;
     setup.options = ps11::executorOptionsFor(call.hardware);
     for (size_t i = 0; i < setup.constants.size() && i < call.program.constants.size(); ++i)
@@ -108,7 +108,7 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
         if (!st.texture) continue;
         if (!ps11::hasTexelTiles(*st.texture)) return nullptr;
         st.tiles = st.texture->texelTiles();
-        if (st.tiles) continue;
+        if (st.tiles || !scan) continue;
         // First read of this texture (of this generation): its facts, tile rows over the workers.
         // Where the device knew them uniform (cleared whole, then drawn into in places), only
         // the tiles drawn into since are scanned (ps11::uniformTileRange).
@@ -145,7 +145,7 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
     // The whole texture's lookup ranges (TileSkipper::widenedCopy): every texel, and the border
     // colour wherever an axis may reach it.
     // (Stages reading one texture, as a blur's taps do, take its whole range once.)
-    sk->m_widens = eval->colorsRead() == 0;
+    sk->m_widens = scan && eval->colorsRead() == 0;
     const ps11::TexelTiles* wholeOf = nullptr;
     ps11::TexelRange whole;
     for (int s = 0; s < 8 && sk->m_widens; ++s) {
@@ -205,6 +205,30 @@ bool TileSkipper::lookupRanges(const Stage& st, ps11::TexelRange r, bool border,
         out[size_t(c)] = lookupRange(r.lo[size_t(c)], r.hi[size_t(c)], nan, (r.negZero >> c) & 1, m_fx);
     }
     return true;
+}
+
+TileDecision TileSkipper::anyData() const {
+    ps11::IntervalInputs in;
+    for (int s = 0; s < 8; ++s) {
+        const Stage& st = m_stages[size_t(s)];
+        if (!st.read) continue;
+        ps11::ValueRange4& out = in.stages[size_t(s)].value;
+        if (!st.texture) {
+            for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
+            continue;
+        }
+        ps11::TexelRange r;  // 8-bit texels: [0, 1]; others: anything, NaN included
+        if (st.texture->storage() == ps11::TexelStorage::Unorm8) {
+            r.lo = {0, 0, 0, 0}, r.hi = {1, 1, 1, 1};
+        } else {
+            r.nan = 0xf;
+        }
+        const bool border = st.sampler.addressU == ps11::TextureAddress::Border ||
+                            st.sampler.addressV == ps11::TextureAddress::Border;
+        if (!lookupRanges(st, r, border, out)) return TileDecision{};
+    }
+    // (Colours stay anything: IntervalInputs' default.)
+    return evaluate(in);
 }
 
 TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1,

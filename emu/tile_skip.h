@@ -73,8 +73,16 @@ public:
     // (texture coordinates read as values, dependent reads, a program the evaluator refuses).
     // Computes the per-tile facts of the textures the program reads where they are missing, over
     // `pool`.
+    // With `scan` off no facts are computed: the skipper then serves anyData() alone.
     static std::unique_ptr<TileSkipper> create(const ps11::Program& program, const DrawCall& call,
-                                               const ps11::TapPlan& plan, ThreadPool& pool);
+                                               const ps11::TapPlan& plan, ThreadPool& pool, bool scan = true);
+
+    // The decision every tile takes whatever its textures hold: each stage over every value its
+    // texture's format can hold (8-bit: [0, 1]; others: anything), the border colour added where
+    // an axis may reach it, colours anything. A program that reduces to a copy of one tap for
+    // every input (a composite of one texture scaled by 1) is then copied without a decision per
+    // tile; Shade where nothing better holds.
+    TileDecision anyData() const;
 
     // The decision for pixels [x0, x1) × [y0, y1) of the triangles `tris` (those that may
     // cover the tile, all on the row path); `memo` is the calling worker's.

@@ -1,6 +1,6 @@
 // Tile skipping (emu/tile_skip.h) against every pixel shaded: random draws over partly constant
 // textures, 1:1 copies stored straight from the texel row, tiles over different constants of one
-// texture.
+// texture, programs that copy whatever they read on draws not decided per tile.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -15,6 +15,7 @@
 #include "emu/aligned_pass_kernels.h"
 #include "emu/device.h"
 #include "emu/format.h"
+#include "emu/fullscreen.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
 #include "aligned_cases.h"
@@ -217,4 +218,92 @@ TEST_CASE("tile skipping: tiles over different constants of one texture are deci
         CHECK(ks.tilesCopied > 0);
         CHECK(ks.tilesShaded > 0);
     }
+}
+
+TEST_CASE("tile skipping: a program that copies one tap whatever it reads copies on draws not decided per tile",
+          "[draw][aligned][skip]") {
+    // TileSkipper::anyData: `mul r0, t0, c0` with c0 = (1, 1, 1, 0) and `mov r0, t0` copy their tap
+    // for every texel, so a draw the renderer does not decide tile by tile (untimed: the first
+    // draw's copies of one 1:1 or magnified tap save nothing, so the next three wait) still copies
+    // every tile. Each of six draws of one shader, over new texels each time, plain or ONE/ONE,
+    // fx8, float and ideal, must equal the draw with skipping off; the waiting draws (fx8, ideal)
+    // must have copied every tile they drew, with no per-tile decision made.
+    std::mt19937 rng(1201);
+    const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n",
+                                    "ps_1_1\ntex t0\nmul r0, t0, c1\n"};
+    const UINT w = 320, h = 240;
+    uint64_t waitingCopied = 0;
+    for (int i = 0; i < 18; ++i) {
+        const int profile = i % 3;  // fx8, float, ideal
+        const UINT tw = i % 2 ? w / 4 : w, th = i % 2 ? h / 4 : h;  // 1:1, or magnified 4x (bilinear)
+        const size_t program = size_t(i / 3) % std::size(programs);
+        const bool add = (i / 6) % 2 == 1;
+        Device* devs[2];
+        DeviceOptions on, off;
+        on.software.timeTiles = off.software.timeTiles = false;
+        off.software.skipTiles = false;
+        if (profile) on.precision = off.precision = profile == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        Device skipDev(on), plainDev(off);
+        devs[0] = &skipDev, devs[1] = &plainDev;
+        Handle rt[2], tex[2], ps[2];
+        const float c0[8] = {1, 1, 1, 0, 0.5f, 0.25f, 1, 1};  // c1: not a copy
+        for (int d = 0; d < 2; ++d) {
+            Device& dev = *devs[d];
+            REQUIRE(dev.CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 1, &rt[d]) == D3D_OK);
+            REQUIRE(dev.SetRenderTarget(0, rt[d]) == D3D_OK);
+            REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x20406080u, 1.0f, 0) == D3D_OK);
+            REQUIRE(dev.CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex[d]) == D3D_OK);
+            REQUIRE(dev.CreatePixelShaderFromText(programs[program], &ps[d]) == D3D_OK);
+            REQUIRE(dev.SetPixelShader(ps[d]) == D3D_OK);
+            REQUIRE(dev.SetPixelShaderConstantF(0, c0, 2) == D3D_OK);
+            REQUIRE(dev.SetTexture(0, tex[d]) == D3D_OK);
+            for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
+                REQUIRE(dev.SetSamplerState(0, f, i % 2 ? D3DTEXF_LINEAR : D3DTEXF_POINT) == D3D_OK);
+            REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, add ? 1 : 0) == D3D_OK);
+            REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+            REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+        }
+        for (int draw = 0; draw < 6; ++draw) {
+            std::vector<uint8_t> texels(size_t(tw) * th * 4);
+            for (uint8_t& b : texels) b = uint8_t(rng() % 3 ? rng() % 64 : rng());
+            std::vector<uint8_t> out[2];
+            DrawStats stats[2];
+            for (int d = 0; d < 2; ++d) {
+                Device& dev = *devs[d];
+                D3DLOCKED_RECT lr;
+                REQUIRE(dev.LockRect(tex[d], 0, &lr, nullptr, 0) == D3D_OK);
+                for (UINT y = 0; y < th; ++y)
+                    std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &texels[size_t(y) * tw * 4], tw * 4);
+                REQUIRE(dev.UnlockRect(tex[d], 0) == D3D_OK);
+                REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+                stats[d] = dev.lastDrawStats();
+                REQUIRE(dev.LockRect(rt[d], &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+                for (UINT y = 0; y < h; ++y) {
+                    const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch;
+                    out[d].insert(out[d].end(), row, row + w * 4);
+                }
+                REQUIRE(dev.UnlockRect(rt[d]) == D3D_OK);
+            }
+            INFO("case " << i << " (" << programs[program] << "), " << tw << "x" << th << ", profile " << profile
+                         << (add ? ", ONE/ONE" : "") << ", draw " << draw);
+            REQUIRE(out[0] == out[1]);
+            const DrawStats& s = stats[0];
+            const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
+            if (draw >= 1 && draw <= 3 && profile != 1) {
+                // Not decided per tile: every tile copied where the program is a copy, none counted
+                // otherwise. (Not in the float profile of this class: its registers clamp at MaxValue
+                // 1 and the evaluator's float lookups are widened past their bounds, so a lookup
+                // that may reach 1 is not proven to pass the clamp unchanged: no copy whatever the
+                // data, and the draws shade.)
+                if (program == 2) {
+                    CHECK(tiles == 0);
+                } else {
+                    CHECK(s.tilesCopied > 0);
+                    CHECK(s.tilesCopied == tiles);
+                    waitingCopied += s.tilesCopied;
+                }
+            }
+        }
+    }
+    CHECK(waitingCopied > 0);
 }
