@@ -13,6 +13,7 @@
 #endif
 
 #include "emu/output_merger_kernels.h"
+#include "ps11/cpu_features.h"
 #include "ps11/precision.h"
 #include "ps11/simd_dispatch.h"
 
@@ -25,6 +26,25 @@ int64_t floorDiv(int64_t n, int64_t d) {
     int64_t q = n / d;
     if ((n % d) != 0 && n < 0) --q;
     return q;
+}
+
+// memcpy with the destination's aligned 16-byte blocks stored around the caches (streamFence
+// orders them before anything after).
+void streamCopy(uint8_t* dst, const uint8_t* src, size_t n) {
+#if defined(__SSE2__)
+    const size_t head = std::min(n, size_t((16 - (reinterpret_cast<uintptr_t>(dst) & 15)) & 15));
+    std::memcpy(dst, src, head);
+    dst += head, src += head, n -= head;
+    for (; n >= 16; n -= 16, dst += 16, src += 16)
+        _mm_stream_si128(reinterpret_cast<__m128i*>(dst), _mm_loadu_si128(reinterpret_cast<const __m128i*>(src)));
+#endif
+    std::memcpy(dst, src, n);
+}
+
+void streamFence() {
+#if defined(__SSE2__)
+    _mm_sfence();
+#endif
 }
 
 PixelBox meet(const PixelBox& a, const PixelBox& b) {
@@ -51,9 +71,23 @@ void clearImages(const ClearCall& call, RowRange rows) {
             for (int64_t x = c.x0; x < c.x1; ++x)
                 std::copy_n(call.colorTexel.data(), f.bytes, target->texel(uint32_t(x), uint32_t(c.y0)));
             const size_t row = size_t(c.x1 - c.x0) * f.bytes;
-            for (int64_t y = c.y0 + 1; y < c.y1; ++y)
-                std::memcpy(target->texel(uint32_t(c.x0), uint32_t(y)), target->texel(uint32_t(c.x0), uint32_t(c.y0)),
-                            row);
+            // A target of more than half the last cache level does not stay in it beside the
+            // surfaces a frame reads with it: its rows are written around the caches (no read for
+            // ownership: the clear moves half the bytes). Smaller ones stay cached for the draws
+            // that follow (with a 32 MB cache, the sprites' 8 MB glare buffer drew 15 % slower
+            // after a streamed clear, its 33 MB float one 25 % faster).
+            const uint64_t cache = ps11::cpuFeatures().lastLevelCacheBytes;
+            const bool stream = cache > 0 && uint64_t(target->width) * target->height * f.bytes > cache / 2;
+            for (int64_t y = c.y0 + 1; y < c.y1; ++y) {
+                uint8_t* dst = target->texel(uint32_t(c.x0), uint32_t(y));
+                const uint8_t* src = target->texel(uint32_t(c.x0), uint32_t(c.y0));
+                if (stream) {
+                    streamCopy(dst, src, row);
+                    continue;
+                }
+                std::memcpy(dst, src, row);
+            }
+            if (stream) streamFence();
         }
     }
     if (call.depth.valid()) {

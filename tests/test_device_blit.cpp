@@ -13,6 +13,7 @@
 #include "device_test_util.h"
 #include "emu/blit.h"
 #include "emu/device.h"
+#include "ps11/cpu_features.h"
 
 using namespace emu;
 
@@ -151,6 +152,45 @@ TEST_CASE("device: Clear shared by worker threads writes exactly its rects", "[d
                 for (const D3DRECT& r : rects) in = in || (LONG(x) >= r.x1 && LONG(x) < r.x2 && LONG(y) >= r.y1 && LONG(y) < r.y2);
                 wrong += readPixel(dev, rt, x, y) != (in ? 0x80402010u : 0xFF000000u | (y << 9) | x);
             }
+        CHECK(wrong == 0);
+    }
+}
+
+TEST_CASE("device: Clear of a target past half the last cache level writes exactly its rects", "[device]") {
+    // Targets of 32 MB (8-bit and float texels): on a machine whose last cache level holds at most
+    // 64 MB their rows are stored around the caches (emu/blit.cpp), in 16-byte blocks from the
+    // first aligned byte of each row. Rects start on odd columns; every byte is checked.
+    INFO("last cache level: " << ps11::cpuFeatures().lastLevelCacheBytes << " bytes");
+    for (D3DFORMAT fmt : {D3DFMT_A8R8G8B8, D3DFMT_A32B32G32R32F}) {
+        const UINT w = fmt == D3DFMT_A8R8G8B8 ? 4096 : 2048, h = 2048, bpp = fmt == D3DFMT_A8R8G8B8 ? 4 : 16;
+        Device dev;
+        Handle rt{};
+        REQUIRE(dev.CreateRenderTarget(w, h, fmt, 1, &rt) == D3D_OK);
+        REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x00000000u, 1.0f, 0) == D3D_OK);
+        const D3DRECT rects[2] = {{3, 1, LONG(w) - 5, 900}, {1, 1500, 2, 2047}};
+        REQUIRE(dev.Clear(2, rects, D3DCLEAR_TARGET, 0x80402010u, 1.0f, 0) == D3D_OK);
+        std::vector<uint8_t> cleared(bpp), zero(bpp, 0);
+        if (fmt == D3DFMT_A8R8G8B8) {
+            const uint32_t c = 0x80402010u;
+            std::memcpy(cleared.data(), &c, 4);
+        } else {
+            const float v[4] = {float(0x40 / 255.0), float(0x20 / 255.0), float(0x10 / 255.0), float(0x80 / 255.0)};
+            std::memcpy(cleared.data(), v, 16);
+        }
+        size_t wrong = 0;
+        REQUIRE(dev.readSurface(rt, [&](const D3DLOCKED_RECT& lr) {
+            for (UINT y = 0; y < h; ++y) {
+                const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + size_t(y) * UINT(lr.Pitch);
+                for (UINT x = 0; x < w; ++x) {
+                    bool in = false;
+                    for (const D3DRECT& r : rects)
+                        in = in || (LONG(x) >= r.x1 && LONG(x) < r.x2 && LONG(y) >= r.y1 && LONG(y) < r.y2);
+                    wrong += std::memcmp(row + size_t(x) * bpp, in ? cleared.data() : zero.data(), bpp) != 0;
+                }
+            }
+        }) == D3D_OK);
+        INFO((fmt == D3DFMT_A8R8G8B8 ? "A8R8G8B8" : "A32B32G32R32F"));
         CHECK(wrong == 0);
     }
 }
