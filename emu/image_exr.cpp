@@ -430,7 +430,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
                     " pixels; refused before reading its pixels");
     if (width * height * kFloatPixelBytes > kMaxImageBytes)
         return fail("the image is " + sizeText +
-                    " and its float RGBA pixels take more than 1 GiB; refused before reading its pixels");
+                    " and its float RGBA pixels take more than " + maxImageBytesText() + "; refused before reading its pixels");
     ExrLayout layout;
     if (const std::string problem = channelProblem(header, layout); !problem.empty()) return fail(problem);
 
@@ -455,7 +455,7 @@ std::optional<FloatImage> decodeExr(ExrStream& s, const std::string& name, std::
     }
     if (pixelBytes * chunkWidth * chunkRows > kMaxImageBytes)
         return fail("unsupported EXR: a block of " + std::to_string(chunkRows) + " rows of its channels (" +
-                    std::to_string(pixelBytes) + " bytes a pixel) takes more than 1 GiB");
+                    std::to_string(pixelBytes) + " bytes a pixel) takes more than " + maxImageBytesText());
     const uint64_t follow = total - std::min(total, s.tellg());
     if (follow < leastBytes)
         return fail("truncated EXR: a " + sizeText + " image " + (tiled ? "in " : "of ") + std::to_string(chunks) +

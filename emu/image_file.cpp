@@ -19,6 +19,14 @@
 #include <new>
 
 namespace emu {
+
+std::string maxImageBytesText() {
+    // Whole GiB or MiB where the limit is one; bytes otherwise.
+    if (kMaxImageBytes % (uint64_t(1) << 30) == 0) return std::to_string(kMaxImageBytes >> 30) + " GiB";
+    if (kMaxImageBytes % (uint64_t(1) << 20) == 0) return std::to_string(kMaxImageBytes >> 20) + " MiB";
+    return std::to_string(kMaxImageBytes) + " bytes";
+}
+
 namespace {
 
 constexpr size_t kSignatureBytes = 8;
@@ -150,7 +158,7 @@ std::string sizeText(uint64_t width, uint64_t height) { return std::to_string(wi
 std::string sizeProblem(uint64_t width, uint64_t height) {
     if (width > kMaxImageSide || height > kMaxImageSide)
         return "a side is larger than " + std::to_string(kMaxImageSide) + " pixels";
-    if (width * height * 4 > kMaxImageBytes) return "its RGBA pixels take more than 1 GiB";
+    if (width * height * 4 > kMaxImageBytes) return "its RGBA pixels take more than " + maxImageBytesText();
     return "";
 }
 
@@ -314,7 +322,7 @@ std::optional<LoadedImage> readImage(const std::string& path, std::string& error
         const uint64_t pixels = uint64_t(png->width) * png->height;
         if (pixels * kFloatPixelBytes > kMaxImageBytes) {
             error = path + ": the image is " + sizeText(png->width, png->height) +
-                    " and its float RGBA pixels take more than 1 GiB";
+                    " and its float RGBA pixels take more than " + maxImageBytesText();
             return std::nullopt;
         }
         loaded.image.width = png->width;

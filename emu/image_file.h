@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "ps11/caps.h"
+
 namespace emu {
 
 // An 8-bit image: r g b a per pixel, rows top to bottom, no padding (rgba.size() == width * height * 4).
@@ -27,11 +29,14 @@ inline RgbaImage opaque(RgbaImage image) {
     return image;
 }
 
-// The largest image read or written: a side, and the bytes of its RGBA8 pixels. Checked against a
-// file's header before any pixel memory is allocated. 16384 a side is exactly 1 GiB of RGBA8, so the
-// byte limit binds only if the side limit is raised.
-inline constexpr uint32_t kMaxImageSide = 16384;
-inline constexpr uint64_t kMaxImageBytes = uint64_t(1) << 30;
+// The largest image read or written: a side, and the bytes of its RGBA8 pixels, those of the
+// largest texture it can become (ps11/caps.h). Checked against a file's header before any pixel
+// memory is allocated. 16384 a side is exactly 1 GiB of RGBA8, so the byte limit binds only if the
+// side limit is raised.
+inline constexpr uint32_t kMaxImageSide = ps11::kMaxTextureSide;
+inline constexpr uint64_t kMaxImageBytes = ps11::kMaxResourceBytes;
+// kMaxImageBytes as the error messages name it ("1 GiB").
+std::string maxImageBytesText();
 // A float image counts its float RGBA pixels (16 bytes each) against kMaxImageBytes: at most 2^26
 // pixels (8192x8192), besides kMaxImageSide a side. Checked against a file's header before any pixel
 // memory is allocated, like the limits above.

@@ -139,7 +139,7 @@ std::optional<FloatImage> decodeHdr(const uint8_t* data, size_t size, const std:
                     " pixels; refused before reading its pixels");
     if (width * height * kFloatPixelBytes > kMaxImageBytes)
         return fail("the image is " + sizeText +
-                    " and its float RGBA pixels take more than 1 GiB; refused before reading its pixels");
+                    " and its float RGBA pixels take more than " + maxImageBytesText() + "; refused before reading its pixels");
 
     const uint64_t follow = size - pixelsAt;
     const uint8_t* p = data + pixelsAt;
@@ -190,13 +190,13 @@ std::optional<FloatImage> readHdr(const std::string& path, std::string& error) {
     struct stat st {};
     const image_detail::FilePtr file = image_detail::openImageFile(path, st, error);
     if (!file) return std::nullopt;
-    // The largest image allowed takes 256 MiB of flat pixels; a file past 1 GiB is not one.
+    // The largest image allowed takes 256 MiB of flat pixels; a file past kMaxImageBytes is not one.
     std::vector<uint8_t> bytes;
     uint8_t buffer[65536];
     try {
         for (size_t got; (got = std::fread(buffer, 1, sizeof buffer, file.get())) > 0;) {
             if (bytes.size() + got > kMaxImageBytes) {
-                error = path + ": the file is larger than 1 GiB, more than any Radiance HDR image within the limits";
+                error = path + ": the file is larger than " + maxImageBytesText() + ", more than any Radiance HDR image within the limits";
                 return std::nullopt;
             }
             bytes.insert(bytes.end(), buffer, buffer + got);
