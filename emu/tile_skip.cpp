@@ -43,6 +43,16 @@ void addressAxis(ps11::TextureAddress mode, int64_t i0, int64_t i1, int64_t n, i
 // The lookups' range from the texels' range. fx filters are convex integer sums rounded to the
 // grid: inside the texels' range. Float lerps (1 − f)·a + f·b may leave it by rounding: widened
 // by a relative 2⁻²⁰, except zeros, whose lerps are zeros.
+// The lookups of a stage without a texture: (0, 0, 0, 1).
+void unboundLookups(ps11::ValueRange4& out) {
+    for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
+}
+
+// Whether an axis of the sampler may reach the border colour (somewhere in the texture).
+bool mayReachBorder(const ps11::SamplerState& ss) {
+    return ss.addressU == ps11::TextureAddress::Border || ss.addressV == ps11::TextureAddress::Border;
+}
+
 ps11::ValueRange lookupRange(float lo, float hi, bool nan, bool negZero, bool fx) {
     ps11::ValueRange r;
     if (!std::isfinite(lo) || !std::isfinite(hi)) nan = true;  // ∞ · 0 in a lerp
@@ -151,8 +161,7 @@ std::unique_ptr<TileSkipper> TileSkipper::create(const ps11::Program& program, c
     for (int s = 0; s < 8 && sk->m_widens; ++s) {
         Stage& st = sk->m_stages[size_t(s)];
         if (!st.read || !st.texture) continue;
-        const bool border = st.sampler.addressU == ps11::TextureAddress::Border ||
-                            st.sampler.addressV == ps11::TextureAddress::Border;
+        const bool border = mayReachBorder(st.sampler);
         if (st.tiles.get() != wholeOf) wholeOf = st.tiles.get(), whole = st.tiles->whole();
         sk->m_widens = st.tiles->width > 0 && st.tiles->height > 0 && sk->lookupRanges(st, whole, border, st.whole);
     }
@@ -214,7 +223,7 @@ TileDecision TileSkipper::anyData() const {
         if (!st.read) continue;
         ps11::ValueRange4& out = in.stages[size_t(s)].value;
         if (!st.texture) {
-            for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
+            unboundLookups(out);
             continue;
         }
         ps11::TexelRange r;  // 8-bit texels: [0, 1]; others: anything, NaN included
@@ -223,9 +232,7 @@ TileDecision TileSkipper::anyData() const {
         } else {
             r.nan = 0xf;
         }
-        const bool border = st.sampler.addressU == ps11::TextureAddress::Border ||
-                            st.sampler.addressV == ps11::TextureAddress::Border;
-        if (!lookupRanges(st, r, border, out)) return TileDecision{};
+        if (!lookupRanges(st, r, mayReachBorder(st.sampler), out)) return TileDecision{};
     }
     // (Colours stay anything: IntervalInputs' default.)
     return evaluate(in);
@@ -243,7 +250,7 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
         if (!st.read) continue;
         ps11::ValueRange4& out = in.stages[size_t(s)].value;
         if (!st.texture) {
-            for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
+            unboundLookups(out);
             continue;
         }
         // The coordinates' extremes over the tile (u affine in x alone, v in y alone on the
