@@ -216,8 +216,8 @@ bool TileSkipper::lookupRanges(const Stage& st, ps11::TexelRange r, bool border,
     return true;
 }
 
-TileDecision TileSkipper::anyData() const {
-    ps11::IntervalInputs in;
+template <class F>
+bool TileSkipper::stageRanges(ps11::IntervalInputs& in, F bound) const {
     for (int s = 0; s < 8; ++s) {
         const Stage& st = m_stages[size_t(s)];
         if (!st.read) continue;
@@ -226,16 +226,24 @@ TileDecision TileSkipper::anyData() const {
             unboundLookups(out);
             continue;
         }
+        if (!bound(st, out)) return false;
+    }
+    return true;
+}
+
+TileDecision TileSkipper::anyData() const {
+    ps11::IntervalInputs in;
+    const bool known = stageRanges(in, [&](const Stage& st, ps11::ValueRange4& out) {
         ps11::TexelRange r;  // 8-bit texels: [0, 1]; others: anything, NaN included
         if (st.texture->storage() == ps11::TexelStorage::Unorm8) {
             r.lo = {0, 0, 0, 0}, r.hi = {1, 1, 1, 1};
         } else {
             r.nan = 0xf;
         }
-        if (!lookupRanges(st, r, mayReachBorder(st.sampler), out)) return TileDecision{};
-    }
+        return lookupRanges(st, r, mayReachBorder(st.sampler), out);
+    });
     // (Colours stay anything: IntervalInputs' default.)
-    return evaluate(in);
+    return known ? evaluate(in) : TileDecision{};
 }
 
 TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count, int x0, int x1, int y0, int y1,
@@ -245,14 +253,7 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
     if (memo.skipper != m_id) memo = TileMemo{}, memo.skipper = m_id;
     // Only the ranges this draw reads are written (the rest stay unknown from the start).
     ps11::IntervalInputs& in = memo.in;
-    for (int s = 0; s < 8; ++s) {
-        const Stage& st = m_stages[size_t(s)];
-        if (!st.read) continue;
-        ps11::ValueRange4& out = in.stages[size_t(s)].value;
-        if (!st.texture) {
-            unboundLookups(out);
-            continue;
-        }
+    const bool known = stageRanges(in, [&](const Stage& st, ps11::ValueRange4& out) {
         // The coordinates' extremes over the tile (u affine in x alone, v in y alone on the
         // row paths), on every triangle.
         double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
@@ -264,7 +265,7 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
             v[1] = rowV(*tris[i], st.coordSet, y1 - 1);
             for (int k = 0; k < 2; ++k) {
                 if (!std::isfinite(u[k]) || !std::isfinite(v[k]) || std::fabs(u[k]) > 1e6f || std::fabs(v[k]) > 1e6f)
-                    return shade;
+                    return false;
                 umin = std::min(umin, double(u[k])), umax = std::max(umax, double(u[k]));
                 vmin = std::min(vmin, double(v[k])), vmax = std::max(vmax, double(v[k]));
             }
@@ -281,8 +282,9 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
         addressAxis(st.sampler.addressV, j0, j1, H, b0, b1, border);
         ps11::TexelRange r;
         if (a0 <= a1 && b0 <= b1) r = tiles.over(uint32_t(a0), uint32_t(b0), uint32_t(a1), uint32_t(b1));
-        if (!lookupRanges(st, r, border, out)) return shade;
-    }
+        return lookupRanges(st, r, border, out);
+    });
+    if (!known) return shade;
     // Colours: constant on a triangle, or affine (extremes at the tile's corners, widened for
     // the float rounding of the interpolation).
     for (int k = 0; k < 2; ++k)

@@ -92,6 +92,10 @@ public:
 private:
     struct Stage;
     TileDecision evaluate(const ps11::IntervalInputs& in) const;
+    // The ranges of every stage the program reads into `in`: (0, 0, 0, 1) for a stage without a
+    // texture, `bound(stage, out)` for the others (false: nothing known; then false).
+    template <class F>
+    bool stageRanges(ps11::IntervalInputs& in, F bound) const;
     // A copy decided over the tile's inputs with the varying stages widened to their whole
     // texture's range, where a copied channel varies in the tile (so the tile's own evaluation
     // could not have filled or skipped it).
