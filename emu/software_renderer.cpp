@@ -315,8 +315,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     SoftwareDrawContext::TileHistory& history = dc.tileHistory[historyKey];
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
     // (Nor are draws whose taps' levels the level of detail picks: the tiles' facts are level 0's.)
-    const bool tileable = m_options.skipTiles && (alignedDraw || floatDraw) && !aligned.levelTaps.mask &&
-                          !floatRows.levelTaps.mask && call.primitiveCount <= kMaxAlignedTriangles;
+    // (Tile-shaped: what drawBandTiles draws. Tileable: decided per tile, with skipping on.)
+    const bool tileShaped = (alignedDraw || floatDraw) && !aligned.levelTaps.mask && !floatRows.levelTaps.mask &&
+                            call.primitiveCount <= kMaxAlignedTriangles;
+    const bool tileable = m_options.skipTiles && tileShaped;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
     // Timed: a program that pays is drawn undecided once after its second decided draw (the
     // first one's time, with the first reads of textures that may stay, is not taken), then on
@@ -463,25 +465,29 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 yLo = std::min(yLo, t.yMin);
                 yHi = std::max(yHi, t.yMax);
             }
-            const bool tileShape = tileable && setups.size() <= kMaxAlignedTriangles &&
+            const bool tileShape = tileShaped && setups.size() <= kMaxAlignedTriangles &&
                                    std::all_of(isAligned.begin(), isAligned.end(), [](uint8_t a) { return a == 1; });
-            const bool tileChunk = decide && tileShape;
+            const bool tileChunk = decide && tileable && tileShape;
             if (tileChunk && !skipperTried) {
                 skipperTried = true;
                 skipper =
                     TileSkipper::create(*prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool);
             }
             const bool tiles = tileChunk && skipper;
-            // A chunk not decided tile by tile (deciding did not pay lately, or the program cannot
-            // be) whose program makes one decision whatever its textures hold (TileSkipper::anyData:
-            // a composite of one texture scaled by 1 is a copy of it) takes that decision in every
-            // tile: no facts scanned, no tile evaluated. Asked once per draw (bench_draw: a 1×1
-            // blur's 3.9 µs did not change).
+            // A chunk not decided tile by tile (skipping off, deciding did not pay lately, or the
+            // program cannot be) whose program makes one decision whatever its textures hold
+            // (TileSkipper::anyData: a composite of one texture scaled by 1 is a copy of it) is drawn
+            // as that: a specialisation of the program, as the executor's fast paths are, taken
+            // with skipping on or off (no pixel is left out: a skip, the merge of a zero that
+            // changes nothing, is drawn as that fill with skipping off). No facts are scanned, no
+            // tile is evaluated, and no tile is counted as decided. Asked once per draw
+            // (bench_draw: a 1×1 blur's 3.9 µs did not change).
             if (!tiles && tileShape && !anyDataTried) {
                 anyDataTried = true;
                 const std::unique_ptr<TileSkipper> sk = TileSkipper::create(
                     *prog.program, call, alignedDraw ? aligned.plan : floatRows.plan, dc.pool, false);
                 if (sk) anyData = sk->anyData();
+                if (anyData.action == TileAction::Skip && !m_options.skipTiles) anyData.action = TileAction::Fill;
             }
             const TileDecision* fixed = !tiles && tileShape && anyData.action != TileAction::Shade ? &anyData : nullptr;
 
@@ -600,6 +606,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     // rows (each texel row the windows need is filtered once per pixel row).
                     windows.clear();
                     auto addRun = [&](const TileDecision& d, int xa, int xb, uint64_t count) {
+                        if (fixed) count = 0;  // (not decided per tile: not counted)
                         switch (d.action) {
                             case TileAction::Shade:
                                 ws.tilesShaded += count;

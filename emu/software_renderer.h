@@ -25,7 +25,8 @@ struct SoftwareRendererOptions {
     // kernels themselves).
     bool fastSampler = true;
     // Tiles of row-path draws whose result the interval evaluator decides are filled, copied or
-    // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile shaded.
+    // skipped instead of shaded (emu/tile_skip.h; bit-identical images). Off: every tile drawn (a
+    // program that copies one tap whatever it reads is still drawn as that copy: TileSkipper::anyData).
     bool skipTiles = true;
     // Whether deciding a program's tiles pays is judged by the wall time per pixel of its
     // decided draws against its undecided ones (the draws' own times, so it varies from run to

@@ -91,7 +91,7 @@ bool runFrames(const FrameDebugRequest& rq, uint32_t width, uint32_t height, Fra
     RunnerOptions ro;
     ro.width = width, ro.height = height;
     ro.device.hardware = rq.hardware;
-    ro.skip = false;  // every pass runs, every tile shaded: what the captures show is what ran
+    ro.skip = false;  // every pass runs, every tile drawn: what the captures show is what ran
     cls.runner = std::make_unique<Runner>(ro);
     ro.device.precision = ps11::Precision::Ideal;
     ideal.runner = std::make_unique<Runner>(ro);

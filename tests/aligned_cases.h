@@ -376,7 +376,7 @@ inline void requireRowsEqual(const DeviceOptions& rowOpt, const Case& c, const s
     CHECK(rs.pixelsWritten == qs.pixelsWritten);
     if (qs.pixelsCovered == 0) return;
     ++cases;
-    if (rs.pixelsShaded == rs.pixelsCovered) ++rows;
+    if (rs.pixelsRowPath == rs.pixelsCovered && rs.pixelsShaded <= rs.pixelsCovered) ++rows;
 }
 
 // The float row path's profiles for case i: float or ideal (overriding the class's profile:

@@ -193,7 +193,8 @@ TEST_CASE("draw: timed, a program whose tiles pay is drawn undecided once after 
 
 TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and bilinear)", "[draw]") {
     for (DWORD filter : {DWORD(D3DTEXF_POINT), DWORD(D3DTEXF_LINEAR)}) {
-        // Every pixel shaded (tile skipping would copy the texture without running the program).
+        // Every pixel shaded: the texel times a white diffuse (`mov r0, t0` would be drawn as the
+        // copy it is whatever it reads, without running the program: TileSkipper::anyData).
         DeviceOptions opt;
         opt.software.skipTiles = false;
         Device dev(opt);
@@ -204,14 +205,14 @@ TEST_CASE("draw: tex t0 over the 1:1 quad copies the texture exactly (point and 
         REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
         REQUIRE(dev.SetSamplerState(0, D3DSAMP_MINFILTER, filter) == D3D_OK);
         REQUIRE(dev.SetSamplerState(0, D3DSAMP_MAGFILTER, filter) == D3D_OK);
-        shader(dev, "ps_1_1\ntex t0\nmov r0, t0\n");
+        shader(dev, "ps_1_1\ntex t0\nmul r0, t0, v0\n");
         REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
         auto v = quad(W, H, 0xffffffff);
         REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, v.data(), sizeof(QuadVertex)) == D3D_OK);
         CHECK(readTarget(dev, rt, W, H) == texels);
         const DrawStats& st = dev.lastDrawStats();
         CHECK(st.pixelsCovered == W * H);
-        // Instructions: tex + mov per shaded lane; one texel per point lookup, four per bilinear.
+        // Instructions: tex + mul per shaded lane; one texel per point lookup, four per bilinear.
         CHECK(st.instructions == 2 * st.pixelsShaded);
         CHECK(st.texelsFetched == st.pixelsShaded * (filter == D3DTEXF_LINEAR ? 4 : 1));
         // A second draw counts its own fetches only (the workers' samplers persist between draws).

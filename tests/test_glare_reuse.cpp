@@ -94,7 +94,7 @@ TEST_CASE("tiles: sparse and dense frames are byte-identical with skipping on an
     // Skipping's measuring scenes, moving, on every hardware class (fx8, fx12, float) and under
     // ideal: the software renderer fills, copies and skips tiles (docs/device.md "Tile
     // skipping"), reuses passes and puts the scene's copy off into the composite's bands; the
-    // frames must be those of every pass run, every tile shaded and every copy made at once.
+    // frames must be those of every pass run, every tile drawn and every copy made at once.
     uint64_t decided = 0;
     std::vector<emu::DeviceOptions> devices;
     for (const ps11::HardwareClass& h : ps11::hardwareClasses()) {

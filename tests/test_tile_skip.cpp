@@ -220,34 +220,37 @@ TEST_CASE("tile skipping: tiles over different constants of one texture are deci
     }
 }
 
-TEST_CASE("tile skipping: a program that copies one tap whatever it reads copies on draws not decided per tile",
+TEST_CASE("tile skipping: a program that copies one tap whatever it reads is drawn as that copy when not decided per tile",
           "[draw][aligned][skip]") {
     // TileSkipper::anyData: `mul r0, t0, c0` with c0 = (1, 1, 1, 0) and `mov r0, t0` copy their tap
-    // for every texel, so a draw the renderer does not decide tile by tile (untimed: the first
-    // draw's copies of one 1:1 or magnified tap save nothing, so the next three wait) still copies
-    // every tile. Each of six draws of one shader, over new texels each time, plain or ONE/ONE,
-    // fx8, float and ideal, must equal the draw with skipping off; the waiting draws (fx8, ideal)
-    // must have copied every tile they drew, with no per-tile decision made.
+    // for every texel, so a draw that is not decided tile by tile — every draw with skipping off;
+    // with it on (untimed), the three after a first decided draw whose copies of one filtered tap
+    // saved nothing — runs no program: its windows copy the tap. Each of six draws of one shader, over new texels each
+    // time, 1:1 or magnified 4×, plain or ONE/ONE, in fx8, float and ideal, with skipping on and
+    // off, must equal the quad path's bytes. Those draws must have shaded no pixel in fx8 and
+    // ideal and counted no tile; a program that is no copy (c1) must shade.
     std::mt19937 rng(1201);
     const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n",
                                     "ps_1_1\ntex t0\nmul r0, t0, c1\n"};
     const UINT w = 320, h = 240;
-    uint64_t waitingCopied = 0;
+    uint64_t copiedDraws = 0;
     for (int i = 0; i < 18; ++i) {
         const int profile = i % 3;  // fx8, float, ideal
         const UINT tw = i % 2 ? w / 4 : w, th = i % 2 ? h / 4 : h;  // 1:1, or magnified 4x (bilinear)
         const size_t program = size_t(i / 3) % std::size(programs);
         const bool add = (i / 6) % 2 == 1;
-        Device* devs[2];
-        DeviceOptions on, off;
+        DeviceOptions on, off, quads;
         on.software.timeTiles = off.software.timeTiles = false;
         off.software.skipTiles = false;
-        if (profile) on.precision = off.precision = profile == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
-        Device skipDev(on), plainDev(off);
-        devs[0] = &skipDev, devs[1] = &plainDev;
-        Handle rt[2], tex[2], ps[2];
+        quads.software.alignedPasses = false;
+        if (profile)
+            on.precision = off.precision = quads.precision =
+                profile == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        Device skipDev(on), plainDev(off), quadDev(quads);
+        Device* devs[3] = {&skipDev, &plainDev, &quadDev};
+        Handle rt[3], tex[3], ps[3];
         const float c0[8] = {1, 1, 1, 0, 0.5f, 0.25f, 1, 1};  // c1: not a copy
-        for (int d = 0; d < 2; ++d) {
+        for (int d = 0; d < 3; ++d) {
             Device& dev = *devs[d];
             REQUIRE(dev.CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 1, &rt[d]) == D3D_OK);
             REQUIRE(dev.SetRenderTarget(0, rt[d]) == D3D_OK);
@@ -266,9 +269,9 @@ TEST_CASE("tile skipping: a program that copies one tap whatever it reads copies
         for (int draw = 0; draw < 6; ++draw) {
             std::vector<uint8_t> texels(size_t(tw) * th * 4);
             for (uint8_t& b : texels) b = uint8_t(rng() % 3 ? rng() % 64 : rng());
-            std::vector<uint8_t> out[2];
-            DrawStats stats[2];
-            for (int d = 0; d < 2; ++d) {
+            std::vector<uint8_t> out[3];
+            DrawStats stats[3];
+            for (int d = 0; d < 3; ++d) {
                 Device& dev = *devs[d];
                 D3DLOCKED_RECT lr;
                 REQUIRE(dev.LockRect(tex[d], 0, &lr, nullptr, 0) == D3D_OK);
@@ -286,24 +289,66 @@ TEST_CASE("tile skipping: a program that copies one tap whatever it reads copies
             }
             INFO("case " << i << " (" << programs[program] << "), " << tw << "x" << th << ", profile " << profile
                          << (add ? ", ONE/ONE" : "") << ", draw " << draw);
-            REQUIRE(out[0] == out[1]);
-            const DrawStats& s = stats[0];
-            const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
-            if (draw >= 1 && draw <= 3 && profile != 1) {
-                // Not decided per tile: every tile copied where the program is a copy, none counted
-                // otherwise. (Not in the float profile of this class: its registers clamp at MaxValue
-                // 1 and the evaluator's float lookups are widened past their bounds, so a lookup
-                // that may reach 1 is not proven to pass the clamp unchanged: no copy whatever the
-                // data, and the draws shade.)
-                if (program == 2) {
-                    CHECK(tiles == 0);
-                } else {
-                    CHECK(s.tilesCopied > 0);
-                    CHECK(s.tilesCopied == tiles);
-                    waitingCopied += s.tilesCopied;
-                }
+            REQUIRE(out[0] == out[2]);
+            REQUIRE(out[1] == out[2]);
+            // (Not in the float profile of this class: its registers clamp at MaxValue 1 and the
+            // evaluator's float lookups are widened past their bounds, so a lookup that may reach 1
+            // is not proven to pass the clamp unchanged: no copy whatever the data; those draws shade.)
+            if (profile == 1) continue;
+            const bool copy = program != 2;
+            for (int d = 0; d < 2; ++d) {
+                const DrawStats& s = stats[d];
+                const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
+                INFO((d ? "skipping off" : "skipping on"));
+                if (d == 1) CHECK(tiles == 0);
+                if (tiles) continue;  // (skipping on: decided per tile, as the draw's history said)
+                CHECK(s.pixelsCovered == uint64_t(w) * h);
+                CHECK((s.pixelsShaded == 0) == copy);
+                copiedDraws += copy && s.pixelsShaded == 0 ? (d ? 1 : 1000) : 0;
             }
         }
     }
-    CHECK(waitingCopied > 0);
+    // Copied without a program with skipping off, and on draws that waited with it on (the
+    // magnified fx8 copies, whose first decided draw saved nothing).
+    CHECK(copiedDraws % 1000 > 0);
+    CHECK(copiedDraws / 1000 > 0);
+}
+
+TEST_CASE("tile skipping: a program whose ONE/ONE adds zero whatever it reads is skipped only with skipping on",
+          "[draw][aligned][skip]") {
+    // anyData of `mov r0, c2` with c2 = 0, added ONE/ONE into an A8R8G8B8 target: a skip. With
+    // skipping off the draw is a fill of that zero, merged over every pixel (nothing is left out);
+    // with it on, the tiles are skipped (decided or not). The bytes stay the clear colour.
+    for (bool skip : {false, true}) {
+        DeviceOptions o;
+        o.software.skipTiles = skip;
+        o.software.timeTiles = false;
+        Device dev(o);
+        Handle rt{}, ps{};
+        REQUIRE(dev.CreateRenderTarget(160, 120, D3DFMT_A8R8G8B8, 1, &rt) == D3D_OK);
+        REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x20406080u, 1.0f, 0) == D3D_OK);
+        REQUIRE(dev.CreatePixelShaderFromText("ps_1_1\ndef c2, 0, 0, 0, 0\nmov r0, c2\n", &ps) == D3D_OK);
+        REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, 1) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+        REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+        for (int draw = 0; draw < 3; ++draw) {
+            REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+            const DrawStats& s = dev.lastDrawStats();
+            INFO((skip ? "skipping on" : "skipping off") << ", draw " << draw);
+            CHECK(s.pixelsCovered == 160u * 120u);
+            CHECK(s.pixelsWritten == (skip ? 0u : 160u * 120u));
+        }
+        size_t other = 0;
+        REQUIRE(dev.readSurface(rt, [&](const D3DLOCKED_RECT& lr) {
+            for (UINT y = 0; y < 120; ++y)
+                for (UINT x = 0; x < 160; ++x) {
+                    uint32_t p;
+                    std::memcpy(&p, static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch) + x * 4, 4);
+                    other += p != 0x20406080u;
+                }
+        }) == D3D_OK);
+        CHECK(other == 0);
+    }
 }

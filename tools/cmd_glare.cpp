@@ -547,7 +547,7 @@ int runGlare(const GlareOptions& o) {
                 " tiles: tiles of 16 rows by 64 pixels of the software renderer's full-screen draws, shaded, filled\n"
                 " with a constant, copied from one texture or skipped, as the interval evaluator decided; -: none\n"
                 " decided (no such draw, or deciding did not pay on the program's recent draws); --no-skip runs every\n"
-                " pass and shades every tile)\n");
+                " pass and draws every tile)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",

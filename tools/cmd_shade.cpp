@@ -23,7 +23,7 @@ constexpr const char* kShadeUsage =
     "                  [--exposure STOPS] [--no-skip]\n"
     "                  -o OUT.png\n"
     "  N is a texture stage 0..3 (ps_1_4: 0..5) or a constant 0..7; the output size defaults to texture 0's\n"
-    "  --no-skip  the emulator shades every tile (no tile skipping; for comparison: the image is the same)\n";
+    "  --no-skip  the emulator draws every tile (no tile skipping; for comparison: the image is the same)\n";
 
 int shadeUsage(const std::string& msg) {
     std::cerr << "ps11 shade: " << msg << "\n" << kShadeUsage;
@@ -48,7 +48,7 @@ int cmdShade(const std::vector<std::string>& args) {
     const HardwareClass* hardware = nullptr;
     std::optional<Precision> precision;
     float exposure = 0;
-    bool noSkip = false;  // --no-skip: the emulator shades every tile
+    bool noSkip = false;  // --no-skip: the emulator draws every tile
     for (size_t i = 0; i < args.size(); ++i) {
         const std::string& a = args[i];
         std::string v;

@@ -36,7 +36,7 @@ constexpr const char* kUsage =
     "                 the emulator, its probes and differences counted, not failed)\n"
     "  --hardware H   the emulated GPU for every file, overriding [require] hardware (`ps11 hardware` lists\n"
     "                 them); `all` runs the files once per class\n"
-    "  --no-skip      the emulator shades every tile (no tile skipping; for comparison: the images are\n"
+    "  --no-skip      the emulator draws every tile (no tile skipping; for comparison: the images are\n"
     "                 the same); with --backend gl or both it applies to the emu side only\n"
     "  --stats        executor statistics and draw statistics per file (with the tiles shaded, filled,\n"
     "                 copied and skipped)\n";
