@@ -12,6 +12,9 @@ namespace {
 
 // Triangles assembled per pass over a draw's primitives (memory stays bounded for any count).
 constexpr uint32_t kMarkChunk = 1024;
+// A draw of more triangles forgets the facts instead of assembling its triangles a second time
+// (a scene's geometry; a frame's sprites are a few hundred).
+constexpr uint32_t kMaxMarkedTriangles = 16384;
 
 }  // namespace
 
@@ -22,13 +25,10 @@ size_t uniformTileCount(const Image& image) {
 
 std::shared_ptr<const std::vector<uint8_t>> markDrawnTiles(const DrawCall& call, const Image& target,
                                                            const std::vector<uint8_t>& stale) {
+    if (call.primitiveCount > kMaxMarkedTriangles || stale.size() != uniformTileCount(target)) return nullptr;
     auto out = std::make_shared<std::vector<uint8_t>>(stale);
     const uint32_t side = ps11::texelTileSide(target.width, target.height);
     const int64_t tilesX = (int64_t(target.width) + side - 1) / side;
-    if (out->size() != uniformTileCount(target)) {
-        out->assign(uniformTileCount(target), 1);
-        return out;
-    }
     const ClipRect& clip = call.clip;
     const int64_t cx0 = std::max(0, clip.x0), cy0 = std::max(0, clip.y0);
     const int64_t cx1 = std::min<int64_t>(clip.x1, target.width), cy1 = std::min<int64_t>(clip.y1, target.height);
@@ -57,6 +57,9 @@ std::shared_ptr<const std::vector<uint8_t>> markDrawnTiles(const DrawCall& call,
                  int64_t(std::ceil(std::clamp(x1, -lim, lim))) + 2, int64_t(std::ceil(std::clamp(y1, -lim, lim))) + 2);
         }
     }
+    // Every tile stale: nothing is known any more (a full-screen pass), and later draws need not
+    // look at their triangles.
+    if (std::find(out->begin(), out->end(), uint8_t(0)) == out->end()) return nullptr;
     return out;
 }
 

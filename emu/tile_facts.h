@@ -16,8 +16,9 @@ namespace emu {
 // The tiles of an image's tile grid, all unflagged.
 size_t uniformTileCount(const Image& image);
 // `stale` with every tile flagged that a triangle of `call` may cover inside its clip rectangle
-// (each triangle's bounding box, a pixel wider each side); every tile where a triangle's
-// vertices are not finite.
+// (each triangle's bounding box, a pixel wider each side; every tile where a triangle's vertices
+// are not finite). Null, nothing known, where every tile is then flagged, or where the draw has
+// more triangles than are worth assembling a second time.
 std::shared_ptr<const std::vector<uint8_t>> markDrawnTiles(const DrawCall& call, const Image& target,
                                                            const std::vector<uint8_t>& stale);
 
