@@ -220,6 +220,11 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             if (!b.empty()) boxes.push_back(b);  // inverted or outside rects clear nothing
         }
     }
+    // Whether the boxes are one that covers the whole of `im`.
+    auto coversAll = [&](const Image& im) {
+        return boxes.size() == 1 && boxes[0].x0 <= 0 && boxes[0].y0 <= 0 && boxes[0].x1 >= int64_t(im.width) &&
+               boxes[0].y1 >= int64_t(im.height);
+    };
     if (m_fingerprint.active) {
         uint32_t zBits;
         std::memcpy(&zBits, &z, 4);
@@ -229,10 +234,7 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
             const int64_t box[4] = {b.x0, b.y0, b.x1, b.y1};
             fingerprintWords(box, sizeof box);
         }
-        auto whole = [&](const Resource* r, const Image* im) {
-            return r->levels.size() == 1 && boxes.size() == 1 && boxes[0].x0 <= 0 && boxes[0].y0 <= 0 &&
-                   boxes[0].x1 >= int64_t(im->width) && boxes[0].y1 >= int64_t(im->height);
-        };
+        auto whole = [&](const Resource* r, const Image* im) { return r->levels.size() == 1 && coversAll(*im); };
         // A depth surface cleared of depth but not of its stencil keeps the stencil bits.
         const bool depthWhole = depth && (flags & D3DCLEAR_ZBUFFER) &&
                                 ((flags & D3DCLEAR_STENCIL) || depth->format->stencilBits == 0) && whole(ds, depth);
@@ -292,8 +294,7 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
         if (depth) markWritten(*ds, dsRef.level);
     }
     // Level 0 of a texture cleared whole holds one value: its tile facts need no scan until drawn into.
-    if (target && rtRef.level == 0 && boxes.size() == 1 && boxes[0].x0 <= 0 && boxes[0].y0 <= 0 &&
-        boxes[0].x1 >= int64_t(target->width) && boxes[0].y1 >= int64_t(target->height))
+    if (target && rtRef.level == 0 && coversAll(*target))
         rt->uniformStale = std::make_shared<const std::vector<uint8_t>>(uniformTileCount(*target), uint8_t(0));
     return D3D_OK;
 }

@@ -23,6 +23,7 @@
 #include "ps11/intervals.h"
 #include "ps11/texture.h"
 #include "ps11/texture_tiles.h"
+#include "texel_tiles_util.h"
 #include "runner/random_program.h"
 
 using namespace ps11;
@@ -801,14 +802,7 @@ TEST_CASE("texel tiles: each tile's facts are the exact ranges, NaN and -0 of it
                     : flavour == 2 && rng() % 4 == 0 ? specials[rng() % 8]
                                                      : float(std::ldexp(double(int64_t(rng() % 2001) - 1000), -8));
         }
-        TextureLevelBytes level;
-        level.width = w, level.height = h;
-        level.data = unorm8 ? bytes.data() : reinterpret_cast<const uint8_t*>(floats.data());
-        level.rowPitch = size_t(w) * (unorm8 ? 4 : 16);
-        std::string error;
-        std::optional<Texture> t = Texture::fromLevels(unorm8 ? TexFormat::A8R8G8B8 : TexFormat::A32B32G32R32F, false,
-                                                       &level, 1, SignedDecode::Snorm, error);
-        REQUIRE(t);
+        const std::optional<Texture> t = tiletest::levelTexture(unorm8, w, h, bytes, floats);
         TexelTiles tiles;
         prepareTexelTiles(*t, tiles);
         // In two halves, as workers scan them.

@@ -15,6 +15,7 @@
 #include "emu/fullscreen.h"
 #include "ps11/texture.h"
 #include "ps11/texture_tiles.h"
+#include "texel_tiles_util.h"
 
 using namespace ps11;
 
@@ -95,16 +96,9 @@ TEST_CASE("tile facts: one value everywhere but the stale tiles gives the full s
         }
         for (int k = uni(0, 3); k > 0; --k) stale[rng() % stale.size()] = 1;
         if (i % 17 == 0) std::fill(stale.begin(), stale.end(), uint8_t(1));
-        TextureLevelBytes level;
-        level.width = w, level.height = h;
-        level.data = unorm8 ? bytes.data() : reinterpret_cast<const uint8_t*>(floats.data());
-        level.rowPitch = size_t(w) * (unorm8 ? 4 : 16);
-        std::string error;
-        std::optional<Texture> t = Texture::fromLevels(unorm8 ? TexFormat::A8R8G8B8 : TexFormat::A32B32G32R32F, false,
-                                                       &level, 1, SignedDecode::Snorm, error);
-        REQUIRE(t);
+        const Texture t = tiletest::levelTexture(unorm8, w, h, bytes, floats);
         INFO((unorm8 ? "A8R8G8B8 " : "A32B32G32R32F ") << w << "x" << h << ", " << blocks << " blocks");
-        checkUniformPath(*t, stale);
+        checkUniformPath(t, stale);
     }
 }
 
