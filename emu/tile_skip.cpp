@@ -40,9 +40,6 @@ void addressAxis(ps11::TextureAddress mode, int64_t i0, int64_t i1, int64_t n, i
     }
 }
 
-// The lookups' range from the texels' range. fx filters are convex integer sums rounded to the
-// grid: inside the texels' range. Float lerps (1 − f)·a + f·b may leave it by rounding: widened
-// by a relative 2⁻²⁰, except zeros, whose lerps are zeros.
 // The lookups of a stage without a texture: (0, 0, 0, 1).
 void unboundLookups(ps11::ValueRange4& out) {
     for (int c = 0; c < 4; ++c) out[size_t(c)] = ps11::ValueRange::point(c == 3 ? 1 : 0);
@@ -53,6 +50,9 @@ bool mayReachBorder(const ps11::SamplerState& ss) {
     return ss.addressU == ps11::TextureAddress::Border || ss.addressV == ps11::TextureAddress::Border;
 }
 
+// The lookups' range from the texels' range. fx filters are convex integer sums rounded to the
+// grid: inside the texels' range. Float lerps (1 − f)·a + f·b may leave it by rounding: widened
+// by a relative 2⁻²⁰, except zeros, whose lerps are zeros.
 ps11::ValueRange lookupRange(float lo, float hi, bool nan, bool negZero, bool fx) {
     ps11::ValueRange r;
     if (!std::isfinite(lo) || !std::isfinite(hi)) nan = true;  // ∞ · 0 in a lerp
