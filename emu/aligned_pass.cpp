@@ -143,6 +143,39 @@ void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint3
         storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
 }
 
+// n pixels' b g r a words from `src` to a row of the 8-bit target: each (word & keep) | set, or
+// with `additive` (ONE/ONE ADD) that added to the row's bytes with saturation, as storeRow
+// stores lanes.
+void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool additive, uint8_t* dst) {
+    if (!additive && keep == ~0u && set == 0) {
+        std::memcpy(dst, src, size_t(n) * 4);
+        return;
+    }
+    int i = 0;
+#if defined(__SSE2__)
+    const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
+    // (One pass: the masked words are never read back from a copy just made, which the store
+    // buffer cannot forward from a string move.)
+    for (; i + 4 <= n; i += 4) {
+        __m128i w = _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
+        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
+        if (additive) w = _mm_adds_epu8(_mm_loadu_si128(d), w);
+        _mm_storeu_si128(d, w);
+    }
+#endif
+    for (; i < n; ++i) {
+        uint32_t w = (load32(src + 4 * i) & keep) | set;
+        if (additive) {
+            const uint32_t old = load32(dst + 4 * i);
+            uint32_t sum = 0;
+            for (int b = 0; b < 4; ++b)
+                sum |= std::min<uint32_t>(((w >> (8 * b)) & 0xff) + ((old >> (8 * b)) & 0xff), 255u) << (8 * b);
+            w = sum;
+        }
+        std::memcpy(dst + 4 * i, &w, 4);
+    }
+}
+
 // A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
 // zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
 // ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
@@ -186,47 +219,10 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
             }
             set |= uint32_t(byte) << shift;
         }
-    const uint8_t* src = row.row0 + o;
-    if (!additive && keep == ~0u && set == 0) {
-        std::memcpy(dst, src, size_t(n) * 4);
-        return true;
-    }
-    int i = 0;
-#if defined(__SSE2__)
-    const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
-    // (One pass: the masked words are never read back from a copy just made, which the store
-    // buffer cannot forward from a string move.)
-    if (!additive)
-        for (; i + 4 <= n; i += 4)
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i),
-                             _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv));
-#endif
-    if (!additive) {
-        for (; i < n; ++i) {
-            const uint32_t w = (load32(src + 4 * i) & keep) | set;
-            std::memcpy(dst + 4 * i, &w, 4);
-        }
-        return true;
-    }
-#if defined(__SSE2__)
-    for (; i + 4 <= n; i += 4) {
-        const __m128i w =
-            _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
-        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
-        _mm_storeu_si128(d, _mm_adds_epu8(_mm_loadu_si128(d), w));
-    }
-#endif
-    for (; i < n; ++i) {
-        const uint32_t w = (load32(src + 4 * i) & keep) | set, old = load32(dst + 4 * i);
-        uint32_t sum = 0;
-        for (int b = 0; b < 4; ++b)
-            sum |= std::min<uint32_t>(((w >> (8 * b)) & 0xff) + ((old >> (8 * b)) & 0xff), 255u) << (8 * b);
-        std::memcpy(dst + 4 * i, &sum, 4);
-    }
+    storeWords(row.row0 + o, n, keep, set, additive, dst);
     return true;
 }
 
-// The texel rows and vertical weight of a tap on pixel row y.
 }  // namespace
 
 namespace {
@@ -435,6 +431,46 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
         }
         x = e;
     }
+}
+
+// ---- chain rows (AlignedDraw::chainRows) ----
+
+// A configuration whose runs chain rows read as they lie: one texel a column, at horizontal
+// weight 0 or 128.
+inline bool chainConfig(const HConfig& h) { return h.step == 1 && (h.wx == 0 || h.wx == 128); }
+
+// Whether chain rows can read every tap on this row: each bound, with tables whose every
+// configuration is a chain one, its texel row at hand at vertical weight 0. (At weight 128 the
+// H rows, shared by the taps and rows that read a texel row, cost less than reading the texel
+// rows again per tap: Sousa's pinwheel passes.)
+bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows) {
+    for (int t = 0; t < draw.plan.count; ++t) {
+        const TapRow& r = rows[size_t(t)];
+        const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+        if (!draw.taps[size_t(t)].bound || ((tri.freeTaps >> t) & 1) || !r.row0 || r.wy != 0) return false;
+        for (int c = 0; c < cols.configCount; ++c)
+            if (!chainConfig(tri.configs[size_t(cols.configs[size_t(c)])])) return false;
+    }
+    return true;
+}
+
+// The columns [x, e) (e <= end) where every tap lies in one run of a chain configuration, with
+// each tap's texels at column x in `taps`: e, or x where column x does not qualify.
+int chainStretch(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows, int x,
+                 int end, ps11::ChainRowTap* taps) {
+    for (int t = 0; t < draw.plan.count; ++t) {
+        const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+        const int32_t r = cols.run[size_t(x - tri.x0)];
+        if (r < 0) return x;
+        const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+        const HConfig& h = tri.configs[size_t(cols.configs[size_t(run.config)])];
+        if (run.tabulated || !chainConfig(h)) return x;
+        const TapRow& row = rows[size_t(t)];
+        const size_t o = size_t(cols.off0[size_t(x - tri.x0)]);
+        taps[t] = ps11::ChainRowTap{row.row0 + o, h.wx != 0};
+        end = std::min(end, int(run.x1));
+    }
+    return end;
 }
 
 // Takes a slot for (row, key), whose hash `h` no slot has: the next slot, round the slots from
@@ -702,6 +738,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         }
         for (int c = 0; c < 4; ++c) std::memcpy(f.r0[c] + first, lanes[c], sizeof(int16_t) * size_t(count));
     };
+    // Chain rows only where every window shades (a copied window's tap reads the H rows).
+    bool shadesOnly = true;
+    for (size_t wi = 0; wi < windowCount; ++wi) shadesOnly = shadesOnly && windows[wi].mode != RowMode::Copy;
     HRowCache& cache = sc.hrows;
     if (cache.serial != draw.serial) {
         // Another draw: its textures may have changed since (the slots keep their memory).
@@ -780,14 +819,21 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 } else {
                     setTapRow(r, tap, tapV[t]);
                 }
+            }
+            // Chain rows read the texel rows of chain configurations' runs: those need no H rows.
+            const bool chain = draw.chainRows && shadesOnly && chainRow(draw, tri, rows);
+            for (int t = 0; t < taps; ++t) {
+                const AlignedTap& tap = draw.taps[size_t(t)];
+                if (!tap.bound || !((neededTaps >> t) & 1) || ((tri.freeTaps >> t) & 1)) continue;
+                TapRow& r = rows[size_t(t)];
                 // The H rows of the tap's long runs (built on first use, shared by taps and rows).
                 const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
                 const bool rowsOk = r.row0 && (r.row1 || r.wy == 0);
                 for (int c = 0; c < cols.configCount; ++c) {
-                    r.ready[size_t(c)] = rowsOk;
-                    if (!rowsOk) continue;
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     const HConfig& h = tri.configs[ci];
+                    r.ready[size_t(c)] = rowsOk && !(chain && chainConfig(h));
+                    if (!r.ready[size_t(c)]) continue;
                     r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
                     if (r.direct[size_t(c)]) continue;
                     const uint64_t id =
@@ -832,6 +878,31 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
+                    if (mode == RowMode::Shade && chain) {
+                        // Chain rows over the stretches where every tap lies in a chain run; the
+                        // columns between them (a border's) pre-sampled pixel by pixel.
+                        ps11::ChainRowTap chainTaps[8];
+                        for (int c = x; c < x + n;) {
+                            int e = chainStretch(draw, tri, rows, c, x + n, chainTaps);
+                            if (e > c) {
+                                ps11::runChainRow(exec, chainTaps, e - c, sc.bytes, &stats.exec);
+                                storeWords(sc.bytes, e - c, ~0u, orMask, draw.directAdd,
+                                           target.texel(uint32_t(c), uint32_t(y)));
+                                c = e;
+                                continue;
+                            }
+                            e = c + 1;
+                            while (e < x + n && chainStretch(draw, tri, rows, e, x + n, chainTaps) == e) ++e;
+                            in.count = e - c;
+                            ctx.x = c;
+                            ctx.out = target.texel(uint32_t(c), uint32_t(y));
+                            ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
+                            c = e;
+                        }
+                        stats.pixels += uint64_t(n);
+                        stats.written += uint64_t(n);
+                        continue;
+                    }
                     if (mode == RowMode::Shade) {
                         fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;

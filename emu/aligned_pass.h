@@ -94,6 +94,10 @@ struct AlignedDraw {
     bool fogFirst = false;
     MergeState afterDepth;  // `merge` with its depth test and write off
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
+    // The program runs as chain rows (ps11::chainRows) where its taps read a row's texels side by
+    // side (1:1, at texel centres or halfway between them): fx8, read no colour, stored here
+    // with no depth test or fog first.
+    bool chainRows = false;
 };
 
 // Decides whether a draw can take the aligned path (per-triangle checks come later) and fills
@@ -267,6 +271,7 @@ struct AlignedScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
+    alignas(32) uint8_t bytes[4 * ps11::kMaxSpan];             // chain rows' r0 (AlignedDraw::chainRows)
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps
     // whose level the level of detail picks on triangles where they are sampled per pixel, at
     // their quads' levels (SampleRequest::levels). Set by the caller before drawAlignedRows.

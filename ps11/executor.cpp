@@ -60,6 +60,7 @@ public:
         if (options.path != ExecPath::Generic) {
             buildFastProgram(m_p, m_ops, m_fast);
             presampledOps(m_fast, m_p, m_ops, m_presampled);
+            chainRowPlan(m_fast, m_p, m_ops, m_presampled, m_vUsed, m_chainRows);
         }
     }
 
@@ -68,7 +69,10 @@ public:
         m_api[size_t(index)] = value;
         refreshConstant(index);
         m_constsId = nextConstsId();
-        if (m_fast.ready) presampledOps(m_fast, m_p, m_ops, m_presampled);
+        if (m_fast.ready) {
+            presampledOps(m_fast, m_p, m_ops, m_presampled);
+            chainRowPlan(m_fast, m_p, m_ops, m_presampled, m_vUsed, m_chainRows);
+        }
     }
     void setStageState(int stage, const StageState& state) override {
         if (stage >= 0 && stage < kMaxTextureStages) m_p.stages[size_t(stage)] = state;
@@ -92,6 +96,11 @@ public:
     bool plainTaps(TapPlan& plan) const;
     void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                        ExecutorStats* stats) const;
+    bool chainRows() const { return m_chainRows.ready; }
+    void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, ExecutorStats* stats) const {
+        exec::runChainRow(m_chainRows, m_presampled, taps, count, out);
+        countRun(stats, std::clamp(count, 0, kMaxSpan));
+    }
 
 private:
     void refreshConstant(int i) {
@@ -127,6 +136,7 @@ private:
     uint8_t m_r0Preset = 0xF;          // r0PresetChannels(m_ops)
     FastProgram m_fast;                // not ready: the generic path runs
     std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
+    ChainRowPlan m_chainRows;          // from m_presampled
     uint64_t m_constsId = 0;           // names the constants (a thread's fast bank keeps them)
 };
 
@@ -601,6 +611,14 @@ bool plainTaps(const Executor& executor, TapPlan& plan) {
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                    ExecutorStats* stats) {
     static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats);
+}
+
+bool chainRows(const Executor& executor) {
+    return static_cast<const exec::ExecutorImpl&>(executor).chainRows();
+}
+
+void runChainRow(const Executor& executor, const ChainRowTap* taps, int count, uint8_t* out, ExecutorStats* stats) {
+    static_cast<const exec::ExecutorImpl&>(executor).runChainRow(taps, count, out, stats);
 }
 
 }  // namespace ps11

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "ps11/executor_fast.h"
+#include "ps11/texture.h"
 
 namespace ps11::exec {
 namespace {
@@ -340,6 +341,81 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
         }
         markChains(ops, out);
     }
+}
+
+void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+                  const std::vector<FastOp>& ops2, uint8_t vUsed, ChainRowPlan& out) {
+    out = ChainRowPlan{};
+    if (!fp.ready || vUsed != 0 || p.nMax < 255 || !fastKernels(simdLevel())) return;
+    std::array<int8_t, kFastSlots> tapOf;  // the tap whose register a slot is (−1: none)
+    tapOf.fill(-1);
+    int taps = 0, head = -1;
+    for (size_t i = 0; i < ops.size(); ++i) {
+        const DOp& d = ops[i];
+        if (d.op == Opcode::Phase) continue;
+        if (d.texture) {
+            if (head >= 0) return;  // a read after the chain began
+            tapOf[d.dstSlot] = int8_t(taps++);
+            continue;
+        }
+        if (head >= 0) {
+            if (!ops2[i].inChain) return;  // arithmetic outside the chain
+            continue;
+        }
+        if (ops2[i].chain == 0) return;
+        head = int(i);
+    }
+    if (head < 0) return;
+    const int count = ops2[size_t(head)].chain;
+    if (ops2[size_t(head)].dst != kSlotR || ops2[size_t(head)].mask != kMaskAll) return;
+    for (int k = 0; k < count; ++k) {
+        const FastOp& f = ops2[size_t(head + k)];
+        for (int s = 0; s < 2; ++s) {
+            const FastSrc& src = f.src[size_t(s)];
+            if (src.sw != std::array<uint8_t, 4>{0, 1, 2, 3}) return;
+            int8_t code = 0;
+            if (src.slot >= kFastConstSlot) {
+                code = int8_t(-1 - (src.slot - kFastConstSlot));
+            } else if (tapOf[src.slot] >= 0) {
+                code = tapOf[src.slot];
+            } else {
+                return;
+            }
+            out.factor[size_t(k)][size_t(s)] = code;
+        }
+        // One factor a tap, the other a constant.
+        if ((out.factor[size_t(k)][0] >= 0) == (out.factor[size_t(k)][1] >= 0)) return;
+    }
+    for (int i = 0; i < kNumConsts; ++i)
+        for (int c = 0; c < 4; ++c)
+            out.pattern[size_t(i)][size_t(kUnorm8Byte[c])] = int16_t(p.constGrid[size_t(i)][size_t(c)]);
+    if (taps > 8) return;
+    out.head = head;
+    out.count = count;
+    out.taps = taps;
+    out.ready = true;
+}
+
+void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, const ChainRowTap* taps, int count,
+                 uint8_t* out) {
+    const FastKernels& kern = *fastKernels(simdLevel());
+    const int bytes = 4 * std::clamp(count, 0, kMaxSpan);
+    const int whole = bytes / kern.lanes * kern.lanes;
+    const FastOp* ops = &ops2[size_t(plan.head)];
+    if (whole) kern.chainRow(ops, plan, taps, whole, out);
+    if (whole == bytes) return;
+    // The last lanes from copies of the texels they read, padded to a whole step.
+    constexpr int kMaxLanes = 32;
+    alignas(64) uint8_t texels[8][kMaxLanes + 4] = {};
+    alignas(64) uint8_t last[kMaxLanes];
+    std::array<ChainRowTap, 8> rest{};
+    const int n = bytes - whole;
+    for (int t = 0; t < plan.taps && t < 8; ++t) {
+        std::memcpy(texels[t], taps[t].row + whole, size_t(n + (taps[t].halfX ? 4 : 0)));
+        rest[size_t(t)] = ChainRowTap{texels[t], taps[t].halfX};
+    }
+    kern.chainRow(ops, plan, rest.data(), kern.lanes, last);
+    std::memcpy(out + whole, last, size_t(n));
 }
 
 // Texel lanes clamped to ±m. Out of line: inlined, its hoisted broadcast of m (a 16-bit store

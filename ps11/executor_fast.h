@@ -72,6 +72,22 @@ using FastChainFn = void (*)(const FastOp* ops, int count, FastBank& bank, int n
 // The longest chain.
 constexpr int kMaxFastChain = 8;
 
+// A program that runs as chain rows (ps11/executor_presampled_internal.h, chainRows): its
+// chain's ops (FastOp::chain, from ops[head]) and each op's two factors, a tap (its index in the
+// TapPlan, >= 0) or a constant (−1 − k); constant k's grid integers in b g r a byte order.
+struct ChainRowPlan {
+    bool ready = false;
+    int head = 0, count = 0;
+    int taps = 0;  // the program's texture reads
+    std::array<std::array<int8_t, 2>, kMaxFastChain> factor{};
+    std::array<std::array<int16_t, 4>, kNumConsts> pattern{};
+};
+// Runs a ChainRowPlan over `bytes` (a multiple of the kernels' lanes) lanes of row bytes: lane
+// l of tap t is its filtered texel byte (ChainRowTap) at l, r0's lanes go to out saturated to
+// [0, 255]. Reads and writes whole steps of lanes (the caller pads).
+using FastChainRowFn = void (*)(const FastOp* ops, const ChainRowPlan& plan, const ChainRowTap* taps, int bytes,
+                                uint8_t* out);
+
 // Test hooks: the rounding steps of the kernels on their own, over count lanes (any count).
 // Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
 // [lo, hi]. Linear: n = round_half_even(K·2^s / 2), clamped.
@@ -96,6 +112,7 @@ struct FastKernels {
     FastNarrowFn narrow;
     FastRoundProductFn roundProduct;
     FastRoundLinearFn roundLinear;
+    FastChainRowFn chainRow;
 };
 
 // The kernels of a SIMD level: SSE2 at Baseline, AVX2 + FMA at Avx2, AVX-512 BW at Avx512.
@@ -144,6 +161,18 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
                        TapFill fill, ResultSink sink, void* ctx);
+
+// The chain-row plan of a program (ops2: presampledOps' for the current constants): ready when
+// fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic is one chain
+// writing all of r0 each of whose products is of a plain read's register and a constant, both
+// unswizzled.
+void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
+                  const std::vector<FastOp>& ops2, uint8_t vUsed, ChainRowPlan& out);
+
+// runChainRow (ps11/executor_presampled_internal.h) with the kernels of simdLevel(): `taps` holds
+// plan.taps taps, `ops2` is what `plan` was made from.
+void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, const ChainRowTap* taps, int count,
+                 uint8_t* out);
 
 // fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
 // 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.

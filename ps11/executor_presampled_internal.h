@@ -46,4 +46,23 @@ using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* cons
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                    ExecutorStats* stats = nullptr);
 
+// Chain rows: a program whose arithmetic is one chain of products (mul, then mads adding it, all
+// of whose factors are >= 0: the glow's separable blur) each of a tap and a constant, the same on
+// every channel, runs over a row's bytes as they lie (b g r a, 4 lanes a pixel), each tap read
+// straight from its texel row, no lanes of r g b a planes made. Tap t of a run of pixels: the
+// texel bytes at `row` (pixel p's texel at row + 4p), at vertical weight 0 and horizontal weight
+// 0, or with halfX 128 (each with the next texel: round(Σ / 2), the reference filter's exact
+// sum).
+struct ChainRowTap {
+    const uint8_t* row = nullptr;
+    bool halfX = false;
+};
+// Whether the executor's program (with its constants now) runs as chain rows.
+bool chainRows(const Executor& executor);
+// r0 of `count` (<= kMaxSpan) pixels as bytes saturated to [0, 255], b g r a, to out[0, 4·count):
+// what runPresampled gives for those taps, as an 8-bit target stores it. Reads the taps'
+// footprints only. Only valid after tapPlan() and chainRows() returned true.
+void runChainRow(const Executor& executor, const ChainRowTap* taps, int count, uint8_t* out,
+                 ExecutorStats* stats = nullptr);
+
 }  // namespace ps11

@@ -446,6 +446,79 @@ TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel b
     }
 }
 
+TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path", "[draw][aligned]") {
+    // The glow's passes, which the row path runs as chain rows (ps11::runChainRow): two to four
+    // taps of one texture along a row (at whole texels, or halfway between two with LINEAR) or
+    // along a column (whole texels), weighted by non-negative constants, _sat or not, drawn over
+    // the target or added to it (ONE/ONE), into A8R8G8B8 or X8R8G8B8, every address mode (the
+    // columns at the edges read clamped, wrapped or border texels: filtered per pixel between the
+    // chain rows), rows wider than a span, a scissor now and then; and now and then a constant
+    // with a negative channel or a swizzled tap, which are no chain.
+    std::mt19937 rng(20261130);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const char* programs[] = {
+        "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
+        "mad r0, t3, c3, r0\n",
+        "ps_1_1\ntex t0\ntex t1\ntex t2\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad_sat r0, t2, c2, r0\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, c0, t0\nmad r0, c1, t1, r0\n",
+        "ps_1_3\ntex t0\ntex t1\ntex t2\nmul r0, t2, c0\nmad r0, t1, c1, r0\nmad r0, t0, c2, r0\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, t0.a, c0\nmad r0, t1, c1, r0\n",  // swizzled: no chain
+    };
+    for (int i = 0; i < 40; ++i) {
+        Case c;
+        c.w = UINT(uni(200, 700));
+        c.h = UINT(uni(2, 7));
+        c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const bool horizontal = uni(0, 1);
+        const bool half = horizontal && uni(0, 1);
+        Case::Tex t;
+        t.w = c.w, t.h = c.h;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 5) ? rng() : 255);
+        t.filter = half || uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        t.addressU = DWORD(uni(1, 5));
+        t.addressV = DWORD(uni(1, 5));
+        t.border = DWORD(rng());
+        c.tex.assign(4, t);
+        c.oneTexture = true;
+        c.program = programs[size_t(uni(0, int(std::size(programs)) - 1))];
+        for (auto& k : c.consts)
+            for (float& v : k) v = float(uni(0, 16)) / 16.0f;
+        if (uni(0, 7) == 0) c.consts[uni(0, 3)][uni(0, 3)] = -float(uni(1, 16)) / 16.0f;
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                const float o = float(s - 2) + (half ? 0.5f : 0.0f);  // taps at −2, −1, 0, +1 (+½)
+                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (horizontal ? o : 0.0f) / float(t.w);
+                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (horizontal ? 0.0f : o) / float(t.h);
+            }
+            c.verts.push_back(q);
+        }
+        c.blend = DWORD(uni(0, 1));
+        c.scissor = uni(0, 3) == 0;
+        c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        INFO("case " << i << ": " << c.w << "x" << c.h << (horizontal ? ", along a row" : ", along a column")
+                     << (half ? ", halfway" : "") << ", " << c.program << (c.scissor ? ", scissor" : ""));
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+            Device rowDev(rowOpt);
+            DrawStats rs;
+            REQUIRE(drawCase(rowDev, c, rs) == expected);
+            CHECK(rs.pixelsRowPath == rs.pixelsCovered);
+        });
+    }
+}
+
 TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][aligned]") {
     // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with vector kernels (the Avx2 level), all
     // columns but a few at the edges (clamped pairs) belong to runs of the tabulated configuration

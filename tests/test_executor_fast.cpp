@@ -612,6 +612,116 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
     CHECK(runs == 40 * int(std::size(programs) * std::size(configs)));
 }
 
+TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[fast]") {
+    // runChainRow (a chain of products of taps and constants over a row's bytes as they lie)
+    // against runPresampled fed each tap's filtered texel (the texel, or round_half_even of it and
+    // the next one's mean), at every SIMD level, over runs of 1 to kMaxSpan pixels (the last
+    // lanes of a run past the kernels' whole steps included), and which programs and constants
+    // run as chain rows at all.
+    using namespace ps11;
+    struct Program {
+        const char* text;
+        bool chain;  // with every constant >= 0
+        bool def = false;  // its constants are def'd: no negative API value reaches them
+        float maxValue = 0;  // the profile's MaxValue (0: the version's)
+    };
+    const Program programs[] = {
+        {"ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c1, r0\nmad r0, t2, c2, r0\n"
+         "mad r0, t3, c3, r0\n",
+         true},
+        {"ps_1_1\ndef c0, 0.25, 0.25, 0.25, 0.25\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\n"
+         "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n",
+         true, true},
+        {"ps_1_1\ntex t0\ntex t1\nmul_sat r0, c2, t1\nmad_sat r0, c1, t0, r0\n", true},
+        {"ps_1_4\ntexld r1, t0\ntexld r2, t1\nmul r0, r2, c0\nmad r0, r1, c1, r0\n", true, false, 1},
+        // MaxValue 8: products past 16 bits (no chain of small products).
+        {"ps_1_4\ntexld r1, t0\ntexld r2, t1\nmul r0, r2, c0\nmad r0, r1, c1, r0\n", false},
+        {"ps_1_1\ntex t0\nmul r0, t0, c0\n", false},                                   // no chain: one product
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, t1\nmad r0, t1, c1, r0\n", false},       // a product of two taps
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0.a\nmad r0, t1, c1, r0\n", false},     // a swizzle
+        {"ps_1_1\ntex t0\ntex t1\nmul r1, t0, c0\nmad r1, t1, c1, r1\nmov r0, r1\n", false},  // not r0
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0\nmad r0, t1, c1, r0\nadd r0, r0, c2\n", false},
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, v0\nmad r0, t1, c1, r0\n", false},       // reads v0
+    };
+    std::mt19937 rng(3011);
+    std::vector<std::array<uint8_t, 4>> texels[8];
+    int chained = 0;
+    testutil::forEachSimdLevel([&](SimdLevel) {
+        for (const Program& prog : programs) {
+            INFO(prog.text);
+            auto fast = make(prog.text, Precision::Fx8, prog.maxValue, ExecPath::Auto);
+            TapPlan plan;
+            REQUIRE(tapPlan(*fast, plan));
+            for (int trial = 0; trial < 12; ++trial) {
+                const bool negative = trial % 4 == 3;
+                for (int i = 0; i < 8; ++i) {
+                    std::array<float, 4> v;
+                    for (float& f : v) f = rng() % 5 < 1 ? 0.0f : float(rng() % 256) / 255.0f;
+                    if (negative && i < 2) v[rng() % 4] = -float(1 + rng() % 255) / 255.0f;
+                    fast->setConstant(i, v);
+                }
+                const bool want = prog.chain && (!negative || prog.def);
+                REQUIRE(chainRows(*fast) == want);
+                if (!want) continue;
+                const int count = trial == 0 ? kMaxSpan : 1 + int(rng() % kMaxSpan);
+                // Each tap's texel row (one texel more for its neighbour) and how it is read.
+                std::vector<uint8_t> rows[8];
+                ChainRowTap taps[8];
+                for (int t = 0; t < plan.count; ++t) {
+                    rows[t].resize(4 * size_t(count + 1));
+                    for (uint8_t& b : rows[t]) b = uint8_t(rng() % 7 ? rng() : 255);
+                    taps[t] = ChainRowTap{rows[t].data(), rng() % 2 == 0};
+                    auto& tx = texels[plan.stage[size_t(t)]];
+                    tx.resize(size_t(count));
+                    for (int p = 0; p < count; ++p)
+                        for (int c = 0; c < 4; ++c) {
+                            const int k = 4 * p + kUnorm8Byte[c];
+                            int v = rows[t][size_t(k)];
+                            if (taps[t].halfX) {
+                                const int sum = v + rows[t][size_t(k + 4)];
+                                v = sum / 2 + (sum % 2 == 1 && (sum / 2) % 2 == 1 ? 1 : 0);
+                            }
+                            tx[size_t(p)][size_t(c)] = uint8_t(v);
+                        }
+                }
+                std::vector<uint8_t> got(4 * size_t(count) + 64, 0xcd);
+                runChainRow(*fast, taps, count, got.data());
+                // runPresampled over the same filtered texels.
+                Lanes l(count);
+                PixelInputs pin = l.inputs(0, count);
+                struct Ctx {
+                    const std::vector<std::array<uint8_t, 4>>* texels;
+                    const TapPlan* plan;
+                    std::vector<uint8_t>* want;
+                } ctx{texels, &plan, nullptr};
+                std::vector<uint8_t> expect(4 * size_t(count));
+                ctx.want = &expect;
+                const TapFill fill = [](void* p, int tap, int first, int n, int16_t* const dst[4]) {
+                    const Ctx& x = *static_cast<const Ctx*>(p);
+                    for (int c = 0; c < 4; ++c)
+                        for (int i = 0; i < n; ++i)
+                            dst[c][i] = x.texels[x.plan->stage[size_t(tap)]][size_t(first + i)][size_t(c)];
+                };
+                const ResultSink sink = [](void* p, int first, int n, const int16_t* const r0[4]) {
+                    const Ctx& x = *static_cast<const Ctx*>(p);
+                    for (int c = 0; c < 4; ++c)
+                        for (int i = 0; i < n; ++i)
+                            (*x.want)[4 * size_t(first + i) + size_t(kUnorm8Byte[c])] =
+                                uint8_t(std::clamp<int>(r0[c][i], 0, 255));
+                };
+                runPresampled(*fast, pin, fill, sink, &ctx);
+                ++chained;
+                INFO("trial " << trial << ", " << count << " pixels");
+                REQUIRE(std::equal(expect.begin(), expect.end(), got.begin()));
+                // Nothing written past the run.
+                CHECK(std::all_of(got.begin() + std::ptrdiff_t(expect.size()), got.end(),
+                                  [](uint8_t b) { return b == 0xcd; }));
+            }
+        }
+    });
+    CHECK(chained > 0);
+}
+
 TEST_CASE("fast: the fast path applies to fx8 within int16 only", "[fast]") {
     if (!ps11::exec::fastKernels(ps11::SimdLevel::Baseline)) return;  // no x86 kernels in this build
     const std::string text = "ps_1_4\ntexcrd r0.rgb, t0\nmul r0.rgb, r0, r0\n";
