@@ -439,15 +439,26 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
 // weight 0 or 128.
 inline bool chainConfig(const HConfig& h) { return h.step == 1 && (h.wx == 0 || h.wx == 128); }
 
-// Whether chain rows can read every tap on this row: each bound, with tables whose every
-// configuration is a chain one, its texel row at hand at vertical weight 0. (At weight 128 the
-// H rows, shared by the taps and rows that read a texel row, cost less than reading the texel
-// rows again per tap: Sousa's pinwheel passes.)
+// A texel row of (0, 0, 0, 1) texels, what a stage without a texture reads, for chain rows.
+const uint8_t* unboundRow() {
+    static const auto row = [] {
+        std::array<uint8_t, 4 * (ps11::kMaxSpan + 1)> r{};
+        for (size_t i = size_t(ps11::kUnorm8Byte[3]); i < r.size(); i += 4) r[i] = 255;
+        return r;
+    }();
+    return row.data();
+}
+
+// Whether chain rows can read every tap on this row: each without a texture, or with tables
+// whose every configuration is a chain one and its texel row at hand at vertical weight 0. (At
+// weight 128 the H rows, shared by the taps and rows that read a texel row, cost less than
+// reading the texel rows again per tap: Sousa's pinwheel passes.)
 bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows) {
     for (int t = 0; t < draw.plan.count; ++t) {
         const TapRow& r = rows[size_t(t)];
         const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
-        if (!draw.taps[size_t(t)].bound || ((tri.freeTaps >> t) & 1) || !r.row0 || r.wy != 0) return false;
+        if (!draw.taps[size_t(t)].bound) continue;
+        if (((tri.freeTaps >> t) & 1) || !r.row0 || r.wy != 0) return false;
         for (int c = 0; c < cols.configCount; ++c)
             if (!chainConfig(tri.configs[size_t(cols.configs[size_t(c)])])) return false;
     }
@@ -459,6 +470,10 @@ bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::ar
 int chainStretch(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows, int x,
                  int end, ps11::ChainRowTap* taps) {
     for (int t = 0; t < draw.plan.count; ++t) {
+        if (!draw.taps[size_t(t)].bound) {
+            taps[t] = ps11::ChainRowTap{unboundRow(), false};
+            continue;
+        }
         const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
         const int32_t r = cols.run[size_t(x - tri.x0)];
         if (r < 0) return x;

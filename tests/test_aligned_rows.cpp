@@ -453,7 +453,8 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
     // the target or added to it (ONE/ONE), into A8R8G8B8 or X8R8G8B8, every address mode (the
     // columns at the edges read clamped, wrapped or border texels: filtered per pixel between the
     // chain rows), rows wider than a span, a scissor now and then; and now and then a constant
-    // with a negative channel or a swizzled tap, which are no chain.
+    // with a negative channel or a swizzled tap, which are no chain; a stage without a texture
+    // (the glow's last pass of fewer taps).
     std::mt19937 rng(20261130);
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     const char* programs[] = {
@@ -483,6 +484,7 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
         t.border = DWORD(rng());
         c.tex.assign(4, t);
         c.oneTexture = true;
+        c.tex[3].bound = uni(0, 3) != 0;  // a last pass of fewer taps: stage 3 reads (0, 0, 0, 1)
         c.program = programs[size_t(uni(0, int(std::size(programs)) - 1))];
         for (auto& k : c.consts)
             for (float& v : k) v = float(uni(0, 16)) / 16.0f;
