@@ -488,6 +488,50 @@ int chainStretch(const AlignedDraw& draw, const AlignedTriangle& tri, const std:
     return end;
 }
 
+// Tap t's texels of columns [x, x + n) (n <= kMaxSpan) as a texel row of their own, for chain
+// rows at weight 0: its chain runs' texels copied (halfway taps' rounded means of each texel and
+// the next), the columns between them filtered per pixel (filterTap); a tap without a texture's
+// (0, 0, 0, 1) row.
+const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
+                          int t, int x, int n, AlignedScratch& sc) {
+    const AlignedTap& tap = draw.taps[size_t(t)];
+    if (!tap.bound) return unboundRow();
+    const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+    const TapRow& row = rows[size_t(t)];
+    uint8_t* const out = sc.tapBytes[t];
+    auto chainRun = [&](int c) -> const AlignedTriangle::Run* {
+        const int32_t r = cols.run[size_t(c - tri.x0)];
+        if (r < 0) return nullptr;
+        const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+        return !run.tabulated && chainConfig(tri.configs[size_t(cols.configs[size_t(run.config)])]) ? &run : nullptr;
+    };
+    for (int c = x; c < x + n;) {
+        uint8_t* dst = out + 4 * size_t(c - x);
+        if (const AlignedTriangle::Run* run = chainRun(c)) {
+            const int e = std::min(x + n, int(run->x1));
+            const uint8_t* src = row.row0 + cols.off0[size_t(c - tri.x0)];
+            if (tri.configs[size_t(cols.configs[size_t(run->config)])].wx == 0) {
+                std::memcpy(dst, src, 4 * size_t(e - c));
+            } else {
+                for (int i = 0; i < 4 * (e - c); ++i) {  // round_half_even((a + b) / 2)
+                    const int sum = src[i] + src[i + 4];
+                    dst[i] = uint8_t((sum + ((sum >> 1) & 1)) >> 1);
+                }
+            }
+            c = e;
+            continue;
+        }
+        int e = c + 1;
+        while (e < x + n && !chainRun(e)) ++e;
+        int16_t* const planes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
+        filterTap(draw.kernels, false, tap, cols, row, tri.x0, c, e - c, planes);
+        for (int i = 0; i < e - c; ++i)
+            for (int ch = 0; ch < 4; ++ch) dst[4 * i + ps11::kUnorm8Byte[ch]] = uint8_t(sc.r0[ch][i]);
+        c = e;
+    }
+    return out;
+}
+
 // Takes a slot for (row, key), whose hash `h` no slot has: the next slot, round the slots from
 // the last one taken, used on neither the current pixel row (so every pointer handed out for a
 // row stays valid until the next row) nor the one before, or a new one.
@@ -894,26 +938,15 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
                     if (mode == RowMode::Shade && chain) {
-                        // Chain rows over the stretches where every tap lies in a chain run; the
-                        // columns between them (a border's) pre-sampled pixel by pixel.
+                        // Chain rows, the taps read from their texel rows where every tap's chain
+                        // run covers the columns, else each from a row of its own (patchedRow: a
+                        // horizontal blur's taps at a clamped or bordered edge).
                         ps11::ChainRowTap chainTaps[8];
-                        for (int c = x; c < x + n;) {
-                            int e = chainStretch(draw, tri, rows, c, x + n, chainTaps);
-                            if (e > c) {
-                                ps11::runChainRow(exec, chainTaps, e - c, sc.bytes, &stats.exec);
-                                storeWords(sc.bytes, e - c, ~0u, orMask, draw.directAdd,
-                                           target.texel(uint32_t(c), uint32_t(y)));
-                                c = e;
-                                continue;
-                            }
-                            e = c + 1;
-                            while (e < x + n && chainStretch(draw, tri, rows, e, x + n, chainTaps) == e) ++e;
-                            in.count = e - c;
-                            ctx.x = c;
-                            ctx.out = target.texel(uint32_t(c), uint32_t(y));
-                            ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
-                            c = e;
-                        }
+                        if (chainStretch(draw, tri, rows, x, x + n, chainTaps) < x + n)
+                            for (int t = 0; t < taps; ++t)
+                                chainTaps[t] = ps11::ChainRowTap{patchedRow(draw, tri, rows, t, x, n, sc), false};
+                        ps11::runChainRow(exec, chainTaps, n, sc.bytes, &stats.exec);
+                        storeWords(sc.bytes, n, ~0u, orMask, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
                         stats.pixels += uint64_t(n);
                         stats.written += uint64_t(n);
                         continue;
