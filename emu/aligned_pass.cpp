@@ -81,18 +81,20 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
     }
 }
 
+// The words' bytes added one by one, each sum saturated to 255 (ONE/ONE ADD into an 8-bit target).
+inline uint32_t addBytesSaturated(uint32_t a, uint32_t b) {
+    uint32_t s = 0;
+    for (int k = 0; k < 4; ++k)
+        s |= std::min<uint32_t>(((a >> (8 * k)) & 0xff) + ((b >> (8 * k)) & 0xff), 255u) << (8 * k);
+    return s;
+}
+
 template <bool Additive>
 void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
     for (int i = 0; i < count; ++i) {
         auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
         uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
-        if constexpr (Additive) {
-            const uint32_t old = load32(dst + 4 * i);
-            uint32_t s = 0;
-            for (int k = 0; k < 4; ++k)
-                s |= std::min<uint32_t>(((w >> (8 * k)) & 0xff) + ((old >> (8 * k)) & 0xff), 255u) << (8 * k);
-            w = s;
-        }
+        if constexpr (Additive) w = addBytesSaturated(w, load32(dst + 4 * i));
         std::memcpy(dst + 4 * i, &w, 4);
     }
 }
@@ -165,13 +167,7 @@ void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool add
 #endif
     for (; i < n; ++i) {
         uint32_t w = (load32(src + 4 * i) & keep) | set;
-        if (additive) {
-            const uint32_t old = load32(dst + 4 * i);
-            uint32_t sum = 0;
-            for (int b = 0; b < 4; ++b)
-                sum |= std::min<uint32_t>(((w >> (8 * b)) & 0xff) + ((old >> (8 * b)) & 0xff), 255u) << (8 * b);
-            w = sum;
-        }
+        if (additive) w = addBytesSaturated(w, load32(dst + 4 * i));
         std::memcpy(dst + 4 * i, &w, 4);
     }
 }

@@ -382,6 +382,44 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 4x, 8x, 16x, non-integer) equal
     CHECK(aligned * 10 >= cases * 9);
 }
 
+namespace {
+
+// A quad over the whole c.w × c.h target whose stage s reads texture t 1:1, its texel offset by
+// (dx[s], dy[s]) texels.
+void screenQuad(Case& c, const Case::Tex& t, const float dx[4], const float dy[4]) {
+    const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+    const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+    for (int k : {0, 1, 2, 0, 2, 3}) {
+        Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
+        for (int s = 0; s < 4; ++s) {
+            q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + dx[s] / float(t.w);
+            q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + dy[s] / float(t.h);
+        }
+        c.verts.push_back(q);
+    }
+}
+
+// Case i drawn by a device with the row paths off, then at every SIMD level by one with them on
+// (tile skipping off, 1 or 2 threads): the same bytes, and every pixel drawn by a row path.
+void rowPathEqualsQuads(const Case& c, int i) {
+    DeviceOptions quadOpt, rowOpt;
+    quadOpt.software.alignedPasses = false;
+    quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+    rowOpt.software.skipTiles = false;
+    Device quadDev(quadOpt);
+    DrawStats qs;
+    const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+        Device rowDev(rowOpt);
+        DrawStats rs;
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        CHECK(rs.pixelsRowPath == rs.pixelsCovered);
+        CHECK(rs.pixelsShaded == rs.pixelsCovered);  // no helper lanes
+    });
+}
+
+}  // namespace
+
 TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel blur) equal the quad path",
           "[draw][aligned]") {
     // Four taps of one texture at (−½, −½), (+½, −½), (−½, +½), (+½, +½) texels plus a common
@@ -413,36 +451,16 @@ TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel b
         for (auto& k : c.consts)
             for (float& v : k) v = float(uni(0, 8)) / 16.0f;
         const float ox = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f, oy = float(uni(0, 1) ? 0 : uni(-7, 7)) / 8.0f;
-        const float dx[4] = {-0.5f, 0.5f, -0.5f, 0.5f}, dy[4] = {-0.5f, -0.5f, 0.5f, 0.5f};
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
-            for (int s = 0; s < 4; ++s) {
-                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (dx[s] + ox) / float(t.w);
-                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (dy[s] + oy) / float(t.h);
-            }
-            c.verts.push_back(q);
-        }
+        const float dx[4] = {-0.5f + ox, 0.5f + ox, -0.5f + ox, 0.5f + ox};
+        const float dy[4] = {-0.5f + oy, -0.5f + oy, 0.5f + oy, 0.5f + oy};
+        screenQuad(c, t, dx, dy);
         c.blend = DWORD(uni(0, 1));
         // A scissor rectangle now and then: spans that start and end anywhere.
         c.scissor = uni(0, 2) == 0;
         c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
-        DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        rowOpt.software.skipTiles = false;
-        Device quadDev(quadOpt);
-        DrawStats qs;
-        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
         INFO("case " << i << ": " << c.w << "x" << c.h << ", scale " << scale << ", offset " << ox << ", " << oy
                      << (c.scissor ? ", scissor" : ""));
-        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-            Device rowDev(rowOpt);
-            DrawStats rs;
-            REQUIRE(drawCase(rowDev, c, rs) == expected);
-            CHECK(rs.pixelsShaded == rs.pixelsCovered);  // the row path drew it
-        });
+        rowPathEqualsQuads(c, i);
     }
 }
 
@@ -489,35 +507,18 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
         for (auto& k : c.consts)
             for (float& v : k) v = float(uni(0, 16)) / 16.0f;
         if (uni(0, 7) == 0) c.consts[uni(0, 3)][uni(0, 3)] = -float(uni(1, 16)) / 16.0f;
-        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-        for (int k : {0, 1, 2, 0, 2, 3}) {
-            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
-            for (int s = 0; s < 4; ++s) {
-                const float o = float(s - 2) + (half ? 0.5f : 0.0f);  // taps at −2, −1, 0, +1 (+½)
-                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (horizontal ? o : 0.0f) / float(t.w);
-                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (horizontal ? 0.0f : o) / float(t.h);
-            }
-            c.verts.push_back(q);
+        float dx[4], dy[4];  // taps at −2, −1, 0, +1 (+½)
+        for (int s = 0; s < 4; ++s) {
+            const float o = float(s - 2) + (half ? 0.5f : 0.0f);
+            dx[s] = horizontal ? o : 0.0f, dy[s] = horizontal ? 0.0f : o;
         }
+        screenQuad(c, t, dx, dy);
         c.blend = DWORD(uni(0, 1));
         c.scissor = uni(0, 3) == 0;
         c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
-        DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
-        rowOpt.software.skipTiles = false;
         INFO("case " << i << ": " << c.w << "x" << c.h << (horizontal ? ", along a row" : ", along a column")
                      << (half ? ", halfway" : "") << ", " << c.program << (c.scissor ? ", scissor" : ""));
-        Device quadDev(quadOpt);
-        DrawStats qs;
-        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-        testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-            Device rowDev(rowOpt);
-            DrawStats rs;
-            REQUIRE(drawCase(rowDev, c, rs) == expected);
-            CHECK(rs.pixelsRowPath == rs.pixelsCovered);
-        });
+        rowPathEqualsQuads(c, i);
     }
 }
 
