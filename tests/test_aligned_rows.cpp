@@ -399,13 +399,14 @@ void screenQuad(Case& c, const Case::Tex& t, const float dx[4], const float dy[4
     }
 }
 
-// Case i drawn by a device with the row paths off, then at every SIMD level by one with them on
-// (tile skipping off, 1 or 2 threads): the same bytes, and every pixel drawn by a row path.
-void rowPathEqualsQuads(const Case& c, int i) {
+// The case drawn in quads and on the row path (tiles not decided) at every SIMD level: the same
+// bytes, every covered pixel shaded in rows.
+void requireRowsAtEveryLevel(const Case& c, ps11::Precision precision, int threads) {
     DeviceOptions quadOpt, rowOpt;
     quadOpt.software.alignedPasses = false;
-    quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
     rowOpt.software.skipTiles = false;
+    quadOpt.precision = rowOpt.precision = precision;
+    quadOpt.software.threads = rowOpt.software.threads = threads;
     Device quadDev(quadOpt);
     DrawStats qs;
     const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
@@ -414,7 +415,7 @@ void rowPathEqualsQuads(const Case& c, int i) {
         DrawStats rs;
         REQUIRE(drawCase(rowDev, c, rs) == expected);
         CHECK(rs.pixelsRowPath == rs.pixelsCovered);
-        CHECK(rs.pixelsShaded == rs.pixelsCovered);  // no helper lanes
+        CHECK(rs.pixelsShaded == rs.pixelsCovered);
     });
 }
 
@@ -460,7 +461,7 @@ TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel b
         c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
         INFO("case " << i << ": " << c.w << "x" << c.h << ", scale " << scale << ", offset " << ox << ", " << oy
                      << (c.scissor ? ", scissor" : ""));
-        rowPathEqualsQuads(c, i);
+        requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
     }
 }
 
@@ -518,7 +519,7 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
         c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
         INFO("case " << i << ": " << c.w << "x" << c.h << (horizontal ? ", along a row" : ", along a column")
                      << (half ? ", halfway" : "") << ", " << c.program << (c.scissor ? ", scissor" : ""));
-        rowPathEqualsQuads(c, i);
+        requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
     }
 }
 
@@ -845,36 +846,10 @@ Case reductionCase(std::mt19937& rng, UINT w, UINT h, int scale, DWORD filter, D
                 "mad r0, t1, c0, r0\nmad r0, t2, c0, r0\nmad r0, t3, c0, r0\n";
     c.blend = blend, c.alphaTest = false, c.writeMask = 0xf, c.scissor = false;
     c.verts.clear();
-    const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
-    const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
-    for (int k : {0, 1, 2, 0, 2, 3}) {
-        Vtx v{xs[k], ys[k], 0.5f, 1.0f, 0xffffffff, 0xff000000u, {}};
-        for (int s = 0; s < 4; ++s) {
-            v.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + offsets[s][0] / float(c.tex[0].w);
-            v.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + offsets[s][1] / float(c.tex[0].h);
-        }
-        c.verts.push_back(v);
-    }
+    const float dx[4] = {offsets[0][0], offsets[1][0], offsets[2][0], offsets[3][0]};
+    const float dy[4] = {offsets[0][1], offsets[1][1], offsets[2][1], offsets[3][1]};
+    screenQuad(c, c.tex[0], dx, dy);
     return c;
-}
-
-// The case drawn in quads and on the row path (tiles not decided) at every SIMD level: the same
-// bytes, every covered pixel shaded in rows.
-void requireRowsAtEveryLevel(const Case& c, ps11::Precision precision, int threads) {
-    DeviceOptions quadOpt, rowOpt;
-    quadOpt.software.alignedPasses = false;
-    rowOpt.software.skipTiles = false;
-    quadOpt.precision = rowOpt.precision = precision;
-    quadOpt.software.threads = rowOpt.software.threads = threads;
-    Device quadDev(quadOpt);
-    DrawStats qs;
-    const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
-    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
-        Device rowDev(rowOpt);
-        DrawStats rs;
-        REQUIRE(drawCase(rowDev, c, rs) == expected);
-        CHECK(rs.pixelsShaded == rs.pixelsCovered);
-    });
 }
 
 }  // namespace
