@@ -1,10 +1,11 @@
-// The fx8 fast path of the executor: registers as int16 lanes (16 per AVX2 register), sources
-// fetched as k = a·n + b in int16, products and sums of products formed exactly in int32 by
-// pmaddwd, then the one round-half-even of docs/precision.md done with integer and float
-// operations whose exactness is proven over the whole input range (tests/test_executor_fast.cpp).
-// It gives results bit-identical to the generic int32/int64 path (executor_arith_fx.inc), which
-// stays the reference and runs whatever the fast path does not cover. The kernels are compiled
-// twice (executor_fast_sse2.cpp for any x86-64, executor_fast_avx2.cpp for the Avx2 level) and
+// The fx8 fast path of the executor: registers as int16 lanes (16 per AVX2 register, 32 per
+// AVX-512 one), sources fetched as k = a·n + b in int16, products and sums of products formed
+// exactly in int32 by pmaddwd, then the one round-half-even of docs/precision.md done with
+// integer and float operations whose exactness is proven over the whole input range
+// (tests/test_executor_fast.cpp). It gives results bit-identical to the generic int32/int64 path
+// (executor_arith_fx.inc), which stays the reference and runs whatever the fast path does not
+// cover. The kernels (executor_fast_kernels.inc) are compiled once per SIMD level
+// (executor_fast_sse2.cpp for any x86-64, executor_fast_avx2.cpp, executor_fast_avx512.cpp) and
 // fetched per run from fastKernels(simdLevel()) (ps11/simd_dispatch.h). Not part of the public API.
 #pragma once
 
