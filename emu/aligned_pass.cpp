@@ -486,7 +486,8 @@ int chainStretch(const AlignedDraw& draw, const AlignedTriangle& tri, const std:
 
 // Tap t's texels of columns [x, x + n) (n <= kMaxSpan) as a texel row of their own, for chain
 // rows at weight 0: its chain runs' texels copied (halfway taps' rounded means of each texel and
-// the next), the columns between them filtered per pixel (filterTap); a tap without a texture's
+// the next), each column between them at horizontal weight 0 its one texel (or the border
+// colour's bytes), the others filtered per pixel (filterTap); a tap without a texture's
 // (0, 0, 0, 1) row.
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
                           int t, int x, int n, AlignedScratch& sc) {
@@ -517,8 +518,17 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
             c = e;
             continue;
         }
+        // A column at horizontal weight 0 reads one texel (or the border); the others are
+        // filtered per pixel.
+        const size_t k = size_t(c - tri.x0);
+        if (cols.w[k] == 0) {
+            const uint32_t word = cols.off0[k] >= 0 ? load32(row.row0 + cols.off0[k]) : tap.borderWord;
+            std::memcpy(dst, &word, 4);
+            ++c;
+            continue;
+        }
         int e = c + 1;
-        while (e < x + n && !chainRun(e)) ++e;
+        while (e < x + n && !chainRun(e) && cols.w[size_t(e - tri.x0)] != 0) ++e;
         int16_t* const planes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
         filterTap(draw.kernels, false, tap, cols, row, tri.x0, c, e - c, planes);
         for (int i = 0; i < e - c; ++i)
