@@ -445,50 +445,55 @@ const uint8_t* unboundRow() {
     return row.data();
 }
 
-// Whether chain rows can read every tap on this row: each without a texture, or with tables
-// whose every configuration is a chain one and its texel row at hand at vertical weight 0. (At
-// weight 128 the H rows, shared by the taps and rows that read a texel row, cost less than
-// reading the texel rows again per tap: Sousa's pinwheel passes.)
+// Whether chain rows run this row: every tap is filtered on the row path (none is sampled per
+// pixel at its quads' levels), and one reads a texel row as it lies (a chain configuration at
+// vertical weight 0: what saves the r g b a planes). Where every tap is blended from H rows (a
+// magnified tap, Sousa's pinwheel at vertical weight 128), blending them into planes, as the
+// pre-sampled run takes them, costs less than into words.
 bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows) {
+    bool asItLies = false;
     for (int t = 0; t < draw.plan.count; ++t) {
+        if (!draw.taps[size_t(t)].bound) continue;
+        if ((tri.freeTaps >> t) & 1) return false;
         const TapRow& r = rows[size_t(t)];
         const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
-        if (!draw.taps[size_t(t)].bound) continue;
-        if (((tri.freeTaps >> t) & 1) || !r.row0 || r.wy != 0) return false;
-        for (int c = 0; c < cols.configCount; ++c)
-            if (!chainConfig(tri.configs[size_t(cols.configs[size_t(c)])])) return false;
+        for (int c = 0; c < cols.configCount && !asItLies; ++c)
+            asItLies = r.row0 && r.wy == 0 && chainConfig(tri.configs[size_t(cols.configs[size_t(c)])]);
     }
+    return asItLies;
+}
+
+// Whether tap t's run at column c is read from its texel row as it lies: a chain configuration's
+// run at vertical weight 0 (those have no H rows on chain rows).
+const AlignedTriangle::Run* chainRun(const AlignedTriangle& tri, const AlignedTriangle::Columns& cols,
+                                     const TapRow& row, int c) {
+    const int32_t r = cols.run[size_t(c - tri.x0)];
+    if (r < 0 || !row.row0 || row.wy != 0) return nullptr;
+    const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+    return !run.tabulated && chainConfig(tri.configs[size_t(cols.configs[size_t(run.config)])]) ? &run : nullptr;
+}
+
+// Tap t of columns [x, x + n) straight from its texel row, where one chain run covers them all.
+bool directTap(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows, int t, int x,
+               int n, ps11::ChainRowTap& tap) {
+    if (!draw.taps[size_t(t)].bound) {
+        tap = ps11::ChainRowTap{unboundRow(), false};
+        return true;
+    }
+    const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+    const TapRow& row = rows[size_t(t)];
+    const AlignedTriangle::Run* run = chainRun(tri, cols, row, x);
+    if (!run || int(run->x1) < x + n) return false;
+    const HConfig& h = tri.configs[size_t(cols.configs[size_t(run->config)])];
+    tap = ps11::ChainRowTap{row.row0 + cols.off0[size_t(x - tri.x0)], h.wx != 0};
     return true;
 }
 
-// The columns [x, e) (e <= end) where every tap lies in one run of a chain configuration, with
-// each tap's texels at column x in `taps`: e, or x where column x does not qualify.
-int chainStretch(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows, int x,
-                 int end, ps11::ChainRowTap* taps) {
-    for (int t = 0; t < draw.plan.count; ++t) {
-        if (!draw.taps[size_t(t)].bound) {
-            taps[t] = ps11::ChainRowTap{unboundRow(), false};
-            continue;
-        }
-        const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
-        const int32_t r = cols.run[size_t(x - tri.x0)];
-        if (r < 0) return x;
-        const AlignedTriangle::Run& run = cols.runs[size_t(r)];
-        const HConfig& h = tri.configs[size_t(cols.configs[size_t(run.config)])];
-        if (run.tabulated || !chainConfig(h)) return x;
-        const TapRow& row = rows[size_t(t)];
-        const size_t o = size_t(cols.off0[size_t(x - tri.x0)]);
-        taps[t] = ps11::ChainRowTap{row.row0 + o, h.wx != 0};
-        end = std::min(end, int(run.x1));
-    }
-    return end;
-}
-
-// Tap t's texels of columns [x, x + n) (n <= kMaxSpan) as a texel row of their own, for chain
-// rows at weight 0: its chain runs' texels copied (halfway taps' rounded means of each texel and
-// the next), each column between them at horizontal weight 0 its one texel (or the border
-// colour's bytes), the others filtered per pixel (filterTap); a tap without a texture's
-// (0, 0, 0, 1) row.
+// Tap t's filtered texels of columns [x, x + n) (n <= kMaxSpan) as a row of words of its own, for
+// chain rows: chain runs at vertical weight 0 copied from the texel row (halfway taps' rounded
+// means of each texel and the next), runs with H rows blended into words (verticalBytes), each
+// other column at weight 0 both ways its one texel (or the border colour's bytes), the rest
+// filtered per pixel (filterTap).
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
                           int t, int x, int n, AlignedScratch& sc) {
     const AlignedTap& tap = draw.taps[size_t(t)];
@@ -496,15 +501,16 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
     uint8_t* const out = sc.tapBytes[t];
-    auto chainRun = [&](int c) -> const AlignedTriangle::Run* {
+    auto blendRun = [&](int c) -> const AlignedTriangle::Run* {
         const int32_t r = cols.run[size_t(c - tri.x0)];
         if (r < 0) return nullptr;
         const AlignedTriangle::Run& run = cols.runs[size_t(r)];
-        return !run.tabulated && chainConfig(tri.configs[size_t(cols.configs[size_t(run.config)])]) ? &run : nullptr;
+        return row.ready[size_t(run.config)] && !row.direct[size_t(run.config)] ? &run : nullptr;
     };
+    auto onePoint = [&](int c) { return row.wy == 0 && row.row0 && cols.w[size_t(c - tri.x0)] == 0; };
     for (int c = x; c < x + n;) {
         uint8_t* dst = out + 4 * size_t(c - x);
-        if (const AlignedTriangle::Run* run = chainRun(c)) {
+        if (const AlignedTriangle::Run* run = chainRun(tri, cols, row, c)) {
             const int e = std::min(x + n, int(run->x1));
             const uint8_t* src = row.row0 + cols.off0[size_t(c - tri.x0)];
             if (tri.configs[size_t(cols.configs[size_t(run->config)])].wx == 0) {
@@ -518,20 +524,34 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
             c = e;
             continue;
         }
-        // A column at horizontal weight 0 reads one texel (or the border); the others are
-        // filtered per pixel.
-        const size_t k = size_t(c - tri.x0);
-        if (cols.w[k] == 0) {
+        if (const AlignedTriangle::Run* run = blendRun(c)) {
+            const int e = std::min(x + n, int(run->x1));
+            const int j = run->j0 + (c - run->x0);
+            const TapRow::Planes& p0 = row.h0[size_t(run->config)];
+            const TapRow::Planes& p1 = row.h1[size_t(run->config)];
+            const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
+            const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
+                                           row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
+            const HKind kind = run->tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H)
+                                              : hKindOf(cols.w[size_t(c - tri.x0)]);
+            draw.kernels->verticalBytes(kind, h0, h1, row.wy, e - c, dst);
+            c = e;
+            continue;
+        }
+        if (onePoint(c)) {
+            const size_t k = size_t(c - tri.x0);
             const uint32_t word = cols.off0[k] >= 0 ? load32(row.row0 + cols.off0[k]) : tap.borderWord;
             std::memcpy(dst, &word, 4);
             ++c;
             continue;
         }
         int e = c + 1;
-        while (e < x + n && !chainRun(e) && cols.w[size_t(e - tri.x0)] != 0) ++e;
+        while (e < x + n && !chainRun(tri, cols, row, e) && !blendRun(e) && !onePoint(e)) ++e;
         int16_t* const planes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
         filterTap(draw.kernels, false, tap, cols, row, tri.x0, c, e - c, planes);
-        for (int i = 0; i < e - c; ++i)
+        const int16_t* const lanes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
+        const int stored = draw.kernels->storeRow(false, lanes, e - c, 0, dst);
+        for (int i = stored; i < e - c; ++i)
             for (int ch = 0; ch < 4; ++ch) dst[4 * i + ps11::kUnorm8Byte[ch]] = uint8_t(sc.r0[ch][i]);
         c = e;
     }
@@ -885,7 +905,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     setTapRow(r, tap, tapV[t]);
                 }
             }
-            // Chain rows read the texel rows of chain configurations' runs: those need no H rows.
+            // Chain rows read the texel rows of chain configurations' runs at vertical weight 0:
+            // those need no H rows.
             const bool chain = draw.chainRows && shadesOnly && chainRow(draw, tri, rows);
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
@@ -897,7 +918,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 for (int c = 0; c < cols.configCount; ++c) {
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     const HConfig& h = tri.configs[ci];
-                    r.ready[size_t(c)] = rowsOk && !(chain && chainConfig(h));
+                    r.ready[size_t(c)] = rowsOk && !(chain && r.wy == 0 && chainConfig(h));
                     if (!r.ready[size_t(c)]) continue;
                     r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
                     if (r.direct[size_t(c)]) continue;
@@ -944,15 +965,15 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
                     if (mode == RowMode::Shade && chain) {
-                        // Chain rows, the taps read from their texel rows where every tap's chain
-                        // run covers the columns, else each from a row of its own (patchedRow: a
-                        // horizontal blur's taps at a clamped or bordered edge).
+                        // Chain rows, each tap read from its texel row where a chain run covers
+                        // the columns, else from a row of its own (patchedRow: a magnified or
+                        // blended tap, a horizontal blur's taps at a clamped or bordered edge).
                         ps11::ChainRowTap chainTaps[8];
-                        if (chainStretch(draw, tri, rows, x, x + n, chainTaps) < x + n)
-                            for (int t = 0; t < taps; ++t)
+                        for (int t = 0; t < taps; ++t)
+                            if (!directTap(draw, tri, rows, t, x, n, chainTaps[t]))
                                 chainTaps[t] = ps11::ChainRowTap{patchedRow(draw, tri, rows, t, x, n, sc), false};
-                        ps11::runChainRow(exec, chainTaps, n, sc.bytes, &stats.exec);
-                        storeWords(sc.bytes, n, ~0u, orMask, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
+                        ps11::runChainRow(exec, chainTaps, n, target.texel(uint32_t(x), uint32_t(y)),
+                                          ps11::ChainRowStore{orMask, draw.directAdd}, &stats.exec);
                         stats.pixels += uint64_t(n);
                         stats.written += uint64_t(n);
                         continue;

@@ -271,8 +271,8 @@ struct AlignedScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
-    alignas(32) uint8_t bytes[4 * ps11::kMaxSpan];             // chain rows' r0 (AlignedDraw::chainRows)
-    alignas(32) uint8_t tapBytes[8][4 * ps11::kMaxSpan];       // chain rows' taps filtered per pixel
+    // Chain rows' taps formed into rows of their own (with room for verticalBytes' whole groups).
+    alignas(32) uint8_t tapBytes[8][4 * (ps11::kMaxSpan + 32)];
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps
     // whose level the level of detail picks on triangles where they are sampled per pixel, at
     // their quads' levels (SampleRequest::levels). Set by the caller before drawAlignedRows.

@@ -290,8 +290,6 @@ inline VI roundToInt(VF v) { return _mm256_cvtps_epi32(v); }
 inline VF cvtf(VI v) { return _mm256_cvtepi32_ps(v); }
 inline VF fmaddf(VF a, VF b, VF c) { return _mm256_fmadd_ps(a, b, c); }
 
-#include "emu/aligned_vertical.inc"
-
 // 16 pixels' words (b g r a bytes, `om` or-ed in) from int16 r g b a lanes, each clamped to
 // [0, 255]: pixels 0-7 in `first`, 8-15 in `second`.
 inline void packWords(__m256i r, __m256i g, __m256i b, __m256i a, __m256i om, __m256i& first, __m256i& second) {
@@ -305,6 +303,21 @@ inline void packWords(__m256i r, __m256i g, __m256i b, __m256i a, __m256i om, __
     first = _mm256_permute2x128_si256(w0, w1, 0x20);                            // px 0-7
     second = _mm256_permute2x128_si256(w0, w1, 0x31);                           // px 8-15
 }
+
+// Every group of 16 lanes of every channel as 16 b g r a words at out + 4k (whole groups: up to
+// 15 words past the count).
+template <typename F>
+inline void bytesGroups(int count, uint8_t* out, F f) {
+    const __m256i none = _mm256_setzero_si256();
+    for (int k = 0; k < count; k += 16) {
+        __m256i first, second;
+        packWords(f(0, k), f(1, k), f(2, k), f(3, k), none, first, second);
+        storeu(out + 4 * k, first);
+        storeu(out + 4 * k + 32, second);
+    }
+}
+
+#include "emu/aligned_vertical.inc"
 
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
@@ -399,7 +412,7 @@ int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, u
 }  // namespace
 
 const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2,   &alignedPairSums4Avx2,
-                                    &alignedBuildTabulatedAvx2, &verticalBlend,        &verticalBlend12,
+                                    &alignedBuildTabulatedAvx2, &verticalBlend,        &verticalBlend12,       &verticalBytes,
                                     &alignedStoreRowAvx2,       &alignedStoreRow12Avx2};
 
 }  // namespace emu

@@ -1,4 +1,4 @@
-// The aligned-pass kernels at the Avx512 level (emu/aligned_pass_kernels.h): the vertical blend
+// The aligned-pass kernels at the Avx512 level (emu/aligned_pass_kernels.h): the vertical blends
 // and the texel rows' deinterleave 32 lanes a step; every other kernel is the Avx2 level's.
 // CMakeLists.txt builds this file with the Avx2 level's flags and AVX-512 F, DQ, BW and VL on
 // x86-64 only; alignedKernels() hands the table out only where the CPU runs that level.
@@ -87,6 +87,25 @@ inline VI roundToInt(VF v) { return _mm512_cvtps_epi32(v); }
 inline VF cvtf(VI v) { return _mm512_cvtepi32_ps(v); }
 inline VF fmaddf(VF a, VF b, VF c) { return _mm512_fmadd_ps(a, b, c); }
 
+// Every group of 32 lanes of every channel as 32 b g r a words at out + 4k (whole groups: up to
+// 31 words past the count).
+template <typename F>
+inline void bytesGroups(int count, uint8_t* out, F f) {
+    const __m512i firstHalf = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
+    const __m512i secondHalf = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+    for (int k = 0; k < count; k += 32) {
+        // packus per 128-bit lane j: b(8j .. 8j + 7) then g likewise; r and a the same.
+        const __m512i bg = _mm512_packus_epi16(f(2, k), f(1, k));
+        const __m512i ra = _mm512_packus_epi16(f(0, k), f(3, k));
+        const __m512i bgPairs = _mm512_unpacklo_epi8(bg, _mm512_bsrli_epi128(bg, 8));  // b g b g ...
+        const __m512i raPairs = _mm512_unpacklo_epi8(ra, _mm512_bsrli_epi128(ra, 8));
+        const __m512i w0 = _mm512_unpacklo_epi16(bgPairs, raPairs);  // lane j: pixels 8j .. 8j + 3
+        const __m512i w1 = _mm512_unpackhi_epi16(bgPairs, raPairs);  // 8j + 4 .. 8j + 7
+        _mm512_storeu_si512(out + 4 * k, _mm512_permutex2var_epi64(w0, firstHalf, w1));
+        _mm512_storeu_si512(out + 4 * k + 64, _mm512_permutex2var_epi64(w0, secondHalf, w1));
+    }
+}
+
 #include "emu/aligned_vertical.inc"
 
 }  // namespace
@@ -97,6 +116,7 @@ const AlignedKernels& avx512::alignedTable() {
         k.deinterleave = &alignedDeinterleaveAvx512;
         k.vertical = &verticalBlend;
         k.vertical12 = &verticalBlend12;
+        k.verticalBytes = &verticalBytes;
         return k;
     }();
     return table;

@@ -70,6 +70,10 @@ struct AlignedKernels {
     void (*vertical12)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                        int lane, int16_t* const out[4]);
 
+    // vertical's blends (fx8) as b g r a words at out[0 .. count), in whole groups of lanes: up to
+    // 31 words past the count are written too.
+    void (*verticalBytes)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
+                          uint8_t* out);
     // Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
     // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
     // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes

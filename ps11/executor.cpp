@@ -97,8 +97,9 @@ public:
     void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
                        ExecutorStats* stats) const;
     bool chainRows() const { return m_chainRows.ready; }
-    void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, ExecutorStats* stats) const {
-        exec::runChainRow(m_chainRows, m_presampled, taps, count, out);
+    void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, const ChainRowStore& store,
+                     ExecutorStats* stats) const {
+        exec::runChainRow(m_chainRows, m_presampled, taps, count, out, store);
         countRun(stats, std::clamp(count, 0, kMaxSpan));
     }
 
@@ -617,8 +618,9 @@ bool chainRows(const Executor& executor) {
     return static_cast<const exec::ExecutorImpl&>(executor).chainRows();
 }
 
-void runChainRow(const Executor& executor, const ChainRowTap* taps, int count, uint8_t* out, ExecutorStats* stats) {
-    static_cast<const exec::ExecutorImpl&>(executor).runChainRow(taps, count, out, stats);
+void runChainRow(const Executor& executor, const ChainRowTap* taps, int count, uint8_t* out,
+                 const ChainRowStore& store, ExecutorStats* stats) {
+    static_cast<const exec::ExecutorImpl&>(executor).runChainRow(taps, count, out, store, stats);
 }
 
 }  // namespace ps11

@@ -354,7 +354,7 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
         const DOp& d = ops[i];
         if (d.op == Opcode::Phase) continue;
         if (d.texture) {
-            if (head >= 0) return;  // a read after the chain began
+            if (head >= 0) return;  // a read after the arithmetic began
             tapOf[d.dstSlot] = int8_t(taps++);
             continue;
         }
@@ -362,34 +362,57 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
             if (!ops2[i].inChain) return;  // arithmetic outside the chain
             continue;
         }
-        if (ops2[i].chain == 0) return;
         head = int(i);
     }
-    if (head < 0) return;
-    const int count = ops2[size_t(head)].chain;
-    if (ops2[size_t(head)].dst != kSlotR || ops2[size_t(head)].mask != kMaskAll) return;
+    if (head < 0 || taps > 8) return;
+    const FastOp& first = ops2[size_t(head)];
+    // A chain, or one small non-negative product on its own.
+    const bool single = first.chain == 0;
+    if (single && !(first.small && first.nonNegative && (first.kind == FastKind::Mul || first.kind == FastKind::Mad)))
+        return;
+    if (first.dst != kSlotR || first.mask != kMaskAll) return;
+    const std::array<uint8_t, 4> identity{0, 1, 2, 3};
+    auto code = [&](const FastSrc& src, int8_t& c) {
+        if (src.sw != identity) return false;
+        if (src.slot >= kFastConstSlot) {
+            c = int8_t(-1 - (src.slot - kFastConstSlot));
+            return true;
+        }
+        c = tapOf[src.slot];
+        return c >= 0;
+    };
+    const int count = single ? 1 : first.chain;
     for (int k = 0; k < count; ++k) {
         const FastOp& f = ops2[size_t(head + k)];
-        for (int s = 0; s < 2; ++s) {
-            const FastSrc& src = f.src[size_t(s)];
-            if (src.sw != std::array<uint8_t, 4>{0, 1, 2, 3}) return;
-            int8_t code = 0;
-            if (src.slot >= kFastConstSlot) {
-                code = int8_t(-1 - (src.slot - kFastConstSlot));
-            } else if (tapOf[src.slot] >= 0) {
-                code = tapOf[src.slot];
-            } else {
-                return;
-            }
-            out.factor[size_t(k)][size_t(s)] = code;
+        if (f.lo > 0 || f.hi < 0) return;  // (no modifier clamps so: the kernels leave out the lower clamp)
+        int8_t c0 = 0, c1 = 0;
+        if (!code(f.src[0], c0) || !code(f.src[1], c1)) return;
+        uint8_t comp = f.complement & 3;
+        if (c0 < 0) {  // the tap first
+            std::swap(c0, c1);
+            comp = uint8_t(((comp & 1) << 1) | (comp >> 1));
         }
-        // One factor a tap, the other a constant.
-        if ((out.factor[size_t(k)][0] >= 0) == (out.factor[size_t(k)][1] >= 0)) return;
+        if (c0 < 0 || (c1 < 0 && (comp & 2))) return;  // no tap, or a complemented constant
+        out.factor[size_t(k)] = {c0, c1};
+        out.complement[size_t(k)] = comp;
+        if (comp & 1) out.flat = uint8_t(out.flat | (1u << c0));
+        if (c1 >= 0) out.flat = uint8_t(out.flat | (1u << c1));
     }
     for (int i = 0; i < kNumConsts; ++i)
         for (int c = 0; c < 4; ++c)
             out.pattern[size_t(i)][size_t(kUnorm8Byte[c])] = int16_t(p.constGrid[size_t(i)][size_t(c)]);
-    if (taps > 8) return;
+    if (single && first.kind == FastKind::Mad) {
+        // The addend as it is: unnegated, and >= 0 (the sum of non-negative terms then needs no
+        // lower clamp beyond the op's own).
+        const FastSrc& add = first.src[2];
+        int8_t c = 0;
+        if (add.a != 2 || add.b != 0 || !code(add, c)) return;
+        if (c < 0)
+            for (int16_t v : out.pattern[size_t(-1 - c)])
+                if (v < 0) return;
+        if (c >= 0) out.flat = uint8_t(out.flat | (1u << c));
+        out.addend = c;
+    }
     out.head = head;
     out.count = count;
     out.taps = taps;
@@ -397,12 +420,28 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
 }
 
 void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, const ChainRowTap* taps, int count,
-                 uint8_t* out) {
+                 uint8_t* out, const ChainRowStore& store) {
     const FastKernels& kern = *fastKernels(simdLevel());
     const int bytes = 4 * std::clamp(count, 0, kMaxSpan);
     const int whole = bytes / kern.lanes * kern.lanes;
     const FastOp* ops = &ops2[size_t(plan.head)];
-    if (whole) kern.chainRow(ops, plan, taps, whole, out);
+    // Halfway taps read other than as a first factor: their rows formed first (round_half_even of
+    // each texel and the next one's sum).
+    std::array<ChainRowTap, 8> own{};
+    for (int t = 0; t < plan.taps && t < 8; ++t) own[size_t(t)] = taps[t];
+    thread_local std::vector<uint8_t> formed;
+    for (int t = 0; t < plan.taps && t < 8; ++t) {
+        if (!((plan.flat >> t) & 1) || !taps[t].halfX) continue;
+        formed.resize(size_t(8) * 4 * kMaxSpan);
+        uint8_t* row = formed.data() + size_t(t) * 4 * kMaxSpan;
+        const uint8_t* src = taps[t].row;
+        for (int i = 0; i < bytes; ++i) {
+            const int sum = src[i] + src[i + 4];
+            row[i] = uint8_t((sum + ((sum >> 1) & 1)) >> 1);
+        }
+        own[size_t(t)] = ChainRowTap{row, false};
+    }
+    if (whole) kern.chainRow(ops, plan, own.data(), whole, out, store.orMask, store.additive);
     if (whole == bytes) return;
     // The last lanes from copies of the texels they read, padded to a whole step.
     constexpr int kMaxLanes = 32;
@@ -411,10 +450,11 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
     std::array<ChainRowTap, 8> rest{};
     const int n = bytes - whole;
     for (int t = 0; t < plan.taps && t < 8; ++t) {
-        std::memcpy(texels[t], taps[t].row + whole, size_t(n + (taps[t].halfX ? 4 : 0)));
-        rest[size_t(t)] = ChainRowTap{texels[t], taps[t].halfX};
+        std::memcpy(texels[t], own[size_t(t)].row + whole, size_t(n + (own[size_t(t)].halfX ? 4 : 0)));
+        rest[size_t(t)] = ChainRowTap{texels[t], own[size_t(t)].halfX};
     }
-    kern.chainRow(ops, plan, rest.data(), kern.lanes, last);
+    if (store.additive) std::memcpy(last, out + whole, size_t(n));
+    kern.chainRow(ops, plan, rest.data(), kern.lanes, last, store.orMask, store.additive);
     std::memcpy(out + whole, last, size_t(n));
 }
 

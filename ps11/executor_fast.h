@@ -73,21 +73,34 @@ using FastChainFn = void (*)(const FastOp* ops, int count, FastBank& bank, int n
 // The longest chain.
 constexpr int kMaxFastChain = 8;
 
-// A program that runs as chain rows (ps11/executor_presampled_internal.h, chainRows): its
-// chain's ops (FastOp::chain, from ops[head]) and each op's two factors, a tap (its index in the
-// TapPlan, >= 0) or a constant (−1 − k); constant k's grid integers in b g r a byte order.
+// A program that runs as chain rows (ps11/executor_presampled_internal.h, chainRows): `count`
+// small non-negative products into r0 (productSmall's formulas, FastOp::nonNegative), ops2[head]
+// and the ops after it: one mul or mad on its own, or a chain (FastOp::chain) whose ops after the
+// first add r0. Each op's two factors are a tap (its index in the TapPlan, >= 0) or a constant
+// (−1 − k), the first always a tap (the factors are swapped where the program has the constant
+// first); `complement` bit s: factor s is 1 − n (255 − n; taps only). The first op's addend (a
+// mad's third source): a tap, a constant known >= 0 in every channel, or kNoAddend. Every op's
+// clamp holds 0 (lo <= 0 <= hi): a sum of non-negative terms needs its upper clamp only. Constant k's
+// grid integers in b g r a byte order. `flat`: the taps read other than as an uncomplemented
+// first factor (a tap halfway between two texels is formed into a row of its own first).
 struct ChainRowPlan {
+    static constexpr int8_t kNoAddend = -128;
     bool ready = false;
     int head = 0, count = 0;
     int taps = 0;  // the program's texture reads
     std::array<std::array<int8_t, 2>, kMaxFastChain> factor{};
+    std::array<uint8_t, kMaxFastChain> complement{};
+    int8_t addend = kNoAddend;
+    uint8_t flat = 0;
     std::array<std::array<int16_t, 4>, kNumConsts> pattern{};
 };
 // Runs a ChainRowPlan over `bytes` (a multiple of the kernels' lanes) lanes of row bytes: lane
 // l of tap t is its filtered texel byte (ChainRowTap) at l, r0's lanes go to out saturated to
-// [0, 255]. Reads and writes whole steps of lanes (the caller pads).
+// [0, 255], each word or-ed with orMask, with `additive` added to out's bytes with saturation.
+// Reads and writes whole steps of lanes (the caller pads); the taps in plan.flat are not
+// halfway ones.
 using FastChainRowFn = void (*)(const FastOp* ops, const ChainRowPlan& plan, const ChainRowTap* taps, int bytes,
-                                uint8_t* out);
+                                uint8_t* out, uint32_t orMask, bool additive);
 
 // Test hooks: the rounding steps of the kernels on their own, over count lanes (any count).
 // Products: n = round_half_even(P·2^s / (4G)) (half: round_half_even(P·2^s / G)), clamped to
@@ -164,16 +177,16 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
                        TapFill fill, ResultSink sink, void* ctx);
 
 // The chain-row plan of a program (ops2: presampledOps' for the current constants): ready when
-// fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic is one chain
-// writing all of r0 each of whose products is of a plain read's register and a constant, both
-// unswizzled.
+// fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic after the texture
+// reads is one small non-negative mul or mad, or one chain, writing all of r0, each of whose
+// factors is a plain read's register or a constant, unswizzled (ChainRowPlan).
 void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops,
                   const std::vector<FastOp>& ops2, uint8_t vUsed, ChainRowPlan& out);
 
 // runChainRow (ps11/executor_presampled_internal.h) with the kernels of simdLevel(): `taps` holds
 // plan.taps taps, `ops2` is what `plan` was made from.
 void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, const ChainRowTap* taps, int count,
-                 uint8_t* out);
+                 uint8_t* out, const ChainRowStore& store);
 
 // fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
 // 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace ps11::exec::avx2 {
 #define PS11_FAST_AVX2 1

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace ps11::exec::avx512 {
 #define PS11_FAST_AVX512 1

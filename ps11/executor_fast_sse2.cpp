@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 
 namespace ps11::exec::sse2 {
 #define PS11_FAST_AVX2 0

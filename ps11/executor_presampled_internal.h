@@ -57,12 +57,19 @@ struct ChainRowTap {
     const uint8_t* row = nullptr;
     bool halfX = false;
 };
+// How runChainRow stores r0's words: each or-ed with orMask (X8R8G8B8's X = 0xff), with
+// `additive` added to the bytes out holds with saturation (ONE/ONE into an 8-bit target).
+struct ChainRowStore {
+    uint32_t orMask = 0;
+    bool additive = false;
+};
 // Whether the executor's program (with its constants now) runs as chain rows.
 bool chainRows(const Executor& executor);
-// r0 of `count` (<= kMaxSpan) pixels as bytes saturated to [0, 255], b g r a, to out[0, 4·count):
-// what runPresampled gives for those taps, as an 8-bit target stores it. Reads the taps'
-// footprints only. Only valid after tapPlan() and chainRows() returned true.
+// r0 of `count` (<= kMaxSpan) pixels as bytes saturated to [0, 255], b g r a, to out[0, 4·count)
+// as `store` says: what runPresampled gives for those taps, as an 8-bit target stores it. Reads
+// the taps' footprints only; writes out's 4·count bytes only. Only valid after tapPlan() and
+// chainRows() returned true.
 void runChainRow(const Executor& executor, const ChainRowTap* taps, int count, uint8_t* out,
-                 ExecutorStats* stats = nullptr);
+                 const ChainRowStore& store = {}, ExecutorStats* stats = nullptr);
 
 }  // namespace ps11

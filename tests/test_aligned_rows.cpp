@@ -523,6 +523,71 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
     }
 }
 
+TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one (chain rows) equal the quad path",
+          "[draw][aligned]") {
+    // Programs of one product (Sousa's screen composite mad r0, t1, 1-t0, t0, a scale, a tap
+    // added) over a scene read 1:1 (t0, at texel centres or halfway between two, which chain rows
+    // read from its texel rows) and a glare texture magnified 2× to 8× or by any factor (t1,
+    // LINEAR, blended into words from its H rows or filtered per pixel at the edges), every
+    // address mode, drawn over the target or added to it, into A8R8G8B8 or X8R8G8B8; and a
+    // program that reads the magnified tap alone (the pre-sampled path).
+    std::mt19937 rng(20261201);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const char* programs[] = {
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n",
+        "ps_1_1\ntex t0\nmul r0, t0, c0\n",
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n",
+        "ps_1_1\ntex t0\ntex t1\nmad_sat r0, 1-t1, t0, t1\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, t1, 1-t0\n",
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t0, t1, c1\n",
+        "ps_1_1\ntex t0\ntex t1\nmul r0, t1, c0\n",
+    };
+    for (int i = 0; i < 36; ++i) {
+        Case c;
+        c.w = UINT(uni(200, 700));
+        c.h = UINT(uni(3, 20));
+        c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        c.rtInit.resize(size_t(c.w) * c.h * 4);
+        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const int scales[] = {2, 4, 8, 3};
+        const int scale = scales[i % 4];
+        Case::Tex scene, glare;
+        scene.w = c.w, scene.h = c.h;
+        glare.w = UINT((int(c.w) + scale - 1) / scale + uni(0, 1)), glare.h = UINT((int(c.h) + scale - 1) / scale);
+        for (Case::Tex* t : {&scene, &glare}) {
+            t->bytes.resize(size_t(t->w) * t->h * 4);
+            for (uint8_t& b : t->bytes) b = uint8_t(uni(0, 5) ? rng() : 255);
+            t->addressU = DWORD(1 + uni(0, 4)), t->addressV = DWORD(1 + uni(0, 4));
+            t->border = DWORD(rng());
+        }
+        const bool half = uni(0, 3) == 0;  // the scene read halfway between two texels
+        scene.filter = half || uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        glare.filter = D3DTEXF_LINEAR;
+        c.tex.assign(4, scene);
+        c.tex[1] = glare;
+        c.tex[2].bound = c.tex[3].bound = false;
+        c.program = programs[size_t(uni(0, int(std::size(programs)) - 1))];
+        for (auto& k : c.consts)
+            for (float& v : k) v = float(uni(0, 16)) / 16.0f;
+        const float xs[4] = {-0.5f, float(c.w) - 0.5f, float(c.w) - 0.5f, -0.5f};
+        const float ys[4] = {-0.5f, -0.5f, float(c.h) - 0.5f, float(c.h) - 0.5f};
+        for (int k : {0, 1, 2, 0, 2, 3}) {
+            Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
+            for (int s = 0; s < 4; ++s) {
+                q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (s == 0 && half ? 0.5f / float(scene.w) : 0.0f);
+                q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+            }
+            c.verts.push_back(q);
+        }
+        c.blend = DWORD(uni(0, 1));
+        c.scissor = uni(0, 3) == 0;
+        c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", glare " << glare.w << "x" << glare.h
+                     << (half ? ", scene halfway" : "") << ", " << c.program << (c.scissor ? ", scissor" : ""));
+        requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
+    }
+}
+
 TEST_CASE("aligned pass: a magnified tap's columns are tabulated runs", "[draw][aligned]") {
     // 2x, 3x, 8x and 2.5x magnification over a 1:1 quad: with vector kernels (the Avx2 level), all
     // columns but a few at the edges (clamped pairs) belong to runs of the tabulated configuration

@@ -622,7 +622,7 @@ TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[
     struct Program {
         const char* text;
         bool chain;  // with every constant >= 0
-        bool def = false;  // its constants are def'd: no negative API value reaches them
+        bool def = false;  // its constants are def'd (or it reads none): no negative API value reaches them
         float maxValue = 0;  // the profile's MaxValue (0: the version's)
     };
     const Program programs[] = {
@@ -636,8 +636,22 @@ TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[
         {"ps_1_4\ntexld r1, t0\ntexld r2, t1\nmul r0, r2, c0\nmad r0, r1, c1, r0\n", true, false, 1},
         // MaxValue 8: products past 16 bits (no chain of small products).
         {"ps_1_4\ntexld r1, t0\ntexld r2, t1\nmul r0, r2, c0\nmad r0, r1, c1, r0\n", false},
-        {"ps_1_1\ntex t0\nmul r0, t0, c0\n", false},                                   // no chain: one product
-        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, t1\nmad r0, t1, c1, r0\n", false},       // a product of two taps
+        {"ps_1_1\ntex t0\nmul r0, t0, c0\n", true},                                    // one product
+        {"ps_1_1\ntex t0\nmul r0, c1, t0\n", true},                                    // the constant first
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, t1\nmad r0, t1, c1, r0\n", true},        // a product of two taps
+        {"ps_1_1\ntex t0\ntex t1\nmad r0, t1, 1-t0, t0\n", true, true},                      // Sousa's screen composite
+        {"ps_1_1\ntex t0\ntex t1\nmad_sat r0, 1-t1, t0, t1\n", true, true},
+        {"ps_1_1\ntex t0\nmul r0, 1-t0, c0\n", true},
+        {"ps_1_1\ntex t0\ntex t1\nmad r0, c1, 1-t1, t0\n", true},                     // the constant first
+        {"ps_1_1\ntex t0\ntex t1\nmad r0, t0, c0, c1\n", true},                       // a constant addend
+        {"ps_1_1\ntex t0\ntex t1\nmad r0, t0, t0, t1\n", true, true},
+        {"ps_1_1\ntex t0\nmul r0, t0, 1-c0\n", false},                                 // a complemented constant
+        {"ps_1_1\ntex t0\ntex t1\nmad r0, t0, t1, -t1\n", false},                      // a negated addend
+        {"ps_1_1\ntex t0\ntex t1\nmov r1, t1\nmad r0, t0, c0, r1\n", false},            // a register addend
+        {"ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n", false},                           // no product
+        {"ps_1_1\ntex t0\nmul_x2 r0, t0, c0\n", false},                               // a shift
+        {"ps_1_1\ntex t0\nmul r0.rgb, t0, c0\n", false},                              // not all of r0
+        {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0\nmad r0, t1, c1, t0\n", false},       // two products, not a chain
         {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0.a\nmad r0, t1, c1, r0\n", false},     // a swizzle
         {"ps_1_1\ntex t0\ntex t1\nmul r1, t0, c0\nmad r1, t1, c1, r1\nmov r0, r1\n", false},  // not r0
         {"ps_1_1\ntex t0\ntex t1\nmul r0, t0, c0\nmad r0, t1, c1, r0\nadd r0, r0, c2\n", false},
@@ -684,8 +698,13 @@ TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[
                             tx[size_t(p)][size_t(c)] = uint8_t(v);
                         }
                 }
-                std::vector<uint8_t> got(4 * size_t(count) + 64, 0xcd);
-                runChainRow(*fast, taps, count, got.data());
+                // Stored plain, or-ed with X8R8G8B8's mask, or added (ONE/ONE) onto what the row holds.
+                const int how = int(rng() % 3);
+                const ChainRowStore store{how == 1 ? 0xff000000u : 0u, how == 2};
+                std::vector<uint8_t> got(4 * size_t(count) + 64, 0xcd), before(4 * size_t(count));
+                if (store.additive)
+                    for (size_t i = 0; i < before.size(); ++i) got[i] = before[i] = uint8_t(rng() % 3 ? rng() % 64 : rng());
+                runChainRow(*fast, taps, count, got.data(), store);
                 // runPresampled over the same filtered texels.
                 Lanes l(count);
                 PixelInputs pin = l.inputs(0, count);
@@ -710,6 +729,10 @@ TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[
                                 uint8_t(std::clamp<int>(r0[c][i], 0, 255));
                 };
                 runPresampled(*fast, pin, fill, sink, &ctx);
+                for (size_t i = 0; i < expect.size(); ++i) {
+                    if (i % 4 == size_t(kUnorm8Byte[3]) && how == 1) expect[i] = 255;
+                    if (store.additive) expect[i] = uint8_t(std::min(255, expect[i] + before[i]));
+                }
                 ++chained;
                 INFO("trial " << trial << ", " << count << " pixels");
                 REQUIRE(std::equal(expect.begin(), expect.end(), got.begin()));
