@@ -237,6 +237,20 @@ struct HRowCache {
     uint64_t staged = 0, built = 0, hits = 0;  // rows deinterleaved, H rows built and reused (tests, benchmarks)
 };
 
+// An H row's four planes: data + c·stride (returned whole, not as four pointers stored one by one
+// and read back together, which the store buffer cannot forward).
+struct HRowRef {
+    const uint16_t* data = nullptr;
+    size_t stride = 0;
+};
+
+// The H row of texel row `row` for `config` (planes from element jlo), from the worker's cache.
+// Texel rows are first deinterleaved once per draw (a "staged" slot over the triangle's texel
+// range of that texture), then combined per configuration; weight 0 at step 1 is the staged row
+// itself (emu/aligned_hrows.cpp).
+void hRow(const AlignedKernels& kernels, HRowCache& cache, const uint8_t* row, const HConfig& config, uint64_t tableId,
+          HRowRef& planes);
+
 // The level and filter of each 2×2 quad of a triangle's tap whose level the level of detail picks
 // and which is sampled per pixel (freeTaps, freeLevels): chosen on the quad's first row drawn and
 // kept for its other, within one drawAlignedRows call (which draws both rows of every quad: its
