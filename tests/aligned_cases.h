@@ -151,15 +151,22 @@ inline void withoutNaNs(std::vector<uint8_t>& bytes, D3DFORMAT f) {
     }
 }
 
+// A case of a w × h target, A8R8G8B8 or (a quarter of the time) X8R8G8B8, of random bytes.
+inline Case randomTarget(std::mt19937& rng, UINT w, UINT h) {
+    Case c;
+    c.w = w, c.h = h;
+    c.rtFormat = std::uniform_int_distribution<int>(0, 3)(rng) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+    c.rtInit.resize(size_t(c.w) * c.h * 4);
+    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    return c;
+}
+
 inline Case randomCase(std::mt19937& rng, bool floatFormats = false) {
     auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
-    Case c;
-    c.w = UINT(uni(1, 300));
-    c.h = UINT(uni(1, 24));
-    c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
-    c.rtInit.resize(size_t(c.w) * c.h * 4);
-    for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+    const UINT w = UINT(uni(1, 300));
+    const UINT h = UINT(uni(1, 24));
+    Case c = randomTarget(rng, w, h);
     c.tex.resize(4);
     for (Case::Tex& t : c.tex) {
         t.w = UINT(uni(0, 2) ? uni(1, 320) : c.w);

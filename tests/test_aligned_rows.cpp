@@ -400,12 +400,15 @@ void screenQuad(Case& c, const Case::Tex& t, const float dx[4], const float dy[4
 }
 
 // The case drawn in quads and on the row path (tiles not decided) at every SIMD level: the same
-// bytes, every covered pixel shaded in rows.
-void requireRowsAtEveryLevel(const Case& c, ps11::Precision precision, int threads) {
+// bytes, every covered pixel shaded in rows. In `precision`, or with `hardware` its class's
+// own profile and filter weights.
+void requireRowsAtEveryLevel(const Case& c, ps11::Precision precision, int threads,
+                             const ps11::HardwareClass* hardware = nullptr) {
     DeviceOptions quadOpt, rowOpt;
     quadOpt.software.alignedPasses = false;
     rowOpt.software.skipTiles = false;
-    quadOpt.precision = rowOpt.precision = precision;
+    quadOpt.hardware = rowOpt.hardware = hardware;
+    if (!hardware) quadOpt.precision = rowOpt.precision = precision;
     quadOpt.software.threads = rowOpt.software.threads = threads;
     Device quadDev(quadOpt);
     DrawStats qs;
@@ -485,12 +488,9 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
         "ps_1_1\ntex t0\ntex t1\nmul r0, t0.a, c0\nmad r0, t1, c1, r0\n",  // swizzled: no chain
     };
     for (int i = 0; i < 40; ++i) {
-        Case c;
-        c.w = UINT(uni(200, 700));
-        c.h = UINT(uni(2, 7));
-        c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
-        c.rtInit.resize(size_t(c.w) * c.h * 4);
-        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const UINT w = UINT(uni(200, 700));
+        const UINT h = UINT(uni(2, 7));
+        Case c = randomTarget(rng, w, h);
         // Every address mode along a row and along a column, the rest random.
         const bool horizontal = (i / 5) % 2 == 0;
         const bool half = horizontal && uni(0, 1);
@@ -523,11 +523,11 @@ TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path"
     }
 }
 
-TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one (chain rows) equal the quad path",
+TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one equal the quad path",
           "[draw][aligned]") {
     // Programs of one product (Sousa's screen composite mad r0, t1, 1-t0, t0, a scale, a tap
-    // added) over a scene read 1:1 (t0, at texel centres or halfway between two, which chain rows
-    // read from its texel rows) and a glare texture magnified 2× to 8× or by any factor (t1,
+    // added: chain rows in fx8) over a scene read 1:1 (t0, at texel centres or halfway between two
+    // texels or rows; chain rows read it from its texel rows at vertical weight 0) and a glare texture magnified 2× to 8× or by any factor (t1,
     // LINEAR, blended into words from its H rows or filtered per pixel at the edges), every
     // address mode, drawn over the target or added to it, into A8R8G8B8 or X8R8G8B8; and a
     // program that reads the magnified tap alone (the pre-sampled path).
@@ -543,12 +543,9 @@ TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one (chain rows
         "ps_1_1\ntex t0\ntex t1\nmul r0, t1, c0\n",
     };
     for (int i = 0; i < 36; ++i) {
-        Case c;
-        c.w = UINT(uni(200, 700));
-        c.h = UINT(uni(3, 20));
-        c.rtFormat = uni(0, 3) ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
-        c.rtInit.resize(size_t(c.w) * c.h * 4);
-        for (uint8_t& b : c.rtInit) b = uint8_t(rng());
+        const UINT w = UINT(uni(200, 700));
+        const UINT h = UINT(uni(3, 20));
+        Case c = randomTarget(rng, w, h);
         const int scales[] = {2, 4, 8, 3};
         const int scale = scales[i % 4];
         Case::Tex scene, glare;
@@ -560,8 +557,9 @@ TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one (chain rows
             t->addressU = DWORD(1 + uni(0, 4)), t->addressV = DWORD(1 + uni(0, 4));
             t->border = DWORD(rng());
         }
-        const bool half = uni(0, 3) == 0;  // the scene read halfway between two texels
-        scene.filter = half || uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+        const bool half = uni(0, 3) == 0;   // the scene read halfway between two texels
+        const bool halfV = uni(0, 3) == 0;  // or between two rows
+        scene.filter = half || halfV || uni(0, 1) ? D3DTEXF_LINEAR : D3DTEXF_POINT;
         glare.filter = D3DTEXF_LINEAR;
         c.tex.assign(4, scene);
         c.tex[1] = glare;
@@ -575,16 +573,23 @@ TEST_CASE("aligned pass: composites of a 1:1 tap and a magnified one (chain rows
             Vtx q{xs[k], ys[k], 0.5f, 1.0f, 0xffffffffu, 0xff000000u, {}};
             for (int s = 0; s < 4; ++s) {
                 q.uv[s][0] = ((k == 1 || k == 2) ? 1.0f : 0.0f) + (s == 0 && half ? 0.5f / float(scene.w) : 0.0f);
-                q.uv[s][1] = k >= 2 ? 1.0f : 0.0f;
+                q.uv[s][1] = (k >= 2 ? 1.0f : 0.0f) + (s == 0 && halfV ? 0.5f / float(scene.h) : 0.0f);
             }
             c.verts.push_back(q);
         }
         c.blend = DWORD(uni(0, 1));
         c.scissor = uni(0, 3) == 0;
         c.scissorRect = RECT{uni(0, 40), 0, int(c.w) - uni(0, 40), int(c.h)};
+        // fx8 every time; then float, ideal, or the d3d9 class's float profile with 8-bit filter
+        // weights, by turns (the float row path).
+        const ps11::Precision other = i % 3 == 1 ? ps11::Precision::Float : ps11::Precision::Ideal;
+        const ps11::HardwareClass* d3d9 = i % 3 == 0 ? ps11::findHardware("d3d9") : nullptr;
+        REQUIRE((i % 3 != 0 || d3d9));
         INFO("case " << i << ": " << c.w << "x" << c.h << ", glare " << glare.w << "x" << glare.h
-                     << (half ? ", scene halfway" : "") << ", " << c.program << (c.scissor ? ", scissor" : ""));
+                     << (half ? ", scene halfway" : "") << (halfV ? ", scene between rows" : "") << ", " << c.program
+                     << (c.scissor ? ", scissor" : ""));
         requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
+        requireRowsAtEveryLevel(c, other, 1 + (i & 1), d3d9);
     }
 }
 
