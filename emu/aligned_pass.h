@@ -94,9 +94,9 @@ struct AlignedDraw {
     bool fogFirst = false;
     MergeState afterDepth;  // `merge` with its depth test and write off
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
-    // The program runs as chain rows (ps11::chainRows) where its taps read a row's texels side by
-    // side (1:1, at texel centres or halfway between them): fx8, read no colour, stored here
-    // with no depth test or fog first.
+    // The program runs as chain rows (ps11::chainRows): fx8, reads no colour, stored here with
+    // no depth test or fog first. The row path takes them on rows where a tap reads a texel row's
+    // texels side by side (1:1, at texel centres or halfway between them; chainRow).
     bool chainRows = false;
 };
 

@@ -446,7 +446,7 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
     // The last lanes from copies of the texels they read, padded to a whole step.
     constexpr int kMaxLanes = 32;
     alignas(64) uint8_t texels[8][kMaxLanes + 4] = {};
-    alignas(64) uint8_t last[kMaxLanes];
+    alignas(64) uint8_t last[kMaxLanes] = {};
     std::array<ChainRowTap, 8> rest{};
     const int n = bytes - whole;
     for (int t = 0; t < plan.taps && t < 8; ++t) {
