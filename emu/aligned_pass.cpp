@@ -332,6 +332,27 @@ void setTapRow(TapRow& r, const AlignedTap& tap, float v) {
     r.wy = w;
 }
 
+// What the vertical blend of a vector run reads from column x on: both texel rows' H-row planes
+// (the second only at vertical weight ≠ 0) and their kind.
+struct BlendRows {
+    const uint16_t* h0[4];
+    const uint16_t* h1[4];
+    HKind kind;
+};
+inline BlendRows blendRows(const TapRow& row, const AlignedTriangle::Columns& cols, const AlignedTriangle::Run& run,
+                           int x, int colBase) {
+    const int j = run.j0 + (x - run.x0);
+    const TapRow::Planes& p0 = row.h0[size_t(run.config)];
+    const TapRow::Planes& p1 = row.h1[size_t(run.config)];
+    BlendRows b{};
+    for (int c = 0; c < 4; ++c) {
+        b.h0[c] = p0.p[c] + j;
+        b.h1[c] = row.wy ? p1.p[c] + j : nullptr;
+    }
+    b.kind = run.tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H) : hKindOf(cols.w[size_t(x - colBase)]);
+    return b;
+}
+
 // Stretches of columns outside vector runs at least this long are filtered with the tabulated
 // kernels directly (filterTap).
 constexpr int kMinDirectColumns = 8;
@@ -384,15 +405,8 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
                 x = e;
                 continue;
             }
-            const int j = run.j0 + (x - run.x0);
-            const TapRow::Planes& p0 = row.h0[size_t(run.config)];
-            const TapRow::Planes& p1 = row.h1[size_t(run.config)];
-            const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
-            const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
-                                           row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
-            const HKind kind = run.tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H)
-                                              : hKindOf(cols.w[size_t(x - colBase)]);
-            vertical(kind, h0, h1, row.wy, e - x, x - first, out);
+            const BlendRows b = blendRows(row, cols, run, x, colBase);
+            vertical(b.kind, b.h0, b.h1, row.wy, e - x, x - first, out);
             x = e;
             continue;
         }
@@ -527,15 +541,8 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
         }
         if (const AlignedTriangle::Run* run = blendRun(c)) {
             const int e = std::min(x + n, int(run->x1));
-            const int j = run->j0 + (c - run->x0);
-            const TapRow::Planes& p0 = row.h0[size_t(run->config)];
-            const TapRow::Planes& p1 = row.h1[size_t(run->config)];
-            const uint16_t* const h0[4] = {p0.p[0] + j, p0.p[1] + j, p0.p[2] + j, p0.p[3] + j};
-            const uint16_t* const h1[4] = {row.wy ? p1.p[0] + j : nullptr, row.wy ? p1.p[1] + j : nullptr,
-                                           row.wy ? p1.p[2] + j : nullptr, row.wy ? p1.p[3] + j : nullptr};
-            const HKind kind = run->tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H)
-                                              : hKindOf(cols.w[size_t(c - tri.x0)]);
-            draw.kernels->verticalBytes(kind, h0, h1, row.wy, e - c, dst);
+            const BlendRows b = blendRows(row, cols, *run, c, tri.x0);
+            draw.kernels->verticalBytes(b.kind, b.h0, b.h1, row.wy, e - c, dst);
             c = e;
             continue;
         }
