@@ -531,10 +531,7 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
             if (tri.configs[size_t(cols.configs[size_t(run->config)])].wx == 0) {
                 std::memcpy(dst, src, 4 * size_t(e - c));
             } else {
-                for (int i = 0; i < 4 * (e - c); ++i) {  // round_half_even((a + b) / 2)
-                    const int sum = src[i] + src[i + 4];
-                    dst[i] = uint8_t((sum + ((sum >> 1) & 1)) >> 1);
-                }
+                ps11::halfwayBytes(src, 4 * (e - c), dst);
             }
             c = e;
             continue;

@@ -434,11 +434,7 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
         if (!((plan.flat >> t) & 1) || !taps[t].halfX) continue;
         formed.resize(size_t(8) * 4 * kMaxSpan);
         uint8_t* row = formed.data() + size_t(t) * 4 * kMaxSpan;
-        const uint8_t* src = taps[t].row;
-        for (int i = 0; i < bytes; ++i) {
-            const int sum = src[i] + src[i + 4];
-            row[i] = uint8_t((sum + ((sum >> 1) & 1)) >> 1);
-        }
+        halfwayBytes(taps[t].row, bytes, row);
         own[size_t(t)] = ChainRowTap{row, false};
     }
     if (whole) kern.chainRow(ops, plan, own.data(), whole, out, store.orMask, store.additive);

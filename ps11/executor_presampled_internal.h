@@ -57,6 +57,14 @@ struct ChainRowTap {
     const uint8_t* row = nullptr;
     bool halfX = false;
 };
+// `n` bytes of a halfway tap's row: each byte round_half_even((b + the next texel's b) / 2), the
+// reference filter's exact sum at weight 128 (src holds n + 4 bytes).
+inline void halfwayBytes(const uint8_t* src, int n, uint8_t* dst) {
+    for (int i = 0; i < n; ++i) {
+        const int sum = src[i] + src[i + 4];
+        dst[i] = uint8_t((sum + ((sum >> 1) & 1)) >> 1);
+    }
+}
 // How runChainRow stores r0's words: each or-ed with orMask (X8R8G8B8's X = 0xff), with
 // `additive` added to the bytes out holds with saturation (ONE/ONE into an 8-bit target).
 struct ChainRowStore {
