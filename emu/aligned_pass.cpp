@@ -62,23 +62,32 @@ struct TapRow {
     std::array<bool, kMaxTapConfigs> direct{};
 };
 
-// Any footprint, one pixel at a time: the exact four-texel sum of the reference.
+// Any footprint, one pixel at a time: the exact four-texel sum of the reference, column x (of the
+// triangle's columns), r g b a.
+template <bool Fx12>
+inline void filterTexel(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int x,
+                        int32_t out[4]) {
+    const int32_t wy = row.wy;
+    const int32_t o0 = cols.off0[size_t(x)], o1 = cols.off1[size_t(x)], wx = cols.w[size_t(x)];
+    const uint32_t a = row.row0 && o0 >= 0 ? load32(row.row0 + o0) : tap.borderWord;
+    const uint32_t b = row.row0 && o1 >= 0 ? load32(row.row0 + o1) : tap.borderWord;
+    const uint32_t c = row.row1 && o0 >= 0 ? load32(row.row1 + o0) : tap.borderWord;
+    const uint32_t d = row.row1 && o1 >= 0 ? load32(row.row1 + o1) : tap.borderWord;
+    for (int ch = 0; ch < 4; ++ch) {
+        const uint32_t h0 = channel(a, ch) * uint32_t(256 - wx) + channel(b, ch) * uint32_t(wx);
+        const uint32_t h1 = channel(c, ch) * uint32_t(256 - wx) + channel(d, ch) * uint32_t(wx);
+        out[ch] = roundBlend<Fx12>(h0 * uint32_t(256 - wy) + h1 * uint32_t(wy));
+    }
+}
+
+// filterTexel over pixels [first, first + count) into lanes [lane, lane + count) of out.
 template <bool Fx12>
 void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, const TapRow& row, int colBase,
                   int first, int count, int lane, int16_t* const out[4]) {
-    const int32_t wy = row.wy;
     for (int i = 0; i < count; ++i) {
-        const int x = first + i - colBase;
-        const int32_t o0 = cols.off0[size_t(x)], o1 = cols.off1[size_t(x)], wx = cols.w[size_t(x)];
-        const uint32_t a = row.row0 && o0 >= 0 ? load32(row.row0 + o0) : tap.borderWord;
-        const uint32_t b = row.row0 && o1 >= 0 ? load32(row.row0 + o1) : tap.borderWord;
-        const uint32_t c = row.row1 && o0 >= 0 ? load32(row.row1 + o0) : tap.borderWord;
-        const uint32_t d = row.row1 && o1 >= 0 ? load32(row.row1 + o1) : tap.borderWord;
-        for (int ch = 0; ch < 4; ++ch) {
-            const uint32_t h0 = channel(a, ch) * uint32_t(256 - wx) + channel(b, ch) * uint32_t(wx);
-            const uint32_t h1 = channel(c, ch) * uint32_t(256 - wx) + channel(d, ch) * uint32_t(wx);
-            out[ch][lane + i] = int16_t(roundBlend<Fx12>(h0 * uint32_t(256 - wy) + h1 * uint32_t(wy)));
-        }
+        int32_t v[4];
+        filterTexel<Fx12>(tap, cols, row, first + i - colBase, v);
+        for (int ch = 0; ch < 4; ++ch) out[ch][lane + i] = int16_t(v[ch]);
     }
 }
 
@@ -460,11 +469,17 @@ const uint8_t* unboundRow() {
     return row.data();
 }
 
+// Whether a chain configuration's run reads this row's texels as they lie (vertical weight 0:
+// each column's texel, or the mean of it and the next) or as rounded means of the two texel rows
+// (weight 128, both rows texels: the half-texel taps of Sousa's pinwheel and of box and 3×3
+// filters). Chain rows take those with no H rows.
+inline bool chainWeight(const TapRow& row) { return row.row0 && (row.wy == 0 || (row.wy == 128 && row.row1)); }
+
 // Whether chain rows run this row: every tap is filtered on the row path (none is sampled per
-// pixel at its quads' levels), and one reads a texel row as it lies (a chain configuration at
-// vertical weight 0: what saves the r g b a planes). Where every tap is blended from H rows (a
-// magnified tap, Sousa's pinwheel at vertical weight 128), blending them into planes, as the
-// pre-sampled run takes them, costs less than into words.
+// pixel at its quads' levels), and one reads its texel rows as they lie (a chain configuration at
+// chainWeight: what saves the r g b a planes). Where every tap is blended from H rows (a
+// magnified tap), blending them into planes, as the pre-sampled run takes them, costs less than
+// into words.
 bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows) {
     bool asItLies = false;
     for (int t = 0; t < draw.plan.count; ++t) {
@@ -473,17 +488,16 @@ bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::ar
         const TapRow& r = rows[size_t(t)];
         const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
         for (int c = 0; c < cols.configCount && !asItLies; ++c)
-            asItLies = r.row0 && r.wy == 0 && chainConfig(tri.configs[size_t(cols.configs[size_t(c)])]);
+            asItLies = chainWeight(r) && chainConfig(tri.configs[size_t(cols.configs[size_t(c)])]);
     }
     return asItLies;
 }
 
-// Whether tap t's run at column c is read from its texel row as it lies: a chain configuration's
-// run at vertical weight 0 (those have no H rows on chain rows).
+// Tap t's chain run at column c, where its texel rows are read as they lie (chainWeight), or null.
 const AlignedTriangle::Run* chainRun(const AlignedTriangle& tri, const AlignedTriangle::Columns& cols,
                                      const TapRow& row, int c) {
     const int32_t r = cols.run[size_t(c - tri.x0)];
-    if (r < 0 || !row.row0 || row.wy != 0) return nullptr;
+    if (r < 0 || !chainWeight(row)) return nullptr;
     const AlignedTriangle::Run& run = cols.runs[size_t(r)];
     return !run.tabulated && chainConfig(tri.configs[size_t(cols.configs[size_t(run.config)])]) ? &run : nullptr;
 }
@@ -498,15 +512,15 @@ bool directTap(const AlignedDraw& draw, const AlignedTriangle& tri, const std::a
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
     const AlignedTriangle::Run* run = chainRun(tri, cols, row, x);
-    if (!run || int(run->x1) < x + n) return false;
+    if (!run || row.wy != 0 || int(run->x1) < x + n) return false;
     const HConfig& h = tri.configs[size_t(cols.configs[size_t(run->config)])];
     tap = ps11::ChainRowTap{row.row0 + cols.off0[size_t(x - tri.x0)], h.wx != 0};
     return true;
 }
 
 // Tap t's filtered texels of columns [x, x + n) (n <= kMaxSpan) as a row of words of its own, for
-// chain rows: chain runs at vertical weight 0 copied from the texel row (halfway taps' rounded
-// means of each texel and the next), runs with H rows blended into words (verticalBytes), each
+// chain rows: chain runs copied from the texel row or formed as the rounded means of their two
+// or four texels (meanBytes: a halfway tap's, either way or both), runs with H rows blended into words (verticalBytes), each
 // other column at weight 0 both ways its one texel (or the border colour's bytes), the rest
 // filtered per pixel (filterTap).
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
@@ -527,11 +541,18 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
         uint8_t* dst = out + 4 * size_t(c - x);
         if (const AlignedTriangle::Run* run = chainRun(tri, cols, row, c)) {
             const int e = std::min(x + n, int(run->x1));
-            const uint8_t* src = row.row0 + cols.off0[size_t(c - tri.x0)];
-            if (tri.configs[size_t(cols.configs[size_t(run->config)])].wx == 0) {
-                std::memcpy(dst, src, 4 * size_t(e - c));
+            const int32_t off = cols.off0[size_t(c - tri.x0)];
+            const uint8_t* const r0 = row.row0 + off;
+            const bool halfway = tri.configs[size_t(cols.configs[size_t(run->config)])].wx != 0;
+            if (row.wy == 0 && !halfway) {
+                std::memcpy(dst, r0, 4 * size_t(e - c));
+            } else if (row.wy == 0) {
+                const uint8_t* const src[4] = {r0, r0 + 4, nullptr, nullptr};
+                draw.kernels->meanBytes(src, 2, 4 * (e - c), dst);
             } else {
-                ps11::halfwayBytes(src, 4 * (e - c), dst);
+                const uint8_t* const r1 = row.row1 + off;
+                const uint8_t* const src[4] = {r0, r1, r0 + 4, r1 + 4};
+                draw.kernels->meanBytes(src, halfway ? 4 : 2, 4 * (e - c), dst);
             }
             c = e;
             continue;
@@ -552,6 +573,15 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
         }
         int e = c + 1;
         while (e < x + n && !chainRun(tri, cols, row, e) && !blendRun(e) && !onePoint(e)) ++e;
+        if (e - c < kMinDirectColumns) {
+            // A few columns (a clamped or bordered edge): each pixel's bytes at once.
+            for (; c < e; ++c) {
+                int32_t v[4];
+                filterTexel<false>(tap, cols, row, c - tri.x0, v);
+                for (int ch = 0; ch < 4; ++ch) out[4 * size_t(c - x) + size_t(ps11::kUnorm8Byte[ch])] = uint8_t(v[ch]);
+            }
+            continue;
+        }
         int16_t* const planes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
         filterTap(draw.kernels, false, tap, cols, row, tri.x0, c, e - c, planes);
         const int16_t* const lanes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
@@ -723,8 +753,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     setTapRow(r, tap, tapV[t]);
                 }
             }
-            // Chain rows read the texel rows of chain configurations' runs at vertical weight 0:
-            // those need no H rows.
+            // Chain rows read the texel rows of chain configurations' runs at vertical weight 0
+            // or 128: those need no H rows.
             const bool chain = draw.chainRows && shadesOnly && chainRow(draw, tri, rows);
             for (int t = 0; t < taps; ++t) {
                 const AlignedTap& tap = draw.taps[size_t(t)];
@@ -736,7 +766,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 for (int c = 0; c < cols.configCount; ++c) {
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     const HConfig& h = tri.configs[ci];
-                    r.ready[size_t(c)] = rowsOk && !(chain && r.wy == 0 && chainConfig(h));
+                    r.ready[size_t(c)] = rowsOk && !(chain && chainWeight(r) && chainConfig(h));
                     if (!r.ready[size_t(c)]) continue;
                     r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
                     if (r.direct[size_t(c)]) continue;

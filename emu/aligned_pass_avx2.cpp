@@ -275,6 +275,9 @@ inline VI madd16(VI a, VI b) { return _mm256_madd_epi16(a, b); }
 inline VI packs32(VI a, VI b) { return _mm256_packs_epi32(a, b); }
 inline VI unpacklo16(VI a, VI b) { return _mm256_unpacklo_epi16(a, b); }
 inline VI unpackhi16(VI a, VI b) { return _mm256_unpackhi_epi16(a, b); }
+inline VI unpacklo8(VI a, VI b) { return _mm256_unpacklo_epi8(a, b); }
+inline VI unpackhi8(VI a, VI b) { return _mm256_unpackhi_epi8(a, b); }
+inline VI packus16(VI a, VI b) { return _mm256_packus_epi16(a, b); }
 inline VI set16(int16_t x) { return _mm256_set1_epi16(x); }
 inline VI set32(int32_t x) { return _mm256_set1_epi32(x); }
 inline VF setf(float x) { return _mm256_set1_ps(x); }
@@ -413,6 +416,6 @@ int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, u
 
 const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2,   &alignedPairSums4Avx2,
                                     &alignedBuildTabulatedAvx2, &verticalBlend,        &verticalBlend12,       &verticalBytes,
-                                    &alignedStoreRowAvx2,       &alignedStoreRow12Avx2};
+                                    &meanBytes,                 &alignedStoreRowAvx2,  &alignedStoreRow12Avx2};
 
 }  // namespace emu

@@ -1,5 +1,5 @@
-// The aligned-pass kernels at the Avx512 level (emu/aligned_pass_kernels.h): the vertical blends
-// and the texel rows' deinterleave 32 lanes a step; every other kernel is the Avx2 level's.
+// The aligned-pass kernels at the Avx512 level (emu/aligned_pass_kernels.h): the vertical blends,
+// the texel rows' means and deinterleave 32 lanes a step; every other kernel is the Avx2 level's.
 // CMakeLists.txt builds this file with the Avx2 level's flags and AVX-512 F, DQ, BW and VL on
 // x86-64 only; alignedKernels() hands the table out only where the CPU runs that level.
 #if !defined(__AVX512BW__) || !defined(__AVX2__) || !defined(__FMA__)
@@ -15,6 +15,7 @@ namespace emu {
 namespace {
 
 inline __m512i loadu(const void* p) { return _mm512_loadu_si512(p); }
+inline void storeu(void* p, __m512i v) { _mm512_storeu_si512(p, v); }
 
 // 32 texels (128 bytes, b g r a) as r g b a uint16 planes at out[c] + k.
 inline void deinterleave32(const uint8_t* p, uint16_t* const out[4], int k) {
@@ -72,6 +73,9 @@ inline VI madd16(VI a, VI b) { return _mm512_madd_epi16(a, b); }
 inline VI packs32(VI a, VI b) { return _mm512_packs_epi32(a, b); }
 inline VI unpacklo16(VI a, VI b) { return _mm512_unpacklo_epi16(a, b); }
 inline VI unpackhi16(VI a, VI b) { return _mm512_unpackhi_epi16(a, b); }
+inline VI unpacklo8(VI a, VI b) { return _mm512_unpacklo_epi8(a, b); }
+inline VI unpackhi8(VI a, VI b) { return _mm512_unpackhi_epi8(a, b); }
+inline VI packus16(VI a, VI b) { return _mm512_packus_epi16(a, b); }
 inline VI set16(int16_t x) { return _mm512_set1_epi16(x); }
 inline VI set32(int32_t x) { return _mm512_set1_epi32(x); }
 inline VF setf(float x) { return _mm512_set1_ps(x); }
@@ -117,6 +121,7 @@ const AlignedKernels& avx512::alignedTable() {
         k.vertical = &verticalBlend;
         k.vertical12 = &verticalBlend12;
         k.verticalBytes = &verticalBytes;
+        k.meanBytes = &meanBytes;
         return k;
     }();
     return table;

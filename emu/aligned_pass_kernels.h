@@ -1,7 +1,7 @@
 // The vector kernels of the aligned-pass path (emu/aligned_pass.h): a table per SIMD level
 // (ps11/simd_dispatch.h), fetched once per draw (AlignedDraw::kernels): the Avx2 level's
-// (aligned_pass_avx2.cpp), and the Avx512 level's, which replaces its vertical blends and
-// deinterleave (aligned_pass_avx512.cpp; the vertical blends are one source for both,
+// (aligned_pass_avx2.cpp), and the Avx512 level's, which replaces its vertical blends, texel
+// means and deinterleave (aligned_pass_avx512.cpp; the vertical blends are one source for both,
 // aligned_vertical.inc); at Baseline there is none and every pixel is filtered
 // and stored one at a time. Internal to emu/aligned_pass*.cpp.
 //
@@ -74,6 +74,10 @@ struct AlignedKernels {
     // 31 words past the count are written too.
     void (*verticalBytes)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                           uint8_t* out);
+    // Texel bytes' rounded means, what a 1:1 tap at weight 0 or 128 each way filters:
+    // out[i] = round_half_even((src[0][i] + ... + src[sources - 1][i]) / sources) for i in [0, n),
+    // sources 2 or 4. Reads src[k][0, n) only; writes out[0, n) only.
+    void (*meanBytes)(const uint8_t* const src[4], int sources, int n, uint8_t* out);
     // Stores `count` pixels of r0 (int16 r g b a planes, clamped to [0, 255]) as b g r a words at
     // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
     // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes
@@ -90,7 +94,7 @@ const AlignedKernels* alignedKernels(ps11::SimdLevel level);
 namespace avx2 {
 extern const AlignedKernels kAligned;
 }
-// The Avx512 table: the Avx2 one with its own vertical blends and deinterleave (built on first
+// The Avx512 table: the Avx2 one with its own vertical blends, means and deinterleave (built on first
 // use, from the Avx2 table); use alignedKernels().
 namespace avx512 {
 const AlignedKernels& alignedTable();
