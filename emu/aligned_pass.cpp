@@ -518,13 +518,61 @@ bool directTap(const AlignedDraw& draw, const AlignedTriangle& tri, const std::a
     return true;
 }
 
+// Texels past a chain row's span that a tap's row of means is formed for (AlignedScratch::tapBytes
+// has room for 32).
+constexpr int kFormedPast = 16;
+
+// Words of means a tap formed on a chain row (patchedRow: its longest run's): their texel rows,
+// weights and form (halfway: of each texel and the next), where the first word's texels lie (src,
+// in row0) and where `pixels` words are.
+struct FormedRow {
+    const uint8_t* row0 = nullptr;
+    const uint8_t* row1 = nullptr;
+    int32_t wy = 0;
+    bool halfway = false;
+    const uint8_t* src = nullptr;
+    const uint8_t* bytes = nullptr;
+    int pixels = 0;
+};
+
+// The words of an earlier tap's formed row (formed[0, count)) that are `key`'s: the same texel
+// rows, weights and form, its `pixels` words from key.src on within that row's (a box or 3×3
+// blur's taps ±½ texel apart read each other's means one texel over), or null.
+const uint8_t* formedWords(const FormedRow& key, const FormedRow* formed, int count) {
+    for (int u = 0; u < count; ++u) {
+        const FormedRow& f = formed[u];
+        if (!f.bytes || f.row0 != key.row0 || f.row1 != key.row1 || f.wy != key.wy || f.halfway != key.halfway ||
+            key.src < f.src)
+            continue;
+        const ptrdiff_t delta = key.src - f.src;
+        if (delta % 4 == 0 && delta / 4 + key.pixels <= f.pixels) return f.bytes + delta;
+    }
+    return nullptr;
+}
+
+// Tap t's columns [x, x + n) straight from an earlier tap's formed row (formedWords), where one
+// run of means covers them all, or null.
+const uint8_t* sharedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
+                         int t, int x, int n, const FormedRow* formed) {
+    if (!draw.taps[size_t(t)].bound) return nullptr;
+    const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
+    const TapRow& row = rows[size_t(t)];
+    const AlignedTriangle::Run* run = chainRun(tri, cols, row, x);
+    if (!run || int(run->x1) < x + n) return nullptr;
+    const bool halfway = tri.configs[size_t(cols.configs[size_t(run->config)])].wx != 0;
+    if (row.wy == 0 && !halfway) return nullptr;
+    const FormedRow key{row.row0, row.row1, row.wy, halfway, row.row0 + cols.off0[size_t(x - tri.x0)], nullptr, n};
+    return formedWords(key, formed, t);
+}
+
 // Tap t's filtered texels of columns [x, x + n) (n <= kMaxSpan) as a row of words of its own, for
 // chain rows: chain runs copied from the texel row or formed as the rounded means of their two
 // or four texels (meanBytes: a halfway tap's, either way or both), runs with H rows blended into words (verticalBytes), each
 // other column at weight 0 both ways its one texel (or the border colour's bytes), the rest
 // filtered per pixel (filterTap).
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
-                          int t, int x, int n, AlignedScratch& sc) {
+                          int t, int x, int n, AlignedScratch& sc, FormedRow* formed) {
+    formed[t] = FormedRow{};
     const AlignedTap& tap = draw.taps[size_t(t)];
     if (!tap.bound) return unboundRow();
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
@@ -544,15 +592,28 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
             const int32_t off = cols.off0[size_t(c - tri.x0)];
             const uint8_t* const r0 = row.row0 + off;
             const bool halfway = tri.configs[size_t(cols.configs[size_t(run->config)])].wx != 0;
+            int m = e - c;
+            if (row.wy != 0 || halfway) {
+                const FormedRow key{row.row0, row.row1, row.wy, halfway, r0, nullptr, m};
+                if (const uint8_t* earlier = formedWords(key, formed, t)) {
+                    std::memcpy(dst, earlier, 4 * size_t(m));
+                    c = e;
+                    continue;
+                }
+                // The row's last run: formed kFormedPast texels further where the texel row has
+                // them, for a later tap on the same rows a few texels to the right.
+                if (e == x + n) m += std::clamp(int(tap.width) - off / 4 - (halfway ? 1 : 0) - m, 0, kFormedPast);
+                if (m > formed[t].pixels) formed[t] = FormedRow{row.row0, row.row1, row.wy, halfway, r0, dst, m};
+            }
             if (row.wy == 0 && !halfway) {
-                std::memcpy(dst, r0, 4 * size_t(e - c));
+                std::memcpy(dst, r0, 4 * size_t(m));
             } else if (row.wy == 0) {
                 const uint8_t* const src[4] = {r0, r0 + 4, nullptr, nullptr};
-                draw.kernels->meanBytes(src, 2, 4 * (e - c), dst);
+                draw.kernels->meanBytes(src, 2, 4 * m, dst);
             } else {
                 const uint8_t* const r1 = row.row1 + off;
                 const uint8_t* const src[4] = {r0, r1, r0 + 4, r1 + 4};
-                draw.kernels->meanBytes(src, halfway ? 4 : 2, 4 * (e - c), dst);
+                draw.kernels->meanBytes(src, halfway ? 4 : 2, 4 * m, dst);
             }
             c = e;
             continue;
@@ -817,9 +878,14 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         // the columns, else from a row of its own (patchedRow: a magnified or
                         // blended tap, a horizontal blur's taps at a clamped or bordered edge).
                         ps11::ChainRowTap chainTaps[8];
-                        for (int t = 0; t < taps; ++t)
-                            if (!directTap(draw, tri, rows, t, x, n, chainTaps[t]))
-                                chainTaps[t] = ps11::ChainRowTap{patchedRow(draw, tri, rows, t, x, n, sc), false};
+                        FormedRow formed[8];
+                        for (int t = 0; t < taps; ++t) {
+                            if (directTap(draw, tri, rows, t, x, n, chainTaps[t])) continue;
+                            formed[t] = FormedRow{};
+                            const uint8_t* row = sharedRow(draw, tri, rows, t, x, n, formed);
+                            if (!row) row = patchedRow(draw, tri, rows, t, x, n, sc, formed);
+                            chainTaps[t] = ps11::ChainRowTap{row, false};
+                        }
                         ps11::runChainRow(exec, chainTaps, n, target.texel(uint32_t(x), uint32_t(y)),
                                           ps11::ChainRowStore{orMask, draw.directAdd}, &stats.exec);
                         stats.pixels += uint64_t(n);

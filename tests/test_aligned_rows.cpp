@@ -468,6 +468,57 @@ TEST_CASE("aligned pass: taps one texel apart on the same rows (the half-texel b
     }
 }
 
+TEST_CASE("aligned pass: chain rows' half-texel taps on shared texel rows equal the quad path", "[draw][aligned]") {
+    // Four LINEAR taps of one texture at whole or half texels: on a few rows (dy in −1 … +½, so
+    // taps read the same texel rows at vertical weight 0 or ½, halfway along the row or not) and
+    // now and then far apart along a row (up to ±9½ texels, or pairs up to 17 texels apart). Chain rows form each tap's rounded
+    // means once and later taps on the same rows read them one or more texels over, or copy the
+    // runs they share. Every address mode, rows wider than a span, a scissor now and then.
+    std::mt19937 rng(20261201);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 60; ++i) {
+        const UINT w = UINT(uni(0, 2) ? uni(150, 1200) : uni(17, 60));
+        const UINT h = UINT(uni(2, 6));
+        Case c = randomTarget(rng, w, h);
+        Case::Tex t;
+        t.w = c.w, t.h = c.h;
+        t.bytes.resize(size_t(t.w) * t.h * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(uni(0, 5) ? rng() : 255);
+        t.filter = D3DTEXF_LINEAR;
+        t.addressU = DWORD(uni(1, 5));
+        t.addressV = DWORD(uni(1, 5));
+        t.border = DWORD(rng());
+        c.tex.assign(4, t);
+        c.oneTexture = true;
+        c.program = kPrograms[1];
+        for (auto& k : c.consts)
+            for (float& v : k) v = float(uni(0, 8)) / 16.0f;
+        const int reach = uni(0, 3) ? 4 : 19;  // half texels either way along a row
+        float dx[4], dy[4];
+        for (int s = 0; s < 4; ++s) {
+            dx[s] = float(uni(-reach, reach)) / 2.0f;
+            dy[s] = float(uni(-2, 1)) / 2.0f;
+        }
+        if (uni(0, 2) == 0) {
+            // Pairs on the same rows 1, 2, 3, 16 or 17 texels apart: the second reads the first's
+            // means from where they start up to past its last (formed 16 texels further).
+            const int apart[] = {1, 2, 3, 16, 17};
+            for (int s : {1, 3}) {
+                dx[s] = dx[s - 1] + float(apart[uni(0, 4)]);
+                dy[s] = dy[s - 1];
+            }
+        }
+        screenQuad(c, t, dx, dy);
+        c.blend = DWORD(uni(0, 1));
+        c.scissor = uni(0, 3) == 0;
+        c.scissorRect = RECT{uni(0, 12), 0, int(c.w) - uni(0, 12), int(c.h)};
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", taps (" << dx[0] << ", " << dy[0] << ") (" << dx[1] << ", "
+                     << dy[1] << ") (" << dx[2] << ", " << dy[2] << ") (" << dx[3] << ", " << dy[3] << ")"
+                     << (c.scissor ? ", scissor" : ""));
+        requireRowsAtEveryLevel(c, ps11::Precision::Fx8, 1 + (i & 1));
+    }
+}
+
 TEST_CASE("aligned pass: separable blur passes (chain rows) equal the quad path", "[draw][aligned]") {
     // The glow's passes, which the row path runs as chain rows (ps11::runChainRow): two to four
     // taps of one texture along a row (at whole texels, or halfway between two with LINEAR) or
