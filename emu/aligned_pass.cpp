@@ -525,14 +525,15 @@ constexpr int kFormedPast = 16;
 // Words of means a tap formed on a chain row (patchedRow: its longest run's): their texel rows,
 // weights and form (halfway: of each texel and the next), where the first word's texels lie (src,
 // in row0) and where `pixels` words are.
+// (No member initialisers: a row's array of them is set tap by tap, FormedRow{} for none.)
 struct FormedRow {
-    const uint8_t* row0 = nullptr;
-    const uint8_t* row1 = nullptr;
-    int32_t wy = 0;
-    bool halfway = false;
-    const uint8_t* src = nullptr;
-    const uint8_t* bytes = nullptr;
-    int pixels = 0;
+    const uint8_t* row0;
+    const uint8_t* row1;
+    int32_t wy;
+    bool halfway;
+    const uint8_t* src;
+    const uint8_t* bytes;
+    int pixels;
 };
 
 // The words of an earlier tap's formed row (formed[0, count)) that are `key`'s: the same texel
@@ -566,13 +567,14 @@ const uint8_t* sharedRow(const AlignedDraw& draw, const AlignedTriangle& tri, co
 }
 
 // Tap t's filtered texels of columns [x, x + n) (n <= kMaxSpan) as a row of words of its own, for
-// chain rows: chain runs copied from the texel row or formed as the rounded means of their two
-// or four texels (meanBytes: a halfway tap's, either way or both), runs with H rows blended into words (verticalBytes), each
-// other column at weight 0 both ways its one texel (or the border colour's bytes), the rest
-// filtered per pixel (filterTap).
+// chain rows: chain runs copied from the texel row or formed as the rounded means of their two or
+// four texels (meanBytes: a halfway tap's, either way or both; or copied where an earlier tap
+// formed them, formed[0, t)), runs with H rows blended into words (verticalBytes), each other
+// column at weight 0 both ways its one texel (or the border colour's bytes), the rest filtered
+// per pixel (filterTap). formed[t], which the caller cleared, says where its longest run of means
+// is for the taps after it.
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
                           int t, int x, int n, AlignedScratch& sc, FormedRow* formed) {
-    formed[t] = FormedRow{};
     const AlignedTap& tap = draw.taps[size_t(t)];
     if (!tap.bound) return unboundRow();
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
@@ -880,8 +882,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         ps11::ChainRowTap chainTaps[8];
                         FormedRow formed[8];
                         for (int t = 0; t < taps; ++t) {
-                            if (directTap(draw, tri, rows, t, x, n, chainTaps[t])) continue;
                             formed[t] = FormedRow{};
+                            if (directTap(draw, tri, rows, t, x, n, chainTaps[t])) continue;
                             const uint8_t* row = sharedRow(draw, tri, rows, t, x, n, formed);
                             if (!row) row = patchedRow(draw, tri, rows, t, x, n, sc, formed);
                             chainTaps[t] = ps11::ChainRowTap{row, false};
