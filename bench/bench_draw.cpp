@@ -36,6 +36,8 @@ struct QuadVertex {
 // Down2: 1080p texture to a 960×540 target, one bilinear tap on the corner of each 2×2 block.
 // Down2Mip: the same from a mip-mapped 1080p texture, MIP filter POINT: every quad picks level 1
 // (960×540), read 1:1 — the row path over that level.
+// Down8Point: 1080p texture to 240×135, one point tap per 8×8 block (the adaptive glare's bright
+// pass reads the scene so): each pixel row reads a texel row eight below the last one's.
 // Down4: 1080p texture to 480×270, the blur program's four bilinear taps at ±1 texel around the
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
 // Sprites: 400 quads of 64x64 pixels at sub-pixel positions over a 1080p target, each a 32x32
@@ -76,9 +78,10 @@ enum class Pass {
     Dependent,
     Down2Mip,
     PerspectiveMip,
-    PerspectiveTrilinear
+    PerspectiveTrilinear,
+    Down8Point
 };
-constexpr int kPasses = 18;
+constexpr int kPasses = 19;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -90,14 +93,14 @@ struct Scene {
     UINT w = kW, h = kH;
 
     Scene(Pass pass, int threads, bool aligned = true) {
-        if (pass == Pass::CopySmall || pass == Pass::Blur4Small) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
+        if (pass == Pass::CopySmall || pass == Pass::Blur4Small || pass == Pass::Down8Point) w = kW / 8, h = kH / 8;  // 240×135, the small passes of PERF.md
         const bool trilinear = pass == Pass::PerspectiveTrilinear;
         const bool mip = pass == Pass::Down2Mip || pass == Pass::PerspectiveMip || trilinear;
         if (pass == Pass::Down2 || pass == Pass::Down2Mip) w = kW / 2, h = kH / 2;
         if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
-        const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4;
+        const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4 || pass == Pass::Down8Point;
         const bool addGlare = pass == Pass::CompositeAdd;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : addGlare ? h / 4 : h;
@@ -137,7 +140,9 @@ struct Scene {
         const int stages = fourTaps ? 4 : pass == Pass::Composite ? 2 : 1;
         for (int s = 0; s < stages; ++s) {
             const DWORD filter =
-                pass == Pass::CopyPoint || weighted || (pass == Pass::Composite && s == 0) ? D3DTEXF_POINT : D3DTEXF_LINEAR;
+                pass == Pass::CopyPoint || pass == Pass::Down8Point || weighted || (pass == Pass::Composite && s == 0)
+                    ? D3DTEXF_POINT
+                    : D3DTEXF_LINEAR;
             dev->SetTexture(DWORD(s), pass == Pass::Composite && s == 1 ? glare : tex);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MINFILTER, filter);
             dev->SetSamplerState(DWORD(s), D3DSAMP_MAGFILTER, filter);
@@ -352,6 +357,11 @@ BENCHMARK_CAPTURE(BM_Draw, copy_linear_240x135_fx8, Pass::CopySmall)
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, blur4_1x1_fx8, Pass::Tiny)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, down8_point_1080p_to_240x135_fx8, Pass::Down8Point)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMicrosecond)

@@ -747,6 +747,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     }
     HRowRef planes{};
     float tapV[8] = {};  // each tap's v on the current pixel row
+    ps11::ChainRowTap chainTaps[8];  // a chain row's taps (set tap by tap on each)
     // Tabulated configurations: a triangle whose table equals an earlier one's over the same
     // columns takes that one's id, so their H rows are shared (a full-screen quad's two halves).
     // (Only the entries of existing configurations are set and read.)
@@ -879,7 +880,6 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         // Chain rows, each tap read from its texel row where a chain run covers
                         // the columns, else from a row of its own (patchedRow: a magnified or
                         // blended tap, a horizontal blur's taps at a clamped or bordered edge).
-                        ps11::ChainRowTap chainTaps[8];
                         FormedRow formed[8];
                         for (int t = 0; t < taps; ++t) {
                             formed[t] = FormedRow{};
