@@ -581,6 +581,9 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;
     d.target = target;
+    bool planned = false;
+    d.mergePlan = makePlan(merge, target, planned);
+    if (!planned) return false;
     d.wantZ = wantZ;
     out = d;
     return true;
@@ -815,7 +818,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     mi.z = draw.wantZ ? sc.z : nullptr;
                     for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
                     MergeStats ms;
-                    mergePixels(draw.merge, mi, draw.target, &ms);
+                    mergePixels(draw.mergePlan, draw.merge, mi, &ms);
                     stats.written += ms.written;
                     stats.pixels += uint64_t(n);
                 }

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "emu/aligned_pass.h"
+#include "emu/merge_plan.h"
 #include "emu/output_merger.h"
 #include "emu/raster.h"
 #include "ps11/executor.h"
@@ -60,6 +61,7 @@ struct FloatRowDraw {
     uint64_t colorAttrs = 0;
     MergeState merge;
     MergeTarget target;
+    Plan mergePlan;      // makePlan(merge, target), made once (prepareFloatRowDraw)
     bool wantZ = false;  // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
     LevelTaps levelTaps;  // the taps whose level or filter the level of detail picks
 };

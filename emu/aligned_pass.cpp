@@ -964,7 +964,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         mi.grid[c] = sc.grid[c];
                     }
                     MergeStats ms;
-                    mergePixels(*mergeState, mi, draw.target, &ms);
+                    mergePixels(mergeState == &draw.afterDepth ? draw.afterDepthPlan : draw.mergePlan, *mergeState, mi,
+                                &ms);
                     stats.written += ms.written;
                 }
             }

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "emu/merge_plan.h"
 #include "emu/output_merger.h"
 #include "emu/prefetch.h"
 #include "emu/raster.h"
@@ -93,6 +94,7 @@ struct AlignedDraw {
     bool depthFirst = false;
     bool fogFirst = false;
     MergeState afterDepth;  // `merge` with its depth test and write off
+    Plan mergePlan, afterDepthPlan;  // makePlan of each with `target`, made once (prepareAlignedDraw)
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
     // The program runs as chain rows (ps11::chainRows): fx8, reads no colour, stored here with
     // no depth test or fog first. The row path takes them on rows where a tap reads a texel row's

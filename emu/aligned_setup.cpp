@@ -83,6 +83,10 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     d.fogFirst = (d.directStore || d.directAdd) && merge.fog;
     d.afterDepth = merge;
     d.afterDepth.depthTest = d.afterDepth.depthWrite = false;
+    bool planned = false, plannedAfter = false;
+    d.mergePlan = makePlan(d.merge, target, planned);
+    d.afterDepthPlan = makePlan(d.afterDepth, target, plannedAfter);
+    if (!planned || !plannedAfter) return false;
     d.chainRows = !fx12 && d.kernels && ps11::chainRows(executor) && d.colorAttrs == 0 &&
                   (d.directStore || d.directAdd) && !d.depthFirst && !d.fogFirst;
     out = d;

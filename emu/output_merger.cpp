@@ -251,32 +251,42 @@ void storeUnorm8Plain(const Plan& p, const MergeInputs& in, const int32_t* const
         const int32_t *g0 = g[0], *g1 = g[1], *g2 = g[2], *g3 = g[3];
         const auto b = [](int32_t v) { return Fx<4080>::byteOf(v < 0 ? 0 : v > 4080 ? 4080 : v); };
         for (int i = 0; i < count; ++i) words[i] = packArgb(b(g0[i]), b(g1[i]), b(g2[i]), b(g3[i])) | alphaFill;
-    } else {
-        mergerKernels(ps11::simdLevel()).unorm8Words(f, count, alphaFill, words);
     }
     const Surf cs = p.colorSurf;
     const Lanes lanes(in, p);
     const uint8_t* live = in.live;
+    // One run of a row (its first pixel, or null): the words straight into it.
+    uint8_t* run = nullptr;
     if (in.row && !live && count > 0) {
-        // One run of a row: the words straight into it.
         uint32_t x, y;
         const bool inside = lanes.inside(0, x, y) && x + uint32_t(count) <= p.boundW;
         assert(inside && in.x[count - 1] == in.x[0] + count - 1 && in.y[count - 1] == in.y[0]);
-        if (inside) {
-            uint8_t* q = cs.at(x, y);
-            if (!Additive && mask == 0xffffffffu) {
-                std::memcpy(q, words, 4 * size_t(count));
-            } else {
-                for (int i = 0; i < count; ++i, q += 4) {
-                    uint32_t w = words[i];
-                    const uint32_t old = load32(q);
-                    if constexpr (Additive) w = addSaturateBytes(w, old);
-                    store32(q, (w & mask) | (old & ~mask));
-                }
-            }
+        if (inside) run = cs.at(x, y);
+    }
+    if (!ps11::isFixedPoint(p.precision)) {
+        // (The float profiles' words go into the run themselves where nothing else is kept.)
+        const bool straight = run && !Additive && mask == 0xffffffffu;
+        mergerKernels(ps11::simdLevel())
+            .unorm8Words(f, count, alphaFill, straight ? reinterpret_cast<uint32_t*>(run) : words);
+        if (straight) {
             n.written += uint64_t(count);
             return;
         }
+    }
+    if (run) {
+        uint8_t* q = run;
+        if (!Additive && mask == 0xffffffffu) {
+            std::memcpy(q, words, 4 * size_t(count));
+        } else {
+            for (int i = 0; i < count; ++i, q += 4) {
+                uint32_t w = words[i];
+                const uint32_t old = load32(q);
+                if constexpr (Additive) w = addSaturateBytes(w, old);
+                store32(q, (w & mask) | (old & ~mask));
+            }
+        }
+        n.written += uint64_t(count);
+        return;
     }
     uint64_t written = 0;
     for (int i = 0; i < count; ++i) {
@@ -686,9 +696,14 @@ void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarg
     // caller's programming error: asserted, and in release builds nothing is written.
     assert(!target.color || supportedColor(target.color));
     bool ok = false;
-    Plan p = makePlan(state, target, ok);
+    const Plan p = makePlan(state, target, ok);
     assert(ok);
-    if (!ok || in.count <= 0 || (!p.color && !p.depth)) return;
+    if (ok) mergePixels(p, state, in, stats);
+}
+
+void mergePixels(const Plan& plan, const MergeState& state, const MergeInputs& in, MergeStats* stats) {
+    Plan p = plan;  // (the merges below drop the stages they take first)
+    if (in.count <= 0 || (!p.color && !p.depth)) return;
     assert(in.count <= ps11::kMaxSpan && in.x && in.y);
     const int count = std::min(in.count, int(ps11::kMaxSpan));
     MergeInputs lanes = in;

@@ -87,6 +87,11 @@ bool mergeReadsColor(ps11::Precision precision, const MergeTarget& target);
 // caller's programming errors: asserted (debug), and skipped in release builds.
 void mergePixels(const MergeState& state, const MergeInputs& in, const MergeTarget& target, MergeStats* stats);
 
+// The same with the plan made once for a draw's many calls (makePlan of `state` and the target,
+// emu/merge_plan.h; ok): valid while both are as they were.
+struct Plan;
+void mergePixels(const Plan& plan, const MergeState& state, const MergeInputs& in, MergeStats* stats);
+
 // The depth test, and the write where it passes, of the live lanes of `in` (x, y, z, live, row),
 // as mergePixels makes it first when no alpha test comes before it; passed[i] says which lanes
 // passed. True when every lane did. A row path tests a run so before shading it: the run's colour

@@ -319,12 +319,16 @@ void addUnorm8Float(const Plan& p, const MergeInputs& in, const float* const f[4
         }
     }
     alignas(32) uint32_t words[ps11::kMaxSpan];
-    // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both.
-    mergerKernels(ps11::simdLevel()).addUnorm8Words(f, dst, count, x8 ? 0xff000000u : 0u, words);
+    // X8R8G8B8 reads its missing alpha as 1 and stores 0xff: the fill gives both. A run whose
+    // every channel changes takes the sums in place.
+    const bool inPlace = run && mask == 0xffffffffu;
+    mergerKernels(ps11::simdLevel())
+        .addUnorm8Words(f, dst, count, x8 ? 0xff000000u : 0u, inPlace ? reinterpret_cast<uint32_t*>(run) : words);
     if (run) {
-        if (mask != 0xffffffffu)
+        if (!inPlace) {
             for (int i = 0; i < count; ++i) words[i] = (words[i] & mask) | (load32(dst + 4 * i) & ~mask);
-        std::memcpy(run, words, 4 * size_t(count));
+            std::memcpy(run, words, 4 * size_t(count));
+        }
         n.written += uint64_t(count);
         return;
     }

@@ -33,6 +33,7 @@ struct MergerKernels {
     // table). Avx2 and Avx512: a product and two FMAs in place of the division, the same float for
     // every byte (checked for all 256); eight (Avx512: sixteen) pixels whose sources are all 0, negative or NaN keep
     // their words (the sum is d, whose byte is d's), without converting.
+    // out may be `words` itself (each group's words are read before its own are written).
     void (*addUnorm8Words)(const float* const src[4], const uint8_t* words, int count, uint32_t alphaFill,
                            uint32_t* out);
     // The FloatBlendConsts blend of planar sources f[c][i] onto the interleaved float pixels
