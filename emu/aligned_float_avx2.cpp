@@ -83,6 +83,9 @@ void lerpWordsAvx2(const uint8_t* row, int len, const int32_t* i0, const int32_t
             // s = 2: the pairs are the 64-bit words 0..7 of v0 ‖ v1; s = 4: the even ones of
             // v0 ‖ v1 ‖ v2 ‖ v3, gathered by two 64-bit unpacks (in lane order 0 2 1 3 | 4 6 5 7).
             const __m256i* p = reinterpret_cast<const __m256i*>(words + base);
+            // The row's lines ahead (a reduction streams its texel rows): one thread waits on each else.
+            _mm_prefetch(reinterpret_cast<const char*>(p) + kPrefetchAhead, _MM_HINT_T0);
+            if (s4) _mm_prefetch(reinterpret_cast<const char*>(p + 2) + kPrefetchAhead, _MM_HINT_T0);
             __m256 x = _mm256_castsi256_ps(_mm256_loadu_si256(p)), y = _mm256_castsi256_ps(_mm256_loadu_si256(p + 1));
             __m256i order = _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7);  // a0 a1 a4 a5 | a2 a3 a6 a7 → in order
             if (s4) {
