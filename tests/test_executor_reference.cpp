@@ -315,9 +315,10 @@ struct DiffStats {
     int generated = 0, valid = 0, compared = 0, mismatches = 0;
 };
 
-// Runs one program over kLanes random pixels in one profile and compares with the reference.
+// Runs one program over `lanes` random pixels (kLanes unless told) in one profile and compares
+// with the reference.
 bool diffOne(const Prog& p, const ps11::Program& prog, Gen& g, ps11::Precision prec, float M, bool overrideM,
-             DiffStats& st) {
+             DiffStats& st, int lanes = kLanes) {
     ps11::ExecutorOptions opt;
     opt.precision = prec;
     opt.maxValue = overrideM ? M : 0.0f;
@@ -327,59 +328,61 @@ bool diffOne(const Prog& p, const ps11::Program& prog, Gen& g, ps11::Precision p
         FAIL_CHECK("Executor::create failed for a valid program:\n" << progText(p) << diags.formatAll());
         return false;
     }
-    std::vector<Inputs> ins(kLanes);
+    std::vector<Inputs> ins(static_cast<size_t>(lanes));
     for (auto& i : ins) i = g.inputs();
     // constants are per draw: lane 0's constants for all lanes
     for (int i = 0; i < 8; ++i) exec->setConstant(i, ins[0].consts[i]);
     for (auto& i : ins)
         for (int c = 0; c < 8; ++c) i.consts[c] = ins[0].consts[c];
-    float col[2][4][kLanes], tc[8][4][kLanes];
+    // Per register and channel, the lanes (plane k of 4 for colours, of 32 for coordinates).
+    std::vector<std::vector<float>> col(8, std::vector<float>(size_t(lanes))), tc(32, std::vector<float>(size_t(lanes)));
     ps11::PixelInputs pin;
-    pin.count = kLanes;
-    for (int l = 0; l < kLanes; ++l) {
+    pin.count = lanes;
+    for (int l = 0; l < lanes; ++l) {
         for (int i = 0; i < 2; ++i)
-            for (int c = 0; c < 4; ++c) col[i][c][l] = ins[l].color[i][c];
+            for (int c = 0; c < 4; ++c) col[size_t(4 * i + c)][size_t(l)] = ins[size_t(l)].color[i][c];
         for (int i = 0; i < 8; ++i)
-            for (int c = 0; c < 4; ++c) tc[i][c][l] = ins[l].tc[i][c];
+            for (int c = 0; c < 4; ++c) tc[size_t(4 * i + c)][size_t(l)] = ins[size_t(l)].tc[i][c];
     }
     for (int i = 0; i < 2; ++i)
-        for (int c = 0; c < 4; ++c) pin.color[i][c] = col[i][c];
+        for (int c = 0; c < 4; ++c) pin.color[i][c] = col[size_t(4 * i + c)].data();
     for (int i = 0; i < 8; ++i)
-        for (int c = 0; c < 4; ++c) pin.texcoord[i][c] = tc[i][c];
-    float outc[4][kLanes] = {};
-    int32_t outg[4][kLanes] = {};
+        for (int c = 0; c < 4; ++c) pin.texcoord[i][c] = tc[size_t(4 * i + c)].data();
+    std::vector<std::vector<float>> outc(4, std::vector<float>(size_t(lanes)));
+    std::vector<std::vector<int32_t>> outg(4, std::vector<int32_t>(size_t(lanes)));
     ps11::PixelOutputs pout;
-    for (int c = 0; c < 4; ++c) pout.color[c] = outc[c], pout.grid[c] = outg[c];
+    for (int c = 0; c < 4; ++c) pout.color[c] = outc[size_t(c)].data(), pout.grid[c] = outg[size_t(c)].data();
     ps11::NullSampler sampler;
     exec->run(pin, sampler, pout);
     const int mask = r0WrittenMask(p);
     std::vector<int> consts;
     for (int i = 0; i < 8; ++i) consts.push_back(i);
     bool ok = true;
-    for (int l = 0; l < kLanes && ok; ++l) {
+    for (int l = 0; l < lanes && ok; ++l) {
         ++st.compared;
         std::ostringstream diff;
         if (ps11::isFixedPoint(prec)) {
-            auto want = runFx(p, ins[l], prec, M);
+            auto want = runFx(p, ins[size_t(l)], prec, M);
             for (int c = 0; c < 4; ++c)
-                if ((mask & (1 << c)) && want[c] != outg[c][l]) {
+                if ((mask & (1 << c)) && want[c] != outg[size_t(c)][size_t(l)]) {
                     ok = false;
-                    diff << "r0." << "rgba"[c] << ": reference " << want[c] << ", executor " << outg[c][l] << "\n";
+                    diff << "r0." << "rgba"[c] << ": reference " << want[c] << ", executor " << outg[size_t(c)][size_t(l)]
+                         << "\n";
                 }
         } else {
-            auto want = runFloat(p, ins[l], prec == ps11::Precision::Ideal, M);
+            auto want = runFloat(p, ins[size_t(l)], prec == ps11::Precision::Ideal, M);
             for (int c = 0; c < 4; ++c)
-                if ((mask & (1 << c)) && !(want[c] == outc[c][l])) {  // bit-identical except the sign of zero
+                if ((mask & (1 << c)) && !(want[c] == outc[size_t(c)][size_t(l)])) {  // bit-identical but ±0
                     ok = false;
                     diff << "r0." << "rgba"[c] << ": reference " << floatText(want[c]) << ", executor "
-                         << floatText(outc[c][l]) << "\n";
+                         << floatText(outc[size_t(c)][size_t(l)]) << "\n";
                 }
         }
         if (!ok) {
             ++st.mismatches;
             FAIL_CHECK("mismatch at " << ps11::precisionName(prec) << " maxValue " << M << "\n"
                                       << progText(p) << "inputs:\n"
-                                      << inputsText(ins[l], p, consts) << diff.str());
+                                      << inputsText(ins[size_t(l)], p, consts) << diff.str());
         }
     }
     return ok;
@@ -405,6 +408,70 @@ void differential(uint32_t seed, int minor, int programs, DiffStats& st) {
             if (!diffOne(p, *prog, g, prec, M, overrideM, st) && ++reported >= 10) return;
         }
     }
+}
+
+// A filter's weighted sum, the shape of the glare techniques' blur programs: texcoord t0..t3,
+// then a mul of a register by a constant into r0 and mads adding r0, each with its own shift and
+// saturation; now and then something else in the sequence (a register's modifier or component,
+// another mask, a co-issued pair, r1).
+Prog weightedSumProgram(Gen& g, int minor) {
+    Prog p;
+    p.minor = minor;
+    if (g.coin(0.5)) {
+        p.defIndex.push_back(g.uni(0, 7));
+        std::array<float, 4> v;
+        for (float& f : v) f = g.value(-1.0f, 1.0f);
+        p.defs.push_back(v);
+    }
+    const int ntex = g.uni(1, 4);
+    for (int i = 0; i < ntex; ++i) {
+        TexIns t;
+        t.tindex = i;
+        p.tex.push_back(t);
+    }
+    auto reg = [&] {
+        Src r;
+        if (g.coin(0.8)) {
+            r.type = T, r.index = g.uni(0, ntex - 1);
+        } else {
+            r.type = V, r.index = g.uni(0, 1);
+        }
+        return r;
+    };
+    auto constant = [&] {
+        Src c;
+        c.type = C, c.index = g.uni(0, 7);
+        if (g.coin(0.3)) c.mod = std::array<int, 5>{1, 4, 6, 7, 2}[size_t(g.uni(0, 4))];
+        return c;
+    };
+    const int mask = std::array<int, 3>{15, 15, 7}[size_t(g.uni(0, 2))];
+    const int length = g.uni(2, 8);
+    for (int k = 0; k < length; ++k) {
+        Ins in;
+        in.op = k == 0 ? MUL : MAD;
+        in.mask = mask;
+        in.shift = g.coin(0.25) ? std::array<int, 3>{-1, 1, 2}[size_t(g.uni(0, 2))] : 0;
+        in.sat = g.coin(0.3);
+        Src r = reg(), c = constant();
+        if (g.coin(0.06)) r.mod = std::array<int, 3>{1, 4, 6}[size_t(g.uni(0, 2))];
+        if (g.coin(0.06)) r.sel = 3;
+        const bool constFirst = g.coin(0.4);
+        in.s[0] = constFirst ? c : r;
+        in.s[1] = constFirst ? r : c;
+        in.s[2].type = R, in.s[2].index = 0;
+        if (k > 0 && g.coin(0.05)) in.mask = 7;
+        if (k > 0 && g.coin(0.04)) in.dindex = 1, in.op = MUL;  // r1
+        p.ins.push_back(in);
+        if (k > 0 && mask == 7 && g.coin(0.1)) {
+            // A co-issued alpha op.
+            Ins a = in;
+            a.coissue = true;
+            a.mask = 8;
+            a.op = MUL;
+            p.ins.push_back(a);
+        }
+    }
+    return p;
 }
 
 // ---------------------------------------------------------------- hand cases for the reference
@@ -528,6 +595,33 @@ TEST_CASE("reference: random ps_1_x arithmetic programs, executor == reference b
             CHECK(st.mismatches == 0);
             CHECK(st.valid >= r.programs / 2);
         }
+    });
+}
+
+TEST_CASE("reference: weighted sums (a mul, then mads into one register) equal the reference", "[reference]") {
+    // Run over 5 to 300 lanes (vector groups and their tails, two chunks of 256 lanes), in float
+    // and ideal, at every SIMD level.
+    testutil::forEachSimdLevel([&](ps11::SimdLevel level) {
+        Gen g(0xc4a1 + uint32_t(level));
+        DiffStats st;
+        int reported = 0;
+        while (st.valid < 600 && st.generated < 4000 && reported < 10) {
+            ++st.generated;
+            const Prog p = weightedSumProgram(g, g.uni(1, 3));
+            std::string err;
+            auto prog = assemble(progText(p), err);
+            if (!prog) continue;
+            ++st.valid;
+            const bool overrideM = g.coin(0.2);
+            const float M = overrideM ? 2.0f : ps11::defaultHardware(p.minor).maxValue;
+            const int lanes = std::array<int, 4>{5, 16, 37, 300}[size_t(g.uni(0, 3))];
+            for (ps11::Precision prec : {ps11::Precision::Float, ps11::Precision::Ideal})
+                if (!diffOne(p, *prog, g, prec, M, overrideM, st, lanes)) ++reported;
+        }
+        INFO(ps11::simdLevelName(level) << ": " << st.generated << " generated, " << st.valid << " valid, "
+                                        << st.compared << " pixel comparisons, " << st.mismatches << " mismatches");
+        CHECK(st.mismatches == 0);
+        CHECK(st.valid >= 400);
     });
 }
 
