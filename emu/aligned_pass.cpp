@@ -494,8 +494,10 @@ bool chainRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::ar
 }
 
 // Tap t's chain run at column c, where its texel rows are read as they lie (chainWeight), or null.
-const AlignedTriangle::Run* chainRun(const AlignedTriangle& tri, const AlignedTriangle::Columns& cols,
-                                     const TapRow& row, int c) {
+// (Inlined: it runs for every tap of every chain row and its columns between runs.)
+[[gnu::always_inline]] inline const AlignedTriangle::Run* chainRun(const AlignedTriangle& tri,
+                                                                const AlignedTriangle::Columns& cols,
+                                                                const TapRow& row, int c) {
     const int32_t r = cols.run[size_t(c - tri.x0)];
     if (r < 0 || !chainWeight(row)) return nullptr;
     const AlignedTriangle::Run& run = cols.runs[size_t(r)];
