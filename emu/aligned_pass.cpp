@@ -573,8 +573,8 @@ const uint8_t* sharedRow(const AlignedDraw& draw, const AlignedTriangle& tri, co
 // four texels (meanBytes: a halfway tap's, either way or both; or copied where an earlier tap
 // formed them, formed[0, t)), runs with H rows blended into words (verticalBytes), each other
 // column at weight 0 both ways its one texel (or the border colour's bytes), the rest filtered
-// per pixel (filterTap). formed[t], which the caller cleared, says where its longest run of means
-// is for the taps after it.
+// per pixel (filterTexel for a few columns, filterTap for a longer stretch). formed[t], which the
+// caller cleared, says where its longest run of means is for the taps after it.
 const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
                           int t, int x, int n, AlignedScratch& sc, FormedRow* formed) {
     const AlignedTap& tap = draw.taps[size_t(t)];
