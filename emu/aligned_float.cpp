@@ -15,6 +15,7 @@
 
 #include "emu/aligned_float_kernels.h"
 #include "emu/vertex.h"
+#include "ps11/fill_lanes.h"
 
 namespace emu {
 
@@ -363,7 +364,7 @@ public:
         const int t = req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
         const FloatRowTap* tap = t >= 0 ? &m_draw.taps[size_t(t)] : nullptr;
         if (!tap || !tap->bound) {
-            for (int c = 0; c < 4; ++c) std::fill_n(out.value[c], n, c == 3 ? 1.0f : 0.0f);
+            for (int c = 0; c < 4; ++c) ps11::fillLanes(out.value[c], n, c == 3 ? 1.0f : 0.0f);
             out.unitRange = true;
             return;
         }
@@ -802,10 +803,10 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                         for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
                         sampler.sample(req, res);
                         for (int c = 0; c < 4; ++c)
-                            if (!((window->copyMask >> c) & 1)) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                            if (!((window->copyMask >> c) & 1)) ps11::fillLanes(sc.out[c], n, window->value[size_t(c)]);
                         stats.texels += uint64_t(n) * (tap.bound ? (tap.linear ? 4 : 1) : 0);
                     } else {
-                        for (int c = 0; c < 4; ++c) std::fill_n(sc.out[c], n, window->value[size_t(c)]);
+                        for (int c = 0; c < 4; ++c) ps11::fillLanes(sc.out[c], n, window->value[size_t(c)]);
                     }
                     MergeInputs mi;
                     mi.count = n;

@@ -19,6 +19,7 @@
 #endif
 
 #include "emu/aligned_pass_kernels.h"
+#include "ps11/fill_lanes.h"
 #include "ps11/texture_sampler_fast.h"
 
 namespace emu {
@@ -244,7 +245,7 @@ void rowInverseW(const TriangleSetup& s, int x, int y, int n, float* inv) {
 // or planeValue, times `inv` (rowInverseW) on a triangle with perspective.
 void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const float* inv, float* dst) {
     if ((s.constMask >> k) & 1) {
-        std::fill_n(dst, n, s.constValue[size_t(k)]);
+        ps11::fillLanes(dst, n, s.constValue[size_t(k)]);
         return;
     }
     fillPlaneRow(s.attr[size_t(k)], s.ox, s.oy, x, y, n, dst);
@@ -376,7 +377,7 @@ __attribute__((optimize("no-tree-slp-vectorize")))
 void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, const AlignedTriangle::Columns& cols,
                const TapRow& row, int colBase, int first, int count, int16_t* const out[4]) {
     if (!tap.bound) {
-        for (int c = 0; c < 4; ++c) std::fill_n(out[c], count, int16_t(c == 3 ? (fx12 ? kG12 : 255) : 0));
+        for (int c = 0; c < 4; ++c) ps11::fillLanes(out[c], count, int16_t(c == 3 ? (fx12 ? kG12 : 255) : 0));
         return;
     }
     // fx12 takes the vertical kernel that rounds 16·t / 65536 and its texels times 16.
@@ -917,9 +918,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         fill(&ctx, window->copyTap, 0, n, r0);
                         for (int c = 0; c < 4; ++c)
                             if (!((window->copyMask >> c) & 1))
-                                std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                                ps11::fillLanes(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     } else {
-                        for (int c = 0; c < 4; ++c) std::fill_n(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                        for (int c = 0; c < 4; ++c) ps11::fillLanes(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     }
                     stats.pixels += uint64_t(n);
                     uint8_t* row = target.texel(uint32_t(x), uint32_t(y));

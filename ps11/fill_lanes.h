@@ -1,0 +1,27 @@
+// A run of lanes set to one value. GCC 12 at -O2 (the RelWithDebInfo build) compiles std::fill_n
+// over a run of unknown length to one scalar store a lane; the row paths fill runs of up to
+// kMaxSpan lanes per channel (constant colours, filled tiles, unbound stages), so these store 16
+// bytes at a time (SSE2: every x86-64 level), the value's bits unchanged.
+#pragma once
+
+#include <emmintrin.h>
+
+#include <cstdint>
+
+namespace ps11 {
+
+inline void fillLanes(float* dst, int n, float value) {
+    const __m128 v = _mm_set1_ps(value);
+    int i = 0;
+    for (; i + 4 <= n; i += 4) _mm_storeu_ps(dst + i, v);
+    for (; i < n; ++i) dst[i] = value;
+}
+
+inline void fillLanes(int16_t* dst, int n, int16_t value) {
+    const __m128i v = _mm_set1_epi16(value);
+    int i = 0;
+    for (; i + 8 <= n; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i), v);
+    for (; i < n; ++i) dst[i] = value;
+}
+
+}  // namespace ps11
