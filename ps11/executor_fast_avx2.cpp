@@ -13,6 +13,8 @@
 #include <cstring>
 #include <utility>
 
+#include "ps11/fill_lanes.h"
+
 namespace ps11::exec::avx2 {
 #define PS11_FAST_AVX2 1
 #define PS11_FAST_NAME "fast-avx2"

@@ -13,6 +13,8 @@
 #include <cstring>
 #include <utility>
 
+#include "ps11/fill_lanes.h"
+
 namespace ps11::exec::avx512 {
 #define PS11_FAST_AVX512 1
 #define PS11_FAST_AVX2 0

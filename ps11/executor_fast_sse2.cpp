@@ -10,6 +10,8 @@
 #include <cstring>
 #include <utility>
 
+#include "ps11/fill_lanes.h"
+
 namespace ps11::exec::sse2 {
 #define PS11_FAST_AVX2 0
 #define PS11_FAST_NAME "fast-sse2"

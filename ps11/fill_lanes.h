@@ -1,14 +1,21 @@
-// A run of lanes set to one value. GCC 12 at -O2 (the RelWithDebInfo build) compiles std::fill_n
-// over a run of unknown length to one scalar store a lane; the row paths fill runs of up to
-// kMaxSpan lanes per channel (constant colours, filled tiles, unbound stages), so these store 16
-// bytes at a time (SSE2: every x86-64 level), the value's bits unchanged.
+// A run of lanes set to one value. GCC 12 at -O2 compiles std::fill_n over a run of unknown
+// length to one scalar store a lane (at -O3, the default build's level under GCC, it vectorises
+// it itself); the row paths and the fast executor fill runs of up to kMaxSpan lanes per channel
+// (constant colours, filled tiles, unbound stages), so on x86-64 these store 16 bytes at a time
+// (SSE2: every x86-64 level), the value's bits unchanged. Elsewhere they are std::fill_n.
 #pragma once
-
-#include <emmintrin.h>
 
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#else
+#include <algorithm>
+#endif
+
 namespace ps11 {
+
+#if defined(__SSE2__)
 
 inline void fillLanes(float* dst, int n, float value) {
     const __m128 v = _mm_set1_ps(value);
@@ -23,5 +30,17 @@ inline void fillLanes(int16_t* dst, int n, int16_t value) {
     for (; i + 8 <= n; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i), v);
     for (; i < n; ++i) dst[i] = value;
 }
+
+#else
+
+inline void fillLanes(float* dst, int n, float value) {
+    if (n > 0) std::fill_n(dst, n, value);
+}
+
+inline void fillLanes(int16_t* dst, int n, int16_t value) {
+    if (n > 0) std::fill_n(dst, n, value);
+}
+
+#endif
 
 }  // namespace ps11
