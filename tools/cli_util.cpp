@@ -182,15 +182,19 @@ std::optional<std::pair<float, float>> parseRange(const std::string& s) {
     return std::pair<float, float>{*lo, *hi};
 }
 
-bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide) {
+bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide, uint32_t minSide) {
     unsigned long a = 0, b = 0;
     char x = 0, tail = 0;
     if (std::sscanf(text.c_str(), "%lu%c%lu%c", &a, &x, &b, &tail) != 3 || (x != 'x' && x != 'X')) return false;
     if (text.find_first_of("+- ") != std::string::npos) return false;
-    if (a < 1 || b < 1 || a > maxSide || b > maxSide) return false;
+    if (a < std::max(minSide, 1u) || b < std::max(minSide, 1u) || a > maxSide || b > maxSide) return false;
     width = uint32_t(a);
     height = uint32_t(b);
     return true;
+}
+
+std::string sizeRule(uint32_t maxSide, uint32_t minSide) {
+    return "WxH with sides " + std::to_string(std::max(minSide, 1u)) + ".." + std::to_string(maxSide);
 }
 
 bool parseCount(const std::string& text, int lo, int hi, int& value) {

@@ -51,8 +51,16 @@ std::optional<uint32_t> parseHexWord(const std::string& s);
 std::optional<std::array<float, 4>> parseVector(const std::string& s, bool allowWord);
 // "lo,hi": two finite floats with lo <= hi.
 std::optional<std::pair<float, float>> parseRange(const std::string& s);
-// "WxH" (or "WXH") with both sides in 1..maxSide; false for anything else.
-bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide = 8192);
+// The sides a command's --size takes: kMaxSizeSide at most (every command that renders a frame),
+// and at least kMinGlareFrameSide where a whole glare frame is run (demo, bench: a technique's
+// smallest target is an eighth of the frame's side).
+constexpr uint32_t kMaxSizeSide = 8192;
+constexpr uint32_t kMinGlareFrameSide = 8;
+// "WxH" (or "WXH") with both sides in minSide..maxSide; false for anything else.
+bool parseSize(const std::string& text, uint32_t& width, uint32_t& height, uint32_t maxSide = kMaxSizeSide,
+               uint32_t minSide = 1);
+// What parseSize takes, for usage errors: "WxH with sides 1..8192".
+std::string sizeRule(uint32_t maxSide = kMaxSizeSide, uint32_t minSide = 1);
 // A whole decimal number in lo..hi; false for anything else (signs, spaces, overflow).
 bool parseCount(const std::string& text, int lo, int hi, int& value);
 

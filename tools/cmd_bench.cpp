@@ -202,8 +202,9 @@ int cmdBench(const std::vector<std::string>& args) {
             if (!value() || v.empty()) return benchUsage("--in needs an image file or a folder of them");
             in = v;
         } else if (a == "--size") {
-            if (!value() || !cli::parseSize(v, width, height) || width < 8 || height < 8)
-                return benchUsage("--size takes WxH with sides 8..8192" + (v.empty() ? std::string() : ", not '" + v + "'"));
+            if (!value() || !cli::parseSize(v, width, height, cli::kMaxSizeSide, cli::kMinGlareFrameSide))
+                return benchUsage("--size takes " + cli::sizeRule(cli::kMaxSizeSide, cli::kMinGlareFrameSide) +
+                                  (v.empty() ? std::string() : ", not '" + v + "'"));
         } else if (a == "--frames") {
             if (!value() || !cli::parseCount(v, 1, 10000, frames))
                 return benchUsage("--frames takes a count 1..10000" + (v.empty() ? std::string() : ", not '" + v + "'"));

@@ -27,6 +27,10 @@ namespace ps11 {
 
 namespace {
 
+// compare holds both renderers' images of every draw and their differences at once: its --size
+// stops at 4096 a side, below other commands' cli::kMaxSizeSide.
+constexpr uint32_t kMaxCompareSide = 4096;
+
 constexpr const char* kUsage =
     "usage: ps11 compare SHADER.psh|FILE.ps11test [--size WxH] [--seed S] [--hardware H] [--precision P]\n"
     "                    [--heatmap OUT.png] [--json] [--gl osmesa|egl] [--gl-mode exact|native] [--gl-filtering] [-v]\n"
@@ -437,7 +441,8 @@ int cmdCompare(const std::vector<std::string>& args) {
             opts.glFiltering = true;
         } else if (a == "--size") {
             uint32_t w = 0, h = 0;
-            if (!value(v) || !cli::parseSize(v, w, h, 4096)) return usageError("--size takes WxH with sides 1..4096");
+            if (!value(v) || !cli::parseSize(v, w, h, kMaxCompareSide))
+                return usageError("--size takes " + cli::sizeRule(kMaxCompareSide));
             opts.width = w, opts.height = h;
         } else if (a == "--seed") {
             if (!value(v) || v.empty() || v.find_first_not_of("0123456789") != std::string::npos)

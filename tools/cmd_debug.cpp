@@ -191,7 +191,7 @@ int cmdDebugFrame(const std::vector<std::string>& args) {
         } else if (a == "--frame") {
             if (!value() || !cli::parseCount(v, 0, 9999, rq.frame)) return frameUsage("--frame takes a frame number 0..9999");
         } else if (a == "--size") {
-            if (!value() || !cli::parseSize(v, rq.width, rq.height)) return frameUsage("--size takes WxH with sides 1..8192");
+            if (!value() || !cli::parseSize(v, rq.width, rq.height)) return frameUsage("--size takes " + cli::sizeRule());
             sizeGiven = true;
         } else if (a == "--quality") {
             if (!value()) return frameUsage("--quality needs low, medium, high or published");

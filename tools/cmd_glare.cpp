@@ -646,7 +646,7 @@ int cmdGlare(const std::vector<std::string>& args) {
         } else if (a == "--frames") {
             if (!value(v) || !cli::parseCount(v, 1, 99999, o.frames)) return glareUsage("--frames takes a count 1..99999");
         } else if (a == "--size") {
-            if (!value(v) || !cli::parseSize(v, o.width, o.height)) return glareUsage("--size takes WxH with sides 1..8192");
+            if (!value(v) || !cli::parseSize(v, o.width, o.height)) return glareUsage("--size takes " + cli::sizeRule());
         } else if (a == "--backend") {
             if (!value(o.backend) || (o.backend != "emu" && o.backend != "gl"))
                 return glareUsage("--backend takes emu or gl");

@@ -76,7 +76,7 @@ int cmdShade(const std::vector<std::string>& args) {
             request.constants.push_back({n, c});
         } else if (a == "--size") {
             uint32_t w = 0, h = 0;
-            if (!value() || !cli::parseSize(v, w, h)) return shadeUsage("--size takes WxH with sides 1..8192");
+            if (!value() || !cli::parseSize(v, w, h)) return shadeUsage("--size takes " + cli::sizeRule());
             request.width = w, request.height = h;
         } else if (a == "--backend") {
             if (!value() || (v != "emu" && v != "gl")) return shadeUsage("--backend takes emu or gl");

@@ -332,8 +332,8 @@ int cmdDemo(const std::vector<std::string>& args) {
                 demo.hardware = findHardware(v);
                 if (!demo.hardware) return usage("demo: " + unknownHardwareMessage(v));
             } else if (a == "--size") {
-                if (!parseSize(v, demo.width, demo.height, 8192) || demo.width < 8 || demo.height < 8)
-                    return usage("demo: --size takes WIDTHxHEIGHT with sides 8..8192, not " + quote(v));
+                if (!parseSize(v, demo.width, demo.height, kMaxSizeSide, kMinGlareFrameSide))
+                    return usage("demo: --size takes " + sizeRule(kMaxSizeSide, kMinGlareFrameSide) + ", not " + quote(v));
             } else if (a == "--out") {
                 demo.outDir = v;
             } else if (!parseCount(v, 0, 256, demo.threads)) {

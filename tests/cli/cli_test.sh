@@ -334,6 +334,12 @@ expect_in "$work/demo/index.html" "sensors need vertex texture fetch (vs_3_0)" "
 expect_in "$work/err" "stress:" "demo progress on stderr"
 expect_rc 2 "demo unknown class" "$ps11" demo --hardware voodoo
 expect_rc 2 "demo bad size" "$ps11" demo --size 0x5
+expect_in "$work/err" "sides 8..8192, not '0x5'" "demo states the size rule"
+expect_rc 2 "demo size below a glare frame's least" "$ps11" demo --size 7x100
+expect_rc 2 "bench size below a glare frame's least" "$ps11" bench --technique adaptive --size 100x7
+expect_in "$work/err" "--size takes WxH with sides 8..8192, not '100x7'" "bench states the size rule"
+expect_rc 2 "glare size above the largest" "$ps11" glare --technique adaptive --scene box --size 8193x8 -o "$work/never.png"
+expect_in "$work/err" "--size takes WxH with sides 1..8192" "glare states the size rule"
 expect_rc 2 "demo bad threads" "$ps11" demo --threads many
 expect_rc 2 "demo unknown argument" "$ps11" demo --bogus
 expect_in "$work/err" "unknown argument" "demo names the bad argument"
@@ -434,6 +440,7 @@ fi
 expect_rc 2 "compare without input" "$ps11" compare
 expect_in "$work/err" "missing SHADER.psh or FILE.ps11test" "compare says what is missing"
 expect_rc 2 "compare --size bad" "$ps11" compare x.psh --size 0x4
+expect_in "$work/err" "--size takes WxH with sides 1..4096" "compare states its size rule"
 expect_rc 2 "compare --random with a file" "$ps11" compare x.psh --random 3
 expect_rc 2 "compare unknown option" "$ps11" compare x.psh --heatmpa h.png
 expect_in "$work/err" "did you mean '--heatmap'?" "compare suggests the option"
