@@ -90,14 +90,17 @@ const SensorKernels& sensorKernels(ps11::SimdLevel level) {
 
 namespace {
 
+// Bands the sensors' steps split the frame into, at most (per-band results are kept per band).
+constexpr unsigned kMaxSensorBands = 8;
+
 // The workers of `pool` (null: the calling thread alone) over `rows` items of `rowsPerItem`
-// pixel rows: bands of at least 64 pixel rows, at most 8, the calling thread taking the first;
-// `work(first, last, band)`. Callers join per-band results in band order, so the sprites and
+// pixel rows: bands of at least 64 pixel rows, at most kMaxSensorBands, the calling thread
+// taking the first; `work(first, last, band)`. Callers join per-band results in band order, so the sprites and
 // every sum are those of one pass in raster order.
 void rowBands(uint32_t rows, uint32_t rowsPerItem, emu::ThreadPool* pool,
               const std::function<void(uint32_t, uint32_t, unsigned)>& work) {
     const unsigned wanted = pool ? unsigned(pool->size()) : 1u;
-    const unsigned bands = std::max(1u, std::min({wanted, 8u, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
+    const unsigned bands = std::max(1u, std::min({wanted, kMaxSensorBands, rows * rowsPerItem / 64 + 1, std::max(rows, 1u)}));
     if (bands == 1) {
         work(0, rows, 0);
         return;
@@ -186,7 +189,7 @@ std::vector<Sprite> senseSprites(const SensorFrame& f, const SensorSettings& s) 
         out.push_back(sp);
     };
     std::vector<Sprite> out;
-    std::vector<std::vector<Sprite>> bands(8);
+    std::vector<std::vector<Sprite>> bands(kMaxSensorBands);
     auto join = [&] {
         for (std::vector<Sprite>& b : bands) {
             out.insert(out.end(), b.begin(), b.end());
