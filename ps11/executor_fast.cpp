@@ -60,10 +60,11 @@ bool fastKind(Opcode op, FastKind& k) {
 }
 
 // Texture ops that write all four components of their destination for every lane, so the
-// int32 copy of the destination need not be brought up to date first.
+// int32 copy of the destination need not be brought up to date first: every one that writes its
+// destination (the opcode table's writesDst) writes it whole, save 1_4's texcrd (its mask only).
 bool textureWritesAll(const DOp& op, int minor) {
-    if (op.op == Opcode::TexCoord) return minor < 4;  // 1_4 texcrd writes its mask only
-    return samplesStage(op.op) || op.op == Opcode::TexM3x3 || op.op == Opcode::TexDp3;
+    if (op.op == Opcode::TexCoord && minor >= 4) return false;
+    return op.info->cls == OpClass::Texture && op.info->writesDst;
 }
 
 struct FastRunState {

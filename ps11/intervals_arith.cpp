@@ -168,8 +168,10 @@ void arithFx(const Profile& p, const DOp& op, const Regs& regs, AV out[4], Write
     if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
         // One sum of products (each bounded at its corners), written to every enabled channel.
         KI sum{0, 0};
-        for (int c = 0; c < (op.op == Opcode::Dp3 ? 3 : 4); ++c)
-            sum = kAdd(sum, kMul(fetch<true>(p, regs, op.src[0], c).k, fetch<true>(p, regs, op.src[1], c).k));
+        const uint8_t reads = componentsRead(*op.info, 0, op.mask);  // dp3 .rgb, dp4 .rgba
+        for (int c = 0; c < 4; ++c)
+            if ((reads >> c) & 1)
+                sum = kAdd(sum, kMul(fetch<true>(p, regs, op.src[0], c).k, fetch<true>(p, regs, op.src[1], c).k));
         AV r;
         fxWrite(p, op, sum, kProd, r, wf, op.mask);
         for (int c = 0; c < 4; ++c)

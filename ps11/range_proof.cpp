@@ -260,7 +260,9 @@ private:
         if (op.op == Opcode::Dp3 || op.op == Opcode::Dp4) {
             bool even = true;
             double e = 0, magnitude = 0;
-            for (int k = 0; k < (op.op == Opcode::Dp3 ? 3 : 4); ++k) {
+            const uint8_t reads = componentsRead(*op.info, 0, op.mask);  // dp3 .rgb, dp4 .rgba
+            for (int k = 0; k < 4; ++k) {
+                if (!((reads >> k) & 1)) continue;
                 const EV a = fetch(op.src[0], k, even), b = fetch(op.src[1], k, even);
                 e += product(a, b);
                 magnitude += mag(a) * mag(b);

@@ -497,9 +497,7 @@ std::vector<Instruction> Generator::arithUnit(bool pair, bool final) {
         if (m_dice.chance(30)) in.dst.shift = int8_t(m_dice.pick(is14() ? kShifts14 : kShifts13));
         in.dst.saturate = m_dice.chance(25);
         // The components each source gives: what the operation reads, else the write mask.
-        uint8_t channels = mask;
-        if (row.opcode == Opcode::Dp3) channels = ps11::kMaskRGB;
-        if (row.opcode == Opcode::Dp4) channels = ps11::kMaskAll;
+        const uint8_t channels = ps11::componentsReadAny(row, mask);
         for (size_t s = 0; s < row.numSrc; ++s) in.src[s] = arithSource(channels, mask);
         // The 1_1-1_3 cnd condition is r0.a exactly (spec §2.2).
         if (row.opcode == Opcode::Cnd && !is14())
