@@ -80,6 +80,25 @@ const NameEntry<TexFormat> kTexFormatNames[kTexFormatCount] = {
 };
 static_assert(kTexFormatCount == 13, "kTexFormatNames names every texture row");
 
+namespace {
+// The k-th texture row (in enum order) that a render target may take.
+constexpr NameEntry<TexFormat> renderTargetName(size_t k) {
+    for (size_t i = 0; i < kTexFormatCount; ++i)
+        if (kFormatRows[i].renderTarget && k-- == 0) return nameOf(i);
+    return {"", TexFormat::A8R8G8B8};
+}
+constexpr size_t renderTargetRows() {
+    size_t n = 0;
+    for (size_t i = 0; i < kTexFormatCount; ++i) n += kFormatRows[i].renderTarget ? 1 : 0;
+    return n;
+}
+static_assert(renderTargetRows() == kRenderTargetFormatCount, "kRenderTargetFormatNames names every render target");
+}  // namespace
+
+const NameEntry<TexFormat> kRenderTargetFormatNames[kRenderTargetFormatCount] = {
+    renderTargetName(0), renderTargetName(1), renderTargetName(2), renderTargetName(3), renderTargetName(4),
+};
+
 const char* texFormatName(TexFormat f) { return size_t(f) < kTexFormatCount ? formatRow(f).name : "?"; }
 
 std::optional<TexFormat> parseTexFormat(std::string_view name) {

@@ -85,6 +85,10 @@ const FormatRow& formatRow(TexFormat f);
 
 // Every texture format with its name, in enum order (from kFormatRows).
 extern const NameEntry<TexFormat> kTexFormatNames[kTexFormatCount];
+// The texture formats a render target may take (kFormatRows' renderTarget), with their names,
+// in enum order: what a .ps11test [render target] accepts.
+constexpr size_t kRenderTargetFormatCount = 5;
+extern const NameEntry<TexFormat> kRenderTargetFormatNames[kRenderTargetFormatCount];
 const char* texFormatName(TexFormat f);
 std::optional<TexFormat> parseTexFormat(std::string_view name);  // case-insensitive
 bool isFloatFormat(TexFormat f);

@@ -20,12 +20,6 @@ namespace ps11 {
 namespace testfile_detail {
 namespace {
 
-const NameEntry<TexFormat> kTargetFormats[] = {
-    {"A8R8G8B8", TexFormat::A8R8G8B8},
-    {"X8R8G8B8", TexFormat::X8R8G8B8},
-    {"A16B16G16R16F", TexFormat::A16B16G16R16F},
-    {"A32B32G32R32F", TexFormat::A32B32G32R32F},
-};
 const NameEntry<TextureOp> kTextureOps[] = {
     {"disable", TextureOp::Disable},
     {"selectarg1", TextureOp::SelectArg1},
@@ -382,7 +376,7 @@ void Parser::renderTargetLine(Args& a, std::string_view kw) {
         std::optional<int64_t> h = a.integer("render target height", 1, kMaxTextureSide);
         if (w && h) rt.size = {{uint32_t(*w), uint32_t(*h)}, line};
     } else if (iequals(kw, "format")) {
-        assign(rt.format, a.name(kTargetFormats, "render target format"), line);
+        assign(rt.format, a.name(kRenderTargetFormatNames, "render target format"), line);
     } else if (iequals(kw, "clear")) {
         assign(rt.clear, a.color("clear colour"), line);
     } else if (iequals(kw, "depth")) {

@@ -129,6 +129,13 @@ TEST_CASE("testfile: [render target]", "[testfile]") {
     CHECK_ERROR(parse("[render target]\nsize 4\n"), 2, "missing render target height");
     CHECK_ERROR(parse("[render target]\nsize 4.5 4\n"), 2, "must be an integer");
     CHECK_ERROR(parse("[render target]\nformat L8\n"), 2, "unknown render target format 'L8'");
+    // Every render-target format of the format rows, and only those, names a target.
+    for (const FormatRow& row : kFormatRows) {
+        if (!row.texture) continue;
+        Parsed f = parse(std::string("[render target]\nformat ") + row.name + "\n");
+        CHECK(f.errors.empty() == row.renderTarget);
+        if (row.renderTarget) CHECK(f.file.renderTarget.format.value == row.texFormat);
+    }
     CHECK_ERROR(parse("[render target]\nclear 0 0\n"), 2, "one 0xAARRGGBB word or 4 floats");
     CHECK_ERROR(parse("[render target]\nclear red\n"), 2, "bad clear colour 'red'");
     CHECK_ERROR(parse("[render target]\nclear 0x1ffffffff\n"), 2, "bad clear colour");
