@@ -34,12 +34,6 @@ const std::array<FormatInfo, std::size(ps11::kFormatRows)>& formats() {
 
 uint32_t fieldMask(const Channel& ch) { return ch.bits >= 32 ? ~0u : ((uint32_t(1) << ch.bits) - 1) << ch.shift; }
 
-float loadFloat(const uint8_t* p) {
-    float f;
-    std::memcpy(&f, p, 4);
-    return f;
-}
-
 void storeFloat(float f, uint8_t* p) { std::memcpy(p, &f, 4); }
 
 }  // namespace
@@ -69,14 +63,7 @@ uint32_t loadWord(const uint8_t* p, uint32_t bytes) {
 }
 
 std::array<uint8_t, 4> decodeUnorm8(const FormatInfo& f, const uint8_t* p) {
-    if (f.cls != FormatClass::Unorm8) return {0, 0, 0, 255};
-    const uint32_t w = loadWord(p, f.bytes);
-    std::array<uint8_t, 4> out;
-    for (size_t c = 0; c < 4; ++c) {
-        const Channel& ch = f.rgba[c];
-        out[c] = ch.kind == ChannelKind::Unorm ? uint8_t(w >> ch.shift) : ch.kind == ChannelKind::Zero ? 0 : 255;
-    }
-    return out;
+    return ps11::unorm8Channels(f, f.cls == FormatClass::Unorm8 ? loadWord(p, f.bytes) : 0);
 }
 
 void encodeUnorm8(const FormatInfo& f, const std::array<uint8_t, 4>& c, uint8_t* p) {
@@ -99,17 +86,7 @@ std::array<float, 4> decodeTexel(const FormatInfo& f, const uint8_t* p, ps11::Si
         return {float(b[0] / 255.0), float(b[1] / 255.0), float(b[2] / 255.0), float(b[3] / 255.0)};
     }
     if (f.cls == FormatClass::Signed) return ps11::signedTexelValue(f.texFormat, loadWord(p, f.bytes), decode);
-    if (f.cls != FormatClass::Float) return {0, 0, 0, 1};
-    std::array<float, 4> v;
-    for (size_t c = 0; c < 4; ++c) {
-        const Channel& ch = f.rgba[c];
-        const uint8_t* q = p + ch.shift / 8;
-        v[c] = ch.kind == ChannelKind::Float  ? loadFloat(q)
-               : ch.kind == ChannelKind::Half ? halfToFloat(uint16_t(q[0] | (q[1] << 8)))
-               : ch.kind == ChannelKind::Zero ? 0.0f
-                                              : 1.0f;
-    }
-    return v;
+    return ps11::floatChannels(f, p);
 }
 
 void encodeFloat(const FormatInfo& f, const std::array<float, 4>& v, uint8_t* p) {

@@ -49,17 +49,12 @@ uint32_t fieldOf(const Channel& ch, uint32_t w) {
     return ch.bits >= 32 ? w >> ch.shift : (w >> ch.shift) & ((uint32_t(1) << ch.bits) - 1);
 }
 
-// A packed word of an Unorm8 format -> the stored bytes b g r a (spec §6.4: missing channels
-// read 1, except A8 whose rgb read 0). A8R8G8B8 keeps D3D's byte order, so its hand-over is a copy.
-std::array<uint8_t, 4> decodeUnorm8(const FormatRow& row, uint32_t w) {
-    std::array<uint8_t, 4> out{0, 0, 0, 255};
-    if (row.cls != FormatClass::Unorm8) return out;
-    for (size_t c = 0; c < 4; ++c) {
-        const Channel& ch = row.rgba[c];
-        out[size_t(kUnorm8Byte[c])] = ch.kind == ChannelKind::Unorm  ? uint8_t(fieldOf(ch, w))
-                                      : ch.kind == ChannelKind::Zero ? 0
-                                                                     : 255;
-    }
+// A packed word of an Unorm8 format -> the stored bytes b g r a (kUnorm8Byte). A8R8G8B8 keeps
+// D3D's byte order, so its hand-over is a copy.
+std::array<uint8_t, 4> storedUnorm8(const FormatRow& row, uint32_t w) {
+    const std::array<uint8_t, 4> rgba = unorm8Channels(row, w);
+    std::array<uint8_t, 4> out{};
+    for (size_t c = 0; c < 4; ++c) out[size_t(kUnorm8Byte[c])] = rgba[c];
     return out;
 }
 
@@ -314,7 +309,7 @@ const TextureLevelInfo& TextureBuilder::level(uint32_t k) const { return m_textu
 
 void TextureBuilder::storeWord(size_t index, uint32_t word) {
     if (m_storage == TexelStorage::Unorm8) {
-        const std::array<uint8_t, 4> b = decodeUnorm8(*m_row, word);
+        const std::array<uint8_t, 4> b = storedUnorm8(*m_row, word);
         std::copy(b.begin(), b.end(), m_texture.m_u8.begin() + ptrdiff_t(index * 4));
     } else if (!m_floats) {
         const std::array<int32_t, 4> r = decodeSigned(*m_row, word);
@@ -398,6 +393,30 @@ void unorm8Row(const FormatRow& row, const uint8_t* src, uint32_t width, uint8_t
 }
 
 }  // namespace
+
+std::array<uint8_t, 4> unorm8Channels(const FormatRow& row, uint32_t word) {
+    std::array<uint8_t, 4> out{0, 0, 0, 255};
+    if (row.cls != FormatClass::Unorm8) return out;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        out[c] = ch.kind == ChannelKind::Unorm ? uint8_t(fieldOf(ch, word)) : ch.kind == ChannelKind::Zero ? 0 : 255;
+    }
+    return out;
+}
+
+std::array<float, 4> floatChannels(const FormatRow& row, const uint8_t* p) {
+    std::array<float, 4> out{0, 0, 0, 1};
+    if (row.cls != FormatClass::Float) return out;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        const uint8_t* q = p + ch.shift / 8;
+        out[c] = ch.kind == ChannelKind::Float  ? loadF32(q)
+                 : ch.kind == ChannelKind::Half ? halfToFloat(uint16_t(loadLE(q, 2)))
+                 : ch.kind == ChannelKind::Zero ? 0.0f
+                                                : 1.0f;
+    }
+    return out;
+}
 
 std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const TextureLevelBytes* levels,
                                            size_t levelCount, SignedDecode decode, std::string& error,
@@ -491,15 +510,8 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         forEachRow([&](const uint8_t* src, uint32_t width, size_t first) {
             float* d = rawf.data() + first * 4;
             for (uint32_t x = 0; x < width; ++x, d += 4) {
-                const uint8_t* p = src + size_t(x) * bpt;
-                for (size_t c = 0; c < 4; ++c) {
-                    const Channel& ch = row.rgba[c];
-                    const uint8_t* q = p + ch.shift / 8;
-                    d[c] = ch.kind == ChannelKind::Float  ? loadF32(q)
-                           : ch.kind == ChannelKind::Half ? halfToFloat(uint16_t(loadLE(q, 2)))
-                           : ch.kind == ChannelKind::Zero ? 0.0f
-                                                          : 1.0f;
-                }
+                const std::array<float, 4> v = floatChannels(row, src + size_t(x) * bpt);
+                std::copy(v.begin(), v.end(), d);
             }
         });
     } else {

@@ -156,6 +156,13 @@ uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth);
 // Bytes per texel of a format in D3D's memory layout.
 uint32_t bytesPerTexel(TexFormat f);
 
+// One texel's channels as the sampler reads them, from its format's row (ps1x-spec §6.4: missing
+// channels read 1, A8's rgb 0): an Unorm8 format's packed word as the bytes r g b a (other
+// classes: 0 0 0 255); a Float format's texel at p, D3D9 layout, as the values r g b a (other
+// classes: 0 0 0 1). The device's conversions and the textures' hand-over both decode with these.
+std::array<uint8_t, 4> unorm8Channels(const FormatRow& row, uint32_t word);
+std::array<float, 4> floatChannels(const FormatRow& row, const uint8_t* p);
+
 // float32 -> nearest IEEE half bits (ties to even, overflow to infinity, NaN kept quiet).
 uint16_t floatToHalf(float v);
 // IEEE half bits -> float32 (exact).
