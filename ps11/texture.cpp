@@ -371,20 +371,34 @@ inline float loadF32(const uint8_t* p) {
     return f;
 }
 
+// The bytes per texel of a format whose D3D9 texels are already the texture's stored form, so
+// that its levels can be read where they lie: an Unorm8 format whose four channels sit in the b g r
+// a bytes of a word (kUnorm8Byte: A8R8G8B8), or a Float format of four float32 r g b a
+// (A32B32G32R32F); 0 for every other format.
+uint32_t storedAsIs(const FormatRow& row) {
+    const uint32_t unit = row.cls == FormatClass::Unorm8 ? 8 : row.cls == FormatClass::Float ? 32 : 0;
+    if (!unit || row.bytes != 4 * unit / 8) return 0;
+    for (size_t c = 0; c < 4; ++c) {
+        const Channel& ch = row.rgba[c];
+        const ChannelKind kind = unit == 8 ? ChannelKind::Unorm : ChannelKind::Float;
+        const uint32_t at = unit == 8 ? uint32_t(kUnorm8Byte[c]) * 8 : uint32_t(c) * 32;
+        if (ch.kind != kind || ch.shift != at || ch.bits != unit) return 0;
+    }
+    return row.bytes;
+}
+
 // One row of an Unorm8 format into b g r a words: a copy where the format's layout is the stored
-// one (A8R8G8B8), else each stored byte from the texel byte that holds its channel, or a constant.
+// one (storedAsIs), else each stored byte from the texel byte that holds its channel, or a constant.
 void unorm8Row(const FormatRow& row, const uint8_t* src, uint32_t width, uint8_t* dst) {
     std::array<int, 4> from{};      // per stored byte: the texel byte it copies, or -1
     std::array<uint8_t, 4> fill{};  // the constant of a byte no texel byte gives
-    bool copy = row.bytes == 4;
     for (size_t c = 0; c < 4; ++c) {
         const Channel& ch = row.rgba[c];
         const size_t b = size_t(kUnorm8Byte[c]);
         from[b] = ch.kind == ChannelKind::Unorm ? ch.shift / 8 : -1;
         fill[b] = ch.kind == ChannelKind::Zero ? 0 : 255;
-        copy = copy && from[b] == int(b);
     }
-    if (copy) {
+    if (storedAsIs(row)) {
         std::memcpy(dst, src, size_t(width) * 4);  // D3D's byte order is the stored order
         return;
     }
@@ -476,10 +490,10 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
                         li.offset + (size_t(z) * li.height + y) * li.width);
         }
     };
-    // In place: D3D's A8R8G8B8 word is the stored b g r a order and A32B32G32R32F's four floats
-    // the stored r g b a values, when the levels follow each other exactly at the texture's own
-    // texel offsets.
-    const size_t inPlaceBytes = fmt == TexFormat::A8R8G8B8 ? 4 : fmt == TexFormat::A32B32G32R32F ? 16 : 0;
+    // In place: a format stored as it is (storedAsIs: A8R8G8B8's word is the stored b g r a order,
+    // A32B32G32R32F's four floats the stored r g b a values), when the levels follow each other
+    // exactly at the texture's own texel offsets.
+    const size_t inPlaceBytes = storedAsIs(formatRow(fmt));
     bool inPlace = owner && inPlaceBytes && (inPlaceBytes == 4 || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
     for (size_t k = 0; inPlace && k < levelCount; ++k) {
         const TextureLevelInfo& li = t.m_levels[k];

@@ -396,6 +396,14 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         CHECK(tx->texelValue(0, 0, 0)[3] == 1.0f);
         REQUIRE(dev.CreateTexture(4, 4, 1, 0, D3DFMT_A8, D3DPOOL_MANAGED, &a8) == D3D_OK);
         CHECK_FALSE(dev.sampledTexture(a8)->readsInPlace());
+        // Of the float formats only A32B32G32R32F is stored as the sampler keeps values.
+        for (const D3DFORMAT f : {D3DFMT_A32B32G32R32F, D3DFMT_A16B16G16R16F, D3DFMT_R32F}) {
+            Handle ft{};
+            REQUIRE(dev.CreateTexture(4, 4, 1, 0, f, D3DPOOL_MANAGED, &ft) == D3D_OK);
+            auto sampled = dev.sampledTexture(ft);
+            REQUIRE(sampled);
+            CHECK(sampled->readsInPlace() == (f == D3DFMT_A32B32G32R32F));
+        }
     }
 
     SECTION("every write leaves a view someone holds as it was") {
