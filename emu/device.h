@@ -219,10 +219,11 @@ private:
     HRESULT registerShader(const char* call, PixelShaderObject&& shader, Handle* out);
     // AUTOGENMIPMAP: levels 1.. from level 0, in the front's images.
     void regenerateMips(Resource& r);
-    // The front wrote a level in its own image.
-    void markWritten(Resource& r, uint32_t level);
+    // The front wrote a level in its own image; `setsPad`: every texel it wrote has its pad bits
+    // set (Resource::padOnes stands), else padOnes is cleared.
+    void markWritten(Resource& r, uint32_t level, bool setsPad = false);
     // The renderer wrote a level in its copy (the front's image is stale until syncLevel).
-    void rendererWrote(Resource& r, uint32_t level);
+    void rendererWrote(Resource& r, uint32_t level, bool setsPad = false);
     // Called before anything writes a resource's levels (the front, a renderer, a lock): drops
     // the sampler's view and gives the levels a copy if a texture still reads them in place.
     void prepareWrite(Resource& r);

@@ -283,16 +283,18 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     if (boxes.empty()) return D3D_OK;
     if (target) prepareWrite(*rt);
     if (depth) prepareWrite(*ds);
+    // (The cleared texels are cc.colorTexel, its pad bits set by encodeUnorm8.)
     if (m_renderer->clear(cc)) {
-        if (target) rendererWrote(*rt, rtRef.level);
+        if (target) rendererWrote(*rt, rtRef.level, /*setsPad=*/true);
         if (depth) rendererWrote(*ds, dsRef.level);
     } else {
         if (target) syncLevel(*rt, rtRef.level);
         if (depth) syncLevel(*ds, dsRef.level);
         clearImages(cc);
-        if (target) markWritten(*rt, rtRef.level);
+        if (target) markWritten(*rt, rtRef.level, /*setsPad=*/true);
         if (depth) markWritten(*ds, dsRef.level);
     }
+    if (target && rt->levels.size() == 1 && coversAll(*target)) rt->padOnes = true;
     // Level 0 of a texture cleared whole holds one value: its tile facts need no scan until drawn into.
     if (target && rtRef.level == 0 && coversAll(*target))
         rt->uniformStale = std::make_shared<const std::vector<uint8_t>>(uniformTileCount(*target), uint8_t(0));

@@ -483,7 +483,7 @@ std::optional<CallError> Device::submit(DrawSetup& d, DrawStats& stats) {
     CallError error;
     if (!m_renderer->draw(call, stats, error)) return error;
     if (stats.trianglesDrawn) {
-        rendererWrote(*d.rt, d.rtRef.level);
+        rendererWrote(*d.rt, d.rtRef.level, /*setsPad=*/true);  // every path stores X8's X byte as 1s
         if (d.depth && call.merge.depthWrite) rendererWrote(*d.ds, d.dsRef.level);
         if (uniform) d.rt->uniformStale = markDrawnTiles(call, *d.target, *uniform);
     }

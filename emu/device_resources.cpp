@@ -342,7 +342,8 @@ void Device::regenerateMips(Resource& r) {
 }
 
 
-void Device::markWritten(Resource& r, uint32_t level) {
+void Device::markWritten(Resource& r, uint32_t level, bool setsPad) {
+    if (!setsPad) r.padOnes = false;
     r.levelGeneration.resize(r.levels.size(), 0);
     r.rendererNewer.resize(r.levels.size(), 0);
     if (!r.bytesBefore.empty()) {
@@ -363,8 +364,8 @@ void Device::markWritten(Resource& r, uint32_t level) {
     if (level == 0 && r.autoGenMips()) r.mipsDirty = true;
 }
 
-void Device::rendererWrote(Resource& r, uint32_t level) {
-    markWritten(r, level);
+void Device::rendererWrote(Resource& r, uint32_t level, bool setsPad) {
+    markWritten(r, level, setsPad);
     r.rendererNewer[level] = m_renderer->leftNewer(surfaceDesc(SurfaceRef{r.handle, level}, r)) ? 1 : 0;
 }
 
@@ -588,7 +589,9 @@ std::shared_ptr<const ps11::Texture> Device::makeSampled(Handle texture, CallErr
     // A locked level's bytes may change under the texture: it gets a copy then.
     const bool locked = std::find(r->locked.begin(), r->locked.end(), 1) != r->locked.end();
     try {
-        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, locked, why);
+        // (Pad bits are known only in the front's own images: not on a renderer that keeps copies.)
+        r->sampled = makeSampledTexture(*r, m_hardware.hardware->signedDecode, locked,
+                                        r->padOnes && !m_renderer->keepsCopies(), why);
     } catch (const std::bad_alloc&) {
         r->sampled = nullptr;
         why = "out of memory";

@@ -169,9 +169,10 @@ void detachStore(Resource& r) {
 }
 
 std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode, bool copy,
-                                                       std::string& error) {
+                                                       bool padOnes, std::string& error) {
     // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): read in
-    // place for A8R8G8B8, a per-texel expansion for the other formats. No transient per-texel model.
+    // place for A8R8G8B8, A32B32G32R32F and (padOnes) X8R8G8B8, a per-texel expansion for the other
+    // formats. No transient per-texel model.
     std::vector<ps11::TextureLevelBytes> levels(r.levels.size());
     for (size_t k = 0; k < r.levels.size(); ++k) {
         const Image& im = r.levels[k];
@@ -179,7 +180,7 @@ std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11:
     }
     std::optional<ps11::Texture> t = ps11::Texture::fromLevels(
         r.format->texFormat, r.kind == ResourceKind::VolumeTexture, levels.data(), levels.size(), decode, error,
-        copy || r.levels.empty() ? std::shared_ptr<const void>{} : std::shared_ptr<const void>(r.store()));
+        copy || r.levels.empty() ? std::shared_ptr<const void>{} : std::shared_ptr<const void>(r.store()), padOnes);
     if (!t) return nullptr;
     return std::make_shared<const ps11::Texture>(std::move(*t));
 }

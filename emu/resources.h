@@ -110,6 +110,12 @@ struct Resource {
     // (ps11::texelTileSide) that draws may have written since; null after any other write.
     // Handed to each sampled view (ps11::Texture::setUniformTiles).
     std::shared_ptr<const std::vector<uint8_t>> uniformStale;
+    // Every texel's pad bits (the X byte of X8R8G8B8) are 1s, so the sampler, which reads them as
+    // alpha 1, can read the level where it lies (ps11::Texture::fromLevels' `padOnes`). Set by a
+    // clear of the whole of a one-level resource (its texels encoded with the pad set); kept by
+    // draws and clears, whose stores set the pad (the merger's X8 or-mask, encodeUnorm8); cleared
+    // by every other write (a lock, a copy of bytes as given, StretchRect, mip generation).
+    bool padOnes = false;
 
     // The one buffer all levels view (allocateLevels).
     const std::shared_ptr<uint8_t[]>& store() const { return levels.front().bytes.store(); }
@@ -167,8 +173,9 @@ void generateMips(Resource& r);
 // Gives the levels a private copy of their buffer (before a write while a texture reads it).
 void detachStore(Resource& r);
 // Builds the sampler's immutable texture from the stored levels; nullptr and `error` on failure.
-// A8R8G8B8 textures read the levels in place, sharing the buffer (unless `copy`).
+// A8R8G8B8 and A32B32G32R32F textures read the levels in place, sharing the buffer (unless `copy`);
+// X8R8G8B8 ones too with `padOnes` (every texel's pad bits set: Resource::padOnes).
 std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode, bool copy,
-                                                       std::string& error);
+                                                       bool padOnes, std::string& error);
 
 }  // namespace emu

@@ -373,15 +373,19 @@ inline float loadF32(const uint8_t* p) {
 
 // The bytes per texel of a format whose D3D9 texels are already the texture's stored form, so
 // that its levels can be read where they lie: an Unorm8 format whose four channels sit in the b g r
-// a bytes of a word (kUnorm8Byte: A8R8G8B8), or a Float format of four float32 r g b a
-// (A32B32G32R32F); 0 for every other format.
-uint32_t storedAsIs(const FormatRow& row) {
+// a bytes of a word (kUnorm8Byte: A8R8G8B8; with `padOnes`, X8R8G8B8 too, its alpha read 1 from
+// pad bits known to be 1s), or a Float format of four float32 r g b a (A32B32G32R32F); 0 for every
+// other format.
+uint32_t storedAsIs(const FormatRow& row, bool padOnes = false) {
     const uint32_t unit = row.cls == FormatClass::Unorm8 ? 8 : row.cls == FormatClass::Float ? 32 : 0;
     if (!unit || row.bytes != 4 * unit / 8) return 0;
     for (size_t c = 0; c < 4; ++c) {
-        const Channel& ch = row.rgba[c];
         const ChannelKind kind = unit == 8 ? ChannelKind::Unorm : ChannelKind::Float;
         const uint32_t at = unit == 8 ? uint32_t(kUnorm8Byte[c]) * 8 : uint32_t(c) * 32;
+        // (A channel that reads 1 where the pad's 8 bits of 1s sit reads the same from them.)
+        const Channel ch = padOnes && unit == 8 && row.rgba[c].kind == ChannelKind::One && row.pad.bits == 8
+                               ? Channel{ChannelKind::Unorm, row.pad.shift, row.pad.bits}
+                               : row.rgba[c];
         if (ch.kind != kind || ch.shift != at || ch.bits != unit) return 0;
     }
     return row.bytes;
@@ -434,7 +438,7 @@ std::array<float, 4> floatChannels(const FormatRow& row, const uint8_t* p) {
 
 std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const TextureLevelBytes* levels,
                                            size_t levelCount, SignedDecode decode, std::string& error,
-                                           std::shared_ptr<const void> owner) {
+                                           std::shared_ptr<const void> owner, bool padOnes) {
     static_assert(std::endian::native == std::endian::little, "Unorm8 words are stored little endian");
     if (levelCount == 0 || !levels) {
         error = "texture has no levels";
@@ -493,7 +497,7 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
     // In place: a format stored as it is (storedAsIs: A8R8G8B8's word is the stored b g r a order,
     // A32B32G32R32F's four floats the stored r g b a values), when the levels follow each other
     // exactly at the texture's own texel offsets.
-    const size_t inPlaceBytes = storedAsIs(formatRow(fmt));
+    const size_t inPlaceBytes = storedAsIs(formatRow(fmt), padOnes);
     bool inPlace = owner && inPlaceBytes && (inPlaceBytes == 4 || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
     for (size_t k = 0; inPlace && k < levelCount; ++k) {
         const TextureLevelInfo& li = t.m_levels[k];

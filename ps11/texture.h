@@ -97,9 +97,11 @@ public:
     // levels are copied (A8R8G8B8 row by row) or decoded.
     // On failure returns nullopt and sets `error`; never allocates more than kMaxResourceBytes.
     // Signed channels decode as `decode` says (the hardware class's rule).
+    // X8R8G8B8 levels are read in place too where the caller knows every texel's X byte is 0xff
+    // (`padOnes`: the byte the sampler reads as alpha 1; emu's Resource::padOnes).
     static std::optional<Texture> fromLevels(TexFormat format, bool volume, const TextureLevelBytes* levels,
                                              size_t levelCount, SignedDecode decode, std::string& error,
-                                             std::shared_ptr<const void> owner = {});
+                                             std::shared_ptr<const void> owner = {}, bool padOnes = false);
     // Whether the texels are read where fromLevels found them (no copy).
     bool readsInPlace() const { return m_u8view != nullptr || m_valueView != nullptr; }
     // The rule the signed channels were decoded with (Snorm for textures without them).

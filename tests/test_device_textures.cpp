@@ -439,6 +439,57 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         CHECK(red(dev.sampledTexture(tex), 0) == 0x44);
     }
 
+    SECTION("an X8R8G8B8 target is read in place while every X byte is known to be 0xff") {
+        Handle tex{}, level{}, src{};
+        REQUIRE(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_X8R8G8B8, D3DPOOL_DEFAULT, &tex) == D3D_OK);
+        REQUIRE(dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK);
+        auto alpha = [](const std::shared_ptr<const ps11::Texture>& t) {
+            bool one = true;
+            for (int y = 0; y < 4; ++y)
+                for (int x = 0; x < 4; ++x) one = one && t->texelValue(0, x, y)[3] == 1.0f;
+            return one;
+        };
+        // Fresh (zero-filled, X bytes 0): copied, alpha forced to 1.
+        CHECK_FALSE(dev.sampledTexture(tex)->readsInPlace());
+        CHECK(alpha(dev.sampledTexture(tex)));
+        REQUIRE(dev.SetRenderTarget(0, level) == D3D_OK);
+        // A clear of part of it writes 0xff X bytes there only: still copied.
+        const D3DRECT part{0, 0, 2, 2};
+        REQUIRE(dev.Clear(1, &part, D3DCLEAR_TARGET, 0x00070000u, 1.0f, 0) == D3D_OK);
+        CHECK_FALSE(dev.sampledTexture(tex)->readsInPlace());
+        // A clear of the whole of it (alpha 0 in the colour: X8 stores no alpha).
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x00080000u, 1.0f, 0) == D3D_OK);
+        auto v1 = dev.sampledTexture(tex);
+        CHECK(v1->readsInPlace());
+        CHECK(red(v1, 0) == 8);
+        CHECK(alpha(v1));
+        // A draw with alpha 0 keeps it in place: every store sets the X byte.
+        struct V { float x, y, z, rhw; DWORD c; };
+        const V quad[4] = {{-0.5f, -0.5f, 0, 1, 0x00440000u}, {2.5f, -0.5f, 0, 1, 0x00440000u},
+                           {-0.5f, 2.5f, 0, 1, 0x00440000u}, {2.5f, 2.5f, 0, 1, 0x00440000u}};
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAARG1, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+        auto v2 = dev.sampledTexture(tex);
+        CHECK(v2->readsInPlace());
+        CHECK(red(v2, 0) == 0x44);
+        CHECK(int(std::lround(v2->texelValue(0, 3, 3)[0] * 255.0f)) == 8);
+        CHECK(alpha(v2));
+        CHECK(red(v1, 0) == 8);  // the view held before the draw is as it was
+        // A StretchRect copies bytes it was given: copied again until the next whole clear.
+        src = makeTarget(dev, 4, 4, [](UINT, UINT) { return 0x00330000u; });
+        REQUIRE(dev.StretchRect(src, nullptr, level, nullptr, D3DTEXF_POINT) == D3D_OK);
+        auto v3 = dev.sampledTexture(tex);
+        CHECK_FALSE(v3->readsInPlace());
+        CHECK(red(v3, 0) == 0x33);
+        CHECK(alpha(v3));
+        REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x00090000u, 1.0f, 0) == D3D_OK);
+        CHECK(dev.sampledTexture(tex)->readsInPlace());
+    }
+
     SECTION("a texture a draw sampled is written in place afterwards (nothing keeps the view)") {
         Handle tex{}, level{}, out{};
         REQUIRE(dev.CreateTexture(8, 8, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT, &tex) == D3D_OK);
