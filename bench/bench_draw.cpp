@@ -336,8 +336,67 @@ void BM_Raster(benchmark::State& state) {
         double(kW) * kH * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
+// A freshly drawn 1080p render-target texture read by a small pass: each iteration clears the
+// target (`whole`: all of it; else all but its last column, a clear that leaves the X8R8G8B8 X
+// bytes of that column unknown) and then draws the 240×135 point reduction from it (one texel in
+// 64; the adaptive glare's bright pass). What the first read of a freshly written target costs:
+// A8R8G8B8 and an X8R8G8B8 cleared whole are sampled where they lie (docs/device.md "Textures");
+// the partly cleared X8R8G8B8 is copied whole with alpha forced first.
+void BM_FreshTargetRead(benchmark::State& state, D3DFORMAT format, bool whole) {
+    DeviceOptions o;
+    o.software.threads = int(state.range(0));
+    Device dev(o);
+    Handle tex{}, level{}, small{}, ps{};
+    bool ok = dev.CreateTexture(kW, kH, 1, D3DUSAGE_RENDERTARGET, format, D3DPOOL_DEFAULT, &tex) == D3D_OK &&
+              dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK &&
+              dev.CreateRenderTarget(kW / 8, kH / 8, D3DFMT_A8R8G8B8, 0, &small) == D3D_OK &&
+              dev.CreatePixelShaderFromText(bench::kCopy, &ps) == D3D_OK && dev.SetPixelShader(ps) == D3D_OK &&
+              dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4) == D3D_OK;
+    for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
+        ok = ok && dev.SetSamplerState(0, f, D3DTEXF_POINT) == D3D_OK;
+    if (!ok) {
+        state.SkipWithError(("device refused the setup: " + dev.lastError().message).c_str());
+        return;
+    }
+    const float w = kW / 8, h = kH / 8;
+    std::vector<QuadVertex> quad;
+    const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
+    const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+    for (int c : {0, 1, 2, 0, 2, 3}) {
+        QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
+        q.uv[0][0] = us[c], q.uv[0][1] = vs[c];
+        quad.push_back(q);
+    }
+    const D3DRECT most{0, 0, LONG(kW - 1), LONG(kH)};
+    DWORD colour = 0;
+    for (auto _ : state) {
+        colour = (colour + 0x010203u) & 0xffffffu;  // a new value each time: every clear writes
+        ok = dev.SetRenderTarget(0, level) == D3D_OK &&
+             dev.Clear(whole ? 0 : 1, whole ? nullptr : &most, D3DCLEAR_TARGET, colour, 1.0f, 0) == D3D_OK &&
+             dev.SetRenderTarget(0, small) == D3D_OK && dev.SetTexture(0, tex) == D3D_OK &&
+             dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(QuadVertex)) == D3D_OK &&
+             dev.SetTexture(0, Handle::Null) == D3D_OK;
+        if (!ok) {
+            state.SkipWithError(dev.lastError().message.c_str());
+            return;
+        }
+    }
+}
+
 }  // namespace
 
+BENCHMARK_CAPTURE(BM_FreshTargetRead, a8r8g8b8_cleared_1080p, D3DFMT_A8R8G8B8, true)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FreshTargetRead, x8r8g8b8_cleared_1080p, D3DFMT_X8R8G8B8, true)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FreshTargetRead, x8r8g8b8_partly_cleared_1080p, D3DFMT_X8R8G8B8, false)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)
