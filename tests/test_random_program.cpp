@@ -375,7 +375,7 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
     // are ps11::lodFree) and by one drawing the general way: every triangle in 2×2 quads, every
     // lookup by the reference sampler (DrawRunner::create's fastPaths). The targets must be
     // identical bit for bit; where every sampled texture is lodFree no helper lane is shaded.
-    int rows = 0, quads = 0, rowPathDepthFog = 0;
+    int rows = 0, quads = 0, rowPathDepthFog = 0, x8Targets = 0;
     for (uint64_t seed = 20000; seed < 20160; ++seed) {
         const RandomCase c = caseOf(seed, 0, 13, 7);
         INFO("seed " << seed << "\n" << c.testText);
@@ -415,6 +415,23 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
             REQUIRE(quadRunner->targetPixels(b, error));
             REQUIRE(a.size() == b.size());
             CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof a[0]) == 0);
+            // Every store into an X8R8G8B8 target leaves its X byte 0xff (on both paths): the
+            // device samples such a target where it lies after a whole clear (Resource::padOnes).
+            if (file.renderTarget.format.value == ps11::TexFormat::X8R8G8B8) {
+                ++x8Targets;
+                for (ps11test::DrawRunner* r : {rowRunner.get(), quadRunner.get()}) {
+                    emu::Handle rt{};
+                    REQUIRE(r->device().GetRenderTarget(0, &rt) == emu::D3D_OK);
+                    size_t notSet = 0;
+                    REQUIRE(r->device().readSurface(rt, [&](const emu::D3DLOCKED_RECT& lr) {
+                        for (uint32_t y = 0; y < file.renderTarget.size.value[1]; ++y)
+                            for (uint32_t x = 0; x < file.renderTarget.size.value[0]; ++x)
+                                notSet += static_cast<const uint8_t*>(lr.pBits)[size_t(y) * size_t(lr.Pitch) +
+                                                                                 4 * size_t(x) + 3] != 0xff;
+                    }) == emu::D3D_OK);
+                    CHECK(notSet == 0);
+                }
+            }
             const emu::DrawStats& rs = rowRunner->device().lastDrawStats();
             const emu::DrawStats& qs = quadRunner->device().lastDrawStats();
             CHECK(rs.pixelsCovered == qs.pixelsCovered);
@@ -439,6 +456,7 @@ TEST_CASE("random programs: rows and quads draw the same bytes in every profile"
     CHECK(rows > 200);
     CHECK(quads > 50);
     CHECK(rowPathDepthFog > 20);
+    CHECK(x8Targets > 20);
 }
 
 TEST_CASE("random programs: the shrinker keeps a mul and little else", "[random]") {
