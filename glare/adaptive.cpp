@@ -62,7 +62,7 @@ public:
 
         // The glare amount, smoothed over frames in a 1x1 target by alpha blending.
         const TextureId adapted = fb.persistent("adapted glare amount", {1, 1, f}, 0);
-        const bool blend = !(fb.frame() == 0 && fb.choice("start") == 0);
+        const bool blend = !(fb.firstFrame() && fb.choice("start") == 0);
         const float a = float(fb.get("smoothing"));
         const bool dither = fb.choice("dither") == 1;
         const bool mulx4 = fb.choice("square") == 1;

@@ -100,28 +100,30 @@ bool Runner::renderScene(Scene& scene, int frame, int frameCount, double& millis
     return true;
 }
 
-bool Runner::buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
-                        PassGraph& graph) {
+FrameDependence Runner::buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
+                                   PassGraph& graph) {
     const TextureId scene = graph.import("scene", {m_options.width, m_options.height, intermediateFormat()}, m_scene, false);
     const TextureId output = graph.import("output", {m_options.width, m_options.height, D3DFMT_A8R8G8B8}, m_output, true);
     FrameBuild fb{graph, *this, settings, scene, output, frame, frameCount, intermediateFormat(),
                   m_device->hardware().precision};
     technique.build(fb);
     graph.compile();
-    return fb.readFrame();
+    return fb.dependence();
 }
 
 bool Runner::runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
                       FrameResult& result, std::string& error, const PassGraph::Hook& hook,
                       const std::function<void(PassGraph&)>& built, bool hookObserves) {
     const auto start = std::chrono::steady_clock::now();
-    // A still input: the last frame reused every pass, its build read no frame index, and the
+    // A still input: the last frame reused every pass, its build read no frame index (or only
+    // whether the frame is the first, and this one is as first as that one was), and the
     // technique, its settings and the contents of the scene and the output are the same. This
     // frame would build the same graph and reuse every pass again (the memo, the persistent
     // textures and what the technique keeps are as that frame left them): nothing is built or
     // run. Hooks and `built` look at a frame's passes as they run, so they get a whole frame.
     const StillFrame& still = m_still;
-    if (reuses() && !hook && !built && still.valid && still.technique == &technique &&
+    if (reuses() && !hook && !built && still.valid && (!still.askedFirst || still.first == (frame == 0)) &&
+        still.technique == &technique &&
         still.techniqueName == technique.name() && still.settings == settings &&
         m_device->contentGeneration(m_scene) == still.sceneGeneration &&
         m_device->contentGeneration(m_output) == still.outputGeneration) {
@@ -134,7 +136,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     m_still.valid = false;
     result.still = false;
     PassGraph graph;
-    const bool readFrame = buildFrame(technique, settings, frame, frameCount, graph);
+    const FrameDependence dependence = buildFrame(technique, settings, frame, frameCount, graph);
     result.buildMilliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     if (!m_persistentError.empty()) {
         error = m_persistentError;
@@ -148,10 +150,17 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     for (const PassStats& s : result.passes) result.milliseconds += s.milliseconds;
     if (ok && built) built(graph);  // again, with the aliasing filled in
     if (ok && m_options.graphviz) m_lastGraphviz = graph.graphviz(std::string(technique.name()));
-    if (ok && reuses() && !readFrame && !result.passes.empty() &&
+    if (ok && reuses() && dependence != FrameDependence::Index && !result.passes.empty() &&
         std::all_of(result.passes.begin(), result.passes.end(), [](const PassStats& p) { return p.reused; })) {
-        m_still = StillFrame{true, &technique, std::string(technique.name()), settings, m_device->contentGeneration(m_scene),
-                             m_device->contentGeneration(m_output), result.passes};
+        m_still = StillFrame{true,
+                             dependence == FrameDependence::First,
+                             frame == 0,
+                             &technique,
+                             std::string(technique.name()),
+                             settings,
+                             m_device->contentGeneration(m_scene),
+                             m_device->contentGeneration(m_output),
+                             result.passes};
         for (PassStats& p : m_still.passes) p.milliseconds = 0;
     }
     return ok;

@@ -85,9 +85,10 @@ public:
     bool runFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, FrameResult& result,
                   std::string& error, const PassGraph::Hook& hook = {},
                   const std::function<void(PassGraph&)>& built = {}, bool hookObserves = false);
-    // Builds (and compiles) without running: for reports and --graph. True if the technique's
-    // build read the frame's index or count (FrameBuild::frame).
-    bool buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount, PassGraph& graph);
+    // Builds (and compiles) without running: for reports and --graph. What the technique's build
+    // read of the frame (FrameBuild::frame, firstFrame).
+    FrameDependence buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
+                               PassGraph& graph);
 
     // The Graphviz of the last frame's graph as it ran (with the aliasing it got); empty unless
     // RunnerOptions::graphviz.
@@ -163,6 +164,8 @@ private:
     // depended on: a frame with all of it the same is skipped whole (runFrame).
     struct StillFrame {
         bool valid = false;
+        bool askedFirst = false;  // the build read only whether the frame was the first,
+        bool first = false;       // and it was (or not)
         const Technique* technique = nullptr;
         std::string techniqueName;  // (an object made where another was has another name, or is the same technique)
         Settings settings;

@@ -34,6 +34,10 @@ inline constexpr int kDefaultPreset = 3;
 
 using Settings = std::map<std::string, double>;
 
+// What a technique's build read of the frame it built: nothing, only whether it is the first,
+// or its index or count.
+enum class FrameDependence : uint8_t { None, First, Index };
+
 // What a technique's build() works with for one frame.
 struct FrameBuild {
     FrameBuild(PassGraph& g, Runner& r, const Settings& s, TextureId sceneId, TextureId outputId, int frameIndex,
@@ -45,17 +49,23 @@ struct FrameBuild {
     const Settings& settings;
     TextureId scene;   // the frame (A8R8G8B8, or float under the ideal profile)
     TextureId output;  // the result, scene-sized A8R8G8B8
-    // The frame's index and count. A build that reads neither gives the same graph every frame
-    // for the same settings, which lets a still input skip the whole frame (Runner::runFrame).
+    // The frame's index and count, or only whether it is the first. A build that reads neither
+    // index nor count gives the same graph every frame for the same settings (one that asked
+    // only firstFrame(), every frame after the first), which lets a still input skip the whole
+    // frame (Runner::runFrame).
     int frame() const {
-        m_readFrame = true;
+        m_dependence = FrameDependence::Index;
         return m_frame;
     }
     int frameCount() const {
-        m_readFrame = true;
+        m_dependence = FrameDependence::Index;
         return m_frameCount;
     }
-    bool readFrame() const { return m_readFrame; }
+    bool firstFrame() const {
+        if (m_dependence == FrameDependence::None) m_dependence = FrameDependence::First;
+        return m_frame == 0;
+    }
+    FrameDependence dependence() const { return m_dependence; }
     // The format of intermediate textures: A8R8G8B8, or A32B32G32R32F under the ideal profile
     // (docs/precision.md: ideal keeps intermediates in float render targets).
     D3DFORMAT format = D3DFMT_A8R8G8B8;
@@ -69,7 +79,7 @@ struct FrameBuild {
 
 private:
     int m_frame = 0, m_frameCount = 1;
-    mutable bool m_readFrame = false;
+    mutable FrameDependence m_dependence = FrameDependence::None;
 };
 
 class Technique {

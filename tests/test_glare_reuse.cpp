@@ -209,9 +209,11 @@ TEST_CASE("reuse: a still frame whose every pass was reused is skipped whole, un
           "[glare][reuse]") {
     // Pyramid's build reads no frame index: held still, from its third frame on it is skipped
     // whole (FrameResult::still). A setting, the image, the output's contents, the persistent
-    // textures, a hook: each makes the next frame run. Glow with its strength ramping and
-    // adaptive (its dither) read the frame index: never skipped whole. Every output equals the
-    // one of a runner that runs every pass.
+    // textures, a hook: each makes the next frame run. Adaptive's build asks only whether the
+    // frame is the first (a converged start writes its amount instead of blending it): skipped
+    // whole too once its amount stops changing, but not on another first frame. Glow with its
+    // strength ramping and adaptive with its temporal dither read the frame index: never skipped
+    // whole. Every output equals the one of a runner that runs every pass.
     const auto run = [](const char* name, glare::Settings settings, auto change, std::vector<int> wantStill) {
         INFO(name);
         const glare::Technique* t = glare::findTechnique(name);
@@ -266,8 +268,26 @@ TEST_CASE("reuse: a still frame whose every pass was reused is skipped whole, un
     glare::Settings glow = *glare::presetSettings(*glare::findTechnique("glow"), "published");
     glow["ramp"] = 0.5;
     run("glow", glow, nothing, std::vector<int>{0, 0, 0, 0, 0});
-    run("adaptive", *glare::presetSettings(*glare::findTechnique("adaptive"), "published"), nothing,
-        std::vector<int>{0, 0, 0, 0, 0});
+    glare::Settings adaptive = *glare::presetSettings(*glare::findTechnique("adaptive"), "published");
+    REQUIRE(adaptive["dither"] == 0);
+    run("adaptive", adaptive,
+        [](int f, const glare::Technique&, glare::Runner& a, glare::Runner& b, glare::Settings& s, emu::RgbaImage&) {
+            // Frame 6 runs as frame 0 again (below): the converged start writes the amount.
+            if (f == 6) {
+                std::string err;
+                glare::FrameResult ra, rb;
+                REQUIRE(a.runFrame(*glare::findTechnique("adaptive"), s, 0, 100, ra, err));
+                REQUIRE(b.runFrame(*glare::findTechnique("adaptive"), s, 0, 100, rb, err));
+                CHECK_FALSE(ra.still);
+                const std::optional<emu::RgbaImage> oa = a.readOutput(err), ob = b.readOutput(err);
+                REQUIRE(oa);
+                REQUIRE(ob);
+                CHECK(oa->rgba == ob->rgba);
+            }
+        },
+        std::vector<int>{0, 0, 0, 1, 1, 1, 0, 0, 1, 1});
+    adaptive["dither"] = 1;
+    run("adaptive", adaptive, nothing, std::vector<int>{0, 0, 0, 0, 0});
 }
 
 TEST_CASE("reuse: the same on the GL renderer", "[glare][reuse][gl]") {
