@@ -379,6 +379,20 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
     auto red = [](const std::shared_ptr<const ps11::Texture>& t, int level) {
         return int(std::lround(t->texelValue(level, 0, 0)[0] * 255.0f));
     };
+    // A quad of one diffuse colour (alpha too) over pixels [0, w) × [0, h) of the render target,
+    // through the fixed function.
+    auto drawFlat = [&](UINT w, UINT h, DWORD colour) {
+        struct V { float x, y, z, rhw; DWORD c; };
+        const float r = float(w) - 0.5f, b = float(h) - 0.5f;
+        const V quad[4] = {{-0.5f, -0.5f, 0, 1, colour}, {r, -0.5f, 0, 1, colour}, {-0.5f, b, 0, 1, colour},
+                           {r, b, 0, 1, colour}};
+        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAARG1, D3DTA_DIFFUSE) == D3D_OK);
+        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+    };
 
     SECTION("a mip chain is read where it is; X8R8G8B8 and A8 are copied") {
         Handle tex{}, x8{}, a8{};
@@ -427,14 +441,7 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         CHECK(red(v2, 0) == 2);
         auto v3 = dev.sampledTexture(tex);
         CHECK(red(v3, 0) == 0x33);
-        // A draw into the level (a clear-coloured quad through the fixed function's diffuse).
-        struct V { float x, y, z, rhw; DWORD c; };
-        const V quad[4] = {{-0.5f, -0.5f, 0, 1, 0xFF440000u}, {3.5f, -0.5f, 0, 1, 0xFF440000u},
-                           {-0.5f, 3.5f, 0, 1, 0xFF440000u}, {3.5f, 3.5f, 0, 1, 0xFF440000u}};
-        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE) == D3D_OK);
-        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+        drawFlat(4, 4, 0xFF440000u);  // a draw into the level
         CHECK(red(v3, 0) == 0x33);
         CHECK(red(dev.sampledTexture(tex), 0) == 0x44);
     }
@@ -463,16 +470,7 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         CHECK(v1->readsInPlace());
         CHECK(red(v1, 0) == 8);
         CHECK(alpha(v1));
-        // A draw with alpha 0 keeps it in place: every store sets the X byte.
-        struct V { float x, y, z, rhw; DWORD c; };
-        const V quad[4] = {{-0.5f, -0.5f, 0, 1, 0x00440000u}, {2.5f, -0.5f, 0, 1, 0x00440000u},
-                           {-0.5f, 2.5f, 0, 1, 0x00440000u}, {2.5f, 2.5f, 0, 1, 0x00440000u}};
-        REQUIRE(dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_DIFFUSE) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_SELECTARG1) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_DIFFUSE) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAOP, D3DTOP_SELECTARG1) == D3D_OK);
-        REQUIRE(dev.SetTextureStageState(0, D3DTSS_ALPHAARG1, D3DTA_DIFFUSE) == D3D_OK);
-        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLESTRIP, 2, quad, sizeof(V)) == D3D_OK);
+        drawFlat(3, 3, 0x00440000u);  // alpha 0 keeps it in place: every store sets the X byte
         auto v2 = dev.sampledTexture(tex);
         CHECK(v2->readsInPlace());
         CHECK(red(v2, 0) == 0x44);
