@@ -52,8 +52,7 @@ std::optional<std::array<float, 4>> parseVector(const std::string& s, bool allow
 // "lo,hi": two finite floats with lo <= hi.
 std::optional<std::pair<float, float>> parseRange(const std::string& s);
 // The sides a command's --size takes: kMaxSizeSide at most (every command that renders a frame),
-// and at least kMinGlareFrameSide where a whole glare frame is run (demo, bench: a technique's
-// smallest target is an eighth of the frame's side).
+// and at least kMinGlareFrameSide where the commands run whole glare frames (demo, bench).
 constexpr uint32_t kMaxSizeSide = 8192;
 constexpr uint32_t kMinGlareFrameSide = 8;
 // "WxH" (or "WXH") with both sides in minSide..maxSide; false for anything else.

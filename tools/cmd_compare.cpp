@@ -27,8 +27,7 @@ namespace ps11 {
 
 namespace {
 
-// compare holds both renderers' images of every draw and their differences at once: its --size
-// stops at 4096 a side, below other commands' cli::kMaxSizeSide.
+// compare's --size stops at 4096 a side, below the other commands' cli::kMaxSizeSide.
 constexpr uint32_t kMaxCompareSide = 4096;
 
 constexpr const char* kUsage =
