@@ -340,8 +340,8 @@ void BM_Raster(benchmark::State& state) {
 // target (`whole`: all of it; else all but its last column, a clear that leaves the X8R8G8B8 X
 // bytes of that column unknown) and then draws the 240×135 point reduction from it (one texel in
 // 64; the adaptive glare's bright pass). What the first read of a freshly written target costs:
-// A8R8G8B8 and an X8R8G8B8 cleared whole are sampled where they lie (docs/device.md "Textures");
-// the partly cleared X8R8G8B8 is copied whole with alpha forced first.
+// A8R8G8B8, an X8R8G8B8 cleared whole and the float targets are sampled where they lie
+// (docs/device.md "Textures"); the partly cleared X8R8G8B8 is copied whole with alpha forced first.
 void BM_FreshTargetRead(benchmark::State& state, D3DFORMAT format, bool whole) {
     DeviceOptions o;
     o.software.threads = int(state.range(0));
@@ -394,6 +394,14 @@ BENCHMARK_CAPTURE(BM_FreshTargetRead, x8r8g8b8_cleared_1080p, D3DFMT_X8R8G8B8, t
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_FreshTargetRead, x8r8g8b8_partly_cleared_1080p, D3DFMT_X8R8G8B8, false)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FreshTargetRead, a16b16g16r16f_cleared_1080p, D3DFMT_A16B16G16R16F, true)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FreshTargetRead, r32f_cleared_1080p, D3DFMT_R32F, true)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -38,8 +38,10 @@ inline void texel(const FloatRowTap& tap, int32_t ix, int32_t iy, float t[4]) {
     const size_t i = (size_t(iy) * tap.width + size_t(ix)) * 4;
     if (tap.unorm8) {
         for (int c = 0; c < 4; ++c) t[c] = kUnorm8[tap.bytes[i + size_t(ps11::kUnorm8Byte[c])]];
-    } else {
+    } else if (tap.values) {
         for (int c = 0; c < 4; ++c) t[c] = tap.values[i + size_t(c)];
+    } else {
+        tap.texels.get(i / 4, t);
     }
 }
 
@@ -161,8 +163,9 @@ struct RowTaps {
 const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_t j, FloatRowScratch& sc,
                         bool* nan = nullptr) {
     const size_t tw = tap.width;
-    const uint8_t* row =
-        tap.unorm8 ? tap.bytes + size_t(j) * tw * 4 : reinterpret_cast<const uint8_t*>(tap.values + size_t(j) * tw * 4);
+    const uint8_t* row = tap.unorm8   ? tap.bytes + size_t(j) * tw * 4
+                         : tap.values ? reinterpret_cast<const uint8_t*>(tap.values + size_t(j) * tw * 4)
+                                      : tap.texels.base + size_t(j) * tw * tap.texels.stride;
     FloatRowScratch::DecodedRow* slot = nullptr;
     for (FloatRowScratch::DecodedRow& d : sc.decoded) {
         if (d.serial == draw.serial && d.row == row && d.width == tap.width) {
@@ -177,6 +180,19 @@ const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_
     slot->nan = false;
     if (tap.unorm8) {
         draw.kernels->decode(row, int(tw), slot->v.data(), tw);
+    } else if (!tap.values) {
+        float* out = slot->v.data();
+        bool nanSeen = false;
+        const ps11::FloatTexels texels = tap.texels.from(size_t(j) * tw);
+        for (size_t i = 0; i < tw; ++i) {
+            float t[4];
+            texels.get(i, t);
+            for (size_t c = 0; c < 4; ++c) {
+                nanSeen |= t[c] != t[c];
+                out[c * tw + i] = t[c];
+            }
+        }
+        slot->nan = nanSeen;
     } else {
         const float* v = tap.values + size_t(j) * tw * 4;
         float* out = slot->v.data();
@@ -243,7 +259,7 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     bool nan = false;
     // A row whose columns have no run of consecutive pairs (a minification's) is filtered from
     // the texels where they are (8-bit words, or float r g b a); the others from the decoded row.
-    const bool inPlace = j >= 0 && std::none_of(cols.stretches.begin(), cols.stretches.end(), [](const auto& st) {
+    const bool inPlace = j >= 0 && (tap.unorm8 || tap.values) && std::none_of(cols.stretches.begin(), cols.stretches.end(), [](const auto& st) {
                              return st.kind == FloatRowTriangle::Columns::kSeq;
                          });
     if (inPlace) {
@@ -454,7 +470,7 @@ public:
         const ptrdiff_t stride = ptrdiff_t(step / sizeof(float));
         const bool strided = at(1) > at(0) && step % sizeof(float) == 0 && stride >= n && at(2) - at(1) == step &&
                              at(3) - at(2) == step;
-        if (!tap->unorm8 && r.j0 >= 0 && strided) {
+        if (!tap->unorm8 && tap->values && r.j0 >= 0 && strided) {
             // A float row's texels moved where they lie into the lanes, bit for bit: runs of
             // consecutive texels by the transpose kernel, border lanes the border colour.
             const float* values = tap->values + size_t(r.j0) * tap->width * 4;
@@ -565,8 +581,10 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
         tap.unorm8 = tex->storage() == ps11::TexelStorage::Unorm8;
         if (tap.unorm8)
             tap.bytes = tex->unorm8() + li.offset * 4;
-        else
+        else if (tex->values())
             tap.values = tex->values() + li.offset * 4;
+        else
+            tap.texels = tex->floatTexels().from(li.offset);
         tap.width = li.width;
         tap.height = li.height;
         tap.linear = linearFilter(ss.magFilter);
@@ -599,10 +617,12 @@ void setTapLevels(FloatRowDraw& draw, const TapLevels& levels) {
         const ps11::TextureLevelInfo& li = tex.level(levels.level[size_t(i)]);
         const bool linear = (levels.linear >> i) & 1;
         const uint8_t* bytes = tap.unorm8 ? tex.unorm8() + li.offset * 4 : nullptr;
-        const float* values = tap.unorm8 ? nullptr : tex.values() + li.offset * 4;
-        changed |= bytes != tap.bytes || values != tap.values || linear != tap.linear;
+        const float* values = tap.unorm8 || !tex.values() ? nullptr : tex.values() + li.offset * 4;
+        const ps11::FloatTexels texels = tap.unorm8 || values ? ps11::FloatTexels{} : tex.floatTexels().from(li.offset);
+        changed |= bytes != tap.bytes || values != tap.values || texels.base != tap.texels.base || linear != tap.linear;
         tap.bytes = bytes;
         tap.values = values;
+        tap.texels = texels;
         tap.width = li.width;
         tap.height = li.height;
         tap.linear = linear;
@@ -696,6 +716,7 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
         const FloatRowTriangle &ti = tris[tableOf[i]], &tj = tris[tableOf[j]];
         const FloatRowTriangle::Columns &c = ti.taps[size_t(t)], &o = tj.taps[size_t(u)];
         return a.bound == b.bound && a.unorm8 == b.unorm8 && a.bytes == b.bytes && a.values == b.values &&
+               a.texels.base == b.texels.base &&
                a.width == b.width && a.border == b.border && tj.x0 == ti.x0 && tj.x1 == ti.x1 && o.i0 == c.i0 &&
                o.i1 == c.i1 && o.f.size() == c.f.size() &&
                (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0);

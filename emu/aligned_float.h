@@ -33,7 +33,8 @@ struct FloatRowTap {
     int stage = 0, coordSet = 0;
     bool unorm8 = false;             // texels as b g r a bytes (else float r g b a values)
     const uint8_t* bytes = nullptr;  // level 0 (Unorm8)
-    const float* values = nullptr;   // level 0 (Decoded)
+    const float* values = nullptr;   // level 0 (Decoded as four float32), else:
+    ps11::FloatTexels texels;        // level 0 read in its own float layout (values null)
     uint32_t width = 1, height = 1;
     bool linear = false;
     ps11::TextureAddress addressU = ps11::TextureAddress::Wrap, addressV = ps11::TextureAddress::Wrap;

@@ -171,8 +171,8 @@ void detachStore(Resource& r) {
 std::shared_ptr<const ps11::Texture> makeSampledTexture(const Resource& r, ps11::SignedDecode decode, bool copy,
                                                        bool padOnes, std::string& error) {
     // The levels are handed over in D3D's memory layout (ps11::Texture::fromLevels): read in
-    // place for A8R8G8B8, A32B32G32R32F and (padOnes) X8R8G8B8, a per-texel expansion for the other
-    // formats. No transient per-texel model.
+    // place for A8R8G8B8, the float formats and (padOnes) X8R8G8B8, a per-texel expansion for the
+    // other formats. No transient per-texel model.
     std::vector<ps11::TextureLevelBytes> levels(r.levels.size());
     for (size_t k = 0; k < r.levels.size(); ++k) {
         const Image& im = r.levels[k];

@@ -144,18 +144,6 @@ uint16_t floatToHalf(float v) {
     return uint16_t(sign | (exponent << 10) | mantissa);
 }
 
-float halfToFloat(uint16_t h) {
-    const int sign = (h >> 15) & 1, exponent = (h >> 10) & 31, mantissa = h & 1023;
-    double v;
-    if (exponent == 0)
-        v = std::ldexp(double(mantissa), -24);
-    else if (exponent == 31)
-        v = mantissa ? double(NAN) : double(INFINITY);
-    else
-        v = std::ldexp(double(mantissa + 1024), exponent - 25);
-    return float(sign ? -v : v);
-}
-
 const float* Texture::unorm8Values() {
     static const std::array<float, 256> table = [] {
         std::array<float, 256> t{};
@@ -171,20 +159,45 @@ size_t Texture::texelIndex(int level, uint32_t x, uint32_t y, uint32_t z) const 
     return l.offset + (size_t(z) * l.height + y) * l.width + x;
 }
 
+FloatTexels Texture::floatTexels() const {
+    FloatTexels f;
+    if (!m_rawView) {
+        f.base = reinterpret_cast<const uint8_t*>(values());
+        return f;
+    }
+    const FormatRow& row = formatRow(m_format);
+    f.base = m_rawView.get();
+    f.stride = row.bytes;
+    for (size_t c = 0; c < 4; ++c) {
+        f.kind[c] = row.rgba[c].kind;
+        f.offset[c] = uint8_t(row.rgba[c].shift / 8);
+    }
+    return f;
+}
+
 std::array<float, 4> Texture::texelValue(int level, uint32_t x, uint32_t y, uint32_t z) const {
-    size_t i = texelIndex(level, x, y, z) * 4;
+    const size_t i = texelIndex(level, x, y, z);
     std::array<float, 4> v;
-    for (size_t c = 0; c < 4; ++c)
-        v[c] = m_storage == TexelStorage::Unorm8 ? unorm8Values()[unorm8()[i + size_t(kUnorm8Byte[c])]] : values()[i + c];
+    if (m_storage == TexelStorage::Unorm8) {
+        for (size_t c = 0; c < 4; ++c) v[c] = unorm8Values()[unorm8()[i * 4 + size_t(kUnorm8Byte[c])]];
+    } else {
+        floatTexels().get(i, v.data());
+    }
     return v;
 }
 
 std::array<int32_t, 4> Texture::texelGrid(int level, uint32_t x, uint32_t y, uint32_t z, Precision p) const {
-    size_t i = texelIndex(level, x, y, z) * 4;
+    const size_t i = texelIndex(level, x, y, z);
     std::array<int32_t, 4> g{};
-    int32_t scale = gridScale(p) / 255;
-    for (size_t c = 0; c < 4; ++c)
-        g[c] = m_storage == TexelStorage::Unorm8 ? int32_t(unorm8()[i + size_t(kUnorm8Byte[c])]) * scale : grid(p)[i + c];
+    if (m_storage == TexelStorage::Unorm8) {
+        const int32_t scale = gridScale(p) / 255;
+        for (size_t c = 0; c < 4; ++c) g[c] = int32_t(unorm8()[i * 4 + size_t(kUnorm8Byte[c])]) * scale;
+    } else if (readsInPlace()) {  // one texel's grid, not the whole texture's (grid())
+        const std::array<float, 4> v = texelValue(level, x, y, z);
+        for (size_t c = 0; c < 4; ++c) g[c] = texelGridOf(v[c], p);
+    } else {
+        for (size_t c = 0; c < 4; ++c) g[c] = grid(p)[i * 4 + c];
+    }
     return g;
 }
 
@@ -248,10 +261,13 @@ const int32_t* Texture::grid(Precision p) const {
     if (formatInfo(m_format).floats)
         std::call_once(fx12 ? g.once12 : g.once8, [&] {
             const Precision q = fx12 ? Precision::Fx12 : Precision::Fx8;
-            const float* v = values();
+            const FloatTexels f = floatTexels();
             out.resize(m_texelCount * 4);
-            for (size_t i = 0; i < out.size(); ++i)
-                out[i] = std::clamp(toGrid(double(v[i]), q), -kMaxTexelGrid, kMaxTexelGrid);
+            for (size_t i = 0; i < m_texelCount; ++i) {
+                float v[4];
+                f.get(i, v);
+                for (size_t c = 0; c < 4; ++c) out[i * 4 + c] = texelGridOf(v[c], q);
+            }
         });
     return out.data();
 }
@@ -495,15 +511,24 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
         }
     };
     // In place: a format stored as it is (storedAsIs: A8R8G8B8's word is the stored b g r a order,
-    // A32B32G32R32F's four floats the stored r g b a values), when the levels follow each other
-    // exactly at the texture's own texel offsets.
-    const size_t inPlaceBytes = storedAsIs(formatRow(fmt), padOnes);
-    bool inPlace = owner && inPlaceBytes && (inPlaceBytes == 4 || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
+    // A32B32G32R32F's four floats the stored r g b a values), or any other float format (read
+    // through its row: floatTexels), when the levels follow each other exactly at the texture's
+    // own texel offsets.
+    const size_t asIs = storedAsIs(row, padOnes);
+    const bool viaRow = !asIs && row.cls == FormatClass::Float;
+    const size_t inPlaceBytes = viaRow ? row.bytes : asIs;
+    bool inPlace = owner && inPlaceBytes &&
+                   (inPlaceBytes == 4 || viaRow || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
     for (size_t k = 0; inPlace && k < levelCount; ++k) {
         const TextureLevelInfo& li = t.m_levels[k];
         const TextureLevelBytes& lb = levels[k];
         inPlace = lb.data == levels[0].data + li.offset * inPlaceBytes && lb.rowPitch == size_t(li.width) * inPlaceBytes &&
                   (li.depth == 1 || lb.slicePitch == lb.rowPitch * li.height);
+    }
+    if (inPlace && viaRow) {
+        t.m_signedDecode = decode;
+        t.m_rawView = std::shared_ptr<const uint8_t>(std::move(owner), levels[0].data);
+        return t;
     }
     if (inPlace && inPlaceBytes == 4) {
         t.m_u8view = std::shared_ptr<const uint8_t>(std::move(owner), levels[0].data);

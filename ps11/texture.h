@@ -2,14 +2,16 @@
 // decoded per channel so that every precision profile reads exact values (8-bit channels as
 // bytes, signed and float formats as per-profile grid integers and float32). Built from levels in
 // D3D's memory layout by Texture::fromLevels() (the device's hand-over, which samples A8R8G8B8
-// levels where they are), or texel by texel by the library's TextureBuilder
+// and float levels where they are), or texel by texel by the library's TextureBuilder
 // (ps11/texture_internal.h; the .ps11test model's textureFromDesc, ps11/testfile_textures.h);
 // immutable afterwards, shared by samplers.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -60,6 +62,23 @@ struct TextureLevelInfo {
     size_t offset = 0;  // index of the level's first texel in the texture's arrays
 };
 
+// A float format's texels as they lie in its levels (Texture::floatTexels): texel i's channel c
+// is the float32 or IEEE half at base + i * stride + offset[c], or the constant 0 or 1 (its
+// ChannelKind). Reads what the format's row (ps11/formats.h) says, with memcpy (no alignment).
+struct FloatTexels {
+    const uint8_t* base = nullptr;
+    uint32_t stride = 16;
+    std::array<ChannelKind, 4> kind{ChannelKind::Float, ChannelKind::Float, ChannelKind::Float, ChannelKind::Float};
+    std::array<uint8_t, 4> offset{0, 4, 8, 12};
+    inline void get(size_t i, float t[4]) const;
+    // The same texels from texel `first` on (a level's offset).
+    FloatTexels from(size_t first) const {
+        FloatTexels f = *this;
+        f.base += first * stride;
+        return f;
+    }
+};
+
 class Texture {
 public:
     TexFormat format() const { return m_format; }
@@ -78,9 +97,18 @@ public:
     // Raw arrays for the sampler, 4 entries per texel, indexed by level offset + texel: Unorm8 as
     // b g r a bytes (kUnorm8Byte), Decoded as r g b a.
     const uint8_t* unorm8() const { return m_u8view ? m_u8view.get() : m_u8.data(); }  // Unorm8
-    const float* values() const { return m_valueView ? m_valueView.get() : m_value.data(); }  // Decoded
+    // Decoded: null for a float texture read in place whose texels are not four float32 r g b a
+    // (A16B16G16R16F, R32F): floatTexels() reads every Decoded float texture.
+    const float* values() const {
+        return m_valueView ? m_valueView.get() : m_rawView ? nullptr : m_value.data();
+    }
+    // A Decoded texture's texels, r g b a: where fromLevels found them when it reads them in place,
+    // else values() as four float32 per texel.
+    FloatTexels floatTexels() const;
     // Decoded, fx. Float formats compute a profile's grid from the values on its first use (a
-    // float texture sampled only by float profiles never needs one); thread-safe.
+    // float texture sampled only by float profiles never needs one); thread-safe. A texture read
+    // in place is never converted whole this way by the sampler: it takes each texel's grid as it
+    // reads it (texelGridOf), the same integers.
     const int32_t* grid(Precision p) const;
     // Float32 of byte b (b / 255), shared by all Unorm8 textures.
     static const float* unorm8Values();
@@ -89,10 +117,10 @@ public:
     // hand-over; no mip generation). `levels` must be the chain's first levels.size() levels
     // (level k has the extents of level 0 halved k times). The result reads as the one
     // TextureBuilder (the .ps11test model's textureFromDesc) gives for the same texels.
-    // A8R8G8B8 and A32B32G32R32F levels laid out exactly as the texture keeps them (one buffer,
-    // rows of width * 4 bytes or width * 4 floats, level after level with no gap) are not copied
-    // when `owner` is given: the texture
-    // reads them where they are and keeps `owner` alive; the caller must not change those bytes
+    // A8R8G8B8 and float levels laid out exactly as the texture keeps them (one buffer, rows of
+    // width texels, level after level with no gap) are not copied when `owner` is given: the
+    // texture reads them where they are (A16B16G16R16F and R32F through floatTexels) and keeps
+    // `owner` alive; the caller must not change those bytes
     // while the texture is in use (emu's device copies them first: Device::prepareWrite). Other
     // levels are copied (A8R8G8B8 row by row) or decoded.
     // On failure returns nullopt and sets `error`; never allocates more than kMaxResourceBytes.
@@ -103,7 +131,7 @@ public:
                                              size_t levelCount, SignedDecode decode, std::string& error,
                                              std::shared_ptr<const void> owner = {}, bool padOnes = false);
     // Whether the texels are read where fromLevels found them (no copy).
-    bool readsInPlace() const { return m_u8view != nullptr || m_valueView != nullptr; }
+    bool readsInPlace() const { return m_u8view != nullptr || m_valueView != nullptr || m_rawView != nullptr; }
     // The rule the signed channels were decoded with (Snorm for textures without them).
     SignedDecode signedDecode() const { return m_signedDecode; }
     // The per-tile facts of level 0 (ps11/texture_tiles.h) once a caller computed and kept them
@@ -135,6 +163,7 @@ private:
     std::shared_ptr<const uint8_t> m_u8view;  // fromLevels' levels, read in place (owner kept)
     std::vector<float> m_value;
     std::shared_ptr<const float> m_valueView;  // fromLevels' A32B32G32R32F levels, read in place
+    std::shared_ptr<const uint8_t> m_rawView;  // fromLevels' other float levels, read in place
     struct Grids {
         std::once_flag once8, once12;  // float formats: filled on first use
         std::vector<int32_t> g8, g12;
@@ -167,8 +196,47 @@ std::array<float, 4> floatChannels(const FormatRow& row, const uint8_t* p);
 
 // float32 -> nearest IEEE half bits (ties to even, overflow to infinity, NaN kept quiet).
 uint16_t floatToHalf(float v);
-// IEEE half bits -> float32 (exact).
-float halfToFloat(uint16_t h);
+// IEEE half bits -> float32 (exact; a NaN reads as the quiet NaN 0x7fc00000 with the half's sign).
+inline float halfToFloat(uint16_t h) {
+    const uint32_t sign = uint32_t(h & 0x8000u) << 16, exponent = (h >> 10) & 31u, mantissa = h & 1023u;
+    if (exponent == 0) {  // zero and subnormals: mantissa * 2^-24, exact in float32
+        const float v = float(mantissa) * 0x1p-24f;
+        return sign ? -v : v;
+    }
+    const uint32_t bits = exponent == 31 ? (mantissa ? 0x7fc00000u : 0x7f800000u)
+                                         : ((exponent + 112u) << 23) | (mantissa << 13);  // rebias 15 -> 127
+    float v;
+    std::memcpy(&v, &bits, 4);
+    return sign ? -v : v;
+}
+
+// The grid value a fixed-point profile samples for a float texel's channel: toGrid clamped to
+// +-kMaxTexelGrid (Texture::grid's integers, one at a time).
+inline int32_t texelGridOf(float v, Precision p) { return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid); }
+
+void FloatTexels::get(size_t i, float t[4]) const {
+    const uint8_t* p = base + i * stride;
+    for (size_t c = 0; c < 4; ++c) {
+        const uint8_t* q = p + offset[c];
+        switch (kind[c]) {
+            case ChannelKind::Float:
+                std::memcpy(&t[c], q, 4);
+                break;
+            case ChannelKind::Half: {
+                uint16_t h;
+                std::memcpy(&h, q, 2);
+                t[c] = halfToFloat(h);
+                break;
+            }
+            case ChannelKind::Zero:
+                t[c] = 0.0f;
+                break;
+            default:
+                t[c] = 1.0f;
+                break;
+        }
+    }
+}
 // float32 -> nearest IEEE half -> float32.
 inline float roundToHalf(float v) { return halfToFloat(floatToHalf(v)); }
 

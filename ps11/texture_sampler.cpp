@@ -96,6 +96,21 @@ struct ValueFloat {
         for (int c = 0; c < 4; ++c) t[c] = p[i * 4 + size_t(c)];
     }
 };
+// A float texture read in place (Texture::floatTexels): its texels decoded as they are read, and
+// in fx profiles each channel's grid taken then (texelGridOf), so no first read converts it whole.
+struct RowFloat {
+    FloatTexels f;
+    void get(size_t i, float t[4]) const { f.get(i, t); }
+};
+struct RowGrid {
+    FloatTexels f;
+    Precision p;
+    void get(size_t i, int64_t t[4]) const {
+        float v[4];
+        f.get(i, v);
+        for (int c = 0; c < 4; ++c) t[c] = texelGridOf(v[c], p);
+    }
+};
 
 struct CombineInput {
     int count;
@@ -363,6 +378,10 @@ uint64_t sampleReference(const SampleRequest& req, int count, const float* const
             U8Grid src{tex.unorm8(), gridScale(req.precision) / 255};
             volume ? combineFx<U8Grid, true>(in, src, border, gridDst)
                    : combineFx<U8Grid, false>(in, src, border, gridDst);
+        } else if (tex.readsInPlace()) {
+            RowGrid src{tex.floatTexels(), req.precision};
+            volume ? combineFx<RowGrid, true>(in, src, border, gridDst)
+                   : combineFx<RowGrid, false>(in, src, border, gridDst);
         } else {
             IntGrid src{tex.grid(req.precision)};
             volume ? combineFx<IntGrid, true>(in, src, border, gridDst)
@@ -374,10 +393,14 @@ uint64_t sampleReference(const SampleRequest& req, int count, const float* const
             U8Float src{tex.unorm8(), Texture::unorm8Values()};
             volume ? combineFloat<U8Float, true>(in, src, border, valueDst)
                    : combineFloat<U8Float, false>(in, src, border, valueDst);
-        } else {
-            ValueFloat src{tex.values()};
+        } else if (const float* values = tex.values()) {
+            ValueFloat src{values};
             volume ? combineFloat<ValueFloat, true>(in, src, border, valueDst)
                    : combineFloat<ValueFloat, false>(in, src, border, valueDst);
+        } else {
+            RowFloat src{tex.floatTexels()};
+            volume ? combineFloat<RowFloat, true>(in, src, border, valueDst)
+                   : combineFloat<RowFloat, false>(in, src, border, valueDst);
         }
     }
     return fetched;

@@ -410,13 +410,15 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         CHECK(tx->texelValue(0, 0, 0)[3] == 1.0f);
         REQUIRE(dev.CreateTexture(4, 4, 1, 0, D3DFMT_A8, D3DPOOL_MANAGED, &a8) == D3D_OK);
         CHECK_FALSE(dev.sampledTexture(a8)->readsInPlace());
-        // Of the float formats only A32B32G32R32F is stored as the sampler keeps values.
+        // Every float format is read in place: A32B32G32R32F as the values the sampler keeps, the
+        // others through their rows (ps11::Texture::floatTexels).
         for (const D3DFORMAT f : {D3DFMT_A32B32G32R32F, D3DFMT_A16B16G16R16F, D3DFMT_R32F}) {
             Handle ft{};
             REQUIRE(dev.CreateTexture(4, 4, 1, 0, f, D3DPOOL_MANAGED, &ft) == D3D_OK);
             auto sampled = dev.sampledTexture(ft);
             REQUIRE(sampled);
-            CHECK(sampled->readsInPlace() == (f == D3DFMT_A32B32G32R32F));
+            CHECK(sampled->readsInPlace());
+            CHECK((sampled->values() != nullptr) == (f == D3DFMT_A32B32G32R32F));
         }
     }
 
@@ -444,6 +446,29 @@ TEST_CASE("device: A8R8G8B8 textures are sampled in place, and a held view never
         drawFlat(4, 4, 0xFF440000u);  // a draw into the level
         CHECK(red(v3, 0) == 0x33);
         CHECK(red(dev.sampledTexture(tex), 0) == 0x44);
+    }
+
+    SECTION("float targets are read in place, and a view held across a draw keeps its values") {
+        for (const D3DFORMAT f : {D3DFMT_A16B16G16R16F, D3DFMT_R32F}) {
+            INFO("format " << f);
+            Handle tex{}, level{};
+            REQUIRE(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, f, D3DPOOL_DEFAULT, &tex) == D3D_OK);
+            REQUIRE(dev.GetSurfaceLevel(tex, 0, &level) == D3D_OK);
+            REQUIRE(dev.SetRenderTarget(0, level) == D3D_OK);
+            REQUIRE(dev.Clear(0, nullptr, D3DCLEAR_TARGET, 0x80110000u, 1.0f, 0) == D3D_OK);
+            auto v1 = dev.sampledTexture(tex);
+            REQUIRE(v1);
+            CHECK(v1->readsInPlace());
+            CHECK(red(v1, 0) == 0x11);
+            // R32F has no alpha: it reads 1; A16B16G16R16F's is the cleared 0x80 / 255, half-rounded.
+            CHECK(v1->texelValue(0, 1, 2)[3] == (f == D3DFMT_R32F ? 1.0f : ps11::roundToHalf(128.0f / 255.0f)));
+            drawFlat(2, 2, 0xFF440000u);
+            auto v2 = dev.sampledTexture(tex);
+            CHECK(v2->readsInPlace());
+            CHECK(red(v2, 0) == 0x44);
+            CHECK(red(v1, 0) == 0x11);  // the view held before the draw is as it was
+            CHECK(int(std::lround(v2->texelValue(0, 3, 3)[0] * 255.0f)) == 0x11);
+        }
     }
 
     SECTION("an X8R8G8B8 target is read in place while every X byte is known to be 0xff") {
