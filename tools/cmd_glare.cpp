@@ -284,6 +284,8 @@ int runGlare(const GlareOptions& o) {
         if (s) s->setGlowFog(fogStart, fogEnd);
     Progress progress(o.frames);
     std::vector<glare::PassStats> lastStats;
+    // Each pass's time in every frame that ran it (not reused), by name: the table's medians.
+    std::map<std::string, std::vector<double>> passMs;
     double lastBuildMs = 0;  // the last frame's graph, built and compiled
     bool lastStill = false;  // the last frame was skipped whole
     emu::RgbaImage frameImage;  // -o: each frame's output, read into one buffer
@@ -371,6 +373,8 @@ int runGlare(const GlareOptions& o) {
             return cli::kUserError;
         }
         lastStats = result.passes;
+        for (const glare::PassStats& ps : result.passes)
+            if (!ps.reused) passMs[ps.pass].push_back(ps.milliseconds);
         lastBuildMs = result.buildMilliseconds;
         lastStill = result.still;
         frameMs.push_back(result.milliseconds);
@@ -468,6 +472,14 @@ int runGlare(const GlareOptions& o) {
     // The host's memory speed, measured now, after the frames: what the MB column's passes would
     // reach if moving their bytes were all they did.
     const glare::Runner::CopySpeed copy = main->copySpeed();
+    // A pass's median time over the frames that ran it (0 when none did), and how many did.
+    auto medianOf = [&](const std::string& pass) -> std::pair<double, size_t> {
+        auto it = passMs.find(pass);
+        if (it == passMs.end() || it->second.empty()) return {0.0, 0};
+        std::vector<double> v = it->second;
+        std::sort(v.begin(), v.end());
+        return {v[v.size() / 2], v.size()};
+    };
     if (o.json) {
         json::Json j;
         j["technique"] = std::string(technique->name());
@@ -479,6 +491,8 @@ int runGlare(const GlareOptions& o) {
         for (const glare::PassStats& s : lastStats)
             passes.push_back({{"pass", s.pass},
                               {"ms", json::rounded(s.milliseconds, "%.3f")},
+                              {"median_ms", json::rounded(medianOf(s.pass).first, "%.3f")},
+                              {"frames_run", medianOf(s.pass).second},
                               {"draws", s.draws},
                               {"pixels", s.pixels},
                               {"texels", s.texels},
@@ -508,12 +522,16 @@ int runGlare(const GlareOptions& o) {
     std::printf("%s on %ux%u (%s), %s / %s, %s renderer, %d frame(s): median %.2f ms per frame\n",
                 std::string(technique->name()).c_str(), width, height, scene ? ("scene " + o.scene).c_str() : o.in.c_str(),
                 hw.c_str(), profile.c_str(), main->device().rendererName(), o.frames, sorted[sorted.size() / 2]);
-    std::printf("%-22s %9s %6s %11s %11s %13s %4s %4s %8s %7s  %-6s %s\n", "pass (last frame)", "ms", "draws", "pixels",
-                "texels", "instructions", "up", "back", "MB", "GB/s", "run", "tiles shaded/filled/copied/skipped");
+    std::printf("%-22s %9s %9s %6s %11s %11s %13s %4s %4s %8s %7s  %-6s %s\n", "pass (last frame)", "ms", "median",
+                "draws", "pixels", "texels", "instructions", "up", "back", "MB", "GB/s", "run",
+                "tiles shaded/filled/copied/skipped");
     for (const glare::PassStats& s : lastStats) {
+        const auto [median, ran] = medianOf(s.pass);
+        char medianText[16] = "-";
+        if (ran) std::snprintf(medianText, sizeof medianText, "%.3f", median);
         if (s.reused) {
-            std::printf("%-22s %9.3f %6s %11s %11s %13s %4s %4s %8s %7s  reused -\n", s.pass.c_str(), s.milliseconds, "-",
-                        "-", "-", "-", "-", "-", "-", "-");
+            std::printf("%-22s %9.3f %9s %6s %11s %11s %13s %4s %4s %8s %7s  reused -\n", s.pass.c_str(), s.milliseconds,
+                        medianText, "-", "-", "-", "-", "-", "-", "-", "-");
             continue;
         }
         const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
@@ -521,9 +539,9 @@ int runGlare(const GlareOptions& o) {
                                                  std::to_string(s.tilesCopied) + "/" + std::to_string(s.tilesSkipped)
                                            : "-";
         char gbps[16] = "-";  // a copy put off moved nothing in its own time
-        if (!s.putOff && s.milliseconds > 0) std::snprintf(gbps, sizeof gbps, "%.1f", double(s.bytes) / 1e6 / s.milliseconds);
-        std::printf("%-22s %9.3f %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7s  %-6s %s\n", s.pass.c_str(),
-                    s.milliseconds, (unsigned long long)s.draws, (unsigned long long)s.pixels,
+        if (!s.putOff && median > 0) std::snprintf(gbps, sizeof gbps, "%.1f", double(s.bytes) / 1e6 / median);
+        std::printf("%-22s %9.3f %9s %6llu %11llu %11llu %13llu %4llu %4llu %8.2f %7s  %-6s %s\n", s.pass.c_str(),
+                    s.milliseconds, medianText, (unsigned long long)s.draws, (unsigned long long)s.pixels,
                     (unsigned long long)s.texels, (unsigned long long)s.instructions, (unsigned long long)s.uploads,
                     (unsigned long long)s.readBacks, double(s.bytes) / 1e6, gbps, s.putOff ? "put off" : "ran",
                     tileText.c_str());
@@ -540,7 +558,9 @@ int runGlare(const GlareOptions& o) {
     if (lastStill)
         std::printf("(the last frame was skipped whole: a still input whose frame before reused every pass; nothing was\n"
                     " built or run)\n");
-    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its time;\n"
+    std::printf("(ms: the last frame's; median: over the frames that ran the pass, not reused (with -o each frame's PNG\n"
+                " is written between frames, so the passes start from caches it evicted)\n");
+    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its median;\n"
                 " reused: its inputs were last frame's, its outputs kept, nothing ran; put off: a whole-surface copy the\n"
                 " software renderer makes in the pass that next draws into, reads or writes its destination, in whose\n"
                 " time it then is (the composite copies each band of the scene just before it blends onto it);\n"

@@ -479,6 +479,7 @@ expect_in "$work/out" '"fits_ps_1_1": false' "the report says what does not fit"
 expect_rc 0 "glare on a scene" "$ps11" glare --technique adaptive --scene box --size 64x36 --frames 2 -o "$work/g.png"
 [ -s "$work/g_0000.png" ] && [ -s "$work/g_0001.png" ] || fail "glare --frames 2 did not write g_0000.png and g_0001.png"
 expect_in "$work/out" "bright_pass" "glare prints its passes"
+expect_in "$work/out" "  median  draws" "glare prints each pass's median over the frames"
 expect_rc 0 "glare on an image, dumped" "$ps11" glare --technique quarter --in "$work/tex.png" --dump-passes "$work/dump" -o "$work/q.png"
 [ -s "$work/dump/contact_sheet.png" ] && [ -s "$work/dump/00_downsample-quarter.png" ] || fail "glare --dump-passes wrote no pass images"
 expect_rc 0 "glare on a held image, reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 3 -o "$work/r.png"
@@ -491,6 +492,9 @@ cmp -s "$work/r_0002.png" "$work/r_reused.png" || fail "glare: the reused frame 
 expect_rc 0 "glare --json says reused" "$ps11" glare --technique glow --in "$work/tex.png" --frames 2 --json -o "$work/r.png"
 expect_in "$work/out" '"reused": true' "glare --json reused"
 expect_json "$work/out" "glare --json"
+# Each pass's median over the frames that ran it: glow's first frame runs every pass, its second reuses
+# them, so every pass ran in exactly one frame.
+python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["passes"]; assert p and all(x["frames_run"] == 1 and x["median_ms"] >= 0 for x in p)' "$work/out" || fail "glare --json: median_ms and frames_run of a reused pass"
 # --in DIR: each image file of the folder in turn, sorted, outputs named after the image.
 mkdir -p "$work/photos/sub.png" "$work/glare_out" "$work/no_photos"
 cp "$work/tex.png" "$work/photos/b.png"
