@@ -170,28 +170,35 @@ std::optional<Texture> handOverOld(const std::vector<uint8_t>& bytes) {
     return textureFromDesc(desc, SignedDecode::Snorm, error);
 }
 
-void BM_HandOver1080p(benchmark::State& state) {
-    const std::vector<uint8_t>& bytes = imageBytes();
-    double oldNs = 0, newNs = 0;
+// Runs `a` then `b` in every iteration (A B A B ...), each timed on its own: their mean ms.
+template <class A, class B>
+std::pair<double, double> interleavedMs(benchmark::State& state, A&& a, B&& b) {
+    double aNs = 0, bNs = 0;
     for (auto _ : state) {
-        auto t0 = Clock::now();
-        std::optional<Texture> a = handOverOld(bytes);
-        benchmark::DoNotOptimize(a);
-        a.reset();
-        auto t1 = Clock::now();
-        TextureLevelBytes l{kW, kH, 1, bytes.data(), kW * 4, size_t(kW) * 4 * kH};
-        std::string error;
-        std::optional<Texture> b = Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error);
-        benchmark::DoNotOptimize(b);
-        b.reset();
-        auto t2 = Clock::now();
-        oldNs += double(t1 - t0);
-        newNs += double(t2 - t1);
+        const auto t0 = Clock::now();
+        a();
+        const auto t1 = Clock::now();
+        b();
+        const auto t2 = Clock::now();
+        aNs += double(t1 - t0);
+        bNs += double(t2 - t1);
     }
     const double n = double(state.iterations());
-    state.counters["old_ms"] = oldNs / n * 1e-6;
-    state.counters["new_ms"] = newNs / n * 1e-6;
-    state.counters["old/new"] = oldNs / newNs;
+    return {aNs / n * 1e-6, bNs / n * 1e-6};
+}
+
+void BM_HandOver1080p(benchmark::State& state) {
+    const std::vector<uint8_t>& bytes = imageBytes();
+    const TextureLevelBytes l{kW, kH, 1, bytes.data(), kW * 4, size_t(kW) * 4 * kH};
+    std::string error;
+    const auto [oldMs, newMs] = interleavedMs(
+        state, [&] { benchmark::DoNotOptimize(handOverOld(bytes)); },
+        [&] {
+            benchmark::DoNotOptimize(Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error));
+        });
+    state.counters["old_ms"] = oldMs;
+    state.counters["new_ms"] = newMs;
+    state.counters["old/new"] = oldMs / newMs;
 }
 
 // A 1080p float level handed over decoded into a copy (no owner: what the device's first read of a
@@ -205,24 +212,13 @@ void BM_HandOverFloat1080p(benchmark::State& state, TexFormat format) {
         bytes[i + 1] = 0x34;
     }
     const TextureLevelBytes l{kW, kH, 1, bytes.get(), size_t(kW) * bpt, size_t(kW) * bpt * kH};
-    double copyNs = 0, inPlaceNs = 0;
     std::string error;
-    for (auto _ : state) {
-        auto t0 = Clock::now();
-        std::optional<Texture> a = Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error);
-        benchmark::DoNotOptimize(a);
-        a.reset();
-        auto t1 = Clock::now();
-        std::optional<Texture> b = Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error, bytes);
-        benchmark::DoNotOptimize(b);
-        b.reset();
-        auto t2 = Clock::now();
-        copyNs += double(t1 - t0);
-        inPlaceNs += double(t2 - t1);
-    }
-    const double n = double(state.iterations());
-    state.counters["copy_ms"] = copyNs / n * 1e-6;
-    state.counters["in_place_ms"] = inPlaceNs / n * 1e-6;
+    const auto [copyMs, inPlaceMs] = interleavedMs(
+        state,
+        [&] { benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error)); },
+        [&] { benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error, bytes)); });
+    state.counters["copy_ms"] = copyMs;
+    state.counters["in_place_ms"] = inPlaceMs;
 }
 
 }  // namespace
