@@ -261,11 +261,11 @@ HRESULT Device::Clear(DWORD count, const D3DRECT* rects, DWORD flags, D3DCOLOR c
     if (depth) {
         const FormatInfo& f = *depth->format;
         // The stored word is (old & keep) | set, computed once: depth as the nearest of 2^bits − 1
-        // steps (D32F_LOCKABLE: the float), stencil in the low 8 bits of D24S8.
+        // steps (a float depth format: the float), stencil in the low 8 bits of D24S8.
         uint32_t keep = 0xffffffffu, set = 0;
         if (flags & D3DCLEAR_ZBUFFER) {
             uint32_t zw;
-            if (f.format == D3DFMT_D32F_LOCKABLE) {
+            if (f.depthFloat) {
                 std::memcpy(&zw, &z, 4);
                 keep = 0, set = zw;
             } else if (f.depthBits == 16) {

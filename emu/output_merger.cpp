@@ -119,7 +119,7 @@ bool resolveTarget(const MergeTarget& t, Plan& p) {
     if (t.depth) {
         const FormatInfo* f = t.depth->format;
         if (!f || f->cls != FormatClass::Depth) return false;
-        p.depthKind = f->format == D3DFMT_D32F_LOCKABLE ? DepthKind::D32F
+        p.depthKind = f->depthFloat                     ? DepthKind::D32F
                       : f->depthBits == 16              ? DepthKind::D16
                       : f->depthBits == 24              ? DepthKind::D24
                                                         : DepthKind::D32;

@@ -32,26 +32,26 @@ using TF = TexFormat;
 // One row per line:
 // clang-format off
 constexpr FormatRow kFormatRows[19] = {
-    // d3d, name, bytes, class, r g b a, pad, texture, render target, lockable depth, depth, stencil, TexFormat
-    {21, "A8R8G8B8", 4, FC::Unorm8, {U(16, 8), U(8, 8), U(0, 8), U(24, 8)}, kNoPad, true, true, false, 0, 0, TF::A8R8G8B8},
-    {22, "X8R8G8B8", 4, FC::Unorm8, {U(16, 8), U(8, 8), U(0, 8), kOne}, U(24, 8), true, true, false, 0, 0, TF::X8R8G8B8},
-    {28, "A8", 1, FC::Unorm8, {kZero, kZero, kZero, U(0, 8)}, kNoPad, true, false, false, 0, 0, TF::A8},
-    {50, "L8", 1, FC::Unorm8, {U(0, 8), U(0, 8), U(0, 8), kOne}, kNoPad, true, false, false, 0, 0, TF::L8},
-    {51, "A8L8", 2, FC::Unorm8, {U(0, 8), U(0, 8), U(0, 8), U(8, 8)}, kNoPad, true, false, false, 0, 0, TF::A8L8},
-    {60, "V8U8", 2, FC::Signed, {S(0, 8), S(8, 8), kOne, kOne}, kNoPad, true, false, false, 0, 0, TF::V8U8},
-    {61, "L6V5U5", 2, FC::Signed, {S(0, 5), S(5, 5), U(10, 6), kOne}, kNoPad, true, false, false, 0, 0, TF::L6V5U5},
-    {62, "X8L8V8U8", 4, FC::Signed, {S(0, 8), S(8, 8), U(16, 8), kOne}, U(24, 8), true, false, false, 0, 0, TF::X8L8V8U8},
-    {63, "Q8W8V8U8", 4, FC::Signed, {S(0, 8), S(8, 8), S(16, 8), S(24, 8)}, kNoPad, true, false, false, 0, 0, TF::Q8W8V8U8},
-    {64, "V16U16", 4, FC::Signed, {S(0, 16), S(16, 16), kOne, kOne}, kNoPad, true, false, false, 0, 0, TF::V16U16},
-    {113, "A16B16G16R16F", 8, FC::Float, {H(0), H(16), H(32), H(48)}, kNoPad, true, true, false, 0, 0, TF::A16B16G16R16F},
-    {116, "A32B32G32R32F", 16, FC::Float, {F(0), F(32), F(64), F(96)}, kNoPad, true, true, false, 0, 0, TF::A32B32G32R32F},
-    {114, "R32F", 4, FC::Float, {F(0), kOne, kOne, kOne}, kNoPad, true, true, false, 0, 0, TF::R32F},
-    {80, "D16", 2, FC::Depth, {}, kNoPad, false, false, false, 16, 0},
-    {70, "D16_LOCKABLE", 2, FC::Depth, {}, kNoPad, false, false, true, 16, 0},
-    {75, "D24S8", 4, FC::Depth, {}, kNoPad, false, false, false, 24, 8},
-    {77, "D24X8", 4, FC::Depth, {}, kNoPad, false, false, false, 24, 0},
-    {71, "D32", 4, FC::Depth, {}, kNoPad, false, false, false, 32, 0},
-    {82, "D32F_LOCKABLE", 4, FC::Depth, {}, kNoPad, false, false, true, 32, 0},
+    // d3d, name, bytes, class, r g b a, pad, texture, render target, lockable depth, depth, stencil, float depth, TexFormat
+    {21, "A8R8G8B8", 4, FC::Unorm8, {U(16, 8), U(8, 8), U(0, 8), U(24, 8)}, kNoPad, true, true, false, 0, 0, false, TF::A8R8G8B8},
+    {22, "X8R8G8B8", 4, FC::Unorm8, {U(16, 8), U(8, 8), U(0, 8), kOne}, U(24, 8), true, true, false, 0, 0, false, TF::X8R8G8B8},
+    {28, "A8", 1, FC::Unorm8, {kZero, kZero, kZero, U(0, 8)}, kNoPad, true, false, false, 0, 0, false, TF::A8},
+    {50, "L8", 1, FC::Unorm8, {U(0, 8), U(0, 8), U(0, 8), kOne}, kNoPad, true, false, false, 0, 0, false, TF::L8},
+    {51, "A8L8", 2, FC::Unorm8, {U(0, 8), U(0, 8), U(0, 8), U(8, 8)}, kNoPad, true, false, false, 0, 0, false, TF::A8L8},
+    {60, "V8U8", 2, FC::Signed, {S(0, 8), S(8, 8), kOne, kOne}, kNoPad, true, false, false, 0, 0, false, TF::V8U8},
+    {61, "L6V5U5", 2, FC::Signed, {S(0, 5), S(5, 5), U(10, 6), kOne}, kNoPad, true, false, false, 0, 0, false, TF::L6V5U5},
+    {62, "X8L8V8U8", 4, FC::Signed, {S(0, 8), S(8, 8), U(16, 8), kOne}, U(24, 8), true, false, false, 0, 0, false, TF::X8L8V8U8},
+    {63, "Q8W8V8U8", 4, FC::Signed, {S(0, 8), S(8, 8), S(16, 8), S(24, 8)}, kNoPad, true, false, false, 0, 0, false, TF::Q8W8V8U8},
+    {64, "V16U16", 4, FC::Signed, {S(0, 16), S(16, 16), kOne, kOne}, kNoPad, true, false, false, 0, 0, false, TF::V16U16},
+    {113, "A16B16G16R16F", 8, FC::Float, {H(0), H(16), H(32), H(48)}, kNoPad, true, true, false, 0, 0, false, TF::A16B16G16R16F},
+    {116, "A32B32G32R32F", 16, FC::Float, {F(0), F(32), F(64), F(96)}, kNoPad, true, true, false, 0, 0, false, TF::A32B32G32R32F},
+    {114, "R32F", 4, FC::Float, {F(0), kOne, kOne, kOne}, kNoPad, true, true, false, 0, 0, false, TF::R32F},
+    {80, "D16", 2, FC::Depth, {}, kNoPad, false, false, false, 16, 0, false},
+    {70, "D16_LOCKABLE", 2, FC::Depth, {}, kNoPad, false, false, true, 16, 0, false},
+    {75, "D24S8", 4, FC::Depth, {}, kNoPad, false, false, false, 24, 8, false},
+    {77, "D24X8", 4, FC::Depth, {}, kNoPad, false, false, false, 24, 0, false},
+    {71, "D32", 4, FC::Depth, {}, kNoPad, false, false, false, 32, 0, false},
+    {82, "D32F_LOCKABLE", 4, FC::Depth, {}, kNoPad, false, false, true, 32, 0, true},
 };
 // clang-format on
 

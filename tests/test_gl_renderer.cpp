@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "emu/device.h"
+#include "emu/format.h"
+#include "emu/gl/gl_internal.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
 #include "runner/gl_backend.h"
@@ -270,5 +272,50 @@ TEST_CASE("gl renderer: a draw after applyState equals the draw after the Set* c
         CHECK(surfaceBytes(restored, o.depth, 24, 16, 2) == depth);
         if (gl) CHECK(colour == softwareColour);
         softwareColour = colour;
+    }
+}
+
+TEST_CASE("gl renderer: native mode keeps every surface format in the GL format its row describes", "[gl]") {
+    using emu::gl::NativeFormat;
+    struct Want {
+        emu::D3DFORMAT format;
+        bool kept;
+        NativeFormat nf;
+    };
+    // The GL format whose client layout is D3D's texel (glTexImage2D's tables), per format.
+    const Want wants[] = {
+        {emu::D3DFMT_A8R8G8B8, true, {GL_RGBA8, GL_BGRA, GL_UNSIGNED_BYTE}},
+        {emu::D3DFMT_X8R8G8B8, true, {GL_RGBA8, GL_BGRA, GL_UNSIGNED_BYTE}},
+        {emu::D3DFMT_A16B16G16R16F, true, {GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT}},
+        {emu::D3DFMT_A32B32G32R32F, true, {GL_RGBA32F, GL_RGBA, GL_FLOAT}},
+        {emu::D3DFMT_R32F, true, {GL_R32F, GL_RED, GL_FLOAT}},
+        {emu::D3DFMT_D16, true, {GL_DEPTH_COMPONENT16, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, true, false}},
+        {emu::D3DFMT_D16_LOCKABLE, true, {GL_DEPTH_COMPONENT16, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, true, false}},
+        {emu::D3DFMT_D24S8, true, {GL_DEPTH24_STENCIL8, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, true, true}},
+        {emu::D3DFMT_D24X8, true, {GL_DEPTH24_STENCIL8, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, true, true}},
+        {emu::D3DFMT_D32, true, {GL_DEPTH_COMPONENT32, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, true, false}},
+        {emu::D3DFMT_D32F_LOCKABLE, true, {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, true, false}},
+        {emu::D3DFMT_A8, false, {}},
+        {emu::D3DFMT_L8, false, {}},
+        {emu::D3DFMT_A8L8, false, {}},
+        {emu::D3DFMT_V8U8, false, {}},
+        {emu::D3DFMT_L6V5U5, false, {}},
+        {emu::D3DFMT_X8L8V8U8, false, {}},
+        {emu::D3DFMT_Q8W8V8U8, false, {}},
+        {emu::D3DFMT_V16U16, false, {}},
+    };
+    CHECK(std::size(wants) == std::size(ps11::kFormatRows));  // every row
+    for (const Want& w : wants) {
+        const emu::FormatInfo* f = emu::formatInfo(w.format);
+        INFO(emu::formatName(w.format));
+        REQUIRE(f);
+        NativeFormat nf;
+        REQUIRE(emu::gl::nativeFormatOf(*f, nf) == w.kept);
+        if (!w.kept) continue;
+        CHECK(nf.internal == w.nf.internal);
+        CHECK(nf.format == w.nf.format);
+        CHECK(nf.type == w.nf.type);
+        CHECK(nf.depth == w.nf.depth);
+        CHECK(nf.stencil == w.nf.stencil);
     }
 }

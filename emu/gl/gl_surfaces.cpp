@@ -80,35 +80,48 @@ void main() {
 
 }  // namespace
 
+// From the format's row (ps11/formats.cpp): D3D's 32-bit b g r a word is GL_BGRA of
+// GL_UNSIGNED_BYTE (X8R8G8B8's X byte rides along as alpha); float formats whose first n channels
+// are halves or floats laid one after another (the rest missing) are GL's R, RG, RGB or RGBA of
+// GL_HALF_FLOAT or GL_FLOAT, sampled as GL samples them (native mode); depth by its bits and
+// float-ness (D3D's 24-bit word is depth << 8 | stencil or X: GL_UNSIGNED_INT_24_8's layout).
 bool nativeFormatOf(const FormatInfo& f, NativeFormat& out) {
-    switch (f.format) {
-        case D3DFMT_A8R8G8B8:
-        case D3DFMT_X8R8G8B8:
-            out = {GL_RGBA8, GL_BGRA, GL_UNSIGNED_BYTE};
-            return true;
-        case D3DFMT_R32F:
-            out = {GL_R32F, GL_RED, GL_FLOAT};
-            return true;
-        case D3DFMT_A16B16G16R16F:
-            out = {GL_RGBA16F, GL_RGBA, GL_HALF_FLOAT};
-            return true;
-        case D3DFMT_A32B32G32R32F:
-            out = {GL_RGBA32F, GL_RGBA, GL_FLOAT};
-            return true;
-        case D3DFMT_D16:
-        case D3DFMT_D16_LOCKABLE:
+    if (f.cls == FormatClass::Unorm8) {
+        if (f.bytes != 4) return false;
+        for (size_t c = 0; c < 3; ++c)
+            if (f.rgba[c].kind != ps11::ChannelKind::Unorm || f.rgba[c].shift != 8 * ps11::kUnorm8Byte[c]) return false;
+        out = {GL_RGBA8, GL_BGRA, GL_UNSIGNED_BYTE};
+        return true;
+    }
+    if (f.cls == FormatClass::Float) {
+        const ps11::ChannelKind kind = f.rgba[0].kind;
+        const uint32_t size = kind == ps11::ChannelKind::Half ? 16 : 32;
+        size_t n = 0;
+        while (n < 4 && f.rgba[n].kind == kind && f.rgba[n].shift == n * size) ++n;
+        for (size_t c = n; c < 4; ++c)
+            if (f.rgba[c].kind != ps11::ChannelKind::One) return false;
+        if (n == 0) return false;
+        static const GLenum halves[4] = {GL_R16F, GL_RG16F, GL_RGB16F, GL_RGBA16F};
+        static const GLenum floats[4] = {GL_R32F, GL_RG32F, GL_RGB32F, GL_RGBA32F};
+        static const GLenum formats[4] = {GL_RED, GL_RG, GL_RGB, GL_RGBA};
+        const bool half = kind == ps11::ChannelKind::Half;
+        out = {half ? halves[n - 1] : floats[n - 1], formats[n - 1], GLenum(half ? GL_HALF_FLOAT : GL_FLOAT)};
+        return true;
+    }
+    if (f.cls != FormatClass::Depth) return false;
+    if (f.depthFloat) {
+        out = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, true, false};
+        return true;
+    }
+    switch (f.depthBits) {
+        case 16:
             out = {GL_DEPTH_COMPONENT16, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, true, false};
             return true;
-        case D3DFMT_D24S8:
-        case D3DFMT_D24X8:
-            // D3D's word is depth << 8 | stencil: GL_UNSIGNED_INT_24_8's layout.
+        case 24:  // D24X8 too: its X byte is GL's stencil
             out = {GL_DEPTH24_STENCIL8, GL_DEPTH_STENCIL, GL_UNSIGNED_INT_24_8, true, true};
             return true;
-        case D3DFMT_D32:
+        case 32:
             out = {GL_DEPTH_COMPONENT32, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, true, false};
-            return true;
-        case D3DFMT_D32F_LOCKABLE:
-            out = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT, true, false};
             return true;
         default:
             return false;
