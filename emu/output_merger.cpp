@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cstring>
+#include <optional>
 #include <string>
 
 #if defined(__SSE2__)
@@ -94,27 +95,41 @@ Factor factorOf(D3DBLEND b, int c) {
 
 Surf surfOf(Image* img) { return img ? Surf{img->bytes.data(), img->rowPitch, img->format->bytes} : Surf{}; }
 
+// The store kernels' layout of a render-target format, from its row (ps11/formats.cpp): the b g
+// r a bytes of a 32-bit word with alpha (Argb8) or an 8-bit pad read as 1 (Xrgb8); four halves
+// (Rgba16F) or four floats (Rgba32F) r g b a one after another; one float r, the rest missing
+// (R32F). None for any other layout.
+std::optional<TargetKind> targetKindOf(const FormatInfo& f) {
+    using ps11::ChannelKind;
+    auto at = [&](size_t c, ChannelKind kind, uint32_t shift, uint32_t bits) {
+        return f.rgba[c].kind == kind && f.rgba[c].shift == shift && f.rgba[c].bits == bits;
+    };
+    if (f.cls == FormatClass::Unorm8 && f.bytes == 4) {
+        for (size_t c = 0; c < 3; ++c)
+            if (!at(c, ChannelKind::Unorm, 8u * uint32_t(ps11::kUnorm8Byte[c]), 8)) return std::nullopt;
+        if (at(3, ChannelKind::Unorm, 24, 8)) return TargetKind::Argb8;
+        if (f.rgba[3].kind == ChannelKind::One && f.pad.shift == 24 && f.pad.bits == 8) return TargetKind::Xrgb8;
+        return std::nullopt;
+    }
+    if (f.cls != FormatClass::Float) return std::nullopt;
+    bool halves = true, floats = true;
+    for (size_t c = 0; c < 4; ++c) {
+        halves = halves && at(c, ChannelKind::Half, 16u * uint32_t(c), 16);
+        floats = floats && at(c, ChannelKind::Float, 32u * uint32_t(c), 32);
+    }
+    if (halves) return TargetKind::Rgba16F;
+    if (floats) return TargetKind::Rgba32F;
+    bool rOnly = at(0, ChannelKind::Float, 0, 32);
+    for (size_t c = 1; c < 4; ++c) rOnly = rOnly && f.rgba[c].kind == ChannelKind::One;
+    if (rOnly) return TargetKind::R32F;
+    return std::nullopt;
+}
+
 bool resolveTarget(const MergeTarget& t, Plan& p) {
     if (t.color) {
-        switch (t.color->format ? t.color->format->format : D3DFMT_UNKNOWN) {
-            case D3DFMT_A8R8G8B8:
-                p.target = TargetKind::Argb8;
-                break;
-            case D3DFMT_X8R8G8B8:
-                p.target = TargetKind::Xrgb8;
-                break;
-            case D3DFMT_A16B16G16R16F:
-                p.target = TargetKind::Rgba16F;
-                break;
-            case D3DFMT_A32B32G32R32F:
-                p.target = TargetKind::Rgba32F;
-                break;
-            case D3DFMT_R32F:
-                p.target = TargetKind::R32F;
-                break;
-            default:
-                return false;
-        }
+        const std::optional<TargetKind> kind = t.color->format ? targetKindOf(*t.color->format) : std::nullopt;
+        if (!kind) return false;
+        p.target = *kind;
     }
     if (t.depth) {
         const FormatInfo* f = t.depth->format;
