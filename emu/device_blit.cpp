@@ -107,7 +107,7 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
     if (!s->format->renderTarget || !d->format->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
                     std::string("StretchRect: formats ") + s->format->name + " -> " + d->format->name +
-                        " not taken (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+                        " not taken (" + renderTargetFormatList() + ")");
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "StretchRect: a surface is locked");
     const RECT sr = sourceRect ? *sourceRect : RECT{0, 0, LONG(s->width), LONG(s->height)};

@@ -253,7 +253,7 @@ std::optional<CallError> Device::resolveTargets(DrawSetup& d) {
     if (!d.target->format->renderTarget)
         return refuse(D3DERR_INVALIDCALL, "E4118",
                       std::string("render target format ") + d.target->format->name +
-                          " is not drawn (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+                          " is not drawn (" + renderTargetFormatList() + ")");
     if (d.rt->locked[d.rtRef.level]) return refuse(D3DERR_INVALIDCALL, "E4106", "the render target is locked");
     if (m_state.depthStencil == Handle::Null) return std::nullopt;
     d.depth = findSurface(m_state.depthStencil, "depth stencil surface", error, &d.ds, &d.dsRef);

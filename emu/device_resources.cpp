@@ -71,7 +71,7 @@ HRESULT Device::CreateTexture(UINT width, UINT height, UINT levels, DWORD usage,
     if ((usage & D3DUSAGE_RENDERTARGET) && !f->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
                     std::string("CreateTexture: format ") + f->name +
-                        " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+                        " cannot be a render target (" + renderTargetFormatList() + ")");
     // D3D9: render targets and DYNAMIC resources live in D3DPOOL_DEFAULT; DYNAMIC and MANAGED
     // exclude each other; AUTOGENMIPMAP is not allowed in SYSTEMMEM (D3DUSAGE reference page).
     if ((usage & D3DUSAGE_RENDERTARGET) && pool != D3DPOOL_DEFAULT)
@@ -157,7 +157,7 @@ HRESULT Device::CreateRenderTarget(UINT width, UINT height, D3DFORMAT format, BO
     if (!f || !f->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
                     std::string("CreateRenderTarget: format ") + formatName(format) +
-                        " cannot be a render target (A8R8G8B8, X8R8G8B8, R32F, A16B16G16R16F, A32B32G32R32F)");
+                        " cannot be a render target (" + renderTargetFormatList() + ")");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;
@@ -176,7 +176,7 @@ HRESULT Device::CreateDepthStencilSurface(UINT width, UINT height, D3DFORMAT for
     if (!f || f->cls != FormatClass::Depth)
         return fail(D3DERR_INVALIDCALL, "E4104",
                     std::string("CreateDepthStencilSurface: format ") + formatName(format) +
-                        " is not a depth format (D16, D16_LOCKABLE, D24S8, D24X8, D32, D32F_LOCKABLE)");
+                        " is not a depth format (" + depthFormatList() + ")");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;

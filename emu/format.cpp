@@ -56,6 +56,28 @@ const char* formatName(D3DFORMAT format) {
     return buf;
 }
 
+namespace {
+
+template <class Takes>
+std::string namesOf(Takes takes) {
+    std::string out;
+    for (const FormatInfo& f : formats())
+        if (takes(f)) out += (out.empty() ? "" : ", ") + std::string(f.name);
+    return out;
+}
+
+}  // namespace
+
+const std::string& renderTargetFormatList() {
+    static const std::string names = namesOf([](const FormatInfo& f) { return f.renderTarget; });
+    return names;
+}
+
+const std::string& depthFormatList() {
+    static const std::string names = namesOf([](const FormatInfo& f) { return f.cls == FormatClass::Depth; });
+    return names;
+}
+
 uint32_t loadWord(const uint8_t* p, uint32_t bytes) {
     uint32_t w = 0;
     for (uint32_t i = 0; i < bytes && i < 4; ++i) w |= uint32_t(p[i]) << (8 * i);

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 
 #include "emu/d3d9types.h"
 #include "ps11/formats.h"
@@ -28,6 +29,10 @@ const FormatInfo* formatInfo(D3DFORMAT format);
 D3DFORMAT d3dFormatOf(ps11::TexFormat format);
 // "A8R8G8B8", or "format 23" for an unknown value.
 const char* formatName(D3DFORMAT format);
+// The names of the render-target formats ("A8R8G8B8, X8R8G8B8, …") and of the depth formats,
+// in row order, from the rows: what an error message lists as the formats a call takes.
+const std::string& renderTargetFormatList();
+const std::string& depthFormatList();
 
 // Channel values of one texel stored at p (D3D layout), as the sampler reads them: r g b a,
 // missing channels 1 except A8's rgb 0 (ps1x-spec §6.4); signed channels decoded by the
