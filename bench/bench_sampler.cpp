@@ -194,7 +194,8 @@ void BM_HandOver1080p(benchmark::State& state) {
     const auto [oldMs, newMs] = interleavedMs(
         state, [&] { benchmark::DoNotOptimize(handOverOld(bytes)); },
         [&] {
-            benchmark::DoNotOptimize(Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error));
+            benchmark::DoNotOptimize(
+                Texture::fromLevels(TexFormat::A8R8G8B8, false, &l, 1, SignedDecode::Snorm, error));
         });
     state.counters["old_ms"] = oldMs;
     state.counters["new_ms"] = newMs;
@@ -214,9 +215,10 @@ void BM_HandOverFloat1080p(benchmark::State& state, TexFormat format) {
     const TextureLevelBytes l{kW, kH, 1, bytes.get(), size_t(kW) * bpt, size_t(kW) * bpt * kH};
     std::string error;
     const auto [copyMs, inPlaceMs] = interleavedMs(
-        state,
-        [&] { benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error)); },
-        [&] { benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error, bytes)); });
+        state, [&] { benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error)); },
+        [&] {
+            benchmark::DoNotOptimize(Texture::fromLevels(format, false, &l, 1, SignedDecode::Snorm, error, bytes));
+        });
     state.counters["copy_ms"] = copyMs;
     state.counters["in_place_ms"] = inPlaceMs;
 }

@@ -259,9 +259,9 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     bool nan = false;
     // A row whose columns have no run of consecutive pairs (a minification's) is filtered from
     // the texels where they are (8-bit words, or float r g b a); the others from the decoded row.
-    const bool inPlace = j >= 0 && (tap.unorm8 || tap.values) && std::none_of(cols.stretches.begin(), cols.stretches.end(), [](const auto& st) {
-                             return st.kind == FloatRowTriangle::Columns::kSeq;
-                         });
+    const bool inPlace = j >= 0 && (tap.unorm8 || tap.values) &&
+                         std::none_of(cols.stretches.begin(), cols.stretches.end(),
+                                      [](const auto& st) { return st.kind == FloatRowTriangle::Columns::kSeq; });
     if (inPlace) {
         const size_t at = size_t(j) * tap.width * 4;
         for (const FloatRowTriangle::Columns::Stretch& st : cols.stretches) {
@@ -716,9 +716,8 @@ void shareFloatRowTables(const FloatRowDraw& draw, FloatRowTriangle* tris, const
         const FloatRowTriangle &ti = tris[tableOf[i]], &tj = tris[tableOf[j]];
         const FloatRowTriangle::Columns &c = ti.taps[size_t(t)], &o = tj.taps[size_t(u)];
         return a.bound == b.bound && a.unorm8 == b.unorm8 && a.bytes == b.bytes && a.values == b.values &&
-               a.texels.base == b.texels.base &&
-               a.width == b.width && a.border == b.border && tj.x0 == ti.x0 && tj.x1 == ti.x1 && o.i0 == c.i0 &&
-               o.i1 == c.i1 && o.f.size() == c.f.size() &&
+               a.texels.base == b.texels.base && a.width == b.width && a.border == b.border && tj.x0 == ti.x0 &&
+               tj.x1 == ti.x1 && o.i0 == c.i0 && o.i1 == c.i1 && o.f.size() == c.f.size() &&
                (c.f.empty() || std::memcmp(o.f.data(), c.f.data(), sizeof(float) * c.f.size()) == 0);
     };
     for (size_t i = 0; i < count; ++i) {

@@ -106,8 +106,8 @@ HRESULT Device::StretchRect(Handle source, const RECT* sourceRect, Handle dest, 
                         " is neither a render target nor an offscreen plain surface");
     if (!s->format->renderTarget || !d->format->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
-                    std::string("StretchRect: formats ") + s->format->name + " -> " + d->format->name +
-                        " not taken (" + renderTargetFormatList() + ")");
+                    std::string("StretchRect: formats ") + s->format->name + " -> " + d->format->name + " not taken (" +
+                        renderTargetFormatList() + ")");
     if (src->locked[srcRef.level] || dst->locked[dstRef.level])
         return fail(D3DERR_INVALIDCALL, "E4106", "StretchRect: a surface is locked");
     const RECT sr = sourceRect ? *sourceRect : RECT{0, 0, LONG(s->width), LONG(s->height)};

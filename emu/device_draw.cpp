@@ -252,8 +252,8 @@ std::optional<CallError> Device::resolveTargets(DrawSetup& d) {
     if (!d.target) return error;
     if (!d.target->format->renderTarget)
         return refuse(D3DERR_INVALIDCALL, "E4118",
-                      std::string("render target format ") + d.target->format->name +
-                          " is not drawn (" + renderTargetFormatList() + ")");
+                      std::string("render target format ") + d.target->format->name + " is not drawn (" +
+                          renderTargetFormatList() + ")");
     if (d.rt->locked[d.rtRef.level]) return refuse(D3DERR_INVALIDCALL, "E4106", "the render target is locked");
     if (m_state.depthStencil == Handle::Null) return std::nullopt;
     d.depth = findSurface(m_state.depthStencil, "depth stencil surface", error, &d.ds, &d.dsRef);

@@ -70,8 +70,8 @@ HRESULT Device::CreateTexture(UINT width, UINT height, UINT levels, DWORD usage,
         return fail(D3DERR_INVALIDCALL, "E4104", "CreateTexture: depth textures are not supported");
     if ((usage & D3DUSAGE_RENDERTARGET) && !f->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
-                    std::string("CreateTexture: format ") + f->name +
-                        " cannot be a render target (" + renderTargetFormatList() + ")");
+                    std::string("CreateTexture: format ") + f->name + " cannot be a render target (" +
+                        renderTargetFormatList() + ")");
     // D3D9: render targets and DYNAMIC resources live in D3DPOOL_DEFAULT; DYNAMIC and MANAGED
     // exclude each other; AUTOGENMIPMAP is not allowed in SYSTEMMEM (D3DUSAGE reference page).
     if ((usage & D3DUSAGE_RENDERTARGET) && pool != D3DPOOL_DEFAULT)
@@ -156,8 +156,8 @@ HRESULT Device::CreateRenderTarget(UINT width, UINT height, D3DFORMAT format, BO
     const FormatInfo* f = formatInfo(format);
     if (!f || !f->renderTarget)
         return fail(D3DERR_INVALIDCALL, "E4104",
-                    std::string("CreateRenderTarget: format ") + formatName(format) +
-                        " cannot be a render target (" + renderTargetFormatList() + ")");
+                    std::string("CreateRenderTarget: format ") + formatName(format) + " cannot be a render target (" +
+                        renderTargetFormatList() + ")");
     Resource r;
     r.kind = ResourceKind::Surface;
     r.format = f;

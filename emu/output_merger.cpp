@@ -134,10 +134,10 @@ bool resolveTarget(const MergeTarget& t, Plan& p) {
     if (t.depth) {
         const FormatInfo* f = t.depth->format;
         if (!f || f->cls != FormatClass::Depth) return false;
-        p.depthKind = f->depthFloat                     ? DepthKind::D32F
-                      : f->depthBits == 16              ? DepthKind::D16
-                      : f->depthBits == 24              ? DepthKind::D24
-                                                        : DepthKind::D32;
+        p.depthKind = f->depthFloat        ? DepthKind::D32F
+                      : f->depthBits == 16 ? DepthKind::D16
+                      : f->depthBits == 24 ? DepthKind::D24
+                                           : DepthKind::D32;
     }
     p.color = t.color;
     p.depth = t.depth;

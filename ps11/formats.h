@@ -74,7 +74,7 @@ struct FormatRow {
     bool renderTarget = false;      // D3DUSAGE_RENDERTARGET / CreateRenderTarget / StretchRect
     bool lockableDepth = false;     // a depth format LockRect may lock (the _LOCKABLE ones)
     uint32_t depthBits = 0, stencilBits = 0;
-    bool depthFloat = false;        // a depth format whose depth is a float32 (D32F_LOCKABLE), else unorm
+    bool depthFloat = false;                    // a depth format whose depth is a float32 (D32F_LOCKABLE), else unorm
     TexFormat texFormat = TexFormat::A8R8G8B8;  // the sampler's name for it (texture formats)
 };
 

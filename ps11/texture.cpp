@@ -517,8 +517,8 @@ std::optional<Texture> Texture::fromLevels(TexFormat fmt, bool volume, const Tex
     const size_t asIs = storedAsIs(row, padOnes);
     const bool viaRow = !asIs && row.cls == FormatClass::Float;
     const size_t inPlaceBytes = viaRow ? row.bytes : asIs;
-    bool inPlace = owner && inPlaceBytes &&
-                   (inPlaceBytes == 4 || viaRow || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
+    bool inPlace =
+        owner && inPlaceBytes && (inPlaceBytes == 4 || viaRow || reinterpret_cast<uintptr_t>(levels[0].data) % 4 == 0);
     for (size_t k = 0; inPlace && k < levelCount; ++k) {
         const TextureLevelInfo& li = t.m_levels[k];
         const TextureLevelBytes& lb = levels[k];

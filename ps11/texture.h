@@ -99,9 +99,7 @@ public:
     const uint8_t* unorm8() const { return m_u8view ? m_u8view.get() : m_u8.data(); }  // Unorm8
     // Decoded: null for a float texture read in place whose texels are not four float32 r g b a
     // (A16B16G16R16F, R32F): floatTexels() reads every Decoded float texture.
-    const float* values() const {
-        return m_valueView ? m_valueView.get() : m_rawView ? nullptr : m_value.data();
-    }
+    const float* values() const { return m_valueView ? m_valueView.get() : m_rawView ? nullptr : m_value.data(); }
     // A Decoded texture's texels, r g b a: where fromLevels found them when it reads them in place,
     // else values() as four float32 per texel.
     FloatTexels floatTexels() const;
@@ -212,7 +210,9 @@ inline float halfToFloat(uint16_t h) {
 
 // The grid value a fixed-point profile samples for a float texel's channel: toGrid clamped to
 // +-kMaxTexelGrid (Texture::grid's integers, one at a time).
-inline int32_t texelGridOf(float v, Precision p) { return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid); }
+inline int32_t texelGridOf(float v, Precision p) {
+    return std::clamp(toGrid(double(v), p), -kMaxTexelGrid, kMaxTexelGrid);
+}
 
 void FloatTexels::get(size_t i, float t[4]) const {
     const uint8_t* p = base + i * stride;

@@ -158,11 +158,11 @@ void scanDecodedTile(const Texture& tex, uint32_t w, uint32_t x0, uint32_t x1, u
     const float* values = tex.values();
     const FloatTexels texels = tex.floatTexels();  // a float texture read in place in its own layout
     for (uint32_t y = y0; y < y1; ++y) {
-        const float* t = values ? values + (size_t(y) * w + x0) * 4 : nullptr;
-        for (uint32_t x = x0; x < x1; ++x, t += values ? 4 : 0) {
+        for (uint32_t x = x0; x < x1; ++x) {
+            const size_t i = size_t(y) * w + x;
             float own[4];
-            if (!values) texels.get(size_t(y) * w + x, own);
-            const __m128 v = _mm_loadu_ps(values ? t : own);
+            if (!values) texels.get(i, own);
+            const __m128 v = _mm_loadu_ps(values ? values + i * 4 : own);
             // minps/maxps give their second operand where either is NaN: the NaN is passed over.
             lo = _mm_min_ps(v, lo);
             hi = _mm_max_ps(v, hi);

@@ -366,11 +366,13 @@ TEST_CASE("device: resource creation rules and refusals", "[device]") {
     CHECK(dev.CreateTexture(4, 4, 1, 0, D3DFMT_D16, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_L8, D3DPOOL_DEFAULT, &h) == D3DERR_INVALIDCALL);
     // The formats a refusal lists come from the format rows, in row order.
-    CHECK(dev.lastError().message == "E4104 CreateTexture: format L8 cannot be a render target (A8R8G8B8, X8R8G8B8, "
-                                     "A16B16G16R16F, A32B32G32R32F, R32F)");
+    CHECK(dev.lastError().message ==
+          "E4104 CreateTexture: format L8 cannot be a render target (A8R8G8B8, X8R8G8B8, "
+          "A16B16G16R16F, A32B32G32R32F, R32F)");
     CHECK(dev.CreateDepthStencilSurface(4, 4, D3DFMT_A8R8G8B8, &h) == D3DERR_INVALIDCALL);
-    CHECK(dev.lastError().message == "E4104 CreateDepthStencilSurface: format A8R8G8B8 is not a depth format (D16, "
-                                     "D16_LOCKABLE, D24S8, D24X8, D32, D32F_LOCKABLE)");
+    CHECK(dev.lastError().message ==
+          "E4104 CreateDepthStencilSurface: format A8R8G8B8 is not a depth format (D16, "
+          "D16_LOCKABLE, D24S8, D24X8, D32, D32F_LOCKABLE)");
     CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) ==
           D3DERR_INVALIDCALL);
     CHECK(dev.CreateTexture(4, 4, 1, D3DUSAGE_DYNAMIC, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &h) == D3DERR_INVALIDCALL);

@@ -108,7 +108,8 @@ TEST_CASE("texture: float levels read in place sample as their decoded copy", "[
             std::string error;
             std::optional<Texture> in =
                 Texture::fromLevels(f, volume, lv.data(), lv.size(), SignedDecode::Snorm, error, owned);
-            std::optional<Texture> copy = Texture::fromLevels(f, volume, lv.data(), lv.size(), SignedDecode::Snorm, error);
+            std::optional<Texture> copy =
+                Texture::fromLevels(f, volume, lv.data(), lv.size(), SignedDecode::Snorm, error);
             INFO(formatRow(f).name << (volume ? " volume" : " 2-D") << ": " << error);
             REQUIRE(in);
             REQUIRE(copy);

@@ -530,8 +530,8 @@ int runGlare(const GlareOptions& o) {
         char medianText[16] = "-";
         if (ran) std::snprintf(medianText, sizeof medianText, "%.3f", median);
         if (s.reused) {
-            std::printf("%-22s %9.3f %9s %6s %11s %11s %13s %4s %4s %8s %7s  reused -\n", s.pass.c_str(), s.milliseconds,
-                        medianText, "-", "-", "-", "-", "-", "-", "-", "-");
+            std::printf("%-22s %9.3f %9s %6s %11s %11s %13s %4s %4s %8s %7s  reused -\n", s.pass.c_str(),
+                        s.milliseconds, medianText, "-", "-", "-", "-", "-", "-", "-", "-");
             continue;
         }
         const uint64_t tiles = s.tilesShaded + s.tilesFilled + s.tilesCopied + s.tilesSkipped;
@@ -558,16 +558,18 @@ int runGlare(const GlareOptions& o) {
     if (lastStill)
         std::printf("(the last frame was skipped whole: a still input whose frame before reused every pass; nothing was\n"
                     " built or run)\n");
-    std::printf("(ms: the last frame's; median: over the frames that ran the pass, not reused (with -o each frame's PNG\n"
-                " is written between frames, so the passes start from caches it evicted)\n");
-    std::printf("(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its median;\n"
-                " reused: its inputs were last frame's, its outputs kept, nothing ran; put off: a whole-surface copy the\n"
-                " software renderer makes in the pass that next draws into, reads or writes its destination, in whose\n"
-                " time it then is (the composite copies each band of the scene just before it blends onto it);\n"
-                " tiles: tiles of 16 rows by 64 pixels of the software renderer's full-screen draws, shaded, filled\n"
-                " with a constant, copied from one texture or skipped, as the interval evaluator decided; -: none\n"
-                " decided (no such draw, or deciding did not pay on the program's recent draws); --no-skip runs every\n"
-                " pass and draws every tile)\n");
+    std::printf(
+        "(ms: the last frame's; median: over the frames that ran the pass, not reused (with -o each frame's PNG\n"
+        " is written between frames, so the passes start from caches it evicted))\n");
+    std::printf(
+        "(MB: what each pass must move at least, every texture it reads and writes once; GB/s: that over its median;\n"
+        " reused: its inputs were last frame's, its outputs kept, nothing ran; put off: a whole-surface copy the\n"
+        " software renderer makes in the pass that next draws into, reads or writes its destination, in whose\n"
+        " time it then is (the composite copies each band of the scene just before it blends onto it);\n"
+        " tiles: tiles of 16 rows by 64 pixels of the software renderer's full-screen draws, shaded, filled\n"
+        " with a constant, copied from one texture or skipped, as the interval evaluator decided; -: none\n"
+        " decided (no such draw, or deciding did not pay on the program's recent draws); --no-skip runs every\n"
+        " pass and draws every tile)\n");
     if (o.backend == "gl")
         std::printf("surfaces crossing between the device and the %s renderer in the last frame: %llu uploaded, %llu read "
                     "back%s\n",
