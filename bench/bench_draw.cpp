@@ -383,6 +383,104 @@ void BM_FreshTargetRead(benchmark::State& state, D3DFORMAT format, bool whole) {
     }
 }
 
+// What deciding tiles costs against shading them (docs/device.md "Tile skipping"): a 1080p bright
+// pass (`sub_sat r0, t0, c0`, c0 = 0.6) over a texture like the `sparse` scene — dark noise (8–40
+// a channel, never black) with 36 bright 24×24 squares (1 % of the pixels) — drawn 1:1 on a
+// device that decides every tile (skipping on, deciding by the share of tiles saved: not timed)
+// and on one that shades every tile (skipping off), alternated, each timed on its own. The texture
+// is uploaded once, so its tile facts are scanned once (before timing): the decided draw's time
+// is its decisions and the tiles they leave to shade. Reported: the decided draw's time;
+// `plain_ms`, `decided_ms`, the tiles shaded and filled by the decided draw, and `decide_ns`:
+// (decided − plain × shaded / all tiles) over the tiles filled — what each tile saved cost to
+// decide, counting the shaded tiles at the plain draw's cost per tile.
+void BM_TileDecisions(benchmark::State& state) {
+    const int threads = int(state.range(0));
+    struct Side {
+        std::unique_ptr<Device> dev;
+        bool ok = false;
+    } side[2];
+    std::vector<uint32_t> texels(size_t(kW) * kH);
+    std::mt19937 rng(7);
+    for (uint32_t& t : texels) {
+        uint32_t v = 0xff000000u;
+        for (int c = 0; c < 3; ++c) v |= (8u + rng() % 33u) << (8 * c);
+        t = v;
+    }
+    for (int k = 0; k < 36; ++k) {
+        const UINT x0 = rng() % (kW - 24), y0 = rng() % (kH - 24);
+        for (UINT y = y0; y < y0 + 24; ++y)
+            for (UINT x = x0; x < x0 + 24; ++x) texels[size_t(y) * kW + x] = 0xffe0f0ffu;
+    }
+    std::vector<QuadVertex> quad;
+    const float xs[4] = {-0.5f, kW - 0.5f, kW - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, kH - 0.5f, kH - 0.5f};
+    const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+    for (int c : {0, 1, 2, 0, 2, 3}) {
+        QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
+        q.uv[0][0] = us[c], q.uv[0][1] = vs[c];
+        quad.push_back(q);
+    }
+    auto draw = [&](Device& dev) {
+        return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, 2, quad.data(), sizeof(QuadVertex)) == D3D_OK;
+    };
+    for (int k = 0; k < 2; ++k) {
+        DeviceOptions o;
+        o.software.threads = threads;
+        o.software.skipTiles = k == 0;
+        o.software.timeTiles = false;
+        side[k].dev = std::make_unique<Device>(o);
+        Device& dev = *side[k].dev;
+        Handle rt{}, tex{}, ps{};
+        D3DLOCKED_RECT lr{};
+        bool ok = dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) == D3D_OK && dev.SetRenderTarget(0, rt) == D3D_OK &&
+                  dev.CreateTexture(kW, kH, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK &&
+                  dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK;
+        if (ok) {
+            for (UINT y = 0; y < kH; ++y)
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), &texels[size_t(y) * kW], kW * 4);
+            ok = dev.UnlockRect(tex, 0) == D3D_OK;
+        }
+        const float c0[4] = {0.6f, 0.6f, 0.6f, 0.6f};
+        ok = ok && dev.CreatePixelShaderFromText("ps_1_1\ntex t0\nsub_sat r0, t0, c0\n", &ps) == D3D_OK &&
+             dev.SetPixelShader(ps) == D3D_OK && dev.SetPixelShaderConstantF(0, c0, 1) == D3D_OK &&
+             dev.SetTexture(0, tex) == D3D_OK && dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4) == D3D_OK;
+        for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
+            ok = ok && dev.SetSamplerState(0, f, D3DTEXF_POINT) == D3D_OK;
+        side[k].ok = ok && draw(dev) && draw(dev);  // the facts scanned, the executor made
+        if (!side[k].ok) {
+            state.SkipWithError(("device refused the setup: " + dev.lastError().message).c_str());
+            return;
+        }
+    }
+    double sum[2] = {0, 0};
+    bool flip = false;
+    for (auto _ : state) {
+        double t[2];
+        for (int i = 0; i < 2; ++i) {
+            const int k = flip ? 1 - i : i;
+            const auto t0 = std::chrono::steady_clock::now();
+            if (!draw(*side[k].dev)) {
+                state.SkipWithError(side[k].dev->lastError().message.c_str());
+                return;
+            }
+            t[k] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        }
+        flip = !flip;
+        sum[0] += t[0], sum[1] += t[1];
+        state.SetIterationTime(t[0]);
+    }
+    const double n = double(std::max<int64_t>(state.iterations(), 1));
+    const DrawStats& st = side[0].dev->lastDrawStats();
+    const double all = double(st.tilesShaded + st.tilesFilled + st.tilesCopied + st.tilesSkipped);
+    const double decided = sum[0] / n, plain = sum[1] / n;
+    state.counters["decided_ms"] = decided * 1e3;
+    state.counters["plain_ms"] = plain * 1e3;
+    state.counters["tiles_shaded"] = double(st.tilesShaded);
+    state.counters["tiles_filled"] = double(st.tilesFilled);
+    const double saved = all - double(st.tilesShaded);
+    state.counters["decide_ns"] = saved > 0 ? (decided - plain * double(st.tilesShaded) / all) / saved * 1e9 : 0;
+    state.counters["shade_ns"] = all > 0 ? plain / all * 1e9 : 0;
+}
+
 }  // namespace
 
 BENCHMARK_CAPTURE(BM_FreshTargetRead, a8r8g8b8_cleared_1080p, D3DFMT_A8R8G8B8, true)
@@ -405,6 +503,7 @@ BENCHMARK_CAPTURE(BM_FreshTargetRead, r32f_cleared_1080p, D3DFMT_R32F, true)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_TileDecisions)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime();
 BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)

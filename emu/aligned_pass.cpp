@@ -183,6 +183,24 @@ void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool add
     }
 }
 
+// n pixels of a row of the 8-bit target set to the b g r a word `word`, or with `additive` that
+// word added to each with saturation (storeWords of n copies of it).
+void fillWords(const uint8_t word[4], int n, bool additive, uint8_t* dst) {
+    const uint32_t w = load32(word);
+    int i = 0;
+#if defined(__SSE2__)
+    const __m128i v = _mm_set1_epi32(int32_t(w));
+    for (; i + 4 <= n; i += 4) {
+        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
+        _mm_storeu_si128(d, additive ? _mm_adds_epu8(_mm_loadu_si128(d), v) : v);
+    }
+#endif
+    for (; i < n; ++i) {
+        const uint32_t out = additive ? addBytesSaturated(w, load32(dst + 4 * i)) : w;
+        std::memcpy(dst + 4 * i, &out, 4);
+    }
+}
+
 // A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
 // zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
 // ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
@@ -919,6 +937,19 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         for (int c = 0; c < 4; ++c)
                             if (!((window->copyMask >> c) & 1))
                                 ps11::fillLanes(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
+                    } else if (storeAsShaded) {
+                        // A filled run stored directly: its word is what storeLanes makes of one
+                        // lane (added to a zero word: the word itself), written n times or added
+                        // n times with saturation, as storeLanes writes or adds every lane.
+                        int16_t lane[4];
+                        for (int c = 0; c < 4; ++c) lane[c] = int16_t(window->grid[size_t(c)]);
+                        const int16_t* const one[4] = {&lane[0], &lane[1], &lane[2], &lane[3]};
+                        uint8_t word[4] = {0, 0, 0, 0};
+                        storeLanes(draw, one, 1, orMask, word);
+                        fillWords(word, n, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
+                        stats.pixels += uint64_t(n);
+                        stats.written += uint64_t(n);
+                        continue;
                     } else {
                         for (int c = 0; c < 4; ++c) ps11::fillLanes(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
                     }
