@@ -383,18 +383,21 @@ void BM_FreshTargetRead(benchmark::State& state, D3DFORMAT format, bool whole) {
     }
 }
 
-// What deciding tiles costs against shading them (docs/device.md "Tile skipping"): a 1080p bright
-// pass (`sub_sat r0, t0, c0`, c0 = 0.6) over a texture like the `sparse` scene — dark noise (8–40
-// a channel, never black) with 36 bright 24×24 squares (1 % of the pixels) — drawn 1:1 on a
-// device that decides every tile (skipping on, deciding by the share of tiles saved: not timed)
-// and on one that shades every tile (skipping off), alternated, each timed on its own. The texture
-// is uploaded once, so its tile facts are scanned once (before timing): the decided draw's time
-// is its decisions and the tiles they leave to shade. Reported: the decided draw's time;
-// `plain_ms`, `decided_ms`, the tiles shaded and filled by the decided draw, and `decide_ns`:
-// (decided − plain × shaded / all tiles) over the tiles filled — what each tile saved cost to
-// decide, counting the shaded tiles at the plain draw's cost per tile.
+// What deciding tiles costs against shading them (docs/device.md "Tile skipping"), on a 1080p
+// texture like the `sparse` scene's passes read: 36 bright 24×24 squares (1 % of the pixels) over
+// dark noise (8–40 a channel, never black) for the bright pass (argument 0: `sub_sat r0, t0, c0`,
+// c0 = 0.6, point), over black for the blur (1: the 4-tap blur, c0 = 0.25, bilinear taps at ±½
+// texel diagonally, as a glare's blur of its bright pass reads). Drawn 1:1 on a device that decides
+// every tile (skipping on, deciding by the share of tiles saved: not timed) and on one that shades
+// every tile (skipping off), alternated, each timed on its own. The texture is uploaded once, so
+// its tile facts are scanned once (before timing): the decided draw's time is its decisions and
+// the tiles they leave to shade. Reported: the decided draw's time; `plain_ms`, `decided_ms`, the
+// tiles shaded and filled by the decided draw, `shade_ns` (the plain draw per tile) and
+// `decide_ns`: (decided − plain × shaded / all tiles) over the tiles saved — what each tile saved
+// cost to decide and fill, counting the shaded tiles at the plain draw's cost per tile.
 void BM_TileDecisions(benchmark::State& state) {
     const int threads = int(state.range(0));
+    const bool blur = state.range(1) == 1;
     struct Side {
         std::unique_ptr<Device> dev;
         bool ok = false;
@@ -403,7 +406,7 @@ void BM_TileDecisions(benchmark::State& state) {
     std::mt19937 rng(7);
     for (uint32_t& t : texels) {
         uint32_t v = 0xff000000u;
-        for (int c = 0; c < 3; ++c) v |= (8u + rng() % 33u) << (8 * c);
+        for (int c = 0; c < 3; ++c) v |= (blur ? 0u : 8u + rng() % 33u) << (8 * c);
         t = v;
     }
     for (int k = 0; k < 36; ++k) {
@@ -414,9 +417,13 @@ void BM_TileDecisions(benchmark::State& state) {
     std::vector<QuadVertex> quad;
     const float xs[4] = {-0.5f, kW - 0.5f, kW - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, kH - 0.5f, kH - 0.5f};
     const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+    const float off[4][2] = {{-0.5f, -0.5f}, {0.5f, -0.5f}, {-0.5f, 0.5f}, {0.5f, 0.5f}};
     for (int c : {0, 1, 2, 0, 2, 3}) {
         QuadVertex q{xs[c], ys[c], 0.0f, 1.0f, {}};
-        q.uv[0][0] = us[c], q.uv[0][1] = vs[c];
+        for (int t = 0; t < 4; ++t) {
+            q.uv[t][0] = us[c] + (blur ? off[t][0] / float(kW) : 0.0f);
+            q.uv[t][1] = vs[c] + (blur ? off[t][1] / float(kH) : 0.0f);
+        }
         quad.push_back(q);
     }
     auto draw = [&](Device& dev) {
@@ -439,12 +446,16 @@ void BM_TileDecisions(benchmark::State& state) {
                 std::memcpy(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), &texels[size_t(y) * kW], kW * 4);
             ok = dev.UnlockRect(tex, 0) == D3D_OK;
         }
-        const float c0[4] = {0.6f, 0.6f, 0.6f, 0.6f};
-        ok = ok && dev.CreatePixelShaderFromText("ps_1_1\ntex t0\nsub_sat r0, t0, c0\n", &ps) == D3D_OK &&
+        const float w = blur ? 0.25f : 0.6f, c0[4] = {w, w, w, w};
+        ok = ok &&
+             dev.CreatePixelShaderFromText(blur ? bench::kBlur4 : "ps_1_1\ntex t0\nsub_sat r0, t0, c0\n", &ps) == D3D_OK &&
              dev.SetPixelShader(ps) == D3D_OK && dev.SetPixelShaderConstantF(0, c0, 1) == D3D_OK &&
-             dev.SetTexture(0, tex) == D3D_OK && dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4) == D3D_OK;
-        for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
-            ok = ok && dev.SetSamplerState(0, f, D3DTEXF_POINT) == D3D_OK;
+             dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4) == D3D_OK;
+        for (DWORD t = 0; t < (blur ? 4u : 1u); ++t) {
+            ok = ok && dev.SetTexture(t, tex) == D3D_OK;
+            for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
+                ok = ok && dev.SetSamplerState(t, f, blur ? D3DTEXF_LINEAR : D3DTEXF_POINT) == D3D_OK;
+        }
         side[k].ok = ok && draw(dev) && draw(dev);  // the facts scanned, the executor made
         if (!side[k].ok) {
             state.SkipWithError(("device refused the setup: " + dev.lastError().message).c_str());
@@ -503,7 +514,7 @@ BENCHMARK_CAPTURE(BM_FreshTargetRead, r32f_cleared_1080p, D3DFMT_R32F, true)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_TileDecisions)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK(BM_TileDecisions)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames({"threads", "blur"})->Unit(benchmark::kMillisecond)->UseManualTime();
 BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)

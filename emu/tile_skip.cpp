@@ -253,9 +253,21 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
     if (memo.skipper != m_id) memo = TileMemo{}, memo.skipper = m_id;
     // Only the ranges this draw reads are written (the rest stay unknown from the start).
     ps11::IntervalInputs& in = memo.in;
-    const bool known = stageRanges(in, [&](const Stage& st, ps11::ValueRange4& out) {
-        // The coordinates' extremes over the tile (u affine in x alone, v in y alone on the
-        // row paths), on every triangle.
+    // Each stage's footprint: the texels its coordinates reach over the tile (u affine in x
+    // alone, v in y alone on the row paths, on every triangle), a bilinear footprint (also
+    // covering point sampling) and one texel more each side for the samplers' own rounding of
+    // coordinates, after addressing. Stages that read one texture's facts with the same
+    // addressing and border (a blur's taps) take the range of the union of their footprints,
+    // looked up once: a claim over the wider range holds over each one's.
+    struct Footprint {
+        int64_t a0 = 0, a1 = -1, b0 = 0, b1 = -1;  // texels [a0, a1] x [b0, b1] (empty: none)
+        bool border = false;
+        int leader = -1;  // the stage whose union this one joined (itself for the first)
+    };
+    std::array<Footprint, 8> feet{};
+    for (int s = 0; s < 8; ++s) {
+        const Stage& st = m_stages[size_t(s)];
+        if (!st.read || !st.texture) continue;
         double umin = kInf, umax = -kInf, vmin = kInf, vmax = -kInf;
         for (size_t i = 0; i < count; ++i) {
             float u[2], v[2];
@@ -265,25 +277,58 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
             v[1] = rowV(*tris[i], st.coordSet, y1 - 1);
             for (int k = 0; k < 2; ++k) {
                 if (!std::isfinite(u[k]) || !std::isfinite(v[k]) || std::fabs(u[k]) > 1e6f || std::fabs(v[k]) > 1e6f)
-                    return false;
+                    return shade;
                 umin = std::min(umin, double(u[k])), umax = std::max(umax, double(u[k]));
                 vmin = std::min(vmin, double(v[k])), vmax = std::max(vmax, double(v[k]));
             }
         }
-        // A bilinear footprint (also covers point sampling) and one texel more each side for
-        // the samplers' own rounding of coordinates.
         const ps11::TexelTiles& tiles = *st.tiles;
         const int64_t W = tiles.width, H = tiles.height;
         const int64_t i0 = int64_t(std::floor(umin * double(W) - 0.5)) - 1, i1 = int64_t(std::floor(umax * double(W) - 0.5)) + 2;
         const int64_t j0 = int64_t(std::floor(vmin * double(H) - 0.5)) - 1, j1 = int64_t(std::floor(vmax * double(H) - 0.5)) + 2;
-        int64_t a0 = 0, a1 = 0, b0 = 0, b1 = 0;
-        bool border = false;
-        addressAxis(st.sampler.addressU, i0, i1, W, a0, a1, border);
-        addressAxis(st.sampler.addressV, j0, j1, H, b0, b1, border);
+        Footprint f;
+        addressAxis(st.sampler.addressU, i0, i1, W, f.a0, f.a1, f.border);
+        addressAxis(st.sampler.addressV, j0, j1, H, f.b0, f.b1, f.border);
+        f.leader = s;
+        for (int l = 0; l < s; ++l) {
+            const Stage& o = m_stages[size_t(l)];
+            if (feet[size_t(l)].leader != l || o.tiles != st.tiles || o.sampler.addressU != st.sampler.addressU ||
+                o.sampler.addressV != st.sampler.addressV ||
+                std::memcmp(o.sampler.border.data(), st.sampler.border.data(), sizeof st.sampler.border) != 0)
+                continue;
+            Footprint& u = feet[size_t(l)];
+            u.border = u.border || f.border;
+            if (f.a0 <= f.a1 && f.b0 <= f.b1) {
+                if (u.a0 <= u.a1 && u.b0 <= u.b1) {
+                    u.a0 = std::min(u.a0, f.a0), u.a1 = std::max(u.a1, f.a1);
+                    u.b0 = std::min(u.b0, f.b0), u.b1 = std::max(u.b1, f.b1);
+                } else {
+                    u.a0 = f.a0, u.a1 = f.a1, u.b0 = f.b0, u.b1 = f.b1;
+                }
+            }
+            f.leader = l;
+            break;
+        }
+        feet[size_t(s)] = f;
+    }
+    bool known = true;
+    for (int s = 0; s < 8 && known; ++s) {
+        const Stage& st = m_stages[size_t(s)];
+        if (!st.read) continue;
+        ps11::ValueRange4& out = in.stages[size_t(s)].value;
+        if (!st.texture) {
+            unboundLookups(out);
+            continue;
+        }
+        const Footprint& f = feet[size_t(s)];
+        if (f.leader != s) {
+            out = in.stages[size_t(f.leader)].value;  // (the leader comes first: looked up already)
+            continue;
+        }
         ps11::TexelRange r;
-        if (a0 <= a1 && b0 <= b1) r = tiles.over(uint32_t(a0), uint32_t(b0), uint32_t(a1), uint32_t(b1));
-        return lookupRanges(st, r, border, out);
-    });
+        if (f.a0 <= f.a1 && f.b0 <= f.b1) r = st.tiles->over(uint32_t(f.a0), uint32_t(f.b0), uint32_t(f.a1), uint32_t(f.b1));
+        known = lookupRanges(st, r, f.border, out);
+    }
     if (!known) return shade;
     // Colours: constant on a triangle, or affine (extremes at the tile's corners, widened for
     // the float rounding of the interpolation).

@@ -220,6 +220,72 @@ TEST_CASE("tile skipping: tiles over different constants of one texture are deci
     }
 }
 
+TEST_CASE("tile skipping: taps of one texture far apart are each bounded by their own texels",
+          "[draw][aligned][skip]") {
+    // Stages that read one texture with the same addressing take the union of their footprints
+    // (TileSkipper::decide): a blur's taps, a texel apart. Here the taps are up to 120 texels
+    // apart over a zero texture with a few bright blocks, so a tile's first tap may read only
+    // zeros while another reaches a block: a tile bounded by one tap's texels alone would be
+    // filled or skipped wrongly. Clamp, border and wrap; point and linear; plain and ONE/ONE;
+    // fx8 and the radeon8500 class. Bytes must equal skipping off; tiles must be filled or
+    // skipped and shaded.
+    std::mt19937 rng(20261202);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    uint64_t saved = 0, shaded = 0;
+    for (int i = 0; i < 24; ++i) {
+        Case c = randomCase(rng);
+        c.w = 512, c.h = 64;
+        c.oneTexture = true;
+        c.rtFormat = D3DFMT_A8R8G8B8;
+        c.rtInit.assign(size_t(c.w) * c.h * 4, 0);
+        c.tex.resize(4);
+        const DWORD address[] = {D3DTADDRESS_CLAMP, D3DTADDRESS_BORDER, D3DTADDRESS_WRAP};
+        for (size_t s = 0; s < c.tex.size(); ++s) {
+            Case::Tex& t = c.tex[s];
+            t = Case::Tex{};
+            t.w = c.w, t.h = c.h;
+            t.format = D3DFMT_A8R8G8B8;
+            t.filter = i & 1 ? D3DTEXF_LINEAR : D3DTEXF_POINT;
+            t.addressU = t.addressV = address[(i / 2) % 3];
+            t.border = 0;
+            t.bound = s < 2;
+            t.bytes.assign(size_t(t.w) * t.h * 4, 0);  // (stage 1 reads stage 0's texture)
+            if (s == 0) {
+                for (int b = 0; b < 3; ++b) {
+                    const int bx = uni(0, int(t.w) - 8), by = uni(0, int(t.h) - 8);
+                    for (int y = by; y < by + 8; ++y)
+                        for (int x = bx; x < bx + 8; ++x)
+                            for (int k = 0; k < 4; ++k) t.bytes[(size_t(y) * t.w + size_t(x)) * 4 + size_t(k)] = 200;
+                }
+            }
+        }
+        c.program = "ps_1_1\ntex t0\ntex t1\nadd r0, t0, t1\n";
+        fullTargetQuad(c);
+        // t1 shifted by up to ±120 texels across and ±20 down.
+        const float du = float(uni(-120, 120)) / float(c.w), dv = float(uni(-20, 20)) / float(c.h);
+        for (Vtx& v : c.verts) v.uv[1][0] += du, v.uv[1][1] += dv;
+        c.blend = DWORD(i >> 2 & 1);  // plain, ONE/ONE
+        c.alphaTest = false, c.writeMask = 0xf, c.scissor = false, c.fog = false, c.depth = false;
+        DeviceOptions rowOpt, other;
+        rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        rowOpt.software.timeTiles = false;
+        if (i >= 12) radeon8500(rowOpt, other);
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats rs, ks;
+        INFO("case " << i << ": shift " << du * float(c.w) << ", " << dv * float(c.h) << " texels");
+        const std::vector<uint8_t> expected = drawCase(rowDev, c, rs);
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        saved += ks.tilesFilled + ks.tilesSkipped + ks.tilesCopied;
+        shaded += ks.tilesShaded;
+    }
+    INFO("tiles saved " << saved << ", shaded " << shaded);
+    CHECK(saved > 100);
+    CHECK(shaded > 20);
+}
+
 TEST_CASE("tile skipping: a program that copies one tap whatever it reads is drawn as that copy when not decided per tile",
           "[draw][aligned][skip]") {
     // TileSkipper::anyData: `mul r0, t0, c0` with c0 = (1, 1, 1, 0) and `mov r0, t0` copy their tap
