@@ -438,17 +438,20 @@ void BM_TileDecisions(benchmark::State& state) {
         Device& dev = *side[k].dev;
         Handle rt{}, tex{}, ps{};
         D3DLOCKED_RECT lr{};
-        bool ok = dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) == D3D_OK && dev.SetRenderTarget(0, rt) == D3D_OK &&
+        bool ok = dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 0, &rt) == D3D_OK &&
+                  dev.SetRenderTarget(0, rt) == D3D_OK &&
                   dev.CreateTexture(kW, kH, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK &&
                   dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK;
         if (ok) {
             for (UINT y = 0; y < kH; ++y)
-                std::memcpy(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), &texels[size_t(y) * kW], kW * 4);
+                std::memcpy(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch), &texels[size_t(y) * kW],
+                            kW * 4);
             ok = dev.UnlockRect(tex, 0) == D3D_OK;
         }
         const float w = blur ? 0.25f : 0.6f, c0[4] = {w, w, w, w};
         ok = ok &&
-             dev.CreatePixelShaderFromText(blur ? bench::kBlur4 : "ps_1_1\ntex t0\nsub_sat r0, t0, c0\n", &ps) == D3D_OK &&
+             dev.CreatePixelShaderFromText(blur ? bench::kBlur4 : "ps_1_1\ntex t0\nsub_sat r0, t0, c0\n", &ps) ==
+                 D3D_OK &&
              dev.SetPixelShader(ps) == D3D_OK && dev.SetPixelShaderConstantF(0, c0, 1) == D3D_OK &&
              dev.SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4) == D3D_OK;
         for (DWORD t = 0; t < (blur ? 4u : 1u); ++t) {
@@ -514,7 +517,11 @@ BENCHMARK_CAPTURE(BM_FreshTargetRead, r32f_cleared_1080p, D3DFMT_R32F, true)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
-BENCHMARK(BM_TileDecisions)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames({"threads", "blur"})->Unit(benchmark::kMillisecond)->UseManualTime();
+BENCHMARK(BM_TileDecisions)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "blur"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
 BENCHMARK(BM_Raster)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Draw, blur4_1080p_fx8, Pass::Blur4)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, copy_point_1080p_fx8, Pass::CopyPoint)

@@ -311,24 +311,18 @@ TileDecision TileSkipper::decide(const TriangleSetup* const* tris, size_t count,
         }
         feet[size_t(s)] = f;
     }
-    bool known = true;
-    for (int s = 0; s < 8 && known; ++s) {
-        const Stage& st = m_stages[size_t(s)];
-        if (!st.read) continue;
-        ps11::ValueRange4& out = in.stages[size_t(s)].value;
-        if (!st.texture) {
-            unboundLookups(out);
-            continue;
-        }
+    const bool known = stageRanges(in, [&](const Stage& st, ps11::ValueRange4& out) {
+        const int s = int(&st - m_stages.data());
         const Footprint& f = feet[size_t(s)];
         if (f.leader != s) {
             out = in.stages[size_t(f.leader)].value;  // (the leader comes first: looked up already)
-            continue;
+            return true;
         }
         ps11::TexelRange r;
-        if (f.a0 <= f.a1 && f.b0 <= f.b1) r = st.tiles->over(uint32_t(f.a0), uint32_t(f.b0), uint32_t(f.a1), uint32_t(f.b1));
-        known = lookupRanges(st, r, f.border, out);
-    }
+        if (f.a0 <= f.a1 && f.b0 <= f.b1)
+            r = st.tiles->over(uint32_t(f.a0), uint32_t(f.b0), uint32_t(f.a1), uint32_t(f.b1));
+        return lookupRanges(st, r, f.border, out);
+    });
     if (!known) return shade;
     // Colours: constant on a triangle, or affine (extremes at the tile's corners, widened for
     // the float rounding of the interpolation).
