@@ -937,10 +937,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         for (int c = 0; c < 4; ++c)
                             if (!((window->copyMask >> c) & 1))
                                 ps11::fillLanes(sc.r0[c], n, int16_t(window->grid[size_t(c)]));
-                    } else if (storeAsShaded) {
+                    } else if (storeAsShaded && !(draw.fx12 && draw.directAdd)) {
                         // A filled run stored directly: its word is what storeLanes makes of one
-                        // lane (added to a zero word: the word itself), written n times or added
-                        // n times with saturation, as storeLanes writes or adds every lane.
+                        // lane, written n times, or (fx8) added n times with saturation, as
+                        // storeLanes writes or adds every lane. (fx12 adds the 12-bit value and
+                        // rounds the sum once: not a byte added.)
                         int16_t lane[4];
                         for (int c = 0; c < 4; ++c) lane[c] = int16_t(window->grid[size_t(c)]);
                         const int16_t* const one[4] = {&lane[0], &lane[1], &lane[2], &lane[3]};

@@ -286,6 +286,44 @@ TEST_CASE("tile skipping: taps of one texture far apart are each bounded by thei
     CHECK(shaded > 20);
 }
 
+TEST_CASE("tile skipping: filled runs stored directly equal every lane stored, plain and ONE/ONE, fx8 and fx12",
+          "[draw][aligned][skip]") {
+    // A program of constants (and a colour constant on the quad) fills every tile: where the draw
+    // stores its runs directly, the fill's word is made once and written or added across the
+    // run. fx12's ONE/ONE adds the 12-bit value and rounds the sum once, so a constant between
+    // two bytes (grid not a multiple of 16) must not be added as a byte. Bytes must equal
+    // skipping off and the quad path; tiles must be filled.
+    std::mt19937 rng(20261202);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    const char* const programs[] = {"ps_1_1\nmov r0, c0\n", "ps_1_1\nadd r0, v0, c0\n"};
+    for (int i = 0; i < 32; ++i) {
+        Case c = randomTarget(rng, 200, 40);
+        c.tex.assign(4, Case::Tex{});
+        for (Case::Tex& t : c.tex) t.bound = false, t.bytes.assign(4, 0);
+        c.program = programs[i % 2];
+        fullTargetQuad(c);
+        const DWORD diffuse = 0xff000000u | uint32_t(uni(0, 0xffffff));
+        for (Vtx& v : c.verts) v.diffuse = diffuse;
+        for (int k = 0; k < 4; ++k) c.consts[0][k] = float(uni(0, 40)) / 4080.0f;  // often between two bytes in fx12
+        c.blend = DWORD(i / 2 % 2);  // plain, ONE/ONE
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = false;
+        rowOpt.software.timeTiles = false;
+        if (i >= 16) radeon8500(quadOpt, rowOpt);
+        DeviceOptions skipOpt = rowOpt;
+        skipOpt.software.skipTiles = true;
+        Device quadDev(quadOpt), rowDev(rowOpt), skipDev(skipOpt);
+        DrawStats qs, rs, ks;
+        INFO("case " << i << ", blend " << c.blend << ", program:\n" << c.program);
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        REQUIRE(drawCase(rowDev, c, rs) == expected);
+        REQUIRE(drawCase(skipDev, c, ks) == expected);
+        CHECK(ks.tilesFilled > 0);
+    }
+}
+
 TEST_CASE("tile skipping: a program that copies one tap whatever it reads is drawn as that copy when not decided per tile",
           "[draw][aligned][skip]") {
     // TileSkipper::anyData: `mul r0, t0, c0` with c0 = (1, 1, 1, 0) and `mov r0, t0` copy their tap
