@@ -305,7 +305,7 @@ TEST_CASE("tile skipping: filled runs stored directly equal every lane stored, p
         const DWORD diffuse = 0xff000000u | uint32_t(uni(0, 0xffffff));
         for (Vtx& v : c.verts) v.diffuse = diffuse;
         for (int k = 0; k < 4; ++k) c.consts[0][k] = float(uni(0, 40)) / 4080.0f;  // often between two bytes in fx12
-        c.blend = DWORD(i / 2 % 2);  // plain, ONE/ONE
+        c.blend = DWORD(i / 2 % 2);                                                // plain, ONE/ONE
         DeviceOptions quadOpt, rowOpt;
         quadOpt.software.alignedPasses = false;
         quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
