@@ -942,9 +942,10 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         // lane, written n times, or (fx8) added n times with saturation, as
                         // storeLanes writes or adds every lane. (fx12 adds the 12-bit value and
                         // rounds the sum once: not a byte added.)
-                        int16_t lane[4];
-                        for (int c = 0; c < 4; ++c) lane[c] = int16_t(window->grid[size_t(c)]);
-                        const int16_t* const one[4] = {&lane[0], &lane[1], &lane[2], &lane[3]};
+                        // (Whole groups of lanes: the store kernels read them past the count.)
+                        alignas(64) int16_t lanes[4][64];
+                        for (int c = 0; c < 4; ++c) ps11::fillLanes(lanes[c], 64, int16_t(window->grid[size_t(c)]));
+                        const int16_t* const one[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
                         uint8_t word[4] = {0, 0, 0, 0};
                         storeLanes(draw, one, 1, orMask, word);
                         fillWords(word, n, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
