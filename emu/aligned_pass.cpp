@@ -706,6 +706,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                      size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* windows,
                      size_t windowCount) {
     const RowWindows ws = rowWindows(windows, windowCount);
+    // The word of the last filled window stored directly (made once per window, not per row).
+    const RowWindow* wordOf = nullptr;
+    uint8_t fillWord[4] = {0, 0, 0, 0};
     windows = ws.data, windowCount = ws.count;
     const uint32_t neededTaps = ws.taps;
     const ps11::Executor& exec = *draw.executor;
@@ -942,13 +945,17 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         // lane, written n times, or (fx8) added n times with saturation, as
                         // storeLanes writes or adds every lane. (fx12 adds the 12-bit value and
                         // rounds the sum once: not a byte added.)
-                        // (Whole groups of lanes: the store kernels read them past the count.)
-                        alignas(64) int16_t lanes[4][64];
-                        for (int c = 0; c < 4; ++c) ps11::fillLanes(lanes[c], 64, int16_t(window->grid[size_t(c)]));
-                        const int16_t* const one[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
-                        uint8_t word[4] = {0, 0, 0, 0};
-                        storeLanes(draw, one, 1, orMask, word);
-                        fillWords(word, n, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
+                        if (wordOf != window) {
+                            // (Whole groups of lanes: the store kernels read them past the count.)
+                            alignas(64) int16_t lanes[4][64];
+                            for (int c = 0; c < 4; ++c)
+                                ps11::fillLanes(lanes[c], 64, int16_t(window->grid[size_t(c)]));
+                            const int16_t* const one[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
+                            std::memset(fillWord, 0, sizeof fillWord);
+                            storeLanes(draw, one, 1, orMask, fillWord);
+                            wordOf = window;
+                        }
+                        fillWords(fillWord, n, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
                         stats.pixels += uint64_t(n);
                         stats.written += uint64_t(n);
                         continue;
