@@ -760,7 +760,6 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them: a full-screen quad's two triangles
     // share their tables, so each texel row is filtered once, not once per triangle).
-    const bool prefetch = prefetchesRows(*draw.target.color);
     for (int y = y0; y < y1; ++y) {
         sc.rowStart = sc.stamp;  // H rows used from here on serve this pixel row
         for (size_t ti = 0; ti < count; ++ti) {
@@ -777,7 +776,6 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
                                         windows, windowCount, xl, xr);
-            if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(*draw.target.color, xl, xr, y + 1);
             sampler.setTriangle(tri, s, y, sc.sampler);
             // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit,
             // or at their quads' levels, which the row sampler counts where it filters them.)

@@ -799,7 +799,6 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     }
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them).
-    const bool prefetch = prefetchesRows(target);
     for (int y = y0; y < y1; ++y) {
         ++cache.stamp;
         for (size_t ti = 0; ti < count; ++ti) {
@@ -816,7 +815,6 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs, y,
                                         windows, windowCount, xl, xr);
-            if (prefetch && ti == 0 && y + 1 < y1) prefetchRow(target, xl, xr, y + 1);
             ctx.tri = &tri;
             ctx.setup = &s;
             ctx.y = y;

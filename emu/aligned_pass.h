@@ -18,7 +18,6 @@
 
 #include "emu/merge_plan.h"
 #include "emu/output_merger.h"
-#include "emu/prefetch.h"
 #include "emu/raster.h"
 #include "ps11/executor.h"
 #include "ps11/executor_presampled_internal.h"
@@ -381,14 +380,6 @@ inline bool rowSpan(const TriangleSetup& s, int y, const RowWindow* windows, siz
     return xl < xr;
 }
 
-// Both row paths ask for the target's bytes of pixels [x0, x1) of the next row ahead (emu/prefetch.h).
-inline bool prefetchesRows(const Image& target) { return target.bytes.size() >= kPrefetchTargetBytes; }
-inline void prefetchRow(const Image& target, int x0, int x1, int y) {
-    if (x1 <= x0) return;
-    const uintptr_t first = reinterpret_cast<uintptr_t>(target.texel(uint32_t(x0), uint32_t(y))) & ~uintptr_t(63);
-    const uint8_t* const end = target.texel(uint32_t(x1 - 1), uint32_t(y)) + target.format->bytes;
-    for (const uint8_t* p = reinterpret_cast<const uint8_t*>(first); p < end; p += 64) __builtin_prefetch(p, 1, 3);
-}
 
 // Whether the row paths' tables of triangles a and b over the same columns are equal: every tap's
 // u gives each column the same float (the same constant, or the same float row base and step;

@@ -19,9 +19,5 @@ constexpr int kPrefetchAhead = 2048;
 // …and the float row path's decoding of a texel row where the row spans at least this many bytes
 // (its H rows are built per texel row; a minified sprite image's short rows are read scattered).
 constexpr int kPrefetchRowBytes = 4096;
-// The row paths ask for a target's next pixel row while drawing the current one (a ONE/ONE sum
-// reads it; a store fetches the line before writing it) where the target is larger than the
-// second-level cache.
-constexpr size_t kPrefetchTargetBytes = size_t(1) << 20;
 
 }  // namespace emu
