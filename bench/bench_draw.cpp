@@ -16,6 +16,7 @@
 
 #include "bench/bench_shaders.h"
 #include "emu/device.h"
+#include "emu/fullscreen.h"
 #include "emu/raster.h"
 #include "ps11/hardware.h"
 
@@ -42,6 +43,10 @@ struct QuadVertex {
 // centre of each 4×4 block (the 16-texel box of a bloom chain's first reduction).
 // Sprites: 400 quads of 64x64 pixels at sub-pixel positions over a 1080p target, each a 32x32
 // texture magnified 2x and scaled by c0, added ONE/ONE (the sprites technique's draw).
+// SpritesFfp: the sprites technique's draw as glare/sprites.cpp makes it on its `lights` scene at
+// 1080p: 20 quads of 113.4×113.4 pixels at sub-pixel positions, fixed function (texture ×
+// diffuse, a colour per quad), the 128×128 glare image read from 0.06 to 0.94 bilinear (magnified
+// about 1.05×, the shrunk sprites), added ONE/ONE; the texture a bright centre falling off.
 // Tiny: the blur on a 1×1 target from a 1×1 texture (a glare technique's adaptation step): what a
 // draw costs besides its pixels.
 // Weighted4: the glow's blur passes (glare/shaders/weighted4.psh) at 480×270 — four POINT taps at
@@ -69,6 +74,7 @@ enum class Pass {
     Down4,
     Blur4Small,
     Sprites,
+    SpritesFfp,
     Tiny,
     Composite,
     Weighted4,
@@ -81,13 +87,14 @@ enum class Pass {
     PerspectiveTrilinear,
     Down8Point
 };
-constexpr int kPasses = 19;
+constexpr int kPasses = 20;
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
 struct Scene {
     std::unique_ptr<Device> dev;
     std::vector<QuadVertex> quad;
+    std::vector<emu::QuadVertex> ffpQuad;  // SpritesFfp (diffuse per vertex)
     bool ok = false;
 
     UINT w = kW, h = kH;
@@ -102,8 +109,9 @@ struct Scene {
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4 || pass == Pass::Down8Point;
         const bool addGlare = pass == Pass::CompositeAdd;
-        const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : addGlare ? w / 4 : w;
-        const UINT th = down ? kH : pass == Pass::Sprites ? 32 : addGlare ? h / 4 : h;
+        const bool ffp = pass == Pass::SpritesFfp;
+        const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? w / 4 : w;
+        const UINT th = down ? kH : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? h / 4 : h;
         DeviceOptions o;
         o.software.threads = threads;
         o.software.alignedPasses = aligned;
@@ -120,7 +128,14 @@ struct Scene {
             if (dev->LockRect(tex, level, &lr, nullptr, 0) != D3D_OK) return;
             for (UINT y = 0; y < lh; ++y) {
                 auto* row = reinterpret_cast<uint32_t*>(static_cast<uint8_t*>(lr.pBits) + size_t(y) * size_t(lr.Pitch));
-                for (UINT x = 0; x < lw; ++x) row[x] = rng();
+                for (UINT x = 0; x < lw; ++x) {
+                    row[x] = rng();
+                    if (ffp) {  // grey, alpha 255, falling off from the centre
+                        const double d = std::hypot(double(x) - 63.5, double(y) - 63.5) / 64.0;
+                        const uint32_t g = uint32_t(std::lround(255.0 * std::exp(-6.0 * d)));
+                        row[x] = 0xff000000u | g << 16 | g << 8 | g;
+                    }
+                }
             }
             dev->UnlockRect(tex, level);
         }
@@ -194,6 +209,28 @@ struct Scene {
         const float wOff[4][2] = {{-2, 0}, {-1, 0}, {0, 0}, {1, 0}};
         const float xs[4] = {-0.5f, w - 0.5f, w - 0.5f, -0.5f}, ys[4] = {-0.5f, -0.5f, h - 0.5f, h - 0.5f};
         const float us[4] = {0, 1, 1, 0}, vs[4] = {0, 0, 1, 1};
+        if (ffp) {
+            dev->SetPixelShader(Handle::Null);
+            dev->SetTextureStageState(0, D3DTSS_COLOROP, D3DTOP_MODULATE);
+            dev->SetTextureStageState(0, D3DTSS_COLORARG1, D3DTA_TEXTURE);
+            dev->SetTextureStageState(0, D3DTSS_COLORARG2, D3DTA_DIFFUSE);
+            dev->SetTextureStageState(1, D3DTSS_COLOROP, D3DTOP_DISABLE);
+            dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
+            dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
+            dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
+            dev->SetFVF(kQuadFvf);
+            std::uniform_real_distribution<float> px(0.0f, float(w) - 114.0f), py(0.0f, float(h) - 114.0f);
+            const float size = 113.4f, t0 = 0.06f, t1 = 0.94f;
+            const QuadCoords uv{t0, t0, t1, t1};
+            for (int k = 0; k < 20; ++k) {
+                const float x0 = px(rng), y0 = py(rng);
+                const DWORD colour = 0xff000000u | (rng() & 0x7f7f7fu);
+                const auto q = halfPixelQuad(x0, y0, x0 + size, y0 + size, {uv, uv, uv, uv}, colour);
+                for (int i : {0, 1, 2, 2, 1, 3}) ffpQuad.push_back(q[size_t(i)]);
+            }
+            ok = draw();
+            return;
+        }
         if (pass == Pass::Sprites) {
             dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
             dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
@@ -229,6 +266,9 @@ struct Scene {
     }
 
     bool draw() {
+        if (!ffpQuad.empty())
+            return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(ffpQuad.size() / 3), ffpQuad.data(),
+                                        sizeof(emu::QuadVertex)) == D3D_OK;
         return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(quad.size() / 3), quad.data(), sizeof(QuadVertex)) == D3D_OK;
     }
 };
@@ -589,6 +629,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_linear_1080p_fx8, Pass::CopyLinear)
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_Draw, sprites_400x64x64_1080p_fx8, Pass::Sprites)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, sprites_ffp_20x113_1080p_fx8, Pass::SpritesFfp)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -804,7 +804,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     const int n = std::min(ps11::kMaxSpan, wr - x);
                     sampler.setX(x);
                     if (mode == RowMode::Shade) {
-                        fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        in.uniformColor = fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
                         exec.run(in, sampler, outp, &stats.exec);
                         stats.texels += uint64_t(n) * rowTexelsPerPixel + sampler.takeLevelTexels();

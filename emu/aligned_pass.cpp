@@ -336,15 +336,25 @@ void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, i
 
 }  // namespace
 
-void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]) {
+uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n,
+                      float (*color)[ps11::kMaxSpan]) {
     // (Called per span: most post-processing programs read no colour.)
-    if (!(colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular)))) return;
+    const uint64_t used = colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular));
+    if (!used) return 0;
+    uint8_t uniform = 0;
     alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
+    if (s.perspective && (used & ~s.constMask)) rowInverseW(s, x, y, n, inv);
     for (int k = 0; k < 8; ++k) {
         const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
-        if ((colorAttrs >> attr) & 1) rowAttribute(s, attr, x, y, n, inv, color[k]);
+        if (!((used >> attr) & 1)) continue;
+        if ((s.constMask >> attr) & 1) {
+            color[k][0] = s.constValue[size_t(attr)];
+            uniform = uint8_t(uniform | (1u << k));
+            continue;
+        }
+        rowAttribute(s, attr, x, y, n, inv, color[k]);
     }
+    return uniform;
 }
 
 namespace {
@@ -917,7 +927,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         continue;
                     }
                     if (mode == RowMode::Shade) {
-                        fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        in.uniformColor = fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
                         ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);

@@ -333,9 +333,11 @@ void columnU(const TriangleSetup& s, int set, int x0, int n, float* u);
 float rowV(const TriangleSetup& s, int set, int y);
 
 // The diffuse (color[0..3]) and specular (color[4..7]) lanes of pixels x .. x + n − 1 of row y
-// that `colorAttrs` names, as the quad path interpolates them (constant, affine, or with
-// perspective divided by the interpolated rhw).
-void fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n, float (*color)[ps11::kMaxSpan]);
+// that `colorAttrs` names, as the quad path interpolates them (affine, or with perspective divided
+// by the interpolated rhw); one constant over the triangle is written to lane 0 alone and its bit
+// k set in the result (ps11::PixelInputs::uniformColor).
+uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n,
+                      float (*color)[ps11::kMaxSpan]);
 // The merger's other per-lane inputs for pixels x .. x + n − 1 of row y, as the spans of one row
 // interpolate them (rasterizeRowSpans): the fog factor, the specular alpha (where `fog`), and z,
 // linear on the screen (where `z`).

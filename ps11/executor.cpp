@@ -144,21 +144,24 @@ private:
 void ExecutorImpl::loadColors(RunState& st) const {
     // v# are saturated to [0, 1] and rounded to the grid once per pixel (docs/precision.md "Inputs").
     const bool fx = isFixedPoint(m_p.precision);
-    const float g = float(m_p.g);
+    const int32_t g = m_p.g;
     for (int v = 0; v < kNumRegV; ++v) {
         if (!((m_vUsed >> v) & 1)) continue;
         for (int c = 0; c < 4; ++c) {
-            const float* src = st.in->color[v][c] ? st.in->color[v][c] + st.offset : kZeroLanes;
+            const float* src = colorLanes(*st.in, v, c, st.offset);
+            const bool uniform = uniformColor(*st.in, v, c);
             if (fx) {
-                // s·G rounded half to even (roundEvenSmall: exact below 2^51).
                 int32_t* d = st.bi.reg[kSlotV + v][c];
-                for (int i = 0; i < st.n; ++i) {
-                    float s = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;  // NaN -> 0
-                    d[i] = int32_t(roundEvenSmall(double(s) * double(g)));
-                }
+                if (uniform)
+                    std::fill_n(d, st.n, colorGrid(src[0], g));
+                else
+                    for (int i = 0; i < st.n; ++i) d[i] = colorGrid(src[i], g);
             } else {
                 float* d = st.bf.reg[kSlotV + v][c];
-                for (int i = 0; i < st.n; ++i) d[i] = src[i] > 0.0f ? (src[i] < 1.0f ? src[i] : 1.0f) : 0.0f;
+                if (uniform)
+                    fillLanes(d, st.n, saturateColor(src[0]));
+                else
+                    for (int i = 0; i < st.n; ++i) d[i] = saturateColor(src[i]);
             }
         }
     }

@@ -65,6 +65,9 @@ struct PixelInputs {
     bool quads = false;  // lanes 4i..4i+3 are 2x2 quads (see SampleRequest::quads)
     const float* color[2][4] = {};     // v0, v1: r g b a
     const float* texcoord[kMaxTexCoordSets][4] = {};  // TC[0..7]: u v w q
+    // Bit 4·v + c: v#'s channel c is one value in every lane (a colour constant over a triangle),
+    // read from color[v][c][0] alone and converted once.
+    uint8_t uniformColor = 0;
 };
 
 // Results of `count` pixels. color is always filled (r0 as a real value); grid, if given,

@@ -112,6 +112,21 @@ void commitPair(const std::vector<DOp>& ops, size_t idx, FastBank& bank, int nv)
             std::memcpy(bank.reg[first.dstSlot][c], bank.hold[c], sizeof(int16_t) * size_t(nv));
 }
 
+// The v# lanes [off, off + n) of a chunk, saturated and rounded once per pixel (docs/precision.md
+// "Inputs"), as the generic path; a uniform channel (PixelInputs::uniformColor) converted once.
+void loadColors(const FastKernels& kern, int32_t g, const PixelInputs& inputs, uint8_t vUsed, int off, int n,
+                FastBank& bank) {
+    for (int v = 0; v < kNumRegV; ++v) {
+        if (!((vUsed >> v) & 1)) continue;
+        for (int c = 0; c < 4; ++c) {
+            const float* src = colorLanes(inputs, v, c, off);
+            if (uniformColor(inputs, v, c))
+                fillLanes(bank.reg[kSlotV + v][c], n, int16_t(colorGrid(src[0], g)));
+            else
+                kern.loadColor(src, bank.reg[kSlotV + v][c], n);
+        }
+    }
+}
 
 }  // namespace
 
@@ -211,14 +226,7 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
         const int n = st.n;
         const int nv = (n + kern.lanes - 1) / kern.lanes * kern.lanes;
         std::memset(st.killed, 0, sizeof st.killed);
-        // v# saturated and rounded once per pixel (docs/precision.md "Inputs"), as the generic path.
-        for (int v = 0; v < kNumRegV; ++v) {
-            if (!((vUsed >> v) & 1)) continue;
-            for (int c = 0; c < 4; ++c) {
-                const float* src = inputs.color[v][c] ? inputs.color[v][c] + off : kZeroLanes;
-                kern.loadColor(src, bank.reg[kSlotV + v][c], n);
-            }
-        }
+        loadColors(kern, p.g, inputs, vUsed, off, n, bank);
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase) continue;
@@ -478,11 +486,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
         const int nv = (n + kern.lanes - 1) / kern.lanes * kern.lanes;
-        for (int v = 0; v < kNumRegV; ++v) {
-            if (!((vUsed >> v) & 1)) continue;
-            for (int c = 0; c < 4; ++c)
-                kern.loadColor(inputs.color[v][c] ? inputs.color[v][c] + off : kZeroLanes, bank.reg[kSlotV + v][c], n);
-        }
+        loadColors(kern, p.g, inputs, vUsed, off, n, bank);
         int tap = 0;
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];

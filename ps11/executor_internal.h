@@ -11,6 +11,8 @@
 #include "ps11/decoded_program.h"
 #include "ps11/executor.h"
 #include "ps11/executor_presampled_internal.h"
+#include "ps11/fill_lanes.h"
+#include "ps11/precision.h"
 #include "ps11/simd_dispatch.h"
 
 namespace ps11::exec {
@@ -22,6 +24,20 @@ constexpr int kChunk = 256;
 
 // A chunk of 0.0f lanes: what an absent input (texture coordinate, colour) reads.
 alignas(64) inline constexpr float kZeroLanes[kChunk] = {};
+
+// A v# channel as the executor reads it (docs/precision.md "Inputs"): saturated to [0, 1], NaN
+// as 0; in fx profiles then its grid integer round_half_even(s·G) (roundEvenSmall: exact below
+// 2^51).
+inline float saturateColor(float s) { return s > 0.0f ? (s < 1.0f ? s : 1.0f) : 0.0f; }
+inline int32_t colorGrid(float s, int32_t g) { return int32_t(roundEvenSmall(double(saturateColor(s)) * double(g))); }
+
+// Whether lanes of v#'s channel c are one value (PixelInputs::uniformColor), and where they start
+// for a chunk at `offset` (a null pointer reads as 0).
+inline bool uniformColor(const PixelInputs& in, int v, int c) { return (in.uniformColor >> (4 * v + c)) & 1; }
+inline const float* colorLanes(const PixelInputs& in, int v, int c, int offset) {
+    const float* src = in.color[v][c];
+    return !src ? kZeroLanes : uniformColor(in, v, c) ? src : src + offset;
+}
 
 // Register storage of one chunk. Only one of the int / float banks is used per profile.
 template <class T>

@@ -413,6 +413,69 @@ TEST_CASE("fast: random valid programs over spans of 1..kMaxSpan pixels equal th
     CHECK(genericRuns >= 5);
 }
 
+TEST_CASE("uniform colour channels read once equal the same value in every lane", "[fast]") {
+    // PixelInputs::uniformColor: a channel named uniform is read from its first float alone (the
+    // arrays here hold that one float, so a read of another lane is out of bounds under ASan) and
+    // must give what the value repeated in every lane gives, on the generic path and the fast
+    // one at every SIMD level, in every profile; values outside [0, 1], NaN and ties included.
+    using namespace execrand;
+    ps11::NullSampler sampler;
+    const float special[] = {std::nanf(""), -0.25f, 1.75f, 0.5f / 255.0f, 1.5f / 255.0f, 127.5f / 255.0f, 1.0f, 0.0f};
+    int64_t bad = 0;
+    int programs = 0;
+    Gen g(0x0c0104e5u);
+    for (int minor = 1; minor <= 4; ++minor) {
+        int valid = 0;
+        for (int tries = 0; valid < 40 && tries < 2000; ++tries) {
+            const std::string text = progText(g.program(minor));
+            std::string err;
+            if (!assemble(text, err) || (text.find("v0") == std::string::npos && text.find("v1") == std::string::npos)) continue;
+            ++valid;
+            const int count = g.coin(0.5) ? g.uni(1, 40) : g.uni(41, 600);
+            Lanes l(count);
+            // One float per uniform channel; the others vary per lane.
+            std::vector<float> one[2][4];
+            uint8_t uniform = 0;
+            for (int v = 0; v < 2; ++v)
+                for (int c = 0; c < 4; ++c) {
+                    const bool u = g.coin(0.7);
+                    const float value = g.coin(0.3) ? special[size_t(g.uni(0, 7))] : g.inputs().color[v][c];
+                    for (int i = 0; i < count; ++i) l.col[v][c][size_t(i)] = u ? value : g.inputs().color[v][c];
+                    if (u) {
+                        one[v][c].assign(1, value);
+                        uniform = uint8_t(uniform | (1u << (4 * v + c)));
+                    }
+                }
+            Inputs ci = g.inputs();
+            for (const Precision prec : {Precision::Fx8, Precision::Fx12, Precision::Float, Precision::Ideal}) {
+                for (const ExecPath path : {ExecPath::Generic, ExecPath::Auto}) {
+                    auto e = make(text, prec, 0.0f, path);
+                    for (int i = 0; i < 8; ++i) e->setConstant(i, ci.consts[i]);
+                    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                        Out want(count), got(count);
+                        runAll(*e, l, want, sampler, ps11::kMaxSpan);
+                        for (int off = 0; off < count; off += ps11::kMaxSpan) {
+                            ps11::PixelInputs in = l.inputs(off, std::min(ps11::kMaxSpan, count - off));
+                            in.uniformColor = uniform;
+                            for (int v = 0; v < 2; ++v)
+                                for (int c = 0; c < 4; ++c)
+                                    if (!one[v][c].empty()) in.color[v][c] = one[v][c].data();
+                            ps11::PixelOutputs o = got.outputs(off);
+                            e->run(in, sampler, o);
+                        }
+                        bad += compare(got, want, count,
+                                       std::string(e->pathName()) + " profile " + std::to_string(int(prec)) + "\n" + text);
+                    });
+                }
+            }
+            ++programs;
+            if (bad > 10) break;
+        }
+    }
+    CHECK(programs >= 150);
+    CHECK(bad == 0);
+}
+
 namespace {
 
 std::shared_ptr<const ps11::Texture> smallTexture() {
