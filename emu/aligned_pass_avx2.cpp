@@ -187,47 +187,76 @@ void alignedBuildTabulatedAvx2(const uint8_t* row, int rowTexels, const int32_t*
         selB[c] = loadu(kSel.b[c]);
     }
     const __m256i zero = _mm256_setzero_si256(), w256 = _mm256_set1_epi32(256);
-    const __m256i three = _mm256_set1_epi32(3);
+    const __m256i three = _mm256_set1_epi32(3), four = _mm256_set1_epi32(4);
+    const __m256i evensOdds = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
     const int* base = reinterpret_cast<const int*>(row);
+    // Columns k .. k + 7: per channel the eight sums a·(256 − w) + b·w as dwords.
+    auto columns = [&](int k, __m256i m[4]) __attribute__((always_inline)) {
+        const __m256i i0 = _mm256_max_epi32(loadu(off0 + k), zero), i1 = _mm256_max_epi32(loadu(off1 + k), zero);
+        // Eight columns over at most eight texels from the first one's (a magnification): one
+        // load and two permutes; over at most sixteen (a nearly 1:1 mapping: the glare
+        // sprites'), two loads and four permutes; each column's texel and the next one (a
+        // minification's bilinear taps inside the row), eight 8-byte loads; else two gathers.
+        __m256i a, b;
+        const int first = std::max(off0[k], 0) >> 2;
+        const __m256i firstV = _mm256_set1_epi32(first);
+        const __m256i r0 = _mm256_sub_epi32(_mm256_srli_epi32(i0, 2), firstV);
+        const __m256i r1 = _mm256_sub_epi32(_mm256_srli_epi32(i1, 2), firstV);
+        const __m256i unaligned = _mm256_and_si256(_mm256_or_si256(i0, i1), three);  // byte offsets of whole texels
+        const bool whole = _mm256_testz_si256(unaligned, unaligned);
+        const __m256i apart = _mm256_xor_si256(_mm256_sub_epi32(i1, i0), four);
+        if (whole && first + 8 <= rowTexels && withinEight(r0, r1)) {
+            const __m256i words = loadu(base + first);
+            a = _mm256_permutevar8x32_epi32(words, r0);
+            b = _mm256_permutevar8x32_epi32(words, r1);
+        } else if (whole && first + 16 <= rowTexels && withinSixteen(r0, r1)) {
+            const __m256i lo = loadu(base + first), hi = loadu(base + first + 8);
+            a = permuteSixteen(lo, hi, r0);
+            b = permuteSixteen(lo, hi, r1);
+        } else if (_mm256_testz_si256(apart, apart)) {
+            // (off1 = off0 + 4 bytes: both texels lie in the row wherever off1 does.)
+            auto pair = [&](int l) {
+                int64_t v;
+                std::memcpy(&v, row + std::max(off0[k + l], 0), 8);
+                return v;
+            };
+            const __m256i lo = _mm256_permutevar8x32_epi32(_mm256_setr_epi64x(pair(0), pair(1), pair(2), pair(3)), evensOdds);
+            const __m256i hi = _mm256_permutevar8x32_epi32(_mm256_setr_epi64x(pair(4), pair(5), pair(6), pair(7)), evensOdds);
+            a = _mm256_permute2x128_si256(lo, hi, 0x20);
+            b = _mm256_permute2x128_si256(lo, hi, 0x31);
+        } else {
+            a = _mm256_i32gather_epi32(base, i0, 1);
+            b = _mm256_i32gather_epi32(base, i1, 1);
+        }
+        const __m256i wv = loadu(w + k);
+        const __m256i wp = _mm256_or_si256(_mm256_sub_epi32(w256, wv), _mm256_slli_epi32(wv, 16));
+        for (int c = 0; c < 4; ++c)
+            m[c] = _mm256_madd_epi16(_mm256_or_si256(_mm256_shuffle_epi8(a, selA[c]), _mm256_shuffle_epi8(b, selB[c])),
+                                     wp);
+    };
     int j = 0;
     for (; j + 16 <= n; j += 16) {
         __m256i m[2][4];
-        for (int h = 0; h < 2; ++h) {
-            const int k = j + 8 * h;
-            const __m256i i0 = _mm256_max_epi32(loadu(off0 + k), zero), i1 = _mm256_max_epi32(loadu(off1 + k), zero);
-            // Eight columns over at most eight texels from the first one's (a magnification): one
-            // load and two permutes; over at most sixteen (a nearly 1:1 mapping: the glare
-            // sprites'), two loads and four permutes; else two gathers.
-            __m256i a, b;
-            const int first = std::max(off0[k], 0) >> 2;
-            const __m256i firstV = _mm256_set1_epi32(first);
-            const __m256i r0 = _mm256_sub_epi32(_mm256_srli_epi32(i0, 2), firstV);
-            const __m256i r1 = _mm256_sub_epi32(_mm256_srli_epi32(i1, 2), firstV);
-            const __m256i unaligned = _mm256_and_si256(_mm256_or_si256(i0, i1), three);  // byte offsets of whole texels
-            const bool whole = _mm256_testz_si256(unaligned, unaligned);
-            if (whole && first + 8 <= rowTexels && withinEight(r0, r1)) {
-                const __m256i words = loadu(base + first);
-                a = _mm256_permutevar8x32_epi32(words, r0);
-                b = _mm256_permutevar8x32_epi32(words, r1);
-            } else if (whole && first + 16 <= rowTexels && withinSixteen(r0, r1)) {
-                const __m256i lo = loadu(base + first), hi = loadu(base + first + 8);
-                a = permuteSixteen(lo, hi, r0);
-                b = permuteSixteen(lo, hi, r1);
-            } else {
-                a = _mm256_i32gather_epi32(base, i0, 1);
-                b = _mm256_i32gather_epi32(base, i1, 1);
-            }
-            const __m256i wv = loadu(w + k);
-            const __m256i wp = _mm256_or_si256(_mm256_sub_epi32(w256, wv), _mm256_slli_epi32(wv, 16));
-            for (int c = 0; c < 4; ++c)
-                m[h][c] = _mm256_madd_epi16(
-                    _mm256_or_si256(_mm256_shuffle_epi8(a, selA[c]), _mm256_shuffle_epi8(b, selB[c])), wp);
-        }
+        columns(j, m[0]);
+        columns(j + 8, m[1]);
         for (int c = 0; c < 4; ++c)
             storeu(out[c] + j, _mm256_permute4x64_epi64(
                                    _mm256_packus_epi32(_mm256_srl_epi32(m[0][c], shiftV), _mm256_srl_epi32(m[1][c], shiftV)),
                                    0xD8));
     }
+    // The last columns (a small sprite's rows are a few dozen) eight at a time, the last eight
+    // ending at n (columns computed twice get the same values).
+    auto eight = [&](int k) __attribute__((always_inline)) {
+        __m256i m[4];
+        columns(k, m);
+        for (int c = 0; c < 4; ++c) {
+            const __m256i packed = _mm256_packus_epi32(_mm256_srl_epi32(m[c], shiftV), zero);
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out[c] + k),
+                             _mm256_castsi256_si128(_mm256_permute4x64_epi64(packed, 0xD8)));
+        }
+    };
+    if (j + 8 <= n) eight(j), j += 8;
+    if (j < n && n >= 8) eight(n - 8), j = n;
     for (; j < n; ++j) {
         uint32_t a, b;
         std::memcpy(&a, row + std::max(off0[j], 0), 4);
