@@ -138,7 +138,7 @@ const FloatRowKernels kBaseline{&lerpColumnsBase, &lerpGatherBase, &lerpWordsBas
 const FloatRowKernels& floatRowKernels(ps11::SimdLevel level) {
 #if defined(PS11_HAVE_AVX512)
     return *ps11::simdTable<FloatRowKernels>(level, &kBaseline, &avx2::kFloatRow,
-                                             level >= ps11::SimdLevel::Avx512 ? &avx512::floatRowTable() : nullptr);
+                                             ps11::madeTable(level, ps11::SimdLevel::Avx512, &avx512::floatRowTable));
 #elif defined(PS11_HAVE_AVX2)
     return *ps11::simdTable<FloatRowKernels>(level, &kBaseline, &avx2::kFloatRow);
 #else

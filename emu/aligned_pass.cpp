@@ -692,7 +692,7 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
 const AlignedKernels* alignedKernels(ps11::SimdLevel level) {
 #if defined(PS11_HAVE_AVX512)
     return ps11::simdTable<AlignedKernels>(level, nullptr, &avx2::kAligned,
-                                           level >= ps11::SimdLevel::Avx512 ? &avx512::alignedTable() : nullptr);
+                                           ps11::madeTable(level, ps11::SimdLevel::Avx512, &avx512::alignedTable));
 #elif defined(PS11_HAVE_AVX2)
     return ps11::simdTable<AlignedKernels>(level, nullptr, &avx2::kAligned);
 #else

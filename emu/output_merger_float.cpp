@@ -431,7 +431,7 @@ const MergerKernels baseline::kMerger{&merger::halvesBaseline, &merger::unorm8Wo
 const MergerKernels& mergerKernels(ps11::SimdLevel level) {
 #if defined(PS11_HAVE_AVX512)
     return *ps11::simdTable(level, &baseline::kMerger, &avx2::kMerger,
-                            level >= ps11::SimdLevel::Avx512 ? &avx512::mergerTable() : nullptr);
+                            ps11::madeTable(level, ps11::SimdLevel::Avx512, &avx512::mergerTable));
 #elif defined(PS11_HAVE_AVX2)
     return *ps11::simdTable(level, &baseline::kMerger, &avx2::kMerger);
 #else

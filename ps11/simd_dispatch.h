@@ -73,4 +73,13 @@ const Kernels* simdTable(SimdLevel level, const Kernels* baseline, const Kernels
     return level >= SimdLevel::Avx2 && avx2 ? avx2 : baseline;
 }
 
+// A table that code compiled for `tableLevel` makes on first use (`make`): made and handed out
+// only where `level` asks for it and this CPU runs that level, else null (simdTable then falls
+// back). Its making may run that level's instructions (a copy of another table through its
+// registers), which a CPU without them stops on.
+template <class Kernels>
+const Kernels* madeTable(SimdLevel level, SimdLevel tableLevel, const Kernels& (*make)()) {
+    return level >= tableLevel && simdLevelRuns(tableLevel) ? &make() : nullptr;
+}
+
 }  // namespace ps11

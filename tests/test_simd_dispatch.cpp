@@ -299,12 +299,16 @@ TEST_CASE("simd dispatch: every family has its tables, distinct per level where 
     // Avx512: the generic path's arithmetic, the fx8 fast path and (in part) the aligned pass and
     // the output merger have their own tables; every other family runs its Avx2 one.
     CHECK(&fastpath::samplerKernels(SimdLevel::Avx512) == &fastpath::samplerKernels(SimdLevel::Avx2));
-    // Some Avx512 tables are made on first use by code compiled for AVX-512 (a copy of the Avx2
-    // table may move it through AVX-512 registers), so they are looked at only where this CPU
-    // runs the level: a CPU without it stops on an illegal instruction (a Zen 3 host did,
-    // 2026-12-02).
+    // Some Avx512 tables are made on first use by code compiled for AVX-512 (ps11::madeTable): a
+    // CPU without it gets the Avx2 tables (making them stopped a Zen 3 host on an illegal
+    // instruction, 2026-12-02), so the distinct tables are looked for only where it runs.
 #ifdef PS11_HAVE_AVX512
-    if (!simdLevelRuns(SimdLevel::Avx512)) return;
+    if (!simdLevelRuns(SimdLevel::Avx512)) {
+        CHECK(emu::alignedKernels(SimdLevel::Avx512) == emu::alignedKernels(SimdLevel::Avx2));
+        CHECK(&emu::mergerKernels(SimdLevel::Avx512) == &emu::mergerKernels(SimdLevel::Avx2));
+        CHECK(&emu::floatRowKernels(SimdLevel::Avx512) == &emu::floatRowKernels(SimdLevel::Avx2));
+        return;
+    }
     CHECK(&exec::fxArithKernels(SimdLevel::Avx512) != &exec::fxArithKernels(SimdLevel::Avx2));
     CHECK(&exec::floatArithKernels(SimdLevel::Avx512) != &exec::floatArithKernels(SimdLevel::Avx2));
     REQUIRE(exec::fastKernels(SimdLevel::Avx512));
