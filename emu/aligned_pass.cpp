@@ -448,15 +448,27 @@ void filterTap(const AlignedKernels* kernels, bool fx12, const AlignedTap& tap, 
             x = e;
             continue;
         }
-        // Up to the next vector run: columns whose texels are all inside the texture, with both
-        // texel rows at hand, have their H rows built for these columns alone and blended at once
-        // (the tabulated kernels without the cache: stretches shorter than a run); border texels,
-        // short stretches or no vector kernels, one pixel at a time.
-        int e = x + 1;
-        while (e < end && vectorRun(e) < 0) ++e;
-        bool inside = kernels && e - x >= kMinDirectColumns && row.row0 && (row.wy == 0 || row.row1);
-        for (int i = x; inside && i < e; ++i)
-            inside = cols.off0[size_t(i - colBase)] >= 0 && cols.off1[size_t(i - colBase)] >= 0;
+        // Up to the next ready vector run: columns whose texels are all inside the texture, with
+        // both texel rows at hand, have their H rows built for these columns alone and blended at
+        // once (the tabulated kernels without the cache: stretches shorter than a run, and runs of
+        // an uncached configuration, HConfig::uncached); border texels, short stretches or no
+        // vector kernels, one pixel at a time. (A run's columns all lie inside the texture: a run
+        // that is not ready is passed whole.)
+        int e = x;
+        bool inside = kernels && row.row0 && (row.wy == 0 || row.row1);
+        while (e < end) {
+            const size_t i = size_t(e - colBase);
+            const int32_t r = cols.run[i];
+            if (r >= 0) {
+                const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+                if (row.ready[size_t(run.config)]) break;
+                e = std::min(end, int(run.x1));
+                continue;
+            }
+            inside = inside && cols.off0[i] >= 0 && cols.off1[i] >= 0;
+            ++e;
+        }
+        inside = inside && e - x >= kMinDirectColumns;
         if (inside) {
             alignas(32) uint16_t planes[2][4][ps11::kMaxSpan + kHRowPad];
             uint16_t* const h0[4] = {planes[0][0], planes[0][1], planes[0][2], planes[0][3]};
@@ -862,7 +874,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                 for (int c = 0; c < cols.configCount; ++c) {
                     const size_t ci = size_t(cols.configs[size_t(c)]);
                     const HConfig& h = tri.configs[ci];
-                    r.ready[size_t(c)] = rowsOk && !(chain && chainWeight(r) && chainConfig(h));
+                    r.ready[size_t(c)] = rowsOk && !(chain && chainWeight(r) && chainConfig(h)) && !h.uncached;
                     if (!r.ready[size_t(c)]) continue;
                     r.direct[size_t(c)] = h.wx == 0 && h.step == 1 && r.wy == 0;
                     if (r.direct[size_t(c)]) continue;

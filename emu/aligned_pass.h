@@ -137,6 +137,10 @@ struct HConfig {
     const int32_t* w = nullptr;
     int32_t rowTexels = 0;  // texels in a texel row (the texture's width)
     bool q16 = false;       // tabulated, every weight a multiple of 16: its H rows are of kind Q
+    // Tabulated, its tap reading texel rows no neighbouring pixel row reads (a minification in v:
+    // 2 texel rows or more a pixel row bilinear, 1 or more point): the cache would never find its
+    // H rows again, so each pixel row builds them for its own columns (filterTap) instead.
+    bool uncached = false;
     uint64_t hash = 0;
     uint64_t tableId = 0;  // unique per prepared table (a slot that checked it needs no second look)
 };

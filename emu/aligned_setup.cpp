@@ -453,6 +453,9 @@ void fillAlignedTables(const AlignedDraw& draw, const TriangleSetup& s, AlignedT
                 for (const int32_t v : {h.off0[k], h.off1[k], h.w[k]}) hash = (hash ^ uint32_t(v)) * 1099511628211ull;
             h.hash = hash;
             h.q16 = std::all_of(h.w, h.w + len, [](int32_t w) { return w % 16 == 0; });
+            // (Tabulated triangles have no perspective: v moves by one step a row.)
+            const float dv = (rowV(s, tap.coordSet, s.yMin + 1) - rowV(s, tap.coordSet, s.yMin)) * float(tap.height);
+            h.uncached = std::abs(dv) >= (tap.linear ? 2.0f : 1.0f);
             cols.tabulatedQ16 = h.q16;
             static std::atomic<uint64_t> tableIds{0};
             h.tableId = ++tableIds;
