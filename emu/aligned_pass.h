@@ -386,7 +386,6 @@ inline bool rowSpan(const TriangleSetup& s, int y, const RowWindow* windows, siz
     return xl < xr;
 }
 
-
 // Whether the row paths' tables of triangles a and b over the same columns are equal: every tap's
 // u gives each column the same float (the same constant, or the same float row base and step;
 // a table depends on nothing else of its triangle). A quad's second half then takes the first
@@ -401,8 +400,30 @@ bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11
 // the same columns (they are then equal). A quad's two halves split every row at the diagonal;
 // joined, each row is one run: half the runs of a sprite, and full-width spans for a
 // full-screen pass. True when joined (the next triangle's pixels of the row are then this run's).
-bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
-             uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr);
+// What it compares is worked out once per pair (joinPlan).
+struct JoinPlan {
+    // An attribute can agree on no row: constant in one triangle only, two different constants, or
+    // float steps that differ (or rhw's under perspective).
+    bool never = false;
+    bool perspective = false;  // rhw's row bases compared row by row too
+    // Attributes (bit k) compared row by row; the others agree on every row (the same constant,
+    // or the same plane from the same origin, bit for bit).
+    uint64_t rows = 0;
+};
+JoinPlan joinPlan(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
+                  uint64_t colorAttrs);
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const JoinPlan& plan, int y, const RowWindow* windows,
+             size_t count, int& xl, int& xr);
+// joinPlan of each consecutive pair of a drawAlignedRows group (entry i: triangles i and i + 1).
+struct JoinPlans {
+    std::array<JoinPlan, kMaxAlignedTriangles> pairs;
+    template <typename Tri>
+    JoinPlans(const Tri* const* tris, const TriangleSetup* const* setups, size_t count, const ps11::TapPlan& plan,
+              uint64_t colorAttrs) {
+        for (size_t i = 0; i + 1 < count && i < pairs.size(); ++i)
+            pairs[i] = joinPlan(*setups[i], *setups[i + 1], tris[i + 1] == tris[i], plan, colorAttrs);
+    }
+};
 
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in

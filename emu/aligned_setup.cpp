@@ -6,6 +6,7 @@
 // (ps11::fastpath::axisTable), and the coordinates are the rasteriser's own formula (emu/raster.h
 // planeValue; this file is compiled without FMA contraction so that it evaluates it alike).
 #include <algorithm>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -292,24 +293,50 @@ bool sameColumnTables(const TriangleSetup& a, const TriangleSetup& b, const ps11
     return true;
 }
 
-bool joinRow(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
-             uint64_t colorAttrs, int y, const RowWindow* windows, size_t count, int& xl, int& xr) {
-    int nl = 0, nr = 0;
-    if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
+JoinPlan joinPlan(const TriangleSetup& s, const TriangleSetup& next, bool sharedTables, const ps11::TapPlan& plan,
+                  uint64_t colorAttrs) {
+    JoinPlan jp;
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    auto bits64 = [](double d) { return std::bit_cast<uint64_t>(d); };
     // With perspective the attributes compared are the planes of attr·rhw: rhw must agree too.
-    if (s.perspective != next.perspective) return false;
-    if (s.perspective) {
-        auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
-        if (bits(float(s.rhw.dx)) != bits(float(next.rhw.dx)) ||
-            bits(float(planeRowBase(s.rhw, s.ox, s.oy, y))) != bits(float(planeRowBase(next.rhw, next.ox, next.oy, y))))
-            return false;
+    if (s.perspective != next.perspective || (s.perspective && bits(float(s.rhw.dx)) != bits(float(next.rhw.dx)))) {
+        jp.never = true;
+        return jp;
     }
+    jp.perspective = s.perspective;
+    const bool sameOrigin = bits64(s.ox) == bits64(next.ox) && bits64(s.oy) == bits64(next.oy);
+    // sameOnRow's tests that do not depend on the row, once.
+    auto add = [&](int k) {
+        const bool ca = (s.constMask >> k) & 1, cb = (next.constMask >> k) & 1;
+        if (ca != cb || (ca && bits(s.constValue[size_t(k)]) != bits(next.constValue[size_t(k)]))) jp.never = true;
+        if (ca || cb) return;
+        const Plane &pa = s.attr[size_t(k)], &pb = next.attr[size_t(k)];
+        if (bits(float(pa.dx)) != bits(float(pb.dx))) jp.never = true;
+        const bool samePlane = sameOrigin && bits64(pa.base) == bits64(pb.base) && bits64(pa.dx) == bits64(pb.dx) &&
+                               bits64(pa.dy) == bits64(pb.dy);
+        if (!samePlane) jp.rows |= uint64_t(1) << k;
+    };
     for (int i = 0; i < plan.count; ++i) {
         const int ku = attrTex(plan.coordSet[size_t(i)], 0);
-        if ((!sharedTables && !sameOnRow(s, next, ku, y, y)) || !sameOnRow(s, next, ku + 1, y, y)) return false;
+        if (!sharedTables) add(ku);
+        add(ku + 1);
     }
     for (int k = 0; k < kAttrCount; ++k)
-        if (((colorAttrs >> k) & 1) && !sameOnRow(s, next, k, y, y)) return false;
+        if ((colorAttrs >> k) & 1) add(k);
+    return jp;
+}
+
+bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const JoinPlan& plan, int y, const RowWindow* windows,
+             size_t count, int& xl, int& xr) {
+    if (plan.never) return false;
+    int nl = 0, nr = 0;
+    if (!rowSpan(next, y, windows, count, nl, nr) || (nl != xr && nr != xl)) return false;
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    if (plan.perspective &&
+        bits(float(planeRowBase(s.rhw, s.ox, s.oy, y))) != bits(float(planeRowBase(next.rhw, next.ox, next.oy, y))))
+        return false;
+    for (uint64_t m = plan.rows; m; m &= m - 1)
+        if (!sameOnRow(s, next, std::countr_zero(m), y, y)) return false;
     xl = std::min(xl, nl), xr = std::max(xr, nr);
     return true;
 }
