@@ -481,11 +481,14 @@ std::optional<CallError> Device::submit(DrawSetup& d, DrawStats& stats) {
     // A target of known tile facts keeps them, with the tiles the triangles reach marked stale.
     std::shared_ptr<const std::vector<uint8_t>> uniform = d.rtRef.level == 0 ? d.rt->uniformStale : nullptr;
     CallError error;
+    // (The boxes of the triangles the renderer assembles are kept for markDrawnTiles.)
+    std::optional<AssembledBoxes> assembled;
+    if (uniform) assembled.emplace(call);
     if (!m_renderer->draw(call, stats, error)) return error;
     if (stats.trianglesDrawn) {
         rendererWrote(*d.rt, d.rtRef.level, /*setsPad=*/true);  // every path stores X8's X byte as 1s
         if (d.depth && call.merge.depthWrite) rendererWrote(*d.ds, d.dsRef.level);
-        if (uniform) d.rt->uniformStale = markDrawnTiles(call, *d.target, *uniform);
+        if (uniform) d.rt->uniformStale = markDrawnTiles(call, *d.target, *uniform, &*assembled);
     }
     return std::nullopt;
 }

@@ -16,7 +16,32 @@ constexpr uint32_t kMarkChunk = 1024;
 // (a scene's geometry; a frame's sprites are a few hundred).
 constexpr uint32_t kMaxMarkedTriangles = 16384;
 
+AssembledBoxes::Box boxOf(const ScreenTriangle& t) {
+    AssembledBoxes::Box b{t.v[0].x, t.v[0].y, t.v[0].x, t.v[0].y};
+    for (const ScreenVertex& v : t.v) {
+        if (!std::isfinite(v.x) || !std::isfinite(v.y)) return {NAN, NAN, NAN, NAN};
+        b.x0 = std::min(b.x0, v.x), b.x1 = std::max(b.x1, v.x), b.y0 = std::min(b.y0, v.y), b.y1 = std::max(b.y1, v.y);
+    }
+    return b;
+}
+
 }  // namespace
+
+AssembledBoxes::AssembledBoxes(DrawCall& call) : m_call(call), m_assemble(call.assemble) {
+    if (call.primitiveCount > kMaxMarkedTriangles || !m_assemble) return;
+    m_watching = true;
+    m_seen.assign(call.primitiveCount, 0);
+    call.assemble = [this](uint32_t first, uint32_t count, std::vector<ScreenTriangle>& out) {
+        const size_t before = out.size();
+        m_assemble(first, count, out);
+        std::lock_guard<std::mutex> lock(m_mutex);
+        for (size_t i = before; i < out.size(); ++i) m_boxes.push_back(boxOf(out[i]));
+        for (uint32_t p = first; p < first + count && p < m_seen.size(); ++p)
+            if (!m_seen[p]) m_seen[p] = 1, ++m_seenCount;
+    };
+}
+
+AssembledBoxes::~AssembledBoxes() { m_call.assemble = m_assemble; }
 
 size_t uniformTileCount(const Image& image) {
     const uint32_t side = ps11::texelTileSide(image.width, image.height);
@@ -24,7 +49,8 @@ size_t uniformTileCount(const Image& image) {
 }
 
 std::shared_ptr<const std::vector<uint8_t>> markDrawnTiles(const DrawCall& call, const Image& target,
-                                                           const std::vector<uint8_t>& stale) {
+                                                           const std::vector<uint8_t>& stale,
+                                                           const AssembledBoxes* assembled) {
     if (call.primitiveCount > kMaxMarkedTriangles || stale.size() != uniformTileCount(target)) return nullptr;
     auto out = std::make_shared<std::vector<uint8_t>>(stale);
     const uint32_t side = ps11::texelTileSide(target.width, target.height);
@@ -39,22 +65,25 @@ std::shared_ptr<const std::vector<uint8_t>> markDrawnTiles(const DrawCall& call,
         for (int64_t ty = y0 / side; ty <= (y1 - 1) / side; ++ty)
             std::fill_n(out->begin() + ty * tilesX + x0 / side, (x1 - 1) / side - x0 / side + 1, uint8_t(1));
     };
-    std::vector<ScreenTriangle> tris;
-    for (uint32_t first = 0; first < call.primitiveCount; first += kMarkChunk) {
-        tris.clear();
-        call.assemble(first, std::min(kMarkChunk, call.primitiveCount - first), tris);
-        for (const ScreenTriangle& t : tris) {
-            double x0 = t.v[0].x, x1 = x0, y0 = t.v[0].y, y1 = y0;
-            for (const ScreenVertex& v : t.v) x0 = std::min(x0, v.x), x1 = std::max(x1, v.x), y0 = std::min(y0, v.y), y1 = std::max(y1, v.y);
-            if (!std::isfinite(x0) || !std::isfinite(x1) || !std::isfinite(y0) || !std::isfinite(y1)) {
-                mark(cx0, cy0, cx1, cy1);
-                continue;
-            }
-            // Pixel centres at integer coordinates: a covered pixel lies within the box; one
-            // pixel more each side for the snapping of positions.
-            const double lim = 1e9;
-            mark(int64_t(std::floor(std::clamp(x0, -lim, lim))) - 1, int64_t(std::floor(std::clamp(y0, -lim, lim))) - 1,
-                 int64_t(std::ceil(std::clamp(x1, -lim, lim))) + 2, int64_t(std::ceil(std::clamp(y1, -lim, lim))) + 2);
+    auto markBox = [&](const AssembledBoxes::Box& b) {
+        if (!std::isfinite(b.x0) || !std::isfinite(b.x1) || !std::isfinite(b.y0) || !std::isfinite(b.y1)) {
+            mark(cx0, cy0, cx1, cy1);
+            return;
+        }
+        // Pixel centres at integer coordinates: a covered pixel lies within the box; one
+        // pixel more each side for the snapping of positions.
+        const double lim = 1e9;
+        mark(int64_t(std::floor(std::clamp(b.x0, -lim, lim))) - 1, int64_t(std::floor(std::clamp(b.y0, -lim, lim))) - 1,
+             int64_t(std::ceil(std::clamp(b.x1, -lim, lim))) + 2, int64_t(std::ceil(std::clamp(b.y1, -lim, lim))) + 2);
+    };
+    if (assembled && assembled->complete()) {
+        for (const AssembledBoxes::Box& b : assembled->boxes()) markBox(b);
+    } else {
+        std::vector<ScreenTriangle> tris;
+        for (uint32_t first = 0; first < call.primitiveCount; first += kMarkChunk) {
+            tris.clear();
+            call.assemble(first, std::min(kMarkChunk, call.primitiveCount - first), tris);
+            for (const ScreenTriangle& t : tris) markBox(boxOf(t));
         }
     }
     // Every tile stale: nothing is known any more (a full-screen pass), and later draws need not

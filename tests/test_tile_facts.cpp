@@ -13,6 +13,7 @@
 
 #include "emu/device.h"
 #include "emu/fullscreen.h"
+#include "emu/tile_facts.h"
 #include "ps11/texture.h"
 #include "ps11/texture_tiles.h"
 #include "texel_tiles_util.h"
@@ -190,4 +191,61 @@ TEST_CASE("tile facts: a target cleared whole, then drawn into, is known but whe
         checkUniformPath(*t, *t->uniformTiles());
     }
     CHECK(checkedDraws > 40);
+}
+
+TEST_CASE("tile facts: the boxes kept while a renderer assembles give the tiles a second assembly gives",
+          "[tiles]") {
+    // A call of small random triangles (some partly off the target) whose assemble counts its
+    // calls: marked from the boxes the watched assemble kept, the tiles equal those marked by
+    // assembling again, and nothing is assembled a second time. A renderer that leaves
+    // primitives unassembled gets the second assembly. A NaN vertex marks every tile.
+    emu::Image target;
+    target.width = 300, target.height = 200;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> corner(-20.0, 300.0), size(0.0, 25.0);
+    std::vector<emu::ScreenTriangle> all(40);
+    for (emu::ScreenTriangle& t : all) {
+        const double x = corner(rng), y = corner(rng) * 2 / 3;
+        for (emu::ScreenVertex& v : t.v) v.x = x + size(rng), v.y = y + size(rng);
+    }
+    emu::DrawCall call;
+    call.primitiveCount = uint32_t(all.size());
+    call.clip = emu::ClipRect{0, 0, 300, 200};
+    int assembles = 0;
+    call.assemble = [&](uint32_t first, uint32_t count, std::vector<emu::ScreenTriangle>& out) {
+        ++assembles;
+        out.insert(out.end(), all.begin() + first, all.begin() + first + count);
+    };
+    const std::vector<uint8_t> stale(emu::uniformTileCount(target), 0);
+    const auto again = emu::markDrawnTiles(call, target, stale);
+    REQUIRE(assembles > 0);
+    REQUIRE(again);  // (some tiles marked, some not)
+    const auto marked = std::count(again->begin(), again->end(), uint8_t(1));
+    CHECK(marked > 0);
+    CHECK(size_t(marked) < again->size());
+    for (const uint32_t upTo : {40u, 39u}) {
+        assembles = 0;
+        std::shared_ptr<const std::vector<uint8_t>> kept;
+        {
+            emu::AssembledBoxes boxes(call);
+            std::vector<emu::ScreenTriangle> tris;
+            for (uint32_t first = 0; first < upTo; first += 16) call.assemble(first, std::min(16u, upTo - first), tris);
+            CHECK(boxes.complete() == (upTo == 40));
+            const int drawn = assembles;
+            kept = emu::markDrawnTiles(call, target, stale, &boxes);
+            CHECK((assembles == drawn) == (upTo == 40));
+        }
+        REQUIRE(bool(again) == bool(kept));
+        if (again) CHECK(*again == *kept);
+        // The call's own assemble is back.
+        assembles = 0;
+        std::vector<emu::ScreenTriangle> tris;
+        call.assemble(0, 1, tris);
+        CHECK(assembles == 1);
+    }
+    all[17].v[2].y = std::numeric_limits<double>::quiet_NaN();
+    emu::AssembledBoxes boxes(call);
+    std::vector<emu::ScreenTriangle> tris;
+    call.assemble(0, 40, tris);
+    CHECK_FALSE(emu::markDrawnTiles(call, target, stale, &boxes));  // every tile: nothing known
 }
