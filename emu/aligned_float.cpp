@@ -757,7 +757,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     uint64_t texelsPerPixel = 0;
     for (int t = 0; t < taps; ++t)
         texelsPerPixel += draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0;
-    const JoinPlans joins(tris, setups, count, draw.plan, draw.colorAttrs);  // (joinRow)
+    JoinPlans joins(tris, setups, count, draw.plan, draw.colorAttrs);  // (joinRow)
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them: a full-screen quad's two triangles
     // share their tables, so each texel row is filtered once, not once per triangle).
@@ -775,11 +775,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
                                 tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1],
-                                        ti < joins.pairs.size()
-                                            ? joins.pairs[ti]
-                                            : joinPlan(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs),
-                                        y, windows, windowCount, xl, xr);
+                                joinRow(s, *setups[ti + 1], joins.pair(ti), y, windows, windowCount, xl, xr);
             sampler.setTriangle(tri, s, y, sc.sampler);
             // (The worker's sampler counts the texels of the per-pixel taps it serves: not 8-bit,
             // or at their quads' levels, which the row sampler counts where it filters them.)

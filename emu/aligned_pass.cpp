@@ -819,7 +819,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             }
         }
     }
-    const JoinPlans joins(tris, setups, count, draw.plan, draw.colorAttrs);  // (joinRow)
+    JoinPlans joins(tris, setups, count, draw.plan, draw.colorAttrs);  // (joinRow)
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them).
     for (int y = y0; y < y1; ++y) {
@@ -836,11 +836,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
                                 tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
-                                joinRow(s, *setups[ti + 1],
-                                        ti < joins.pairs.size()
-                                            ? joins.pairs[ti]
-                                            : joinPlan(s, *setups[ti + 1], tris[ti + 1] == &tri, draw.plan, draw.colorAttrs),
-                                        y, windows, windowCount, xl, xr);
+                                joinRow(s, *setups[ti + 1], joins.pair(ti), y, windows, windowCount, xl, xr);
             ctx.tri = &tri;
             ctx.setup = &s;
             ctx.y = y;

@@ -414,15 +414,35 @@ JoinPlan joinPlan(const TriangleSetup& s, const TriangleSetup& next, bool shared
                   uint64_t colorAttrs);
 bool joinRow(const TriangleSetup& s, const TriangleSetup& next, const JoinPlan& plan, int y, const RowWindow* windows,
              size_t count, int& xl, int& xr);
-// joinPlan of each consecutive pair of a drawAlignedRows group (entry i: triangles i and i + 1).
-struct JoinPlans {
-    std::array<JoinPlan, kMaxAlignedTriangles> pairs;
+// joinPlan of each consecutive pair of a drawAlignedRows group (pair i: triangles i and i + 1), made
+// on first use (a band's call meets few of its pairs on a joined row; a sprite's pair is met again
+// by the call of each band it crosses).
+class JoinPlans {
+public:
     template <typename Tri>
     JoinPlans(const Tri* const* tris, const TriangleSetup* const* setups, size_t count, const ps11::TapPlan& plan,
-              uint64_t colorAttrs) {
-        for (size_t i = 0; i + 1 < count && i < pairs.size(); ++i)
-            pairs[i] = joinPlan(*setups[i], *setups[i + 1], tris[i + 1] == tris[i], plan, colorAttrs);
+              uint64_t colorAttrs)
+        : m_setups(setups), m_count(count), m_plan(plan), m_colorAttrs(colorAttrs) {
+        for (size_t i = 0; i + 1 < count && i < kMaxAlignedTriangles; ++i)
+            m_shared |= uint32_t(tris[i + 1] == tris[i]) << i;
     }
+    JoinPlan pair(size_t i) {
+        if (i >= kMaxAlignedTriangles)
+            return joinPlan(*m_setups[i], *m_setups[i + 1], false, m_plan, m_colorAttrs);
+        if (!((m_made >> i) & 1)) {
+            m_pairs[i] = joinPlan(*m_setups[i], *m_setups[i + 1], (m_shared >> i) & 1, m_plan, m_colorAttrs);
+            m_made |= uint32_t(1) << i;
+        }
+        return m_pairs[i];
+    }
+
+private:
+    const TriangleSetup* const* m_setups;
+    size_t m_count;
+    const ps11::TapPlan& m_plan;
+    uint64_t m_colorAttrs;
+    uint32_t m_shared = 0, m_made = 0;  // bit per pair
+    std::array<JoinPlan, kMaxAlignedTriangles> m_pairs;
 };
 
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
