@@ -234,12 +234,8 @@ float rowV(const TriangleSetup& s, int set, int y) {
 }
 
 bool tableColumns(const TriangleSetup& s, int& x0, int& x1) {
-    int xlo = s.clip.x1, xhi = s.clip.x0;
-    for (int y = s.yMin; y < s.yMax; ++y) {
-        int xl = 0, xr = 0;
-        if (rowCoverage(s, y, xl, xr)) xlo = std::min(xlo, xl), xhi = std::max(xhi, xr);
-    }
-    if (xlo >= xhi) return false;
+    int xlo = 0, xhi = 0;
+    if (!coveredColumns(s, xlo, xhi)) return false;
     const bool narrow = 2 * (xhi - xlo) < s.clip.x1 - s.clip.x0;
     x0 = narrow ? xlo : s.clip.x0;
     x1 = narrow ? xhi : s.clip.x1;

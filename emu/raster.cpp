@@ -198,6 +198,55 @@ bool rowCoverage(const TriangleSetup& s, int y, int& xl, int& xr) {
     return true;
 }
 
+bool coveredColumns(const TriangleSetup& s, int& xlo, int& xhi) {
+    // Each edge's bound on a row is a quotient of n = q·d + r (0 <= r < d): lo = ceil(n / A) =
+    // q + (r ≠ 0) for A > 0 with n = t − k, hi = floor(n / −A) + 1 = q + 1 for A < 0 with n = k − t.
+    // From one row to the next n moves by a constant, so q and r move by its quotient and
+    // remainder. (A = 0: the row is covered while k >= t.)
+    struct Edge {
+        int kind = 0;  // +1 bounds lo, −1 bounds hi, 0 none (A = 0)
+        int64_t q = 0, r = 0, d = 1, dq = 0, dr = 0;
+        int64_t k = 0, dk = 0, t = 0;  // (kind 0)
+    };
+    Edge e[3];
+    const int64_t Y0 = int64_t(s.yMin) * kOne;
+    for (size_t i = 0; i < 3; ++i) {
+        Edge& g = e[i];
+        const int64_t k = s.b[i] * Y0 + s.c[i], dk = s.b[i] * kOne, A = s.a[i] * kOne;
+        if (A == 0) {
+            g.k = k, g.dk = dk, g.t = s.t[i];
+            continue;
+        }
+        g.kind = A > 0 ? 1 : -1;
+        g.d = A > 0 ? A : -A;
+        const int64_t n = A > 0 ? s.t[i] - k : k - s.t[i], dn = A > 0 ? -dk : dk;
+        g.q = floorDiv(n, g.d), g.r = n - g.q * g.d;
+        g.dq = floorDiv(dn, g.d), g.dr = dn - g.dq * g.d;
+    }
+    int64_t lo0 = s.clip.x1, hi0 = s.clip.x0;
+    for (int y = s.yMin; y < s.yMax; ++y) {
+        int64_t lo = s.clip.x0, hi = s.clip.x1;
+        bool covered = true;
+        for (Edge& g : e) {
+            if (g.kind > 0) {
+                lo = std::max(lo, g.q + (g.r != 0));
+            } else if (g.kind < 0) {
+                hi = std::min(hi, g.q + 1);
+            } else {
+                covered = covered && g.k >= g.t;
+                g.k += g.dk;
+                continue;
+            }
+            g.q += g.dq, g.r += g.dr;
+            if (g.r >= g.d) g.r -= g.d, ++g.q;
+        }
+        if (covered && lo < hi) lo0 = std::min(lo0, lo), hi0 = std::max(hi0, hi);
+    }
+    if (lo0 >= hi0) return false;
+    xlo = int(lo0), xhi = int(hi0);
+    return true;
+}
+
 void rasterizeRows(const TriangleSetup& s, int y0, int y1, uint64_t used, bool wantZ, QuadSpan& span,
                    const std::function<void(QuadSpan&)>& emit) {
     const int yStart = std::max(y0, s.yMin & ~1);

@@ -60,6 +60,10 @@ bool setupTriangle(const ScreenTriangle& tri, uint64_t used, const ClipRect& cli
 
 // The covered pixels of row y: [xl, xr) inside the clip rect; false when empty.
 bool rowCoverage(const TriangleSetup& s, int y, int& xl, int& xr);
+// The columns [xlo, xhi) that rowCoverage covers on any row of the triangle (the union of its
+// rows' spans), stepping each edge's bound from row to row instead of dividing on every row;
+// false when no row is covered.
+bool coveredColumns(const TriangleSetup& s, int& xlo, int& xhi);
 
 // A span of up to ps11::kMaxSpan lanes laid out as 2×2 quads: lanes 4i..4i+3 are
 // (x, y), (x+1, y), (x, y+1), (x+1, y+1) of quad i. Helper lanes (outside the triangle or the

@@ -198,6 +198,44 @@ TEST_CASE("raster: the clip rectangle limits coverage", "[raster]") {
     }
 }
 
+TEST_CASE("raster: coveredColumns is the union of rowCoverage's rows", "[raster]") {
+    // Random triangles (slivers, sub-pixel ones, ones far outside the clip, both windings, huge
+    // ones): the columns stepped from row to row equal those of rowCoverage row by row.
+    std::mt19937 rng(31);
+    std::uniform_real_distribution<double> near(-30.0, 130.0), far(-5000.0, 5000.0), tiny(-0.7, 0.7);
+    const ClipRect clip{3, 5, 97, 83};
+    int compared = 0, empty = 0;
+    for (int i = 0; i < 20000; ++i) {
+        ScreenTriangle t;
+        const int shape = i % 4;
+        for (ScreenVertex& v : t.v) {
+            v = shape == 1 ? sv(far(rng), far(rng)) : sv(near(rng), near(rng));
+            if (shape == 2 && &v != &t.v[0]) v = sv(t.v[0].x + tiny(rng), t.v[0].y + near(rng) / 10);
+            if (shape == 3 && &v == &t.v[2]) v = sv(t.v[1].x, t.v[0].y);  // a horizontal and a vertical edge
+        }
+        TriangleSetup s;
+        if (!setupTriangle(t, 0, clip, s)) continue;
+        int lo = clip.x1, hi = clip.x0;
+        for (int y = s.yMin; y < s.yMax; ++y) {
+            int xl = 0, xr = 0;
+            if (rowCoverage(s, y, xl, xr)) lo = std::min(lo, xl), hi = std::max(hi, xr);
+        }
+        int xlo = -1, xhi = -1;
+        const bool any = coveredColumns(s, xlo, xhi);
+        REQUIRE(any == (lo < hi));
+        if (any) {
+            INFO("triangle " << i);
+            REQUIRE(xlo == lo);
+            REQUIRE(xhi == hi);
+            ++compared;
+        } else {
+            ++empty;
+        }
+    }
+    CHECK(compared > 5000);
+    CHECK(empty > 100);
+}
+
 TEST_CASE("raster: the half-pixel quad gives every pixel the coordinate of its own centre", "[raster]") {
     // Quad (−0.5, −0.5)–(W − 0.5, H − 0.5), u 0..1, v 0..1: pixel x gets u = (x + 0.5)/W.
     const int W = 1920, H = 6;
