@@ -235,10 +235,13 @@ const float* decodedRow(const FloatRowDraw& draw, const FloatRowTap& tap, int32_
 // (the first step of combineFloat), over every column of the triangle. Kept per worker and
 // shared by the taps whose column tables are equal, so a magnified tap builds each texel row
 // once for all the pixel rows it serves and a vertical blur one row per pixel row.
-const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, int32_t j, FloatRowScratch& sc) {
-    const uint64_t id = tri.taps[size_t(t)].tableId;
-    FloatRowScratch::HRow* victim = nullptr;
-    for (FloatRowScratch::HRow& h : sc.hrows) {
+// `own`: built there, without looking for it among the kept rows or keeping it (an uncached tap's).
+const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, int32_t j, FloatRowScratch& sc,
+                  FloatRowScratch::HRow* own = nullptr) {
+    const uint64_t id = own ? 0 : tri.taps[size_t(t)].tableId;
+    FloatRowScratch::HRow* victim = own;
+    for (size_t i = 0; !own && i < sc.hrows.size(); ++i) {
+        FloatRowScratch::HRow& h = sc.hrows[i];
         if (h.serial == draw.serial && h.tableId == id && h.row == j) {
             h.stamp = ++sc.stamp;
             return h.h.data();
@@ -697,6 +700,9 @@ void fillFloatRowTables(const FloatRowDraw& draw, const TriangleSetup& s, FloatR
         ps11::floatAxisTaps(tap.addressU, tap.linear, draw.weights8, n, u.data(), tap.width, cols.i0.data(),
                             cols.i1.data(), cols.f.data());
         columnStretches(cols, n);
+        // (Row-path triangles have no perspective: v moves by one step a row.)
+        const float dv = (rowV(s, tap.coordSet, s.yMin + 1) - rowV(s, tap.coordSet, s.yMin)) * float(tap.height);
+        cols.uncached = tap.linear && std::abs(dv) >= 2.0f;
         cols.runEnd.resize(tap.linear ? 0 : size_t(n));
         if (!tap.linear)
             for (int x = n - 1; x >= 0; --x)
@@ -791,8 +797,9 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                 RowTaps& r = rows[size_t(t)];
                 ps11::floatAxisTaps(tap.addressV, tap.linear, draw.weights8, 1, &v, tap.height, &r.j0, &r.j1, &r.fy);
                 if (tap.linear) {
-                    r.h0 = hRow(draw, tri, t, r.j0, sc);
-                    r.h1 = hRow(draw, tri, t, r.j1, sc);
+                    const bool own = tri.taps[size_t(t)].uncached;
+                    r.h0 = hRow(draw, tri, t, r.j0, sc, own ? &sc.own[2 * size_t(t)] : nullptr);
+                    r.h1 = hRow(draw, tri, t, r.j1, sc, own ? &sc.own[2 * size_t(t) + 1] : nullptr);
                 }
                 // (Point taps read the lanes' texels straight from the row: RowSampler::sample.)
             }

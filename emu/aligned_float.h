@@ -97,6 +97,10 @@ struct FloatRowTriangle {
         // Equal tables of one draw share their H rows (a full-screen quad's two triangles, the
         // taps of a vertical blur): shareFloatRowTables gives them the id of the first.
         uint64_t tableId = 0;
+        // A linear tap moving 2 texel rows or more a pixel row (a minification in v): no other
+        // pixel row reads its texel rows, so its H rows are built into the worker's own slots
+        // (FloatRowScratch::own) without a search of the kept ones (as HConfig::uncached).
+        bool uncached = false;
     };
     std::array<Columns, 8> taps;
     // Taps sampled per pixel on this triangle (bit per tap, freeTaps): no tables; the worker's
@@ -144,6 +148,8 @@ struct FloatRowScratch {
         std::vector<float> h;
     };
     std::vector<HRow> hrows;
+    // The H rows of uncached taps (Columns::uncached): two a tap, rebuilt on every pixel row.
+    std::array<HRow, 16> own;
     // Texel rows as planar r g b a floats (8-bit ones decoded, float ones deinterleaved: the
     // taps of a horizontal blur read one row), keyed by draw, the row's first byte and its
     // width (a texture's memory is rewritten between draws); kept like the H rows.
