@@ -17,18 +17,26 @@ namespace ps11 {
 
 #if defined(__SSE2__)
 
+// (The last lanes of a run of at least one store's width: one more store ending at n, over lanes
+// already set to the same value; shorter runs one lane at a time.)
 inline void fillLanes(float* dst, int n, float value) {
     const __m128 v = _mm_set1_ps(value);
-    int i = 0;
-    for (; i + 4 <= n; i += 4) _mm_storeu_ps(dst + i, v);
-    for (; i < n; ++i) dst[i] = value;
+    if (n < 4) {
+        for (int i = 0; i < n; ++i) dst[i] = value;
+        return;
+    }
+    for (int i = 0; i + 4 <= n; i += 4) _mm_storeu_ps(dst + i, v);
+    if (n & 3) _mm_storeu_ps(dst + n - 4, v);
 }
 
 inline void fillLanes(int16_t* dst, int n, int16_t value) {
     const __m128i v = _mm_set1_epi16(value);
-    int i = 0;
-    for (; i + 8 <= n; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i), v);
-    for (; i < n; ++i) dst[i] = value;
+    if (n < 8) {
+        for (int i = 0; i < n; ++i) dst[i] = value;
+        return;
+    }
+    for (int i = 0; i + 8 <= n; i += 8) _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + i), v);
+    if (n & 7) _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + n - 8), v);
 }
 
 #else

@@ -1,5 +1,5 @@
 // ps11::fillLanes (ps11/fill_lanes.h): exactly lanes [0, n) take the value, bit for bit, for every
-// run length across the vector steps and the scalar tail.
+// run length across the vector steps, the overlapping last store and the short runs done lane by lane.
 #include <catch2/catch.hpp>
 
 #include <cmath>
