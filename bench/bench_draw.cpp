@@ -47,6 +47,9 @@ struct QuadVertex {
 // 1080p: 20 quads of 113.4×113.4 pixels at sub-pixel positions, fixed function (texture ×
 // diffuse, a colour per quad), the 128×128 glare image read from 0.06 to 0.94 bilinear (magnified
 // about 1.05×, the shrunk sprites), added ONE/ONE; the texture a bright centre falling off.
+// SpritesSmall: the same draw as on the `sparse` scene's 480×270 panel (bench_glare): 1 296 quads
+// of 28.4×28.4 pixels, overlapping about eight deep, the image minified about 4:1 (each pixel row
+// reads texel rows no other pixel row reads).
 // Tiny: the blur on a 1×1 target from a 1×1 texture (a glare technique's adaptation step): what a
 // draw costs besides its pixels.
 // Weighted4: the glow's blur passes (glare/shaders/weighted4.psh) at 480×270 — four POINT taps at
@@ -75,6 +78,7 @@ enum class Pass {
     Blur4Small,
     Sprites,
     SpritesFfp,
+    SpritesSmall,
     Tiny,
     Composite,
     Weighted4,
@@ -104,12 +108,12 @@ struct Scene {
         const bool trilinear = pass == Pass::PerspectiveTrilinear;
         const bool mip = pass == Pass::Down2Mip || pass == Pass::PerspectiveMip || trilinear;
         if (pass == Pass::Down2 || pass == Pass::Down2Mip) w = kW / 2, h = kH / 2;
-        if (pass == Pass::Down4 || pass == Pass::Weighted4) w = kW / 4, h = kH / 4;
+        if (pass == Pass::Down4 || pass == Pass::Weighted4 || pass == Pass::SpritesSmall) w = kW / 4, h = kH / 4;
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4 || pass == Pass::Down8Point;
         const bool addGlare = pass == Pass::CompositeAdd;
-        const bool ffp = pass == Pass::SpritesFfp;
+        const bool ffp = pass == Pass::SpritesFfp || pass == Pass::SpritesSmall;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? h / 4 : h;
         DeviceOptions o;
@@ -219,10 +223,11 @@ struct Scene {
             dev->SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE);
             dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
             dev->SetFVF(kQuadFvf);
-            std::uniform_real_distribution<float> px(0.0f, float(w) - 114.0f), py(0.0f, float(h) - 114.0f);
-            const float size = 113.4f, t0 = 0.06f, t1 = 0.94f;
+            const bool small = pass == Pass::SpritesSmall;
+            const float size = small ? 28.4f : 113.4f, t0 = 0.06f, t1 = 0.94f;
+            std::uniform_real_distribution<float> px(0.0f, float(w) - size - 1), py(0.0f, float(h) - size - 1);
             const QuadCoords uv{t0, t0, t1, t1};
-            for (int k = 0; k < 20; ++k) {
+            for (int k = 0; k < (small ? 1296 : 20); ++k) {
                 const float x0 = px(rng), y0 = py(rng);
                 const DWORD colour = 0xff000000u | (rng() & 0x7f7f7fu);
                 const auto q = halfPixelQuad(x0, y0, x0 + size, y0 + size, {uv, uv, uv, uv}, colour);
@@ -634,6 +639,11 @@ BENCHMARK_CAPTURE(BM_Draw, sprites_400x64x64_1080p_fx8, Pass::Sprites)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, sprites_ffp_20x113_1080p_fx8, Pass::SpritesFfp)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, sprites_ffp_1296x28_480x270_fx8, Pass::SpritesSmall)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
