@@ -422,12 +422,12 @@ public:
     template <typename Tri>
     JoinPlans(const Tri* const* tris, const TriangleSetup* const* setups, size_t count, const ps11::TapPlan& plan,
               uint64_t colorAttrs)
-        : m_setups(setups), m_count(count), m_plan(plan), m_colorAttrs(colorAttrs) {
+        : m_setups(setups), m_plan(plan), m_colorAttrs(colorAttrs) {
         for (size_t i = 0; i + 1 < count && i < kMaxAlignedTriangles; ++i)
             m_shared |= uint32_t(tris[i + 1] == tris[i]) << i;
     }
     JoinPlan pair(size_t i) {
-        if (i >= kMaxAlignedTriangles)
+        if (i >= kMaxAlignedTriangles)  // (u compared too: the same verdict, a larger group)
             return joinPlan(*m_setups[i], *m_setups[i + 1], false, m_plan, m_colorAttrs);
         if (!((m_made >> i) & 1)) {
             m_pairs[i] = joinPlan(*m_setups[i], *m_setups[i + 1], (m_shared >> i) & 1, m_plan, m_colorAttrs);
@@ -438,7 +438,6 @@ public:
 
 private:
     const TriangleSetup* const* m_setups;
-    size_t m_count;
     const ps11::TapPlan& m_plan;
     uint64_t m_colorAttrs;
     uint32_t m_shared = 0, m_made = 0;  // bit per pair

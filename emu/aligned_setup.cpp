@@ -6,8 +6,8 @@
 // (ps11::fastpath::axisTable), and the coordinates are the rasteriser's own formula (emu/raster.h
 // planeValue; this file is compiled without FMA contraction so that it evaluates it alike).
 #include <algorithm>
-#include <bit>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
