@@ -56,6 +56,8 @@ struct QuadVertex {
 // whole-texel horizontal offsets −2…+1 with weights c0..c3, added ONE/ONE onto the target.
 // CompositeAdd: the last pass of glow, quarter, pyramid and sprites (glare/shaders/scale.psh) —
 // a 480×270 glare magnified 4× (bilinear) × c0, added ONE/ONE onto the 1080p target.
+// CompositeCopy: the same with c0 = (1, 1, 1, 0), as glow, quarter and sprites set it: the program
+// copies its tap (r, g, b; alpha 0) whatever it reads, so every window is a copy.
 // Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
 // Rotated: the 1080p blur with its texture coordinates turned by 10 degrees about the centre (u
@@ -83,6 +85,7 @@ enum class Pass {
     Composite,
     Weighted4,
     CompositeAdd,
+    CompositeCopy,
     Rotated,
     Perspective,
     Dependent,
@@ -112,7 +115,7 @@ struct Scene {
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4 || pass == Pass::Down8Point;
-        const bool addGlare = pass == Pass::CompositeAdd;
+        const bool addGlare = pass == Pass::CompositeAdd || pass == Pass::CompositeCopy;
         const bool ffp = pass == Pass::SpritesFfp || pass == Pass::SpritesSmall;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? h / 4 : h;
@@ -197,8 +200,8 @@ struct Scene {
             dev->SetPixelShaderConstantF(0, cs[0], 4);
         }
         if (addGlare) {
-            const float strength[4] = {0.8f, 0.8f, 0.8f, 0.8f};
-            dev->SetPixelShaderConstantF(0, strength, 1);
+            const float strength[4] = {0.8f, 0.8f, 0.8f, 0.8f}, copy[4] = {1, 1, 1, 0};
+            dev->SetPixelShaderConstantF(0, pass == Pass::CompositeCopy ? copy : strength, 1);
         }
         if (weighted || addGlare) {
             dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
@@ -613,6 +616,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, weighted4_480x270_fx8, Pass::Weighted4)
     ->UseManualTime();
 
 BENCHMARK_CAPTURE(BM_Draw, composite_add_1080p_x4_fx8, Pass::CompositeAdd)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, composite_copy_1080p_x4_fx8, Pass::CompositeCopy)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

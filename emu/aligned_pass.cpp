@@ -201,34 +201,70 @@ void fillWords(const uint8_t word[4], int n, bool additive, uint8_t* dst) {
     }
 }
 
-// A copied window's columns [x, x + n) of a tap that reads consecutive texels of one row with
-// zero weights (a 1:1 tap, point or at texel centres): the filter returns each texel's own bytes
-// ((256·256·t + 2¹⁵) >> 16 = t), and a plain store writes them back in the same b g r a order, so
-// the texel bytes are the target's (| orMask for X8R8G8B8), then the constant channels; an
-// additive store (ONE/ONE into an 8-bit target) adds those bytes to the target's with saturation,
-// as storeRow does. False where the columns do not qualify (the caller filters).
-bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
+// What the vertical blend of a vector run reads from column x on: both texel rows' H-row planes
+// (the second only at vertical weight ≠ 0) and their kind.
+struct BlendRows {
+    const uint16_t* h0[4];
+    const uint16_t* h1[4];
+    HKind kind;
+};
+inline BlendRows blendRows(const TapRow& row, const AlignedTriangle::Columns& cols, const AlignedTriangle::Run& run,
+                           int x, int colBase) {
+    const int j = run.j0 + (x - run.x0);
+    const TapRow::Planes& p0 = row.h0[size_t(run.config)];
+    const TapRow::Planes& p1 = row.h1[size_t(run.config)];
+    BlendRows b{};
+    for (int c = 0; c < 4; ++c) {
+        b.h0[c] = p0.p[c] + j;
+        b.h1[c] = row.wy ? p1.p[c] + j : nullptr;
+    }
+    b.kind = run.tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H) : hKindOf(cols.w[size_t(x - colBase)]);
+    return b;
+}
+
+// A copied window's columns [x, x + n) of its tap, stored (or added) as words without lanes.
+// - A tap that reads consecutive texels of one row with zero weights (a 1:1 tap, point or at
+//   texel centres): the filter returns each texel's own bytes ((256·256·t + 2¹⁵) >> 16 = t), and
+//   a plain store writes them back in the same b g r a order, so the texel bytes are the target's
+//   (| orMask for X8R8G8B8), then the constant channels; an additive store (ONE/ONE into an 8-bit
+//   target) adds those bytes to the target's with saturation, as storeRow does.
+// - fx8, columns all in vector runs whose H rows are ready (a magnified or blended tap: a glare
+//   composite's): each run's vertical blend goes to the target as words (verticalStore), the
+//   bytes vertical makes and storeRow packs, masked and added the same way.
+// None where the columns do not qualify (the caller filters).
+enum class CopyRoute { None, Texels, Blended };
+CopyRoute copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
                 const RowWindow& window, int x, int n, uint32_t orMask, bool additive, uint8_t* dst) {
     const int t = window.copyTap;
     const AlignedTap& tap = draw.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
-    if (!tap.bound || ((tri.freeTaps >> t) & 1) || !row.row0 || row.wy != 0) return false;
+    if (!tap.bound || ((tri.freeTaps >> t) & 1) || !row.row0) return CopyRoute::None;
     const AlignedTriangle::Columns& cols = tri.taps[size_t(t)];
     const size_t i0 = size_t(x - tri.x0);
     const int32_t o = cols.off0[i0];
-    if (o < 0) return false;
-    // A vector run of step 1 and weight 0 covering the columns qualifies as a whole; otherwise
-    // each column is checked.
-    const int32_t r = cols.run[i0];
-    bool whole = false;
-    if (r >= 0) {
-        const AlignedTriangle::Run& run = cols.runs[size_t(r)];
-        const HConfig& h = tri.configs[size_t(cols.configs[size_t(run.config)])];
-        whole = !run.tabulated && h.step == 1 && h.wx == 0 && run.x1 >= x + n;
+    // 1:1 texels: a vector run of step 1 and weight 0 covering the columns qualifies as a whole;
+    // otherwise each column is checked.
+    bool texels = row.wy == 0 && o >= 0;
+    if (texels) {
+        const int32_t r = cols.run[i0];
+        bool whole = false;
+        if (r >= 0) {
+            const AlignedTriangle::Run& run = cols.runs[size_t(r)];
+            const HConfig& h = tri.configs[size_t(cols.configs[size_t(run.config)])];
+            whole = !run.tabulated && h.step == 1 && h.wx == 0 && run.x1 >= x + n;
+        }
+        for (int i = 0; i < n && !whole && texels; ++i)
+            texels = cols.off0[i0 + size_t(i)] == o + 4 * i && cols.w[i0 + size_t(i)] == 0;
     }
-    if (!whole)
-        for (int i = 0; i < n; ++i)
-            if (cols.off0[i0 + size_t(i)] != o + 4 * i || cols.w[i0 + size_t(i)] != 0) return false;
+    // Else ready vector runs over every column.
+    if (!texels) {
+        if (draw.fx12 || !draw.kernels) return CopyRoute::None;
+        for (int c = x; c < x + n;) {
+            const int32_t r = cols.run[size_t(c - tri.x0)];
+            if (r < 0 || !row.ready[size_t(cols.runs[size_t(r)].config)]) return CopyRoute::None;
+            c = int(cols.runs[size_t(r)].x1);
+        }
+    }
     uint32_t keep = ~0u, set = orMask;  // the constant channels' bytes (b g r a: r g b a at 2 1 0 3)
     for (int c = 0; c < 4; ++c)
         if (!((window.copyMask >> c) & 1)) {
@@ -239,13 +275,28 @@ bool copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::
                 // fx12: a texel's grid value is 16·b, whose byte is b, and 16·b + 16·d adds bytes
                 // with saturation; a constant between two bytes would round with the sum: filtered.
                 const int32_t g = std::clamp<int32_t>(window.grid[size_t(c)], 0, kG12);
-                if (additive && g % 16 != 0) return false;
+                if (additive && g % 16 != 0) return CopyRoute::None;
                 byte = int32_t(unorm8OfFx12(g));
             }
             set |= uint32_t(byte) << shift;
         }
-    storeWords(row.row0 + o, n, keep, set, additive, dst);
-    return true;
+    if (texels) {
+        storeWords(row.row0 + o, n, keep, set, additive, dst);
+        return CopyRoute::Texels;
+    }
+    for (int c = x; c < x + n;) {
+        const AlignedTriangle::Run& run = cols.runs[size_t(cols.run[size_t(c - tri.x0)])];
+        const int e = std::min(x + n, int(run.x1));
+        uint8_t* const out = dst + 4 * (c - x);
+        if (row.direct[size_t(run.config)]) {
+            storeWords(row.row0 + cols.off0[size_t(c - tri.x0)], e - c, keep, set, additive, out);
+        } else {
+            const BlendRows b = blendRows(row, cols, run, c, tri.x0);
+            draw.kernels->verticalStore(b.kind, b.h0, b.h1, row.wy, e - c, keep, set, additive, out);
+        }
+        c = e;
+    }
+    return CopyRoute::Blended;
 }
 
 }  // namespace
@@ -368,27 +419,6 @@ void setTapRow(TapRow& r, const AlignedTap& tap, float v) {
     r.row0 = j0 >= 0 ? tap.texels + size_t(j0) * pitch : nullptr;
     r.row1 = j1 >= 0 ? tap.texels + size_t(j1) * pitch : nullptr;
     r.wy = w;
-}
-
-// What the vertical blend of a vector run reads from column x on: both texel rows' H-row planes
-// (the second only at vertical weight ≠ 0) and their kind.
-struct BlendRows {
-    const uint16_t* h0[4];
-    const uint16_t* h1[4];
-    HKind kind;
-};
-inline BlendRows blendRows(const TapRow& row, const AlignedTriangle::Columns& cols, const AlignedTriangle::Run& run,
-                           int x, int colBase) {
-    const int j = run.j0 + (x - run.x0);
-    const TapRow::Planes& p0 = row.h0[size_t(run.config)];
-    const TapRow::Planes& p1 = row.h1[size_t(run.config)];
-    BlendRows b{};
-    for (int c = 0; c < 4; ++c) {
-        b.h0[c] = p0.p[c] + j;
-        b.h1[c] = row.wy ? p1.p[c] + j : nullptr;
-    }
-    b.kind = run.tabulated ? (cols.tabulatedQ16 ? HKind::Q : HKind::H) : hKindOf(cols.w[size_t(x - colBase)]);
-    return b;
 }
 
 // Stretches of columns outside vector runs at least this long are filtered with the tabulated
@@ -949,11 +979,14 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             continue;
                         }
                     } else if (mode == RowMode::Copy) {
-                        if (storeAsShaded && copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
-                                                        target.texel(uint32_t(x), uint32_t(y)))) {
+                        const CopyRoute route =
+                            storeAsShaded ? copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
+                                                       target.texel(uint32_t(x), uint32_t(y)))
+                                          : CopyRoute::None;
+                        if (route != CopyRoute::None) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
-                            stats.copiedDirect += uint64_t(n);
+                            if (route == CopyRoute::Texels) stats.copiedDirect += uint64_t(n);
                             continue;
                         }
                         fill(&ctx, window->copyTap, 0, n, r0);

@@ -349,6 +349,47 @@ inline void bytesGroups(int count, uint8_t* out, F f) {
     }
 }
 
+// 16 b g r a words (first: pixels 0-7, second: 8-15) to dst, or (Additive) added to its words
+// with saturation; fewer than 16 `words`: those alone, by masked loads and stores (dst is never
+// touched past them).
+template <bool Additive>
+inline void putWords(uint8_t* dst, __m256i first, __m256i second, int words) {
+    __m256i* d0 = reinterpret_cast<__m256i*>(dst);
+    __m256i* d1 = reinterpret_cast<__m256i*>(dst + 32);
+    if (words < 16) {
+        int* w0 = reinterpret_cast<int*>(d0);
+        int* w1 = reinterpret_cast<int*>(d1);
+        const __m256i m0 = firstDwords(words), m1 = firstDwords(words - 8);
+        if constexpr (Additive) {
+            first = _mm256_adds_epu8(first, _mm256_maskload_epi32(w0, m0));
+            second = _mm256_adds_epu8(second, _mm256_maskload_epi32(w1, m1));
+        }
+        _mm256_maskstore_epi32(w0, m0, first);
+        _mm256_maskstore_epi32(w1, m1, second);
+        return;
+    }
+    if constexpr (Additive) {
+        first = _mm256_adds_epu8(first, _mm256_loadu_si256(d0));
+        second = _mm256_adds_epu8(second, _mm256_loadu_si256(d1));
+    }
+    _mm256_storeu_si256(d0, first);
+    _mm256_storeu_si256(d1, second);
+}
+
+// Every group of 16 lanes of every channel as 16 b g r a words, each (word & keep) | set, stored
+// at dst + 4k or (Additive) added to its words with saturation (putWords: never past the count).
+template <bool Additive, typename F>
+inline void storeGroups(int count, uint32_t keep, uint32_t set, uint8_t* dst, F f) {
+    const __m256i none = _mm256_setzero_si256();
+    const __m256i kv = _mm256_set1_epi32(int32_t(keep)), sv = _mm256_set1_epi32(int32_t(set));
+    for (int k = 0; k < count; k += 16) {
+        __m256i first, second;
+        packWords(f(0, k), f(1, k), f(2, k), f(3, k), none, first, second);
+        putWords<Additive>(dst + 4 * k, _mm256_or_si256(_mm256_and_si256(first, kv), sv),
+                           _mm256_or_si256(_mm256_and_si256(second, kv), sv), count - k);
+    }
+}
+
 #include "emu/aligned_vertical.inc"
 
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
@@ -360,27 +401,8 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
         auto ld = [&](int c) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i)); };
         __m256i first, second;
         packWords(ld(0), ld(1), ld(2), ld(3), om, first, second);
-        __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
-        __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        if (count - i < 16) {  // the last pixels: masked loads and stores of their words alone
-            int* w0 = reinterpret_cast<int*>(d0);
-            int* w1 = reinterpret_cast<int*>(d1);
-            const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
-            if constexpr (Additive) {
-                first = _mm256_adds_epu8(first, _mm256_maskload_epi32(w0, m0));
-                second = _mm256_adds_epu8(second, _mm256_maskload_epi32(w1, m1));
-            }
-            _mm256_maskstore_epi32(w0, m0, first);
-            _mm256_maskstore_epi32(w1, m1, second);
-            break;
-        }
-        if constexpr (Additive) {
-            first = _mm256_adds_epu8(first, _mm256_loadu_si256(d0));
-            second = _mm256_adds_epu8(second, _mm256_loadu_si256(d1));
-        }
-        _mm256_storeu_si256(d0, first);
-        _mm256_storeu_si256(d1, second);
+        putWords<Additive>(dst + 4 * i, first, second, count - i);  // (the last pixels: their words alone)
     }
     return count;
 }
@@ -426,13 +448,7 @@ int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* d
         __m256i first, second;
         packWords(ch[0], ch[1], ch[2], ch[3], om, first, second);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        if (tail) {  // the last pixels: masked stores of their words alone
-            _mm256_maskstore_epi32(reinterpret_cast<int*>(d0), m0, first);
-            _mm256_maskstore_epi32(reinterpret_cast<int*>(d1), m1, second);
-            break;
-        }
-        _mm256_storeu_si256(d0, first);
-        _mm256_storeu_si256(d1, second);
+        putWords<false>(dst + 4 * i, first, second, count - i);  // (the sums are made: stored)
     }
     return count;
 }
@@ -443,8 +459,9 @@ int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, u
 
 }  // namespace
 
-const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2,   &alignedCombineAvx2,   &alignedPairSums4Avx2,
-                                    &alignedBuildTabulatedAvx2, &verticalBlend,        &verticalBlend12,       &verticalBytes,
-                                    &meanBytes,                 &alignedStoreRowAvx2,  &alignedStoreRow12Avx2};
+const AlignedKernels avx2::kAligned{&alignedDeinterleaveAvx2, &alignedCombineAvx2,  &alignedPairSums4Avx2,
+                                    &alignedBuildTabulatedAvx2, &verticalBlend,   &verticalBlend12,
+                                    &verticalBytes,           &verticalStore,       &meanBytes,
+                                    &alignedStoreRowAvx2,     &alignedStoreRow12Avx2};
 
 }  // namespace emu

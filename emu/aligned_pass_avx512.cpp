@@ -110,6 +110,38 @@ inline void bytesGroups(int count, uint8_t* out, F f) {
     }
 }
 
+// Every group of 32 lanes of every channel as 32 b g r a words (bytesGroups' order), each
+// (word & keep) | set, stored at dst + 4k or (Additive) added to its words with saturation; the
+// last pixels by masked loads and stores of their words alone (dst is never touched past the
+// count).
+template <bool Additive, typename F>
+inline void storeGroups(int count, uint32_t keep, uint32_t set, uint8_t* dst, F f) {
+    const __m512i firstHalf = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
+    const __m512i secondHalf = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
+    const __m512i kv = _mm512_set1_epi32(int32_t(keep)), sv = _mm512_set1_epi32(int32_t(set));
+    auto put = [&](uint8_t* p, __m512i w, int words) {
+        w = _mm512_or_si512(_mm512_and_si512(w, kv), sv);
+        if (words >= 16) {
+            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_loadu_si512(p));
+            _mm512_storeu_si512(p, w);
+        } else if (words > 0) {
+            const __mmask16 m = __mmask16((1u << words) - 1);
+            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_maskz_loadu_epi32(m, p));
+            _mm512_mask_storeu_epi32(p, m, w);
+        }
+    };
+    for (int k = 0; k < count; k += 32) {
+        const __m512i bg = _mm512_packus_epi16(f(2, k), f(1, k));
+        const __m512i ra = _mm512_packus_epi16(f(0, k), f(3, k));
+        const __m512i bgPairs = _mm512_unpacklo_epi8(bg, _mm512_bsrli_epi128(bg, 8));
+        const __m512i raPairs = _mm512_unpacklo_epi8(ra, _mm512_bsrli_epi128(ra, 8));
+        const __m512i w0 = _mm512_unpacklo_epi16(bgPairs, raPairs);
+        const __m512i w1 = _mm512_unpackhi_epi16(bgPairs, raPairs);
+        put(dst + 4 * k, _mm512_permutex2var_epi64(w0, firstHalf, w1), count - k);
+        put(dst + 4 * k + 64, _mm512_permutex2var_epi64(w0, secondHalf, w1), count - k - 16);
+    }
+}
+
 #include "emu/aligned_vertical.inc"
 
 }  // namespace
@@ -121,6 +153,7 @@ const AlignedKernels& avx512::alignedTable() {
         k.vertical = &verticalBlend;
         k.vertical12 = &verticalBlend12;
         k.verticalBytes = &verticalBytes;
+        k.verticalStore = &verticalStore;
         k.meanBytes = &meanBytes;
         return k;
     }();

@@ -902,6 +902,60 @@ TEST_CASE("aligned pass: the fx8 store kernels write the rule's words and nothin
     });
 }
 
+TEST_CASE("aligned pass: verticalStore writes verticalBytes' words masked, stored or added, and nothing past the count",
+          "[draw][aligned]") {
+    // A copied magnified tap goes from its H rows to the target as words (copyTexels). At every
+    // level with vector kernels, for every H-row kind at vertical weights 0, 128 and others,
+    // lengths around whole groups of 16 and 32: the words are verticalBytes', each
+    // (word & keep) | set, stored or (additive) added to the target's bytes with saturation; the
+    // words past the count keep their bytes.
+    testutil::forEachSimdLevel([](ps11::SimdLevel level) {
+        const AlignedKernels* k = alignedKernels(level);
+        if (!k) return;
+        std::mt19937 rng(20261202);
+        constexpr int kMax = 300;
+        std::vector<uint16_t> rows(2 * 4 * size_t(kMax + kHRowPad));
+        for (const HKind kind : {HKind::A, HKind::S, HKind::H, HKind::Q})
+            for (const int32_t wy : {0, 128, 16, 48, 77, 200})
+                for (const bool additive : {false, true})
+                    for (const int n : {1, 7, 15, 16, 17, 31, 32, 33, 47, 63, 64, 65, 255, kMax}) {
+                        const uint32_t top = kind == HKind::A ? 255 : kind == HKind::S ? 510 : kind == HKind::Q ? 4080 : 65280;
+                        for (uint16_t& v : rows) v = uint16_t(rng() % (top + 1));
+                        const size_t stride = size_t(kMax + kHRowPad);
+                        const uint16_t* h0[4];
+                        const uint16_t* h1[4];
+                        for (int c = 0; c < 4; ++c) {
+                            h0[c] = &rows[size_t(c) * stride];
+                            h1[c] = &rows[size_t(4 + c) * stride];
+                        }
+                        // Alpha kept or set to a constant, the X8 target's alpha set.
+                        const uint32_t keep = rng() % 2 ? ~0u : 0x00ffffffu;
+                        const uint32_t set = keep == ~0u ? (rng() % 2 ? 0xff000000u : 0u) : uint32_t(rng() % 256) << 24;
+                        INFO("kind " << int(kind) << ", wy " << wy << ", n " << n << (additive ? ", additive" : "")
+                                     << ", keep " << keep << ", set " << set);
+                        std::vector<uint8_t> words(4 * size_t(n + 32));
+                        k->verticalBytes(kind, h0, h1, wy, n, words.data());
+                        std::vector<uint8_t> dst(4 * size_t(n) + 64), expect;
+                        for (uint8_t& b : dst) b = uint8_t(rng());
+                        expect = dst;
+                        for (int i = 0; i < n; ++i) {
+                            uint32_t w = 0, d = 0;
+                            std::memcpy(&w, &words[4 * size_t(i)], 4);
+                            std::memcpy(&d, &expect[4 * size_t(i)], 4);
+                            w = (w & keep) | set;
+                            if (additive)
+                                for (int b = 0; b < 4; ++b) {
+                                    const uint32_t sum = std::min(255u, ((w >> (8 * b)) & 0xffu) + ((d >> (8 * b)) & 0xffu));
+                                    w = (w & ~(0xffu << (8 * b))) | sum << (8 * b);
+                                }
+                            std::memcpy(&expect[4 * size_t(i)], &w, 4);
+                        }
+                        k->verticalStore(kind, h0, h1, wy, n, keep, set, additive, dst.data());
+                        REQUIRE(dst == expect);
+                    }
+    });
+}
+
 TEST_CASE("aligned pass: a 4:1 reduction's pair sums straight from the texel row equal the staged combine",
           "[draw][aligned]") {
     // pairSums4 against the rule (channel sums of texels 4j, 4j + 1 and 4j + 2, 4j + 3, planes

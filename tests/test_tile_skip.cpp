@@ -418,6 +418,80 @@ TEST_CASE("tile skipping: a program that copies one tap whatever it reads is dra
     CHECK(copiedDraws / 1000 > 0);
 }
 
+TEST_CASE("tile skipping: a magnified tap copied as words equals the quad path at every SIMD level",
+          "[draw][aligned][skip]") {
+    // The glare composites' pass: `mul r0, t0, c0` with c0 = (1, 1, 1, 0) or `mov r0, t0`, a
+    // texture magnified 2x, 2.5x, 3x, 4x or 8x (bilinear, or point), added ONE/ONE or stored
+    // plainly into an A8R8G8B8 or X8R8G8B8 target of a width that ends groups anywhere, with
+    // skipping off: every window copies its tap, and the fx8 copies of ready runs go from the H
+    // rows to the target as words (copyTexels' blended route). Each must equal the quad path's
+    // bytes at every SIMD level, and shade no pixel.
+    std::mt19937 rng(20261203);
+    const char* const programs[] = {"ps_1_1\ntex t0\nmul r0, t0, c0\n", "ps_1_1\ntex t0\nmov r0, t0\n"};
+    int i = 0;
+    for (const double scale : {2.0, 2.5, 3.0, 4.0, 8.0})
+        for (const bool add : {false, true}) {
+            const UINT w = UINT(97 + rng() % 200), h = UINT(9 + rng() % 20);
+            const UINT tw = std::max(2u, UINT(w / scale)), th = std::max(2u, UINT(h / scale));
+            const D3DFORMAT format = i % 3 == 2 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8;
+            const char* const program = programs[i % 2];
+            const bool linear = i % 4 != 3;
+            ++i;
+            std::vector<uint8_t> texels(size_t(tw) * th * 4), init(size_t(w) * h * 4);
+            for (uint8_t& b : texels) b = uint8_t(rng() % 3 ? rng() % 64 : rng());
+            for (uint8_t& b : init) b = uint8_t(rng());
+            auto draw = [&](const DeviceOptions& options, DrawStats& stats) {
+                Device dev(options);
+                Handle rt{}, tex{}, ps{};
+                REQUIRE(dev.CreateRenderTarget(w, h, format, 1, &rt) == D3D_OK);
+                REQUIRE(dev.SetRenderTarget(0, rt) == D3D_OK);
+                D3DLOCKED_RECT lr;
+                REQUIRE(dev.LockRect(rt, &lr, nullptr, 0) == D3D_OK);
+                for (UINT y = 0; y < h; ++y)
+                    std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &init[size_t(y) * w * 4], w * 4);
+                REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+                REQUIRE(dev.CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
+                REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
+                for (UINT y = 0; y < th; ++y)
+                    std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * lr.Pitch, &texels[size_t(y) * tw * 4], tw * 4);
+                REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
+                REQUIRE(dev.CreatePixelShaderFromText(program, &ps) == D3D_OK);
+                REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
+                const float c0[4] = {1, 1, 1, 0};
+                REQUIRE(dev.SetPixelShaderConstantF(0, c0, 1) == D3D_OK);
+                REQUIRE(dev.SetTexture(0, tex) == D3D_OK);
+                for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
+                    REQUIRE(dev.SetSamplerState(0, f, linear ? D3DTEXF_LINEAR : D3DTEXF_POINT) == D3D_OK);
+                REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, add ? 1 : 0) == D3D_OK);
+                REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
+                REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
+                REQUIRE(drawFullscreenQuad(dev) == D3D_OK);
+                stats = dev.lastDrawStats();
+                std::vector<uint8_t> out;
+                REQUIRE(dev.LockRect(rt, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+                for (UINT y = 0; y < h; ++y) {
+                    const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch;
+                    out.insert(out.end(), row, row + w * 4);
+                }
+                REQUIRE(dev.UnlockRect(rt) == D3D_OK);
+                return out;
+            };
+            INFO(program << w << "x" << h << " from " << tw << "x" << th << (linear ? ", linear" : ", point")
+                         << (add ? ", ONE/ONE" : "") << (format == D3DFMT_X8R8G8B8 ? ", X8R8G8B8" : ""));
+            DeviceOptions quads, rows;
+            quads.software.alignedPasses = false;
+            rows.software.skipTiles = false;
+            DrawStats qs;
+            const std::vector<uint8_t> expected = draw(quads, qs);
+            testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+                DrawStats rs;
+                REQUIRE(draw(rows, rs) == expected);
+                CHECK(rs.pixelsRowPath == rs.pixelsCovered);
+                CHECK(rs.pixelsShaded == 0);
+            });
+        }
+}
+
 TEST_CASE("tile skipping: a program whose ONE/ONE adds zero whatever it reads is skipped only with skipping on",
           "[draw][aligned][skip]") {
     // anyData of `mov r0, c2` with c2 = 0, added ONE/ONE into an A8R8G8B8 target: a skip. With
