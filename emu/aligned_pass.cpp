@@ -157,9 +157,10 @@ void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint3
 }
 
 // n pixels' b g r a words from `src` to a row of the 8-bit target: each (word & keep) | set, or
-// with `additive` (ONE/ONE ADD) that added to the row's bytes with saturation, as storeRow
-// stores lanes.
-void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool additive, uint8_t* dst) {
+// with `additive` (ONE/ONE ADD) that added with saturation to the bytes at `base` (the row's own,
+// or a RowSource's), as storeRow stores lanes.
+void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool additive, const uint8_t* base,
+                uint8_t* dst) {
     if (!additive && keep == ~0u && set == 0) {
         std::memcpy(dst, src, size_t(n) * 4);
         return;
@@ -171,32 +172,31 @@ void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool add
     // buffer cannot forward from a string move.)
     for (; i + 4 <= n; i += 4) {
         __m128i w = _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
-        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
-        if (additive) w = _mm_adds_epu8(_mm_loadu_si128(d), w);
-        _mm_storeu_si128(d, w);
+        if (additive) w = _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(base + 4 * i)), w);
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i), w);
     }
 #endif
     for (; i < n; ++i) {
         uint32_t w = (load32(src + 4 * i) & keep) | set;
-        if (additive) w = addBytesSaturated(w, load32(dst + 4 * i));
+        if (additive) w = addBytesSaturated(w, load32(base + 4 * i));
         std::memcpy(dst + 4 * i, &w, 4);
     }
 }
 
 // n pixels of a row of the 8-bit target set to the b g r a word `word`, or with `additive` that
-// word added to each with saturation (storeWords of n copies of it).
-void fillWords(const uint8_t word[4], int n, bool additive, uint8_t* dst) {
+// word added with saturation to each at `base` (storeWords of n copies of it).
+void fillWords(const uint8_t word[4], int n, bool additive, const uint8_t* base, uint8_t* dst) {
     const uint32_t w = load32(word);
     int i = 0;
 #if defined(__SSE2__)
     const __m128i v = _mm_set1_epi32(int32_t(w));
     for (; i + 4 <= n; i += 4) {
-        __m128i* d = reinterpret_cast<__m128i*>(dst + 4 * i);
-        _mm_storeu_si128(d, additive ? _mm_adds_epu8(_mm_loadu_si128(d), v) : v);
+        const __m128i under = _mm_loadu_si128(reinterpret_cast<const __m128i*>(base + 4 * i));
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i), additive ? _mm_adds_epu8(under, v) : v);
     }
 #endif
     for (; i < n; ++i) {
-        const uint32_t out = additive ? addBytesSaturated(w, load32(dst + 4 * i)) : w;
+        const uint32_t out = additive ? addBytesSaturated(w, load32(base + 4 * i)) : w;
         std::memcpy(dst + 4 * i, &out, 4);
     }
 }
@@ -234,7 +234,8 @@ inline BlendRows blendRows(const TapRow& row, const AlignedTriangle::Columns& co
 // None where the columns do not qualify (the caller filters).
 enum class CopyRoute { None, Texels, Blended };
 CopyRoute copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const std::array<TapRow, 8>& rows,
-                const RowWindow& window, int x, int n, uint32_t orMask, bool additive, uint8_t* dst) {
+                     const RowWindow& window, int x, int n, uint32_t orMask, bool additive, const uint8_t* base,
+                     uint8_t* dst) {
     const int t = window.copyTap;
     const AlignedTap& tap = draw.taps[size_t(t)];
     const TapRow& row = rows[size_t(t)];
@@ -281,18 +282,19 @@ CopyRoute copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const 
             set |= uint32_t(byte) << shift;
         }
     if (texels) {
-        storeWords(row.row0 + o, n, keep, set, additive, dst);
+        storeWords(row.row0 + o, n, keep, set, additive, base, dst);
         return CopyRoute::Texels;
     }
     for (int c = x; c < x + n;) {
         const AlignedTriangle::Run& run = cols.runs[size_t(cols.run[size_t(c - tri.x0)])];
         const int e = std::min(x + n, int(run.x1));
         uint8_t* const out = dst + 4 * (c - x);
+        const uint8_t* const under = base + 4 * (c - x);
         if (row.direct[size_t(run.config)]) {
-            storeWords(row.row0 + cols.off0[size_t(c - tri.x0)], e - c, keep, set, additive, out);
+            storeWords(row.row0 + cols.off0[size_t(c - tri.x0)], e - c, keep, set, additive, under, out);
         } else {
             const BlendRows b = blendRows(row, cols, run, c, tri.x0);
-            draw.kernels->verticalStore(b.kind, b.h0, b.h1, row.wy, e - c, keep, set, additive, out);
+            draw.kernels->verticalStore(b.kind, b.h0, b.h1, row.wy, e - c, keep, set, additive, under, out);
         }
         c = e;
     }
@@ -756,7 +758,7 @@ RowWindows rowWindows(const RowWindow* windows, size_t count) {
 
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& sc, AlignedStats& stats, const RowWindow* windows,
-                     size_t windowCount) {
+                     size_t windowCount, const RowSource* source) {
     const RowWindows ws = rowWindows(windows, windowCount);
     // The word of the last filled window stored directly (made once per window, not per row).
     const RowWindow* wordOf = nullptr;
@@ -852,8 +854,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     JoinPlans joins(tris, setups, count, draw.plan, draw.colorAttrs);  // (joinRow)
     // Row by row, and within a row the triangles in primitive order (every pixel sees them in
     // order; the H rows of a pixel row serve all of them).
+    SourcedRow sourced;
     for (int y = y0; y < y1; ++y) {
         ++cache.stamp;
+        const bool fromSource = source && y >= 0 && y < source->height;
+        if (fromSource) sourced.start(source->row0 + size_t(y) * source->pitch, target.texel(0, uint32_t(y)), source->width);
         for (size_t ti = 0; ti < count; ++ti) {
             const AlignedTriangle& tri = *tris[ti];
             const TriangleSetup& s = *setups[ti];
@@ -950,6 +955,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
+                    // (Under a RowSource: the columns written other than by the direct stores of
+                    // copied and filled windows hold the source's words first.)
+                    if (fromSource && !(mode == RowMode::Copy && storeAsShaded) &&
+                        !(mode == RowMode::Fill && storeAsShaded && !(draw.fx12 && draw.directAdd)))
+                        sourced.materialise(x, n);
                     if (mode == RowMode::Shade && chain) {
                         // Chain rows, each tap read from its texel row where a chain run covers
                         // the columns, else from a row of its own (patchedRow: a magnified or
@@ -979,10 +989,17 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             continue;
                         }
                     } else if (mode == RowMode::Copy) {
+                        uint8_t* const at = target.texel(uint32_t(x), uint32_t(y));
                         const CopyRoute route =
                             storeAsShaded ? copyTexels(draw, tri, rows, *window, x, n, orMask, draw.directAdd,
-                                                       target.texel(uint32_t(x), uint32_t(y)))
+                                                       fromSource ? sourced.base(x, n) : at, at)
                                           : CopyRoute::None;
+                        if (fromSource) {
+                            if (route != CopyRoute::None)
+                                sourced.mark(x, n);
+                            else
+                                sourced.materialise(x, n);  // (filtered into lanes and stored below)
+                        }
                         if (route != CopyRoute::None) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
@@ -1008,7 +1025,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             storeLanes(draw, one, 1, orMask, fillWord);
                             wordOf = window;
                         }
-                        fillWords(fillWord, n, draw.directAdd, target.texel(uint32_t(x), uint32_t(y)));
+                        uint8_t* const at = target.texel(uint32_t(x), uint32_t(y));
+                        fillWords(fillWord, n, draw.directAdd, fromSource ? sourced.base(x, n) : at, at);
+                        if (fromSource) sourced.mark(x, n);
                         stats.pixels += uint64_t(n);
                         stats.written += uint64_t(n);
                         continue;
@@ -1067,6 +1086,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             }
             if (joined) ++ti;  // its pixels of this row were drawn
         }
+        if (fromSource) sourced.materialise(0, source->width);  // (the columns no store wrote)
     }
 }
 

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -444,12 +445,111 @@ private:
     std::array<JoinPlan, kMaxAlignedTriangles> m_pairs;
 };
 
+// A whole-surface copy into the 8-bit target put off (SoftwareRendererOptions::putOffCopies)
+// that drawAlignedRows makes as it draws: row y of the target is to hold the `width` words at
+// row0 + y·pitch before the draw (a plain copy: same size and format) — on rows [0, height).
+struct RowSource {
+    const uint8_t* row0 = nullptr;
+    size_t pitch = 0;
+    int width = 0, height = 0;
+};
+
+// One target row under a RowSource (drawAlignedRows): which of its columns hold their words before the draw
+// (copied from the source) or the draw's (written over those), as disjoint spans in column
+// order. A draw's windows go left to right, so a span is most often added at the end.
+class SourcedRow {
+public:
+    void start(const uint8_t* source, uint8_t* target, int width) {
+        m_source = source, m_target = target, m_width = width, m_count = 0, m_whole = false;
+    }
+    // Where a direct store of columns [x, x + n) reads what is under them (ONE/ONE): the source,
+    // where none of them holds a word yet (mark() them once stored), else the target, once the
+    // ones not yet there are copied.
+    const uint8_t* base(int x, int n) {
+        if (!m_whole && !overlaps(x, x + n)) return m_source + 4 * size_t(x);
+        materialise(x, n);
+        return m_target + 4 * size_t(x);
+    }
+    // Columns [x, x + n) now hold the draw's words.
+    void mark(int x, int n) {
+        if (m_whole || n <= 0) return;
+        int lo = x, hi = x + n;
+        // (Spans ordered and disjoint: the new one joins those it touches.)
+        int i = 0;
+        while (i < m_count && m_spans[size_t(i)].second < lo) ++i;
+        int j = i;
+        for (; j < m_count && m_spans[size_t(j)].first <= hi; ++j)
+            lo = std::min(lo, m_spans[size_t(j)].first), hi = std::max(hi, m_spans[size_t(j)].second);
+        if (j == i && m_count == kMaxSpans) {
+            // No room: joined to a neighbour, the columns between them copied.
+            if (i > 0) {
+                --i;
+                copy(m_spans[size_t(i)].second, lo);
+                lo = m_spans[size_t(i)].first;
+            } else {
+                copy(hi, m_spans[0].first);
+                hi = m_spans[0].second;
+            }
+            j = i + 1;
+        }
+        const int removed = j - i;
+        if (removed == 0) {
+            for (int k = m_count; k > i; --k) m_spans[size_t(k)] = m_spans[size_t(k - 1)];
+            ++m_count;
+        } else {
+            for (int k = j; k < m_count; ++k) m_spans[size_t(k - removed + 1)] = m_spans[size_t(k)];
+            m_count -= removed - 1;
+        }
+        m_spans[size_t(i)] = {lo, hi};
+    }
+    // Columns [x, x + n) hold their words before the draw where nothing is there yet.
+    void materialise(int x, int n) {
+        if (m_whole) return;
+        int at = x;
+        const int end = std::min(x + n, m_width);
+        for (int i = 0; i < m_count && at < end; ++i) {
+            const auto [a, b] = m_spans[size_t(i)];
+            if (b <= at) continue;
+            if (a >= end) break;
+            if (a > at) copy(at, a);
+            at = std::max(at, b);
+        }
+        if (at < end) copy(at, end);
+        if (x <= 0 && x + n >= m_width) {
+            m_whole = true;
+            return;
+        }
+        mark(x, n);
+    }
+
+private:
+    static constexpr int kMaxSpans = 32;
+    bool overlaps(int a, int b) const {
+        for (int i = m_count - 1; i >= 0; --i) {
+            if (m_spans[size_t(i)].second <= a) return false;  // (ordered: the rest end before it too)
+            if (m_spans[size_t(i)].first < b) return true;
+        }
+        return false;
+    }
+    void copy(int a, int b) {
+        std::memcpy(m_target + 4 * size_t(a), m_source + 4 * size_t(a), 4 * size_t(b - a));
+    }
+    const uint8_t* m_source = nullptr;
+    uint8_t* m_target = nullptr;
+    int m_width = 0, m_count = 0;
+    bool m_whole = false;
+    std::array<std::pair<int, int>, kMaxSpans + 1> m_spans{};
+};
+
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is
-// filtered once per pixel row for all of them.
+// filtered once per pixel row for all of them. With `source`, each row of the target is first
+// the source's, as if copied before the draw: direct stores of copied and filled windows read
+// (ONE/ONE) the source's words where the draw has not written yet and write the target's, the
+// columns other paths write are copied just before, and the rest of the row after.
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats,
-                     const RowWindow* windows = nullptr, size_t windowCount = 0);
+                     const RowWindow* windows = nullptr, size_t windowCount = 0, const RowSource* source = nullptr);
 
 }  // namespace emu

@@ -349,43 +349,41 @@ inline void bytesGroups(int count, uint8_t* out, F f) {
     }
 }
 
-// 16 b g r a words (first: pixels 0-7, second: 8-15) to dst, or (Additive) added to its words
-// with saturation; fewer than 16 `words`: those alone, by masked loads and stores (dst is never
-// touched past them).
+// 16 b g r a words (first: pixels 0-7, second: 8-15) to dst, or (Additive) those added with
+// saturation to the words at `base` (dst, or the source of a copy into it not made yet); fewer
+// than 16 `words`: those alone, by masked loads and stores (neither is touched past them).
 template <bool Additive>
-inline void putWords(uint8_t* dst, __m256i first, __m256i second, int words) {
+inline void putWords(const uint8_t* base, uint8_t* dst, __m256i first, __m256i second, int words) {
     __m256i* d0 = reinterpret_cast<__m256i*>(dst);
     __m256i* d1 = reinterpret_cast<__m256i*>(dst + 32);
     if (words < 16) {
-        int* w0 = reinterpret_cast<int*>(d0);
-        int* w1 = reinterpret_cast<int*>(d1);
         const __m256i m0 = firstDwords(words), m1 = firstDwords(words - 8);
         if constexpr (Additive) {
-            first = _mm256_adds_epu8(first, _mm256_maskload_epi32(w0, m0));
-            second = _mm256_adds_epu8(second, _mm256_maskload_epi32(w1, m1));
+            first = _mm256_adds_epu8(first, _mm256_maskload_epi32(reinterpret_cast<const int*>(base), m0));
+            second = _mm256_adds_epu8(second, _mm256_maskload_epi32(reinterpret_cast<const int*>(base + 32), m1));
         }
-        _mm256_maskstore_epi32(w0, m0, first);
-        _mm256_maskstore_epi32(w1, m1, second);
+        _mm256_maskstore_epi32(reinterpret_cast<int*>(d0), m0, first);
+        _mm256_maskstore_epi32(reinterpret_cast<int*>(d1), m1, second);
         return;
     }
     if constexpr (Additive) {
-        first = _mm256_adds_epu8(first, _mm256_loadu_si256(d0));
-        second = _mm256_adds_epu8(second, _mm256_loadu_si256(d1));
+        first = _mm256_adds_epu8(first, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base)));
+        second = _mm256_adds_epu8(second, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(base + 32)));
     }
     _mm256_storeu_si256(d0, first);
     _mm256_storeu_si256(d1, second);
 }
 
 // Every group of 16 lanes of every channel as 16 b g r a words, each (word & keep) | set, stored
-// at dst + 4k or (Additive) added to its words with saturation (putWords: never past the count).
+// at dst + 4k or (Additive) added with saturation to base's (putWords: never past the count).
 template <bool Additive, typename F>
-inline void storeGroups(int count, uint32_t keep, uint32_t set, uint8_t* dst, F f) {
+inline void storeGroups(int count, uint32_t keep, uint32_t set, const uint8_t* base, uint8_t* dst, F f) {
     const __m256i none = _mm256_setzero_si256();
     const __m256i kv = _mm256_set1_epi32(int32_t(keep)), sv = _mm256_set1_epi32(int32_t(set));
     for (int k = 0; k < count; k += 16) {
         __m256i first, second;
         packWords(f(0, k), f(1, k), f(2, k), f(3, k), none, first, second);
-        putWords<Additive>(dst + 4 * k, _mm256_or_si256(_mm256_and_si256(first, kv), sv),
+        putWords<Additive>(base + 4 * k, dst + 4 * k, _mm256_or_si256(_mm256_and_si256(first, kv), sv),
                            _mm256_or_si256(_mm256_and_si256(second, kv), sv), count - k);
     }
 }
@@ -402,7 +400,7 @@ int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst
         __m256i first, second;
         packWords(ld(0), ld(1), ld(2), ld(3), om, first, second);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        putWords<Additive>(dst + 4 * i, first, second, count - i);  // (the last pixels: their words alone)
+        putWords<Additive>(dst + 4 * i, dst + 4 * i, first, second, count - i);  // (the last pixels: their words alone)
     }
     return count;
 }
@@ -448,7 +446,7 @@ int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* d
         __m256i first, second;
         packWords(ch[0], ch[1], ch[2], ch[3], om, first, second);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        putWords<false>(dst + 4 * i, first, second, count - i);  // (the sums are made: stored)
+        putWords<false>(dst + 4 * i, dst + 4 * i, first, second, count - i);  // (the sums are made: stored)
     }
     return count;
 }

@@ -111,23 +111,23 @@ inline void bytesGroups(int count, uint8_t* out, F f) {
 }
 
 // Every group of 32 lanes of every channel as 32 b g r a words (bytesGroups' order), each
-// (word & keep) | set, stored at dst + 4k or (Additive) added to its words with saturation; the
-// last pixels by masked loads and stores of their words alone (dst is never touched past the
+// (word & keep) | set, stored at dst + 4k or (Additive) added with saturation to base's words;
+// the last pixels by masked loads and stores of their words alone (neither is touched past the
 // count).
 template <bool Additive, typename F>
-inline void storeGroups(int count, uint32_t keep, uint32_t set, uint8_t* dst, F f) {
+inline void storeGroups(int count, uint32_t keep, uint32_t set, const uint8_t* base, uint8_t* dst, F f) {
     const __m512i firstHalf = _mm512_setr_epi64(0, 1, 8, 9, 2, 3, 10, 11);
     const __m512i secondHalf = _mm512_setr_epi64(4, 5, 12, 13, 6, 7, 14, 15);
     const __m512i kv = _mm512_set1_epi32(int32_t(keep)), sv = _mm512_set1_epi32(int32_t(set));
-    auto put = [&](uint8_t* p, __m512i w, int words) {
+    auto put = [&](int at, __m512i w, int words) {
         w = _mm512_or_si512(_mm512_and_si512(w, kv), sv);
         if (words >= 16) {
-            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_loadu_si512(p));
-            _mm512_storeu_si512(p, w);
+            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_loadu_si512(base + at));
+            _mm512_storeu_si512(dst + at, w);
         } else if (words > 0) {
             const __mmask16 m = __mmask16((1u << words) - 1);
-            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_maskz_loadu_epi32(m, p));
-            _mm512_mask_storeu_epi32(p, m, w);
+            if constexpr (Additive) w = _mm512_adds_epu8(w, _mm512_maskz_loadu_epi32(m, base + at));
+            _mm512_mask_storeu_epi32(dst + at, m, w);
         }
     };
     for (int k = 0; k < count; k += 32) {
@@ -137,8 +137,8 @@ inline void storeGroups(int count, uint32_t keep, uint32_t set, uint8_t* dst, F 
         const __m512i raPairs = _mm512_unpacklo_epi8(ra, _mm512_bsrli_epi128(ra, 8));
         const __m512i w0 = _mm512_unpacklo_epi16(bgPairs, raPairs);
         const __m512i w1 = _mm512_unpackhi_epi16(bgPairs, raPairs);
-        put(dst + 4 * k, _mm512_permutex2var_epi64(w0, firstHalf, w1), count - k);
-        put(dst + 4 * k + 64, _mm512_permutex2var_epi64(w0, secondHalf, w1), count - k - 16);
+        put(4 * k, _mm512_permutex2var_epi64(w0, firstHalf, w1), count - k);
+        put(4 * k + 64, _mm512_permutex2var_epi64(w0, secondHalf, w1), count - k - 16);
     }
 }
 

@@ -75,10 +75,11 @@ struct AlignedKernels {
     void (*verticalBytes)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
                           uint8_t* out);
     // The same words, each (word & keep) | set, stored at dst[0 .. count) or, with `additive`
-    // (ONE/ONE into an 8-bit target), added to dst's bytes with saturation, as storeRow stores
-    // and adds lanes; dst is never touched past its `count` words.
+    // (ONE/ONE into an 8-bit target), added with saturation to the bytes at `base` (dst itself,
+    // or the source of a copy into dst not made yet: RowSource), as storeRow stores and adds
+    // lanes; neither is touched past its `count` words.
     void (*verticalStore)(HKind kind, const uint16_t* const h0[4], const uint16_t* const h1[4], int32_t wy, int count,
-                          uint32_t keep, uint32_t set, bool additive, uint8_t* dst);
+                          uint32_t keep, uint32_t set, bool additive, const uint8_t* base, uint8_t* dst);
     // Texel bytes' rounded means, what a 1:1 tap at weight 0 or 128 each way filters:
     // out[i] = round_half_even((src[0][i] + ... + src[sources - 1][i]) / sources) for i in [0, n),
     // sources 2 or 4. Reads src[k][0, n) only; writes out[0, n) only.

@@ -236,6 +236,21 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     }
     std::vector<uint8_t>& bandCopied = dc.bandCopied;
     if (fused) bandCopied.assign((size_t(colorImage->height) + kBandRows - 1) / kBandRows, 0);
+    // A plain copy (one size, one 8-bit b g r a format) put off into the target of a draw by
+    // the fx row path (alignedDraw) is made by the draw itself on the bands it draws tile by tile
+    // (drawAlignedRows' RowSource): a direct store of a copied or filled window reads the
+    // source's words and writes the target's, so those columns are not copied first.
+    RowSource rowSource;
+    if (fused && colorImage->format->bytes == 4 && colorImage->format->cls == FormatClass::Unorm8 &&
+        fused->source.image->format == colorImage->format && fused->destRect.x0 == 0 && fused->destRect.y0 == 0 &&
+        fused->destRect.x1 == int64_t(colorImage->width) && fused->destRect.y1 == int64_t(colorImage->height) &&
+        fused->sourceRect.x1 - fused->sourceRect.x0 == int64_t(colorImage->width) &&
+        fused->sourceRect.y1 - fused->sourceRect.y0 == int64_t(colorImage->height)) {
+        rowSource.row0 = fused->source.image->texel(uint32_t(fused->sourceRect.x0), uint32_t(fused->sourceRect.y0));
+        rowSource.pitch = fused->source.image->rowPitch;
+        rowSource.width = int(colorImage->width);
+        rowSource.height = int(colorImage->height);
+    }
     auto copyBand = [&](int band) {
         if (bandCopied[size_t(band)]) return;  // (a band a chunk's earlier part reached)
         stretchImages(*fused, RowRange{int64_t(band) * kBandRows, int64_t(band + 1) * kBandRows});
@@ -578,7 +593,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                 std::vector<RowWindow> windows;
                 TileMemo memo;
                 // A band of a chunk drawn wholly by a row path, tile by tile (emu/tile_skip.h).
-                auto drawBandTiles = [&](int b, int by0, int by1) {
+                // True where it drew the band's rows (with `source`: every row then holds the
+                // copy under what was drawn); false where it drew nothing.
+                auto drawBandTiles = [&](int b, int by0, int by1, const RowSource* source) {
                     const TriangleSetup* bt[kMaxAlignedTriangles];
                     const AlignedTriangle* at[kMaxAlignedTriangles];
                     const FloatRowTriangle* ft[kMaxAlignedTriangles];
@@ -593,7 +610,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         ty0 = std::min(ty0, std::max(by0, setups[i].yMin));
                         ty1 = std::max(ty1, std::min(by1, setups[i].yMax));
                     }
-                    if (n == 0 || ty0 >= ty1) return;
+                    if (n == 0 || ty0 >= ty1) return false;
                     // The columns the band's triangles cover (a small quad decides only its own tiles).
                     int tx0 = clip.x1, tx1 = clip.x0;
                     for (size_t t = 0; t < n; ++t)
@@ -601,7 +618,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                             int xl = 0, xr = 0;
                             if (rowCoverage(*bt[t], y, xl, xr)) tx0 = std::min(tx0, xl), tx1 = std::max(tx1, xr);
                         }
-                    if (tx0 >= tx1) return;
+                    if (tx0 >= tx1) return false;
                     // Runs of tiles with one decision become the windows of one pass over the band's
                     // rows (each texel row the windows need is filtered once per pixel row).
                     windows.clear();
@@ -645,20 +662,24 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         ++runTiles;
                     }
                     if (runTiles) addRun(run, runX0, tx1, runTiles);
-                    if (windows.empty()) return;
+                    if (windows.empty()) return false;
                     if (floatDraw) {
                         drawFloatRows(floatRows, ft, bt, n, by0, by1, ws0.floatRows, as, windows.data(),
                                       windows.size());
                     } else {
-                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size());
+                        drawAlignedRows(aligned, at, bt, n, by0, by1, ws0.aligned, as, windows.data(), windows.size(),
+                                        source);
                     }
+                    return true;
                 };
                 for (;;) {
                     const int b = bandQueue.take(w);
                     if (b < 0) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
-                    if (fused) copyBand(firstBand + b);
+                    // (A band drawn tile by tile by the 8-bit row path makes its copy as it draws.)
+                    const bool sourced = (tiles || fixed) && alignedDraw && rowSource.row0 && !bandCopied[size_t(firstBand + b)];
+                    if (fused && !sourced) copyBand(firstBand + b);
                     // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
                     const AlignedTriangle* group[kMaxAlignedTriangles];
                     const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
@@ -672,7 +693,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         grouped = 0;
                     };
                     if (tiles || fixed) {
-                        drawBandTiles(b, by0, by1);
+                        if (!drawBandTiles(b, by0, by1, sourced ? &rowSource : nullptr) && sourced)
+                            copyBand(firstBand + b);  // (nothing drawn: copied now as before)
+                        if (sourced) bandCopied[size_t(firstBand + b)] = 1;
                         continue;
                     }
                     for (uint32_t k = bandStart[size_t(b)]; k < bandStart[size_t(b) + 1]; ++k) {

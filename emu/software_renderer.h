@@ -36,7 +36,9 @@ struct SoftwareRendererOptions {
     // A StretchRect onto a whole surface is put off until something reads or writes the
     // destination or writes the source; a draw into the destination then copies each band of
     // rows just before it draws them (the composite over a copied scene reads its target while
-    // the rows are in cache). Off: the copy is made by StretchRect. Either way the same bytes.
+    // the rows are in cache), or with the fx row path drawing tiles, makes the copy as it
+    // stores (drawAlignedRows' RowSource). Off: the copy is made by StretchRect. Either way the
+    // same bytes.
     bool putOffCopies = true;
 };
 

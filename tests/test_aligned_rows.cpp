@@ -907,8 +907,9 @@ TEST_CASE("aligned pass: verticalStore writes verticalBytes' words masked, store
     // A copied magnified tap goes from its H rows to the target as words (copyTexels). At every
     // level with vector kernels, for every H-row kind at vertical weights 0, 128 and others,
     // lengths around whole groups of 16 and 32: the words are verticalBytes', each
-    // (word & keep) | set, stored or (additive) added to the target's bytes with saturation; the
-    // words past the count keep their bytes.
+    // (word & keep) | set, stored or (additive) added with saturation to the bytes under them —
+    // the target's own, or another row's (a copy into the target not made yet, RowSource); the
+    // target's words past the count keep their bytes.
     testutil::forEachSimdLevel([](ps11::SimdLevel level) {
         const AlignedKernels* k = alignedKernels(level);
         if (!k) return;
@@ -935,13 +936,16 @@ TEST_CASE("aligned pass: verticalStore writes verticalBytes' words masked, store
                                      << ", keep " << keep << ", set " << set);
                         std::vector<uint8_t> words(4 * size_t(n + 32));
                         k->verticalBytes(kind, h0, h1, wy, n, words.data());
-                        std::vector<uint8_t> dst(4 * size_t(n) + 64), expect;
+                        std::vector<uint8_t> dst(4 * size_t(n) + 64), other(4 * size_t(n)), expect;
                         for (uint8_t& b : dst) b = uint8_t(rng());
+                        for (uint8_t& b : other) b = uint8_t(rng());
+                        const bool fromOther = rng() % 2;
+                        const uint8_t* const base = fromOther ? other.data() : dst.data();
                         expect = dst;
                         for (int i = 0; i < n; ++i) {
                             uint32_t w = 0, d = 0;
                             std::memcpy(&w, &words[4 * size_t(i)], 4);
-                            std::memcpy(&d, &expect[4 * size_t(i)], 4);
+                            std::memcpy(&d, base + 4 * size_t(i), 4);
                             w = (w & keep) | set;
                             if (additive)
                                 for (int b = 0; b < 4; ++b) {
@@ -950,10 +954,60 @@ TEST_CASE("aligned pass: verticalStore writes verticalBytes' words masked, store
                                 }
                             std::memcpy(&expect[4 * size_t(i)], &w, 4);
                         }
-                        k->verticalStore(kind, h0, h1, wy, n, keep, set, additive, dst.data());
+                        INFO((fromOther ? "under: another row" : "under: the target's"));
+                        k->verticalStore(kind, h0, h1, wy, n, keep, set, additive, base, dst.data());
                         REQUIRE(dst == expect);
                     }
     });
+}
+
+TEST_CASE("aligned pass: a row under a RowSource ends as if the copy had been made first", "[draw][aligned]") {
+    // SourcedRow against a model row that starts as the source: random sequences of direct
+    // stores (each word from the one under it, read where base() says, then mark()), other
+    // writes (materialise() first, then the word from the target's), and stores that back out
+    // after base() (then written as other writes), over rows of 1 to 400 columns, with more
+    // disjoint spans than the row keeps (32) now and then; the rest of the row at the end.
+    std::mt19937 rng(20261206);
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    for (int i = 0; i < 3000; ++i) {
+        const int w = uni(1, 400);
+        const size_t words = static_cast<size_t>(w);
+        std::vector<uint32_t> source(words), target(words), model(words);
+        for (uint32_t& v : source) v = uint32_t(rng());
+        for (uint32_t& v : target) v = uint32_t(rng());  // what the target held before the copy
+        model = source;
+        SourcedRow row;
+        row.start(reinterpret_cast<const uint8_t*>(source.data()), reinterpret_cast<uint8_t*>(target.data()), w);
+        const int ops = uni(0, 80);
+        const bool narrow = uni(0, 3) == 0;  // many short, scattered writes: spans past the 32 kept
+        for (int k = 0; k < ops; ++k) {
+            const int x = uni(0, w - 1), n = uni(1, std::min(w - x, narrow ? 3 : w));
+            const uint32_t mul = uint32_t(rng()) | 1u, add = uint32_t(rng());
+            const int kind = uni(0, 2);
+            INFO("case " << i << ", width " << w << ", op " << k << ": " << kind << " at " << x << " of " << n);
+            if (kind == 0) {
+                const uint8_t* base = row.base(x, n);
+                for (int j = 0; j < n; ++j) {
+                    uint32_t under = 0;
+                    std::memcpy(&under, base + 4 * size_t(j), 4);
+                    REQUIRE(under == model[size_t(x + j)]);
+                    target[size_t(x + j)] = under * mul + add;
+                }
+                row.mark(x, n);
+            } else {
+                if (kind == 2) (void)row.base(x, n);  // (a store that did not qualify)
+                row.materialise(x, n);
+                for (int j = 0; j < n; ++j) {
+                    REQUIRE(target[size_t(x + j)] == model[size_t(x + j)]);
+                    target[size_t(x + j)] = target[size_t(x + j)] * mul + add;
+                }
+            }
+            for (int j = 0; j < n; ++j) model[size_t(x + j)] = model[size_t(x + j)] * mul + add;
+        }
+        row.materialise(0, w);
+        INFO("case " << i << ", width " << w);
+        REQUIRE(target == model);
+    }
 }
 
 TEST_CASE("aligned pass: a 4:1 reduction's pair sums straight from the texel row equal the staged combine",
