@@ -7,14 +7,12 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "emu/format.h"
 #include "emu/fullscreen.h"
 #include "emu/thread_pool.h"
 #include "glare/scene.h"
+#include "glare/sensors_kernels.h"
 #include "glare/shader_library.h"
 
 namespace glare {
@@ -361,23 +359,6 @@ ImageError imageError(const emu::RgbaImage& a, const emu::RgbaImage& b) {
     return e;
 }
 
-void frameBytes(const float* in, size_t n, uint8_t* out) {
-    size_t i = 0;
-#if defined(__SSE2__)
-    // max(v, 0) is 0 for NaN (MAXPS returns its second operand); the product and the sum round
-    // as frameByte's float operations do, and the conversion truncates as its cast does.
-    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), k255 = _mm_set1_ps(255.0f), half = _mm_set1_ps(0.5f);
-    auto ints = [&](const float* p) {
-        const __m128 x = _mm_min_ps(_mm_max_ps(_mm_loadu_ps(p), zero), one);
-        return _mm_cvttps_epi32(_mm_add_ps(_mm_mul_ps(x, k255), half));
-    };
-    for (; i + 16 <= n; i += 16) {
-        const __m128i lo = _mm_packs_epi32(ints(in + i), ints(in + i + 4));
-        const __m128i hi = _mm_packs_epi32(ints(in + i + 8), ints(in + i + 12));
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm_packus_epi16(lo, hi));
-    }
-#endif
-    for (; i < n; ++i) out[i] = frameByte(in[i]);
-}
+void frameBytes(const float* in, size_t n, uint8_t* out) { sensorKernels(ps11::simdLevel()).frameBytes(in, n, out); }
 
 }  // namespace glare

@@ -1,7 +1,9 @@
-// The sprites technique's sensor row (glare/sprites.cpp): a kernel per SIMD level
-// (ps11/simd_dispatch.h), the same bits at every level. Internal to glare/sprites*.cpp.
+// The sprites technique's sensor row (glare/sprites.cpp) and the float frames' bytes
+// (glare::frameBytes): a kernel per SIMD level (ps11/simd_dispatch.h), the same bits at every
+// level. Internal to glare/sprites*.cpp and glare/runner.cpp.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "ps11/simd_dispatch.h"
@@ -14,6 +16,9 @@ struct SensorKernels {
     // `width` pixels, each a 32-bit word whose bytes at bit shifts rs, 8 and bs are r, g and b.
     // `fires` holds (width + 63) / 64 words, zero on entry.
     void (*fireRow)(const uint8_t* row, uint32_t width, int rs, int bs, float sumAtLeast, uint64_t* fires);
+    // frameBytes (glare/runner.h): out[i] = frameByte(in[i]) for i in [0, n), the same float
+    // operations (a float frame's rows before their sensors, ideal's frames read as bytes).
+    void (*frameBytes)(const float* in, size_t n, uint8_t* out);
 };
 
 const SensorKernels& sensorKernels(ps11::SimdLevel level);

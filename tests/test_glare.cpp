@@ -25,6 +25,7 @@
 #include "glare/scene.h"
 #include "glare/shader_library.h"
 #include "glare/stress.h"
+#include "simd_levels.h"
 #include "glare_test_util.h"
 #include "ps11/assembler.h"
 #include "ps11/validator.h"
@@ -276,7 +277,7 @@ TEST_CASE("glow: feedback decays by k per frame, and 8-bit rounding leaves a res
 
 TEST_CASE("frameBytes is frameByte for every float", "[glare]") {
     // Specials, the ends of [0, 1], every value near a rounding boundary, random bits; lengths
-    // around the vector block.
+    // around the vector blocks (16 and 32 values); at every SIMD level.
     std::vector<float> v = {NAN, -NAN, INFINITY, -INFINITY, 0.0f, -0.0f, 1.0f, 1.0001f, -1e-30f, 1e30f};
     for (int k = 0; k < 256; ++k) {
         const float b = (float(k) + 0.5f) / 255.0f;
@@ -289,15 +290,18 @@ TEST_CASE("frameBytes is frameByte for every float", "[glare]") {
         std::memcpy(&f, &bits, 4);
         v.push_back(i % 2 ? f : float(rng() % 70000) / 65536.0f);
     }
-    for (size_t n : {size_t(0), size_t(5), size_t(16), size_t(17), size_t(31), v.size()}) {
-        std::vector<uint8_t> got(n + 1, 0xAB);
-        glare::frameBytes(v.data(), n, got.data());
-        size_t bad = 0;
-        for (size_t i = 0; i < n; ++i) bad += got[i] != glare::frameByte(v[i]);
-        INFO("length " << n);
-        CHECK(bad == 0);
-        CHECK(got[n] == 0xAB);
-    }
+    testutil::forEachSimdLevel([&](ps11::SimdLevel) {
+        for (size_t n : {size_t(0), size_t(5), size_t(16), size_t(17), size_t(31), size_t(32), size_t(33), size_t(63),
+                         size_t(64), size_t(65), v.size()}) {
+            std::vector<uint8_t> got(n + 1, 0xAB);
+            glare::frameBytes(v.data(), n, got.data());
+            size_t bad = 0;
+            for (size_t i = 0; i < n; ++i) bad += got[i] != glare::frameByte(v[i]);
+            INFO("length " << n);
+            CHECK(bad == 0);
+            CHECK(got[n] == 0xAB);
+        }
+    });
 }
 
 TEST_CASE("runner: readTexture gives each texel as r g b a, into an image it reuses", "[glare]") {
