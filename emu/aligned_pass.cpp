@@ -101,11 +101,11 @@ inline uint32_t addBytesSaturated(uint32_t a, uint32_t b) {
 }
 
 template <bool Additive>
-void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
     for (int i = 0; i < count; ++i) {
         auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
         uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
-        if constexpr (Additive) w = addBytesSaturated(w, load32(dst + 4 * i));
+        if constexpr (Additive) w = addBytesSaturated(w, load32(base + 4 * i));
         std::memcpy(dst + 4 * i, &w, 4);
     }
 }
@@ -115,9 +115,9 @@ void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, uint8
 // one: G·(s + 16·d)·255 / G² = (s + 16·d) / 16).
 // Channel by channel over the lanes (count <= kMaxSpan), in loops the compiler vectorises.
 template <bool Additive>
-void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
     alignas(32) uint32_t old[ps11::kMaxSpan], out[ps11::kMaxSpan];
-    if constexpr (Additive) std::memcpy(old, dst, 4 * size_t(count));
+    if constexpr (Additive) std::memcpy(old, base, 4 * size_t(count));
     for (int i = 0; i < count; ++i) out[i] = orMask;
     for (int c = 0; c < 4; ++c) {
         const int shift = 8 * ps11::kUnorm8Byte[c];
@@ -134,26 +134,28 @@ void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, uin
     std::memcpy(dst, out, 4 * size_t(count));
 }
 
-// Stores (or adds, directAdd) n pixels of int16 lanes to a row of the 8-bit target: the level's
-// vector kernel (which reads the planes in whole groups of 16 lanes: theirs are kChunk or kMaxSpan
-// long), then whatever it left one by one.
-void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, uint8_t* row) {
+// Stores (or adds, directAdd, to the bytes at `base`: the row's own or a RowSource's) n pixels
+// of int16 lanes to a row of the 8-bit target: the level's vector kernel (which reads the planes
+// in whole groups of 16 lanes: theirs are kChunk or kMaxSpan long), then whatever it left one by
+// one.
+void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, const uint8_t* base,
+                uint8_t* row) {
     if (draw.fx12) {
-        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, row) : 0;
+        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, base, row) : 0;
         const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
         if (draw.directAdd)
-            storeRowScalar12<true>(rest, n - done, orMask, row + 4 * done);
+            storeRowScalar12<true>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
         else
-            storeRowScalar12<false>(rest, n - done, orMask, row + 4 * done);
+            storeRowScalar12<false>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
         return;
     }
     int done = 0;
-    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, row);
+    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, base, row);
     const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
     if (draw.directAdd)
-        storeRowScalar<true>(rest, n - done, orMask, row + 4 * done);
+        storeRowScalar<true>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
     else
-        storeRowScalar<false>(rest, n - done, orMask, row + 4 * done);
+        storeRowScalar<false>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
 }
 
 // n pixels' b g r a words from `src` to a row of the 8-bit target: each (word & keep) | set, or
@@ -723,7 +725,7 @@ const uint8_t* patchedRow(const AlignedDraw& draw, const AlignedTriangle& tri, c
         int16_t* const planes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
         filterTap(draw.kernels, false, tap, cols, row, tri.x0, c, e - c, planes);
         const int16_t* const lanes[4] = {sc.r0[0], sc.r0[1], sc.r0[2], sc.r0[3]};
-        const int stored = draw.kernels->storeRow(false, lanes, e - c, 0, dst);
+        const int stored = draw.kernels->storeRow(false, lanes, e - c, 0, dst, dst);
         for (int i = stored; i < e - c; ++i)
             for (int ch = 0; ch < 4; ++ch) dst[4 * i + ps11::kUnorm8Byte[ch]] = uint8_t(sc.r0[ch][i]);
         c = e;
@@ -789,11 +791,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
         const std::array<TapRow, 8>* rows;
         int x, y;
         uint8_t* out;
+        const uint8_t* under;  // what an additive store adds to: out, or a RowSource's row
         uint32_t orMask;
         int16_t* const* r0;
         QuadLevels* quadLevels;
         ps11::Sampler* sampler;
-    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, orMask, r0, &sc.quadLevels, sc.sampler};
+    } ctx{&draw, nullptr, nullptr, &rows, 0, 0, nullptr, nullptr, orMask, r0, &sc.quadLevels, sc.sampler};
     sc.quadLevels.used = 0;  // (a quad's two rows are drawn in one call: bands start on even rows)
     const ps11::TapFill fill = [](void* p, int tap, int first, int count, int16_t* const dst[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
@@ -807,7 +810,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     const ps11::ResultSink sink = [](void* p, int first, int count, const int16_t* const lanes[4]) {
         const FillCtx& f = *static_cast<const FillCtx*>(p);
         if (f.out) {
-            storeLanes(*f.draw, lanes, count, f.orMask, f.out + 4 * first);
+            storeLanes(*f.draw, lanes, count, f.orMask, f.under + 4 * first, f.out + 4 * first);
             return;
         }
         for (int c = 0; c < 4; ++c) std::memcpy(f.r0[c] + first, lanes[c], sizeof(int16_t) * size_t(count));
@@ -957,7 +960,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     const bool storeAsShaded = direct && !draw.fogFirst;
                     // (Under a RowSource: the columns written other than by the direct stores of
                     // copied and filled windows hold the source's words first.)
-                    if (fromSource && !(mode == RowMode::Copy && storeAsShaded) &&
+                    const bool shadeStored = mode == RowMode::Shade && !chain && storeAsShaded;
+                    if (fromSource && !(mode == RowMode::Copy && storeAsShaded) && !shadeStored &&
                         !(mode == RowMode::Fill && storeAsShaded && !(draw.fx12 && draw.directAdd)))
                         sourced.materialise(x, n);
                     if (mode == RowMode::Shade && chain) {
@@ -982,7 +986,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         in.uniformColor = fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
                         in.count = n;
                         ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
+                        ctx.under = fromSource && storeAsShaded ? sourced.base(x, n) : ctx.out;
                         ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
+                        if (fromSource && storeAsShaded) sourced.mark(x, n);
                         if (storeAsShaded) {
                             stats.pixels += uint64_t(n);
                             stats.written += uint64_t(n);
@@ -1022,7 +1028,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                                 ps11::fillLanes(lanes[c], 64, int16_t(window->grid[size_t(c)]));
                             const int16_t* const one[4] = {lanes[0], lanes[1], lanes[2], lanes[3]};
                             std::memset(fillWord, 0, sizeof fillWord);
-                            storeLanes(draw, one, 1, orMask, fillWord);
+                            storeLanes(draw, one, 1, orMask, fillWord, fillWord);
                             wordOf = window;
                         }
                         uint8_t* const at = target.texel(uint32_t(x), uint32_t(y));
@@ -1049,7 +1055,7 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                             for (int i = 0; i < n; ++i) sc.r0[c][i] = int16_t(sc.grid[c][i]);  // (in [0, G])
                     }
                     if (direct) {
-                        storeLanes(draw, r0c, n, orMask, row);
+                        storeLanes(draw, r0c, n, orMask, row, row);
                         stats.written += uint64_t(n);
                         continue;
                     }

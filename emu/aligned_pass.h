@@ -545,9 +545,9 @@ private:
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is
 // filtered once per pixel row for all of them. With `source`, each row of the target is first
-// the source's, as if copied before the draw: direct stores of copied and filled windows read
-// (ONE/ONE) the source's words where the draw has not written yet and write the target's, the
-// columns other paths write are copied just before, and the rest of the row after.
+// the source's, as if copied before the draw: direct stores (copied, filled and shaded windows)
+// read (ONE/ONE) the source's words where the draw has not written yet and write the target's,
+// the columns other paths write are copied just before, and the rest of the row after.
 void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris, const TriangleSetup* const* setups,
                      size_t count, int y0, int y1, AlignedScratch& scratch, AlignedStats& stats,
                      const RowWindow* windows = nullptr, size_t windowCount = 0, const RowSource* source = nullptr);

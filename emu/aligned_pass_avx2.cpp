@@ -393,40 +393,41 @@ inline void storeGroups(int count, uint32_t keep, uint32_t set, const uint8_t* b
 // Words of r0 (int16 r g b a planes) as b g r a bytes: clamp to [0, 255] and pack; `orMask`
 // is or-ed in (X8R8G8B8's X = 0xff). Additive: saturating byte add onto the target row.
 template <bool Additive>
-int storeRow(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+int storeRow(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
     const __m256i om = _mm256_set1_epi32(int32_t(orMask));
     for (int i = 0; i < count; i += 16) {
         auto ld = [&](int c) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r[c] + i)); };
         __m256i first, second;
         packWords(ld(0), ld(1), ld(2), ld(3), om, first, second);
         _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        putWords<Additive>(dst + 4 * i, dst + 4 * i, first, second, count - i);  // (the last pixels: their words alone)
+        putWords<Additive>(base + 4 * i, dst + 4 * i, first, second, count - i);  // (the last pixels: their words alone)
     }
     return count;
 }
 
-int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
-    return additive ? storeRow<true>(r, count, orMask, dst) : storeRow<false>(r, count, orMask, dst);
+int alignedStoreRowAvx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base,
+                        uint8_t* dst) {
+    return additive ? storeRow<true>(r, count, orMask, base, dst) : storeRow<false>(r, count, orMask, base, dst);
 }
 
 // fx12 words: each channel's grid value n clamped to [0, 4080] (additive: n + 16·d, the target
 // byte d, clamped again), then its byte round_half_even(n / 16) = (n + 7 + (n >> 4 & 1)) >> 4,
 // all in int16 lanes (at most 8160).
 template <bool Additive>
-int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
+int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
     const __m256i om = _mm256_set1_epi32(int32_t(orMask)), zero = _mm256_setzero_si256();
     const __m256i top = _mm256_set1_epi16(int16_t(ps11::gridScale(ps11::Precision::Fx12))),
                   seven = _mm256_set1_epi16(7), one = _mm256_set1_epi16(1);
     const __m256i m8 = _mm256_set1_epi32(0xff);
     for (int i = 0; i < count; i += 16) {
-        __m256i* d0 = reinterpret_cast<__m256i*>(dst + 4 * i);
-        __m256i* d1 = reinterpret_cast<__m256i*>(dst + 4 * i + 32);
         const bool tail = count - i < 16;
         const __m256i m0 = firstDwords(count - i), m1 = firstDwords(count - i - 8);
         __m256i old0 = zero, old1 = zero;
         if constexpr (Additive) {
-            old0 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d0), m0) : _mm256_loadu_si256(d0);
-            old1 = tail ? _mm256_maskload_epi32(reinterpret_cast<int*>(d1), m1) : _mm256_loadu_si256(d1);
+            const int* b0 = reinterpret_cast<const int*>(base + 4 * i);
+            const int* b1 = reinterpret_cast<const int*>(base + 4 * i + 32);
+            old0 = tail ? _mm256_maskload_epi32(b0, m0) : _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b0));
+            old1 = tail ? _mm256_maskload_epi32(b1, m1) : _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b1));
         }
         __m256i ch[4];
         for (int c = 0; c < 4; ++c) {
@@ -451,8 +452,9 @@ int storeRow12(const int16_t* const r[4], int count, uint32_t orMask, uint8_t* d
     return count;
 }
 
-int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst) {
-    return additive ? storeRow12<true>(r, count, orMask, dst) : storeRow12<false>(r, count, orMask, dst);
+int alignedStoreRow12Avx2(bool additive, const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base,
+                          uint8_t* dst) {
+    return additive ? storeRow12<true>(r, count, orMask, base, dst) : storeRow12<false>(r, count, orMask, base, dst);
 }
 
 }  // namespace

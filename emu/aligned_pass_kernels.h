@@ -88,10 +88,13 @@ struct AlignedKernels {
     // dst, or-ing orMask (additive: a saturating byte add onto what dst holds); returns how many
     // it stored (the caller stores the rest). The planes are read in whole groups of 16 lanes
     // (the lanes past `count` are ignored); dst is never touched past its `count` words.
-    int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+    // `base`: where an additive store reads the bytes it adds to (dst, or verticalStore's).
+    int (*storeRow)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base,
+                    uint8_t* dst);
     // The same for fx12 lanes: each channel's byte round_half_even(n / 16) of n clamped to
     // [0, 4080]; additive: of n + 16·(the target's byte), clamped again (the merger's ONE/ONE).
-    int (*storeRow12)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, uint8_t* dst);
+    int (*storeRow12)(bool additive, const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base,
+                      uint8_t* dst);
 };
 
 // The table of a level, or null (no vector kernels at that level).

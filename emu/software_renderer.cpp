@@ -237,9 +237,9 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     std::vector<uint8_t>& bandCopied = dc.bandCopied;
     if (fused) bandCopied.assign((size_t(colorImage->height) + kBandRows - 1) / kBandRows, 0);
     // A plain copy (one size, one 8-bit b g r a format) put off into the target of a draw by
-    // the fx row path (alignedDraw) is made by the draw itself on the bands it draws tile by tile
-    // (drawAlignedRows' RowSource): a direct store of a copied or filled window reads the
-    // source's words and writes the target's, so those columns are not copied first.
+    // the fx row path (alignedDraw) is made by the draw itself on the bands that path draws alone
+    // (drawAlignedRows' RowSource): a direct store reads the source's words and writes the
+    // target's, so those columns are not copied first.
     RowSource rowSource;
     if (fused && colorImage->format->bytes == 4 && colorImage->format->cls == FormatClass::Unorm8 &&
         fused->source.image->format == colorImage->format && fused->destRect.x0 == 0 && fused->destRect.y0 == 0 &&
@@ -677,19 +677,22 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                     if (b < 0) break;
                     const int by0 = (firstBand + b) * kBandRows;
                     const int by1 = by0 + kBandRows;
-                    // (A band drawn tile by tile by the 8-bit row path makes its copy as it draws.)
-                    const bool sourced = (tiles || fixed) && alignedDraw && rowSource.row0 && !bandCopied[size_t(firstBand + b)];
+                    // (A band the fx row path draws alone — tile by tile, or every triangle of a
+                    // chunk of at most kMaxAlignedTriangles taking it — makes its copy as it draws.)
+                    const bool sourced = (tiles || fixed || tileShape) && alignedDraw && rowSource.row0 &&
+                                         !bandCopied[size_t(firstBand + b)];
                     if (fused && !sourced) copyBand(firstBand + b);
                     // Consecutive aligned triangles go row by row together (emu/aligned_pass.h).
                     const AlignedTriangle* group[kMaxAlignedTriangles];
                     const FloatRowTriangle* floatGroup[kMaxAlignedTriangles];
                     const TriangleSetup* groupSetups[kMaxAlignedTriangles];
                     size_t grouped = 0;
-                    auto flush = [&] {
+                    auto flush = [&](const RowSource* source = nullptr) {
                         if (grouped && floatDraw)
                             drawFloatRows(floatRows, floatGroup, groupSetups, grouped, by0, by1, ws0.floatRows, as);
                         else if (grouped)
-                            drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as);
+                            drawAlignedRows(aligned, group, groupSetups, grouped, by0, by1, ws0.aligned, as, nullptr, 0,
+                                            source);
                         grouped = 0;
                     };
                     if (tiles || fixed) {
@@ -716,7 +719,10 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
                         else
                             rasterizeRows(s, by0, by1, used, wantZ, *span, emitFn);
                     }
-                    flush();
+                    // (tileShape: every triangle of the band is in this one group.)
+                    if (sourced && grouped == 0) copyBand(firstBand + b);  // (nothing to draw)
+                    flush(sourced ? &rowSource : nullptr);
+                    if (sourced) bandCopied[size_t(firstBand + b)] = 1;
                 }
                 // The draw's textures are not kept alive past it: a texture read in place would
                 // otherwise be copied on its next write (Device::prepareWrite).

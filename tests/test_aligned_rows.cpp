@@ -867,9 +867,10 @@ TEST_CASE("aligned pass: triangles of one mapping join on a row only where their
 
 TEST_CASE("aligned pass: the fx8 store kernels write the rule's words and nothing past the count", "[draw][aligned]") {
     // storeRow at every level with vector kernels, against the rule: each channel's byte at its
-    // b g r a position, orMask or-ed in, or (additive) the saturating byte sum with what the
-    // target holds; lengths around whole groups of 16 and 32, so every tail is masked; the
-    // words past the count keep their bytes.
+    // b g r a position, orMask or-ed in, or (additive) the saturating byte sum with what is under
+    // it (the target's own bytes, or another row's: a copy into the target not made yet,
+    // RowSource); lengths around whole groups of 16 and 32, so every tail is masked; the
+    // target's words past the count keep their bytes.
     testutil::forEachSimdLevel([](ps11::SimdLevel level) {
         const AlignedKernels* k = alignedKernels(level);
         if (!k) return;
@@ -881,21 +882,25 @@ TEST_CASE("aligned pass: the fx8 store kernels write the rule's words and nothin
                     alignas(64) int16_t planes[4][ps11::kMaxSpan];
                     for (auto& plane : planes)
                         for (int16_t& v : plane) v = int16_t(rng() % 256);
-                    std::vector<uint8_t> dst(4 * size_t(n) + 64), expect;
+                    std::vector<uint8_t> dst(4 * size_t(n) + 64), other(4 * size_t(n)), expect;
                     for (uint8_t& b : dst) b = uint8_t(rng());
+                    for (uint8_t& b : other) b = uint8_t(rng());
+                    const bool fromOther = rng() % 2;
+                    const uint8_t* const base = fromOther ? other.data() : dst.data();
+                    INFO((fromOther ? "under: another row" : "under: the target's"));
                     expect = dst;
                     for (int i = 0; i < n; ++i) {
                         uint32_t word = 0;
                         for (int c = 0; c < 4; ++c) {
                             const size_t at = 4 * size_t(i) + size_t(ps11::kUnorm8Byte[c]);
-                            const int v = additive ? std::min(255, planes[c][i] + expect[at]) : planes[c][i];
+                            const int v = additive ? std::min(255, planes[c][i] + base[at]) : planes[c][i];
                             word |= uint32_t(v) << (8 * ps11::kUnorm8Byte[c]);
                         }
                         word |= orMask;
                         for (int b = 0; b < 4; ++b) expect[4 * size_t(i) + size_t(b)] = uint8_t(word >> (8 * b));
                     }
                     const int16_t* const r[4] = {planes[0], planes[1], planes[2], planes[3]};
-                    const int done = k->storeRow(additive, r, n, orMask, dst.data());
+                    const int done = k->storeRow(additive, r, n, orMask, base, dst.data());
                     REQUIRE(done == n);
                     CHECK(dst == expect);
                 }
