@@ -297,7 +297,8 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
     // by tile: the draw makes the copy itself (RowSource) — its direct stores of copied and filled
     // windows read the source's words where nothing is drawn yet, every other write copies its
     // columns first, and the rest of each row is copied after. Random cases: sizes that end
-    // bands and groups anywhere, A8R8G8B8 and X8R8G8B8, a texture of zero, constant and random
+    // bands and groups anywhere, A8R8G8B8 and X8R8G8B8 (the scene now and then in the other
+    // one: a copy that converts, not made by the draw), a texture of zero, constant and random
     // blocks at 1:1 to 8x magnification, programs that copy, fill, shade or add zero, ONE/ONE or
     // not, fx8 and fx12, tiles skipped or not; one full-screen quad, a part of the target, or
     // two overlapping quads in one draw (the second adds onto the first). Against a device that
@@ -311,12 +312,15 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
         "ps_1_1\ntex t0\nadd r0, t0, c2\n",              // filled where the texture is zero
         "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c1, t0\n",  // two taps
     };
-    for (int i = 0; i < 40; ++i) {
+    for (int i = 0; i < 100; ++i) {
         // (Above kComparedResourceBytes, 64 KB: copies into the target may be put off.)
         const UINT w = UINT(uni(170, 330)), h = UINT(uni(100, 140));
         const int scale = 1 << uni(0, 3);
         const UINT tw = std::max(1u, w / UINT(scale)), th = std::max(1u, h / UINT(scale));
         const D3DFORMAT format = uni(0, 3) == 0 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8;
+        // Now and then the scene in the other format: a copy that converts, made band by band.
+        const D3DFORMAT sceneFormat =
+            uni(0, 5) == 0 ? (format == D3DFMT_X8R8G8B8 ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8) : format;
         const size_t program = size_t(uni(0, int(std::size(programs)) - 1));
         const bool add = uni(0, 3) != 0, skip = uni(0, 2) != 0, linear = uni(0, 3) != 0;
         const ps11::Precision precision = uni(0, 4) == 0 ? ps11::Precision::Fx12 : ps11::Precision::Fx8;
@@ -342,7 +346,8 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
             y0 = float(uni(0, int(h) / 3)), y1 = float(uni(int(h) / 2, int(h)));
         }
         INFO("case " << i << ": " << w << "x" << h << ", texture " << tw << "x" << th << ", " << programs[program]
-                     << (format == D3DFMT_X8R8G8B8 ? "X8R8G8B8" : "A8R8G8B8") << (add ? ", ONE/ONE" : "")
+                     << (format == D3DFMT_X8R8G8B8 ? "X8R8G8B8" : "A8R8G8B8")
+                     << (sceneFormat != format ? " from the other format" : "") << (add ? ", ONE/ONE" : "")
                      << (skip ? "" : ", no skipping") << (linear ? ", linear" : ", point") << ", "
                      << ps11::precisionName(precision) << ", shape " << shape);
         std::vector<uint8_t> seen[2];
@@ -355,7 +360,7 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
             o.software.timeTiles = false;
             Device dev(o);
             Handle src{}, out{}, tex{}, ps{};
-            REQUIRE(dev.CreateRenderTarget(w, h, format, 1, &src) == D3D_OK);
+            REQUIRE(dev.CreateRenderTarget(w, h, sceneFormat, 1, &src) == D3D_OK);
             REQUIRE(dev.CreateRenderTarget(w, h, format, 1, &out) == D3D_OK);
             REQUIRE(dev.CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
             D3DLOCKED_RECT lr{};
