@@ -958,8 +958,9 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     // (Fogged runs are stored once their lanes are fogged.)
                     const bool storeAsShaded = direct && !draw.fogFirst;
-                    // (Under a RowSource: the columns written other than by the direct stores of
-                    // copied and filled windows hold the source's words first.)
+                    // (Under a RowSource: columns written other than by a direct store — of a
+                    // copied, filled or shaded run, each reading sourced.base() — hold the
+                    // source's words first.)
                     const bool shadeStored = mode == RowMode::Shade && !chain && storeAsShaded;
                     if (fromSource && !(mode == RowMode::Copy && storeAsShaded) && !shadeStored &&
                         !(mode == RowMode::Fill && storeAsShaded && !(draw.fx12 && draw.directAdd)))
