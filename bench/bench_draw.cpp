@@ -58,6 +58,9 @@ struct QuadVertex {
 // a 480×270 glare magnified 4× (bilinear) × c0, added ONE/ONE onto the 1080p target.
 // CompositeCopy: the same with c0 = (1, 1, 1, 0), as glow, quarter and sprites set it: the program
 // copies its tap (r, g, b; alpha 0) whatever it reads, so every window is a copy.
+// CompositePutOff: CompositeCopy onto a StretchRect of a 1080p scene made just before it, as the
+// glare techniques' copy_scene and composite do: the renderer puts the copy off and the draw
+// makes it as it stores (docs/device.md "StretchRect"); the time is the copy's and the draw's.
 // Composite: a glare technique's last pass — the 1080p scene 1:1 (t0, point) and a 240×135 glare
 // texture magnified 8× (t1, bilinear), screen blend `mad r0, t1, 1-t0, t0`.
 // Rotated: the 1080p blur with its texture coordinates turned by 10 degrees about the centre (u
@@ -86,15 +89,17 @@ enum class Pass {
     Weighted4,
     CompositeAdd,
     CompositeCopy,
+    CompositePutOff,
     Rotated,
     Perspective,
     Dependent,
     Down2Mip,
     PerspectiveMip,
     PerspectiveTrilinear,
-    Down8Point
+    Down8Point,
+    Count  // (not a pass: how many there are)
 };
-constexpr int kPasses = 20;
+constexpr int kPasses = int(Pass::Count);
 
 // One device per (pass, threads), built once: the texture's sampler copy is made by a warm-up
 // draw, so iterations time the draw alone.
@@ -102,6 +107,7 @@ struct Scene {
     std::unique_ptr<Device> dev;
     std::vector<QuadVertex> quad;
     std::vector<emu::QuadVertex> ffpQuad;  // SpritesFfp (diffuse per vertex)
+    Handle target{}, putOffFrom{};         // CompositePutOff: the scene copied onto the target first
     bool ok = false;
 
     UINT w = kW, h = kH;
@@ -115,7 +121,8 @@ struct Scene {
         if (pass == Pass::Tiny) w = h = 1;
         // The texture: the target's size, or 1080p for the reductions.
         const bool down = pass == Pass::Down2 || pass == Pass::Down2Mip || pass == Pass::Down4 || pass == Pass::Down8Point;
-        const bool addGlare = pass == Pass::CompositeAdd || pass == Pass::CompositeCopy;
+        const bool putOff = pass == Pass::CompositePutOff;
+        const bool addGlare = pass == Pass::CompositeAdd || pass == Pass::CompositeCopy || putOff;
         const bool ffp = pass == Pass::SpritesFfp || pass == Pass::SpritesSmall;
         const UINT tw = down ? kW : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? w / 4 : w;
         const UINT th = down ? kH : pass == Pass::Sprites ? 32 : ffp ? 128 : addGlare ? h / 4 : h;
@@ -127,6 +134,16 @@ struct Scene {
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;
         if (dev->SetRenderTarget(0, rt) != D3D_OK) return;
+        target = rt;
+        if (putOff) {  // the scene: random bytes, lockable
+            if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 1, &putOffFrom) != D3D_OK) return;
+            D3DLOCKED_RECT sl;
+            if (dev->LockRect(putOffFrom, &sl, nullptr, 0) != D3D_OK) return;
+            std::mt19937 srng(7);
+            for (UINT y = 0; y < h; ++y)
+                for (UINT i = 0; i < w * 4; ++i) static_cast<uint8_t*>(sl.pBits)[size_t(y) * size_t(sl.Pitch) + i] = uint8_t(srng());
+            if (dev->UnlockRect(putOffFrom) != D3D_OK) return;
+        }
         if (dev->CreateTexture(tw, th, mip ? 0 : 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) != D3D_OK) return;
         D3DLOCKED_RECT lr;
         std::mt19937 rng(42);
@@ -201,7 +218,7 @@ struct Scene {
         }
         if (addGlare) {
             const float strength[4] = {0.8f, 0.8f, 0.8f, 0.8f}, copy[4] = {1, 1, 1, 0};
-            dev->SetPixelShaderConstantF(0, pass == Pass::CompositeCopy ? copy : strength, 1);
+            dev->SetPixelShaderConstantF(0, pass == Pass::CompositeAdd ? strength : copy, 1);
         }
         if (weighted || addGlare) {
             dev->SetRenderState(D3DRS_ALPHABLENDENABLE, 1);
@@ -274,6 +291,8 @@ struct Scene {
     }
 
     bool draw() {
+        if (putOffFrom != Handle{} && dev->StretchRect(putOffFrom, nullptr, target, nullptr, D3DTEXF_POINT) != D3D_OK)
+            return false;
         if (!ffpQuad.empty())
             return dev->DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(ffpQuad.size() / 3), ffpQuad.data(),
                                         sizeof(emu::QuadVertex)) == D3D_OK;
@@ -621,6 +640,11 @@ BENCHMARK_CAPTURE(BM_Draw, composite_add_1080p_x4_fx8, Pass::CompositeAdd)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK_CAPTURE(BM_Draw, composite_copy_1080p_x4_fx8, Pass::CompositeCopy)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Draw, composite_putoff_1080p_x4_fx8, Pass::CompositePutOff)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)

@@ -381,6 +381,10 @@ inline void storeGroups(int count, uint32_t keep, uint32_t set, const uint8_t* b
     const __m256i none = _mm256_setzero_si256();
     const __m256i kv = _mm256_set1_epi32(int32_t(keep)), sv = _mm256_set1_epi32(int32_t(set));
     for (int k = 0; k < count; k += 16) {
+        // (The lines ahead asked for: a RowSource's row and the target's come from memory.)
+        if constexpr (Additive) _mm_prefetch(reinterpret_cast<const char*>(base + 4 * k) + kPrefetchAhead, _MM_HINT_T0);
+        if (!Additive || base != dst)
+            _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * k) + kPrefetchAhead, _MM_HINT_T0);
         __m256i first, second;
         packWords(f(0, k), f(1, k), f(2, k), f(3, k), none, first, second);
         putWords<Additive>(base + 4 * k, dst + 4 * k, _mm256_or_si256(_mm256_and_si256(first, kv), sv),

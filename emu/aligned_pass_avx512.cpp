@@ -131,6 +131,13 @@ inline void storeGroups(int count, uint32_t keep, uint32_t set, const uint8_t* b
         }
     };
     for (int k = 0; k < count; k += 32) {
+        // (The lines ahead asked for: a RowSource's row and the target's come from memory.)
+        for (int line = 0; line < 128; line += 64) {
+            if constexpr (Additive)
+                _mm_prefetch(reinterpret_cast<const char*>(base + 4 * k + line) + kPrefetchAhead, _MM_HINT_T0);
+            if (!Additive || base != dst)
+                _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * k + line) + kPrefetchAhead, _MM_HINT_T0);
+        }
         const __m512i bg = _mm512_packus_epi16(f(2, k), f(1, k));
         const __m512i ra = _mm512_packus_epi16(f(0, k), f(3, k));
         const __m512i bgPairs = _mm512_unpacklo_epi8(bg, _mm512_bsrli_epi128(bg, 8));

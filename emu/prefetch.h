@@ -13,7 +13,8 @@ namespace emu {
 // Kernels reading a texel row ask for the line this many bytes ahead of the one they read (the
 // fx8 row path's deinterleave and 4:1 pair sums: past a row's end, the next texel row, which
 // such passes read next), and the stores of ONE/ONE sums the target's line this far ahead of
-// the one they read (the fx8 row path's store kernel: the 1080p composites −7 to −16 %; the float
+// the one they read (the fx8 row path's store kernels — lanes, `verticalStore`, the copied and
+// filled words — and the RowSource row they add to: the 1080p composites −7 to −16 %; the float
 // merger's sum into 8-bit targets: −2 to −6 %)…
 constexpr int kPrefetchAhead = 2048;
 // …and the float row path's decoding of a texel row where the row spans at least this many bytes
