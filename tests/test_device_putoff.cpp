@@ -100,6 +100,18 @@ struct Script {
     }
 };
 
+// Options of a device whose copies are put off or not, for the composite cases: two threads,
+// deterministic tile decisions (untimed), skipping on or off.
+DeviceOptions compositeOptions(ps11::Precision precision, bool putOff, bool skip) {
+    DeviceOptions o;
+    o.precision = precision;
+    o.software.threads = 2;
+    o.software.putOffCopies = putOff;
+    o.software.skipTiles = skip;
+    o.software.timeTiles = false;
+    return o;
+}
+
 // Runs `steps` on both devices; everything they read must be the same.
 template <class F>
 void bothWays(F steps) {
@@ -244,13 +256,7 @@ TEST_CASE("put-off copies: a magnified ONE/ONE composite over one, tiled or not,
             INFO(ps11::precisionName(p) << (skip ? "" : ", tiles not skipped"));
             std::vector<std::vector<uint8_t>> seen[2];
             for (const bool putOff : {true, false}) {
-                DeviceOptions o;
-                o.precision = p;
-                o.software.threads = 2;
-                o.software.putOffCopies = putOff;
-                o.software.skipTiles = skip;
-                o.software.timeTiles = false;
-                Device dev(o);
+                Device dev(compositeOptions(p, putOff, skip));
                 Handle scene{}, out{}, glow{}, glowLevel{}, sample{};
                 REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &scene) == D3D_OK);
                 REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &out) == D3D_OK);
@@ -352,13 +358,7 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
                      << ps11::precisionName(precision) << ", shape " << shape);
         std::vector<uint8_t> seen[2];
         for (const bool putOff : {true, false}) {
-            DeviceOptions o;
-            o.precision = precision;
-            o.software.threads = 2;
-            o.software.putOffCopies = putOff;
-            o.software.skipTiles = skip;
-            o.software.timeTiles = false;
-            Device dev(o);
+            Device dev(compositeOptions(precision, putOff, skip));
             Handle src{}, out{}, tex{}, ps{};
             REQUIRE(dev.CreateRenderTarget(w, h, sceneFormat, 1, &src) == D3D_OK);
             REQUIRE(dev.CreateRenderTarget(w, h, format, 1, &out) == D3D_OK);
