@@ -8,12 +8,14 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "emu/device.h"
 #include "emu/fullscreen.h"
+#include "runner/random_composite.h"
 
 using namespace emu;
 
@@ -99,18 +101,6 @@ struct Script {
         REQUIRE(dev.SetTexture(0, Handle::Null) == D3D_OK);
     }
 };
-
-// Options of a device whose copies are put off or not, for the composite cases: two threads,
-// deterministic tile decisions (untimed), skipping on or off.
-DeviceOptions compositeOptions(ps11::Precision precision, bool putOff, bool skip) {
-    DeviceOptions o;
-    o.precision = precision;
-    o.software.threads = 2;
-    o.software.putOffCopies = putOff;
-    o.software.skipTiles = skip;
-    o.software.timeTiles = false;
-    return o;
-}
 
 // Runs `steps` on both devices; everything they read must be the same.
 template <class F>
@@ -256,7 +246,7 @@ TEST_CASE("put-off copies: a magnified ONE/ONE composite over one, tiled or not,
             INFO(ps11::precisionName(p) << (skip ? "" : ", tiles not skipped"));
             std::vector<std::vector<uint8_t>> seen[2];
             for (const bool putOff : {true, false}) {
-                Device dev(compositeOptions(p, putOff, skip));
+                Device dev(ps11test::compositeDeviceOptions(p, skip, putOff));
                 Handle scene{}, out{}, glow{}, glowLevel{}, sample{};
                 REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &scene) == D3D_OK);
                 REQUIRE(dev.CreateRenderTarget(kW, kH, D3DFMT_A8R8G8B8, 1, &out) == D3D_OK);
@@ -302,114 +292,26 @@ TEST_CASE("put-off copies: a draw that makes the copy as it draws equals the cop
     // A whole copy of one 8-bit format put off into the target of a draw the row path draws tile
     // by tile: the draw makes the copy itself (RowSource) — its direct stores of copied and filled
     // windows read the source's words where nothing is drawn yet, every other write copies its
-    // columns first, and the rest of each row is copied after. Random cases: sizes that end
-    // bands and groups anywhere, A8R8G8B8 and X8R8G8B8 (the scene now and then in the other
-    // one: a copy that converts, not made by the draw), a texture of zero, constant and random
-    // blocks at 1:1 to 8x magnification, programs that copy, fill, shade or add zero, ONE/ONE or
-    // not, fx8 and fx12, tiles skipped or not; one full-screen quad, a part of the target, or
-    // two overlapping quads in one draw (the second adds onto the first). Against a device that
-    // makes copies at once, then the same target drawn again without a copy (the copy landed).
+    // columns first, and the rest of each row is copied after. 100 random cases
+    // (runner/random_composite.h: sizes that end bands and groups anywhere, A8R8G8B8 and X8R8G8B8,
+    // the scene now and then in the other one, a texture of zero, constant and random blocks at
+    // 1× to 8× magnification, programs that copy, fill, shade or add zero, ONE/ONE, none or
+    // SRCALPHA/INVSRCALPHA, fx8 and fx12, tiles skipped or not, one quad, a part of the target or
+    // two overlapping ones), each then drawn again without a copy (the copy landed). Against a
+    // device that makes copies at once, and one that draws 2×2 quads with the reference sampler.
     std::mt19937 rng(20261204);
-    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
-    const char* const programs[] = {
-        "ps_1_1\ntex t0\nmov r0, t0\n",
-        "ps_1_1\ntex t0\nmul r0, t0, c0\n",              // c0 = (1, 1, 1, 0): a copy of r, g, b
-        "ps_1_1\ntex t0\nmul r0, t0, c1\n",              // shaded
-        "ps_1_1\ntex t0\nadd r0, t0, c2\n",              // filled where the texture is zero
-        "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c1, t0\n",  // two taps
-    };
+    const std::function<uint32_t()> next = [&] { return uint32_t(rng()); };
     for (int i = 0; i < 100; ++i) {
-        // (Above kComparedResourceBytes, 64 KB: copies into the target may be put off.)
-        const UINT w = UINT(uni(170, 330)), h = UINT(uni(100, 140));
-        const int scale = 1 << uni(0, 3);
-        const UINT tw = std::max(1u, w / UINT(scale)), th = std::max(1u, h / UINT(scale));
-        const D3DFORMAT format = uni(0, 3) == 0 ? D3DFMT_X8R8G8B8 : D3DFMT_A8R8G8B8;
-        // Now and then the scene in the other format: a copy that converts, made band by band.
-        const D3DFORMAT sceneFormat =
-            uni(0, 5) == 0 ? (format == D3DFMT_X8R8G8B8 ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8) : format;
-        const size_t program = size_t(uni(0, int(std::size(programs)) - 1));
-        const bool add = uni(0, 3) != 0, skip = uni(0, 2) != 0, linear = uni(0, 3) != 0;
-        const ps11::Precision precision = uni(0, 4) == 0 ? ps11::Precision::Fx12 : ps11::Precision::Fx8;
-        const int shape = uni(0, 2);  // whole, part, two overlapping
-        std::vector<uint8_t> scene(size_t(w) * h * 4), texels(size_t(tw) * th * 4);
-        for (uint8_t& b : scene) b = uint8_t(rng());
-        // Blocks of zero (half of them), one constant or random texels, each what 2 by 2 tiles
-        // of 64 by 16 pixels read at this scale.
-        const UINT bw = std::max(1u, 128u / UINT(scale)), bh = std::max(1u, 32u / UINT(scale));
-        for (UINT by = 0; by < th; by += bh)
-            for (UINT bx = 0; bx < tw; bx += bw) {
-                const int kind = std::max(0, uni(-1, 2));
-                const uint32_t c = uint32_t(rng());
-                for (UINT y = by; y < std::min(th, by + bh); ++y)
-                    for (UINT x = bx; x < std::min(tw, bx + bw); ++x)
-                        for (int k = 0; k < 4; ++k)
-                            texels[(size_t(y) * tw + x) * 4 + size_t(k)] =
-                                kind == 0 ? 0 : kind == 1 ? uint8_t(c >> (8 * k)) : uint8_t(rng());
-            }
-        float x0 = -0.5f, y0 = -0.5f, x1 = float(w) - 0.5f, y1 = float(h) - 0.5f;
-        if (shape == 1) {
-            x0 = float(uni(0, int(w) / 3)) + 0.3f, x1 = float(uni(int(w) / 2, int(w))) - 0.2f;
-            y0 = float(uni(0, int(h) / 3)), y1 = float(uni(int(h) / 2, int(h)));
-        }
-        INFO("case " << i << ": " << w << "x" << h << ", texture " << tw << "x" << th << ", " << programs[program]
-                     << (format == D3DFMT_X8R8G8B8 ? "X8R8G8B8" : "A8R8G8B8")
-                     << (sceneFormat != format ? " from the other format" : "") << (add ? ", ONE/ONE" : "")
-                     << (skip ? "" : ", no skipping") << (linear ? ", linear" : ", point") << ", "
-                     << ps11::precisionName(precision) << ", shape " << shape);
-        std::vector<uint8_t> seen[2];
-        for (const bool putOff : {true, false}) {
-            Device dev(compositeOptions(precision, putOff, skip));
-            Handle src{}, out{}, tex{}, ps{};
-            REQUIRE(dev.CreateRenderTarget(w, h, sceneFormat, 1, &src) == D3D_OK);
-            REQUIRE(dev.CreateRenderTarget(w, h, format, 1, &out) == D3D_OK);
-            REQUIRE(dev.CreateTexture(tw, th, 1, 0, D3DFMT_A8R8G8B8, D3DPOOL_MANAGED, &tex) == D3D_OK);
-            D3DLOCKED_RECT lr{};
-            REQUIRE(dev.LockRect(src, &lr, nullptr, 0) == D3D_OK);
-            for (UINT y = 0; y < h; ++y)
-                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * UINT(lr.Pitch), &scene[size_t(y) * w * 4], w * 4);
-            REQUIRE(dev.UnlockRect(src) == D3D_OK);
-            REQUIRE(dev.LockRect(tex, 0, &lr, nullptr, 0) == D3D_OK);
-            for (UINT y = 0; y < th; ++y)
-                std::memcpy(static_cast<uint8_t*>(lr.pBits) + y * UINT(lr.Pitch), &texels[size_t(y) * tw * 4], tw * 4);
-            REQUIRE(dev.UnlockRect(tex, 0) == D3D_OK);
-            REQUIRE(dev.CreatePixelShaderFromText(programs[program], &ps) == D3D_OK);
-            REQUIRE(dev.SetPixelShader(ps) == D3D_OK);
-            const float c[12] = {1, 1, 1, 0, 0.5f, 0.25f, 0.75f, 1, 0.2f, 0.1f, 0.3f, 0.4f};
-            REQUIRE(dev.SetPixelShaderConstantF(0, c, 3) == D3D_OK);
-            for (DWORD s = 0; s < 2; ++s) {
-                REQUIRE(dev.SetTexture(s, tex) == D3D_OK);
-                for (D3DSAMPLERSTATETYPE f : {D3DSAMP_MINFILTER, D3DSAMP_MAGFILTER})
-                    REQUIRE(dev.SetSamplerState(s, f, linear ? D3DTEXF_LINEAR : D3DTEXF_POINT) == D3D_OK);
-            }
-            REQUIRE(dev.SetRenderState(D3DRS_ALPHABLENDENABLE, add ? 1 : 0) == D3D_OK);
-            REQUIRE(dev.SetRenderState(D3DRS_SRCBLEND, D3DBLEND_ONE) == D3D_OK);
-            REQUIRE(dev.SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE) == D3D_OK);
-            REQUIRE(dev.SetRenderTarget(0, out) == D3D_OK);
-            REQUIRE(dev.SetFVF(kQuadFvf) == D3D_OK);
-            std::vector<QuadVertex> v;
-            auto quad = [&](float a0, float b0, float a1, float b1) {
-                const float tu = (a1 - a0) / float(w), tv = (b1 - b0) / float(h);
-                const float u0 = (a0 + 0.5f) / float(w), v0 = (b0 + 0.5f) / float(h);
-                const auto q =
-                    halfPixelQuad(a0 + 0.5f, b0 + 0.5f, a1 + 0.5f, b1 + 0.5f,
-                                  {QuadCoords{u0, v0, u0 + tu, v0 + tv},
-                                   QuadCoords{u0 + 0.01f, v0, u0 + tu + 0.01f, v0 + tv}, QuadCoords{}, QuadCoords{}});
-                for (int k : {0, 1, 2, 2, 1, 3}) v.push_back(q[size_t(k)]);
-            };
-            quad(x0, y0, x1, y1);
-            if (shape == 2) quad(float(w) / 4, float(h) / 5, float(w) * 3 / 4, float(h) * 4 / 5);
-            for (int pass = 0; pass < 2; ++pass) {
-                if (pass == 0) REQUIRE(dev.StretchRect(src, nullptr, out, nullptr, D3DTEXF_POINT) == D3D_OK);
-                REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(v.size() / 3), v.data(), sizeof(QuadVertex)) ==
-                        D3D_OK);
-                REQUIRE(dev.LockRect(out, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
-                for (UINT y = 0; y < h; ++y) {
-                    const uint8_t* row = static_cast<const uint8_t*>(lr.pBits) + y * UINT(lr.Pitch);
-                    seen[putOff ? 0 : 1].insert(seen[putOff ? 0 : 1].end(), row, row + w * 4);
-                }
-                REQUIRE(dev.UnlockRect(out) == D3D_OK);
-            }
-        }
+        const ps11test::CompositeCase c = ps11test::randomComposite(next);
+        INFO("case " << i << ": " << c.describe());
+        std::vector<uint8_t> seen[3];
+        std::string error;
+        bool putOff = false;
+        REQUIRE(ps11test::drawComposite(c, ps11test::compositeDeviceOptions(c, true), seen[0], error, &putOff));
+        REQUIRE(putOff);
+        REQUIRE(ps11test::drawComposite(c, ps11test::compositeDeviceOptions(c, false), seen[1], error));
+        REQUIRE(ps11test::drawComposite(c, ps11test::compositeDeviceOptions(c, true, false), seen[2], error));
         REQUIRE(seen[0] == seen[1]);
+        REQUIRE(seen[0] == seen[2]);
     }
 }
