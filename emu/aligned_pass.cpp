@@ -1,6 +1,7 @@
 // Device stage: the aligned-pass path of DrawPrimitiveUP (emu/aligned_pass.h), drawing its rows
 // (the set-up, tables and joins are emu/aligned_setup.cpp; the per-worker H-row cache
-// emu/aligned_hrows.cpp): per-row filtering of each tap into int16 lanes (scalar for any
+// emu/aligned_hrows.cpp; the per-pixel attributes emu/aligned_attributes.cpp; the stores to 8-bit
+// targets emu/aligned_store.cpp): per-row filtering of each tap into int16 lanes (scalar for any
 // footprint, the SIMD level's vector kernels for runs of columns that step a fixed number of
 // texels with a fixed weight) or into words (chain rows), the pre-sampled executor run or the
 // chain-row one, and the stores. The blend is the exact sum Σ w·byte rounded once,
@@ -14,20 +15,14 @@
 #include <cstring>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
 #include "emu/aligned_pass_kernels.h"
+#include "emu/format.h"
 #include "ps11/fill_lanes.h"
 #include "ps11/texture_sampler_fast.h"
 
 namespace emu {
 
 namespace {
-
-// fx12's grid scale: an 8-bit texel b is the grid value 16·b, 255 is kG12.
-constexpr int32_t kG12 = ps11::gridScale(ps11::Precision::Fx12);
 
 // The filtered value of a four-texel sum t = Σ byte·weight (weights of 65536 in all, t < 2^24):
 // fx8 round_half_even(t / 65536); fx12 round_half_even(16·t / 65536) = round_half_even(t / 4096).
@@ -39,12 +34,6 @@ inline int32_t roundBlend(uint32_t t) {
 
 // Channel c (r g b a) of a b g r a word.
 inline uint32_t channel(uint32_t word, int c) { return (word >> (8 * ps11::kUnorm8Byte[c])) & 0xffu; }
-
-inline uint32_t load32(const uint8_t* p) {
-    uint32_t v;
-    std::memcpy(&v, p, 4);
-    return v;
-}
 
 // One row of one tap: the two texel rows (null = border), the vertical weight, and per config of
 // the tap the H-row planes of both texel rows (not ready: the tap's runs are filtered per pixel
@@ -89,129 +78,6 @@ void filterScalar(const AlignedTap& tap, const AlignedTriangle::Columns& cols, c
         int32_t v[4];
         filterTexel<Fx12>(tap, cols, row, first + i - colBase, v);
         for (int ch = 0; ch < 4; ++ch) out[ch][lane + i] = int16_t(v[ch]);
-    }
-}
-
-// The words' bytes added one by one, each sum saturated to 255 (ONE/ONE ADD into an 8-bit target).
-inline uint32_t addBytesSaturated(uint32_t a, uint32_t b) {
-    uint32_t s = 0;
-    for (int k = 0; k < 4; ++k)
-        s |= std::min<uint32_t>(((a >> (8 * k)) & 0xff) + ((b >> (8 * k)) & 0xff), 255u) << (8 * k);
-    return s;
-}
-
-template <bool Additive>
-void storeRowScalar(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
-    for (int i = 0; i < count; ++i) {
-        auto b = [&](int c) { return uint32_t(std::clamp<int>(r[c][i], 0, 255)); };
-        uint32_t w = b(2) | (b(1) << 8) | (b(0) << 16) | (b(3) << 24) | orMask;
-        if constexpr (Additive) w = addBytesSaturated(w, load32(base + 4 * i));
-        std::memcpy(dst + 4 * i, &w, 4);
-    }
-}
-
-// fx12: each channel's byte of its grid value saturated to [0, 4080]; additive (ONE/ONE ADD):
-// the byte of s + 16·d saturated, which is what the merger's exact blend rounds to (both factors
-// one: G·(s + 16·d)·255 / G² = (s + 16·d) / 16).
-// Channel by channel over the lanes (count <= kMaxSpan), in loops the compiler vectorises.
-template <bool Additive>
-void storeRowScalar12(const int16_t* const r[4], int count, uint32_t orMask, const uint8_t* base, uint8_t* dst) {
-    alignas(32) uint32_t old[ps11::kMaxSpan], out[ps11::kMaxSpan];
-    if constexpr (Additive) std::memcpy(old, base, 4 * size_t(count));
-    for (int i = 0; i < count; ++i) out[i] = orMask;
-    for (int c = 0; c < 4; ++c) {
-        const int shift = 8 * ps11::kUnorm8Byte[c];
-        const int16_t* __restrict rc = r[c];
-        for (int i = 0; i < count; ++i) {
-            int32_t n = rc[i] < 0 ? 0 : rc[i] > kG12 ? kG12 : rc[i];
-            if constexpr (Additive) {
-                n += int32_t((old[i] >> shift) & 0xffu) * 16;
-                n = n > kG12 ? kG12 : n;
-            }
-            out[i] |= unorm8OfFx12(n) << shift;
-        }
-    }
-    std::memcpy(dst, out, 4 * size_t(count));
-}
-
-// Stores (or adds, directAdd, to the bytes at `base`: the row's own or a RowSource's) n pixels
-// of int16 lanes to a row of the 8-bit target: the level's vector kernel (which reads the planes
-// in whole groups of 16 lanes: theirs are kChunk or kMaxSpan long), then whatever it left one by
-// one.
-void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, const uint8_t* base,
-                uint8_t* row) {
-    if (draw.fx12) {
-        const int done = draw.kernels ? draw.kernels->storeRow12(draw.directAdd, r, n, orMask, base, row) : 0;
-        const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
-        if (draw.directAdd)
-            storeRowScalar12<true>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
-        else
-            storeRowScalar12<false>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
-        return;
-    }
-    int done = 0;
-    if (draw.kernels) done = draw.kernels->storeRow(draw.directAdd, r, n, orMask, base, row);
-    const int16_t* const rest[4] = {r[0] + done, r[1] + done, r[2] + done, r[3] + done};
-    if (draw.directAdd)
-        storeRowScalar<true>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
-    else
-        storeRowScalar<false>(rest, n - done, orMask, base + 4 * done, row + 4 * done);
-}
-
-// n pixels' b g r a words from `src` to a row of the 8-bit target: each (word & keep) | set, or
-// with `additive` (ONE/ONE ADD) that added with saturation to the bytes at `base` (the row's own,
-// or a RowSource's), as storeRow stores lanes.
-void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool additive, const uint8_t* base,
-                uint8_t* dst) {
-    if (!additive && keep == ~0u && set == 0) {
-        std::memcpy(dst, src, size_t(n) * 4);
-        return;
-    }
-    int i = 0;
-#if defined(__SSE2__)
-    const __m128i k = _mm_set1_epi32(int32_t(keep)), sv = _mm_set1_epi32(int32_t(set));
-    // (One pass: the masked words are never read back from a copy just made, which the store
-    // buffer cannot forward from a string move.)
-    for (; i + 4 <= n; i += 4) {
-        if (i % 16 == 0) {  // (a line ahead of each row read or written: a 1080p composite's come from memory)
-            _mm_prefetch(reinterpret_cast<const char*>(src + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-            if (additive) _mm_prefetch(reinterpret_cast<const char*>(base + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-            if (!additive || base != dst)
-                _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        }
-        __m128i w = _mm_or_si128(_mm_and_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + 4 * i)), k), sv);
-        if (additive) w = _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(base + 4 * i)), w);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i), w);
-    }
-#endif
-    for (; i < n; ++i) {
-        uint32_t w = (load32(src + 4 * i) & keep) | set;
-        if (additive) w = addBytesSaturated(w, load32(base + 4 * i));
-        std::memcpy(dst + 4 * i, &w, 4);
-    }
-}
-
-// n pixels of a row of the 8-bit target set to the b g r a word `word`, or with `additive` that
-// word added with saturation to each at `base` (storeWords of n copies of it).
-void fillWords(const uint8_t word[4], int n, bool additive, const uint8_t* base, uint8_t* dst) {
-    const uint32_t w = load32(word);
-    int i = 0;
-#if defined(__SSE2__)
-    const __m128i v = _mm_set1_epi32(int32_t(w));
-    for (; i + 4 <= n; i += 4) {
-        if (i % 16 == 0) {  // (as storeWords)
-            if (additive) _mm_prefetch(reinterpret_cast<const char*>(base + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-            if (!additive || base != dst)
-                _mm_prefetch(reinterpret_cast<const char*>(dst + 4 * i) + kPrefetchAhead, _MM_HINT_T0);
-        }
-        __m128i out = v;
-        if (additive) out = _mm_adds_epu8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(base + 4 * i)), v);
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + 4 * i), out);
-    }
-#endif
-    for (; i < n; ++i) {
-        const uint32_t out = additive ? addBytesSaturated(w, load32(base + 4 * i)) : w;
-        std::memcpy(dst + 4 * i, &out, 4);
     }
 }
 
@@ -314,117 +180,6 @@ CopyRoute copyTexels(const AlignedDraw& draw, const AlignedTriangle& tri, const 
     }
     return CopyRoute::Blended;
 }
-
-}  // namespace
-
-namespace {
-
-// 1 / rhw at pixels x .. x + n − 1 of row y of a triangle with perspective, as the rasteriser
-// divides by it (rhw kept positive).
-void rowInverseW(const TriangleSetup& s, int x, int y, int n, float* inv) {
-    fillPlaneRow(s.rhw, s.ox, s.oy, x, y, n, inv);
-    for (int i = 0; i < n; ++i) inv[i] = inverseRhw(inv[i]);
-}
-
-// Attribute k at pixels x .. x + n − 1 of row y, as the rasteriser interpolates it: the constant,
-// or planeValue, times `inv` (rowInverseW) on a triangle with perspective.
-void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const float* inv, float* dst) {
-    if ((s.constMask >> k) & 1) {
-        ps11::fillLanes(dst, n, s.constValue[size_t(k)]);
-        return;
-    }
-    fillPlaneRow(s.attr[size_t(k)], s.ox, s.oy, x, y, n, dst);
-    if (s.perspective)
-        for (int i = 0; i < n; ++i) dst[i] *= inv[i];
-}
-
-}  // namespace
-
-void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int n, float* fogOut, float* zOut) {
-    if (z) fillPlaneRow(s.z, s.ox, s.oy, x, y, n, zOut);
-    if (!fog) return;
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
-    rowAttribute(s, kAttrSpecular + 3, x, y, n, inv, fogOut);
-}
-
-void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v) {
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
-    rowAttribute(s, attrTex(set, 0), x, y, n, inv, u);
-    rowAttribute(s, attrTex(set, 1), x, y, n, inv, v);
-}
-
-namespace {
-
-// Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
-// path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
-// kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16; a tap whose
-// level the level of detail picks through `sampler`, at its quads' levels.
-void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, QuadLevels& cache,
-                ps11::Sampler* sampler, int16_t* const dst[4]) {
-    const AlignedTap& tap = draw.taps[size_t(t)];
-    alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
-    rowCoords(s, tap.coordSet, x, y, n, u, v);
-    alignas(32) int32_t grid[4][ps11::kMaxSpan];
-    if (!((draw.levelTaps.mask >> t) & 1)) {
-        ps11::fastpath::Unorm8Run run;
-        run.texels = tap.texels;
-        run.width = tap.width, run.height = tap.height;
-        run.linear = tap.linear;
-        run.addressU = tap.addressU, run.addressV = tap.addressV;
-        run.borderWord = tap.borderWord;
-        run.scale = draw.fx12 ? 16 : 1;
-        int32_t* const g[4] = {grid[0], grid[1], grid[2], grid[3]};
-        draw.sample(run, n, u, v, g);
-    } else {
-        // Each pixel at the level, filter and mip blend its 2×2 quad picks (quadLevels), through
-        // the worker's sampler (the fast kernel over runs of one level, the reference over
-        // blends of two, as for the quad path).
-        const QuadLevels::Entry& e =
-            quadLevels(cache, s, t, tap.coordSet, *draw.levelTaps.texture[size_t(t)],
-                       *draw.levelTaps.sampler[size_t(t)], draw.levelTaps.fixed, draw.levelTaps.weights8,
-                       draw.target.color->width, x, y, n);
-        thread_local ps11::LevelChoice lanes[ps11::kMaxSpan];
-        for (int i = 0; i < n; ++i) lanes[i] = e.choice[size_t((x + i) >> 1)];
-        ps11::SampleRequest req;
-        req.stage = draw.plan.stage[size_t(t)];
-        req.count = n;
-        req.u = u, req.v = v;
-        req.levels = lanes;
-        req.precision = draw.fx12 ? ps11::Precision::Fx12 : ps11::Precision::Fx8;
-        ps11::SampleResult out;
-        for (int c = 0; c < 4; ++c) out.grid[c] = grid[c];
-        sampler->sample(req, out);
-    }
-    for (int c = 0; c < 4; ++c)
-        for (int i = 0; i < n; ++i) dst[c][i] = int16_t(grid[c][i]);
-}
-
-}  // namespace
-
-uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y, int n,
-                      float (*color)[ps11::kMaxSpan]) {
-    // (Called per span: most post-processing programs read no colour.)
-    const uint64_t used = colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular));
-    if (!used) return 0;
-    uint8_t uniform = 0;
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective && (used & ~s.constMask)) rowInverseW(s, x, y, n, inv);
-    for (int k = 0; k < 8; ++k) {
-        const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
-        if (!((used >> attr) & 1)) continue;
-        if ((s.constMask >> attr) & 1) {
-            color[k][0] = s.constValue[size_t(attr)];
-            uniform = uint8_t(uniform | (1u << k));
-            continue;
-        }
-        rowAttribute(s, attr, x, y, n, inv, color[k]);
-    }
-    return uniform;
-}
-
-namespace {
 
 // Sets the texel rows and vertical weight of `r` for the row's v (its H-row planes are the
 // caller's to set).

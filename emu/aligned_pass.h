@@ -541,6 +541,33 @@ private:
     std::array<std::pair<int, int>, kMaxSpans + 1> m_spans{};
 };
 
+// fx12's grid scale: an 8-bit texel b is the grid value 16·b, 255 is kG12.
+inline constexpr int32_t kG12 = ps11::gridScale(ps11::Precision::Fx12);
+
+// ---- stores to 8-bit targets (emu/aligned_store.cpp) ----
+
+// Stores (or adds, draw.directAdd, to the bytes at `base`: the row's own or a RowSource's) n
+// pixels of int16 lanes r g b a (| orMask) to a row of the 8-bit target.
+void storeLanes(const AlignedDraw& draw, const int16_t* const r[4], int n, uint32_t orMask, const uint8_t* base,
+                uint8_t* row);
+// n pixels' b g r a words from `src` to a row of the 8-bit target: each (word & keep) | set, or
+// with `additive` (ONE/ONE ADD) that added with saturation to the bytes at `base` (the row's own,
+// or a RowSource's), as storeLanes stores lanes.
+void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool additive, const uint8_t* base,
+                uint8_t* dst);
+// n pixels of a row of the 8-bit target set to the b g r a word `word`, or with `additive` that
+// word added with saturation to each at `base` (storeWords of n copies of it).
+void fillWords(const uint8_t word[4], int n, bool additive, const uint8_t* base, uint8_t* dst);
+
+// ---- per-pixel attributes (emu/aligned_attributes.cpp) ----
+
+// Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
+// path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same
+// kernel for a texture levelZeroOnly reads), its grid integers narrowed to int16; a tap whose
+// level the level of detail picks through `sampler`, at its quads' levels.
+void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, QuadLevels& cache,
+                ps11::Sampler* sampler, int16_t* const dst[4]);
+
 // Draws rows [y0, y1) of `count` prepared triangles (tris[i] with setups[i], in primitive
 // order): row by row, each row through every triangle in order. With `windows` (disjoint, in
 // column order), only their columns, each as it says; every texel row the windows need is

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "emu/d3d9types.h"
@@ -47,6 +48,12 @@ void encodeUnorm8(const FormatInfo& f, const std::array<uint8_t, 4>& rgba, uint8
 void encodeFloat(const FormatInfo& f, const std::array<float, 4>& rgba, uint8_t* p);
 // The texel word a packed (<= 32-bit) format stores at p, little endian.
 uint32_t loadWord(const uint8_t* p, uint32_t bytes);
+// The 32-bit word at p (any alignment), in the machine's byte order.
+inline uint32_t load32(const uint8_t* p) {
+    uint32_t w;
+    std::memcpy(&w, p, 4);
+    return w;
+}
 
 // IEEE half <-> float (round to nearest even, overflow to infinity): ps11/texture.h's, the one
 // conversion of the project.

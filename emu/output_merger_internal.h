@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "emu/format.h"
 #include "emu/merge_plan.h"
 #include "emu/output_merger.h"
 #include "ps11/precision.h"
@@ -42,11 +43,6 @@ inline bool cmpPass(uint32_t mask, T a, T b) {
     return (mask >> outcome) & 1u;
 }
 
-inline uint32_t load32(const uint8_t* p) {
-    uint32_t w;
-    std::memcpy(&w, p, 4);
-    return w;
-}
 inline void store32(uint8_t* p, uint32_t w) { std::memcpy(p, &w, 4); }
 
 // IEEE half <-> float by bits, round to nearest even; the same results as emu::floatToHalf /

@@ -1,4 +1,4 @@
-// Random draws for the row-path tests (test_aligned_pass.cpp, test_aligned_rows.cpp,
+// Random draws for the row-path tests (test_aligned_pass.cpp, test_aligned_rows.cpp, test_aligned_kernels.cpp,
 // test_tile_skip.cpp): one Case — target, four textures with their sampler states, program,
 // constants, vertices, blending, alpha test, write mask, scissor, fog and depth — drawn by a device,
 // and the checks that compare a row-path device with the quad path.

@@ -5,7 +5,7 @@
 // DeviceOptions::alignedPasses off, the aligned one at every SIMD level this CPU runs; the render
 // targets must be identical byte for byte, and the aligned device must really have taken the row
 // path (no helper lanes shaded). The cases are tests/aligned_cases.h's; the row paths' own
-// machinery is tested in test_aligned_rows.cpp, tile skipping in test_tile_skip.cpp.
+// machinery is tested in test_aligned_rows.cpp and test_aligned_kernels.cpp, tile skipping in test_tile_skip.cpp.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
