@@ -39,18 +39,28 @@ void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int
     rowAttribute(s, kAttrSpecular + 3, x, y, n, inv, fogOut);
 }
 
-void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v) {
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
+void tapCoords(const ps11::TapPlan& plan, int t, const TriangleSetup& s, int x, int y, int n, float* u, float* v) {
+    const int set = plan.coordSet[size_t(t)];
+    alignas(32) float invLanes[ps11::kMaxSpan];
+    const float* inv = nullptr;  // (read with perspective only)
+    if (s.perspective) rowInverseW(s, x, y, n, invLanes), inv = invLanes;
     rowAttribute(s, attrTex(set, 0), x, y, n, inv, u);
     rowAttribute(s, attrTex(set, 1), x, y, n, inv, v);
+    if (!plan.projected(t)) return;
+    alignas(32) float d[ps11::kMaxSpan];
+    rowAttribute(s, attrTex(set, plan.divisor[size_t(t)]), x, y, n, inv, d);
+    const bool zeroIsOne = (plan.zeroDivisorIsOne >> t) & 1;
+    for (int i = 0; i < n; ++i) {
+        u[i] = ps11::projectCoord(u[i], d[i], zeroIsOne);
+        v[i] = ps11::projectCoord(v[i], d[i], zeroIsOne);
+    }
 }
 
 void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, int y, int n, QuadLevels& cache,
                 ps11::Sampler* sampler, int16_t* const dst[4]) {
     const AlignedTap& tap = draw.taps[size_t(t)];
     alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
-    rowCoords(s, tap.coordSet, x, y, n, u, v);
+    tapCoords(draw.plan, t, s, x, y, n, u, v);
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     if (!((draw.levelTaps.mask >> t) & 1)) {
         ps11::fastpath::Unorm8Run run;
@@ -67,7 +77,7 @@ void sampleFree(const AlignedDraw& draw, const TriangleSetup& s, int t, int x, i
         // the worker's sampler (the fast kernel over runs of one level, the reference over
         // blends of two, as for the quad path).
         const QuadLevels::Entry& e =
-            quadLevels(cache, s, t, tap.coordSet, *draw.levelTaps.texture[size_t(t)],
+            quadLevels(cache, s, draw.plan, t, *draw.levelTaps.texture[size_t(t)],
                        *draw.levelTaps.sampler[size_t(t)], draw.levelTaps.fixed, draw.levelTaps.weights8,
                        draw.target.color->width, x, y, n);
         thread_local ps11::LevelChoice lanes[ps11::kMaxSpan];

@@ -349,6 +349,13 @@ const auto kLaneIndex = [] {
     return t;
 }();
 
+// Ones: every texture-coordinate set's third and fourth components on the row path.
+const auto kOnes = [] {
+    std::array<float, ps11::kMaxSpan> t{};
+    t.fill(1.0f);
+    return t;
+}();
+
 // An 8-bit tap sampled per pixel (a coordinate set that is not screen-aligned): the sampler's
 // own float kernel (ps11/texture_sampler_fast.h: the reference's addressing and lerps, u then v),
 // for lanes [0, n).
@@ -390,7 +397,7 @@ public:
         if ((m_tri->freeTaps >> t) & 1) {
             // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
             alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
-            rowCoords(*m_setup, tap->coordSet, m_x + int(req.u[0]), m_y, n, u, v);
+            tapCoords(m_draw.plan, t, *m_setup, m_x + int(req.u[0]), m_y, n, u, v);
             if ((m_draw.levelTaps.mask >> t) & 1) {
                 // Each pixel at the level, filter and mip blend its 2×2 quad picks (quadLevels):
                 // 8-bit texels at one level by the vector kernel, the rest (blends of two levels,
@@ -398,7 +405,7 @@ public:
                 const LevelTaps& lt = m_draw.levelTaps;
                 const ps11::Texture& tex = *lt.texture[size_t(t)];
                 const int x = m_x + int(req.u[0]);
-                const QuadLevels::Entry& e = quadLevels(*m_quadLevels, *m_setup, t, tap->coordSet, tex,
+                const QuadLevels::Entry& e = quadLevels(*m_quadLevels, *m_setup, m_draw.plan, t, tex,
                                                         *lt.sampler[size_t(t)], lt.fixed, lt.weights8,
                                                         m_draw.target.color->width, x, m_y, n);
                 thread_local ps11::LevelChoice lanes[ps11::kMaxSpan];
@@ -757,7 +764,12 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
         if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
         if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
     }
-    for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) in.texcoord[set][0] = kLaneIndex.data();
+    // (A projected read's divisor components are 1, so the executor hands the sampler the lane
+    // indices as they are; RowSampler divides the coordinates itself, tapCoords.)
+    for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) {
+        in.texcoord[set][0] = kLaneIndex.data();
+        in.texcoord[set][2] = in.texcoord[set][3] = kOnes.data();
+    }
     ps11::PixelOutputs outp;
     for (int c = 0; c < 4; ++c) outp.color[c] = sc.out[c];
     uint64_t texelsPerPixel = 0;

@@ -129,7 +129,7 @@ void setTapLevels(FloatRowDraw& draw, const TapLevels& levels);
 // Per-worker buffers, allocated once and kept by the worker.
 struct FloatRowScratch {
     // The worker's sampler, bound to the draw's textures and sampler states: it filters the taps
-    // sampled per pixel (their lanes' u and v from rowCoords, no quads: such a texture's level
+    // sampled per pixel (their lanes' u and v from tapCoords, no quads: such a texture's level
     // and filter never depend on them, levelZeroOnly). Set by the caller before drawFloatRows.
     ps11::Sampler* sampler = nullptr;
     alignas(32) float color[8][ps11::kMaxSpan];

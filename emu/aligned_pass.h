@@ -190,19 +190,21 @@ bool tableColumns(const TriangleSetup& s, int& x0, int& x1);
 bool rowPathColumns(const ps11::TapPlan& plan, const TriangleSetup& s, int& x0, int& x1);
 
 // The taps of `plan` among `bound` (bit per tap) that the row paths sample per pixel on the
-// triangle: a tap whose u has a dy or whose v has a dx (a rotated, sheared or transposed
-// mapping), and on a triangle with perspective every tap whose u or v is not constant. Each such
-// lane's u and v are the quad path's (rowCoords) and the sampler filters them as the quad path's
-// does: no tables, no H rows.
+// triangle: a projected read (TapPlan::divisor), a tap whose u has a dy or whose v has a dx (a
+// rotated, sheared or transposed mapping), and on a triangle with perspective every tap whose u
+// or v is not constant. Each such lane's u and v are the quad path's (tapCoords) and the sampler
+// filters them as the quad path's does: no tables, no H rows.
 uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s);
 // Both row paths' per-triangle condition, for any mapping of their taps: tableColumns.
 // 0: the triangle takes quads; 1: screen-aligned (screenAligned: every tap tabulated, tile
 // skipping may decide its tiles); 2: some tap sampled per pixel (freeTaps) or perspective.
 int rowPathKind(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup& s, int& x0, int& x1);
-// Coordinate set `set`'s u and v at pixels x .. x + n − 1 (n <= kMaxSpan) of row y, as the
-// rasteriser interpolates them: constant, planeValue, or with perspective planeValue of u·rhw
-// times 1 / rhw (the same float operations in the same order).
-void rowCoords(const TriangleSetup& s, int set, int x, int y, int n, float* u, float* v);
+// Tap t's u and v at pixels x .. x + n − 1 (n <= kMaxSpan) of row y as the executor samples
+// them: its coordinate set's, as the rasteriser interpolates them (constant, planeValue, or with
+// perspective planeValue of u·rhw times 1 / rhw: the same float operations in the same order), a
+// projected read's then divided by its divisor component, interpolated the same way
+// (ps11::projectCoord).
+void tapCoords(const ps11::TapPlan& plan, int t, const TriangleSetup& s, int x, int y, int n, float* u, float* v);
 
 // The columns two consecutive triangles' tables should share (their union), when both have
 // narrow tables that overlap: the two halves of a sprite's quad cover column ranges a pixel apart
@@ -315,11 +317,11 @@ bool levelZeroOnly(const ps11::Texture& tex, const ps11::SamplerState& ss);
 // not finite: the triangle is then shaded in quads.
 bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x1, TapLevels& out);
 // The level and filter of every 2×2 quad whose pixels include x .. x + n − 1 (n <= kMaxSpan) of
-// row y, for tap `tap` of triangle `s` (coordinate set `coordSet`, sampled per pixel): the quad
+// row y, for tap `tap` of `plan` on triangle `s` (sampled per pixel, at tapCoords): the quad
 // path's choice (ps11::chooseLevel, `fixed` and `weights8` as its sampler takes them) from the
 // coordinates of the quad's top-left, top-right and bottom-left pixels, chosen on the quad's first
 // row drawn and kept in `cache` for its other. Quad q = x / 2's is choice[q].
-const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
+const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, const ps11::TapPlan& plan, int tap,
                                     const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
                                     uint32_t width, int x, int y, int n);
 // Points each of draw.levelTaps at its level and filter in `levels` (before the triangles' tables

@@ -162,7 +162,7 @@ bool triangleLevels(const LevelTaps& taps, const TriangleSetup& s, int x0, int x
     return true;
 }
 
-const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, int tap, int coordSet,
+const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, const ps11::TapPlan& plan, int tap,
                                     const ps11::Texture& tex, const ps11::SamplerState& ss, bool fixed, bool weights8,
                                     uint32_t width, int x, int y, int n) {
     QuadLevels::Entry& e = cache.entry(&s, tap, width);
@@ -179,8 +179,8 @@ const QuadLevels::Entry& quadLevels(QuadLevels& cache, const TriangleSetup& s, i
     alignas(32) float ut[ps11::kMaxSpan], vt[ps11::kMaxSpan], ub[ps11::kMaxSpan], vb[ps11::kMaxSpan];
     for (int first = 2 * lo; first < 2 * hi + 2; first += ps11::kMaxSpan) {
         const int len = std::min(ps11::kMaxSpan, 2 * hi + 2 - first);
-        rowCoords(s, coordSet, first, qy, len, ut, vt);
-        rowCoords(s, coordSet, first, qy + 1, len, ub, vb);
+        tapCoords(plan, tap, s, first, qy, len, ut, vt);
+        tapCoords(plan, tap, s, first, qy + 1, len, ub, vb);
         for (int q = 0; q < len; q += 2) {
             const float tl[3] = {ut[q], vt[q], 0.0f}, tr[3] = {ut[q + 1], vt[q + 1], 0.0f}, bl[3] = {ub[q], vb[q], 0.0f};
             const size_t qi = size_t((first + q) >> 1);
@@ -212,6 +212,7 @@ void setTapLevels(AlignedDraw& draw, const TapLevels& levels) {
 bool screenAligned(const ps11::TapPlan& plan, const TriangleSetup& s) {
     if (s.perspective) return false;
     for (int i = 0; i < plan.count; ++i) {
+        if (plan.projected(i)) return false;
         const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
         if (!((s.constMask >> ku) & 1) && s.attr[size_t(ku)].dy != 0.0) return false;
         if (!((s.constMask >> kv) & 1) && s.attr[size_t(kv)].dx != 0.0) return false;
@@ -253,8 +254,9 @@ uint32_t freeTaps(const ps11::TapPlan& plan, uint32_t bound, const TriangleSetup
         if (!((bound >> i) & 1)) continue;
         const int ku = attrTex(plan.coordSet[size_t(i)], 0), kv = ku + 1;
         const bool cu = (s.constMask >> ku) & 1, cv = (s.constMask >> kv) & 1;
-        const bool free = s.perspective ? !(cu && cv)
-                                        : (!cu && s.attr[size_t(ku)].dy != 0.0) || (!cv && s.attr[size_t(kv)].dx != 0.0);
+        const bool free = plan.projected(i) ||
+                          (s.perspective ? !(cu && cv)
+                                         : (!cu && s.attr[size_t(ku)].dy != 0.0) || (!cv && s.attr[size_t(kv)].dx != 0.0));
         if (free) mask |= 1u << i;
     }
     return mask;
@@ -316,6 +318,7 @@ JoinPlan joinPlan(const TriangleSetup& s, const TriangleSetup& next, bool shared
         const int ku = attrTex(plan.coordSet[size_t(i)], 0);
         if (!sharedTables) add(ku);
         add(ku + 1);
+        if (plan.projected(i)) add(attrTex(plan.coordSet[size_t(i)], plan.divisor[size_t(i)]));
     }
     for (int k = 0; k < kAttrCount; ++k)
         if ((colorAttrs >> k) & 1) add(k);

@@ -237,15 +237,26 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
         if (!op.texture) continue;
         if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
         uint8_t set = op.stage;
+        int divisor = -1;
+        bool zeroIsOne = false;
         if (m_p.minor < 4) {
-            if (projectionDivisor(m_p.stages[op.stage]) >= 0) return false;
+            divisor = projectionDivisor(m_p.stages[op.stage]);
         } else {
             const DSrc& s = op.src[0];
-            if (s.kind != SrcKind::TexCoord || s.mod != SrcMod::None || s.sw[0] != 0 || s.sw[1] != 1) return false;
+            const bool divided = s.mod == SrcMod::Dz || s.mod == SrcMod::Dw;
+            if (s.kind != SrcKind::TexCoord || (s.mod != SrcMod::None && !divided) || s.sw[0] != 0 || s.sw[1] != 1)
+                return false;
             set = s.slot;
+            if (divided) {
+                divisor = s.mod == SrcMod::Dz ? 2 : 3;  // the raw component (coords14)
+                zeroIsOne = true;
+            }
         }
-        plan.stage[size_t(plan.count)] = op.stage;
-        plan.coordSet[size_t(plan.count)] = set;
+        const size_t i = size_t(plan.count);
+        plan.stage[i] = op.stage;
+        plan.coordSet[i] = set;
+        plan.divisor[i] = int8_t(divisor);
+        if (zeroIsOne) plan.zeroDivisorIsOne = uint8_t(plan.zeroDivisorIsOne | (1u << i));
         ++plan.count;
     }
     return true;

@@ -11,19 +11,29 @@
 namespace ps11 {
 
 // The texture reads of a program that can take its texels pre-sampled (tapPlan): tap i is the
-// i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy with no
-// projection and no dependency on other registers.
+// i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy, or where
+// divisor[i] >= 0 (a projected read) at (u, v) divided by that component of the same set
+// (projectCoord), with no dependency on other registers.
 struct TapPlan {
     int count = 0;
     std::array<uint8_t, 8> stage{};
     std::array<uint8_t, 8> coordSet{};
+    std::array<int8_t, 8> divisor{-1, -1, -1, -1, -1, -1, -1, -1};
+    uint8_t zeroDivisorIsOne = 0;  // bit i: tap i is ps_1_4's _dz/_dw (projectCoord)
+    bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
+
+// A projected read's coordinate c over its divisor d, as the executor divides it: ps_1_1–1_3's
+// D3DTTFF_PROJECTED c / d (spec §6.5, §7.5), ps_1_4's _dz/_dw (zeroIsOne) 1.0 where d is 0
+// (spec §2.4, §3.1).
+inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne && d == 0.0f ? 1.0f : c / d; }
 
 // Available when the program runs in an fx profile whose register values fit int16 (the fx8
 // fast path, or the generic path with round(M·G) <= 32767: fx8 up to M = 128, the radeon8500
-// class's fx12 with M = 8) and its only texture instructions are plain reads: `tex t#` in
-// ps_1_1–1_3 on a stage without D3DTTFF_PROJECTED (as set now by setStageState), `texld r#, t#`
-// in ps_1_4 (no _dz/_dw, .xy as written). Fills `plan` and returns true, else false.
+// class's fx12 with M = 8) and its only texture instructions are plain or projected reads:
+// `tex t#` in ps_1_1–1_3 (D3DTTFF_PROJECTED as set now by setStageState: the divisor
+// projectionDivisor names), `texld r#, t#` in ps_1_4 (.xy as written; _dz/_dw divide by the
+// set's raw z or w). Fills `plan` and returns true, else false.
 bool tapPlan(const Executor& executor, TapPlan& plan);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
 // is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with

@@ -10,6 +10,7 @@
 #endif
 
 #include "ps11/executor_internal.h"
+#include "ps11/executor_presampled_internal.h"
 
 namespace ps11::exec {
 namespace {
@@ -137,9 +138,9 @@ void staticCoords(const Profile& p, const RunState& st, int m, float* u, float* 
     if (divisor >= 0) {
         const float* q = texcoordLanes(st, m, divisor);
         for (int i = 0; i < n; ++i) {
-            u[i] = tu[i] / q[i];
-            v[i] = tv[i] / q[i];
-            w[i] = tw[i] / q[i];
+            u[i] = projectCoord(tu[i], q[i], false);
+            v[i] = projectCoord(tv[i], q[i], false);
+            w[i] = projectCoord(tw[i], q[i], false);
         }
     } else {
         std::memcpy(u, tu, sizeof(float) * size_t(n));
@@ -171,8 +172,8 @@ void coords14(const Profile& p, const RunState& st, const DSrc& s, float* c0, fl
         Lanes d;
         srcFloat(p, st, s, s.mod == SrcMod::Dz ? 2 : 3, d);
         for (int i = 0; i < st.n; ++i) {
-            c0[i] = d[i] == 0.0f ? 1.0f : c0[i] / d[i];
-            c1[i] = d[i] == 0.0f ? 1.0f : c1[i] / d[i];
+            c0[i] = projectCoord(c0[i], d[i], true);
+            c1[i] = projectCoord(c1[i], d[i], true);
         }
     }
 }

@@ -112,7 +112,37 @@ struct Case {
     bool zWrite = true;
     float zClear = 1.0f;
     std::vector<Vtx> depthVerts;
+    // Projected reads: each stage's D3DTSS_TEXTURETRANSFORMFLAGS, and per vertex of `verts` each
+    // set's third and fourth components (r, q). With `rq` the vertices carry four-component
+    // coordinates (depthVerts' r, q are 0 and 1).
+    std::array<DWORD, 4> transformFlags{};
+    std::vector<std::array<std::array<float, 2>, 4>> rq;
 };
+
+// A vertex with four-component coordinates (Case::rq).
+struct Vtx4 {
+    float x, y, z, rhw;
+    DWORD diffuse, specular;
+    float uvrq[4][4];
+};
+constexpr DWORD kFvf4 = D3DFVF_XYZRHW | D3DFVF_DIFFUSE | D3DFVF_SPECULAR | D3DFVF_TEX4 | D3DFVF_TEXCOORDSIZE4(0) |
+                        D3DFVF_TEXCOORDSIZE4(1) | D3DFVF_TEXCOORDSIZE4(2) | D3DFVF_TEXCOORDSIZE4(3);
+
+// `verts` with four-component coordinates: rq[i] for vertex i, or (0, 1) without rq.
+inline std::vector<Vtx4> withRq(const std::vector<Vtx>& verts, const std::vector<std::array<std::array<float, 2>, 4>>* rq) {
+    std::vector<Vtx4> out;
+    for (size_t i = 0; i < verts.size(); ++i) {
+        const Vtx& v = verts[i];
+        Vtx4 w{v.x, v.y, v.z, v.rhw, v.diffuse, v.specular, {}};
+        for (int s = 0; s < 4; ++s) {
+            w.uvrq[s][0] = v.uv[s][0], w.uvrq[s][1] = v.uv[s][1];
+            w.uvrq[s][2] = rq ? (*rq)[i][size_t(s)][0] : 0.0f;
+            w.uvrq[s][3] = rq ? (*rq)[i][size_t(s)][1] : 1.0f;
+        }
+        out.push_back(w);
+    }
+    return out;
+}
 
 // Depth and fog on a quarter of the cases each, from their own generator seeded by `rng`.
 inline void depthAndFog(std::mt19937& rng, Case& c) {
@@ -312,6 +342,7 @@ inline std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stat
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSU, t.addressU) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, t.addressV) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_BORDERCOLOR, t.border) == D3D_OK);
+        REQUIRE(dev.SetTextureStageState(s, D3DTSS_TEXTURETRANSFORMFLAGS, c.transformFlags[s]) == D3D_OK);
     }
     Handle ps{};
     REQUIRE(dev.CreatePixelShaderFromText(c.program.c_str(), &ps) == D3D_OK);
@@ -351,13 +382,20 @@ inline std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stat
         REQUIRE(dev.SetRenderState(D3DRS_ZFUNC, c.zFunc) == D3D_OK);
         REQUIRE(dev.SetRenderState(D3DRS_ZWRITEENABLE, c.zWrite ? 1 : 0) == D3D_OK);
     }
-    REQUIRE(dev.SetFVF(kFvf) == D3D_OK);
-    REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(c.verts.size() / 3), c.verts.data(), sizeof(Vtx)) == D3D_OK);
+    const bool four = !c.rq.empty();
+    REQUIRE((!four || c.rq.size() == c.verts.size()));
+    auto draw = [&](const std::vector<Vtx>& verts, bool withCoords) {
+        if (!four)
+            return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(verts.size() / 3), verts.data(), sizeof(Vtx));
+        const std::vector<Vtx4> v4 = withRq(verts, withCoords ? &c.rq : nullptr);
+        return dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(v4.size() / 3), v4.data(), sizeof(Vtx4));
+    };
+    REQUIRE(dev.SetFVF(four ? kFvf4 : kFvf) == D3D_OK);
+    REQUIRE(draw(c.verts, true) == D3D_OK);
     stats = dev.lastDrawStats();
     if (c.depth) {
         // The second draw's pixels pass or fail against what the first wrote.
-        REQUIRE(dev.DrawPrimitiveUP(D3DPT_TRIANGLELIST, UINT(c.depthVerts.size() / 3), c.depthVerts.data(),
-                                    sizeof(Vtx)) == D3D_OK);
+        REQUIRE(draw(c.depthVerts, false) == D3D_OK);
         const DrawStats& second = dev.lastDrawStats();
         stats.pixelsCovered += second.pixelsCovered;
         stats.pixelsWritten += second.pixelsWritten;

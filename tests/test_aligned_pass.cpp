@@ -497,3 +497,77 @@ TEST_CASE("aligned pass: rotated and perspective draws take the row path, in fx8
     quadOpt.precision = ps11::Precision::Fx12;
     check("fx12", fx12, true);
 }
+
+// Projected reads (ps11::TapPlan::divisor): each stage D3DTTFF_PROJECTED with COUNT3, COUNT4 or
+// COUNT0 (q), or no flag, and each vertex its sets' r and q (q anywhere in [−0.5, 2]: divisors
+// near and through 0 too); a third of the cases a ps_1_4 program reading through _dw.xyw. Any
+// mapping half the time, mip chains a third of the time. The row paths sample them per pixel at
+// the divided coordinates (tapCoords).
+void projectedReads(Case& c, std::mt19937& rng, bool chains) {
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    const DWORD flags[] = {0, D3DTTFF_PROJECTED | D3DTTFF_COUNT3, D3DTTFF_PROJECTED | D3DTTFF_COUNT4,
+                           D3DTTFF_PROJECTED};
+    for (DWORD& f : c.transformFlags) f = flags[rng() % 4];
+    const char* const dw[] = {
+        "ps_1_4\ntexld r0, t0_dw.xyw\ntexld r1, t1\nmul r0, r0, r1\n",
+        "ps_1_4\ntexld r2, t3_dw.xyw\ntexld r3, t2_dw.xyw\nmad r0, r2, c0, r3\n",
+        "ps_1_4\ntexld r1, t1_dw.xyw\nphase\ntexld r0, t0_dw.xyw\nlrp r0.rgb, c3, r0, r1\n",
+    };
+    if (rng() % 3 == 0) c.program = dw[rng() % 3];
+    if (chains) addMipChains(c, rng);
+    if (rng() & 1) anyMapping(c, rng);
+    c.rq.resize(c.verts.size());
+    for (auto& v : c.rq)
+        for (auto& set : v) set = {real(-1.0f, 2.0f), rng() % 8 == 0 ? real(-0.5f, 2.0f) : real(0.25f, 2.0f)};
+}
+
+TEST_CASE("aligned pass: projected reads take the row path and equal the quad path byte for byte", "[draw][aligned]") {
+    std::mt19937 rng(20261203);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng);
+        projectedReads(c, rng, i % 3 == 0);
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        rowOpt.software.skipTiles = (i % 3) == 1;  // (projected taps' tiles are never decided)
+        fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << " flags " << c.transformFlags[0] << " "
+                     << c.transformFlags[1] << " " << c.transformFlags[2] << " " << c.transformFlags[3]
+                     << " program:\n"
+                     << c.program);
+        testutil::forEachSimdLevel([&](ps11::SimdLevel) { requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath); });
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 7);
+}
+
+TEST_CASE("float row path: projected reads in float and ideal equal the quad path byte for byte", "[draw][aligned]") {
+    std::mt19937 rng(20261204);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 200; ++i) {
+        Case c = randomCase(rng, (i & 2) != 0);
+        projectedReads(c, rng, i % 3 == 0);
+        for (Case::Tex& t : c.tex) {
+            withoutNaNs(t.bytes, t.format);
+            for (std::vector<uint8_t>& level : t.mips) withoutNaNs(level, t.format);
+        }
+        DeviceOptions quadOpt, rowOpt;
+        quadOpt.software.alignedPasses = false;
+        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", flags "
+                     << c.transformFlags[0] << " " << c.transformFlags[1] << " " << c.transformFlags[2] << " "
+                     << c.transformFlags[3] << ", program:\n"
+                     << c.program);
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath);
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 7);
+}
