@@ -70,6 +70,8 @@ struct QuadVertex {
 // filter LINEAR, each pixel a blend of two levels where its quad's level of detail is above 0.
 // Perspective: the 1080p linear copy through a quad whose right edge has rhw ½ (perspective-
 // correct coordinates, divided per pixel).
+// Projected: the 1080p linear copy read through D3DTTFF_PROJECTED (COUNT4): each vertex's
+// coordinates (u·q, v·q, 0, q), q 1 on the left edge and 2 on the right, divided per pixel.
 // Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
 // `texld r1, r0` (the first lookup's colour as the coordinates of the second, bilinear, same
 // texture): spans of one row.
@@ -92,6 +94,7 @@ enum class Pass {
     CompositePutOff,
     Rotated,
     Perspective,
+    Projected,
     Dependent,
     Down2Mip,
     PerspectiveMip,
@@ -226,6 +229,10 @@ struct Scene {
             dev->SetRenderState(D3DRS_DESTBLEND, D3DBLEND_ONE);
         }
         dev->SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX4);
+        if (pass == Pass::Projected) {  // two sets of four components: the same 32 bytes a vertex
+            dev->SetFVF(D3DFVF_XYZRHW | D3DFVF_TEX2 | D3DFVF_TEXCOORDSIZE4(0) | D3DFVF_TEXCOORDSIZE4(1));
+            dev->SetTextureStageState(0, D3DTSS_TEXTURETRANSFORMFLAGS, D3DTTFF_PROJECTED | D3DTTFF_COUNT4);
+        }
         // The half-pixel quad; blur taps at ±0.5 texel diagonally (bilinear weights ½: each tap
         // averages a 2×2 block), the copy at the texel centres; Down4's taps at ±1 texel.
         const float k = pass == Pass::Down4 ? 1.0f : 0.5f;
@@ -284,6 +291,11 @@ struct Scene {
                 const float(*o)[2] = weighted ? wOff : off;
                 q.uv[s][0] = ru + (fourTaps ? o[s][0] / float(tw) : 0.0f);
                 q.uv[s][1] = rv + (fourTaps ? o[s][1] / float(th) : 0.0f);
+            }
+            if (pass == Pass::Projected) {  // set 0: (u·q, v·q, 0, q)
+                const float qv = c == 1 || c == 2 ? 2.0f : 1.0f;
+                q.uv[0][0] *= qv, q.uv[0][1] *= qv;
+                q.uv[1][0] = 0.0f, q.uv[1][1] = qv;
             }
             quad.push_back(q);
         }
@@ -716,6 +728,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_trilinear_1080p_fx8, Pass:
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_1080p_fx8, Pass::Perspective)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_projected_1080p_fx8, Pass::Projected)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
