@@ -2,6 +2,8 @@
 // coordinates, colours, fog and depth along a row span as the rasteriser interpolates them
 // (emu/raster.h planeValue, divided by rhw with perspective), and the taps sampled per pixel from
 // those coordinates (a rotated or perspective mapping, or a tap at its quads' mip levels).
+#include <cstring>
+
 #include "emu/aligned_pass.h"
 #include "ps11/fill_lanes.h"
 #include "ps11/texture_sampler_fast.h"
@@ -37,6 +39,23 @@ void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int
     alignas(32) float inv[ps11::kMaxSpan];
     if (s.perspective) rowInverseW(s, x, y, n, inv);
     rowAttribute(s, kAttrSpecular + 3, x, y, n, inv, fogOut);
+}
+
+bool rowKills(const ps11::TapPlan& plan, const TriangleSetup& s, int x, int y, int n, uint8_t* kept) {
+    alignas(32) float invLanes[ps11::kMaxSpan], c[ps11::kMaxSpan];
+    const float* inv = nullptr;  // (read with perspective only)
+    if (s.perspective) rowInverseW(s, x, y, n, invLanes), inv = invLanes;
+    std::memset(kept, 1, size_t(n));
+    for (int set = 0; set < 8; ++set) {
+        if (!((plan.killSets >> set) & 1)) continue;
+        for (int k = 0; k < 3; ++k) {
+            rowAttribute(s, attrTex(set, k), x, y, n, inv, c);
+            for (int i = 0; i < n; ++i) kept[i] &= uint8_t(!(c[i] < 0.0f));
+        }
+    }
+    uint8_t all = 1;
+    for (int i = 0; i < n; ++i) all &= kept[i];
+    return !all;
 }
 
 void tapCoords(const ps11::TapPlan& plan, int t, const TriangleSetup& s, int x, int y, int n, float* u, float* v) {

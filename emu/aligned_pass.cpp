@@ -709,6 +709,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     bool direct = draw.directStore || draw.directAdd;
                     const MergeState* mergeState = &draw.merge;
                     const uint8_t* live = nullptr;
+                    const bool kills = draw.plan.killSets && rowKills(draw.plan, s, x, y, n, sc.kept);
+                    if (kills) {  // merged over the pixels kept
+                        direct = false;
+                        live = sc.kept;
+                    }
                     if (draw.depthFirst) {
                         // The run's depth test first: stored here where every pixel passed.
                         for (int i = 0; i < n; ++i) sc.x[i] = x + i, sc.y[i] = y;
@@ -719,7 +724,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         zi.row = true;
                         fillRowFogDepth(s, false, true, x, y, n, nullptr, sc.z);
                         zi.z = sc.z;
-                        direct = depthTestFirst(draw.merge, zi, draw.target, sc.passed, nullptr);
+                        zi.live = live;
+                        direct = depthTestFirst(draw.merge, zi, draw.target, sc.passed, nullptr) && !kills;
                         mergeState = &draw.afterDepth;
                         live = direct ? nullptr : sc.passed;
                     }

@@ -85,8 +85,10 @@ struct AlignedDraw {
     MergeTarget target;
     bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
     // Stored here: an 8-bit target, no alpha test, all channels, and no blending (directStore) or
-    // ONE/ONE ADD on every channel (directAdd); under a depth test (depthFirst) only the runs whose
-    // every pixel passed it, which is tested before they are shaded (depthTestFirst), the others
+    // ONE/ONE ADD on every channel (directAdd), a run of a program with texkills only where none
+    // of its pixels is killed (rowKills: the others merged over the pixels kept); under a depth
+    // test (depthFirst) only the runs whose every pixel passed it, which is tested before they
+    // are shaded (depthTestFirst, over the pixels kept: a killed one writes no depth), the others
     // merged with `afterDepth` over the pixels that passed; under fog (fogFirst) once the run's
     // lanes are fogged as the merger fogs them (fogGridFirst).
     bool directStore = false;
@@ -293,6 +295,7 @@ struct AlignedScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
+    alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
     // Chain rows' taps formed into rows of their own (with room for verticalBytes' whole groups).
     alignas(32) uint8_t tapBytes[8][4 * (ps11::kMaxSpan + 32)];
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps
@@ -562,6 +565,11 @@ void storeWords(const uint8_t* src, int n, uint32_t keep, uint32_t set, bool add
 void fillWords(const uint8_t word[4], int n, bool additive, const uint8_t* base, uint8_t* dst);
 
 // ---- per-pixel attributes (emu/aligned_attributes.cpp) ----
+
+// The texkills of `plan` (TapPlan::killSets) at pixels x .. x + n − 1 of row y: kept[i] 0 where
+// a tested set's x, y or z, interpolated as the rasteriser interpolates it, is below 0 (as the
+// executor tests it: a NaN is kept), else 1. True when some pixel is killed.
+bool rowKills(const ps11::TapPlan& plan, const TriangleSetup& s, int x, int y, int n, uint8_t* kept);
 
 // Tap t's lanes for pixels x .. x + n − 1 (n <= kMaxSpan) of row y, sampled per pixel: the quad
 // path's u and v, filtered by the sampler's fast kernel (the quad path's sampler takes the same

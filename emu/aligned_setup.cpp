@@ -320,6 +320,9 @@ JoinPlan joinPlan(const TriangleSetup& s, const TriangleSetup& next, bool shared
         add(ku + 1);
         if (plan.projected(i)) add(attrTex(plan.coordSet[size_t(i)], plan.divisor[size_t(i)]));
     }
+    for (int set = 0; set < 8; ++set)
+        if ((plan.killSets >> set) & 1)
+            for (int k = 0; k < 3; ++k) add(attrTex(set, k));
     for (int k = 0; k < kAttrCount; ++k)
         if ((colorAttrs >> k) & 1) add(k);
     return jp;

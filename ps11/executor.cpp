@@ -175,6 +175,7 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
     int tap = 0;  // texture instructions so far (pre-sampled runs: the tap they read)
     for (const DOp& op : m_ops) {
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
+        if (op.op == Opcode::TexKill && st.fill) continue;  // (the caller tests TapPlan::killSets)
         if (op.texture && st.fill) {
             // A plain read (plainTaps): all four channels, clamped to ±M as sampled texels are.
             alignas(64) int16_t texels[4][kChunk];
@@ -235,6 +236,11 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
     plan = TapPlan{};
     for (const DOp& op : m_ops) {
         if (!op.texture) continue;
+        if (op.op == Opcode::TexKill) {
+            if (op.src[0].kind != SrcKind::TexCoord) return false;  // (r#: a register's value)
+            plan.killSets = uint8_t(plan.killSets | (1u << (op.src[0].slot & 7)));
+            continue;
+        }
         if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
         uint8_t set = op.stage;
         int divisor = -1;

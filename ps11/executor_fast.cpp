@@ -301,7 +301,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
         auto known = [&](const FastSrc& s, int c) { return (pos[s.slot] >> s.sw[size_t(c)]) & 1; };
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];
-            if (op.op == Opcode::Phase) continue;
+            if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (texkill writes nothing)
             if (op.texture) {
                 pos[op.dstSlot] = kMaskAll;
                 continue;
@@ -362,6 +362,7 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
     for (size_t i = 0; i < ops.size(); ++i) {
         const DOp& d = ops[i];
         if (d.op == Opcode::Phase) continue;
+        if (d.op == Opcode::TexKill) return;  // (chain rows store every pixel)
         if (d.texture) {
             if (head >= 0) return;  // a read after the arithmetic began
             tapOf[d.dstSlot] = int8_t(taps++);
@@ -490,7 +491,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
         int tap = 0;
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];
-            if (op.op == Opcode::Phase) continue;
+            if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (TapPlan::killSets)
             if (op.texture) {
                 // A plain read (tapPlan): the caller's texels, clamped to ±M as sampleInto does
                 // (a no-op for 8-bit texels when M >= 1).

@@ -20,6 +20,9 @@ struct TapPlan {
     std::array<uint8_t, 8> coordSet{};
     std::array<int8_t, 8> divisor{-1, -1, -1, -1, -1, -1, -1, -1};
     uint8_t zeroDivisorIsOne = 0;  // bit i: tap i is ps_1_4's _dz/_dw (projectCoord)
+    // Bit s: a texkill tests coordinate set s (TC[s].x, y, z < 0 kills the pixel); the caller
+    // tests it, pre-sampled runs skip the instruction.
+    uint8_t killSets = 0;
     bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
 
@@ -33,7 +36,8 @@ inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne &
 // class's fx12 with M = 8) and its only texture instructions are plain or projected reads:
 // `tex t#` in ps_1_1–1_3 (D3DTTFF_PROJECTED as set now by setStageState: the divisor
 // projectionDivisor names), `texld r#, t#` in ps_1_4 (.xy as written; _dz/_dw divide by the
-// set's raw z or w). Fills `plan` and returns true, else false.
+// set's raw z or w), and texkills of a coordinate set (`texkill t#`, any version: killSets).
+// Fills `plan` and returns true, else false.
 bool tapPlan(const Executor& executor, TapPlan& plan);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
 // is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with
