@@ -72,6 +72,8 @@ struct QuadVertex {
 // correct coordinates, divided per pixel).
 // Projected: the 1080p linear copy read through D3DTTFF_PROJECTED (COUNT4): each vertex's
 // coordinates (u·q, v·q, 0, q), q 1 on the left edge and 2 on the right, divided per pixel.
+// Kill: the 1080p linear copy with `texkill t1`, set 1's u running from −0.5 to 0.5 across the
+// screen: the left half of every row killed.
 // Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
 // `texld r1, r0` (the first lookup's colour as the coordinates of the second, bilinear, same
 // texture): spans of one row.
@@ -95,6 +97,7 @@ enum class Pass {
     Rotated,
     Perspective,
     Projected,
+    Kill,
     Dependent,
     Down2Mip,
     PerspectiveMip,
@@ -200,7 +203,9 @@ struct Scene {
             "mad r0, t3, c3, r0\n";
         const char* const kScale = "ps_1_1\ntex t0\nmul r0, t0, c0\n";
         const char* const kDependent = "ps_1_4\ntexld r0, t0\nphase\ntexld r1, r0\nmov r0, r1\n";
+        const char* const kKill = "ps_1_1\ntex t0\ntexkill t1\nmov r0, t0\n";
         if (dev->CreatePixelShaderFromText(pass == Pass::Dependent   ? kDependent
+                                           : pass == Pass::Kill      ? kKill
                                            : weighted                ? kWeighted4
                                            : addGlare                ? kScale
                                            : fourTaps                ? kBlur4
@@ -292,6 +297,7 @@ struct Scene {
                 q.uv[s][0] = ru + (fourTaps ? o[s][0] / float(tw) : 0.0f);
                 q.uv[s][1] = rv + (fourTaps ? o[s][1] / float(th) : 0.0f);
             }
+            if (pass == Pass::Kill) q.uv[1][0] = us[c] - 0.5f;  // set 1's u: killed where below 0
             if (pass == Pass::Projected) {  // set 0: (u·q, v·q, 0, q)
                 const float qv = c == 1 || c == 2 ? 2.0f : 1.0f;
                 q.uv[0][0] *= qv, q.uv[0][1] *= qv;
@@ -733,6 +739,11 @@ BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_perspective_1080p_fx8, Pass::Perspecti
     ->Unit(benchmark::kMillisecond)
     ->UseManualTime();
 BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_projected_1080p_fx8, Pass::Projected)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseManualTime();
+BENCHMARK_CAPTURE(BM_AlignedVsQuads, copy_texkill_half_1080p_fx8, Pass::Kill)
     ->Arg(1)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
