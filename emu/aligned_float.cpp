@@ -557,12 +557,12 @@ private:
 
 }  // namespace
 
-bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
+bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                          const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out) {
     if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
-    if (kills || !target.color || (wantZ && executor.writesDepth())) return false;
+    if (!target.color || (wantZ && executor.writesDepth())) return false;
     FloatRowDraw d;
     if (!ps11::plainTaps(executor, d.plan)) return false;
     d.serial = nextRowDrawSerial();
@@ -765,7 +765,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
         if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
     }
     // (A projected read's divisor components are 1, so the executor hands the sampler the lane
-    // indices as they are; RowSampler divides the coordinates itself, tapCoords.)
+    // indices as they are; RowSampler divides the coordinates itself, tapCoords. No texkill of
+    // the executor's kills a lane: x, y >= 0 and z 1; the runs test them, rowKills.)
     for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) {
         in.texcoord[set][0] = kLaneIndex.data();
         in.texcoord[set][2] = in.texcoord[set][3] = kOnes.data();
@@ -851,6 +852,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     mi.x = sc.x;
                     mi.y = sc.y;
                     mi.row = true;
+                    if (draw.plan.killSets && rowKills(draw.plan, s, x, y, n, sc.kept)) mi.live = sc.kept;
                     fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
                     mi.fog = draw.merge.fog ? sc.fog : nullptr;
                     mi.z = draw.wantZ ? sc.z : nullptr;

@@ -68,10 +68,10 @@ struct FloatRowDraw {
 };
 
 // Decides whether a draw can take the float row path (float or ideal precision, a program whose
-// texture reads are plain and on distinct stages, 2-D textures, no texkill and no depth written
-// by the program) and fills `out`. A texture whose level or filter the level of detail picks is
+// texture reads are plain or projected and on distinct stages, whose texkills test coordinate
+// sets (rowKills, per run), 2-D textures, no depth written by the program) and fills `out`. A texture whose level or filter the level of detail picks is
 // one of levelTaps: its triangles take the row path where triangleLevels finds one level.
-bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits, bool kills,
+bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                          const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out);
@@ -136,6 +136,7 @@ struct FloatRowScratch {
     alignas(32) float out[4][ps11::kMaxSpan];
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
+    alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
     // H rows: texel rows filtered horizontally over the triangle's columns, planar r g b a (4 ×
     // columns floats each), keyed by draw, column table and texel row, shared by every tap with
     // that table (a vertical blur's taps read each other's rows). Slots used by the pixel row

@@ -305,7 +305,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     // The float profiles' row path (emu/aligned_float.h), the same per-triangle decision.
     FloatRowDraw floatRows;
     const bool floatDraw = m_options.alignedPasses && !alignedDraw &&
-                           prepareFloatRowDraw(executor, precision, call.hardware.weightBits, kills, call.textures,
+                           prepareFloatRowDraw(executor, precision, call.hardware.weightBits, call.textures,
                                                call.samplers, merge, mtarget, wantZ, used, floatRows);
     std::vector<FloatRowTriangle>& floatTris = dc.chunk.floatTris;
     // Tiles the interval evaluator decides (emu/tile_skip.h), on chunks drawn wholly by a row path.

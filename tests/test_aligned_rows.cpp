@@ -205,7 +205,7 @@ TEST_CASE("float row path: texel rows kept by a worker never outlive their draw"
             std::array<ps11::SamplerState, 8> samplers{};
             MergeState merge;
             merge.precision = ps11::Precision::Float;
-            REQUIRE(prepareFloatRowDraw(*exec, ps11::Precision::Float, 0, false, none, samplers, merge,
+            REQUIRE(prepareFloatRowDraw(*exec, ps11::Precision::Float, 0, none, samplers, merge,
                                         MergeTarget{target, nullptr}, false, used, d));
             FloatRowTap& tap = d.taps[0];
             tap.bound = true;
