@@ -36,8 +36,12 @@ Runner::Runner(const RunnerOptions& options) : m_options(options) {
     if (!options.skip) device.software.skipTiles = false;
     m_device = std::make_unique<emu::Device>(device);
     m_pool = std::make_unique<TexturePool>(*m_device);
-    const D3DFORMAT f = intermediateFormat();
-    m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, f, D3DPOOL_DEFAULT, &m_scene);
+    m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT,
+                            &m_scene8);
+    if (intermediateFormat() != D3DFMT_A8R8G8B8)
+        m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, intermediateFormat(),
+                                D3DPOOL_DEFAULT, &m_sceneFloat);
+    m_scene = m_scene8;
     m_device->CreateTexture(options.width, options.height, 1, D3DUSAGE_RENDERTARGET, D3DFMT_A8R8G8B8, D3DPOOL_DEFAULT,
                             &m_output);
 }
@@ -54,53 +58,51 @@ bool Runner::setImage(const emu::RgbaImage& image, std::string& error) {
     f.height = image.height;
     f.rgba.resize(image.rgba.size());
     for (size_t i = 0; i < image.rgba.size(); ++i) f.rgba[i] = float(image.rgba[i]) / 255.0f;
-    return setImage(f, error);
+    return writeScene(f, m_scene8, error);  // (n/255 rounds back to n)
 }
 
 bool Runner::setImage(const emu::FloatImage& image, std::string& error) {
+    return writeScene(image, m_sceneFloat != Handle::Null ? m_sceneFloat : m_scene8, error);
+}
+
+bool Runner::writeScene(const emu::FloatImage& image, Handle scene, std::string& error) {
     if (image.width != m_options.width || image.height != m_options.height) {
         error = "the image is " + std::to_string(image.width) + "x" + std::to_string(image.height) + ", the run " +
                 std::to_string(m_options.width) + "x" + std::to_string(m_options.height);
         return false;
     }
-    const emu::SurfacePixels px = emu::surfacePixels(image, intermediateFormat());
+    D3DSURFACE_DESC desc{};
     Handle surface{};
-    if (m_device->GetSurfaceLevel(m_scene, 0, &surface) != D3D_OK) {
+    if (m_device->GetLevelDesc(scene, 0, &desc) != D3D_OK || m_device->GetSurfaceLevel(scene, 0, &surface) != D3D_OK) {
         error = m_device->lastError().message;
         return false;
     }
-    return emu::writeSurface(*m_device, surface, px, error);
+    if (!emu::writeSurface(*m_device, surface, emu::surfacePixels(image, desc.Format), error)) return false;
+    m_scene = scene;
+    return true;
+}
+
+D3DFORMAT Runner::sceneFormat() const {
+    return m_scene == m_sceneFloat && m_sceneFloat != Handle::Null ? intermediateFormat() : D3DFMT_A8R8G8B8;
 }
 
 bool Runner::renderScene(Scene& scene, int frame, int frameCount, double& milliseconds, std::string& error) {
     const auto start = std::chrono::steady_clock::now();
-    // Scenes draw into an A8R8G8B8 target (the back buffer); under ideal it is copied to the float scene.
+    // Scenes draw into an A8R8G8B8 target (the back buffer), which is the scene in every profile.
     Handle target{};
-    if (intermediateFormat() == D3DFMT_A8R8G8B8) {
-        if (m_device->GetSurfaceLevel(m_scene, 0, &target) != D3D_OK) {
-            error = m_device->lastError().message;
-            return false;
-        }
-        if (!scene.render(*m_device, target, frame, frameCount, error)) return false;
-    } else {
-        const Handle tex = m_pool->acquire({m_options.width, m_options.height, D3DFMT_A8R8G8B8}, error);
-        if (tex == Handle::Null) return false;
-        Handle dst{};
-        const bool ok = m_device->GetSurfaceLevel(tex, 0, &target) == D3D_OK &&
-                        scene.render(*m_device, target, frame, frameCount, error) &&
-                        m_device->GetSurfaceLevel(m_scene, 0, &dst) == D3D_OK &&
-                        m_device->StretchRect(target, nullptr, dst, nullptr, D3DTEXF_POINT) == D3D_OK;
-        if (!ok && error.empty()) error = m_device->lastError().message;
-        m_pool->release(tex);
-        if (!ok) return false;
+    if (m_device->GetSurfaceLevel(m_scene8, 0, &target) != D3D_OK) {
+        error = m_device->lastError().message;
+        return false;
     }
+    if (!scene.render(*m_device, target, frame, frameCount, error)) return false;
+    m_scene = m_scene8;
     milliseconds = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return true;
 }
 
 FrameDependence Runner::buildFrame(const Technique& technique, const Settings& settings, int frame, int frameCount,
                                    PassGraph& graph) {
-    const TextureId scene = graph.import("scene", {m_options.width, m_options.height, intermediateFormat()}, m_scene, false);
+    const TextureId scene = graph.import("scene", {m_options.width, m_options.height, sceneFormat()}, m_scene, false);
     const TextureId output = graph.import("output", {m_options.width, m_options.height, D3DFMT_A8R8G8B8}, m_output, true);
     FrameBuild fb{graph, *this, settings, scene, output, frame, frameCount, intermediateFormat(),
                   m_device->hardware().precision};
@@ -122,7 +124,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
     const StillFrame& still = m_still;
     if (reuses() && !hook && !built && still.valid && (!still.askedFirst || still.first == (frame == 0)) &&
         still.technique == &technique &&
-        still.techniqueName == technique.name() && still.settings == settings &&
+        still.techniqueName == technique.name() && still.settings == settings && still.scene == m_scene &&
         m_device->contentGeneration(m_scene) == still.sceneGeneration &&
         m_device->contentGeneration(m_output) == still.outputGeneration) {
         result.passes = still.passes;
@@ -156,6 +158,7 @@ bool Runner::runFrame(const Technique& technique, const Settings& settings, int 
                              &technique,
                              std::string(technique.name()),
                              settings,
+                             m_scene,
                              m_device->contentGeneration(m_scene),
                              m_device->contentGeneration(m_output),
                              result.passes};

@@ -72,9 +72,14 @@ public:
     uint32_t height() const { return m_options.height; }
     // A8R8G8B8 for the fx profiles and `float`; A32B32G32R32F under `ideal`.
     D3DFORMAT intermediateFormat() const;
+    // The scene's: A8R8G8B8, or intermediateFormat() where a float image went to the float scene.
+    D3DFORMAT sceneFormat() const;
 
     // The scene input: an 8-bit image, a float image (ideal takes values above 1 as they are;
-    // other profiles see them clamped and rounded to 8 bits), or a built-in scene's frame.
+    // other profiles see them clamped and rounded to 8 bits), or a built-in scene's frame. An
+    // 8-bit input (an 8-bit image, a built-in scene) stays in an A8R8G8B8 scene in every profile:
+    // its texels read as the same n/255 they would in a float scene, and ideal's frame moves a
+    // quarter of the bytes to read it; a float image under ideal takes an A32B32G32R32F scene.
     bool setImage(const emu::RgbaImage& image, std::string& error);
     bool setImage(const emu::FloatImage& image, std::string& error);
     bool renderScene(Scene& scene, int frame, int frameCount, double& milliseconds, std::string& error);
@@ -93,7 +98,7 @@ public:
     // The Graphviz of the last frame's graph as it ran (with the aliasing it got); empty unless
     // RunnerOptions::graphviz.
     const std::string& lastGraphviz() const { return m_lastGraphviz; }
-    emu::Handle sceneTexture() const { return m_scene; }
+    emu::Handle sceneTexture() const { return m_scene; }  // the current input's (setImage, renderScene)
     emu::Handle outputTexture() const { return m_output; }
     // Level 0 of a texture as 8-bit r g b a (float channels by frameByte), read where the device
     // keeps it (readPixels). The overloads taking an image reuse its buffer: a frame loop that
@@ -149,13 +154,17 @@ public:
     TexturePool& pool() { return *m_pool; }
 
 private:
+    // Writes `image` into `scene` (in its format) and makes it the current scene.
+    bool writeScene(const emu::FloatImage& image, emu::Handle scene, std::string& error);
+
     RunnerOptions m_options;
     std::unique_ptr<emu::Device> m_device;
     std::unique_ptr<TexturePool> m_pool;
     PassMemo m_memo;  // with RunnerOptions::skip: what runFrame keeps between frames
     std::map<std::string, std::shared_ptr<void>> m_kept;  // kept()
     std::shared_ptr<emu::ThreadPool> m_cpuPool;             // cpuPool() where the renderer has no workers
-    emu::Handle m_scene{}, m_output{};
+    emu::Handle m_scene8{}, m_sceneFloat{};  // the 8-bit scene; the float one (ideal only)
+    emu::Handle m_scene{}, m_output{};       // m_scene: the one the last input went to
     std::map<std::string, emu::Handle> m_shaders;
     std::map<std::string, std::pair<emu::Handle, TextureDesc>> m_persistent;
     std::string m_persistentError;
@@ -169,6 +178,7 @@ private:
         const Technique* technique = nullptr;
         std::string techniqueName;  // (an object made where another was has another name, or is the same technique)
         Settings settings;
+        emu::Handle scene{};
         uint64_t sceneGeneration = 0, outputGeneration = 0;
         std::vector<PassStats> passes;
     } m_still;
