@@ -181,6 +181,21 @@ inline void withoutNaNs(std::vector<uint8_t>& bytes, D3DFORMAT f) {
     }
 }
 
+// Every texture of case c, every level, without NaNs.
+inline void withoutNaNs(Case& c) {
+    for (Case::Tex& t : c.tex) {
+        withoutNaNs(t.bytes, t.format);
+        for (std::vector<uint8_t>& level : t.mips) withoutNaNs(level, t.format);
+    }
+}
+
+// The two devices of a differential case i: the quad path (row paths off) and the row paths,
+// both on one thread or (odd i) two.
+inline void quadAndRowOptions(int i, DeviceOptions& quad, DeviceOptions& rows) {
+    quad.software.alignedPasses = false;
+    quad.software.threads = rows.software.threads = 1 + (i & 1);
+}
+
 // A case of a w × h target, A8R8G8B8 or (a quarter of the time) X8R8G8B8, of random bytes.
 inline Case randomTarget(std::mt19937& rng, UINT w, UINT h) {
     Case c;

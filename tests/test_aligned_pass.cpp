@@ -35,8 +35,7 @@ TEST_CASE("aligned pass: random screen-aligned draws equal the quad path byte fo
     for (int i = 0; i < 400; ++i) {
         const Case c = randomCase(rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         // ps_1_4 programs run on the 1.4-class card, in fx8; every third case on that card in its
         // own fx12 (MaxValue 8: the generic executor's pre-sampled runs).
@@ -120,8 +119,7 @@ TEST_CASE("aligned pass: mip chains and MIN != MAG filters take the row path whe
         Case c = randomCase(rng, profile >= 2);
         const bool chains = addMipChains(c, rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         fxProfile(c, profile == 1, quadOpt, rowOpt);
         if (profile >= 2) floatProfile(i, profile == 3, quadOpt, rowOpt);
         Device quadDev(quadOpt);
@@ -224,9 +222,8 @@ TEST_CASE("aligned pass: fogged and depth-tested passes take the row paths and e
         c.program = "ps_1_1\ntex t0\ntex t1\nmad r0, t1, c0, t0\n";
         c.alphaTest = false;
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = uni(0, 1) == 0;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
         if (profile == 1) radeon8500(quadOpt, rowOpt);
         if (profile >= 2) floatProfile(i, profile == 3, quadOpt, rowOpt);
         Device quadDev(quadOpt), rowDev(rowOpt);
@@ -270,11 +267,10 @@ TEST_CASE("float row path: random screen-aligned draws in float and ideal equal 
             c.blend = DWORD(extra() % 4);
             c.blendFactor = DWORD(extra());
             withoutNaNs(c.rtInit, c.rtFormat);
-            for (Case::Tex& t : c.tex) withoutNaNs(t.bytes, t.format);
+            withoutNaNs(c);
         }
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         floatProfile(c, i, (i / 2) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the statistics below hold
         Device quadDev(quadOpt), rowDev(rowOpt);
@@ -343,8 +339,7 @@ TEST_CASE("aligned pass: random rotated, sheared and perspective draws equal the
         Case c = randomCase(rng);
         anyMapping(c, rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 0;  // such triangles' tiles are never decided
         fxProfile(c, i % 4 == 1, quadOpt, rowOpt);  // radeon8500, fx12: taps sampled per pixel at scale 16
         Device quadDev(quadOpt);
@@ -369,8 +364,7 @@ TEST_CASE("aligned pass: rotated and perspective draws of mip chains pick each p
         const bool chains = addMipChains(c, rng);
         anyMapping(c, rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
@@ -395,10 +389,9 @@ TEST_CASE("float row path: random rotated, sheared and perspective draws in floa
     for (int i = 0; i < 200; ++i) {
         Case c = randomCase(rng, (i & 2) != 0);
         anyMapping(c, rng);
-        for (Case::Tex& t : c.tex) withoutNaNs(t.bytes, t.format);
+        withoutNaNs(c);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 0;
         Device quadDev(quadOpt);
@@ -423,13 +416,9 @@ TEST_CASE("float row path: rotated and perspective draws of mip chains pick each
         Case c = randomCase(rng, (i & 2) != 0);
         const bool chains = addMipChains(c, rng);
         anyMapping(c, rng);
-        for (Case::Tex& t : c.tex) {
-            withoutNaNs(t.bytes, t.format);
-            for (std::vector<uint8_t>& level : t.mips) withoutNaNs(level, t.format);
-        }
+        withoutNaNs(c);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
@@ -528,8 +517,7 @@ TEST_CASE("aligned pass: projected reads take the row path and equal the quad pa
         Case c = randomCase(rng);
         projectedReads(c, rng, i % 3 == 0);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 1;  // (projected taps' tiles are never decided)
         fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
         Device quadDev(quadOpt);
@@ -551,13 +539,9 @@ TEST_CASE("float row path: projected reads in float and ideal equal the quad pat
     for (int i = 0; i < 200; ++i) {
         Case c = randomCase(rng, (i & 2) != 0);
         projectedReads(c, rng, i % 3 == 0);
-        for (Case::Tex& t : c.tex) {
-            withoutNaNs(t.bytes, t.format);
-            for (std::vector<uint8_t>& level : t.mips) withoutNaNs(level, t.format);
-        }
+        withoutNaNs(c);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;
@@ -618,8 +602,7 @@ TEST_CASE("aligned pass: texkills of coordinate sets take the row path and equal
         Case c = randomCase(rng);
         texkills(c, rng);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = (i % 3) == 1;  // (texkills read coordinates: tiles are never decided)
         fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
         Device quadDev(quadOpt);
@@ -641,10 +624,9 @@ TEST_CASE("float row path: texkills of coordinate sets in float and ideal equal 
     for (int i = 0; i < 200; ++i) {
         Case c = randomCase(rng, (i & 2) != 0);
         texkills(c, rng);
-        for (Case::Tex& t : c.tex) withoutNaNs(t.bytes, t.format);
+        withoutNaNs(c);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
         Device quadDev(quadOpt);
         DrawStats qs;

@@ -303,8 +303,7 @@ TEST_CASE("aligned pass: magnified taps (2x, 3x, 4x, 8x, 16x, non-integer) equal
             c.verts.push_back(q);
         }
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;  // every pixel shaded: the row path's count below holds
         fxProfile(c, false, quadOpt, rowOpt);
         Device quadDev(quadOpt);
@@ -634,8 +633,7 @@ TEST_CASE("aligned pass: draws of many small quads (sprites) equal the quad path
         const int quads = floatCase && i % 2 ? uni(2, 8) : uni(20, 300);
         const Case c = spriteCase(rng, quads, i % 2 == 0);
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         if (floatCase)
             quadOpt.precision = rowOpt.precision = i % 4 < 2 ? ps11::Precision::Float : ps11::Precision::Ideal;
         Device quadDev(quadOpt), rowDev(rowOpt);

@@ -79,8 +79,7 @@ TEST_CASE("tile skipping: random draws over partly constant textures equal every
             }
         }
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;
         if (c.program.rfind("ps_1_4", 0) == 0) quadOpt.hardware = rowOpt.hardware = &ps11::defaultHardware(4);
         quadOpt.precision = rowOpt.precision = profile == 0   ? ps11::Precision::Fx8
@@ -142,8 +141,7 @@ TEST_CASE("tile skipping: 1:1 copies stored straight from the texel row, plain a
         c.blend = DWORD(i % 2);  // plain, ONE/ONE
         c.alphaTest = false, c.writeMask = 0xf, c.scissor = uni(0, 5) == 0;
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;
         // The second half in fx12: a texel's grid value 16·b stores b, and a constant channel
         // between two bytes rounds with the sum, so it is not copied (c1.a = 0.5: 2040, whose
@@ -307,8 +305,7 @@ TEST_CASE("tile skipping: filled runs stored directly equal every lane stored, p
         for (int k = 0; k < 4; ++k) c.consts[0][k] = float(uni(0, 40)) / 4080.0f;  // often between two bytes in fx12
         c.blend = DWORD(i / 2 % 2);                                                // plain, ONE/ONE
         DeviceOptions quadOpt, rowOpt;
-        quadOpt.software.alignedPasses = false;
-        quadOpt.software.threads = rowOpt.software.threads = 1 + (i & 1);
+        quadAndRowOptions(i, quadOpt, rowOpt);
         rowOpt.software.skipTiles = false;
         rowOpt.software.timeTiles = false;
         if (i >= 16) radeon8500(quadOpt, rowOpt);
