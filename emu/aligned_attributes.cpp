@@ -19,6 +19,14 @@ void rowInverseW(const TriangleSetup& s, int x, int y, int n, float* inv) {
     for (int i = 0; i < n; ++i) inv[i] = inverseRhw(inv[i]);
 }
 
+// rowInverseW into `lanes` on a triangle with perspective, which it returns; null (what
+// rowAttribute then never reads) without.
+const float* rowInverse(const TriangleSetup& s, int x, int y, int n, float* lanes) {
+    if (!s.perspective) return nullptr;
+    rowInverseW(s, x, y, n, lanes);
+    return lanes;
+}
+
 // Attribute k at pixels x .. x + n − 1 of row y, as the rasteriser interpolates it: the constant,
 // or planeValue, times `inv` (rowInverseW) on a triangle with perspective.
 void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const float* inv, float* dst) {
@@ -36,15 +44,13 @@ void rowAttribute(const TriangleSetup& s, int k, int x, int y, int n, const floa
 void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int n, float* fogOut, float* zOut) {
     if (z) fillPlaneRow(s.z, s.ox, s.oy, x, y, n, zOut);
     if (!fog) return;
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective) rowInverseW(s, x, y, n, inv);
-    rowAttribute(s, kAttrSpecular + 3, x, y, n, inv, fogOut);
+    alignas(32) float lanes[ps11::kMaxSpan];
+    rowAttribute(s, kAttrSpecular + 3, x, y, n, rowInverse(s, x, y, n, lanes), fogOut);
 }
 
 bool rowKills(const ps11::TapPlan& plan, const TriangleSetup& s, int x, int y, int n, uint8_t* kept) {
-    alignas(32) float invLanes[ps11::kMaxSpan], c[ps11::kMaxSpan];
-    const float* inv = nullptr;  // (read with perspective only)
-    if (s.perspective) rowInverseW(s, x, y, n, invLanes), inv = invLanes;
+    alignas(32) float lanes[ps11::kMaxSpan], c[ps11::kMaxSpan];
+    const float* inv = rowInverse(s, x, y, n, lanes);
     std::memset(kept, 1, size_t(n));
     for (int set = 0; set < 8; ++set) {
         if (!((plan.killSets >> set) & 1)) continue;
@@ -60,9 +66,8 @@ bool rowKills(const ps11::TapPlan& plan, const TriangleSetup& s, int x, int y, i
 
 void tapCoords(const ps11::TapPlan& plan, int t, const TriangleSetup& s, int x, int y, int n, float* u, float* v) {
     const int set = plan.coordSet[size_t(t)];
-    alignas(32) float invLanes[ps11::kMaxSpan];
-    const float* inv = nullptr;  // (read with perspective only)
-    if (s.perspective) rowInverseW(s, x, y, n, invLanes), inv = invLanes;
+    alignas(32) float lanes[ps11::kMaxSpan];
+    const float* inv = rowInverse(s, x, y, n, lanes);
     rowAttribute(s, attrTex(set, 0), x, y, n, inv, u);
     rowAttribute(s, attrTex(set, 1), x, y, n, inv, v);
     if (!plan.projected(t)) return;
@@ -121,8 +126,8 @@ uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y,
     const uint64_t used = colorAttrs & ((uint64_t(0xf) << kAttrDiffuse) | (uint64_t(0xf) << kAttrSpecular));
     if (!used) return 0;
     uint8_t uniform = 0;
-    alignas(32) float inv[ps11::kMaxSpan];
-    if (s.perspective && (used & ~s.constMask)) rowInverseW(s, x, y, n, inv);
+    alignas(32) float lanes[ps11::kMaxSpan];
+    const float* inv = (used & ~s.constMask) ? rowInverse(s, x, y, n, lanes) : nullptr;
     for (int k = 0; k < 8; ++k) {
         const int attr = k < 4 ? kAttrDiffuse + k : kAttrSpecular + (k - 4);
         if (!((used >> attr) & 1)) continue;
