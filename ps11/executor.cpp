@@ -66,6 +66,9 @@ public:
 
     void setConstant(int index, const std::array<float, 4>& value) override {
         if (index < 0 || index >= kNumConsts) return;
+        // The same bits as now (a device sets all eight before every draw): nothing changes, and
+        // the fast program's constant-dependent plans and the threads' constant lanes are kept.
+        if (std::memcmp(m_api[size_t(index)].data(), value.data(), sizeof value) == 0) return;
         m_api[size_t(index)] = value;
         refreshConstant(index);
         m_constsId = nextConstsId();

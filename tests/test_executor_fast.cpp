@@ -675,6 +675,36 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
     CHECK(runs == 40 * int(std::size(programs) * std::size(configs)));
 }
 
+TEST_CASE("constants set again with the same bits keep their values; new bits take effect", "[fast]") {
+    // A device sets c0…c7 before every draw; setConstant ignores a value equal bit for bit to the
+    // one it holds. Runs after A, B, A again, A once more and −0 against 0 must each equal a fresh
+    // executor given that constant once, on both paths and in every profile.
+    using namespace ps11;
+    const std::string text = "ps_1_1\nmad r0, v0, c0, c1\n";
+    const std::array<float, 4> a{0.25f, 0.5f, 0.75f, 1.0f}, b{0.5f, 0.0f, 1.0f, 0.125f}, zero{0, 0, 0, 0},
+        negZero{-0.0f, -0.0f, -0.0f, -0.0f}, bias{0.1f, 0.2f, 0.3f, 0.4f};
+    Lanes l(40);
+    for (int i = 0; i < l.count; ++i)
+        for (int c = 0; c < 4; ++c) l.col[0][c][size_t(i)] = float((i * 7 + c * 13) % 41) / 40.0f;
+    LaneSampler sampler;
+    for (const Precision prec : {Precision::Fx8, Precision::Fx12, Precision::Float, Precision::Ideal})
+        for (const ExecPath path : {ExecPath::Generic, ExecPath::Auto}) {
+            INFO("profile " << int(prec) << ", path " << int(path));
+            auto reused = make(text, prec, 0.0f, path);
+            reused->setConstant(1, bias);
+            for (const auto& c0 : {a, b, a, a, zero, negZero, b}) {
+                reused->setConstant(0, c0);
+                auto fresh = make(text, prec, 0.0f, path);
+                fresh->setConstant(1, bias);
+                fresh->setConstant(0, c0);
+                Out want(l.count), got(l.count);
+                runAll(*fresh, l, want, sampler, l.count);
+                runAll(*reused, l, got, sampler, l.count);
+                CHECK(compare(got, want, l.count, "c0 set again") == 0);
+            }
+        }
+}
+
 TEST_CASE("fast: chain rows equal pre-sampled runs over the same texel rows", "[fast]") {
     // runChainRow (a chain of products of taps and constants over a row's bytes as they lie)
     // against runPresampled fed each tap's filtered texel (the texel, or round_half_even of it and
