@@ -64,6 +64,10 @@ struct DOp {
     uint8_t stage = 0;
     uint8_t padIndex = 0;
     uint8_t rowBase = 0;
+    // A plain read (ps11/executor_presampled_internal.h "tapPlan"): `tex t#` (ps_1_1–1_3), or
+    // `texld r#, t#` with .xy as written or _dz/_dw (ps_1_4). Pre-sampled runs take its texels
+    // from the caller; every other texture instruction they execute themselves.
+    bool plainRead = false;
 };
 
 // A source modifier of an fx profile as k = a·n + b: the source's exact value is k/(2G) for the

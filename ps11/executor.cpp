@@ -34,6 +34,16 @@ void constantOf(Precision precision, float v, int32_t& grid, float& value) {
 
 namespace {
 
+// DOp::plainRead: `tex t#` in ps_1_1–1_3; in ps_1_4 `texld r#, t#` reading .xy as written,
+// plain or divided by z or w (_dz/_dw).
+bool isPlainRead(const DOp& op, int minor) {
+    if (op.op != Opcode::Tex) return false;
+    if (minor < 4) return true;
+    const DSrc& s = op.src[0];
+    const bool divided = s.mod == SrcMod::Dz || s.mod == SrcMod::Dw;
+    return s.kind == SrcKind::TexCoord && (s.mod == SrcMod::None || divided) && s.sw[0] == 0 && s.sw[1] == 1;
+}
+
 // A process-wide unique, non-zero number per set of constants (see runFast's constsId).
 uint64_t nextConstsId() {
     static std::atomic<uint64_t> next{0};
@@ -54,6 +64,7 @@ public:
           m_writesDepth(depth),
           m_vUsed(vUsed),
           m_r0Preset(r0PresetChannels(m_ops)) {
+        for (DOp& op : m_ops) op.plainRead = isPlainRead(op, m_p.minor);
         for (auto& c : m_api) c = {0, 0, 0, 0};
         for (int i = 0; i < kNumConsts; ++i) refreshConstant(i);
         m_constsId = nextConstsId();
@@ -95,10 +106,10 @@ public:
         runGeneric(inputs, sampler, outputs, &steps);
     }
     // ps11/executor_presampled_internal.h
-    bool tapPlan(TapPlan& plan) const;
-    bool plainTaps(TapPlan& plan) const;
-    void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                       ExecutorStats* stats) const;
+    bool tapPlan(TapPlan& plan, bool executes) const;
+    bool plainTaps(TapPlan& plan, bool executes = false) const;
+    void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx, ExecutorStats* stats,
+                       Sampler* sampler) const;
     bool chainRows() const { return m_chainRows.ready; }
     void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, const ChainRowStore& store,
                      ExecutorStats* stats) const {
@@ -179,7 +190,7 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
     for (const DOp& op : m_ops) {
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
         if (op.op == Opcode::TexKill && st.fill) continue;  // (the caller tests TapPlan::killSets)
-        if (op.texture && st.fill) {
+        if (op.texture && st.fill && op.plainRead) {
             // A plain read (plainTaps): all four channels, clamped to ±M as sampled texels are.
             alignas(64) int16_t texels[4][kChunk];
             int16_t* const dst[4] = {texels[0], texels[1], texels[2], texels[3]};
@@ -227,15 +238,15 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
     }
 }
 
-bool ExecutorImpl::tapPlan(TapPlan& plan) const {
+bool ExecutorImpl::tapPlan(TapPlan& plan, bool executes) const {
     plan = TapPlan{};
     // The fast path's runs, or the generic path's in an fx profile whose register values fit the
     // int16 lanes of TapFill and ResultSink (|n| <= round(M·G) <= 32767: fx8 to M = 128, fx12 to 8).
     const bool generic = isFixedPoint(m_p.precision) && m_p.nMax <= INT16_MAX;
-    return (m_fast.ready || generic) && plainTaps(plan);
+    return (m_fast.ready || generic) && plainTaps(plan, executes);
 }
 
-bool ExecutorImpl::plainTaps(TapPlan& plan) const {
+bool ExecutorImpl::plainTaps(TapPlan& plan, bool executes) const {
     plan = TapPlan{};
     for (const DOp& op : m_ops) {
         if (!op.texture) continue;
@@ -244,7 +255,19 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
             plan.killSets = uint8_t(plan.killSets | (1u << (op.src[0].slot & 7)));
             continue;
         }
-        if (op.op != Opcode::Tex || plan.count >= int(plan.stage.size())) return false;
+        if (!op.plainRead) {
+            if (!executes) return false;
+            plan.executes = true;
+            plan.executedStages = uint8_t(plan.executedStages | (1u << (op.stage & 7)));
+            // The sets it reads: its own (ps_1_1–1_3: texbem, matrix rows, texcoord), or ps_1_4's
+            // coordinate sources (texcrd, texld r#, t#.xyz).
+            if (m_p.minor < 4) plan.executedSets = uint8_t(plan.executedSets | (1u << (op.stage & 7)));
+            for (int s = 0; s < op.numSrc; ++s)
+                if (op.src[size_t(s)].kind == SrcKind::TexCoord)
+                    plan.executedSets = uint8_t(plan.executedSets | (1u << (op.src[size_t(s)].slot & 7)));
+            continue;
+        }
+        if (plan.count >= int(plan.stage.size())) return false;
         uint8_t set = op.stage;
         int divisor = -1;
         bool zeroIsOne = false;
@@ -253,8 +276,6 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
         } else {
             const DSrc& s = op.src[0];
             const bool divided = s.mod == SrcMod::Dz || s.mod == SrcMod::Dw;
-            if (s.kind != SrcKind::TexCoord || (s.mod != SrcMod::None && !divided) || s.sw[0] != 0 || s.sw[1] != 1)
-                return false;
             set = s.slot;
             if (divided) {
                 divisor = s.mod == SrcMod::Dz ? 2 : 3;  // the raw component (coords14)
@@ -272,17 +293,18 @@ bool ExecutorImpl::plainTaps(TapPlan& plan) const {
 }
 
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                                 ExecutorStats* stats) const {
+                                 ExecutorStats* stats, Sampler* sampler) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.ready) {
-        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx);
+        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx, sampler);
         countRun(stats, count);
         return;
     }
-    // The generic path: runChunk with the taps from `fill`, r0 narrowed to int16 for `sink`.
+    // The generic path: runChunk with the plain reads from `fill` (the other texture
+    // instructions sampled as run() samples them), r0 narrowed to int16 for `sink`.
     const ThreadCached<RunState> st;
     st->in = &inputs;
-    st->sampler = nullptr;
+    st->sampler = sampler;
     st->fill = fill;
     st->fillCtx = ctx;
     for (int c = 0; c < 4; ++c)
@@ -624,8 +646,8 @@ std::unique_ptr<Executor> Executor::create(const Program& program, const Executo
 }
 
 // ExecutorImpl is the only Executor (Executor::create makes it).
-bool tapPlan(const Executor& executor, TapPlan& plan) {
-    return static_cast<const exec::ExecutorImpl&>(executor).tapPlan(plan);
+bool tapPlan(const Executor& executor, TapPlan& plan, bool executes) {
+    return static_cast<const exec::ExecutorImpl&>(executor).tapPlan(plan, executes);
 }
 
 bool plainTaps(const Executor& executor, TapPlan& plan) {
@@ -633,8 +655,8 @@ bool plainTaps(const Executor& executor, TapPlan& plan) {
 }
 
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats) {
-    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats);
+                   ExecutorStats* stats, Sampler* sampler) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler);
 }
 
 bool chainRows(const Executor& executor) {

@@ -303,7 +303,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (texkill writes nothing)
             if (op.texture) {
-                pos[op.dstSlot] = kMaskAll;
+                pos[op.dstSlot] = op.plainRead ? kMaskAll : 0;
                 continue;
             }
             FastOp& f = out[idx];
@@ -363,6 +363,7 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
         const DOp& d = ops[i];
         if (d.op == Opcode::Phase) continue;
         if (d.op == Opcode::TexKill) return;  // (chain rows store every pixel)
+        if (d.texture && !d.plainRead) return;  // (a chain row's taps are rows of texels)
         if (d.texture) {
             if (head >= 0) return;  // a read after the arithmetic began
             tapOf[d.dstSlot] = int8_t(taps++);
@@ -474,10 +475,13 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx) {
+                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
+    RunState& st = fs->st;  // (the texture instructions run() would sample)
+    st.in = &inputs;
+    st.sampler = sampler;
     // r0's channels read before written, or never written, are 0 (as in runFast).
     for (int c = 0; c < 4; ++c)
         if ((fp.r0Preset >> c) & 1) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
@@ -487,12 +491,24 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
     for (int off = 0; off < count; off += kChunk) {
         const int n = std::min(kChunk, count - off);
         const int nv = (n + kern.lanes - 1) / kern.lanes * kern.lanes;
+        st.offset = off;
+        st.n = n;
+        st.depthWritten = false;
         loadColors(kern, p.g, inputs, vUsed, off, n, bank);
         int tap = 0;
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (TapPlan::killSets)
-            if (op.texture) {
+            if (op.texture && !op.plainRead) {
+                // As runFast runs it: its registers through the int32 bank.
+                for (int s = 0; s < op.numSrc; ++s)
+                    if (op.src[size_t(s)].kind == SrcKind::Reg) syncTo32(*fs, op.src[size_t(s)].slot);
+                if (fp.syncDstBefore[idx]) syncTo32(*fs, op.dstSlot);
+                st.deferTexelClamp = op.op == Opcode::Tex;
+                execTexture(p, op, st);
+                st.deferTexelClamp = false;
+                if (op.info->writesDst) syncTo16(*fs, op.dstSlot, kern, p.nMax);
+            } else if (op.texture) {
                 // A plain read (tapPlan): the caller's texels, clamped to ±M as sampleInto does
                 // (a no-op for 8-bit texels when M >= 1).
                 int16_t* const dst[4] = {bank.reg[op.dstSlot][0], bank.reg[op.dstSlot][1], bank.reg[op.dstSlot][2],

@@ -168,13 +168,14 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
              bool writesDepth, const PixelInputs& inputs, Sampler& sampler, PixelOutputs& outputs);
 
 // runPresampled (ps11/executor_presampled_internal.h) on the fast path (the kernels of
-// simdLevel()): texture instructions (plain reads, tapPlan) have `fill` write tap i's lanes
-// straight into their register (then clamped to ±nMax as sampled texels are) instead of
-// sampling; r0's int16 lanes go to `sink` chunk by chunk, straight from the register bank.
-// `ops2` is fp.ops with the sign analysis of presampledOps for the current constants.
+// simdLevel()): plain reads (DOp::plainRead) have `fill` write tap i's lanes straight into their
+// register (then clamped to ±nMax as sampled texels are) instead of sampling; the other texture
+// instructions run as in runFast, with `sampler`; r0's int16 lanes go to `sink` chunk by chunk,
+// straight from the register bank. `ops2` is fp.ops with the sign analysis of presampledOps for
+// the current constants.
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx);
+                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler);
 
 // The chain-row plan of a program (ops2: presampledOps' for the current constants): ready when
 // fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic after the texture
@@ -188,8 +189,9 @@ void chainRowPlan(const FastProgram& fp, const Profile& p, const std::vector<DOp
 void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, const ChainRowTap* taps, int count,
                  uint8_t* out, const ChainRowStore& store);
 
-// fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (taps are
-// 8-bit texels, v# in [0, 1], constants as they are now, _sat results) marked nonNegative.
+// fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (plain reads'
+// taps are 8-bit texels, v# in [0, 1], constants as they are now, _sat results; the other
+// texture instructions' results of any sign) marked nonNegative.
 // Depends on the constants: recomputed when one changes, not per run.
 void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out);
 

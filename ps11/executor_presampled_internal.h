@@ -23,6 +23,13 @@ struct TapPlan {
     // Bit s: a texkill tests coordinate set s (TC[s].x, y, z < 0 kills the pixel); the caller
     // tests it, pre-sampled runs skip the instruction.
     uint8_t killSets = 0;
+    // With tapPlan(…, executes = true): the texture instructions that are not plain reads
+    // (dependent reads, matrix rows, coordinates read as values; DOp::plainRead false), which
+    // pre-sampled runs execute with the sampler and the coordinates of PixelInputs. Bit s of
+    // executedSets: one of them reads coordinate set s; of executedStages: one of them is stage
+    // s's instruction (it may sample stage s).
+    bool executes = false;
+    uint8_t executedSets = 0, executedStages = 0;
     bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
 
@@ -37,8 +44,9 @@ inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne &
 // `tex t#` in ps_1_1–1_3 (D3DTTFF_PROJECTED as set now by setStageState: the divisor
 // projectionDivisor names), `texld r#, t#` in ps_1_4 (.xy as written; _dz/_dw divide by the
 // set's raw z or w), and texkills of a coordinate set (`texkill t#`, any version: killSets).
-// Fills `plan` and returns true, else false.
-bool tapPlan(const Executor& executor, TapPlan& plan);
+// Fills `plan` and returns true, else false. With `executes`, the other texture instructions
+// (but texkills of a register) are allowed too: TapPlan::executes.
+bool tapPlan(const Executor& executor, TapPlan& plan, bool executes = false);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
 // is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with
 // a sampler of its own).
@@ -53,12 +61,13 @@ using TapFill = void (*)(void* ctx, int tap, int first, int count, int16_t* cons
 // (c = r g b a), valid during the call only. It is called once per chunk of lanes, in order, as
 // soon as the chunk is computed (the caller stores it while it is in cache).
 using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* const r0[4]);
-// Runs `count` (<= kMaxSpan) pixels whose texture instructions take their texels from `fill`
-// instead of a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as
-// Executor::run() with a sampler returning those texels. Only valid after tapPlan() returned
-// true. `ctx` is handed to both callbacks.
+// Runs `count` (<= kMaxSpan) pixels whose plain reads take their texels from `fill` instead of
+// a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as Executor::run()
+// with a sampler returning those texels. Only valid after tapPlan() returned true. `ctx` is
+// handed to both callbacks. Where the plan executes other texture instructions, they run as in
+// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail).
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats = nullptr);
+                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr);
 
 // Chain rows: a program whose arithmetic is one chain of products (mul, then mads adding it, all
 // of whose factors are >= 0: the glow's separable blur) each of a tap and a constant, the same on

@@ -675,6 +675,122 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
     CHECK(runs == 40 * int(std::size(programs) * std::size(configs)));
 }
 
+TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[fast]") {
+    // tapPlan(…, executes = true): plain reads come from `fill` (here the same sampler at their
+    // lanes' coordinates), every other texture instruction (texbem, matrix rows, texreg2ar,
+    // texdp3tex, texcoord, texcrd, ps_1_4's dependent texld) runs as run() runs it, with the
+    // sampler handed to runPresampled. Fast path and generic path, fx8 and the radeon8500 class's
+    // fx12, spans of 64 and 37 lanes.
+    using namespace ps11;
+    TextureSampler sampler;
+    auto tex = smallTexture();
+    SamplerDesc sd;
+    sd.minFilter.value = sd.magFilter.value = Filter::Linear;
+    for (int s = 0; s < 4; ++s) {
+        sampler.bind(s, tex);
+        sampler.setSamplerState(s, samplerStateFromDesc(sd));
+    }
+    const char* programs[] = {
+        "ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, c0, v0_bias\n",
+        "ps_1_1\ntex t0\ntexbeml t1, t0\nmul r0, t1, v0\n",
+        "ps_1_3\ntex t0\ntexreg2ar t1, t0\ndp3_sat r0, t0_bx2, t1_bx2\n",
+        "ps_1_1\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2tex t2, t0_bx2\nmul r0, t2, c0\n",
+        "ps_1_1\ntex t0\ntexm3x3pad t1, t0_bx2\ntexm3x3pad t2, t0_bx2\ntexm3x3vspec t3, t0_bx2\nmad r0, t3, c0, "
+        "t0\n",
+        "ps_1_2\ntex t0\ntexdp3tex t1, t0\nadd r0, t1, t0\n",
+        "ps_1_1\ntexcoord t0\ntex t1\nmul r0, t0, t1\n",
+        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
+        "-r2\n+mov r0.a, r3.a\n",
+        "ps_1_4\ntexcrd r0.rgb, t0\ntexld r1, t1\nphase\ntexld r2, r0\nmul r0.rgb, r2, r1\n+mov r0.a, r2.a\n",
+    };
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-0.2f, 1.2f);
+    const int count = 300;
+    Lanes l(count);
+    for (int i = 0; i < count; ++i) {
+        for (int v = 0; v < 2; ++v)
+            for (int c = 0; c < 4; ++c) l.col[v][c][size_t(i)] = u(rng);
+        for (int t = 0; t < 8; ++t)
+            for (int c = 0; c < 4; ++c) l.tc[t][c][size_t(i)] = c == 3 ? u(rng) * 2.0f : u(rng);
+    }
+    struct Ctx {
+        TextureSampler* sampler;
+        const Lanes* lanes;
+        const TapPlan* plan;
+        int base;
+        Precision precision;
+        std::vector<int32_t>* got;
+    };
+    const TapFill fill = [](void* p, int tap, int first, int n, int16_t* const dst[4]) {
+        Ctx& x = *static_cast<Ctx*>(p);
+        const int set = x.plan->coordSet[size_t(tap)];
+        SampleRequest req;
+        req.stage = x.plan->stage[size_t(tap)];
+        req.count = n;
+        req.u = x.lanes->tc[set][0].data() + x.base + first;
+        req.v = x.lanes->tc[set][1].data() + x.base + first;
+        req.precision = x.precision;
+        alignas(64) int32_t g[4][kMaxSpan];
+        SampleResult out;
+        for (int c = 0; c < 4; ++c) out.grid[c] = g[c];
+        x.sampler->sample(req, out);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < n; ++i) dst[c][i] = int16_t(g[c][i]);
+    };
+    const ResultSink sink = [](void* p, int first, int n, const int16_t* const r0[4]) {
+        Ctx& x = *static_cast<Ctx*>(p);
+        for (int c = 0; c < 4; ++c)
+            for (int i = 0; i < n; ++i) x.got[c][size_t(x.base + first + i)] = r0[c][i];
+    };
+    struct Config {
+        Precision precision;
+        float maxValue;
+        ExecPath path;
+    };
+    const Config configs[] = {{Precision::Fx8, 0, ExecPath::Auto},
+                              {Precision::Fx8, 0, ExecPath::Generic},
+                              {Precision::Fx8, 16, ExecPath::Auto},
+                              {Precision::Fx12, 8, ExecPath::Auto}};
+    std::array<std::array<float, 4>, 8> consts;
+    for (auto& c : consts)
+        for (float& f : c) f = u(rng) * 1.6f - 0.8f;
+    int64_t bad = 0;
+    int runs = 0;
+    for (const Config& cfg : configs)
+        for (const char* text : programs) {
+            INFO(text << "precision " << precisionName(cfg.precision) << ", MaxValue " << cfg.maxValue << ", path "
+                      << int(cfg.path));
+            auto ref = make(text, cfg.precision, cfg.maxValue, ExecPath::Generic);
+            auto e = make(text, cfg.precision, cfg.maxValue, cfg.path);
+            for (int i = 0; i < 8; ++i) ref->setConstant(i, consts[size_t(i)]), e->setConstant(i, consts[size_t(i)]);
+            TapPlan plan;
+            CHECK_FALSE(tapPlan(*e, plan));  // (not without executes)
+            REQUIRE(tapPlan(*e, plan, true));
+            CHECK(plan.executes);
+            CHECK(plan.executedStages != 0);
+            Out want(count);
+            runAll(*ref, l, want, sampler, 256);
+            for (int span : {64, 37}) {
+                std::vector<int32_t> got[4];
+                for (auto& g : got) g.assign(count, -9999);
+                for (int off = 0; off < count; off += span) {
+                    const int n = std::min(span, count - off);
+                    PixelInputs pin = l.inputs(off, n);
+                    Ctx ctx{&sampler, &l, &plan, off, cfg.precision, got};
+                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler);
+                }
+                ++runs;
+                for (int c = 0; c < 4; ++c)
+                    for (int i = 0; i < count; ++i)
+                        if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
+                            FAIL_CHECK("span " << span << " lane " << i << " channel " << c << ": pre-sampled "
+                                               << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
+            }
+        }
+    CHECK(bad == 0);
+    CHECK(runs == 2 * int(std::size(programs) * std::size(configs)));
+}
+
 TEST_CASE("constants set again with the same bits keep their values; new bits take effect", "[fast]") {
     // A device sets c0…c7 before every draw; setConstant ignores a value equal bit for bit to the
     // one it holds. Runs after A, B, A again, A once more and −0 against 0 must each equal a fresh
