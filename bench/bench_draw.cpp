@@ -135,7 +135,7 @@ struct Scene {
         DeviceOptions o;
         o.software.threads = threads;
         o.software.alignedPasses = aligned;
-        if (pass == Pass::Dependent) o.hardware = &ps11::defaultHardware(4);  // a ps_1_4 class, fx8
+        if (pass == Pass::Dependent) o.hardware = &ps11::defaultHardware(4);  // the ps_1_4 class: radeon8500, fx12
         dev = std::make_unique<Device>(o);
         Handle rt{}, tex{}, ps{};
         if (dev->CreateRenderTarget(w, h, D3DFMT_A8R8G8B8, 0, &rt) != D3D_OK) return;

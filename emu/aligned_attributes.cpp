@@ -141,4 +141,12 @@ uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y,
     return uniform;
 }
 
+void fillRowCoords(uint64_t attrs, const TriangleSetup& s, int x, int y, int n, float (*coords)[ps11::kMaxSpan]) {
+    alignas(32) float lanes[ps11::kMaxSpan];
+    const float* inv = rowInverse(s, x, y, n, lanes);
+    for (int set = 0; set < kMaxTexSets; ++set)
+        for (int c = 0; c < 4; ++c)
+            if ((attrs >> attrTex(set, c)) & 1) rowAttribute(s, attrTex(set, c), x, y, n, inv, coords[4 * set + c]);
+}
+
 }  // namespace emu

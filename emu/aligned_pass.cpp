@@ -545,6 +545,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
     for (int c = 0; c < 4; ++c) {
         if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
         if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
+        for (int set = 0; set < kMaxTexSets; ++set)
+            if ((draw.executedAttrs >> attrTex(set, c)) & 1) in.texcoord[set][c] = sc.coords[4 * set + c];
     }
     std::array<TapRow, 8> rows{};
     // The executor asks for each tap's lanes chunk by chunk and they are filtered straight into
@@ -638,7 +640,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
             // (Not under a depth test: the two halves' z planes are their own. Nor where a tap is
             // sampled at its quads' levels: those come from the quad's two rows, and joinRow
             // compares one.)
-            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
+            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && !draw.executedAttrs &&
+                                ti + 1 < count &&
                                 tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], joins.pair(ti), y, windows, windowCount, xl, xr);
@@ -758,10 +761,11 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     }
                     if (mode == RowMode::Shade) {
                         in.uniformColor = fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        if (draw.executedAttrs) fillRowCoords(draw.executedAttrs, s, x, y, n, sc.coords);
                         in.count = n;
                         ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ctx.under = fromSource && storeAsShaded ? sourced.base(x, n) : ctx.out;
-                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec);
+                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler);
                         if (fromSource && storeAsShaded) sourced.mark(x, n);
                         if (storeAsShaded) {
                             stats.pixels += uint64_t(n);

@@ -1,5 +1,6 @@
 // The aligned-pass path of DrawPrimitiveUP (docs/device.md "Aligned passes"): fx8 and fx12 triangles with a
-// program whose texture reads are plain (ps11::tapPlan, ps11/executor_presampled_internal.h) are
+// program whose texture reads are plain (ps11::tapPlan, ps11/executor_presampled_internal.h), or
+// whose other texture instructions the executor samples itself per pixel (TapPlan::executes), are
 // drawn row by row without quads. A tap whose coordinates are screen-aligned on the triangle (u
 // depends on x only, v on y only, no perspective) has its texel columns and weights tabulated once
 // per triangle and its rows once per pixel row, and its texels are filtered into int16 lanes (runs
@@ -81,6 +82,9 @@ struct AlignedDraw {
     uint32_t bound = 0;       // the taps with a texture (bit per tap)
     LevelTaps levelTaps;      // the taps whose level or filter the level of detail picks
     uint64_t colorAttrs = 0;  // diffuse/specular attribute bits the draw reads (the specular alpha under fog)
+    // The coordinate attributes the texture instructions the plan executes read (plan.executes:
+    // the executor samples those itself, from PixelInputs' coordinates; fillRowCoords).
+    uint64_t executedAttrs = 0;
     MergeState merge;
     MergeTarget target;
     bool fx12 = false;         // fx12 grid integers (16 per 8-bit level) instead of fx8's
@@ -300,8 +304,10 @@ struct AlignedScratch {
     alignas(32) uint8_t tapBytes[8][4 * (ps11::kMaxSpan + 32)];
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps
     // whose level the level of detail picks on triangles where they are sampled per pixel, at
-    // their quads' levels (SampleRequest::levels). Set by the caller before drawAlignedRows.
+    // their quads' levels (SampleRequest::levels), and the texture instructions the plan
+    // executes. Set by the caller before drawAlignedRows.
     ps11::Sampler* sampler = nullptr;
+    alignas(32) float coords[32][ps11::kMaxSpan];  // fillRowCoords (DrawAligned::executedAttrs)
     alignas(32) int32_t grid[4][ps11::kMaxSpan];
     alignas(32) float colorOut[4][ps11::kMaxSpan];
     HRowCache hrows;
@@ -352,6 +358,9 @@ uint8_t fillRowColors(uint64_t colorAttrs, const TriangleSetup& s, int x, int y,
 // interpolate them (rasterizeRowSpans): the fog factor, the specular alpha (where `fog`), and z,
 // linear on the screen (where `z`).
 void fillRowFogDepth(const TriangleSetup& s, bool fog, bool z, int x, int y, int n, float* fogOut, float* zOut);
+// The texture coordinate lanes of pixels x .. x + n − 1 of row y that `attrs` names, as the spans
+// of one row interpolate them: attribute attrTex(set, c) into coords[4·set + c].
+void fillRowCoords(uint64_t attrs, const TriangleSetup& s, int x, int y, int n, float (*coords)[ps11::kMaxSpan]);
 
 struct AlignedStats {
     uint64_t pixels = 0, written = 0, texels = 0;

@@ -31,7 +31,15 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     if ((precision != ps11::Precision::Fx8 && !fx12) || !target.color || (wantZ && executor.writesDepth()))
         return false;
     AlignedDraw d;
-    if (!ps11::tapPlan(executor, d.plan)) return false;
+    if (!ps11::tapPlan(executor, d.plan, true)) return false;
+    // Instructions the executor samples itself, per pixel at level 0 (as the spans of one row
+    // sample them): their textures must not depend on the level of detail.
+    for (int s = 0; s < 8 && d.plan.executes; ++s)
+        if ((d.plan.executedStages >> s) & 1 && textures[size_t(s)] && !ps11::lodFree(*textures[size_t(s)], samplers[size_t(s)]))
+            return false;
+    for (int set = 0; set < kMaxTexSets; ++set)
+        if ((d.plan.executedSets >> set) & 1)
+            for (int c = 0; c < 4; ++c) d.executedAttrs |= usedAttrs & (uint64_t(1) << attrTex(set, c));
     d.fx12 = fx12;
     d.serial = nextRowDrawSerial();
     d.executor = &executor;

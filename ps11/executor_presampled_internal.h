@@ -11,7 +11,7 @@
 namespace ps11 {
 
 // The texture reads of a program that can take its texels pre-sampled (tapPlan): tap i is the
-// i-th texture instruction; it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy, or where
+// i-th plain read (DOp::plainRead); it samples `stage[i]` at (u, v) = TC[coordSet[i]].xy, or where
 // divisor[i] >= 0 (a projected read) at (u, v) divided by that component of the same set
 // (projectCoord), with no dependency on other registers.
 struct TapPlan {
@@ -45,7 +45,7 @@ inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne &
 // projectionDivisor names), `texld r#, t#` in ps_1_4 (.xy as written; _dz/_dw divide by the
 // set's raw z or w), and texkills of a coordinate set (`texkill t#`, any version: killSets).
 // Fills `plan` and returns true, else false. With `executes`, the other texture instructions
-// (but texkills of a register) are allowed too: TapPlan::executes.
+// (but texkills of a register) are allowed too, and runPresampled executes them: TapPlan::executes.
 bool tapPlan(const Executor& executor, TapPlan& plan, bool executes = false);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
 // is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with

@@ -117,6 +117,8 @@ struct Case {
     // coordinates (depthVerts' r, q are 0 and 1).
     std::array<DWORD, 4> transformFlags{};
     std::vector<std::array<std::array<float, 2>, 4>> rq;
+    // Each stage's bump matrix (00 01 10 11), luminance scale and offset (texbem, texbeml).
+    std::array<std::array<float, 6>, 4> bump{};
 };
 
 // A vertex with four-component coordinates (Case::rq).
@@ -358,6 +360,14 @@ inline std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stat
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSV, t.addressV) == D3D_OK);
         REQUIRE(dev.SetSamplerState(s, D3DSAMP_BORDERCOLOR, t.border) == D3D_OK);
         REQUIRE(dev.SetTextureStageState(s, D3DTSS_TEXTURETRANSFORMFLAGS, c.transformFlags[s]) == D3D_OK);
+        const D3DTEXTURESTAGESTATETYPE bumpStates[6] = {D3DTSS_BUMPENVMAT00, D3DTSS_BUMPENVMAT01,
+                                                        D3DTSS_BUMPENVMAT10, D3DTSS_BUMPENVMAT11,
+                                                        D3DTSS_BUMPENVLSCALE, D3DTSS_BUMPENVLOFFSET};
+        for (int k = 0; k < 6; ++k) {
+            DWORD bits = 0;
+            std::memcpy(&bits, &c.bump[s][size_t(k)], 4);
+            REQUIRE(dev.SetTextureStageState(s, bumpStates[k], bits) == D3D_OK);
+        }
     }
     Handle ps{};
     REQUIRE(dev.CreatePixelShaderFromText(c.program.c_str(), &ps) == D3D_OK);
