@@ -388,6 +388,10 @@ public:
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
         const int n = req.count;
         const int t = req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
+        if (t < 0 && req.stage >= 0 && req.stage < 8 && ((m_draw.plan.executedStages >> req.stage) & 1)) {
+            m_perPixel->sample(req, out);  // an instruction the plan executes: as run() samples it
+            return;
+        }
         const FloatRowTap* tap = t >= 0 ? &m_draw.taps[size_t(t)] : nullptr;
         if (!tap || !tap->bound) {
             for (int c = 0; c < 4; ++c) ps11::fillLanes(out.value[c], n, c == 3 ? 1.0f : 0.0f);
@@ -564,7 +568,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
     if (!target.color || (wantZ && executor.writesDepth())) return false;
     FloatRowDraw d;
-    if (!ps11::plainTaps(executor, d.plan)) return false;
+    if (!ps11::plainTaps(executor, d.plan, true)) return false;
     d.serial = nextRowDrawSerial();
     d.kernels = &floatRowKernels(ps11::simdLevel());
     d.sampler = &ps11::fastpath::samplerKernels(ps11::simdLevel());
@@ -606,6 +610,21 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
                           });
         tap.unitRange = tap.unorm8 && std::all_of(tap.border.begin(), tap.border.end(),
                                                   [](float b) { return b >= 0.0f && b <= 1.0f; });
+    }
+    if (d.plan.executes) {
+        // The row sampler tells a tap from an executed instruction by its stage, and hands the
+        // executor lane indices for a tap's set (drawFloatRows): neither may be shared. The
+        // instructions are sampled per pixel at level 0 (no quads).
+        uint32_t sets = d.plan.killSets;
+        for (int i = 0; i < d.plan.count; ++i) sets |= 1u << d.plan.coordSet[size_t(i)];
+        if ((d.plan.executedStages & stagesSeen) || (d.plan.executedSets & sets)) return false;
+        for (int s = 0; s < 8; ++s)
+            if ((d.plan.executedStages >> s) & 1 && textures[size_t(s)] &&
+                !ps11::lodFree(*textures[size_t(s)], samplers[size_t(s)]))
+                return false;
+        for (int set = 0; set < kMaxTexSets; ++set)
+            if ((d.plan.executedSets >> set) & 1)
+                for (int c = 0; c < 4; ++c) d.executedAttrs |= usedAttrs & (uint64_t(1) << attrTex(set, c));
     }
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;
@@ -770,6 +789,10 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) {
         in.texcoord[set][0] = kLaneIndex.data();
         in.texcoord[set][2] = in.texcoord[set][3] = kOnes.data();
+        // (The sets the plan's executed instructions read: their coordinates, as spans give them.)
+        if ((draw.plan.executedSets >> set) & 1)
+            for (int c = 0; c < 4; ++c)
+                in.texcoord[set][c] = (draw.executedAttrs >> attrTex(set, c)) & 1 ? sc.coords[4 * set + c] : nullptr;
     }
     ps11::PixelOutputs outp;
     for (int c = 0; c < 4; ++c) outp.color[c] = sc.out[c];
@@ -791,7 +814,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
             // (Not under a depth test: the two halves' z planes are their own. Nor where a tap is
             // sampled at its quads' levels: those come from the quad's two rows, and joinRow
             // compares one.)
-            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && ti + 1 < count &&
+            const bool joined = !draw.wantZ && !(tri.freeTaps & draw.levelTaps.mask) && !draw.executedAttrs &&
+                                ti + 1 < count &&
                                 tris[ti + 1]->x0 == tri.x0 &&
                                 tris[ti + 1]->x1 == tri.x1 &&
                                 joinRow(s, *setups[ti + 1], joins.pair(ti), y, windows, windowCount, xl, xr);
@@ -825,6 +849,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     sampler.setX(x);
                     if (mode == RowMode::Shade) {
                         in.uniformColor = fillRowColors(draw.colorAttrs, s, x, y, n, sc.color);
+                        if (draw.executedAttrs) fillRowCoords(draw.executedAttrs, s, x, y, n, sc.coords);
                         in.count = n;
                         exec.run(in, sampler, outp, &stats.exec);
                         stats.texels += uint64_t(n) * rowTexelsPerPixel + sampler.takeLevelTexels();

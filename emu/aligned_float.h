@@ -60,6 +60,9 @@ struct FloatRowDraw {
     uint32_t bound = 0;     // the taps with a texture (bit per tap)
     bool weights8 = false;  // the float profile on a class with 8-bit filter weights
     uint64_t colorAttrs = 0;
+    // The coordinate attributes the texture instructions the plan executes read (plan.executes:
+    // the executor samples those through the worker's sampler, from the row's coordinates).
+    uint64_t executedAttrs = 0;
     MergeState merge;
     MergeTarget target;
     Plan mergePlan;      // makePlan(merge, target), made once (prepareFloatRowDraw)
@@ -69,7 +72,9 @@ struct FloatRowDraw {
 
 // Decides whether a draw can take the float row path (float or ideal precision, a program whose
 // texture reads are plain or projected and on distinct stages, whose texkills test coordinate
-// sets (rowKills, per run), 2-D textures, no depth written by the program) and fills `out`. A texture whose level or filter the level of detail picks is
+// sets (rowKills, per run), 2-D textures, no depth written by the program; its other texture
+// instructions, TapPlan::executes, on stages and coordinate sets of their own and sampling
+// lodFree textures) and fills `out`. A texture whose level or filter the level of detail picks is
 // one of levelTaps: its triangles take the row path where triangleLevels finds one level.
 bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
@@ -130,9 +135,11 @@ void setTapLevels(FloatRowDraw& draw, const TapLevels& levels);
 struct FloatRowScratch {
     // The worker's sampler, bound to the draw's textures and sampler states: it filters the taps
     // sampled per pixel (their lanes' u and v from tapCoords, no quads: such a texture's level
-    // and filter never depend on them, levelZeroOnly). Set by the caller before drawFloatRows.
+    // and filter never depend on them, levelZeroOnly) and the instructions the plan executes.
+    // Set by the caller before drawFloatRows.
     ps11::Sampler* sampler = nullptr;
     alignas(32) float color[8][ps11::kMaxSpan];
+    alignas(32) float coords[32][ps11::kMaxSpan];  // fillRowCoords (FloatRowDraw::executedAttrs)
     alignas(32) float out[4][ps11::kMaxSpan];
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth

@@ -650,8 +650,8 @@ bool tapPlan(const Executor& executor, TapPlan& plan, bool executes) {
     return static_cast<const exec::ExecutorImpl&>(executor).tapPlan(plan, executes);
 }
 
-bool plainTaps(const Executor& executor, TapPlan& plan) {
-    return static_cast<const exec::ExecutorImpl&>(executor).plainTaps(plan);
+bool plainTaps(const Executor& executor, TapPlan& plan, bool executes) {
+    return static_cast<const exec::ExecutorImpl&>(executor).plainTaps(plan, executes);
 }
 
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,

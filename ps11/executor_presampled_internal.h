@@ -48,9 +48,10 @@ inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne &
 // (but texkills of a register) are allowed too, and runPresampled executes them: TapPlan::executes.
 bool tapPlan(const Executor& executor, TapPlan& plan, bool executes = false);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
-// is a plain read as above (the float row path, emu/aligned_float.h, samples them for run() with
-// a sampler of its own).
-bool plainTaps(const Executor& executor, TapPlan& plan);
+// is a plain read as above, or with `executes` any but a texkill of a register (the float row
+// path, emu/aligned_float.h, samples the plain reads for run() with a sampler of its own and
+// hands the others to the worker's).
+bool plainTaps(const Executor& executor, TapPlan& plan, bool executes = false);
 
 // fill(ctx, i, first, n, dst) writes the grid integers of tap i (the profile's: fx8 or fx12) for
 // lanes [first, first + n) into dst[c][0 .. n) (c = r g b a): 8-bit texels, values in [0, G] (the

@@ -717,3 +717,27 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
     CHECK(rowPath * 10 >= cases * 8);
     CHECK(bumpMaps >= 15);
 }
+
+TEST_CASE("float row path: dependent reads in float and ideal equal the quad path byte for byte", "[draw][aligned]") {
+    std::mt19937 rng(20261208);
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 200; ++i) {
+        Case c = randomCase(rng, (i & 2) != 0);
+        dependentReads(c, rng);
+        withoutNaNs(c);
+        DeviceOptions quadOpt, rowOpt;
+        quadAndRowOptions(i, quadOpt, rowOpt);
+        rowOpt.software.skipTiles = (i % 3) == 1;
+        floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", depth " << c.depth
+                     << ", program:\n"
+                     << c.program);
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath);
+    }
+    // (Programs whose executed instructions share a stage or a set with a plain read stay in spans.)
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 6);
+}
