@@ -796,6 +796,9 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     }
     ps11::PixelOutputs outp;
     for (int c = 0; c < 4; ++c) outp.color[c] = sc.out[c];
+    // (A register's texkill discards lanes: merged over the others. The coordinate sets' texkills
+    // never kill here, their lanes' x being lane indices and z 1: rowKills tests those.)
+    outp.killed = draw.plan.registerKills ? sc.killed : nullptr;
     uint64_t texelsPerPixel = 0;
     for (int t = 0; t < taps; ++t)
         texelsPerPixel += draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0;
@@ -878,6 +881,11 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                     mi.y = sc.y;
                     mi.row = true;
                     if (draw.plan.killSets && rowKills(draw.plan, s, x, y, n, sc.kept)) mi.live = sc.kept;
+                    if (draw.plan.registerKills && mode == RowMode::Shade) {
+                        if (!mi.live) std::memset(sc.kept, 1, size_t(n));
+                        for (int i = 0; i < n; ++i) sc.kept[i] = uint8_t(sc.kept[i] & (sc.killed[i] ^ 1));
+                        mi.live = sc.kept;
+                    }
                     fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
                     mi.fog = draw.merge.fog ? sc.fog : nullptr;
                     mi.z = draw.wantZ ? sc.z : nullptr;

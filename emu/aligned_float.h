@@ -144,6 +144,7 @@ struct FloatRowScratch {
     alignas(32) int32_t x[ps11::kMaxSpan], y[ps11::kMaxSpan];
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
+    alignas(32) uint8_t killed[ps11::kMaxSpan];                // a register's texkill (TapPlan::registerKills)
     // H rows: texel rows filtered horizontally over the triangle's columns, planar r g b a (4 ×
     // columns floats each), keyed by draw, column table and texel row, shared by every tap with
     // that table (a vertical blur's taps read each other's rows). Slots used by the pixel row

@@ -765,7 +765,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         in.count = n;
                         ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ctx.under = fromSource && storeAsShaded ? sourced.base(x, n) : ctx.out;
-                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler);
+                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler,
+                                            draw.plan.registerKills ? sc.killed : nullptr);
+                        if (draw.plan.registerKills) {  // (never stored as shaded: directStore is off)
+                            for (int i = 0; i < n; ++i) sc.live[i] = uint8_t((live ? live[i] : 1) & (sc.killed[i] ^ 1));
+                            live = sc.live;
+                        }
                         if (fromSource && storeAsShaded) sourced.mark(x, n);
                         if (storeAsShaded) {
                             stats.pixels += uint64_t(n);

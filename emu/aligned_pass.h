@@ -300,6 +300,7 @@ struct AlignedScratch {
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
     alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
+    alignas(32) uint8_t killed[ps11::kMaxSpan], live[ps11::kMaxSpan];  // a register's texkill (TapPlan::registerKills)
     // Chain rows' taps formed into rows of their own (with room for verticalBytes' whole groups).
     alignas(32) uint8_t tapBytes[8][4 * (ps11::kMaxSpan + 32)];
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps

@@ -82,12 +82,14 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     // (A depth write comes with a depth test: MergeState::from.)
     const bool plain = unorm && !merge.alphaTest && merge.colorWrite == 0xf && (merge.depthTest || !merge.depthWrite) &&
                        (!merge.depthTest || target.depth);
-    d.directStore = plain && !merge.blend;
+    // (A register's texkill is known once the run is shaded: its runs are merged over the pixels
+    // it keeps, the depth tested and written by the merger.)
+    d.directStore = plain && !merge.blend && !d.plan.registerKills;
     const bool oneOne =
         merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
         (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE && merge.dstBlendAlpha == D3DBLEND_ONE &&
                                   merge.blendOpAlpha == D3DBLENDOP_ADD));
-    d.directAdd = plain && merge.blend && oneOne;
+    d.directAdd = plain && merge.blend && oneOne && !d.plan.registerKills;
     d.depthFirst = (d.directStore || d.directAdd) && merge.depthTest;
     d.fogFirst = (d.directStore || d.directAdd) && merge.fog;
     d.afterDepth = merge;

@@ -109,7 +109,7 @@ public:
     bool tapPlan(TapPlan& plan, bool executes) const;
     bool plainTaps(TapPlan& plan, bool executes = false) const;
     void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx, ExecutorStats* stats,
-                       Sampler* sampler) const;
+                       Sampler* sampler, uint8_t* killed) const;
     bool chainRows() const { return m_chainRows.ready; }
     void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, const ChainRowStore& store,
                      ExecutorStats* stats) const {
@@ -189,7 +189,8 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
     int tap = 0;  // texture instructions so far (pre-sampled runs: the tap they read)
     for (const DOp& op : m_ops) {
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
-        if (op.op == Opcode::TexKill && st.fill) continue;  // (the caller tests TapPlan::killSets)
+        // (The caller tests TapPlan::killSets; a register's texkill runs.)
+        if (op.op == Opcode::TexKill && st.fill && op.src[0].kind == SrcKind::TexCoord) continue;
         if (op.texture && st.fill && op.plainRead) {
             // A plain read (plainTaps): all four channels, clamped to ±M as sampled texels are.
             alignas(64) int16_t texels[4][kChunk];
@@ -251,7 +252,11 @@ bool ExecutorImpl::plainTaps(TapPlan& plan, bool executes) const {
     for (const DOp& op : m_ops) {
         if (!op.texture) continue;
         if (op.op == Opcode::TexKill) {
-            if (op.src[0].kind != SrcKind::TexCoord) return false;  // (r#: a register's value)
+            if (op.src[0].kind != SrcKind::TexCoord) {  // (r#: a register's value)
+                if (!executes) return false;
+                plan.executes = plan.registerKills = true;
+                continue;
+            }
             plan.killSets = uint8_t(plan.killSets | (1u << (op.src[0].slot & 7)));
             continue;
         }
@@ -293,10 +298,11 @@ bool ExecutorImpl::plainTaps(TapPlan& plan, bool executes) const {
 }
 
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                                 ExecutorStats* stats, Sampler* sampler) const {
+                                 ExecutorStats* stats, Sampler* sampler, uint8_t* killed) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.ready) {
-        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx, sampler);
+        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx, sampler,
+                          killed);
         countRun(stats, count);
         return;
     }
@@ -320,6 +326,7 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, Result
         runChunk(*st, fxArith, floatArith, nullptr);
         for (int c = 0; c < 4; ++c) fxArith.narrow(st->bi.reg[kSlotR][c], r0[c], st->n);  // |r0| <= nMax
         sink(ctx, off, st->n, out);
+        if (killed) std::memcpy(killed + off, st->killed, size_t(st->n));
     }
     st->fill = nullptr;
     countRun(stats, count);
@@ -655,8 +662,8 @@ bool plainTaps(const Executor& executor, TapPlan& plan, bool executes) {
 }
 
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats, Sampler* sampler) {
-    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler);
+                   ExecutorStats* stats, Sampler* sampler, uint8_t* killed) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler, killed);
 }
 
 bool chainRows(const Executor& executor) {

@@ -475,7 +475,7 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler) {
+                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, uint8_t* killed) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
@@ -494,11 +494,14 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
         st.offset = off;
         st.n = n;
         st.depthWritten = false;
+        std::memset(st.killed, 0, sizeof st.killed);
         loadColors(kern, p.g, inputs, vUsed, off, n, bank);
         int tap = 0;
         for (size_t idx = 0; idx < ops.size(); ++idx) {
             const DOp& op = ops[idx];
-            if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (TapPlan::killSets)
+            if (op.op == Opcode::Phase) continue;
+            // (The caller tests TapPlan::killSets; a register's texkill runs below.)
+            if (op.op == Opcode::TexKill && op.src[0].kind == SrcKind::TexCoord) continue;
             if (op.texture && !op.plainRead) {
                 // As runFast runs it: its registers through the int32 bank.
                 for (int s = 0; s < op.numSrc; ++s)
@@ -526,6 +529,7 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
         const int16_t* const r0[4] = {bank.reg[kSlotR][0], bank.reg[kSlotR][1], bank.reg[kSlotR][2],
                                       bank.reg[kSlotR][3]};
         sink(ctx, off, n, r0);
+        if (killed) std::memcpy(killed + off, st.killed, size_t(n));
     }
 }
 

@@ -30,6 +30,9 @@ struct TapPlan {
     // s's instruction (it may sample stage s).
     bool executes = false;
     uint8_t executedSets = 0, executedStages = 0;
+    // With `executes`: ps_1_4's `texkill r#` (a register's value) among them. Pre-sampled runs
+    // then report the lanes they kill (runPresampled's `killed`).
+    bool registerKills = false;
     bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
 
@@ -45,12 +48,13 @@ inline float projectCoord(float c, float d, bool zeroIsOne) { return zeroIsOne &
 // projectionDivisor names), `texld r#, t#` in ps_1_4 (.xy as written; _dz/_dw divide by the
 // set's raw z or w), and texkills of a coordinate set (`texkill t#`, any version: killSets).
 // Fills `plan` and returns true, else false. With `executes`, the other texture instructions
-// (but texkills of a register) are allowed too, and runPresampled executes them: TapPlan::executes.
+// are allowed too, texkills of a register among them, and runPresampled executes them:
+// TapPlan::executes.
 bool tapPlan(const Executor& executor, TapPlan& plan, bool executes = false);
 // The same plan in any profile, without the fx8 fast path: true when every texture instruction
-// is a plain read as above, or with `executes` any but a texkill of a register (the float row
-// path, emu/aligned_float.h, samples the plain reads for run() with a sampler of its own and
-// hands the others to the worker's).
+// is a plain read as above, or with `executes` any (the float row path, emu/aligned_float.h,
+// samples the plain reads for run() with a sampler of its own and hands the others to the
+// worker's).
 bool plainTaps(const Executor& executor, TapPlan& plan, bool executes = false);
 
 // fill(ctx, i, first, n, dst) writes the grid integers of tap i (the profile's: fx8 or fx12) for
@@ -66,9 +70,11 @@ using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* cons
 // a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as Executor::run()
 // with a sampler returning those texels. Only valid after tapPlan() returned true. `ctx` is
 // handed to both callbacks. Where the plan executes other texture instructions, they run as in
-// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail).
+// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail); where
+// `killed` is given, killed[i] is 1 for each lane i a texkill of a register discarded, else 0
+// (written once the run is done: the sink has seen every lane first).
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr);
+                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr, uint8_t* killed = nullptr);
 
 // Chain rows: a program whose arithmetic is one chain of products (mul, then mads adding it, all
 // of whose factors are >= 0: the glow's separable blur) each of a tap and a constant, the same on

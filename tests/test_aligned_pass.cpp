@@ -644,7 +644,8 @@ TEST_CASE("float row path: texkills of coordinate sets in float and ideal equal 
 
 // Dependent reads and the other texture instructions that are not plain reads (ps11::TapPlan::
 // executes): texbem/texbeml under random bump matrices, texm3x2 and texm3x3 rows (the eye from the
-// coordinates' w), texreg2ar/gb, texdp3tex, texcoord, ps_1_4's texcrd and dependent texld. The
+// coordinates' w), texreg2ar/gb, texdp3tex, texcoord, ps_1_4's texcrd, dependent texld and
+// texkills of a register (a killed pixel writes neither colour nor depth). The
 // executor samples those per pixel from the row's coordinates (fillRowCoords). A sixth of the cases
 // read a V8U8 bump map through a plain tap (the fx row path then refuses the draw), a third have
 // four-component coordinates, half any mapping.
@@ -665,6 +666,9 @@ void dependentReads(Case& c, std::mt19937& rng) {
         "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
         "-r2\n+mov r0.a, r3.a\n",
         "ps_1_4\ntexcrd r0.rgb, t0\ntexld r1, t1\nphase\ntexld r2, r0\nmul r0.rgb, r2, r1\n+mov r0.a, r2.a\n",
+        // Texkills of a register: a computed value's, and coordinates read as values.
+        "ps_1_4\ntexld r1, t0\nsub r2.rgb, r1, c0\nphase\ntexkill r2\nmov r0.rgb, r1\n+mov r0.a, c1.a\n",
+        "ps_1_4\ntexcrd r2.rgb, t1\ntexkill r2\ntexld r1, t0\nmul r0, r1, v0\n",
     };
     c.program = programs[rng() % std::size(programs)];
     for (auto& stage : c.bump)
@@ -686,7 +690,7 @@ void dependentReads(Case& c, std::mt19937& rng) {
 
 TEST_CASE("aligned pass: dependent reads take the row path and equal the quad path byte for byte", "[draw][aligned]") {
     std::mt19937 rng(20261207);
-    int rowPath = 0, cases = 0, bumpMaps = 0;
+    int rowPath = 0, cases = 0, bumpMaps = 0, killing = 0;
     for (int i = 0; i < 300; ++i) {
         Case c = randomCase(rng);
         dependentReads(c, rng);
@@ -703,6 +707,10 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
         int caseRows = 0, caseCount = 0;
         testutil::forEachSimdLevel(
             [&](ps11::SimdLevel) { requireRowsEqual(rowOpt, c, expected, qs, caseCount, caseRows); });
+        // (Pixels a register's texkill discarded: covered, not written, nothing else refusing them.)
+        if (c.program.find("texkill") != std::string::npos && !c.depth && !c.alphaTest && c.writeMask &&
+            qs.pixelsWritten < qs.pixelsCovered)
+            ++killing;
         if (c.tex[0].format == D3DFMT_V8U8) {
             // A plain read of a signed texture: not on the fx row path.
             const bool plainRead = c.tex[0].bound && (c.program.find("\ntex t0\n") != std::string::npos ||
@@ -713,9 +721,11 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
         }
         cases += caseCount, rowPath += caseRows;
     }
-    INFO(rowPath << " of " << cases << " cases took the row path, " << bumpMaps << " read a V8U8 bump map");
+    INFO(rowPath << " of " << cases << " cases took the row path, " << bumpMaps << " read a V8U8 bump map, "
+                 << killing << " killed pixels");
     CHECK(rowPath * 10 >= cases * 8);
     CHECK(bumpMaps >= 15);
+    CHECK(killing >= 10);
 }
 
 TEST_CASE("float row path: dependent reads in float and ideal equal the quad path byte for byte", "[draw][aligned]") {

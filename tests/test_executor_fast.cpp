@@ -702,6 +702,9 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
         "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
         "-r2\n+mov r0.a, r3.a\n",
         "ps_1_4\ntexcrd r0.rgb, t0\ntexld r1, t1\nphase\ntexld r2, r0\nmul r0.rgb, r2, r1\n+mov r0.a, r2.a\n",
+        // texkills of a register: the lanes they discard come back in `killed`.
+        "ps_1_4\ntexld r1, t0\nsub r2.rgb, r1, c0\nphase\ntexkill r2\nmov r0.rgb, r1\n+mov r0.a, c1.a\n",
+        "ps_1_4\ntexcrd r2.rgb, t1\ntexkill r2\ntexld r1, t0\nmul r0, r1, v0\n",
     };
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-0.2f, 1.2f);
@@ -767,17 +770,19 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
             CHECK_FALSE(tapPlan(*e, plan));  // (not without executes)
             REQUIRE(tapPlan(*e, plan, true));
             CHECK(plan.executes);
-            CHECK(plan.executedStages != 0);
+            const bool kills = std::string(text).find("texkill") != std::string::npos;
+            CHECK(plan.registerKills == kills);
             Out want(count);
             runAll(*ref, l, want, sampler, 256);
             for (int span : {64, 37}) {
                 std::vector<int32_t> got[4];
                 for (auto& g : got) g.assign(count, -9999);
+                std::vector<uint8_t> killed(size_t(count), 7);
                 for (int off = 0; off < count; off += span) {
                     const int n = std::min(span, count - off);
                     PixelInputs pin = l.inputs(off, n);
                     Ctx ctx{&sampler, &l, &plan, off, cfg.precision, got};
-                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler);
+                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler, killed.data() + off);
                 }
                 ++runs;
                 for (int c = 0; c < 4; ++c)
@@ -785,6 +790,14 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                         if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
                             FAIL_CHECK("span " << span << " lane " << i << " channel " << c << ": pre-sampled "
                                                << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
+                int dead = 0;
+                for (int i = 0; i < count; ++i) {
+                    dead += killed[size_t(i)];
+                    if (killed[size_t(i)] != want.killed[size_t(i)] && bad++ < 5)
+                        FAIL_CHECK("span " << span << " lane " << i << ": killed " << int(killed[size_t(i)])
+                                           << ", run() " << int(want.killed[size_t(i)]));
+                }
+                if (kills) CHECK((dead > 0 && dead < count));
             }
         }
     CHECK(bad == 0);
