@@ -566,7 +566,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                          const MergeTarget& target, bool wantZ, uint64_t usedAttrs, FloatRowDraw& out) {
     if (precision != ps11::Precision::Float && precision != ps11::Precision::Ideal) return false;
-    if (!target.color || (wantZ && executor.writesDepth())) return false;
+    if (!target.color) return false;
     FloatRowDraw d;
     if (!ps11::plainTaps(executor, d.plan, true)) return false;
     d.serial = nextRowDrawSerial();
@@ -633,6 +633,7 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     d.mergePlan = makePlan(merge, target, planned);
     if (!planned) return false;
     d.wantZ = wantZ;
+    d.shaderDepth = wantZ && executor.writesDepth();
     out = d;
     return true;
 }
@@ -799,6 +800,7 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     // (A register's texkill discards lanes: merged over the others. The coordinate sets' texkills
     // never kill here, their lanes' x being lane indices and z 1: rowKills tests those.)
     outp.killed = draw.plan.registerKills ? sc.killed : nullptr;
+    outp.depth = draw.shaderDepth ? sc.depth : nullptr;  // (the program's depth, for the merger)
     uint64_t texelsPerPixel = 0;
     for (int t = 0; t < taps; ++t)
         texelsPerPixel += draw.taps[size_t(t)].bound ? (draw.taps[size_t(t)].linear ? 4 : 1) : 0;
@@ -886,9 +888,12 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                         for (int i = 0; i < n; ++i) sc.kept[i] = uint8_t(sc.kept[i] & (sc.killed[i] ^ 1));
                         mi.live = sc.kept;
                     }
-                    fillRowFogDepth(s, draw.merge.fog, draw.wantZ, x, y, n, sc.fog, sc.z);
+                    // (The program's own depth where it writes one: shaded runs only, the tiles of
+                    // such draws never being decided.)
+                    const bool z = draw.wantZ && !draw.shaderDepth;
+                    fillRowFogDepth(s, draw.merge.fog, z, x, y, n, sc.fog, sc.z);
                     mi.fog = draw.merge.fog ? sc.fog : nullptr;
-                    mi.z = draw.wantZ ? sc.z : nullptr;
+                    mi.z = draw.shaderDepth ? sc.depth : z ? sc.z : nullptr;
                     for (int c = 0; c < 4; ++c) mi.color[c] = sc.out[c];
                     MergeStats ms;
                     mergePixels(draw.mergePlan, draw.merge, mi, &ms);

@@ -67,12 +67,13 @@ struct FloatRowDraw {
     MergeTarget target;
     Plan mergePlan;      // makePlan(merge, target), made once (prepareFloatRowDraw)
     bool wantZ = false;  // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
+    bool shaderDepth = false;  // wantZ, and the program writes its depth: that goes to the merger instead
     LevelTaps levelTaps;  // the taps whose level or filter the level of detail picks
 };
 
 // Decides whether a draw can take the float row path (float or ideal precision, a program whose
 // texture reads are plain or projected and on distinct stages, whose texkills test coordinate
-// sets (rowKills, per run), 2-D textures, no depth written by the program; its other texture
+// sets (rowKills, per run), 2-D textures; its other texture
 // instructions, TapPlan::executes, on stages and coordinate sets of their own and sampling
 // lodFree textures) and fills `out`. A texture whose level or filter the level of detail picks is
 // one of levelTaps: its triangles take the row path where triangleLevels finds one level.
@@ -145,6 +146,7 @@ struct FloatRowScratch {
     alignas(32) float fog[ps11::kMaxSpan], z[ps11::kMaxSpan];  // fillRowFogDepth
     alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
     alignas(32) uint8_t killed[ps11::kMaxSpan];                // a register's texkill (TapPlan::registerKills)
+    alignas(32) float depth[ps11::kMaxSpan];                   // the program's depth (FloatRowDraw::shaderDepth)
     // H rows: texel rows filtered horizontally over the triangle's columns, planar r g b a (4 ×
     // columns floats each), keyed by draw, column table and texel row, shared by every tap with
     // that table (a vertical blur's taps read each other's rows). Slots used by the pixel row

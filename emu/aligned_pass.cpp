@@ -765,8 +765,10 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         in.count = n;
                         ctx.out = storeAsShaded ? target.texel(uint32_t(x), uint32_t(y)) : nullptr;
                         ctx.under = fromSource && storeAsShaded ? sourced.base(x, n) : ctx.out;
-                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler,
-                                            draw.plan.registerKills ? sc.killed : nullptr);
+                        ps11::PixelOutputs more;
+                        more.killed = draw.plan.registerKills ? sc.killed : nullptr;
+                        more.depth = draw.shaderDepth ? sc.depth : nullptr;
+                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler, &more);
                         if (draw.plan.registerKills) {  // (never stored as shaded: directStore is off)
                             for (int i = 0; i < n; ++i) sc.live[i] = uint8_t((live ? live[i] : 1) & (sc.killed[i] ^ 1));
                             live = sc.live;
@@ -851,10 +853,12 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                     mi.y = sc.y;
                     mi.row = true;
                     mi.live = live;
-                    const bool z = draw.wantZ && !draw.depthFirst;
+                    // (The program's own depth where it writes one: shaded runs only, the tiles of
+                    // such draws never being decided.)
+                    const bool z = draw.wantZ && !draw.depthFirst && !draw.shaderDepth;
                     fillRowFogDepth(s, draw.merge.fog, z, x, y, n, sc.fog, sc.z);
                     mi.fog = draw.merge.fog ? sc.fog : nullptr;
-                    mi.z = z ? sc.z : nullptr;
+                    mi.z = draw.shaderDepth ? sc.depth : z ? sc.z : nullptr;
                     // (The merger merges fx profiles from the grid: mergeReadsColor says where it also
                     // reads the real values.)
                     const bool readsColor =

@@ -102,6 +102,9 @@ struct AlignedDraw {
     MergeState afterDepth;  // `merge` with its depth test and write off
     Plan mergePlan, afterDepthPlan;  // makePlan of each with `target`, made once (prepareAlignedDraw)
     bool wantZ = false;     // depth tested or written: each run's z goes to the merger (fillRowFogDepth)
+    // wantZ, and the program writes its depth (texdepth, texm3x2depth): that goes to the merger
+    // instead, and no run is stored directly.
+    bool shaderDepth = false;
     // The program runs as chain rows (ps11::chainRows): fx8, reads no colour, stored here with
     // no depth test or fog first. The row path takes them on rows where a tap reads a texel row's
     // texels side by side (1:1, at texel centres or halfway between them; chainRow).
@@ -301,6 +304,7 @@ struct AlignedScratch {
     alignas(32) uint8_t passed[ps11::kMaxSpan];                // depthTestFirst
     alignas(32) uint8_t kept[ps11::kMaxSpan];                  // rowKills
     alignas(32) uint8_t killed[ps11::kMaxSpan], live[ps11::kMaxSpan];  // a register's texkill (TapPlan::registerKills)
+    alignas(32) float depth[ps11::kMaxSpan];                           // the program's depth (AlignedDraw::shaderDepth)
     // Chain rows' taps formed into rows of their own (with room for verticalBytes' whole groups).
     alignas(32) uint8_t tapBytes[8][4 * (ps11::kMaxSpan + 32)];
     // The worker's sampler, bound to the draw's textures and sampler states: it samples the taps

@@ -28,8 +28,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
                         const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,
                         const MergeTarget& target, bool wantZ, uint64_t usedAttrs, AlignedDraw& out) {
     const bool fx12 = precision == ps11::Precision::Fx12;
-    if ((precision != ps11::Precision::Fx8 && !fx12) || !target.color || (wantZ && executor.writesDepth()))
-        return false;
+    if ((precision != ps11::Precision::Fx8 && !fx12) || !target.color) return false;
     AlignedDraw d;
     if (!ps11::tapPlan(executor, d.plan, true)) return false;
     // Instructions the executor samples itself, per pixel at level 0 (as the spans of one row
@@ -82,14 +81,15 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     // (A depth write comes with a depth test: MergeState::from.)
     const bool plain = unorm && !merge.alphaTest && merge.colorWrite == 0xf && (merge.depthTest || !merge.depthWrite) &&
                        (!merge.depthTest || target.depth);
-    // (A register's texkill is known once the run is shaded: its runs are merged over the pixels
-    // it keeps, the depth tested and written by the merger.)
-    d.directStore = plain && !merge.blend && !d.plan.registerKills;
+    // (A register's texkill, and a depth the program writes, are known once the run is shaded:
+    // its runs are merged over the pixels it keeps, the depth tested and written by the merger.)
+    d.shaderDepth = wantZ && executor.writesDepth();
+    d.directStore = plain && !merge.blend && !d.plan.registerKills && !d.shaderDepth;
     const bool oneOne =
         merge.srcBlend == D3DBLEND_ONE && merge.dstBlend == D3DBLEND_ONE && merge.blendOp == D3DBLENDOP_ADD &&
         (!merge.separateAlpha || (merge.srcBlendAlpha == D3DBLEND_ONE && merge.dstBlendAlpha == D3DBLEND_ONE &&
                                   merge.blendOpAlpha == D3DBLENDOP_ADD));
-    d.directAdd = plain && merge.blend && oneOne && !d.plan.registerKills;
+    d.directAdd = plain && merge.blend && oneOne && !d.plan.registerKills && !d.shaderDepth;
     d.depthFirst = (d.directStore || d.directAdd) && merge.depthTest;
     d.fogFirst = (d.directStore || d.directAdd) && merge.fog;
     d.afterDepth = merge;

@@ -109,7 +109,7 @@ public:
     bool tapPlan(TapPlan& plan, bool executes) const;
     bool plainTaps(TapPlan& plan, bool executes = false) const;
     void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx, ExecutorStats* stats,
-                       Sampler* sampler, uint8_t* killed) const;
+                       Sampler* sampler, const PixelOutputs* outputs) const;
     bool chainRows() const { return m_chainRows.ready; }
     void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, const ChainRowStore& store,
                      ExecutorStats* stats) const {
@@ -298,11 +298,11 @@ bool ExecutorImpl::plainTaps(TapPlan& plan, bool executes) const {
 }
 
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                                 ExecutorStats* stats, Sampler* sampler, uint8_t* killed) const {
+                                 ExecutorStats* stats, Sampler* sampler, const PixelOutputs* outputs) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     if (m_fast.ready) {
-        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, inputs, fill, sink, ctx, sampler,
-                          killed);
+        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, m_writesDepth, inputs, fill, sink,
+                          ctx, sampler, outputs);
         countRun(stats, count);
         return;
     }
@@ -326,7 +326,9 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, Result
         runChunk(*st, fxArith, floatArith, nullptr);
         for (int c = 0; c < 4; ++c) fxArith.narrow(st->bi.reg[kSlotR][c], r0[c], st->n);  // |r0| <= nMax
         sink(ctx, off, st->n, out);
-        if (killed) std::memcpy(killed + off, st->killed, size_t(st->n));
+        if (outputs && outputs->killed) std::memcpy(outputs->killed + off, st->killed, size_t(st->n));
+        if (outputs && outputs->depth && m_writesDepth && st->depthWritten)
+            std::memcpy(outputs->depth + off, st->depth, sizeof(float) * size_t(st->n));
     }
     st->fill = nullptr;
     countRun(stats, count);
@@ -662,8 +664,8 @@ bool plainTaps(const Executor& executor, TapPlan& plan, bool executes) {
 }
 
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats, Sampler* sampler, uint8_t* killed) {
-    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler, killed);
+                   ExecutorStats* stats, Sampler* sampler, const PixelOutputs* outputs) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler, outputs);
 }
 
 bool chainRows(const Executor& executor) {

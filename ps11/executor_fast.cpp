@@ -474,8 +474,8 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
 }
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
-                       const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, uint8_t* killed) {
+                       const std::vector<FastOp>& ops2, uint8_t vUsed, bool writesDepth, const PixelInputs& inputs,
+                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, const PixelOutputs* outputs) {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
@@ -529,7 +529,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
         const int16_t* const r0[4] = {bank.reg[kSlotR][0], bank.reg[kSlotR][1], bank.reg[kSlotR][2],
                                       bank.reg[kSlotR][3]};
         sink(ctx, off, n, r0);
-        if (killed) std::memcpy(killed + off, st.killed, size_t(n));
+        if (outputs && outputs->killed) std::memcpy(outputs->killed + off, st.killed, size_t(n));
+        if (outputs && outputs->depth && writesDepth && st.depthWritten)
+            std::memcpy(outputs->depth + off, st.depth, sizeof(float) * size_t(n));
     }
 }
 

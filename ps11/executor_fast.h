@@ -171,12 +171,12 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
 // simdLevel()): plain reads (DOp::plainRead) have `fill` write tap i's lanes straight into their
 // register (then clamped to ±nMax as sampled texels are) instead of sampling; the other texture
 // instructions run as in runFast, with `sampler`; r0's int16 lanes go to `sink` chunk by chunk,
-// straight from the register bank, and where `killed` is given the lanes a register's texkill
-// discarded to it. `ops2` is fp.ops with the sign analysis of presampledOps for the current
+// straight from the register bank, and where `outputs` is given its killed and depth lanes as
+// runFast writes them. `ops2` is fp.ops with the sign analysis of presampledOps for the current
 // constants.
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
-                       const std::vector<FastOp>& ops2, uint8_t vUsed, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, uint8_t* killed);
+                       const std::vector<FastOp>& ops2, uint8_t vUsed, bool writesDepth, const PixelInputs& inputs,
+                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, const PixelOutputs* outputs);
 
 // The chain-row plan of a program (ops2: presampledOps' for the current constants): ready when
 // fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic after the texture

@@ -70,11 +70,12 @@ using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* cons
 // a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as Executor::run()
 // with a sampler returning those texels. Only valid after tapPlan() returned true. `ctx` is
 // handed to both callbacks. Where the plan executes other texture instructions, they run as in
-// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail); where
-// `killed` is given, killed[i] is 1 for each lane i a texkill of a register discarded, else 0
-// (written once the run is done: the sink has seen every lane first).
+// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail). Where
+// `outputs` is given, its `killed` and `depth` (the others are not written) take what run()
+// writes there: each lane a texkill of a register discarded, and the depth a program that writes
+// one (texdepth, texm3x2depth) gives each lane (chunk by chunk after the sink took it).
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr, uint8_t* killed = nullptr);
+                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr, const PixelOutputs* outputs = nullptr);
 
 // Chain rows: a program whose arithmetic is one chain of products (mul, then mads adding it, all
 // of whose factors are >= 0: the glow's separable blur) each of a tap and a constant, the same on

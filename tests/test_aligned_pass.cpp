@@ -669,6 +669,10 @@ void dependentReads(Case& c, std::mt19937& rng) {
         // Texkills of a register: a computed value's, and coordinates read as values.
         "ps_1_4\ntexld r1, t0\nsub r2.rgb, r1, c0\nphase\ntexkill r2\nmov r0.rgb, r1\n+mov r0.a, c1.a\n",
         "ps_1_4\ntexcrd r2.rgb, t1\ntexkill r2\ntexld r1, t0\nmul r0, r1, v0\n",
+        // The program's own depth (tested against, and written into, the depth buffer where the case
+        // has one).
+        "ps_1_4\ntexcrd r5.rgb, t1\nphase\ntexdepth r5\ntexld r0, t0\nmul r0, r0, v0\n",
+        "ps_1_3\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2depth t2, t0_bx2\nmov r0, t0\n",
     };
     c.program = programs[rng() % std::size(programs)];
     for (auto& stage : c.bump)
@@ -690,7 +694,7 @@ void dependentReads(Case& c, std::mt19937& rng) {
 
 TEST_CASE("aligned pass: dependent reads take the row path and equal the quad path byte for byte", "[draw][aligned]") {
     std::mt19937 rng(20261207);
-    int rowPath = 0, cases = 0, bumpMaps = 0, killing = 0;
+    int rowPath = 0, cases = 0, bumpMaps = 0, killing = 0, ownDepth = 0;
     for (int i = 0; i < 300; ++i) {
         Case c = randomCase(rng);
         dependentReads(c, rng);
@@ -711,6 +715,7 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
         if (c.program.find("texkill") != std::string::npos && !c.depth && !c.alphaTest && c.writeMask &&
             qs.pixelsWritten < qs.pixelsCovered)
             ++killing;
+        if (c.depth && c.program.find("depth") != std::string::npos && qs.pixelsCovered) ++ownDepth;
         if (c.tex[0].format == D3DFMT_V8U8) {
             // A plain read of a signed texture: not on the fx row path.
             const bool plainRead = c.tex[0].bound && (c.program.find("\ntex t0\n") != std::string::npos ||
@@ -722,15 +727,16 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
         cases += caseCount, rowPath += caseRows;
     }
     INFO(rowPath << " of " << cases << " cases took the row path, " << bumpMaps << " read a V8U8 bump map, "
-                 << killing << " killed pixels");
+                 << killing << " killed pixels, " << ownDepth << " tested the program's depth");
     CHECK(rowPath * 10 >= cases * 8);
     CHECK(bumpMaps >= 15);
     CHECK(killing >= 10);
+    CHECK(ownDepth >= 8);
 }
 
 TEST_CASE("float row path: dependent reads in float and ideal equal the quad path byte for byte", "[draw][aligned]") {
     std::mt19937 rng(20261208);
-    int rowPath = 0, cases = 0;
+    int rowPath = 0, cases = 0, ownDepth = 0;
     for (int i = 0; i < 200; ++i) {
         Case c = randomCase(rng, (i & 2) != 0);
         dependentReads(c, rng);
@@ -746,8 +752,10 @@ TEST_CASE("float row path: dependent reads in float and ideal equal the quad pat
                      << ", program:\n"
                      << c.program);
         requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath);
+        if (c.depth && c.program.find("depth") != std::string::npos && qs.pixelsCovered) ++ownDepth;
     }
     // (Programs whose executed instructions share a stage or a set with a plain read stay in spans.)
-    INFO(rowPath << " of " << cases << " cases took the row path");
+    INFO(rowPath << " of " << cases << " cases took the row path, " << ownDepth << " tested the program's depth");
     CHECK(rowPath * 10 >= cases * 6);
+    CHECK(ownDepth >= 4);
 }

@@ -782,7 +782,9 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                     const int n = std::min(span, count - off);
                     PixelInputs pin = l.inputs(off, n);
                     Ctx ctx{&sampler, &l, &plan, off, cfg.precision, got};
-                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler, killed.data() + off);
+                    PixelOutputs more;
+                    more.killed = killed.data() + off;
+                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler, &more);
                 }
                 ++runs;
                 for (int c = 0; c < 4; ++c)
