@@ -768,7 +768,8 @@ void drawAlignedRows(const AlignedDraw& draw, const AlignedTriangle* const* tris
                         ps11::PixelOutputs more;
                         more.killed = draw.plan.registerKills ? sc.killed : nullptr;
                         more.depth = draw.shaderDepth ? sc.depth : nullptr;
-                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec, sc.sampler, &more);
+                        ps11::runPresampled(exec, in, fill, sink, &ctx, &stats.exec,
+                                            ps11::PresampledRun{sc.sampler, &more, draw.plan.executedTaps});
                         if (draw.plan.registerKills) {  // (never stored as shaded: directStore is off)
                             for (int i = 0; i < n; ++i) sc.live[i] = uint8_t((live ? live[i] : 1) & (sc.killed[i] ^ 1));
                             live = sc.live;

@@ -36,9 +36,6 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     for (int s = 0; s < 8 && d.plan.executes; ++s)
         if ((d.plan.executedStages >> s) & 1 && textures[size_t(s)] && !ps11::lodFree(*textures[size_t(s)], samplers[size_t(s)]))
             return false;
-    for (int set = 0; set < kMaxTexSets; ++set)
-        if ((d.plan.executedSets >> set) & 1)
-            for (int c = 0; c < 4; ++c) d.executedAttrs |= usedAttrs & (uint64_t(1) << attrTex(set, c));
     d.fx12 = fx12;
     d.serial = nextRowDrawSerial();
     d.executor = &executor;
@@ -51,7 +48,16 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        if (tex->isVolume() || tex->storage() != ps11::TexelStorage::Unorm8) return false;
+        if (tex->isVolume() || tex->storage() != ps11::TexelStorage::Unorm8) {
+            // A texture the row path does not filter (signed, float, volume): the executor samples
+            // the tap per pixel as run() does, where the level of detail cannot matter.
+            if (!ps11::lodFree(*tex, ss)) return false;
+            d.plan.executedTaps = uint8_t(d.plan.executedTaps | (1u << i));
+            d.plan.executes = true;
+            d.plan.executedSets = uint8_t(d.plan.executedSets | (1u << tap.coordSet));
+            d.plan.executedStages = uint8_t(d.plan.executedStages | (1u << stage));
+            continue;  // (not bound: no tables, no fill)
+        }
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;
         d.bound |= 1u << i;
@@ -72,6 +78,9 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
         }
         tap.borderWord = word;
     }
+    for (int set = 0; set < kMaxTexSets; ++set)
+        if ((d.plan.executedSets >> set) & 1)
+            for (int c = 0; c < 4; ++c) d.executedAttrs |= usedAttrs & (uint64_t(1) << attrTex(set, c));
     d.colorAttrs = usedAttrs & ((uint64_t(0xF) << kAttrDiffuse) | (uint64_t(0xF) << kAttrSpecular));
     d.merge = merge;
     d.target = target;
@@ -98,7 +107,7 @@ bool prepareAlignedDraw(const ps11::Executor& executor, ps11::Precision precisio
     d.mergePlan = makePlan(d.merge, target, planned);
     d.afterDepthPlan = makePlan(d.afterDepth, target, plannedAfter);
     if (!planned || !plannedAfter) return false;
-    d.chainRows = !fx12 && d.kernels && ps11::chainRows(executor) && d.colorAttrs == 0 &&
+    d.chainRows = !fx12 && d.kernels && ps11::chainRows(executor) && d.colorAttrs == 0 && !d.plan.executedTaps &&
                   (d.directStore || d.directAdd) && !d.depthFirst && !d.fogFirst;
     out = d;
     return true;

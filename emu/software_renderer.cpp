@@ -331,9 +331,11 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     // (Meshes of more triangles than a row-path chunk takes are never tiled: no skipper, no scan.)
     // (Nor are draws whose taps' levels the level of detail picks: the tiles' facts are level 0's.)
     // (Tile-shaped: what drawBandTiles draws. Tileable: decided per tile, with skipping on.)
-    // (Nor are those whose program's depth is tested or written: a tile's fill has none.)
+    // (Nor are those whose program's depth is tested or written: a tile's fill has none. Nor
+    // those whose plain reads the executor samples itself: a copied tile would filter them.)
     const bool tileShaped = (alignedDraw || floatDraw) && !aligned.levelTaps.mask && !floatRows.levelTaps.mask &&
-                            call.primitiveCount <= kMaxAlignedTriangles && !(shaderDepth && wantZ);
+                            call.primitiveCount <= kMaxAlignedTriangles && !(shaderDepth && wantZ) &&
+                            !(alignedDraw && aligned.plan.executedTaps);
     const bool tileable = m_options.skipTiles && tileShaped;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
     // Timed: a program that pays is drawn undecided once after its second decided draw (the

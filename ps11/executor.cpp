@@ -70,8 +70,7 @@ public:
         m_constsId = nextConstsId();
         if (options.path != ExecPath::Generic) {
             buildFastProgram(m_p, m_ops, m_fast);
-            presampledOps(m_fast, m_p, m_ops, m_presampled);
-            chainRowPlan(m_fast, m_p, m_ops, m_presampled, m_vUsed, m_chainRows);
+            refreshPresampled();
         }
     }
 
@@ -83,10 +82,7 @@ public:
         m_api[size_t(index)] = value;
         refreshConstant(index);
         m_constsId = nextConstsId();
-        if (m_fast.ready) {
-            presampledOps(m_fast, m_p, m_ops, m_presampled);
-            chainRowPlan(m_fast, m_p, m_ops, m_presampled, m_vUsed, m_chainRows);
-        }
+        if (m_fast.ready) refreshPresampled();
     }
     void setStageState(int stage, const StageState& state) override {
         if (stage >= 0 && stage < kMaxTextureStages) m_p.stages[size_t(stage)] = state;
@@ -109,7 +105,7 @@ public:
     bool tapPlan(TapPlan& plan, bool executes) const;
     bool plainTaps(TapPlan& plan, bool executes = false) const;
     void runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx, ExecutorStats* stats,
-                       Sampler* sampler, const PixelOutputs* outputs) const;
+                       const PresampledRun& run) const;
     bool chainRows() const { return m_chainRows.ready; }
     void runChainRow(const ChainRowTap* taps, int count, uint8_t* out, const ChainRowStore& store,
                      ExecutorStats* stats) const {
@@ -118,6 +114,13 @@ public:
     }
 
 private:
+    // The pre-sampled runs' sign analyses (plain reads' texels >= 0, and of any sign) and chain
+    // rows for the constants now.
+    void refreshPresampled() {
+        presampledOps(m_fast, m_p, m_ops, m_presampled, true);
+        presampledOps(m_fast, m_p, m_ops, m_presampledAnySign, false);
+        chainRowPlan(m_fast, m_p, m_ops, m_presampled, m_vUsed, m_chainRows);
+    }
     void refreshConstant(int i) {
         // A def in the shader overrides the API value (spec §1.1, def page).
         const std::array<float, 4>& v = (m_defMask >> i) & 1 ? m_defs[size_t(i)] : m_api[size_t(i)];
@@ -151,6 +154,7 @@ private:
     uint8_t m_r0Preset = 0xF;          // r0PresetChannels(m_ops)
     FastProgram m_fast;                // not ready: the generic path runs
     std::vector<FastOp> m_presampled;  // m_fast.ops with the sign analysis of runPresampled
+    std::vector<FastOp> m_presampledAnySign;  // the same, plain reads' texels of any sign (PresampledRun::executedTaps)
     ChainRowPlan m_chainRows;          // from m_presampled
     uint64_t m_constsId = 0;           // names the constants (a thread's fast bank keeps them)
 };
@@ -191,12 +195,15 @@ void ExecutorImpl::runChunk(RunState& st, const FxArithKernels& fxArith, const F
         if (op.op == Opcode::Phase) continue;  // r#.a keep their values (docs/precision.md "ps_1_4")
         // (The caller tests TapPlan::killSets; a register's texkill runs.)
         if (op.op == Opcode::TexKill && st.fill && op.src[0].kind == SrcKind::TexCoord) continue;
-        if (op.texture && st.fill && op.plainRead) {
-            // A plain read (plainTaps): all four channels, clamped to ±M as sampled texels are.
+        // A plain read (plainTaps): all four channels from `fill`, clamped to ±M as sampled texels
+        // are; or, one the caller leaves to the executor (executedTaps), sampled as run() does.
+        const bool filled = op.texture && st.fill && op.plainRead && !((st.executedTaps >> tap) & 1);
+        if (op.texture && st.fill && op.plainRead) ++tap;
+        if (filled) {
             alignas(64) int16_t texels[4][kChunk];
             int16_t* const dst[4] = {texels[0], texels[1], texels[2], texels[3]};
             const int n = st.n;
-            st.fill(st.fillCtx, tap++, st.offset, n, dst);
+            st.fill(st.fillCtx, tap - 1, st.offset, n, dst);
             // (Texels lie in [0, G]: the clamp to M changes nothing where M >= 1.)
             const int32_t hi = m_p.nMax >= m_p.g ? INT16_MAX : m_p.nMax;
             for (int c = 0; c < 4; ++c) fxArith.widen(texels[c], st.bi.reg[op.dstSlot][c], n, hi);
@@ -298,11 +305,13 @@ bool ExecutorImpl::plainTaps(TapPlan& plan, bool executes) const {
 }
 
 void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                                 ExecutorStats* stats, Sampler* sampler, const PixelOutputs* outputs) const {
+                                 ExecutorStats* stats, const PresampledRun& run) const {
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
+    const PixelOutputs* outputs = run.outputs;
     if (m_fast.ready) {
-        runFastPresampled(m_fast, m_p, m_constsId, m_ops, m_presampled, m_vUsed, m_writesDepth, inputs, fill, sink,
-                          ctx, sampler, outputs);
+        // (Plain reads executed hold texels of any sign: the sign analysis without theirs.)
+        runFastPresampled(m_fast, m_p, m_constsId, m_ops, run.executedTaps ? m_presampledAnySign : m_presampled, m_vUsed,
+                          m_writesDepth, inputs, fill, sink, ctx, run);
         countRun(stats, count);
         return;
     }
@@ -310,7 +319,8 @@ void ExecutorImpl::runPresampled(const PixelInputs& inputs, TapFill fill, Result
     // instructions sampled as run() samples them), r0 narrowed to int16 for `sink`.
     const ThreadCached<RunState> st;
     st->in = &inputs;
-    st->sampler = sampler;
+    st->sampler = run.sampler;
+    st->executedTaps = run.executedTaps;
     st->fill = fill;
     st->fillCtx = ctx;
     for (int c = 0; c < 4; ++c)
@@ -664,8 +674,8 @@ bool plainTaps(const Executor& executor, TapPlan& plan, bool executes) {
 }
 
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats, Sampler* sampler, const PixelOutputs* outputs) {
-    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, sampler, outputs);
+                   ExecutorStats* stats, const PresampledRun& run) {
+    static_cast<const exec::ExecutorImpl&>(executor).runPresampled(inputs, fill, sink, ctx, stats, run);
 }
 
 bool chainRows(const Executor& executor) {

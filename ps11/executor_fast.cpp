@@ -283,7 +283,8 @@ static void markChains(const std::vector<DOp>& ops, std::vector<FastOp>& out) {
     }
 }
 
-void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out) {
+void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out,
+                   bool plainTexels) {
     out = fp.ops;
     if (!fp.ready) return;
     // Sign analysis for productSmall: channels known >= 0 per slot (bit c). Taps are 8-bit texels
@@ -303,7 +304,7 @@ void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DO
             const DOp& op = ops[idx];
             if (op.op == Opcode::Phase || op.op == Opcode::TexKill) continue;  // (texkill writes nothing)
             if (op.texture) {
-                pos[op.dstSlot] = op.plainRead ? kMaskAll : 0;
+                pos[op.dstSlot] = op.plainRead && plainTexels ? kMaskAll : 0;
                 continue;
             }
             FastOp& f = out[idx];
@@ -475,13 +476,14 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
 
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, bool writesDepth, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, const PixelOutputs* outputs) {
+                       TapFill fill, ResultSink sink, void* ctx, const PresampledRun& run) {
+    const PixelOutputs* outputs = run.outputs;
     const int count = std::clamp(inputs.count, 0, kMaxSpan);
     const ThreadCached<FastRunState> fs;  // no 60 KB allocation per span
     FastBank& bank = fs->bank;
     RunState& st = fs->st;  // (the texture instructions run() would sample)
     st.in = &inputs;
-    st.sampler = sampler;
+    st.sampler = run.sampler;
     // r0's channels read before written, or never written, are 0 (as in runFast).
     for (int c = 0; c < 4; ++c)
         if ((fp.r0Preset >> c) & 1) std::memset(bank.reg[kSlotR][c], 0, sizeof bank.reg[kSlotR][c]);
@@ -502,7 +504,9 @@ void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsI
             if (op.op == Opcode::Phase) continue;
             // (The caller tests TapPlan::killSets; a register's texkill runs below.)
             if (op.op == Opcode::TexKill && op.src[0].kind == SrcKind::TexCoord) continue;
-            if (op.texture && !op.plainRead) {
+            // (A plain read the caller leaves to the executor is sampled as the others are.)
+            if (op.texture && (!op.plainRead || ((run.executedTaps >> tap) & 1))) {
+                tap += op.plainRead;
                 // As runFast runs it: its registers through the int32 bank.
                 for (int s = 0; s < op.numSrc; ++s)
                     if (op.src[size_t(s)].kind == SrcKind::Reg) syncTo32(*fs, op.src[size_t(s)].slot);

@@ -171,12 +171,13 @@ void runFast(const FastProgram& fp, const Profile& p, uint64_t constsId, const s
 // simdLevel()): plain reads (DOp::plainRead) have `fill` write tap i's lanes straight into their
 // register (then clamped to ±nMax as sampled texels are) instead of sampling; the other texture
 // instructions run as in runFast, with `sampler`; r0's int16 lanes go to `sink` chunk by chunk,
-// straight from the register bank, and where `outputs` is given its killed and depth lanes as
-// runFast writes them. `ops2` is fp.ops with the sign analysis of presampledOps for the current
-// constants.
+// straight from the register bank, and where run.outputs is given its killed and depth lanes as
+// runFast writes them; the plain reads run.executedTaps names are sampled like the others.
+// `ops2` is fp.ops with the sign analysis of presampledOps for the current constants (plain
+// reads of any sign where some are executed).
 void runFastPresampled(const FastProgram& fp, const Profile& p, uint64_t constsId, const std::vector<DOp>& ops,
                        const std::vector<FastOp>& ops2, uint8_t vUsed, bool writesDepth, const PixelInputs& inputs,
-                       TapFill fill, ResultSink sink, void* ctx, Sampler* sampler, const PixelOutputs* outputs);
+                       TapFill fill, ResultSink sink, void* ctx, const PresampledRun& run);
 
 // The chain-row plan of a program (ops2: presampledOps' for the current constants): ready when
 // fp is, no v# is read, nMax >= 255 (texels are not clamped), and the arithmetic after the texture
@@ -191,9 +192,10 @@ void runChainRow(const ChainRowPlan& plan, const std::vector<FastOp>& ops2, cons
                  uint8_t* out, const ChainRowStore& store);
 
 // fp.ops for pre-sampled runs: mul/mad whose factors are known >= 0 in every lane (plain reads'
-// taps are 8-bit texels, v# in [0, 1], constants as they are now, _sat results; the other
-// texture instructions' results of any sign) marked nonNegative.
+// taps are 8-bit texels where `plainTexels`, v# in [0, 1], constants as they are now, _sat
+// results; the other texture instructions' results of any sign) marked nonNegative.
 // Depends on the constants: recomputed when one changes, not per run.
-void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out);
+void presampledOps(const FastProgram& fp, const Profile& p, const std::vector<DOp>& ops, std::vector<FastOp>& out,
+                   bool plainTexels);
 
 }  // namespace ps11::exec

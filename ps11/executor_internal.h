@@ -66,6 +66,7 @@ struct RunState {
     // instruction takes tap k's grid integers from `fill` instead of the sampler; null otherwise.
     TapFill fill = nullptr;
     void* fillCtx = nullptr;
+    uint8_t executedTaps = 0;  // plain reads sampled here all the same (PresampledRun::executedTaps)
 };
 
 // The calling thread's T (a run state of tens of KB), kept between calls so a span costs no

@@ -31,8 +31,13 @@ struct TapPlan {
     bool executes = false;
     uint8_t executedSets = 0, executedStages = 0;
     // With `executes`: ps_1_4's `texkill r#` (a register's value) among them. Pre-sampled runs
-    // then report the lanes they kill (runPresampled's `killed`).
+    // then report the lanes they kill (PresampledRun::outputs).
     bool registerKills = false;
+    // Set by the caller: bit i, plain read i is executed too (sampled by the executor as run()
+    // samples it, its texels of any sign), not filled: a texture the caller does not filter
+    // itself. Its set and stage count among executedSets and executedStages, and `executes` is
+    // set with it. Handed to runPresampled (PresampledRun::executedTaps).
+    uint8_t executedTaps = 0;
     bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
 
@@ -70,12 +75,18 @@ using ResultSink = void (*)(void* ctx, int first, int count, const int16_t* cons
 // a sampler. v0/v1 come from inputs.color. r0 goes to `sink`. Same results as Executor::run()
 // with a sampler returning those texels. Only valid after tapPlan() returned true. `ctx` is
 // handed to both callbacks. Where the plan executes other texture instructions, they run as in
-// run(): with `sampler` and inputs.texcoord (inputs.quads off: no level of detail). Where
-// `outputs` is given, its `killed` and `depth` (the others are not written) take what run()
-// writes there: each lane a texkill of a register discarded, and the depth a program that writes
-// one (texdepth, texm3x2depth) gives each lane (chunk by chunk after the sink took it).
+// run(): with run.sampler and inputs.texcoord (inputs.quads off: no level of detail), and so
+// do the plain reads run.executedTaps names. Where run.outputs is given, its `killed` and `depth`
+// (the others are not written) take what run() writes there: each lane a texkill of a register
+// discarded, and the depth a program that writes one (texdepth, texm3x2depth) gives each lane
+// (chunk by chunk after the sink took it).
+struct PresampledRun {
+    Sampler* sampler = nullptr;
+    const PixelOutputs* outputs = nullptr;
+    uint8_t executedTaps = 0;  // TapPlan::executedTaps
+};
 void runPresampled(const Executor& executor, const PixelInputs& inputs, TapFill fill, ResultSink sink, void* ctx,
-                   ExecutorStats* stats = nullptr, Sampler* sampler = nullptr, const PixelOutputs* outputs = nullptr);
+                   ExecutorStats* stats = nullptr, const PresampledRun& run = {});
 
 // Chain rows: a program whose arithmetic is one chain of products (mul, then mads adding it, all
 // of whose factors are >= 0: the glow's separable blur) each of a tap and a constant, the same on

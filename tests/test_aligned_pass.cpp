@@ -647,8 +647,9 @@ TEST_CASE("float row path: texkills of coordinate sets in float and ideal equal 
 // coordinates' w), texreg2ar/gb, texdp3tex, texcoord, ps_1_4's texcrd, dependent texld and
 // texkills of a register (a killed pixel writes neither colour nor depth). The
 // executor samples those per pixel from the row's coordinates (fillRowCoords). A sixth of the cases
-// read a V8U8 bump map through a plain tap (the fx row path then refuses the draw), a third have
-// four-component coordinates, half any mapping.
+// read a V8U8 bump map through a plain tap (which the executor then samples too: the fx row path
+// filters 8-bit unsigned textures only), a third have four-component coordinates, half any
+// mapping.
 void dependentReads(Case& c, std::mt19937& rng) {
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
     const char* const programs[] = {
@@ -716,14 +717,10 @@ TEST_CASE("aligned pass: dependent reads take the row path and equal the quad pa
             qs.pixelsWritten < qs.pixelsCovered)
             ++killing;
         if (c.depth && c.program.find("depth") != std::string::npos && qs.pixelsCovered) ++ownDepth;
-        if (c.tex[0].format == D3DFMT_V8U8) {
-            // A plain read of a signed texture: not on the fx row path.
-            const bool plainRead = c.tex[0].bound && (c.program.find("\ntex t0\n") != std::string::npos ||
-                                                      c.program.find("\ntexld r0, t0\n") != std::string::npos);
-            bumpMaps += caseCount > 0 && plainRead;
-            if (plainRead) CHECK(caseRows == 0);
-            continue;
-        }
+        if (c.tex[0].format == D3DFMT_V8U8 && c.tex[0].bound &&
+            (c.program.find("\ntex t0\n") != std::string::npos ||
+             c.program.find("\ntexld r0, t0\n") != std::string::npos))
+            bumpMaps += caseCount > 0;  // (a plain read of a signed texture, sampled by the executor)
         cases += caseCount, rowPath += caseRows;
     }
     INFO(rowPath << " of " << cases << " cases took the row path, " << bumpMaps << " read a V8U8 bump map, "
@@ -758,4 +755,37 @@ TEST_CASE("float row path: dependent reads in float and ideal equal the quad pat
     INFO(rowPath << " of " << cases << " cases took the row path, " << ownDepth << " tested the program's depth");
     CHECK(rowPath * 10 >= cases * 6);
     CHECK(ownDepth >= 4);
+}
+
+TEST_CASE("aligned pass: plain reads of signed, float and half textures take the fx row path, sampled by the executor",
+          "[draw][aligned]") {
+    // The fx row path filters 8-bit unsigned textures itself; a plain read of any other 2-D
+    // texture without a level of detail is left to the executor (ps11::TapPlan::executedTaps),
+    // its texels of any sign (the fast path's sign analysis without them), and the draw's tiles
+    // are never decided.
+    std::mt19937 rng(20261209);
+    int rowPath = 0, cases = 0, executed = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng, true);
+        withoutNaNs(c);
+        if (rng() & 1) anyMapping(c, rng);
+        DeviceOptions quadOpt, rowOpt;
+        quadAndRowOptions(i, quadOpt, rowOpt);
+        rowOpt.software.skipTiles = (i % 3) == 1;
+        fxProfile(c, i % 4 == 1, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", program:\n" << c.program);
+        int caseRows = 0, caseCount = 0;
+        requireRowsEqual(rowOpt, c, expected, qs, caseCount, caseRows);
+        bool other = false;
+        for (const Case::Tex& t : c.tex)
+            other = other || (t.bound && t.format != D3DFMT_A8R8G8B8 && t.format != D3DFMT_L8);
+        executed += other && caseRows;
+        cases += caseCount, rowPath += caseRows;
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path, " << executed << " with a texture it does not filter");
+    CHECK(rowPath * 10 >= cases * 8);
+    CHECK(executed >= 100);
 }

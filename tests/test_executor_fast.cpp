@@ -774,7 +774,12 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
             CHECK(plan.registerKills == kills);
             Out want(count);
             runAll(*ref, l, want, sampler, 256);
-            for (int span : {64, 37}) {
+            const TapFill poisonFill = [](void*, int, int, int n, int16_t* const dst[4]) {
+                for (int c = 0; c < 4; ++c) std::fill_n(dst[c], n, int16_t(201));  // (never asked for)
+            };
+            // Spans of 64 and 37 lanes; then every plain read left to the executor too
+            // (PresampledRun::executedTaps: as a texture the caller does not filter).
+            for (int span : {64, 37, 50}) {
                 std::vector<int32_t> got[4];
                 for (auto& g : got) g.assign(count, -9999);
                 std::vector<uint8_t> killed(size_t(count), 7);
@@ -784,7 +789,9 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                     Ctx ctx{&sampler, &l, &plan, off, cfg.precision, got};
                     PixelOutputs more;
                     more.killed = killed.data() + off;
-                    runPresampled(*e, pin, fill, sink, &ctx, nullptr, &sampler, &more);
+                    const uint8_t executed = span == 50 ? uint8_t((1u << plan.count) - 1) : uint8_t(0);
+                    runPresampled(*e, pin, span == 50 ? poisonFill : fill, sink, &ctx, nullptr,
+                                  PresampledRun{&sampler, &more, executed});
                 }
                 ++runs;
                 for (int c = 0; c < 4; ++c)
@@ -803,7 +810,7 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
             }
         }
     CHECK(bad == 0);
-    CHECK(runs == 2 * int(std::size(programs) * std::size(configs)));
+    CHECK(runs == 3 * int(std::size(programs) * std::size(configs)));
 }
 
 TEST_CASE("constants set again with the same bits keep their values; new bits take effect", "[fast]") {
