@@ -76,7 +76,7 @@ struct QuadVertex {
 // screen: the left half of every row killed.
 // Dependent: a ps_1_4 dependent read at 1080p on the 1.4 class (fx12) — `texld r0, t0`, then
 // `texld r1, r0` (the first lookup's colour as the coordinates of the second, bilinear, same
-// texture): spans of one row.
+// texture): the row path, whose pre-sampled runs execute the dependent read itself.
 enum class Pass {
     Blur4,
     CopyPoint,

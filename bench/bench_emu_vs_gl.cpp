@@ -47,8 +47,8 @@ constexpr const char* kComposite =
     "mad r0, t1, c0, t0\n";
 
 // A dependent read, ps_1_1's own: t1 sampled where t0's red and green, through stage 1's bump
-// matrix, move its coordinates (texbem). Neither row path takes it: its lookups are shaded in
-// spans of a row, each lane sampled where the program puts it.
+// matrix, move its coordinates (texbem). The row paths' pre-sampled runs execute it, each lane
+// sampled where the program puts it (docs/device.md "Aligned passes").
 constexpr const char* kBump =
     "ps_1_1\n"
     "tex t0\n"

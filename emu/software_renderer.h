@@ -15,9 +15,9 @@ namespace emu {
 struct SoftwareRendererOptions {
     int threads = 0;  // worker threads of draws; 0 = all cores
     // Rows instead of 2x2 quads (bit-identical images; no helper lanes, so fewer pixels shaded):
-    // the row paths of emu/aligned_pass.h (fx8) and emu/aligned_float.h (float, ideal) for plain
-    // texture reads, and spans of one row (rasterizeRowSpans) for any other triangle whose every
-    // lookup is ps11::lodFree. Off: every draw goes through 2x2 quads.
+    // the row paths of emu/aligned_pass.h (fx8, fx12) and emu/aligned_float.h (float, ideal), and
+    // spans of one row (rasterizeRowSpans) for any other triangle whose every lookup is
+    // ps11::lodFree. Off: every draw goes through 2x2 quads.
     bool alignedPasses = true;
     // The sampler's fast kernels for 8-bit 2-D textures (ps11/texture_sampler_fast.h) on the spans
     // and quads (TextureSampler::setFastPath; bit-identical images). Off: every lookup there by

@@ -3,7 +3,7 @@
 // device must never crash, hang or trip a sanitizer on any setup, state or vertex data the
 // format can express; a refused call must carry a message. Sizes are capped so each input
 // stays fast (the limits themselves are tested elsewhere). In fx8, fx12, float and ideal every file
-// is also drawn with the row paths off (the fx8 aligned passes, the float profiles' row path, the
+// is also drawn with the row paths off (the fx aligned passes, the float profiles' row path, the
 // spans of one row of draws whose lookups are lodFree, and with them tile skipping, which the
 // first device does by default) and the sampler's fast kernels off: every triangle in 2×2 quads,
 // every lookup by the reference sampler. After every draw both render

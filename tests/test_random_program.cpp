@@ -371,7 +371,7 @@ TEST_CASE("random programs: 300 generated files parse and draw on the emu device
 TEST_CASE("random programs: rows and quads draw the same bytes in every profile", "[random][draw]") {
     // Every generated program (dependent reads, texkill, texdepth, projected reads, any version),
     // textures with or without mip chains, depth and fog states: drawn by a device with its row
-    // paths (the fx8 and float row paths, and spans of one row for everything else whose lookups
+    // paths (the fx and float row paths, and spans of one row for what they leave whose lookups
     // are ps11::lodFree) and by one drawing the general way: every triangle in 2×2 quads, every
     // lookup by the reference sampler (DrawRunner::create's fastPaths). The targets must be
     // identical bit for bit; where every sampled texture is lodFree no helper lane is shaded.
