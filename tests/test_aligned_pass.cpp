@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "aligned_cases.h"
+#include "executed_texture_programs.h"
 #include "emu/aligned_float.h"
 #include "emu/aligned_pass.h"
 #include "emu/aligned_pass_kernels.h"
@@ -642,40 +643,17 @@ TEST_CASE("float row path: texkills of coordinate sets in float and ideal equal 
     CHECK(killing * 2 >= 200);
 }
 
-// Dependent reads and the other texture instructions that are not plain reads (ps11::TapPlan::
-// executes): texbem/texbeml under random bump matrices, texm3x2 and texm3x3 rows (the eye from the
-// coordinates' w), texreg2ar/gb, texdp3tex, texcoord, ps_1_4's texcrd, dependent texld and
-// texkills of a register (a killed pixel writes neither colour nor depth). The
+// The programs of executed_texture_programs.h: texbem/texbeml under random bump matrices, texm3x2
+// and texm3x3 rows (the eye from the coordinates' w), texkills of a register (a killed pixel
+// writes neither colour nor depth) and the program's own depth (tested against, and written into,
+// the depth buffer where the case has one). The
 // executor samples those per pixel from the row's coordinates (fillRowCoords). A sixth of the cases
 // read a V8U8 bump map through a plain tap (which the executor then samples too: the fx row path
 // filters 8-bit unsigned textures only), a third have four-component coordinates, half any
 // mapping.
 void dependentReads(Case& c, std::mt19937& rng) {
     auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
-    const char* const programs[] = {
-        "ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, c0, v0_bias\n",
-        "ps_1_1\ntex t0\ntexbeml t1, t0\nmul r0, t1, v0\n",
-        "ps_1_1\ntex t0\ntex t1\ntexbem t2, t1\nmad r0, t2, c1, t0\n",
-        "ps_1_3\ntex t0\ntexreg2ar t1, t0\ndp3_sat r0, t0_bx2, t1_bx2\n",
-        "ps_1_2\ntex t0\ntexreg2gb t1, t0\nmul r0, t1, c2\n",
-        "ps_1_1\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2tex t2, t0_bx2\nmul r0, t2, c0\n",
-        "ps_1_1\ntex t0\ntexm3x3pad t1, t0_bx2\ntexm3x3pad t2, t0_bx2\ntexm3x3vspec t3, t0_bx2\nmad r0, t3, c0, "
-        "t0\n",
-        "ps_1_1\ntex t0\ntexm3x3pad t1, t0_bx2\ntexm3x3pad t2, t0_bx2\ntexm3x3tex t3, t0_bx2\nmul r0, t3, v0\n",
-        "ps_1_2\ntex t0\ntexdp3tex t1, t0\nadd r0, t1, t0\n",
-        "ps_1_1\ntexcoord t0\ntex t1\nmul r0, t0, t1\n",
-        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
-        "-r2\n+mov r0.a, r3.a\n",
-        "ps_1_4\ntexcrd r0.rgb, t0\ntexld r1, t1\nphase\ntexld r2, r0\nmul r0.rgb, r2, r1\n+mov r0.a, r2.a\n",
-        // Texkills of a register: a computed value's, and coordinates read as values.
-        "ps_1_4\ntexld r1, t0\nsub r2.rgb, r1, c0\nphase\ntexkill r2\nmov r0.rgb, r1\n+mov r0.a, c1.a\n",
-        "ps_1_4\ntexcrd r2.rgb, t1\ntexkill r2\ntexld r1, t0\nmul r0, r1, v0\n",
-        // The program's own depth (tested against, and written into, the depth buffer where the case
-        // has one).
-        "ps_1_4\ntexcrd r5.rgb, t1\nphase\ntexdepth r5\ntexld r0, t0\nmul r0, r0, v0\n",
-        "ps_1_3\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2depth t2, t0_bx2\nmov r0, t0\n",
-    };
-    c.program = programs[rng() % std::size(programs)];
+    c.program = executedprograms::kPrograms[rng() % std::size(executedprograms::kPrograms)];
     for (auto& stage : c.bump)
         for (float& m : stage) m = rng() % 4 == 0 ? 0.0f : real(-1.5f, 1.5f);
     if (rng() % 6 == 0) {

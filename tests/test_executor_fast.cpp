@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "executed_texture_programs.h"
 #include "executor_random_programs.h"
 #include "simd_levels.h"
 #include "ps11/assembler.h"
@@ -220,14 +221,17 @@ struct Out {
     std::vector<float> color[4];
     std::vector<int32_t> grid[4];
     std::vector<uint8_t> killed;
+    std::vector<float> depth;  // the program's own depth (texdepth, texm3x2depth); -3 where it writes none
     explicit Out(int n) {
         for (int c = 0; c < 4; ++c) color[c].assign(size_t(n), -7.0f), grid[c].assign(size_t(n), -77777);
         killed.assign(size_t(n), 9);
+        depth.assign(size_t(n), -3.0f);
     }
     ps11::PixelOutputs outputs(int off) {
         ps11::PixelOutputs o;
         for (int c = 0; c < 4; ++c) o.color[c] = color[c].data() + off, o.grid[c] = grid[c].data() + off;
         o.killed = killed.data() + off;
+        o.depth = depth.data() + off;
         return o;
     }
 };
@@ -246,7 +250,8 @@ void runAll(const ps11::Executor& e, const Lanes& l, Out& out, ps11::Sampler& s,
 int64_t compare(const Out& a, const Out& b, int count, const std::string& what) {
     int64_t bad = 0;
     for (int i = 0; i < count; ++i) {
-        bool ok = a.killed[size_t(i)] == b.killed[size_t(i)];
+        bool ok = a.killed[size_t(i)] == b.killed[size_t(i)] &&
+                  std::memcmp(&a.depth[size_t(i)], &b.depth[size_t(i)], sizeof(float)) == 0;
         for (int c = 0; c < 4; ++c) {
             ok = ok && a.grid[c][size_t(i)] == b.grid[c][size_t(i)];
             ok = ok && std::memcmp(&a.color[c][size_t(i)], &b.color[c][size_t(i)], sizeof(float)) == 0;
@@ -496,11 +501,9 @@ std::shared_ptr<const ps11::Texture> smallTexture() {
     return std::make_shared<const Texture>(std::move(*t));
 }
 
-}  // namespace
-
-TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem) equal the generic path", "[fast]") {
+// smallTexture() on stages 0-3, read LINEAR.
+void bindSmallTexture(ps11::TextureSampler& sampler) {
     using namespace ps11;
-    TextureSampler sampler;
     auto tex = smallTexture();
     SamplerDesc sd;
     sd.minFilter.value = sd.magFilter.value = Filter::Linear;
@@ -508,6 +511,14 @@ TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem
         sampler.bind(s, tex);
         sampler.setSamplerState(s, samplerStateFromDesc(sd));
     }
+}
+
+}  // namespace
+
+TEST_CASE("fast: textured programs (tex, texld, texkill, dependent reads, texbem) equal the generic path", "[fast]") {
+    using namespace ps11;
+    TextureSampler sampler;
+    bindSmallTexture(sampler);
     const char* programs[] = {
         "ps_1_1\ntex t0\ntex t1\ntex t2\ntex t3\nmul r0, t0, c0\nmad r0, t1, c0, r0\nmad r0, t2, c0, r0\n"
         "mad r0, t3, c0, r0\n",
@@ -677,35 +688,14 @@ TEST_CASE("fast: pre-sampled runs equal run() with the same texels", "[fast]") {
 
 TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[fast]") {
     // tapPlan(…, executes = true): plain reads come from `fill` (here the same sampler at their
-    // lanes' coordinates), every other texture instruction (texbem, matrix rows, texreg2ar,
-    // texdp3tex, texcoord, texcrd, ps_1_4's dependent texld) runs as run() runs it, with the
-    // sampler handed to runPresampled. Fast path and generic path, fx8 and the radeon8500 class's
-    // fx12, spans of 64 and 37 lanes.
+    // lanes' coordinates), every other texture instruction (executed_texture_programs.h) runs as
+    // run() runs it, with the sampler handed to runPresampled; killed lanes and the program's own
+    // depth come back in PresampledRun::outputs. Fast path and generic path, fx8 and the
+    // radeon8500 class's fx12, spans of 64, 37 and 50 lanes.
     using namespace ps11;
     TextureSampler sampler;
-    auto tex = smallTexture();
-    SamplerDesc sd;
-    sd.minFilter.value = sd.magFilter.value = Filter::Linear;
-    for (int s = 0; s < 4; ++s) {
-        sampler.bind(s, tex);
-        sampler.setSamplerState(s, samplerStateFromDesc(sd));
-    }
-    const char* programs[] = {
-        "ps_1_1\ntex t0\ntexbem t1, t0\nmad r0, t1, c0, v0_bias\n",
-        "ps_1_1\ntex t0\ntexbeml t1, t0\nmul r0, t1, v0\n",
-        "ps_1_3\ntex t0\ntexreg2ar t1, t0\ndp3_sat r0, t0_bx2, t1_bx2\n",
-        "ps_1_1\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2tex t2, t0_bx2\nmul r0, t2, c0\n",
-        "ps_1_1\ntex t0\ntexm3x3pad t1, t0_bx2\ntexm3x3pad t2, t0_bx2\ntexm3x3vspec t3, t0_bx2\nmad r0, t3, c0, "
-        "t0\n",
-        "ps_1_2\ntex t0\ntexdp3tex t1, t0\nadd r0, t1, t0\n",
-        "ps_1_1\ntexcoord t0\ntex t1\nmul r0, t0, t1\n",
-        "ps_1_4\ntexld r0, t0\ntexcrd r1.rgb, t1\nmul r2, r0, c0\nphase\ntexld r3, r2\nmad_x2 r0.rgb, r3, r1, "
-        "-r2\n+mov r0.a, r3.a\n",
-        "ps_1_4\ntexcrd r0.rgb, t0\ntexld r1, t1\nphase\ntexld r2, r0\nmul r0.rgb, r2, r1\n+mov r0.a, r2.a\n",
-        // texkills of a register: the lanes they discard come back in `killed`.
-        "ps_1_4\ntexld r1, t0\nsub r2.rgb, r1, c0\nphase\ntexkill r2\nmov r0.rgb, r1\n+mov r0.a, c1.a\n",
-        "ps_1_4\ntexcrd r2.rgb, t1\ntexkill r2\ntexld r1, t0\nmul r0, r1, v0\n",
-    };
+    bindSmallTexture(sampler);
+    const auto& programs = executedprograms::kPrograms;
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-0.2f, 1.2f);
     const int count = 300;
@@ -783,12 +773,14 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                 std::vector<int32_t> got[4];
                 for (auto& g : got) g.assign(count, -9999);
                 std::vector<uint8_t> killed(size_t(count), 7);
+                std::vector<float> depth(size_t(count), -3.0f);
                 for (int off = 0; off < count; off += span) {
                     const int n = std::min(span, count - off);
                     PixelInputs pin = l.inputs(off, n);
                     Ctx ctx{&sampler, &l, &plan, off, cfg.precision, got};
                     PixelOutputs more;
                     more.killed = killed.data() + off;
+                    more.depth = depth.data() + off;
                     const uint8_t executed = span == 50 ? uint8_t((1u << plan.count) - 1) : uint8_t(0);
                     runPresampled(*e, pin, span == 50 ? poisonFill : fill, sink, &ctx, nullptr,
                                   PresampledRun{&sampler, &more, executed});
@@ -799,14 +791,20 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                         if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
                             FAIL_CHECK("span " << span << " lane " << i << " channel " << c << ": pre-sampled "
                                                << got[c][size_t(i)] << ", run() " << want.grid[c][size_t(i)]);
-                int dead = 0;
+                int dead = 0, depths = 0;
                 for (int i = 0; i < count; ++i) {
+                    depths += want.depth[size_t(i)] != -3.0f;
+                    if (std::memcmp(&depth[size_t(i)], &want.depth[size_t(i)], sizeof(float)) != 0 && bad++ < 5)
+                        FAIL_CHECK("span " << span << " lane " << i << ": depth " << depth[size_t(i)] << ", run() "
+                                           << want.depth[size_t(i)]);
                     dead += killed[size_t(i)];
                     if (killed[size_t(i)] != want.killed[size_t(i)] && bad++ < 5)
                         FAIL_CHECK("span " << span << " lane " << i << ": killed " << int(killed[size_t(i)])
                                            << ", run() " << int(want.killed[size_t(i)]));
                 }
                 if (kills) CHECK((dead > 0 && dead < count));
+                const bool depthProgram = std::string(text).find("depth") != std::string::npos;
+                CHECK((depths > 0) == depthProgram);
             }
         }
     CHECK(bad == 0);
