@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace ps11 {
 
@@ -216,18 +217,25 @@ bool lodFree(const Texture& tex, const SamplerState& st) {
 LevelChoice chooseLevel(const Texture& tex, const SamplerState& st, double dx2, double dy2, bool fixed, bool weights8) {
     const int levels = tex.levelCount();
     const double rho2 = std::max(dx2, dy2);
-    double lod = 0.5 * std::log2(rho2);  // log2(sqrt(rho2)); rho2 = 0 gives -inf (magnified)
-    if (std::isnan(lod)) lod = 0.0;
     LevelChoice c;
-    if (lod > 0.0 && levels > 1) {
+    // LOD > 0 exactly where rho2 > 1 (log2 is monotone and log2(1) = 0; a NaN LOD counts as 0):
+    // a magnified quad needs no log.
+    if (!(rho2 > 1.0)) {
+        c.linear = effective(st.magFilter) == Filter::Linear;
+        return c;
+    }
+    const double lod = 0.5 * std::log2(rho2);  // log2(sqrt(rho2)), > 0
+    if (levels > 1) {
+        // floor(x) >= k exactly where x >= k for an integer k; below that, 0 < x < 2^31 and the
+        // conversion's truncation is the floor.
         if (st.mipFilter == Filter::Point) {
-            const double n = std::floor(lod + 0.5);
+            const double n = lod + 0.5;
             c.level0 = n >= double(levels - 1) ? levels - 1 : int(n);
         } else if (st.mipFilter == Filter::Linear) {
-            const double a = std::floor(lod);
-            if (a >= double(levels - 1)) {
+            if (lod >= double(levels - 1)) {
                 c.level0 = levels - 1;
             } else {
+                const double a = double(int(lod));
                 c.level0 = int(a);
                 c.level1 = c.level0 + 1;
                 const double frac = lod - a;
@@ -243,21 +251,32 @@ LevelChoice chooseLevel(const Texture& tex, const SamplerState& st, double dx2, 
             }
         }
     }
-    c.linear = effective(lod > 0.0 ? st.minFilter : st.magFilter) == Filter::Linear;
+    c.linear = effective(st.minFilter) == Filter::Linear;
     return c;
 }
 
-LevelChoice quadLevel(const Texture& tex, const SamplerState& st, const float tl[3], const float tr[3],
-                      const float bl[3], bool fixed, bool weights8) {
-    const int axes = tex.isVolume() ? 3 : 2;
-    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
-    double dx2 = 0, dy2 = 0;
+namespace {
+
+// A quad's squared derivative lengths in level-0 texels (quadLevel): size holds level 0's
+// extents, axes is 2 or 3 (a volume).
+inline void quadDerivatives(const double size[3], int axes, const float tl[3], const float tr[3], const float bl[3],
+                            double& dx2, double& dy2) {
+    dx2 = 0, dy2 = 0;
     for (int a = 0; a < axes; ++a) {
         const double c0 = double(tl[a]) * size[a];
         const double ddx = double(tr[a]) * size[a] - c0, ddy = double(bl[a]) * size[a] - c0;
         dx2 += ddx * ddx;
         dy2 += ddy * ddy;
     }
+}
+
+}  // namespace
+
+LevelChoice quadLevel(const Texture& tex, const SamplerState& st, const float tl[3], const float tr[3],
+                      const float bl[3], bool fixed, bool weights8) {
+    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
+    double dx2, dy2;
+    quadDerivatives(size, tex.isVolume() ? 3 : 2, tl, tr, bl, dx2, dy2);
     return chooseLevel(tex, st, dx2, dy2, fixed, weights8);
 }
 
@@ -290,12 +309,23 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
             L.level[0][i] = L.level[1][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0, L.mipF[i] = 0.0f;
         return;
     }
+    // quadLevel per quad; a quad whose derivatives equal the last computed quad's takes its
+    // choice (chooseLevel depends on them alone).
+    const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
+    const int axes = tex.isVolume() ? 3 : 2;
+    double lastX = std::numeric_limits<double>::quiet_NaN(), lastY = lastX;
+    LevelChoice c;
     for (int q = 0; q < count; q += 4) {
         const int tl = q, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
         const float ctl[3] = {coord[0][tl], coord[1][tl], coord[2][tl]};
         const float ctr[3] = {coord[0][tr], coord[1][tr], coord[2][tr]};
         const float cbl[3] = {coord[0][bl], coord[1][bl], coord[2][bl]};
-        const LevelChoice c = quadLevel(tex, st, ctl, ctr, cbl, fixed, weights8);
+        double dx2, dy2;
+        quadDerivatives(size, axes, ctl, ctr, cbl, dx2, dy2);
+        if (!(dx2 == lastX && dy2 == lastY)) {  // (NaN never equals: computed again)
+            c = chooseLevel(tex, st, dx2, dy2, fixed, weights8);
+            lastX = dx2, lastY = dy2;
+        }
         for (int i = q; i < std::min(q + 4, count); ++i) setLane(L, i, c);
     }
 }
@@ -426,7 +456,10 @@ struct SetScratch {
     alignas(64) int32_t grid[4][kMaxSpan];
     alignas(64) float value[2][4][kMaxSpan];
     int16_t lane[kMaxSpan];
-    int16_t next[kMaxSpan];  // the next group of the same set (−1: none), by group start lane
+    int16_t next[kMaxSpan];    // the next group of the same set (−1: none), by group start lane
+    uint32_t key[kMaxSpan];    // laneKey of the group starting at each lane
+    int16_t groups[kMaxSpan];  // the visited set's groups' first lanes, in gathered order
+    int groupCount = 0, step = 1;
 };
 
 // Per lane the set it belongs to: its level, filter and blend (the key a fast kernel's run needs).
@@ -436,11 +469,22 @@ uint32_t laneKey(const LaneLevels& lanes, int i) {
            uint32_t(lanes.linear[i] != 0) << 11;
 }
 
-// The span's groups (`step` lanes each, all of one key) set by set: for each distinct key, in
-// the order of its first group, every group of that key is gathered into s (u, v, mipW, lane)
-// and visit(first group's lane, n) is called to sample the n lanes as one run and put them back.
-// Every lane's result depends on its own coordinates alone, so this gives what sampling the
-// groups one by one gives.
+// The key of each group (`step` lanes from 0) into s.key; returns how many runs of consecutive
+// groups share a key.
+int groupKeys(int count, int step, const LaneLevels& lanes, SetScratch& s) {
+    int runs = 0;
+    for (int q = 0; q < count; q += step) {
+        s.key[q] = laneKey(lanes, q);
+        runs += q == 0 || s.key[q] != s.key[q - step];
+    }
+    return runs;
+}
+
+// The span's groups (`step` lanes each, all of one key; s.key from groupKeys) set by set: for each
+// distinct key, in the order of its first group, every group of that key is gathered into s (u,
+// v, mipW, lane, groups) and visit(first group's lane, n) is called to sample the n lanes as one
+// run and put them back (putBack). Every lane's result depends on its own coordinates alone, so
+// this gives what sampling the groups one by one gives.
 template <class Visit>
 void forEachSet(int count, int step, const LaneLevels& lanes, const float* const coord[3], SetScratch& s,
                 const Visit& visit) {
@@ -450,17 +494,29 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
     uint32_t keys[kMaxKeys];
     int16_t first[kMaxKeys], last[kMaxKeys];
     int distinct = 0;
+    s.step = step;
     auto gather = [&](int group0, bool chained) {
-        int n = 0;
-        for (int q = group0; q >= 0; q = chained ? s.next[q] : -1)
+        int n = 0, g = 0;
+        for (int q = group0; q >= 0; q = chained ? s.next[q] : -1) {
+            s.groups[g++] = int16_t(q);
+            if (q + step <= count && step == 4) {  // a whole quad: four lanes at once
+                std::memcpy(s.u + n, coord[0] + q, 4 * sizeof(float));
+                std::memcpy(s.v + n, coord[1] + q, 4 * sizeof(float));
+                std::memcpy(s.mipW + n, lanes.mipW + q, 4 * sizeof(int32_t));
+                for (int j = 0; j < 4; ++j) s.lane[n + j] = int16_t(q + j);
+                n += 4;
+                continue;
+            }
             for (int i = q; i < q + step && i < count; ++i) {
                 s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.lane[n] = int16_t(i);
                 ++n;
             }
+        }
+        s.groupCount = g;
         visit(group0, n);
     };
     for (int q = 0; q < count; q += step) {
-        const uint32_t k = laneKey(lanes, q);
+        const uint32_t k = s.key[q];
         int slot = 0;
         while (slot < distinct && keys[slot] != k) ++slot;
         s.next[q] = -1;
@@ -475,6 +531,23 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
         }
     }
     for (int k = 0; k < distinct; ++k) gather(first[k], true);
+}
+
+// The visited set's results (src, in gathered order) back into the span's lanes (dst), group by
+// group.
+template <class T>
+void putBack(const SetScratch& s, int count, const T* const src[4], T* const dst[4]) {
+    int n = 0;
+    for (int g = 0; g < s.groupCount; ++g) {
+        const int q = s.groups[g];
+        if (s.step == 4 && q + 4 <= count) {  // a whole quad (a copy of a known size)
+            for (int c = 0; c < 4; ++c) std::memcpy(dst[c] + q, src[c] + n, 4 * sizeof(T));
+            n += 4;
+            continue;
+        }
+        for (int i = q; i < q + s.step && i < count; ++i, ++n)
+            for (int c = 0; c < 4; ++c) dst[c][i] = src[c][n];
+    }
 }
 
 }  // namespace
@@ -554,11 +627,8 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 // Groups (quads, or lanes) of one level, filter and blend are drawn together
                 // wherever they lie in the span when runs of consecutive ones are short (each
                 // quad at a level of its own, as a dependent read's often is): forEachSet.
-                int runs = 0;
-                for (int q = 0; q < count; q += step)
-                    runs += q == 0 || laneKey(lanes, q) != laneKey(lanes, q - step);
-                if (runs * 16 > count) {
-                    static thread_local SetScratch set;
+                static thread_local SetScratch set;
+                if (groupKeys(count, step, lanes, set) * 16 > count) {
                     forEachSet(count, step, lanes, coord, set, [&](int g, int n) {
                         const bool two = lanes.slots[g] == 2, linear = lanes.linear[g] != 0;
                         int32_t* dst[4] = {set.grid[0], set.grid[1], set.grid[2], set.grid[3]};
@@ -571,8 +641,8 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                         } else {
                             kernels.unorm8(lower, n, set.u, set.v, dst);
                         }
-                        for (int c = 0; c < 4; ++c)
-                            for (int j = 0; j < n; ++j) gridDst[c][set.lane[j]] = set.grid[c][j];
+                        const int32_t* src[4] = {set.grid[0], set.grid[1], set.grid[2], set.grid[3]};
+                        putBack(set, count, src, gridDst);
                         fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
                         fastLanes += uint64_t(n);
                     });
@@ -632,6 +702,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             static thread_local LaneLevels lanes;
             static thread_local SetScratch set;
             selectLevels(req, count, coord, tex, ss, false, floatWeights8, lanes);
+            groupKeys(count, req.levels ? 1 : 4, lanes, set);
             forEachSet(count, req.levels ? 1 : 4, lanes, coord, set, [&](int g, int n) {
                 const bool two = lanes.slots[g] == 2, linear = lanes.linear[g] != 0;
                 float* lower[4] = {set.value[0][0], set.value[0][1], set.value[0][2], set.value[0][3]};
@@ -642,13 +713,10 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                     levelRun(lanes.level[1][g], linear);
                     kernels.unorm8Float(run, n, set.u, set.v, upper);
                     for (int c = 0; c < 4; ++c)
-                        for (int j = 0; j < n; ++j) {
-                            valueDst[c][set.lane[j]] = lerpf(lower[c][j], upper[c][j], lanes.mipF[set.lane[j]]);
-                        }
-                } else {
-                    for (int c = 0; c < 4; ++c)
-                        for (int j = 0; j < n; ++j) valueDst[c][set.lane[j]] = lower[c][j];
+                        for (int j = 0; j < n; ++j) lower[c][j] = lerpf(lower[c][j], upper[c][j], lanes.mipF[set.lane[j]]);
                 }
+                const float* src[4] = {lower[0], lower[1], lower[2], lower[3]};
+                putBack(set, count, src, valueDst);
                 fetched += uint64_t(n) * (two ? 2 : 1) * (linear ? 4 : 1);
             });
         }

@@ -464,9 +464,13 @@ TEST_CASE("sampler fast: mip levels chosen per quad equal the reference", "[samp
                                 const int count = 1 + int(rng() % kMaxSpan);
                                 std::vector<float> u(static_cast<size_t>(count)), v(static_cast<size_t>(count));
                                 const float scales[] = {0.3f, 1.0f, 1.5f, 2.0f, 3.7f, 8.0f, 40.0f, 100.0f};
+                                // Neighbouring quads often share a level, so runs of several quads form;
+                                // or every quad takes a footprint of its own (as a dependent read's do),
+                                // and the fast path samples the span set by set.
+                                const bool ownLevels = rng() % 2 == 0;
                                 for (int q = 0; q < count; q += 4) {
-                                    // Neighbouring quads often share a level, so runs of several quads form.
-                                    const float s = scales[(q / 16 + rng() % 2) % 8];
+                                    const float s = ownLevels ? scales[rng() % 8] * (0.5f + float(rng() % 64) / 32.0f)
+                                                              : scales[(q / 16 + rng() % 2) % 8];
                                     const float u0 = nastyCoord(rng, w), v0 = nastyCoord(rng, h);
                                     const float du[4] = {0, s / w, 0, s / w}, dv[4] = {0, 0, s / h, s / h};
                                     for (int k = 0; k < 4 && q + k < count; ++k)

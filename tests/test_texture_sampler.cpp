@@ -527,6 +527,86 @@ TEST_CASE("sampler: linear mip filter blends two levels, rounding once", "[sampl
     CHECK(s.texelsFetched() - before == 4 * 8);  // two bilinear levels per lane
 }
 
+TEST_CASE("sampler: chooseLevel equals its definition at the edges of every decision", "[sampler]") {
+    // The definition (docs/textures.md "Level of detail") written plainly: LOD = ½·log2(rho²), a
+    // NaN LOD is 0; mag filter at LOD <= 0, else the min filter; point: floor(LOD + ½); linear:
+    // floor(LOD) and the 8-bit (fx, and 8-bit weights) or float weight of its fraction.
+    auto model = [](int levels, const SamplerState& st, double rho2, bool eight) {
+        double lod = 0.5 * std::log2(rho2);
+        if (std::isnan(lod)) lod = 0.0;
+        LevelChoice c;
+        if (lod > 0.0 && levels > 1) {
+            if (st.mipFilter == Filter::Point) {
+                const double n = std::floor(lod + 0.5);
+                c.level0 = n >= double(levels - 1) ? levels - 1 : int(n);
+            } else if (st.mipFilter == Filter::Linear) {
+                const double a = std::floor(lod);
+                if (a >= double(levels - 1)) {
+                    c.level0 = levels - 1;
+                } else {
+                    c.level0 = int(a), c.level1 = c.level0 + 1;
+                    const double frac = lod - a;
+                    if (eight) {
+                        c.mipW = int32_t(std::nearbyint(frac * 256.0));
+                        if (c.mipW == 256) c.level0 = c.level1;
+                        c.slots = c.mipW == 0 || c.mipW == 256 ? 1 : 2;
+                        c.mipF = float(c.mipW) / 256.0f;
+                    } else {
+                        c.mipF = float(frac);
+                        c.slots = c.mipF == 0.0f ? 1 : 2;
+                    }
+                }
+            }
+        }
+        auto linear = [](Filter f) { return f == Filter::Linear; };
+        c.linear = linear(lod > 0.0 ? st.minFilter : st.magFilter);
+        return c;
+    };
+    // rho² at and one step either side of every LOD of the form k/512 (the decisions' edges: whole
+    // levels, half levels, the 8-bit weights' ties), then random values, zero, inf and NaN.
+    std::vector<double> rho2s = {0.0, -0.0, 1.0, std::nextafter(1.0, 2.0), std::nextafter(1.0, 0.0),
+                                 std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN(),
+                                 std::numeric_limits<double>::max(), std::numeric_limits<double>::denorm_min()};
+    for (int k = -64; k <= 16 * 512; ++k) {
+        const double r = std::exp2(2.0 * k / 512.0);
+        for (double x : {r, std::nextafter(r, 0.0), std::nextafter(r, INFINITY)}) rho2s.push_back(x);
+    }
+    std::mt19937 rng(31);
+    for (int i = 0; i < 20000; ++i) rho2s.push_back(std::exp2(std::uniform_real_distribution<double>(-4, 36)(rng)));
+    int bad = 0;
+    for (int levels : {1, 2, 5, 12})
+        for (Filter mip : {Filter::None, Filter::Point, Filter::Linear})
+            for (Filter minF : {Filter::Point, Filter::Linear})
+                for (Filter magF : {Filter::Point, Filter::Linear}) {
+                    TextureDesc d = makeDesc(TexFormat::L8, 1u << 11, 1, 0, {}, uint32_t(levels));
+                    d.data.clear();
+                    for (int k = 0; k < levels; ++k) {
+                        TextureLevel l;
+                        l.level = uint32_t(k);
+                        l.width = (1u << 11) >> k, l.height = 1;
+                        l.hasFill = true;
+                        l.fill = word(0);
+                        d.data.push_back(l);
+                    }
+                    auto tex = build(d);
+                    REQUIRE(tex->levelCount() == levels);
+                    SamplerState st = state(minF, TextureAddress::Wrap, mip);
+                    st.magFilter = magF;
+                    for (bool eight : {true, false})
+                        for (double r : rho2s) {
+                            const LevelChoice want = model(levels, st, r, eight);
+                            // The two derivatives either way round: rho² is the larger.
+                            const LevelChoice got = chooseLevel(*tex, st, r, r * 0.25, eight, false);
+                            const LevelChoice got2 = chooseLevel(*tex, st, 0.0, r, false, eight);
+                            if (!(got == want && got2 == want) && bad++ < 5)
+                                FAIL_CHECK("rho2 " << r << " levels " << levels << ": level " << got.level0 << "/"
+                                                   << got.level1 << " w " << got.mipW << ", want " << want.level0
+                                                   << "/" << want.level1 << " w " << want.mipW);
+                        }
+                }
+    CHECK(bad == 0);
+}
+
 TEST_CASE("sampler: unbound stages, output spans, fetch counts", "[sampler]") {
     TextureSampler s;
     CHECK_FALSE(s.hasTexture(0));
