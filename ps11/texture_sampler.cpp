@@ -282,6 +282,16 @@ LevelChoice quadLevel(const Texture& tex, const SamplerState& st, const float tl
 
 namespace {
 
+// Lanes [i, i + 4) of L take choice c.
+inline void setQuad(LaneLevels& L, int i, const LevelChoice& c) {
+    auto bytes = [&](uint8_t* p, int v) {
+        const uint32_t word = uint32_t(uint8_t(v)) * 0x01010101u;
+        std::memcpy(p + i, &word, 4);
+    };
+    bytes(L.level[0], c.level0), bytes(L.level[1], c.level1), bytes(L.slots, c.slots), bytes(L.linear, c.linear);
+    for (int k = 0; k < 4; ++k) L.mipW[i + k] = c.mipW, L.mipF[i + k] = c.mipF;
+}
+
 // Lane i of L takes choice c.
 inline void setLane(LaneLevels& L, int i, const LevelChoice& c) {
     L.level[0][i] = uint8_t(c.level0);
@@ -296,7 +306,8 @@ inline void setLane(LaneLevels& L, int i, const LevelChoice& c) {
 // (u*W, v*H, w*D) at level 0 from the top-left lane, then chooseLevel (quadLevel); or the
 // caller's choice per lane (SampleRequest::levels).
 void selectLevels(const SampleRequest& req, int count, const float* const coord[3], const Texture& tex,
-                  const SamplerState& st, bool fixed, bool weights8, LaneLevels& L) {
+                  const SamplerState& st, bool fixed, bool weights8, LaneLevels& L,
+                  const fastpath::SamplerKernels* kernels = nullptr) {
     const bool magLinear = effective(st.magFilter) == Filter::Linear;
     if (req.levels) {
         for (int i = 0; i < count; ++i) setLane(L, i, req.levels[i]);
@@ -309,10 +320,46 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
             L.level[0][i] = L.level[1][i] = 0, L.slots[i] = 1, L.linear[i] = magLinear, L.mipW[i] = 0, L.mipF[i] = 0.0f;
         return;
     }
-    // quadLevel per quad; a quad whose derivatives equal the last computed quad's takes its
-    // choice (chooseLevel depends on them alone).
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
     const int axes = tex.isVolume() ? 3 : 2;
+    if (kernels && (fixed || weights8) && axes == 2) {
+        // The fast paths' 8-bit weights on a 2-D texture: each quad's rho² as quadLevel forms it,
+        // then the SIMD level's quadLevels; the quads it leaves (slots 0) to chooseLevel.
+        constexpr int kQuads = kMaxSpan / 4 + 1;
+        alignas(32) double rho2[kQuads];
+        alignas(16) int32_t l0[kQuads], l1[kQuads], slots[kQuads], mipW[kQuads], linear[kQuads];
+        const int quads = (count + 3) / 4;
+        for (int k = 0; k < quads; ++k) {
+            const int q = 4 * k, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
+            const float ctl[3] = {coord[0][q], coord[1][q], 0.0f};
+            const float ctr[3] = {coord[0][tr], coord[1][tr], 0.0f};
+            const float cbl[3] = {coord[0][bl], coord[1][bl], 0.0f};
+            double dx2, dy2;
+            quadDerivatives(size, 2, ctl, ctr, cbl, dx2, dy2);
+            rho2[k] = std::max(dx2, dy2);
+        }
+        fastpath::QuadLevelRun run;
+        run.levels = tex.levelCount();
+        run.mipFilter = st.mipFilter == Filter::Point || st.mipFilter == Filter::Linear ? st.mipFilter : Filter::None;
+        run.minLinear = effective(st.minFilter) == Filter::Linear, run.magLinear = magLinear;
+        kernels->quadLevels(run, quads, rho2, l0, l1, slots, mipW, linear);
+        for (int k = 0; k < quads; ++k) {
+            LevelChoice c;
+            if (slots[k] == 0) {
+                c = chooseLevel(tex, st, rho2[k], rho2[k], fixed, weights8);  // (max(r, r) = r)
+            } else {
+                c.level0 = l0[k], c.level1 = l1[k], c.slots = slots[k], c.linear = linear[k] != 0;
+                c.mipW = mipW[k], c.mipF = float(mipW[k]) / 256.0f;
+            }
+            if (4 * k + 4 <= count)
+                setQuad(L, 4 * k, c);
+            else
+                for (int i = 4 * k; i < count; ++i) setLane(L, i, c);
+        }
+        return;
+    }
+    // quadLevel per quad; a quad whose derivatives equal the last computed quad's takes its
+    // choice (chooseLevel depends on them alone).
     double lastX = std::numeric_limits<double>::quiet_NaN(), lastY = lastX;
     LevelChoice c;
     for (int q = 0; q < count; q += 4) {
@@ -622,7 +669,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                 // blend, then runs of whole quads (lanes) that agree: one level -> the kernel, a
                 // linear mip blend of two -> the two-level kernel, each lane at its own weight.
                 static thread_local LaneLevels lanes;
-                selectLevels(req, count, coord, tex, ss, true, false, lanes);
+                selectLevels(req, count, coord, tex, ss, true, false, lanes, &kernels);
                 const int step = req.levels ? 1 : 4;
                 // Groups (quads, or lanes) of one level, filter and blend are drawn together
                 // wherever they lie in the span when runs of consecutive ones are short (each
@@ -701,7 +748,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
             // blend of the two (lerpf with its weight).
             static thread_local LaneLevels lanes;
             static thread_local SetScratch set;
-            selectLevels(req, count, coord, tex, ss, false, floatWeights8, lanes);
+            selectLevels(req, count, coord, tex, ss, false, floatWeights8, lanes, &kernels);
             groupKeys(count, req.levels ? 1 : 4, lanes, set);
             forEachSet(count, req.levels ? 1 : 4, lanes, coord, set, [&](int g, int n) {
                 const bool two = lanes.slots[g] == 2, linear = lanes.linear[g] != 0;

@@ -55,6 +55,21 @@ struct Unorm8FloatRun {
 using Unorm8FloatKernel = void (*)(const Unorm8FloatRun& run, int count, const float* u, const float* v,
                                    float* const* dst);
 
+// ps11::chooseLevel (texture_sampler.h) for quads of a 2-D texture where the mip weight has 8
+// bits (fx, and the float profile's 8-bit weights), from each quad's rho² = max(dx², dy²):
+// LOD = ½·log2(rho²) by a polynomial within 1e-10 of the log, whose choice is the exact log's
+// wherever log2(rho²) lies more than 1e-9 from a multiple of 1/256 (every edge of the choice —
+// whole and half levels, the 8-bit weight's ties — lies on one). A quad nearer an edge, or
+// with rho² not below 2^1000, gets slots 0: the caller asks chooseLevel. The Baseline level
+// gives slots 0 everywhere.
+struct QuadLevelRun {
+    int levels = 1;                    // the texture's level count
+    Filter mipFilter = Filter::None;
+    bool minLinear = false, magLinear = false;  // the min and mag filters are LINEAR
+};
+using QuadLevelKernel = void (*)(const QuadLevelRun& run, int quads, const double* rho2, int32_t* level0,
+                                 int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear);
+
 // The kernels of a SIMD level (ps11/simd_dispatch.h), one source (texture_sampler_fast_impl.h)
 // built per level; TextureSampler fetches the table once per span.
 struct SamplerKernels {
@@ -62,6 +77,7 @@ struct SamplerKernels {
     FloatAxisKernel floatAxis;
     Unorm8MipKernel unorm8Mip;
     Unorm8FloatKernel unorm8Float;
+    QuadLevelKernel quadLevels;
 };
 const SamplerKernels& samplerKernels(SimdLevel level);
 // The tables (the Avx2 one in x86-64 builds only); use samplerKernels().

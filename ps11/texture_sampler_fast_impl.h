@@ -253,7 +253,23 @@ bool quadContiguous(int count, const Scratch& s) {
     // (The first quad first: scattered lanes, the usual case when this fails, fail there.)
     if (s.x0[1] != x0 + 1 || s.x0[2] != x0 || s.x0[3] != x0 + 1 || s.y0[1] != ya0 || s.y0[3] != yb0) return false;
     int bad = 0;
-    for (int i = 0; i < count; ++i) {
+    int i = 0;
+#ifdef __AVX2__
+    // Two quads a step: columns x0 + 4k + (0 1 0 1 2 3 2 3), rows (a a b b a a b b).
+    __m256i col = _mm256_add_epi32(_mm256_set1_epi32(x0), _mm256_setr_epi32(0, 1, 0, 1, 2, 3, 2, 3));
+    const __m256i rows0 = _mm256_setr_epi32(ya0, ya0, yb0, yb0, ya0, ya0, yb0, yb0);
+    const __m256i rows1 = _mm256_setr_epi32(ya1, ya1, yb1, yb1, ya1, ya1, yb1, yb1);
+    const __m256i one = _mm256_set1_epi32(1), four = _mm256_set1_epi32(4);
+    __m256i diff = _mm256_setzero_si256();
+    for (; i + 8 <= count; i += 8, col = _mm256_add_epi32(col, four)) {
+        auto load = [&](const int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p + i)); };
+        diff = _mm256_or_si256(diff, _mm256_or_si256(_mm256_sub_epi32(load(s.x0), col),
+                                                     _mm256_sub_epi32(load(s.x1), _mm256_add_epi32(col, one))));
+        diff = _mm256_or_si256(diff, _mm256_or_si256(_mm256_sub_epi32(load(s.y0), rows0), _mm256_sub_epi32(load(s.y1), rows1)));
+    }
+    if (!_mm256_testz_si256(diff, diff)) return false;
+#endif
+    for (; i < count; ++i) {
         const int32_t col = x0 + 2 * (i >> 2) + (i & 1);
         const bool top = (i & 2) == 0;
         bad |= (s.x0[i] - col) | (s.x1[i] - col - 1) | (s.y0[i] - (top ? ya0 : yb0)) | (s.y1[i] - (top ? ya1 : yb1));
@@ -787,8 +803,90 @@ void sampleUnorm8Float(const Unorm8FloatRun& run, int count, const float* u, con
     }
 }
 
+// QuadLevelKernel (texture_sampler_fast.h), four quads a step.
+void quadLevels(const QuadLevelRun& run, int quads, const double* rho2, int32_t* level0, int32_t* level1,
+                int32_t* slots, int32_t* mipW, int32_t* linear) {
+    int q = 0;
+#ifdef __AVX2__
+    const __m256d one = _mm256_set1_pd(1.0), huge = _mm256_set1_pd(0x1p1000);
+    const __m256d sqrt2 = _mm256_set1_pd(1.4142135623730951), half = _mm256_set1_pd(0.5);
+    const __m256d invLn2 = _mm256_set1_pd(1.4426950408889634), k256 = _mm256_set1_pd(256.0);
+    const __m256d edge = _mm256_set1_pd(256.0 * 1e-9);
+    const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
+    const __m256d last = _mm256_set1_pd(double(run.levels - 1));
+    const __m256i mantissa = _mm256_set1_epi64x(0x000fffffffffffffLL), oneBits = _mm256_set1_epi64x(0x3ff0000000000000LL);
+    const __m256i lowHalves = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    // A double lane mask (or 64-bit integers small enough) as four 32-bit lanes.
+    auto narrow = [&](__m256i v) { return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, lowHalves)); };
+    const __m128i zero4 = _mm_setzero_si128(), one4 = _mm_set1_epi32(1), two4 = _mm_set1_epi32(2);
+    const __m128i w256 = _mm_set1_epi32(256);
+    const __m128i minLin = _mm_set1_epi32(run.minLinear), magLin = _mm_set1_epi32(run.magLinear);
+    const bool mips = run.levels > 1 && run.mipFilter != Filter::None;
+    for (; q + 4 <= quads; q += 4) {
+        const __m256d r = _mm256_loadu_pd(rho2 + q);
+        const __m256d minified = _mm256_cmp_pd(r, one, _CMP_GT_OQ);  // LOD > 0 (false for NaN)
+        const __m128i min4 = narrow(_mm256_castpd_si256(minified));
+        __m128i l0 = zero4, l1 = zero4, sl = one4, w = zero4;
+        __m128i fallback = zero4;
+        if (mips && _mm256_movemask_pd(minified) != 0) {
+            // log2(r) = e + log2(m), m in [√½, √2): ln m = 2·atanh(t), t = (m − 1)/(m + 1), |t| < 0.172,
+            // by its series to t^11 (the next term is below 2e-11).
+            const __m256i bits = _mm256_castpd_si256(r);
+            __m256d m = _mm256_castsi256_pd(_mm256_or_si256(_mm256_and_si256(bits, mantissa), oneBits));
+            const __m256d up = _mm256_cmp_pd(m, sqrt2, _CMP_GT_OQ);
+            m = _mm256_blendv_pd(m, _mm256_mul_pd(m, half), up);
+            const __m256i e64 = _mm256_sub_epi64(_mm256_srli_epi64(bits, 52), _mm256_set1_epi64x(1023));
+            const __m128i e = _mm_sub_epi32(narrow(e64), narrow(_mm256_castpd_si256(up)));  // (a true mask is −1)
+            const __m256d t = _mm256_div_pd(_mm256_sub_pd(m, one), _mm256_add_pd(m, one)), t2 = _mm256_mul_pd(t, t);
+            __m256d p = _mm256_set1_pd(1.0 / 11);
+            for (double c : {1.0 / 9, 1.0 / 7, 1.0 / 5, 1.0 / 3, 1.0}) p = _mm256_add_pd(_mm256_mul_pd(p, t2), _mm256_set1_pd(c));
+            const __m256d L = _mm256_add_pd(_mm256_cvtepi32_pd(e),
+                                            _mm256_mul_pd(_mm256_mul_pd(_mm256_add_pd(t, t), p), invLn2));
+            // Near an edge, or beyond the polynomial's range: chooseLevel decides.
+            const __m256d s = _mm256_mul_pd(L, k256);
+            const __m256d dist =
+                _mm256_and_pd(_mm256_sub_pd(s, _mm256_round_pd(s, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC)), absMask);
+            const __m256d unsure = _mm256_or_pd(_mm256_cmp_pd(dist, edge, _CMP_LT_OQ), _mm256_cmp_pd(r, huge, _CMP_NLT_UQ));
+            fallback = _mm_and_si128(min4, narrow(_mm256_castpd_si256(unsure)));
+            const __m256d lod = _mm256_mul_pd(L, half);
+            if (run.mipFilter == Filter::Point) {
+                // floor(LOD + ½), the last level from there on.
+                l0 = _mm256_cvttpd_epi32(_mm256_min_pd(_mm256_add_pd(lod, half), last));
+            } else {
+                const __m256d beyond = _mm256_cmp_pd(lod, last, _CMP_GE_OQ);
+                const __m256d lodIn = _mm256_min_pd(lod, last);  // (beyond lanes are replaced below)
+                const __m128i a = _mm256_cvttpd_epi32(lodIn);
+                const __m256d frac = _mm256_sub_pd(lodIn, _mm256_cvtepi32_pd(a));
+                w = _mm256_cvtpd_epi32(_mm256_mul_pd(frac, k256));  // round half even (the default mode)
+                const __m128i top = _mm_cmpeq_epi32(w, w256), none = _mm_cmpeq_epi32(w, zero4);
+                l0 = _mm_sub_epi32(a, top);  // (a true mask is −1: one level up)
+                l1 = _mm_add_epi32(a, one4);
+                sl = _mm_blendv_epi8(two4, one4, _mm_or_si128(top, none));
+                const __m128i b4 = narrow(_mm256_castpd_si256(beyond));
+                const __m128i lastLevel = _mm_set1_epi32(run.levels - 1);
+                l0 = _mm_blendv_epi8(l0, lastLevel, b4);
+                l1 = _mm_andnot_si128(b4, l1);
+                sl = _mm_blendv_epi8(sl, one4, b4);
+                w = _mm_andnot_si128(b4, w);
+            }
+            // Magnified quads: level 0 alone.
+            l0 = _mm_and_si128(l0, min4), l1 = _mm_and_si128(l1, min4), w = _mm_and_si128(w, min4);
+            sl = _mm_blendv_epi8(one4, sl, min4);
+        }
+        auto store = [&](int32_t* p, __m128i v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p + q), v); };
+        store(level0, l0), store(level1, l1), store(mipW, w);
+        store(slots, _mm_andnot_si128(fallback, sl));
+        store(linear, _mm_blendv_epi8(magLin, minLin, min4));
+    }
+#else
+    (void)run, (void)rho2, (void)level0, (void)level1, (void)mipW, (void)linear;
+#endif
+    for (; q < quads; ++q) slots[q] = 0;
+}
+
 }  // namespace
 
-const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip, &sampleUnorm8Float};
+const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip, &sampleUnorm8Float,
+                                                  &quadLevels};
 
 }  // namespace ps11::fastpath

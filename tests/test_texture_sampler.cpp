@@ -16,6 +16,7 @@
 #include "ps11/testfile_textures.h"
 #include "ps11/texture.h"
 #include "ps11/texture_sampler.h"
+#include "ps11/texture_sampler_fast.h"
 #include "simd_levels.h"
 
 using namespace ps11;
@@ -574,6 +575,7 @@ TEST_CASE("sampler: chooseLevel equals its definition at the edges of every deci
     std::mt19937 rng(31);
     for (int i = 0; i < 20000; ++i) rho2s.push_back(std::exp2(std::uniform_real_distribution<double>(-4, 36)(rng)));
     int bad = 0;
+    int64_t decided = 0, leftToChoose = 0;
     for (int levels : {1, 2, 5, 12})
         for (Filter mip : {Filter::None, Filter::Point, Filter::Linear})
             for (Filter minF : {Filter::Point, Filter::Linear})
@@ -603,8 +605,43 @@ TEST_CASE("sampler: chooseLevel equals its definition at the edges of every deci
                                                    << got.level1 << " w " << got.mipW << ", want " << want.level0
                                                    << "/" << want.level1 << " w " << want.mipW);
                         }
+                    // The fast paths' kernel (8-bit weights): the quads it decides, as the model
+                    // decides them; those near an edge left to chooseLevel (slots 0).
+                    fastpath::QuadLevelRun run;
+                    run.levels = levels, run.mipFilter = mip;
+                    run.minLinear = minF == Filter::Linear, run.magLinear = magF == Filter::Linear;
+                    testutil::forEachSimdLevel([&](SimdLevel simd) {
+                        const auto kernel = fastpath::samplerKernels(simd).quadLevels;
+                        for (size_t first = 0; first < rho2s.size(); first += 61) {
+                            const int n = int(std::min<size_t>(61, rho2s.size() - first));
+                            int32_t l0[61], l1[61], slots[61], mipW[61], linear[61];
+                            kernel(run, n, rho2s.data() + first, l0, l1, slots, mipW, linear);
+                            for (int k = 0; k < n; ++k) {
+                                const double r = rho2s[first + size_t(k)];
+                                if (slots[k] == 0) {
+                                    ++leftToChoose;
+                                    continue;
+                                }
+                                ++decided;
+                                const LevelChoice want = model(levels, st, r, true);
+                                LevelChoice got;
+                                got.level0 = l0[k], got.level1 = l1[k], got.slots = slots[k];
+                                got.linear = linear[k] != 0, got.mipW = mipW[k], got.mipF = float(mipW[k]) / 256.0f;
+                                if (!(got == want) && bad++ < 5)
+                                    FAIL_CHECK("kernel at " << simdLevelName(simd) << ", rho2 " << r << " levels "
+                                                            << levels << ": level " << got.level0 << "/" << got.level1
+                                                            << " slots " << got.slots << " w " << got.mipW << ", want "
+                                                            << want.level0 << "/" << want.level1 << " slots "
+                                                            << want.slots << " w " << want.mipW);
+                            }
+                        }
+                    });
                 }
     CHECK(bad == 0);
+    // Both kinds of quad occur: the random ones decided by the kernel (at the Avx2 level), those
+    // at the edges (and every one at the Baseline level) left to chooseLevel.
+    CHECK(decided > 0);
+    CHECK(leftToChoose > 0);
 }
 
 TEST_CASE("sampler: unbound stages, output spans, fetch counts", "[sampler]") {
