@@ -528,29 +528,24 @@ int groupKeys(int count, int step, const LaneLevels& lanes, SetScratch& s) {
 }
 
 // The span's groups (`step` lanes each, all of one key; s.key from groupKeys) set by set: for each
-// distinct key, in the order of its first group, every group of that key is gathered into s (u,
-// v, mipW, lane, groups) and visit(first group's lane, n) is called to sample the n lanes as one
-// run and put them back (putBack). Every lane's result depends on its own coordinates alone, so
-// this gives what sampling the groups one by one gives.
+// distinct key every group of that key is gathered into s (u, v, mipW, lane, groups) and
+// visit(first group's lane, n) is called to sample the n lanes as one run and put them back
+// (putBack). Every lane's result depends on its own coordinates alone, so this gives what
+// sampling the groups one by one gives, in any order of the sets.
 template <class Visit>
 void forEachSet(int count, int step, const LaneLevels& lanes, const float* const coord[3], SetScratch& s,
                 const Visit& visit) {
-    // At most 16 levels, each one-level key point or linear, and blends of two adjacent levels:
-    // fewer than 64 keys. (A group whose key finds no slot is visited on its own.)
-    constexpr int kMaxKeys = 64;
-    uint32_t keys[kMaxKeys];
-    int16_t first[kMaxKeys], last[kMaxKeys];
-    int distinct = 0;
     s.step = step;
-    auto gather = [&](int group0, bool chained) {
-        int n = 0, g = 0;
-        for (int q = group0; q >= 0; q = chained ? s.next[q] : -1) {
-            s.groups[g++] = int16_t(q);
+    auto gather = [&](const int16_t* groups, int g) {
+        int n = 0;
+        for (int j = 0; j < g; ++j) {
+            const int q = groups[j];
+            s.groups[j] = int16_t(q);
             if (q + step <= count && step == 4) {  // a whole quad: four lanes at once
                 std::memcpy(s.u + n, coord[0] + q, 4 * sizeof(float));
                 std::memcpy(s.v + n, coord[1] + q, 4 * sizeof(float));
                 std::memcpy(s.mipW + n, lanes.mipW + q, 4 * sizeof(int32_t));
-                for (int j = 0; j < 4; ++j) s.lane[n + j] = int16_t(q + j);
+                for (int k = 0; k < 4; ++k) s.lane[n + k] = int16_t(q + k);
                 n += 4;
                 continue;
             }
@@ -560,8 +555,35 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
             }
         }
         s.groupCount = g;
-        visit(group0, n);
+        visit(groups[0], n);
     };
+    // A key (laneKey) names level 0, whether a blend, level 1 and the filter. Where every blend's
+    // level 1 is the next level (as chooseLevel's are), id = level 0 · 4 + blend · 2 + filter
+    // names the same sets: the groups are counted per id and sorted by it, with no search.
+    constexpr int kIds = 16 * 4;
+    bool compact = true;
+    for (int q = 0; q < count; q += step) {
+        const uint32_t k = s.key[q], level0 = k & 31u;
+        compact &= level0 < 16 && (!(k >> 10 & 1u) || (k >> 5 & 31u) == level0 + 1);
+    }
+    int16_t order[kMaxSpan];
+    if (compact) {
+        auto id = [&](int q) { const uint32_t k = s.key[q]; return int((k & 31u) << 2 | (k >> 9 & 2u) | (k >> 11 & 1u)); };
+        int16_t start[kIds + 1] = {};
+        for (int q = 0; q < count; q += step) ++start[id(q) + 1];
+        for (int i = 0; i < kIds; ++i) start[i + 1] = int16_t(start[i + 1] + start[i]);
+        int16_t fill[kIds];
+        std::memcpy(fill, start, sizeof(fill));
+        for (int q = 0; q < count; q += step) order[fill[id(q)]++] = int16_t(q);
+        for (int i = 0; i < kIds; ++i)
+            if (start[i + 1] > start[i]) gather(order + start[i], start[i + 1] - start[i]);
+        return;
+    }
+    // Otherwise each distinct key's groups in the order of its first group.
+    constexpr int kMaxKeys = 64;
+    uint32_t keys[kMaxKeys];
+    int16_t first[kMaxKeys], last[kMaxKeys];
+    int distinct = 0;
     for (int q = 0; q < count; q += step) {
         const uint32_t k = s.key[q];
         int slot = 0;
@@ -569,7 +591,8 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
         s.next[q] = -1;
         if (slot == distinct) {
             if (distinct == kMaxKeys) {
-                gather(q, false);
+                order[0] = int16_t(q);
+                gather(order, 1);
                 continue;
             }
             keys[distinct] = k, first[distinct] = int16_t(q), last[distinct] = int16_t(q), ++distinct;
@@ -577,7 +600,11 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
             s.next[last[slot]] = int16_t(q), last[slot] = int16_t(q);
         }
     }
-    for (int k = 0; k < distinct; ++k) gather(first[k], true);
+    for (int k = 0; k < distinct; ++k) {
+        int g = 0;
+        for (int q = first[k]; q >= 0; q = s.next[q]) order[g++] = int16_t(q);
+        gather(order, g);
+    }
 }
 
 // The visited set's results (src, in gathered order) back into the span's lanes (dst), group by
