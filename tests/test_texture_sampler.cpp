@@ -900,6 +900,22 @@ TEST_CASE("sampler: lanes at levels given per lane, and blends of two levels, eq
                         };
                         same(run(s, p, u, v, {}, true));
                         same(run(s, p, u, v, {}, false, 0, levels.data()));
+                        // Blends of levels that are not neighbours (a caller's choice chooseLevel
+                        // never makes; the fast path then groups lanes by searching their keys): as
+                        // the general path samples the same choices.
+                        if (mip == Filter::Linear) {
+                            std::vector<LevelChoice> far = levels;
+                            for (size_t i = 0; i < far.size(); i += 8)
+                                if (far[i].slots == 2 && far[i].level1 + 1 < tex->levelCount()) ++far[i].level1;
+                            const Result want = run(general, p, u, v, {}, false, 0, far.data());
+                            auto b = run(s, p, u, v, {}, false, 0, far.data());
+                            for (int c = 0; c < 4; ++c) {
+                                if (fixed) CHECK(b.g[size_t(c)] == want.g[size_t(c)]);
+                                for (size_t i = 0; !fixed && i < u.size(); ++i)
+                                    CHECK(std::bit_cast<uint32_t>(b.f[size_t(c)][i]) ==
+                                          std::bit_cast<uint32_t>(want.f[size_t(c)][i]));
+                            }
+                        }
                     });
                 }
     CHECK(blends > 0);  // some quads blend two levels
