@@ -322,28 +322,20 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     }
     const double size[3] = {double(tex.level(0).width), double(tex.level(0).height), double(tex.level(0).depth)};
     const int axes = tex.isVolume() ? 3 : 2;
+    int first = 0;  // the quads from here on: chooseLevel
     if (kernels && (fixed || weights8) && axes == 2) {
-        // The fast paths' 8-bit weights on a 2-D texture: each quad's rho² as quadLevel forms it,
-        // then the SIMD level's quadLevels; the quads it leaves (slots 0) to chooseLevel.
-        constexpr int kQuads = kMaxSpan / 4 + 1;
+        // The fast paths' 8-bit weights on a 2-D texture: the SIMD level's quadLevels for the span's
+        // first quads; those it leaves (slots 0) to chooseLevel.
+        constexpr int kQuads = kMaxSpan / 4;
         alignas(32) double rho2[kQuads];
         alignas(16) int32_t l0[kQuads], l1[kQuads], slots[kQuads], mipW[kQuads], linear[kQuads];
-        const int quads = (count + 3) / 4;
-        for (int k = 0; k < quads; ++k) {
-            const int q = 4 * k, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
-            const float ctl[3] = {coord[0][q], coord[1][q], 0.0f};
-            const float ctr[3] = {coord[0][tr], coord[1][tr], 0.0f};
-            const float cbl[3] = {coord[0][bl], coord[1][bl], 0.0f};
-            double dx2, dy2;
-            quadDerivatives(size, 2, ctl, ctr, cbl, dx2, dy2);
-            rho2[k] = std::max(dx2, dy2);
-        }
         fastpath::QuadLevelRun run;
         run.levels = tex.levelCount();
         run.mipFilter = st.mipFilter == Filter::Point || st.mipFilter == Filter::Linear ? st.mipFilter : Filter::None;
         run.minLinear = effective(st.minFilter) == Filter::Linear, run.magLinear = magLinear;
-        kernels->quadLevels(run, quads, rho2, l0, l1, slots, mipW, linear);
-        for (int k = 0; k < quads; ++k) {
+        run.width = size[0], run.height = size[1];
+        const int done = kernels->quadLevels(run, count, coord[0], coord[1], rho2, l0, l1, slots, mipW, linear);
+        for (int k = 0; k < done; ++k) {
             LevelChoice c;
             if (slots[k] == 0) {
                 c = chooseLevel(tex, st, rho2[k], rho2[k], fixed, weights8);  // (max(r, r) = r)
@@ -351,18 +343,15 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
                 c.level0 = l0[k], c.level1 = l1[k], c.slots = slots[k], c.linear = linear[k] != 0;
                 c.mipW = mipW[k], c.mipF = float(mipW[k]) / 256.0f;
             }
-            if (4 * k + 4 <= count)
-                setQuad(L, 4 * k, c);
-            else
-                for (int i = 4 * k; i < count; ++i) setLane(L, i, c);
+            setQuad(L, 4 * k, c);
         }
-        return;
+        first = 4 * done;
     }
     // quadLevel per quad; a quad whose derivatives equal the last computed quad's takes its
     // choice (chooseLevel depends on them alone).
     double lastX = std::numeric_limits<double>::quiet_NaN(), lastY = lastX;
     LevelChoice c;
-    for (int q = 0; q < count; q += 4) {
+    for (int q = first; q < count; q += 4) {
         const int tl = q, tr = q + 1 < count ? q + 1 : q, bl = q + 2 < count ? q + 2 : q;
         const float ctl[3] = {coord[0][tl], coord[1][tl], coord[2][tl]};
         const float ctr[3] = {coord[0][tr], coord[1][tr], coord[2][tr]};

@@ -55,20 +55,23 @@ struct Unorm8FloatRun {
 using Unorm8FloatKernel = void (*)(const Unorm8FloatRun& run, int count, const float* u, const float* v,
                                    float* const* dst);
 
-// ps11::chooseLevel (texture_sampler.h) for quads of a 2-D texture where the mip weight has 8
-// bits (fx, and the float profile's 8-bit weights), from each quad's rho² = max(dx², dy²):
+// ps11::quadLevel (texture_sampler.h) for the quads of 2-D lanes (TL TR BL BR) where the mip
+// weight has 8 bits (fx, and the float profile's 8-bit weights): each quad's rho² =
+// max(dx², dy²) in level-0 texels as quadLevel forms it (the same double operations), then
 // LOD = ½·log2(rho²) by a polynomial within 1e-10 of the log, whose choice is the exact log's
 // wherever log2(rho²) lies more than 1e-9 from a multiple of 1/256 (every edge of the choice —
-// whole and half levels, the 8-bit weight's ties — lies on one). A quad nearer an edge, or
-// with rho² not below 2^1000, gets slots 0: the caller asks chooseLevel. The Baseline level
-// gives slots 0 everywhere.
+// whole and half levels, the 8-bit weight's ties — lies on one). A quad nearer an edge, or with
+// rho² not below 2^1000, gets slots 0: the caller asks chooseLevel(rho², rho²). Handles the
+// first quads of the span, sixteen lanes at a time, and returns how many (the Baseline level:
+// none); per quad k: rho2, level0, level1, slots, mipW, linear.
 struct QuadLevelRun {
     int levels = 1;                    // the texture's level count
     Filter mipFilter = Filter::None;
     bool minLinear = false, magLinear = false;  // the min and mag filters are LINEAR
+    double width = 1, height = 1;     // level 0's extents
 };
-using QuadLevelKernel = void (*)(const QuadLevelRun& run, int quads, const double* rho2, int32_t* level0,
-                                 int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear);
+using QuadLevelKernel = int (*)(const QuadLevelRun& run, int count, const float* u, const float* v, double* rho2,
+                                int32_t* level0, int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear);
 
 // The kernels of a SIMD level (ps11/simd_dispatch.h), one source (texture_sampler_fast_impl.h)
 // built per level; TextureSampler fetches the table once per span.

@@ -804,10 +804,12 @@ void sampleUnorm8Float(const Unorm8FloatRun& run, int count, const float* u, con
 }
 
 // QuadLevelKernel (texture_sampler_fast.h), four quads a step.
-void quadLevels(const QuadLevelRun& run, int quads, const double* rho2, int32_t* level0, int32_t* level1,
-                int32_t* slots, int32_t* mipW, int32_t* linear) {
+int quadLevels(const QuadLevelRun& run, int count, const float* u, const float* v, double* rho2, int32_t* level0,
+               int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear) {
     int q = 0;
 #ifdef __AVX2__
+    const int quads = count / 16 * 4;
+    const __m256d width = _mm256_set1_pd(run.width), height = _mm256_set1_pd(run.height);
     const __m256d one = _mm256_set1_pd(1.0), huge = _mm256_set1_pd(0x1p1000);
     const __m256d sqrt2 = _mm256_set1_pd(1.4142135623730951), half = _mm256_set1_pd(0.5);
     const __m256d invLn2 = _mm256_set1_pd(1.4426950408889634), k256 = _mm256_set1_pd(256.0);
@@ -823,7 +825,24 @@ void quadLevels(const QuadLevelRun& run, int quads, const double* rho2, int32_t*
     const __m128i minLin = _mm_set1_epi32(run.minLinear), magLin = _mm_set1_epi32(run.magLinear);
     const bool mips = run.levels > 1 && run.mipFilter != Filter::None;
     for (; q + 4 <= quads; q += 4) {
-        const __m256d r = _mm256_loadu_pd(rho2 + q);
+        // Lanes TL TR BL BR of quads q … q + 3, transposed: one vector per corner.
+        __m128 u0 = _mm_loadu_ps(u + 4 * q), u1 = _mm_loadu_ps(u + 4 * q + 4), u2 = _mm_loadu_ps(u + 4 * q + 8),
+               u3 = _mm_loadu_ps(u + 4 * q + 12);
+        __m128 v0 = _mm_loadu_ps(v + 4 * q), v1 = _mm_loadu_ps(v + 4 * q + 4), v2 = _mm_loadu_ps(v + 4 * q + 8),
+               v3 = _mm_loadu_ps(v + 4 * q + 12);
+        _MM_TRANSPOSE4_PS(u0, u1, u2, u3);
+        _MM_TRANSPOSE4_PS(v0, v1, v2, v3);
+        // quadLevel's derivatives: c0 = tl·n, ∂x = tr·n − c0, ∂y = bl·n − c0 per axis, squared and summed.
+        auto deriv = [&](__m128 tl, __m128 other, __m256d n) {
+            const __m256d c0 = _mm256_mul_pd(_mm256_cvtps_pd(tl), n);
+            return _mm256_sub_pd(_mm256_mul_pd(_mm256_cvtps_pd(other), n), c0);
+        };
+        const __m256d dxu = deriv(u0, u1, width), dyu = deriv(u0, u2, width);
+        const __m256d dxv = deriv(v0, v1, height), dyv = deriv(v0, v2, height);
+        const __m256d dx2 = _mm256_add_pd(_mm256_mul_pd(dxu, dxu), _mm256_mul_pd(dxv, dxv));
+        const __m256d dy2 = _mm256_add_pd(_mm256_mul_pd(dyu, dyu), _mm256_mul_pd(dyv, dyv));
+        const __m256d r = _mm256_max_pd(dy2, dx2);  // std::max(dx2, dy2): dx2 where either is NaN
+        _mm256_storeu_pd(rho2 + q, r);
         const __m256d minified = _mm256_cmp_pd(r, one, _CMP_GT_OQ);  // LOD > 0 (false for NaN)
         const __m128i min4 = narrow(_mm256_castpd_si256(minified));
         __m128i l0 = zero4, l1 = zero4, sl = one4, w = zero4;
@@ -879,9 +898,10 @@ void quadLevels(const QuadLevelRun& run, int quads, const double* rho2, int32_t*
         store(linear, _mm_blendv_epi8(magLin, minLin, min4));
     }
 #else
-    (void)run, (void)rho2, (void)level0, (void)level1, (void)mipW, (void)linear;
+    (void)run, (void)count, (void)u, (void)v, (void)rho2, (void)level0, (void)level1, (void)slots, (void)mipW,
+        (void)linear;
 #endif
-    for (; q < quads; ++q) slots[q] = 0;
+    return q;
 }
 
 }  // namespace

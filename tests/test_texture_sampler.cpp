@@ -605,34 +605,52 @@ TEST_CASE("sampler: chooseLevel equals its definition at the edges of every deci
                                                    << got.level1 << " w " << got.mipW << ", want " << want.level0
                                                    << "/" << want.level1 << " w " << want.mipW);
                         }
-                    // The fast paths' kernel (8-bit weights): the quads it decides, as the model
-                    // decides them; those near an edge left to chooseLevel (slots 0).
+                    // The fast paths' kernel (8-bit weights) over quads TL (0, 0), TR (s, 0), BL (0, s / 3)
+                    // (or the other way round) of the same texture, 2048 texels wide: rho² = (2048·s)²
+                    // at and around each value above; the quads it decides, as quadLevel decides
+                    // them, and its rho² for those it leaves to chooseLevel.
                     fastpath::QuadLevelRun run;
                     run.levels = levels, run.mipFilter = mip;
                     run.minLinear = minF == Filter::Linear, run.magLinear = magF == Filter::Linear;
+                    run.width = 2048, run.height = 1;
+                    constexpr int kSpan = 70;  // (the kernel takes 16 quads of it)
+                    std::vector<float> u, v;
+                    for (size_t i = 0; i < rho2s.size(); i += 3) {
+                        const float sx = float(std::sqrt(rho2s[i]) / 2048.0);
+                        const bool across = (i / 3) % 2 == 0;
+                        const float du[4] = {0, sx, 0, sx}, dv[4] = {0, 0, sx * 2048.0f / 3, sx * 2048.0f / 3};
+                        for (int k = 0; k < 4; ++k)
+                            u.push_back(across ? du[k] : dv[k] / 2048.0f), v.push_back(across ? dv[k] / 2048.0f : du[k] * 2048.0f);
+                    }
+                    while (u.size() % kSpan) u.push_back(0.0f), v.push_back(0.0f);
                     testutil::forEachSimdLevel([&](SimdLevel simd) {
                         const auto kernel = fastpath::samplerKernels(simd).quadLevels;
-                        for (size_t first = 0; first < rho2s.size(); first += 61) {
-                            const int n = int(std::min<size_t>(61, rho2s.size() - first));
-                            int32_t l0[61], l1[61], slots[61], mipW[61], linear[61];
-                            kernel(run, n, rho2s.data() + first, l0, l1, slots, mipW, linear);
-                            for (int k = 0; k < n; ++k) {
-                                const double r = rho2s[first + size_t(k)];
+                        for (size_t first = 0; first < u.size(); first += kSpan) {
+                            double rho2[kSpan / 4];
+                            int32_t l0[kSpan / 4], l1[kSpan / 4], slots[kSpan / 4], mipW[kSpan / 4], linear[kSpan / 4];
+                            const int done =
+                                kernel(run, kSpan, u.data() + first, v.data() + first, rho2, l0, l1, slots, mipW, linear);
+                            CHECK(done == (simd == SimdLevel::Baseline ? 0 : 16));
+                            for (int k = 0; k < done; ++k) {
+                                const size_t i = first + size_t(4 * k);
+                                const float tl[3] = {u[i], v[i], 0}, tr[3] = {u[i + 1], v[i + 1], 0},
+                                            bl[3] = {u[i + 2], v[i + 2], 0};
+                                const LevelChoice want = quadLevel(*tex, st, tl, tr, bl, true, false);
+                                LevelChoice got;
                                 if (slots[k] == 0) {
                                     ++leftToChoose;
-                                    continue;
+                                    got = chooseLevel(*tex, st, rho2[k], rho2[k], true, false);
+                                } else {
+                                    ++decided;
+                                    got.level0 = l0[k], got.level1 = l1[k], got.slots = slots[k];
+                                    got.linear = linear[k] != 0, got.mipW = mipW[k], got.mipF = float(mipW[k]) / 256.0f;
                                 }
-                                ++decided;
-                                const LevelChoice want = model(levels, st, r, true);
-                                LevelChoice got;
-                                got.level0 = l0[k], got.level1 = l1[k], got.slots = slots[k];
-                                got.linear = linear[k] != 0, got.mipW = mipW[k], got.mipF = float(mipW[k]) / 256.0f;
                                 if (!(got == want) && bad++ < 5)
-                                    FAIL_CHECK("kernel at " << simdLevelName(simd) << ", rho2 " << r << " levels "
-                                                            << levels << ": level " << got.level0 << "/" << got.level1
-                                                            << " slots " << got.slots << " w " << got.mipW << ", want "
-                                                            << want.level0 << "/" << want.level1 << " slots "
-                                                            << want.slots << " w " << want.mipW);
+                                    FAIL_CHECK("kernel at " << simdLevelName(simd) << ", quad " << i << " levels "
+                                                            << levels << " slots " << slots[k] << ": level "
+                                                            << got.level0 << "/" << got.level1 << " w " << got.mipW
+                                                            << ", want " << want.level0 << "/" << want.level1
+                                                            << " slots " << want.slots << " w " << want.mipW);
                             }
                         }
                     });
