@@ -484,11 +484,12 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
     return true;
 }
 
-// The lanes of one set (forEachSet), gathered: coordinates, mip weights, the lanes they came from,
+// The lanes of one set (forEachSet), gathered: coordinates, mip weights (fx and float), the lanes they came from,
 // and room for the kernels' results.
 struct SetScratch {
     alignas(64) float u[kMaxSpan], v[kMaxSpan];
     alignas(64) int32_t mipW[kMaxSpan];
+    alignas(64) float mipF[kMaxSpan];
     alignas(64) int32_t grid[4][kMaxSpan];
     alignas(64) float value[2][4][kMaxSpan];
     int16_t lane[kMaxSpan];
@@ -517,7 +518,7 @@ int groupKeys(int count, int step, const LaneLevels& lanes, SetScratch& s) {
 }
 
 // The span's groups (`step` lanes each, all of one key; s.key from groupKeys) set by set: for each
-// distinct key every group of that key is gathered into s (u, v, mipW, lane, groups) and
+// distinct key every group of that key is gathered into s (u, v, mipW, mipF, lane, groups) and
 // visit(first group's lane, n) is called to sample the n lanes as one run and put them back
 // (putBack). Every lane's result depends on its own coordinates alone, so this gives what
 // sampling the groups one by one gives, in any order of the sets.
@@ -534,12 +535,14 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
                 std::memcpy(s.u + n, coord[0] + q, 4 * sizeof(float));
                 std::memcpy(s.v + n, coord[1] + q, 4 * sizeof(float));
                 std::memcpy(s.mipW + n, lanes.mipW + q, 4 * sizeof(int32_t));
+                std::memcpy(s.mipF + n, lanes.mipF + q, 4 * sizeof(float));
                 for (int k = 0; k < 4; ++k) s.lane[n + k] = int16_t(q + k);
                 n += 4;
                 continue;
             }
             for (int i = q; i < q + step && i < count; ++i) {
-                s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.lane[n] = int16_t(i);
+                s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.mipF[n] = lanes.mipF[i];
+                s.lane[n] = int16_t(i);
                 ++n;
             }
         }
@@ -776,7 +779,7 @@ void TextureSampler::sample(const SampleRequest& req, SampleResult& out) {
                     levelRun(lanes.level[1][g], linear);
                     kernels.unorm8Float(run, n, set.u, set.v, upper);
                     for (int c = 0; c < 4; ++c)
-                        for (int j = 0; j < n; ++j) lower[c][j] = lerpf(lower[c][j], upper[c][j], lanes.mipF[set.lane[j]]);
+                        for (int j = 0; j < n; ++j) lower[c][j] = lerpf(lower[c][j], upper[c][j], set.mipF[j]);
                 }
                 const float* src[4] = {lower[0], lower[1], lower[2], lower[3]};
                 putBack(set, count, src, valueDst);
