@@ -324,7 +324,7 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
     const int axes = tex.isVolume() ? 3 : 2;
     int first = 0;  // the quads from here on: chooseLevel
     if (kernels && (fixed || weights8) && axes == 2) {
-        // The fast paths' 8-bit weights on a 2-D texture: the SIMD level's quadLevels for the span's
+        // The fast paths' 8-bit weights on a 2-D texture: the SIMD level's chooseQuadLevels for the span's
         // first quads; those it leaves (slots 0) to chooseLevel.
         constexpr int kQuads = kMaxSpan / 4;
         alignas(32) double rho2[kQuads];
@@ -334,7 +334,7 @@ void selectLevels(const SampleRequest& req, int count, const float* const coord[
         run.mipFilter = st.mipFilter == Filter::Point || st.mipFilter == Filter::Linear ? st.mipFilter : Filter::None;
         run.minLinear = effective(st.minFilter) == Filter::Linear, run.magLinear = magLinear;
         run.width = size[0], run.height = size[1];
-        const int done = kernels->quadLevels(run, count, coord[0], coord[1], rho2, l0, l1, slots, mipW, linear);
+        const int done = kernels->chooseQuadLevels(run, count, coord[0], coord[1], rho2, l0, l1, slots, mipW, linear);
         for (int k = 0; k < done; ++k) {
             LevelChoice c;
             if (slots[k] == 0) {
@@ -560,7 +560,10 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
     }
     int16_t order[kMaxSpan];
     if (compact) {
-        auto id = [&](int q) { const uint32_t k = s.key[q]; return int((k & 31u) << 2 | (k >> 9 & 2u) | (k >> 11 & 1u)); };
+        auto id = [&](int q) {
+            const uint32_t k = s.key[q];
+            return int((k & 31u) << 2 | (k >> 9 & 2u) | (k >> 11 & 1u));
+        };
         int16_t start[kIds + 1] = {};
         for (int q = 0; q < count; q += step) ++start[id(q) + 1];
         for (int i = 0; i < kIds; ++i) start[i + 1] = int16_t(start[i + 1] + start[i]);

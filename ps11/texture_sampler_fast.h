@@ -65,10 +65,10 @@ using Unorm8FloatKernel = void (*)(const Unorm8FloatRun& run, int count, const f
 // first quads of the span, sixteen lanes at a time, and returns how many (the Baseline level:
 // none); per quad k: rho2, level0, level1, slots, mipW, linear.
 struct QuadLevelRun {
-    int levels = 1;                    // the texture's level count
-    Filter mipFilter = Filter::None;
+    int levels = 1;                             // the texture's level count
+    Filter mipFilter = Filter::None;            // None, Point or Linear
     bool minLinear = false, magLinear = false;  // the min and mag filters are LINEAR
-    double width = 1, height = 1;     // level 0's extents
+    double width = 1, height = 1;               // level 0's extents
 };
 using QuadLevelKernel = int (*)(const QuadLevelRun& run, int count, const float* u, const float* v, double* rho2,
                                 int32_t* level0, int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear);
@@ -80,7 +80,7 @@ struct SamplerKernels {
     FloatAxisKernel floatAxis;
     Unorm8MipKernel unorm8Mip;
     Unorm8FloatKernel unorm8Float;
-    QuadLevelKernel quadLevels;
+    QuadLevelKernel chooseQuadLevels;
 };
 const SamplerKernels& samplerKernels(SimdLevel level);
 // The tables (the Avx2 one in x86-64 builds only); use samplerKernels().

@@ -265,7 +265,8 @@ bool quadContiguous(int count, const Scratch& s) {
         auto load = [&](const int32_t* p) { return _mm256_load_si256(reinterpret_cast<const __m256i*>(p + i)); };
         diff = _mm256_or_si256(diff, _mm256_or_si256(_mm256_sub_epi32(load(s.x0), col),
                                                      _mm256_sub_epi32(load(s.x1), _mm256_add_epi32(col, one))));
-        diff = _mm256_or_si256(diff, _mm256_or_si256(_mm256_sub_epi32(load(s.y0), rows0), _mm256_sub_epi32(load(s.y1), rows1)));
+        diff = _mm256_or_si256(
+            diff, _mm256_or_si256(_mm256_sub_epi32(load(s.y0), rows0), _mm256_sub_epi32(load(s.y1), rows1)));
     }
     if (!_mm256_testz_si256(diff, diff)) return false;
 #endif
@@ -563,8 +564,10 @@ void levelSums(const Unorm8Run& run, int count, const float* u, const float* v, 
                 return _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srl_epi32(t, _mm_cvtsi32_si128(8 * k)), m8));
             };
             for (int k = 0; k < 4; ++k) {
-                const __m256 a = _mm256_add_ps(_mm256_mul_ps(w00, channel(t00, k)), _mm256_mul_ps(w10, channel(t10, k)));
-                const __m256 b = _mm256_add_ps(_mm256_mul_ps(w01, channel(t01, k)), _mm256_mul_ps(w11, channel(t11, k)));
+                const __m256 a =
+                    _mm256_add_ps(_mm256_mul_ps(w00, channel(t00, k)), _mm256_mul_ps(w10, channel(t10, k)));
+                const __m256 b =
+                    _mm256_add_ps(_mm256_mul_ps(w01, channel(t01, k)), _mm256_mul_ps(w11, channel(t11, k)));
                 _mm256_store_ps(sum[k] + i, _mm256_add_ps(a, b));
             }
         }
@@ -804,8 +807,8 @@ void sampleUnorm8Float(const Unorm8FloatRun& run, int count, const float* u, con
 }
 
 // QuadLevelKernel (texture_sampler_fast.h), four quads a step.
-int quadLevels(const QuadLevelRun& run, int count, const float* u, const float* v, double* rho2, int32_t* level0,
-               int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear) {
+int chooseQuadLevels(const QuadLevelRun& run, int count, const float* u, const float* v, double* rho2, int32_t* level0,
+                     int32_t* level1, int32_t* slots, int32_t* mipW, int32_t* linear) {
     int q = 0;
 #ifdef __AVX2__
     const int quads = count / 16 * 4;
@@ -816,7 +819,8 @@ int quadLevels(const QuadLevelRun& run, int count, const float* u, const float* 
     const __m256d edge = _mm256_set1_pd(256.0 * 1e-9);
     const __m256d absMask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffLL));
     const __m256d last = _mm256_set1_pd(double(run.levels - 1));
-    const __m256i mantissa = _mm256_set1_epi64x(0x000fffffffffffffLL), oneBits = _mm256_set1_epi64x(0x3ff0000000000000LL);
+    const __m256i mantissa = _mm256_set1_epi64x(0x000fffffffffffffLL),
+                  oneBits = _mm256_set1_epi64x(0x3ff0000000000000LL);
     const __m256i lowHalves = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
     // A double lane mask (or 64-bit integers small enough) as four 32-bit lanes.
     auto narrow = [&](__m256i v) { return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, lowHalves)); };
@@ -858,14 +862,16 @@ int quadLevels(const QuadLevelRun& run, int count, const float* u, const float* 
             const __m128i e = _mm_sub_epi32(narrow(e64), narrow(_mm256_castpd_si256(up)));  // (a true mask is −1)
             const __m256d t = _mm256_div_pd(_mm256_sub_pd(m, one), _mm256_add_pd(m, one)), t2 = _mm256_mul_pd(t, t);
             __m256d p = _mm256_set1_pd(1.0 / 11);
-            for (double c : {1.0 / 9, 1.0 / 7, 1.0 / 5, 1.0 / 3, 1.0}) p = _mm256_add_pd(_mm256_mul_pd(p, t2), _mm256_set1_pd(c));
-            const __m256d L = _mm256_add_pd(_mm256_cvtepi32_pd(e),
-                                            _mm256_mul_pd(_mm256_mul_pd(_mm256_add_pd(t, t), p), invLn2));
+            for (double c : {1.0 / 9, 1.0 / 7, 1.0 / 5, 1.0 / 3, 1.0})
+                p = _mm256_add_pd(_mm256_mul_pd(p, t2), _mm256_set1_pd(c));
+            const __m256d L =
+                _mm256_add_pd(_mm256_cvtepi32_pd(e), _mm256_mul_pd(_mm256_mul_pd(_mm256_add_pd(t, t), p), invLn2));
             // Near an edge, or beyond the polynomial's range: chooseLevel decides.
             const __m256d s = _mm256_mul_pd(L, k256);
-            const __m256d dist =
-                _mm256_and_pd(_mm256_sub_pd(s, _mm256_round_pd(s, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC)), absMask);
-            const __m256d unsure = _mm256_or_pd(_mm256_cmp_pd(dist, edge, _CMP_LT_OQ), _mm256_cmp_pd(r, huge, _CMP_NLT_UQ));
+            const __m256d dist = _mm256_and_pd(
+                _mm256_sub_pd(s, _mm256_round_pd(s, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC)), absMask);
+            const __m256d unsure =
+                _mm256_or_pd(_mm256_cmp_pd(dist, edge, _CMP_LT_OQ), _mm256_cmp_pd(r, huge, _CMP_NLT_UQ));
             fallback = _mm_and_si128(min4, narrow(_mm256_castpd_si256(unsure)));
             const __m256d lod = _mm256_mul_pd(L, half);
             if (run.mipFilter == Filter::Point) {
@@ -907,6 +913,6 @@ int quadLevels(const QuadLevelRun& run, int count, const float* u, const float* 
 }  // namespace
 
 const SamplerKernels PS11_SAMPLER_LEVEL::kSampler{&sampleUnorm8, &floatAxis, &sampleUnorm8Mip, &sampleUnorm8Float,
-                                                  &quadLevels};
+                                                  &chooseQuadLevels};
 
 }  // namespace ps11::fastpath

@@ -620,11 +620,12 @@ TEST_CASE("sampler: chooseLevel equals its definition at the edges of every deci
                         const bool across = (i / 3) % 2 == 0;
                         const float du[4] = {0, sx, 0, sx}, dv[4] = {0, 0, sx * 2048.0f / 3, sx * 2048.0f / 3};
                         for (int k = 0; k < 4; ++k)
-                            u.push_back(across ? du[k] : dv[k] / 2048.0f), v.push_back(across ? dv[k] / 2048.0f : du[k] * 2048.0f);
+                            u.push_back(across ? du[k] : dv[k] / 2048.0f),
+                                v.push_back(across ? dv[k] / 2048.0f : du[k] * 2048.0f);
                     }
                     while (u.size() % kSpan) u.push_back(0.0f), v.push_back(0.0f);
                     testutil::forEachSimdLevel([&](SimdLevel simd) {
-                        const auto kernel = fastpath::samplerKernels(simd).quadLevels;
+                        const auto kernel = fastpath::samplerKernels(simd).chooseQuadLevels;
                         for (size_t first = 0; first < u.size(); first += kSpan) {
                             double rho2[kSpan / 4];
                             int32_t l0[kSpan / 4], l1[kSpan / 4], slots[kSpan / 4], mipW[kSpan / 4], linear[kSpan / 4];
