@@ -484,15 +484,14 @@ bool borderAsWord(const std::array<int32_t, 4>& grid, int32_t scale, uint32_t& w
     return true;
 }
 
-// The lanes of one set (forEachSet), gathered: coordinates, mip weights (fx and float), the lanes they came from,
-// and room for the kernels' results.
+// The lanes of one set (forEachSet), gathered: coordinates, mip weights (fx and float), the groups
+// they came from, and room for the kernels' results.
 struct SetScratch {
     alignas(64) float u[kMaxSpan], v[kMaxSpan];
     alignas(64) int32_t mipW[kMaxSpan];
     alignas(64) float mipF[kMaxSpan];
     alignas(64) int32_t grid[4][kMaxSpan];
     alignas(64) float value[2][4][kMaxSpan];
-    int16_t lane[kMaxSpan];
     int16_t next[kMaxSpan];    // the next group of the same set (−1: none), by group start lane
     uint32_t key[kMaxSpan];    // laneKey of the group starting at each lane
     int16_t groups[kMaxSpan];  // the visited set's groups' first lanes, in gathered order
@@ -518,7 +517,7 @@ int groupKeys(int count, int step, const LaneLevels& lanes, SetScratch& s) {
 }
 
 // The span's groups (`step` lanes each, all of one key; s.key from groupKeys) set by set: for each
-// distinct key every group of that key is gathered into s (u, v, mipW, mipF, lane, groups) and
+// distinct key every group of that key is gathered into s (u, v, mipW, mipF, groups) and
 // visit(first group's lane, n) is called to sample the n lanes as one run and put them back
 // (putBack). Every lane's result depends on its own coordinates alone, so this gives what
 // sampling the groups one by one gives, in any order of the sets.
@@ -536,13 +535,11 @@ void forEachSet(int count, int step, const LaneLevels& lanes, const float* const
                 std::memcpy(s.v + n, coord[1] + q, 4 * sizeof(float));
                 std::memcpy(s.mipW + n, lanes.mipW + q, 4 * sizeof(int32_t));
                 std::memcpy(s.mipF + n, lanes.mipF + q, 4 * sizeof(float));
-                for (int k = 0; k < 4; ++k) s.lane[n + k] = int16_t(q + k);
                 n += 4;
                 continue;
             }
             for (int i = q; i < q + step && i < count; ++i) {
                 s.u[n] = coord[0][i], s.v[n] = coord[1][i], s.mipW[n] = lanes.mipW[i], s.mipF[n] = lanes.mipF[i];
-                s.lane[n] = int16_t(i);
                 ++n;
             }
         }
