@@ -347,6 +347,42 @@ void stretchImages(const StretchCall& call, RowRange rows) {
         }
         return;
     }
+    // Fast path: A8R8G8B8 or X8R8G8B8 into A32B32G32R32F at any scale, either filter (the ideal
+    // profile reading an 8-bit scene: a 1080p frame to a 128×128 float target). The general
+    // path's sum over bytes in the same order (X8's alpha the byte 255 through it too), then
+    // store()'s float(v / 255), one pixel's r g b a at a time.
+    if ((sf.format == D3DFMT_A8R8G8B8 || sf.format == D3DFMT_X8R8G8B8) && df.format == D3DFMT_A32B32G32R32F) {
+        const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+        auto bytesOf = [&](const uint8_t* p) {
+            return std::array<double, 4>{double(p[2]), double(p[1]), double(p[0]), x8 ? 255.0 : double(p[3])};
+        };
+        for (int64_t j = j0; j < dh; ++j) {
+            const StretchTap& ty = tapY[size_t(j)];
+            const double wy = ty.w1;
+            const uint8_t* r0 = s->texel(0, uint32_t(ty.i0));
+            const uint8_t* r1 = s->texel(0, uint32_t(ty.i1));
+            const bool ahead = j + 1 < dh;
+            const uint8_t* n0 = ahead ? s->texel(0, uint32_t(tapY[size_t(j + 1)].i0)) : r0;
+            const uint8_t* n1 = ahead ? s->texel(0, uint32_t(tapY[size_t(j + 1)].i1)) : r1;
+            uint8_t* out = d->texel(uint32_t(dr.x0), uint32_t(dr.y0 + j));
+            for (int64_t i = 0; i < dw; ++i, out += 16) {
+                const StretchTap& tx = tapX[size_t(i)];
+                const size_t o0 = size_t(tx.i0) * 4, o1 = size_t(tx.i1) * 4;
+                __builtin_prefetch(n0 + o0);
+                std::array<double, 4> v = bytesOf(r0 + o0);
+                if (linear) {
+                    __builtin_prefetch(n1 + o0);
+                    const double wx = tx.w1;
+                    const std::array<double, 4> b = bytesOf(r0 + o1), c = bytesOf(r1 + o0), e = bytesOf(r1 + o1);
+                    for (size_t k = 0; k < 4; ++k)
+                        v[k] = (1 - wy) * ((1 - wx) * v[k] + wx * b[k]) + wy * ((1 - wx) * c[k] + wx * e[k]);
+                }
+                const float f[4] = {float(v[0] / 255.0), float(v[1] / 255.0), float(v[2] / 255.0), float(v[3] / 255.0)};
+                std::memcpy(out, f, 16);
+            }
+        }
+        return;
+    }
     for (int64_t j = j0; j < dh; ++j) {
         for (int64_t i = 0; i < dw; ++i) {
             const int64_t dx = dr.x0 + i, dy = dr.y0 + j;

@@ -564,6 +564,64 @@ TEST_CASE("device: LINEAR StretchRect between 8-bit targets equals the weighted 
     }
 }
 
+TEST_CASE("device: StretchRect from 8-bit words into A32B32G32R32F is the sum over bytes, over 255, as float", "[device]") {
+    // The ideal profile's reductions of an 8-bit scene: A8R8G8B8 or X8R8G8B8 into a float target at
+    // any scale and rect, LINEAR (the tap mapping's weights, fx ones too, the sum over the bytes in
+    // the documented order, X8's alpha the byte 255) and POINT, each value float(v / 255).
+    std::mt19937 rng(13);
+    for (int round = 0; round < 60; ++round) {
+        DeviceOptions o;
+        o.software.threads = 1 + int(rng() % 2);
+        const bool fixedPoint = round % 4 == 0;
+        o.precision = fixedPoint ? ps11::Precision::Fx8 : ps11::Precision::Ideal;
+        Device dev(o);
+        const D3DFORMAT fmt = rng() % 2 ? D3DFMT_A8R8G8B8 : D3DFMT_X8R8G8B8;
+        const bool linear = round % 3 != 2;
+        const UINT sw = 1 + rng() % 70, sh = 1 + rng() % 70, dw = 1 + rng() % 70, dh = 1 + rng() % 90;
+        std::vector<uint32_t> texels(size_t(sw) * sh);
+        for (uint32_t& t : texels) t = rng();
+        Handle src = makeTarget(dev, sw, sh, [&](UINT x, UINT y) { return texels[size_t(y) * sw + x]; }, fmt);
+        Handle dst{};
+        REQUIRE(dev.CreateRenderTarget(dw, dh, D3DFMT_A32B32G32R32F, 1, &dst) == D3D_OK);
+        RandomStretch rs = randomStretch(rng, sw, sh, dw, dh, fixedPoint);
+        if (!linear) {
+            StretchCall call;
+            call.sourceRect = PixelBox{rs.sr.left, rs.sr.top, rs.sr.right, rs.sr.bottom};
+            call.destRect = PixelBox{rs.dr.left, rs.dr.top, rs.dr.right, rs.dr.bottom};
+            rs.tx = stretchTaps(call, true);
+            rs.ty = stretchTaps(call, false);
+        }
+        const RECT &sr = rs.sr, &dr = rs.dr;
+        INFO("round " << round << ": " << sw << "x" << sh << " -> " << dw << "x" << dh << (linear ? " LINEAR" : " POINT"));
+        REQUIRE(dev.StretchRect(src, &sr, dst, &dr, linear ? D3DTEXF_LINEAR : D3DTEXF_POINT) == D3D_OK);
+        int wrong = 0, inside = 0;
+        D3DLOCKED_RECT lr{};
+        REQUIRE(dev.LockRect(dst, &lr, nullptr, D3DLOCK_READONLY) == D3D_OK);
+        for (UINT y = UINT(dr.top); y < UINT(dr.bottom); ++y)
+            for (UINT x = UINT(dr.left); x < UINT(dr.right); ++x) {
+                const StretchTap& a = rs.tx[size_t(LONG(x) - dr.left)];
+                const StretchTap& b = rs.ty[size_t(LONG(y) - dr.top)];
+                for (UINT k = 0; k < 4; ++k) {  // r g b a: bytes 2 1 0 3 of the word
+                    auto at = [&](int64_t sx, int64_t sy) {
+                        if (k == 3 && fmt == D3DFMT_X8R8G8B8) return 255.0;
+                        return double((texels[size_t(sy) * sw + size_t(sx)] >> (8 * (k == 3 ? 3 : 2 - k))) & 0xFF);
+                    };
+                    const double v = !linear ? at(a.i0, b.i0)
+                                             : (1 - b.w1) * ((1 - a.w1) * at(a.i0, b.i0) + a.w1 * at(a.i1, b.i0)) +
+                                                   b.w1 * ((1 - a.w1) * at(a.i0, b.i1) + a.w1 * at(a.i1, b.i1));
+                    const float want = float(v / 255.0);
+                    float got;
+                    std::memcpy(&got, static_cast<const uint8_t*>(lr.pBits) + y * lr.Pitch + x * 16 + 4 * k, 4);
+                    wrong += std::memcmp(&got, &want, 4) != 0;
+                    ++inside;
+                }
+            }
+        REQUIRE(dev.UnlockRect(dst) == D3D_OK);
+        CHECK(inside > 0);
+        CHECK(wrong == 0);
+    }
+}
+
 TEST_CASE("device: LINEAR StretchRect between A32B32G32R32F targets is the double sum rounded to float", "[device]") {
     // The ideal profile's reductions: the tap mapping's weights (fx ones too), the sum in double
     // in the documented order, stored as float; values of any sign and size, infinities, NaN.
