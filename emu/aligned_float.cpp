@@ -341,14 +341,6 @@ const float* hRow(const FloatRowDraw& draw, const FloatRowTriangle& tri, int t, 
     return h.h.data();
 }
 
-// Lane indices as floats: every texture-coordinate set's u on the row path, so a request's u
-// says which lanes of the row it covers (the executor works through a row in chunks).
-const auto kLaneIndex = [] {
-    std::array<float, ps11::kMaxSpan> t{};
-    for (int i = 0; i < ps11::kMaxSpan; ++i) t[size_t(i)] = float(i);
-    return t;
-}();
-
 // Ones: every texture-coordinate set's third and fourth components on the row path.
 const auto kOnes = [] {
     std::array<float, ps11::kMaxSpan> t{};
@@ -387,7 +379,7 @@ public:
 
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
         const int n = req.count;
-        const int t = req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
+        const int t = req.plainRead && req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
         if (t < 0 && req.stage >= 0 && req.stage < 8 && ((m_draw.plan.executedStages >> req.stage) & 1)) {
             m_perPixel->sample(req, out);  // an instruction the plan executes: as run() samples it
             return;
@@ -401,14 +393,14 @@ public:
         if ((m_tri->freeTaps >> t) & 1) {
             // Sampled per pixel: the quad path's coordinates through the draw's own sampler.
             alignas(32) float u[ps11::kMaxSpan], v[ps11::kMaxSpan];
-            tapCoords(m_draw.plan, t, *m_setup, m_x + int(req.u[0]), m_y, n, u, v);
+            tapCoords(m_draw.plan, t, *m_setup, m_x + req.lane, m_y, n, u, v);
             if ((m_draw.levelTaps.mask >> t) & 1) {
                 // Each pixel at the level, filter and mip blend its 2×2 quad picks (quadLevels):
                 // 8-bit texels at one level by the vector kernel, the rest (blends of two levels,
                 // other formats) by the worker's sampler at those levels.
                 const LevelTaps& lt = m_draw.levelTaps;
                 const ps11::Texture& tex = *lt.texture[size_t(t)];
-                const int x = m_x + int(req.u[0]);
+                const int x = m_x + req.lane;
                 const QuadLevels::Entry& e = quadLevels(*m_quadLevels, *m_setup, m_draw.plan, t, tex,
                                                         *lt.sampler[size_t(t)], lt.fixed, lt.weights8,
                                                         m_draw.target.color->width, x, m_y, n);
@@ -457,7 +449,7 @@ public:
         }
         out.unitRange = tap->unitRange;
         const RowTaps& r = m_rows[size_t(t)];
-        const size_t first = size_t(m_x - m_tri->x0) + size_t(req.u[0]);  // lanes are consecutive
+        const size_t first = size_t(m_x - m_tri->x0) + size_t(req.lane);  // lanes are consecutive
         if (tap->linear) {
             const size_t w = size_t(m_tri->x1 - m_tri->x0);
             if (r.fy == 0.0f && tap->nonNegative) {
@@ -612,12 +604,10 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
                                                   [](float b) { return b >= 0.0f && b <= 1.0f; });
     }
     if (d.plan.executes) {
-        // The row sampler tells a tap from an executed instruction by its stage, and hands the
-        // executor lane indices for a tap's set (drawFloatRows): neither may be shared. The
-        // instructions are sampled per pixel at level 0 (no quads).
-        uint32_t sets = d.plan.killSets;
-        for (int i = 0; i < d.plan.count; ++i) sets |= 1u << d.plan.coordSet[size_t(i)];
-        if ((d.plan.executedStages & stagesSeen) || (d.plan.executedSets & sets)) return false;
+        // The executed instructions are sampled per pixel at level 0 (no quads), from their sets'
+        // coordinates; the row sampler tells the plain reads of a stage from them
+        // (SampleRequest::plainRead) and needs no coordinates for those, so stages and sets may
+        // be shared.
         for (int s = 0; s < 8; ++s)
             if ((d.plan.executedStages >> s) & 1 && textures[size_t(s)] &&
                 !ps11::lodFree(*textures[size_t(s)], samplers[size_t(s)]))
@@ -784,11 +774,10 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
         if ((draw.colorAttrs >> (kAttrDiffuse + c)) & 1) in.color[0][c] = sc.color[c];
         if ((draw.colorAttrs >> (kAttrSpecular + c)) & 1) in.color[1][c] = sc.color[4 + c];
     }
-    // (A projected read's divisor components are 1, so the executor hands the sampler the lane
-    // indices as they are; RowSampler divides the coordinates itself, tapCoords. No texkill of
-    // the executor's kills a lane: x, y >= 0 and z 1; the runs test them, rowKills.)
+    // (RowSampler serves the plain reads by lane position (SampleRequest::lane) and divides
+    // their coordinates itself, tapCoords: the executor sees (0, 0, 1, 1) for their sets, so no
+    // texkill of the executor's kills a lane there; the runs test them, rowKills.)
     for (int set = 0; set < ps11::kMaxTexCoordSets; ++set) {
-        in.texcoord[set][0] = kLaneIndex.data();
         in.texcoord[set][2] = in.texcoord[set][3] = kOnes.data();
         // (The sets the plan's executed instructions read: their coordinates, as spans give them.)
         if ((draw.plan.executedSets >> set) & 1)
@@ -797,8 +786,9 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
     }
     ps11::PixelOutputs outp;
     for (int c = 0; c < 4; ++c) outp.color[c] = sc.out[c];
-    // (A register's texkill discards lanes: merged over the others. The coordinate sets' texkills
-    // never kill here, their lanes' x being lane indices and z 1: rowKills tests those.)
+    // (A register's texkill discards lanes: merged over the others. A coordinate set's texkill
+    // kills no lane here where the set is a plain read's alone (0, 0, 1), and the lanes rowKills
+    // kills where an executed instruction reads it too (its coordinates): rowKills tests them.)
     outp.killed = draw.plan.registerKills ? sc.killed : nullptr;
     outp.depth = draw.shaderDepth ? sc.depth : nullptr;  // (the program's depth, for the merger)
     uint64_t texelsPerPixel = 0;
@@ -864,9 +854,8 @@ void drawFloatRows(const FloatRowDraw& draw, const FloatRowTriangle* const* tris
                         ps11::SampleRequest req;
                         req.stage = tap.stage;
                         req.count = n;
-                        req.u = kLaneIndex.data();
-                        req.v = kLaneIndex.data();
                         req.precision = exec.options().precision;
+                        req.plainRead = true;  // (lanes from 0: RowSampler reads no coordinates)
                         ps11::SampleResult res;
                         for (int c = 0; c < 4; ++c) res.value[c] = sc.out[c];
                         sampler.sample(req, res);

@@ -62,6 +62,7 @@ struct RunState {
     // Set by the fx8 fast path around tex/texld: sampleInto then leaves the ±M clamp of the
     // texels to the caller, which clamps while converting to its int16 registers.
     bool deferTexelClamp = false;
+    bool plainRead = false;  // the texture instruction running is a plain read (SampleRequest::plainRead)
     // Pre-sampled runs on the generic path (runPresampled, fx profiles): the k-th texture
     // instruction takes tap k's grid integers from `fill` instead of the sampler; null otherwise.
     TapFill fill = nullptr;

@@ -91,6 +91,8 @@ void sampleInto(const Profile& p, RunState& st, int stage, int dims, const float
     req.v = v;
     req.w = w;
     req.precision = p.precision;
+    req.lane = st.offset;
+    req.plainRead = st.plainRead;
     SampleResult res;
     const int n = st.n;
     if (isFixedPoint(p.precision)) {
@@ -377,6 +379,7 @@ void execTexdepth(const Profile& p, const DOp& op, RunState& st) {
 
 void execTexture(const Profile& p, const DOp& op, RunState& st) {
     const bool v14 = p.minor >= 4;
+    st.plainRead = op.plainRead;
     switch (op.op) {
         case Opcode::TexCoord: v14 ? execTexcrd(p, op, st) : execTexcoord(p, op, st); break;
         case Opcode::Tex: v14 ? execTexld(p, op, st) : execTex(p, op, st); break;

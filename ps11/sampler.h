@@ -32,6 +32,12 @@ struct SampleRequest {
     const float* v = nullptr;
     const float* w = nullptr;
     Precision precision = Precision::Fx8;
+    // Where the executor asks: the request's first lane within the run's PixelInputs (its chunk's
+    // offset in the span), and whether the instruction is a plain read (DOp::plainRead). A sampler
+    // that serves a row's plain reads by position (emu/aligned_float.h) reads no coordinates for
+    // them, and tells them from the other instructions of their stage.
+    int lane = 0;
+    bool plainRead = false;
 };
 
 // Output lanes: fx profiles fill grid[c][lane] (value = grid / G), float profiles fill

@@ -27,6 +27,13 @@ inline constexpr const char* kPrograms[] = {
     // The program's own depth.
     "ps_1_4\ntexcrd r5.rgb, t1\nphase\ntexdepth r5\ntexld r0, t0\nmul r0, r0, v0\n",
     "ps_1_3\ntex t0\ntexm3x2pad t1, t0_bx2\ntexm3x2depth t2, t0_bx2\nmov r0, t0\n",
+    // A stage or a coordinate set shared with a plain read: phase 2 reading stage 0 again,
+    // coordinates read as values from a plain read's set (and a dependent read through them),
+    // and a texkill of such a set.
+    "ps_1_4\ntexld r0, t0\nphase\ntexld r0, r0\nmul r0, r0, c0\n",
+    "ps_1_4\ntexld r1, t0\ntexcrd r2.rgb, t0\nmad r0.rgb, r1, r2, c1\n+mov r0.a, r1.a\n",
+    "ps_1_4\ntexld r1, t0\ntexcrd r2.rgb, t0\nphase\ntexld r3, r2\nmad r0.rgb, r1, r3, c1\n+mov r0.a, r3.a\n",
+    "ps_1_4\ntexkill t0\ntexcrd r2.rgb, t0\ntexld r1, t1\nmul r0.rgb, r1, r2\n+mov r0.a, r1.a\n",
 };
 
 }  // namespace executedprograms

@@ -760,8 +760,9 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
             CHECK_FALSE(tapPlan(*e, plan));  // (not without executes)
             REQUIRE(tapPlan(*e, plan, true));
             CHECK(plan.executes);
-            const bool kills = std::string(text).find("texkill") != std::string::npos;
+            const bool kills = std::string(text).find("texkill r") != std::string::npos;
             CHECK(plan.registerKills == kills);
+            CHECK((plan.killSets != 0) == (std::string(text).find("texkill t") != std::string::npos));
             Out want(count);
             runAll(*ref, l, want, sampler, 256);
             const TapFill poisonFill = [](void*, int, int, int n, int16_t* const dst[4]) {
@@ -786,6 +787,12 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                                   PresampledRun{&sampler, &more, executed});
                 }
                 ++runs;
+                // (A texkill of a coordinate set is the caller's, TapPlan::killSets: any of its
+                // x, y, z below 0 kills the lane, as rowKills tests it.)
+                for (int set = 0; set < 8; ++set)
+                    if ((plan.killSets >> set) & 1)
+                        for (int i = 0; i < count; ++i)
+                            for (int k = 0; k < 3; ++k) killed[size_t(i)] |= uint8_t(l.tc[set][k][size_t(i)] < 0.0f);
                 for (int c = 0; c < 4; ++c)
                     for (int i = 0; i < count; ++i)
                         if (got[c][size_t(i)] != want.grid[c][size_t(i)] && bad++ < 5)
@@ -802,7 +809,7 @@ TEST_CASE("fast: pre-sampled runs that execute dependent reads equal run()", "[f
                         FAIL_CHECK("span " << span << " lane " << i << ": killed " << int(killed[size_t(i)])
                                            << ", run() " << int(want.killed[size_t(i)]));
                 }
-                if (kills) CHECK((dead > 0 && dead < count));
+                if (kills || plan.killSets) CHECK((dead > 0 && dead < count));
                 const bool depthProgram = std::string(text).find("depth") != std::string::npos;
                 CHECK((depths > 0) == depthProgram);
             }
