@@ -364,7 +364,8 @@ void sampleFreeUnorm8(const FloatRowDraw& draw, const FloatRowTap& tap, const fl
 }
 
 // The sampler the executor sees on the row path: lanes are pixels x .. x + n − 1 of one row,
-// each stage read by one tap (prepareFloatRowDraw checks it).
+// each plain read served by its stage's tap (prepareFloatRowDraw executes the others: two of a
+// stage, a volume texture's).
 class RowSampler final : public ps11::Sampler {
 public:
     RowSampler(const FloatRowDraw& draw, const std::array<RowTaps, 8>& rows, QuadLevels& quadLevels)
@@ -380,8 +381,9 @@ public:
     void sample(const ps11::SampleRequest& req, ps11::SampleResult& out) override {
         const int n = req.count;
         const int t = req.plainRead && req.stage >= 0 && req.stage < 8 ? m_tapOf[size_t(req.stage)] : -1;
-        if (t < 0 && req.stage >= 0 && req.stage < 8 && ((m_draw.plan.executedStages >> req.stage) & 1)) {
-            m_perPixel->sample(req, out);  // an instruction the plan executes: as run() samples it
+        if ((t < 0 && req.stage >= 0 && req.stage < 8 && ((m_draw.plan.executedStages >> req.stage) & 1)) ||
+            (t >= 0 && ((m_draw.plan.executedTaps >> t) & 1))) {
+            m_perPixel->sample(req, out);  // an instruction or plain read the plan executes: as run() samples it
             return;
         }
         const FloatRowTap* tap = t >= 0 ? &m_draw.taps[size_t(t)] : nullptr;
@@ -568,18 +570,33 @@ bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precisi
     d.weights8 = weightBits == 8 && precision == ps11::Precision::Float;
     d.levelTaps.fixed = false;
     d.levelTaps.weights8 = d.weights8;
-    uint32_t stagesSeen = 0;
+    // The stages two plain reads sample (ps_1_4's two phases): the row sampler tells plain reads
+    // apart by stage, so those are sampled per pixel, as below.
+    uint32_t stagesSeen = 0, stagesTwice = 0;
+    for (int i = 0; i < d.plan.count; ++i) {
+        const uint32_t bit = 1u << d.plan.stage[size_t(i)];
+        stagesTwice |= stagesSeen & bit;
+        stagesSeen |= bit;
+    }
     for (int i = 0; i < d.plan.count; ++i) {
         const int stage = d.plan.stage[size_t(i)];
-        if ((stagesSeen >> stage) & 1) return false;  // the row sampler tells taps apart by stage
-        stagesSeen |= 1u << stage;
         FloatRowTap& tap = d.taps[size_t(i)];
         tap.stage = stage;
         tap.coordSet = d.plan.coordSet[size_t(i)];
         const std::shared_ptr<const ps11::Texture>& tex = textures[size_t(stage)];
         if (!tex) continue;  // (0, 0, 0, 1)
         const ps11::SamplerState& ss = samplers[size_t(stage)];
-        if (tex->isVolume()) return false;
+        if (tex->isVolume() || ((stagesTwice >> stage) & 1)) {
+            // A plain read the rows do not filter (a volume texture's; one of two of a stage): the
+            // executor samples it per pixel as run() does, from its set's coordinates, where the
+            // level of detail cannot matter (TapPlan::executedTaps; not bound: no tables).
+            if (!ps11::lodFree(*tex, ss)) return false;
+            d.plan.executedTaps = uint8_t(d.plan.executedTaps | (1u << i));
+            d.plan.executes = true;
+            d.plan.executedSets = uint8_t(d.plan.executedSets | (1u << tap.coordSet));
+            d.plan.executedStages = uint8_t(d.plan.executedStages | (1u << stage));
+            continue;
+        }
         if (!ps11::lodFree(*tex, ss)) d.levelTaps.add(i, *tex, ss, tap.coordSet);
         const ps11::TextureLevelInfo& li = tex->level(0);
         tap.bound = true;

@@ -335,7 +335,7 @@ bool SoftwareRenderer::draw(const DrawCall& call, DrawStats& stats, CallError& e
     // those whose plain reads the executor samples itself: a copied tile would filter them.)
     const bool tileShaped = (alignedDraw || floatDraw) && !aligned.levelTaps.mask && !floatRows.levelTaps.mask &&
                             call.primitiveCount <= kMaxAlignedTriangles && !(shaderDepth && wantZ) &&
-                            !(alignedDraw && aligned.plan.executedTaps);
+                            !(alignedDraw && aligned.plan.executedTaps) && !(floatDraw && floatRows.plan.executedTaps);
     const bool tileable = m_options.skipTiles && tileShaped;
     bool decide = tileable && (history.paid || ++history.since >= history.wait);
     // Timed: a program that pays is drawn undecided once after its second decided draw (the

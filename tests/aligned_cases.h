@@ -86,6 +86,9 @@ struct Case {
         // `filter` (0: the same) and the MIP filter.
         std::vector<std::vector<uint8_t>> mips;
         DWORD minFilter = 0, mipFilter = D3DTEXF_NONE;
+        // Above 1: a volume texture of this depth (one level; `bytes` its slices in order, the
+        // W address as U's).
+        UINT d = 1;
     };
     std::vector<Tex> tex;  // 4 stages
     // Every stage reads stage 0's texture (each with its own sampler states and coordinates):
@@ -340,8 +343,21 @@ inline std::vector<uint8_t> drawCase(Device& dev, const Case& c, DrawStats& stat
     for (DWORD s = 0; s < 4; ++s) {
         const Case::Tex& t = c.tex[s];
         Handle tex{};
-        REQUIRE(dev.CreateTexture(t.w, t.h, UINT(1 + t.mips.size()), 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
-        for (UINT level = 0; level <= t.mips.size(); ++level) {
+        if (t.d > 1) {
+            REQUIRE(dev.CreateVolumeTexture(t.w, t.h, t.d, 1, 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
+            D3DLOCKED_BOX box{};
+            REQUIRE(dev.LockBox(tex, 0, &box, nullptr, 0) == D3D_OK);
+            const size_t row = size_t(t.w) * texelBytes(t.format);
+            REQUIRE(t.bytes.size() == row * t.h * t.d);
+            for (UINT z = 0; z < t.d; ++z)
+                for (UINT y = 0; y < t.h; ++y)
+                    std::memcpy(static_cast<uint8_t*>(box.pBits) + z * box.SlicePitch + y * box.RowPitch,
+                                &t.bytes[(size_t(z) * t.h + y) * row], row);
+            REQUIRE(dev.UnlockBox(tex, 0) == D3D_OK);
+            REQUIRE(dev.SetSamplerState(s, D3DSAMP_ADDRESSW, t.addressU) == D3D_OK);
+        }
+        if (t.d <= 1) REQUIRE(dev.CreateTexture(t.w, t.h, UINT(1 + t.mips.size()), 0, t.format, D3DPOOL_MANAGED, &tex) == D3D_OK);
+        for (UINT level = 0; t.d <= 1 && level <= t.mips.size(); ++level) {
             const UINT lw = std::max(1u, t.w >> level), lh = std::max(1u, t.h >> level);
             const std::vector<uint8_t>& bytes = level == 0 ? t.bytes : t.mips[level - 1];
             REQUIRE(dev.LockRect(tex, level, &lr, nullptr, 0) == D3D_OK);

@@ -734,6 +734,53 @@ TEST_CASE("float row path: dependent reads in float and ideal equal the quad pat
     CHECK(ownDepth >= 4);
 }
 
+TEST_CASE("float row path: plain reads it does not filter, sampled by the executor, equal the quad path", "[draw][aligned]") {
+    // The float row path filters 2-D levels, one plain read a stage; a volume texture's plain read
+    // (w from the set's third component) and two plain reads of one stage (ps_1_4's phases) are
+    // left to the executor, per pixel at level 0 (TapPlan::executedTaps), and the draw's tiles are
+    // never decided. Three cases in four read a volume texture at stage 0.
+    static const char* const programs[] = {
+        "ps_1_1\ntex t0\ntex t1\nmad r0, t0, c0, t1\n",
+        "ps_1_1\ntex t0\nmul r0, t0, v0\n",
+        "ps_1_4\ntexld r0, t0\ntexld r1, t1\nmad r0, r0, c0, r1\n",
+        "ps_1_4\ntexld r0, t0\nphase\ntexld r0, t1\nmul r0, r0, c0\n",
+    };
+    std::mt19937 rng(20261210);
+    auto real = [&](float lo, float hi) { return std::uniform_real_distribution<float>(lo, hi)(rng); };
+    int rowPath = 0, cases = 0;
+    for (int i = 0; i < 160; ++i) {
+        Case c = randomCase(rng, (i & 2) != 0);
+        withoutNaNs(c);
+        c.program = programs[rng() % std::size(programs)];
+        Case::Tex& t = c.tex[0];
+        t.format = D3DFMT_A8R8G8B8;
+        t.d = i % 4 == 3 ? 1 : 2 + UINT(rng() % 4);
+        t.mips.clear();
+        t.minFilter = 0, t.mipFilter = D3DTEXF_NONE;
+        t.bound = true;
+        t.bytes.resize(size_t(t.w) * t.h * t.d * 4);
+        for (uint8_t& b : t.bytes) b = uint8_t(rng());
+        c.oneTexture = false;
+        c.rq.resize(c.verts.size());
+        for (auto& v : c.rq)
+            for (auto& set : v) set = {real(-0.5f, 1.5f), real(0.5f, 2.0f)};
+        if (rng() & 1) anyMapping(c, rng);
+        DeviceOptions quadOpt, rowOpt;
+        quadAndRowOptions(i, quadOpt, rowOpt);
+        rowOpt.software.skipTiles = (i % 3) == 1;
+        floatProfile(c, i, (i / 4) % 2 != 0, quadOpt, rowOpt);
+        Device quadDev(quadOpt);
+        DrawStats qs;
+        const std::vector<uint8_t> expected = drawCase(quadDev, c, qs);
+        INFO("case " << i << ": " << c.w << "x" << c.h << ", " << profileName(quadOpt) << ", depth " << t.d
+                     << ", program:\n"
+                     << c.program);
+        requireRowsEqual(rowOpt, c, expected, qs, cases, rowPath);
+    }
+    INFO(rowPath << " of " << cases << " cases took the row path");
+    CHECK(rowPath * 10 >= cases * 8);
+}
+
 TEST_CASE("aligned pass: plain reads of signed, float and half textures take the fx row path, sampled by the executor",
           "[draw][aligned]") {
     // The fx row path filters 8-bit unsigned textures itself; a plain read of any other 2-D
