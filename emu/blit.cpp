@@ -41,6 +41,35 @@ void streamCopy(uint8_t* dst, const uint8_t* src, size_t n) {
     std::memcpy(dst, src, n);
 }
 
+#if defined(__SSE2__)
+// An 8-bit word's four bytes, in memory order, as doubles two a register (`set` ORed into the word
+// first: X8's alpha byte as 255).
+struct ByteDoubles {
+    __m128d lo, hi;
+};
+ByteDoubles byteDoubles(const uint8_t* p, uint32_t set) {
+    uint32_t w;
+    std::memcpy(&w, p, 4);
+    const __m128i zero = _mm_setzero_si128();
+    const __m128i q = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(int32_t(w | set)), zero), zero);
+    return {_mm_cvtepi32_pd(q), _mm_cvtepi32_pd(_mm_shuffle_epi32(q, 0xEE))};
+}
+
+// stretchImages' LINEAR sum (1 − wy)·((1 − wx)·a + wx·b) + wy·((1 − wx)·c + wx·e) of four such
+// words, each operation as the scalar one (no FMA at this level).
+ByteDoubles lerpBytes(const uint8_t* a, const uint8_t* b, const uint8_t* c, const uint8_t* e, double wx, double wy,
+                      uint32_t set) {
+    const ByteDoubles pa = byteDoubles(a, set), pb = byteDoubles(b, set), pc = byteDoubles(c, set),
+                      pe = byteDoubles(e, set);
+    const __m128d gx = _mm_set1_pd(1 - wx), fx = _mm_set1_pd(wx), gy = _mm_set1_pd(1 - wy), fy = _mm_set1_pd(wy);
+    auto sum = [&](__m128d va, __m128d vb, __m128d vc, __m128d ve) {
+        return _mm_add_pd(_mm_mul_pd(gy, _mm_add_pd(_mm_mul_pd(gx, va), _mm_mul_pd(fx, vb))),
+                          _mm_mul_pd(fy, _mm_add_pd(_mm_mul_pd(gx, vc), _mm_mul_pd(fx, ve))));
+    };
+    return {sum(pa.lo, pb.lo, pc.lo, pe.lo), sum(pa.hi, pb.hi, pc.hi, pe.hi)};
+}
+#endif
+
 void streamFence() {
 #if defined(__SSE2__)
     _mm_sfence();
@@ -338,27 +367,12 @@ void stretchImages(const StretchCall& call, RowRange rows) {
                 } else {
                     const uint8_t *a = r0 + o0, *b = r0 + o1, *c = r1 + o0, *e = r1 + o1;
 #if defined(__SSE2__)
-                    // The same operations in the same order, two channels a register (no FMA at
-                    // this level); the conversion rounds to nearest even as nearbyint does under the
-                    // default mode, and the packs saturate as the clamp does.
+                    // The same sums two channels a register (lerpBytes); the conversion rounds to
+                    // nearest even as nearbyint does under the default mode, and the packs
+                    // saturate as the clamp does.
+                    const ByteDoubles sum = lerpBytes(a, b, c, e, wx, wy, 0);
                     const __m128i zero = _mm_setzero_si128();
-                    auto halves = [&](const uint8_t* p, __m128d& lo, __m128d& hi) {
-                        int32_t w;
-                        std::memcpy(&w, p, 4);
-                        const __m128i q = _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(w), zero), zero);
-                        lo = _mm_cvtepi32_pd(q);
-                        hi = _mm_cvtepi32_pd(_mm_shuffle_epi32(q, 0xEE));
-                    };
-                    __m128d al, ah, bl, bh, cl, ch, el, eh;
-                    halves(a, al, ah), halves(b, bl, bh), halves(c, cl, ch), halves(e, el, eh);
-                    const __m128d gx = _mm_set1_pd(1 - wx), fx = _mm_set1_pd(wx), gy = _mm_set1_pd(1 - wy),
-                                  fy = _mm_set1_pd(wy);
-                    auto sum = [&](__m128d pa, __m128d pb, __m128d pc, __m128d pe) {
-                        return _mm_add_pd(_mm_mul_pd(gy, _mm_add_pd(_mm_mul_pd(gx, pa), _mm_mul_pd(fx, pb))),
-                                          _mm_mul_pd(fy, _mm_add_pd(_mm_mul_pd(gx, pc), _mm_mul_pd(fx, pe))));
-                    };
-                    const __m128i lo = _mm_cvtpd_epi32(sum(al, bl, cl, el)), hi = _mm_cvtpd_epi32(sum(ah, bh, ch, eh));
-                    const __m128i words = _mm_unpacklo_epi64(lo, hi);
+                    const __m128i words = _mm_unpacklo_epi64(_mm_cvtpd_epi32(sum.lo), _mm_cvtpd_epi32(sum.hi));
                     uint32_t word = uint32_t(_mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(words, zero), zero)));
                     if (x8) word |= 0xFF000000u;
                     std::memcpy(out, &word, 4);
@@ -380,9 +394,11 @@ void stretchImages(const StretchCall& call, RowRange rows) {
     // store()'s float(v / 255), one pixel's r g b a at a time.
     if ((sf.format == D3DFMT_A8R8G8B8 || sf.format == D3DFMT_X8R8G8B8) && df.format == D3DFMT_A32B32G32R32F) {
         const bool x8 = sf.format == D3DFMT_X8R8G8B8;
+#if !defined(__SSE2__)
         auto bytesOf = [&](const uint8_t* p) {
             return std::array<double, 4>{double(p[2]), double(p[1]), double(p[0]), x8 ? 255.0 : double(p[3])};
         };
+#endif
         for (int64_t j = j0; j < dh; ++j) {
             const StretchTap& ty = tapY[size_t(j)];
             const double wy = ty.w1;
@@ -396,9 +412,19 @@ void stretchImages(const StretchCall& call, RowRange rows) {
                 const StretchTap& tx = tapX[size_t(i)];
                 const size_t o0 = size_t(tx.i0) * 4, o1 = size_t(tx.i1) * 4;
                 __builtin_prefetch(n0 + o0);
+                if (linear) __builtin_prefetch(n1 + o0);
+#if defined(__SSE2__)
+                // b g r a as doubles (the sum two channels a register: lerpBytes), over 255,
+                // rounded to float as the scalar conversion does, then put in r g b a order.
+                const uint32_t set = x8 ? 0xFF000000u : 0u;
+                const ByteDoubles v = linear ? lerpBytes(r0 + o0, r0 + o1, r1 + o0, r1 + o1, tx.w1, wy, set)
+                                             : byteDoubles(r0 + o0, set);
+                const __m128d unit = _mm_set1_pd(255.0);
+                const __m128 bgra = _mm_movelh_ps(_mm_cvtpd_ps(_mm_div_pd(v.lo, unit)), _mm_cvtpd_ps(_mm_div_pd(v.hi, unit)));
+                _mm_storeu_ps(reinterpret_cast<float*>(out), _mm_shuffle_ps(bgra, bgra, _MM_SHUFFLE(3, 0, 1, 2)));
+#else
                 std::array<double, 4> v = bytesOf(r0 + o0);
                 if (linear) {
-                    __builtin_prefetch(n1 + o0);
                     const double wx = tx.w1;
                     const std::array<double, 4> b = bytesOf(r0 + o1), c = bytesOf(r1 + o0), e = bytesOf(r1 + o1);
                     for (size_t k = 0; k < 4; ++k)
@@ -406,6 +432,7 @@ void stretchImages(const StretchCall& call, RowRange rows) {
                 }
                 const float f[4] = {float(v[0] / 255.0), float(v[1] / 255.0), float(v[2] / 255.0), float(v[3] / 255.0)};
                 std::memcpy(out, f, 16);
+#endif
             }
         }
         return;
