@@ -71,12 +71,13 @@ struct FloatRowDraw {
     LevelTaps levelTaps;  // the taps whose level or filter the level of detail picks
 };
 
-// Decides whether a draw can take the float row path (float or ideal precision, a program whose
-// texture reads are plain or projected and on distinct stages, whose texkills test coordinate
-// sets (rowKills, per run), 2-D textures; its other texture
-// instructions, TapPlan::executes, on stages and coordinate sets of their own and sampling
-// lodFree textures) and fills `out`. A texture whose level or filter the level of detail picks is
-// one of levelTaps: its triangles take the row path where triangleLevels finds one level.
+// Decides whether a draw can take the float row path (float or ideal precision; plain and
+// projected reads, texkills of coordinate sets (rowKills, per run), and the other texture
+// instructions, TapPlan::executes, which sample lodFree textures) and fills `out`. The rows filter
+// one plain read a stage of a 2-D texture; a volume texture's plain read and two plain reads of one
+// stage are executed too (TapPlan::executedTaps: lodFree, not bound). A texture whose level or
+// filter the level of detail picks is one of levelTaps: its triangles take the row path where
+// triangleLevels finds one level.
 bool prepareFloatRowDraw(const ps11::Executor& executor, ps11::Precision precision, int weightBits,
                          const std::array<std::shared_ptr<const ps11::Texture>, 8>& textures,
                          const std::array<ps11::SamplerState, 8>& samplers, const MergeState& merge,

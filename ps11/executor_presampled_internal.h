@@ -36,7 +36,8 @@ struct TapPlan {
     // Set by the caller: bit i, plain read i is executed too (sampled by the executor as run()
     // samples it, its texels of any sign), not filled: a texture the caller does not filter
     // itself. Its set and stage count among executedSets and executedStages, and `executes` is
-    // set with it. Handed to runPresampled (PresampledRun::executedTaps).
+    // set with it. Handed to runPresampled (PresampledRun::executedTaps); the float row path's
+    // row sampler hands such reads to the worker's sampler (emu/aligned_float.h).
     uint8_t executedTaps = 0;
     bool projected(int i) const { return divisor[size_t(i)] >= 0; }
 };
